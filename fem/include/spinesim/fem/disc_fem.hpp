@@ -1,0 +1,66 @@
+// Linear FEM reference for a disc between a fixed inferior endplate and a rigid superior plate.
+//
+// Small-strain isotropic linear elasticity, P1 or P2 tetrahedra, material per region.
+// Boundary conditions (SPEC "fem/", command-line contract):
+//   - nodes with surface == 1 (inferior endplate) are fixed;
+//   - nodes with surface == 2 (superior endplate; for P2 also edge midpoints whose two ends
+//     are both labelled 2) move rigidly with the plate: u_i = t + theta x (x_i - c), small
+//     rotation vector theta in radians inside (degrees on the command line), c = plate centre;
+//   - the plate is driven by a prescribed 6-DOF motion q = (t, theta) or by an applied
+//     wrench w = (F, M about c); all other nodes are free.
+// Reaction wrench: the force and moment the disc exerts on the plate, about c, N and N·mm;
+// so a compressive motion (t_y < 0) gives F_y > 0. With the condensed 6x6 stiffness K6
+// (N/mm, N, N·mm/rad blocks): reaction = -K6 q.
+#pragma once
+
+#include "spinesim/mesh/material.hpp"
+#include "spinesim/mesh/tet_mesh.hpp"
+
+#include <Eigen/Core>
+
+#include <memory>
+
+namespace spinesim::fem {
+
+using Vector6d = Eigen::Matrix<double, 6, 1>;
+using Matrix6d = Eigen::Matrix<double, 6, 6>;
+
+struct Timings {
+  double setup_s = 0, assembly_s = 0, analyse_s = 0, factorise_s = 0, solve_s = 0;
+};
+
+struct PlateSolution {
+  Eigen::MatrixX3d displacement_mm;  ///< #V×3 displacement at the mesh vertices, mm
+  Vector6d plate_motion;             ///< (t mm, theta rad)
+  Vector6d reaction_wrench;          ///< (F N, M N·mm) the disc exerts on the plate, about c
+};
+
+/// Solver object: assembles and factorises once, then answers any number of plate loads.
+class DiscFem {
+ public:
+  /// Validates the mesh (endplate labels required), the materials and `order` (1 or 2);
+  /// throws std::invalid_argument with a one-line message otherwise.
+  DiscFem(const mesh::TetMesh& mesh, const mesh::RegionMaterials& materials, int order,
+          const Eigen::Vector3d& plate_center_mm);
+  ~DiscFem();
+  DiscFem(DiscFem&&) noexcept;
+  DiscFem& operator=(DiscFem&&) noexcept;
+
+  /// Default plate centre: arithmetic mean of the vertices labelled 2.
+  static Eigen::Vector3d default_plate_center(const mesh::TetMesh& mesh);
+
+  PlateSolution solve_motion(const Vector6d& motion) const;   ///< (t mm, theta rad)
+  PlateSolution solve_wrench(const Vector6d& wrench) const;   ///< (F N, M N·mm)
+  /// Condensed plate stiffness (symmetric positive definite), units (N/mm | N/rad ; N | N·mm/rad).
+  const Matrix6d& stiffness_6x6() const;
+
+  Eigen::Index num_dofs() const;          ///< free displacement unknowns
+  Eigen::Index num_nodes() const;         ///< P1 vertices or P2 vertices + edge midpoints
+  const Timings& timings() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace spinesim::fem

@@ -1,0 +1,52 @@
+// Tetrahedral meshing of discs with CGAL Mesh_3 (CGAL stays inside mesh/src).
+#pragma once
+
+#include "spinesim/mesh/disc_geometry.hpp"
+#include "spinesim/mesh/tet_mesh.hpp"
+
+#include <cstdint>
+#include <functional>
+#include <string>
+
+namespace spinesim::mesh {
+
+/// Mesh_3 criteria and optimisers; defaults run out of the box on a lumbar disc.
+struct MeshOptions {
+  double cell_size_mm = 2.0;          ///< upper bound on tet circumradius
+  double facet_distance_mm = 0.1;     ///< boundary approximation error bound
+  double facet_size_mm = 0.0;         ///< 0: same as cell_size_mm
+  double facet_angle_deg = 25.0;
+  double radius_edge_ratio = 2.5;     ///< cell_radius_edge_ratio
+  bool odt = false;
+  bool lloyd = false;
+  bool perturb = true;
+  bool exude = true;
+  std::uint32_t seed = 0;             ///< CGAL random seed, for reproducible meshes
+};
+
+/// A body given by a labelling function: 0 outside, positive label inside (the tet `region`).
+/// `bounding_radius_mm` and `center_mm` bound the body; `exact_volume_mm3` (if known, else <0)
+/// is reported against the mesh volume.
+struct LabeledBody {
+  std::function<int(const Eigen::Vector3d&)> label;
+  Eigen::Vector3d center_mm = Eigen::Vector3d::Zero();
+  double bounding_radius_mm = 0.0;
+  double exact_volume_mm3 = -1.0;
+  /// Classifies a boundary facet (centroid, outward unit normal) into a Surface label;
+  /// may be empty (then every boundary node is labelled outer wall).
+  std::function<Surface(const Eigen::Vector3d&, const Eigen::Vector3d&)> classify_facet;
+};
+
+/// Generic labelled-domain mesher (discs, test cylinders, ...). Throws std::runtime_error if
+/// CGAL produces no tetrahedra.
+TetMesh mesh_labeled_body(const LabeledBody& body, const MeshOptions& opt);
+
+/// The parametric disc of a level, upright at the origin (frame = identity) when
+/// `in_spine` is false, otherwise placed by disc_frame_in_spine().
+TetMesh mesh_parametric_disc(const DiscDimensions& dims, const MeshOptions& opt,
+                             const DiscFrame& placement = DiscFrame());
+
+/// Exact volume (mm^3) of the parametric disc, for the quality report.
+double parametric_disc_volume(const DiscDimensions& dims);
+
+}  // namespace spinesim::mesh

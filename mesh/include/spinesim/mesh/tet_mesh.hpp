@@ -1,0 +1,56 @@
+// TetMesh — the tetrahedral disc mesh every module shares.
+//
+// Conventions (SPEC "Units and frame", "mesh/"):
+//   - coordinates in mm, frame x lateral (body's right is -x), y superior, z anterior;
+//   - tets are positively oriented: det[v1-v0, v2-v0, v3-v0] > 0;
+//   - cell label `region`: 1 annulus, 2 nucleus (other positive labels allowed for
+//     non-disc test bodies);
+//   - point label `surface`: 0 interior, 1 inferior endplate (fixed), 2 superior endplate
+//     (rigid plate), 3 outer wall. Rim nodes shared by an endplate and the wall carry the
+//     endplate label.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <string>
+
+namespace spinesim::mesh {
+
+enum class Region : int { annulus = 1, nucleus = 2 };
+enum class Surface : int { interior = 0, inferior_endplate = 1, superior_endplate = 2, outer_wall = 3 };
+
+/// Rigid frame of a disc: origin at the mid-disc centre, columns of `axes` are the disc's
+/// lateral (x), axial (y, inferior -> superior) and anterior (z) unit vectors, in the global
+/// frame. Identity axes for a disc built upright at the origin.
+struct DiscFrame {
+  Eigen::Vector3d origin_mm = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();
+};
+
+struct TetMesh {
+  Eigen::MatrixX3d V;   ///< #V×3 vertex positions, mm
+  Eigen::MatrixX4i T;   ///< #T×4 vertex indices, positively oriented
+  Eigen::VectorXi region;   ///< #T cell labels (Region)
+  Eigen::VectorXi surface;  ///< #V point labels (Surface)
+  DiscFrame frame;          ///< disc frame (identity when unknown)
+  std::string source;       ///< provenance, e.g. "parametric L4-L5" or a file name
+
+  Eigen::Index num_vertices() const { return V.rows(); }
+  Eigen::Index num_tets() const { return T.rows(); }
+};
+
+/// Signed volume of tet t, mm^3 (positive when correctly oriented).
+double tet_volume(const TetMesh& m, Eigen::Index t);
+
+/// Sum of signed tet volumes, mm^3.
+double mesh_volume(const TetMesh& m);
+
+/// Throws std::invalid_argument with a one-line message when the mesh is unusable:
+/// empty, index out of range, non-finite coordinates, inverted or zero-volume tets
+/// (relative to the mean edge length cubed), label arrays of the wrong size.
+void validate(const TetMesh& m);
+
+/// Throws std::invalid_argument unless both endplate labels (1 and 2) are present.
+void require_endplate_labels(const TetMesh& m);
+
+}  // namespace spinesim::mesh

@@ -1,0 +1,111 @@
+#include "spinesim/mesh/material.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+namespace spinesim::mesh {
+namespace {
+
+std::string fmt(double v) {
+  std::ostringstream os;
+  os.precision(4);
+  os << v;
+  return os.str();
+}
+
+IsotropicMaterial parse_one(const nlohmann::json& j, const std::string& what) {
+  if (!j.is_object()) throw std::invalid_argument(what + ": expected a JSON object");
+  auto number = [&](const char* key) -> double {
+    const auto& v = j.at(key);
+    if (!v.is_number()) throw std::invalid_argument(what + ": '" + key + "' must be a number");
+    return v.get<double>();
+  };
+  IsotropicMaterial m;
+  if (!j.contains("E_mpa")) throw std::invalid_argument(what + ": missing 'E_mpa'");
+  m.youngs_modulus_mpa = number("E_mpa");
+  const bool has_nu = j.contains("nu"), has_g = j.contains("G_mpa");
+  if (has_nu == has_g)
+    throw std::invalid_argument(what + ": give exactly one of 'nu' and 'G_mpa'");
+  if (has_nu) {
+    m.poisson_ratio = number("nu");
+  } else {
+    const double g = number("G_mpa");
+    if (!(g > 0)) throw std::invalid_argument(what + ": G_mpa must be > 0 (got " + fmt(g) + ")");
+    const double nu = m.youngs_modulus_mpa / (2.0 * g) - 1.0;
+    // An (E, G) pair is trusted only when it implies an ordinary isotropic solid: thesis
+    // table 5.1 gives rubber E 30 / G 0.6 (nu = 24) and polyethylene E 200 / G 117 (nu < 0).
+    if (!(nu >= 0.0 && nu < 0.5))
+      throw std::invalid_argument(what + ": E_mpa = " + fmt(m.youngs_modulus_mpa) + " and G_mpa = " +
+                                  fmt(g) + " imply nu = E/(2G) - 1 = " + fmt(nu) +
+                                  ", outside [0, 0.5) of an isotropic solid; give E_mpa and nu");
+    m.poisson_ratio = nu;
+  }
+  if (j.contains("density_kg_m3")) m.density_kg_m3 = number("density_kg_m3");
+  validate(m, what);
+  return m;
+}
+
+}  // namespace
+
+void validate(const IsotropicMaterial& m, const std::string& what) {
+  const double e = m.youngs_modulus_mpa, nu = m.poisson_ratio, rho = m.density_kg_m3;
+  if (!std::isfinite(e) || !std::isfinite(nu) || !std::isfinite(rho))
+    throw std::invalid_argument(what + ": non-finite material constant");
+  if (!(e > 0)) throw std::invalid_argument(what + ": Young's modulus must be > 0 MPa (got " + fmt(e) + ")");
+  if (!(nu > -1.0 && nu < 0.5))
+    throw std::invalid_argument(what + ": Poisson's ratio must lie in (-1, 0.5) (got " + fmt(nu) + ")");
+  if (!(rho > 0)) throw std::invalid_argument(what + ": density must be > 0 kg/m^3 (got " + fmt(rho) + ")");
+}
+
+RegionMaterials material_from_json(const nlohmann::json& j) {
+  if (!j.is_object()) throw std::invalid_argument("material: expected a JSON object");
+  RegionMaterials r;
+  r.name = j.value("name", std::string("unnamed"));
+  const bool per_region = j.contains("annulus") || j.contains("nucleus");
+  try {
+    if (per_region) {
+      if (!j.contains("annulus") || !j.contains("nucleus"))
+        throw std::invalid_argument("material '" + r.name + "': per-region files need both 'annulus' and 'nucleus'");
+      r.by_region[int(Region::annulus)] = parse_one(j.at("annulus"), "material '" + r.name + "' annulus");
+      r.by_region[int(Region::nucleus)] = parse_one(j.at("nucleus"), "material '" + r.name + "' nucleus");
+      r.fallback = r.by_region[int(Region::annulus)];
+    } else {
+      r.fallback = parse_one(j, "material '" + r.name + "'");
+    }
+  } catch (const nlohmann::json::exception& e) {
+    throw std::invalid_argument("material '" + r.name + "': " + e.what());
+  }
+  return r;
+}
+
+RegionMaterials load_material(const std::string& name_or_path, const std::string& data_dir) {
+  namespace fs = std::filesystem;
+  fs::path path(name_or_path);
+  if (!fs::exists(path)) {
+    const fs::path preset = fs::path(data_dir) / "materials" / (name_or_path + ".json");
+    if (!fs::exists(preset)) {
+      std::string known;
+      if (fs::is_directory(fs::path(data_dir) / "materials"))
+        for (const auto& e : fs::directory_iterator(fs::path(data_dir) / "materials"))
+          if (e.path().extension() == ".json") known += (known.empty() ? "" : ", ") + e.path().stem().string();
+      throw std::invalid_argument("unknown material '" + name_or_path + "' (no such file; presets: " + known + ")");
+    }
+    path = preset;
+  }
+  std::ifstream in(path);
+  if (!in) throw std::invalid_argument("cannot read material file " + path.string());
+  nlohmann::json j;
+  try {
+    in >> j;
+  } catch (const nlohmann::json::exception& e) {
+    throw std::invalid_argument("material file " + path.string() + " is not valid JSON");
+  }
+  return material_from_json(j);
+}
+
+}  // namespace spinesim::mesh
