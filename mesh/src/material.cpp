@@ -1,4 +1,5 @@
 #include "spinesim/mesh/material.hpp"
+#include "spinesim/mesh/tet_mesh.hpp"
 
 #include <nlohmann/json.hpp>
 
