@@ -1,0 +1,34 @@
+#!/usr/bin/env bash
+# Installs the Debian packages spinesim needs, only those that are missing.
+# Runs as root or through sudo. Safe to run repeatedly.
+set -euo pipefail
+
+packages=(
+  cmake ninja-build g++ pkg-config
+  libeigen3-dev            # Eigen 3.4
+  libsuitesparse-dev       # CHOLMOD
+  libopenblas0-pthread     # fast BLAS under supernodal CHOLMOD (reference BLAS is ~5x slower)
+  libcgal-dev              # CGAL 5.5 Mesh_3
+  coinor-libipopt-dev      # Ipopt 3.11
+  libcli11-dev nlohmann-json3-dev libtinyxml2-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
+  python3 python3-meshio python3-numpy   # independent VTU reader used by the tests
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#packages[@]} packages present"
+  exit 0
+fi
+
+sudo_cmd=()
+if [ "$(id -u)" -ne 0 ]; then sudo_cmd=(sudo); fi
+echo "install-deps: installing ${missing[*]}"
+"${sudo_cmd[@]}" apt-get update -qq
+DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"

@@ -1,0 +1,51 @@
+// Shared pieces of the `spinesim` command line: value parsing with clear errors, the data
+// folder, JSON on stdout, and stage-by-stage progress on stderr.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <string>
+
+namespace spinesim::cli {
+
+/// Folder with the shipped tables: $SPINESIM_DATA_DIR if set, else the source tree's data/.
+std::string data_dir();
+
+/// Parses "a,b,c" into exactly n finite numbers; throws std::invalid_argument naming `what`.
+Eigen::VectorXd parse_numbers(const std::string& text, int n, const std::string& what);
+
+/// JSON helpers for Eigen values (row-major nested arrays for matrices).
+nlohmann::json to_json(const Eigen::VectorXd& v);
+nlohmann::json to_json(const Eigen::MatrixXd& m);
+
+/// Prints `j` as the only thing on stdout (pretty, one object).
+void print_json(const nlohmann::json& j);
+
+/// Progress on stderr, one line per stage: "[2/4] assembling ... done 0.42 s". Silent when
+/// quiet. Anything that takes more than a second or two is announced before it starts.
+class Progress {
+ public:
+  Progress(int stages, bool quiet) : stages_(stages), quiet_(quiet) {}
+  void begin(const std::string& what);
+  double end(const std::string& detail = "");  ///< returns the stage's seconds
+  bool quiet() const { return quiet_; }
+
+ private:
+  int stages_, current_ = 0;
+  bool quiet_;
+  std::chrono::steady_clock::time_point start_;
+};
+
+/// Seconds since `t0`.
+double seconds_since(std::chrono::steady_clock::time_point t0);
+
+// Sub-command registration; each lives in its own cli_<verb>.cpp.
+void register_mesh(CLI::App& app);
+void register_fem(CLI::App& app);
+void register_demo(CLI::App& app);
+void register_bench(CLI::App& app);
+
+}  // namespace spinesim::cli
