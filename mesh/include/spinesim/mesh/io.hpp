@@ -1,9 +1,20 @@
 // Mesh and result files: VTU (VTK XML UnstructuredGrid), Medit .mesh, and surface meshes.
 //
-// VTU layout (SPEC "mesh/"): points in mm; CellData `region` (Int32); PointData `surface`
-// (Int32) and any extra point arrays (e.g. `displacement`, 3 components, mm); FieldData
-// `disc_frame` (12 Float64: origin, then the 3 axes as columns) when the frame is known.
-// Writers write to a temporary file and rename it, so a failure never leaves a partial file.
+// VTU layout (SPEC "mesh/"), written as VTKFile version 1.0, LittleEndian, header_type UInt64:
+//   - Points: Float64 ×3, mm, full precision (binary is bit-exact; ASCII uses the shortest
+//     round-trip decimal form, so it is exact too);
+//   - Cells: connectivity/offsets Int64, types UInt8 = 10 (VTK_TETRA);
+//   - CellData `region` (Int32) then the caller's cell arrays (Float64);
+//   - PointData `surface` (Int32) then the caller's point arrays (Float64, NumberOfComponents =
+//     columns), e.g. `displacement`, 3 components, mm;
+//   - FieldData (always ASCII) `disc_frame`: 12 Float64 = origin (mm), then the 3 columns of
+//     `axes` (lateral, axial, anterior); and `source`: the provenance string as UInt8 character
+//     codes (not VTK's String type, which meshio cannot read).
+// Writers refuse bad input (non-finite values, wrong array sizes) before touching the disk, write
+// to `path + ".tmp-XXXXXX"` in the same folder and rename it over `path`, so a failure never
+// leaves a partial or stale file. User-input problems throw std::invalid_argument; operating-
+// system failures (folder missing, disk full) throw std::runtime_error. All messages are one line
+// and name the file.
 #pragma once
 
 #include "spinesim/mesh/tet_mesh.hpp"
@@ -15,37 +26,77 @@
 
 namespace spinesim::mesh {
 
-/// A named point- or cell-data array: #rows × ncomponents.
+/// A named point- or cell-data array: #rows × ncomponents (rows = #V for point data, #T for
+/// cell data).
 struct DataArray {
   std::string name;
   Eigen::MatrixXd values;
 };
 
+/// How VTU DataArrays are encoded: inline base64 raw binary (compact, bit-exact; default) or
+/// ASCII text (human readable, also exact).
+enum class VtuEncoding { binary, ascii };
+
+struct VtuWriteOptions {
+  VtuEncoding encoding = VtuEncoding::binary;
+};
+
+/// Writes `m` and the extra arrays to `path` (layout above). Names `surface` and `region` are
+/// reserved. Throws std::invalid_argument "... contains non-finite values" for NaN/Inf in the
+/// coordinates or any array, and for label/array size mismatches or indices out of range;
+/// nothing is written then.
 void write_vtu(const std::string& path, const TetMesh& m,
                const std::vector<DataArray>& point_data = {},
-               const std::vector<DataArray>& cell_data = {});
+               const std::vector<DataArray>& cell_data = {}, const VtuWriteOptions& options = {});
 
-/// Reads linear tets (VTK type 10) from ASCII or raw-binary base64 VTU (UInt32/UInt64 headers,
-/// no compression). Quadratic tets (type 24) are read by their 4 corner vertices. Missing
-/// `region` -> all 1; missing `surface` -> all 0 (fem then refuses: no endplate labels).
-/// Throws std::invalid_argument with a one-line message for a missing or corrupt file.
-TetMesh read_vtu(const std::string& path, std::vector<DataArray>* point_data = nullptr);
+/// Reads a VTU with a single Piece. Supported: format="ascii" and format="binary" (inline base64,
+/// header_type UInt32 or UInt64, no compressor; header and data encoded together or
+/// separately), any VTK numeric type, either byte order. Refused with a message saying how to
+/// re-save: format="appended" / raw AppendedData and compressed files.
+/// Cells: VTK_TETRA (10); VTK_QUADRATIC_TETRA (24) is read by its 4 corner vertices and
+/// vertices used only as mid-edge nodes are dropped (indices and point arrays are remapped).
+/// Any other cell type is an error naming it. Missing `region` -> all 1; missing `surface` ->
+/// all 0 (fem then refuses: no endplate labels). `disc_frame` and `source` FieldData fill
+/// m.frame and m.source when present (else identity frame and the file name).
+/// The other PointData arrays go to `point_data`, the other CellData arrays to `cell_data`
+/// (when non-null). Finally calls validate(m), so inverted/zero-volume tets are reported.
+/// Throws std::invalid_argument with one line "read_vtu: PATH: problem" for any bad file.
+TetMesh read_vtu(const std::string& path, std::vector<DataArray>* point_data = nullptr,
+                 std::vector<DataArray>* cell_data = nullptr);
 
-/// Medit .mesh (Vertices with surface label as reference, Tetrahedra with region label,
-/// boundary Triangles with the surface label).
+/// Medit .mesh (ASCII, MeshVersionFormatted 2, Dimension 3): Vertices with the surface label as
+/// reference, Tetrahedra (1-based) with the region label, and the boundary Triangles (faces used
+/// by exactly one tet, oriented outward) with reference = the label shared by all three vertices
+/// when it is nonzero (1 or 2 for an endplate triangle), else 3 (outer wall). A wall triangle
+/// whose three vertices all lie on one endplate rim would be labelled as endplate: with Mesh_3
+/// discs such triangles are rare and sit on the rim. Atomic write as for write_vtu.
 void write_medit(const std::string& path, const TetMesh& m);
 
 /// A triangle surface (vertebra, endplate patch).
 struct TriSurface {
   Eigen::MatrixX3d V;  ///< #V×3, mm, spinesim frame
-  Eigen::MatrixX3i F;  ///< #F×3
+  Eigen::MatrixX3i F;  ///< #F×3, 0-based vertex indices
 };
 
+/// The file's axis that points superior (up).
 enum class UpAxis { x, y, z, minus_x, minus_y, minus_z };
 
-/// Reads STL/OBJ/PLY/OFF (by extension), scales by `units_to_mm` (1 for mm, 1000 for m) and
-/// rotates so that `up` becomes +y (right-handed; for up = z: (x,y,z) -> (y, z, x)... see
-/// io.cpp for the exact map). Throws std::invalid_argument for missing/empty/corrupt files.
+/// Reads STL (ASCII or binary), OBJ, PLY or OFF, chosen by extension (any letter case), as a
+/// polygon soup (it need not be closed or manifold; OBJ normals/texture coordinates are
+/// ignored). Polygons with more than 3 vertices are fan-triangulated; polygons with fewer are
+/// an error. Coordinates are multiplied by `units_to_mm` (1 for mm, 1000 for m), then mapped
+/// into the spinesim frame (x lateral, y up, z anterior) by a rotation that sends `up` to +y:
+///   up = y:        (x, y, z)_file -> ( x,  y,  z)   (identity)
+///   up = z:        (x, y, z)_file -> ( y,  z,  x)   (cyclic: file x becomes anterior)
+///   up = x:        (x, y, z)_file -> ( z,  x,  y)   (cyclic: file y becomes anterior)
+///   up = minus_a:  the map for `a`, followed by a 180° rotation about the lateral axis,
+///                  (x, y, z) -> (x, -y, -z); e.g. minus_z: (x, y, z)_file -> (y, -z, -x).
+/// All maps are proper rotations (determinant +1), so the orientation of triangles is kept.
+/// For the ArtiSynth lumbar surfaces (metres, z up, x anterior) `units_to_mm = 1000, up = z`
+/// gives anterior = +z directly.
+/// Throws std::invalid_argument with one line "read_surface: PATH: problem" for a missing file,
+/// unknown extension, unreadable or empty file (no triangles), face index out of range or
+/// non-finite coordinates; also for units_to_mm that is not finite and positive.
 TriSurface read_surface(const std::string& path, double units_to_mm, UpAxis up);
 
 }  // namespace spinesim::mesh
