@@ -1,5 +1,7 @@
 #include "cli_common.hpp"
 
+#include <unistd.h>
+
 #include <cmath>
 #include <cstdlib>
 #include <iostream>
@@ -53,6 +55,8 @@ void print_json(const nlohmann::json& j) { std::cout << j.dump(2) << std::endl; 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
+
+Progress::Progress(int stages, bool quiet) : stages_(stages), quiet_(quiet || !isatty(STDERR_FILENO)) {}
 
 void Progress::begin(const std::string& what) {
   ++current_;

@@ -28,7 +28,8 @@ void print_json(const nlohmann::json& j);
 /// quiet. Anything that takes more than a second or two is announced before it starts.
 class Progress {
  public:
-  Progress(int stages, bool quiet) : stages_(stages), quiet_(quiet) {}
+  /// Prints only when not quiet and stderr is a terminal (so scripts see just errors).
+  Progress(int stages, bool quiet);
   void begin(const std::string& what);
   double end(const std::string& detail = "");  ///< returns the stage's seconds
   bool quiet() const { return quiet_; }
