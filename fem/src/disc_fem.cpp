@@ -1,1 +1,157 @@
-// placeholder, replaced by the FEM implementation
+#include "spinesim/fem/disc_fem.hpp"
+
+#include "spinesim/fem/assembly.hpp"
+#include "spinesim/fem/cholmod_solver.hpp"
+#include "spinesim/fem/fe_space.hpp"
+
+#include <Eigen/Cholesky>
+
+#include <chrono>
+#include <set>
+#include <stdexcept>
+#include <string>
+
+namespace spinesim::fem {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+void validate_inputs(const mesh::TetMesh& m, const mesh::RegionMaterials& materials, int order,
+                     const Eigen::Vector3d& c) {
+  if (order != 1 && order != 2)
+    throw std::invalid_argument("FEM order must be 1 (P1) or 2 (P2), got " + std::to_string(order));
+  mesh::validate(m);
+  mesh::require_endplate_labels(m);
+  const std::set<int> regions(m.region.data(), m.region.data() + m.region.size());
+  for (int r : regions) mesh::validate(materials.at(r), "material of region " + std::to_string(r));
+  if (!c.allFinite()) throw std::invalid_argument("plate centre has non-finite coordinates");
+}
+
+std::vector<NodeRole> node_roles(const Eigen::VectorXi& labels) {
+  std::vector<NodeRole> roles(std::size_t(labels.size()), NodeRole::free);
+  for (Eigen::Index i = 0; i < labels.size(); ++i) {
+    if (labels(i) == int(mesh::Surface::inferior_endplate)) roles[std::size_t(i)] = NodeRole::fixed;
+    if (labels(i) == int(mesh::Surface::superior_endplate)) roles[std::size_t(i)] = NodeRole::plate;
+  }
+  return roles;
+}
+
+}  // namespace
+
+struct DiscFem::Impl {
+  FeSpace space;
+  std::vector<NodeRole> roles;
+  FreeBlockPattern pattern;
+  PlateCoupling coupling;
+  CholmodSolver solver;
+  Eigen::MatrixXd Z;          ///< 3nf×6: K_ff^-1 K_fp
+  Matrix6d K6;
+  Eigen::LLT<Matrix6d> K6_llt;
+  double asymmetry = 0;
+  Eigen::Vector3d center;
+  Timings timings;
+
+  PlateSolution solution_for(const Vector6d& q) const;
+};
+
+PlateSolution DiscFem::Impl::solution_for(const Vector6d& q) const {
+  PlateSolution s;
+  s.plate_motion = q;
+  Eigen::VectorXd uf = Eigen::VectorXd::Zero(3 * pattern.num_free_nodes);
+  if (pattern.num_free_nodes > 0) uf.noalias() = -Z * q;
+  s.node_displacement_mm.setZero(space.num_nodes(), 3);
+  for (Eigen::Index i = 0; i < space.num_nodes(); ++i) {
+    const int f = pattern.free_index[std::size_t(i)];
+    if (f >= 0)
+      s.node_displacement_mm.row(i) = uf.segment<3>(3 * f).transpose();
+    else if (roles[std::size_t(i)] == NodeRole::plate)
+      s.node_displacement_mm.row(i) =
+          (plate_map(space.X.row(i).transpose() - center) * q).transpose();
+  }
+  s.displacement_mm = s.node_displacement_mm.topRows(space.num_vertices);
+  // Generalised force the plate applies to the disc is K_pf u_f + K_pp q; the disc pushes back.
+  s.reaction_wrench = -(coupling.K_fp.transpose() * uf + coupling.K_pp * q);
+  return s;
+}
+
+DiscFem::DiscFem(const mesh::TetMesh& mesh, const mesh::RegionMaterials& materials, int order,
+                 const Eigen::Vector3d& plate_center_mm)
+    : impl_(std::make_unique<Impl>()) {
+  Impl& d = *impl_;
+  // 1. Validate and set up the node set, boundary roles and the K_ff sparsity.
+  auto t0 = Clock::now();
+  validate_inputs(mesh, materials, order, plate_center_mm);
+  d.center = plate_center_mm;
+  d.space = make_fe_space(mesh, order);
+  d.roles = node_roles(node_surface_labels(d.space, mesh));
+  d.pattern = build_free_block_pattern(d.space, d.roles);
+  d.timings.setup_s = seconds_since(t0);
+
+  // 2. Assemble K_ff, K_fp, K_pp.
+  t0 = Clock::now();
+  d.coupling = assemble_constrained(d.space, mesh.region, materials, d.roles, d.center, d.pattern);
+  d.timings.assembly_s = seconds_since(t0);
+
+  // 3. Factorise K_ff and condense onto the plate: K6 = K_pp - K_fp^T K_ff^-1 K_fp.
+  d.K6 = d.coupling.K_pp;
+  if (d.pattern.num_free_nodes > 0) {
+    t0 = Clock::now();
+    d.solver.analyze(d.pattern.lower);
+    d.timings.analyse_s = seconds_since(t0);
+    t0 = Clock::now();
+    d.solver.factorize(d.pattern.lower);
+    d.timings.factorise_s = seconds_since(t0);
+    t0 = Clock::now();
+    d.Z = d.solver.solve(d.coupling.K_fp);
+    d.K6.noalias() -= d.coupling.K_fp.transpose() * d.Z;
+    d.timings.solve_s = seconds_since(t0);
+  }
+  const double norm = d.K6.norm();
+  d.asymmetry = norm > 0 ? (d.K6 - d.K6.transpose()).norm() / norm : 0.0;
+  d.K6 = 0.5 * (d.K6 + d.K6.transpose()).eval();
+  d.K6_llt.compute(d.K6);
+  if (!d.K6.allFinite() || d.K6_llt.info() != Eigen::Success || !(norm > 0))
+    throw std::runtime_error("condensed 6x6 plate stiffness is not positive definite");
+}
+
+DiscFem::~DiscFem() = default;
+DiscFem::DiscFem(DiscFem&&) noexcept = default;
+DiscFem& DiscFem::operator=(DiscFem&&) noexcept = default;
+
+Eigen::Vector3d DiscFem::default_plate_center(const mesh::TetMesh& mesh) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  Eigen::Index n = 0;
+  for (Eigen::Index i = 0; i < mesh.num_vertices(); ++i)
+    if (i < mesh.surface.size() && mesh.surface(i) == int(mesh::Surface::superior_endplate)) {
+      sum += mesh.V.row(i).transpose();
+      ++n;
+    }
+  if (n == 0)
+    throw std::invalid_argument("mesh has no superior endplate nodes (surface = 2) for the plate centre");
+  return sum / double(n);
+}
+
+PlateSolution DiscFem::solve_motion(const Vector6d& motion) const {
+  if (!motion.allFinite()) throw std::invalid_argument("plate motion has non-finite components");
+  return impl_->solution_for(motion);
+}
+
+PlateSolution DiscFem::solve_wrench(const Vector6d& wrench) const {
+  if (!wrench.allFinite()) throw std::invalid_argument("plate wrench has non-finite components");
+  const Vector6d q = impl_->K6_llt.solve(wrench);
+  return impl_->solution_for(q);
+}
+
+const Matrix6d& DiscFem::stiffness_6x6() const { return impl_->K6; }
+double DiscFem::stiffness_asymmetry() const { return impl_->asymmetry; }
+const Eigen::Vector3d& DiscFem::plate_center() const { return impl_->center; }
+int DiscFem::order() const { return impl_->space.order; }
+Eigen::Index DiscFem::num_dofs() const { return 3 * impl_->pattern.num_free_nodes; }
+Eigen::Index DiscFem::num_nodes() const { return impl_->space.num_nodes(); }
+const Timings& DiscFem::timings() const { return impl_->timings; }
+
+}  // namespace spinesim::fem

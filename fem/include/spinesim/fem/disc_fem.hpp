@@ -11,6 +11,12 @@
 // Reaction wrench: the force and moment the disc exerts on the plate, about c, N and N·mm;
 // so a compressive motion (t_y < 0) gives F_y > 0. With the condensed 6x6 stiffness K6
 // (N/mm, N, N·mm/rad blocks): reaction = -K6 q.
+//
+// Method: u = T (u_f, q) eliminates the fixed nodes and slaves the plate nodes (assembly.hpp);
+// K_ff is factorised once (CHOLMOD), Z = K_ff^-1 K_fp by 6 solves, and
+//   K6 = K_pp - K_fp^T Z,   motion q: u_f = -Z q,   wrench w: q = K6^-1 w.
+// The reaction is evaluated directly from the assembled blocks, -(K_fp^T u_f + K_pp q), which
+// equals -K6 q (and -w for a wrench solve) up to round-off — the tests check that.
 #pragma once
 
 #include "spinesim/mesh/material.hpp"
@@ -31,11 +37,14 @@ struct Timings {
 
 struct PlateSolution {
   Eigen::MatrixX3d displacement_mm;  ///< #V×3 displacement at the mesh vertices, mm
+  Eigen::MatrixX3d node_displacement_mm;  ///< #nodes×3 at every FE node (P2: vertices, then edge nodes)
   Vector6d plate_motion;             ///< (t mm, theta rad)
   Vector6d reaction_wrench;          ///< (F N, M N·mm) the disc exerts on the plate, about c
 };
 
 /// Solver object: assembles and factorises once, then answers any number of plate loads.
+/// Throws std::invalid_argument for bad input (one-line message) and std::runtime_error if
+/// the stiffness is not positive definite.
 class DiscFem {
  public:
   /// Validates the mesh (endplate labels required), the materials and `order` (1 or 2);
@@ -54,6 +63,11 @@ class DiscFem {
   /// Condensed plate stiffness (symmetric positive definite), units (N/mm | N/rad ; N | N·mm/rad).
   const Matrix6d& stiffness_6x6() const;
 
+  /// ||K6 - K6^T||_F / ||K6||_F before symmetrisation (round-off level for a correct model).
+  double stiffness_asymmetry() const;
+  const Eigen::Vector3d& plate_center() const;  ///< c, mm
+
+  int order() const;
   Eigen::Index num_dofs() const;          ///< free displacement unknowns
   Eigen::Index num_nodes() const;         ///< P1 vertices or P2 vertices + edge midpoints
   const Timings& timings() const;

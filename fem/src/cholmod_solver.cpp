@@ -1,0 +1,55 @@
+#include "spinesim/fem/cholmod_solver.hpp"
+
+#include <Eigen/CholmodSupport>
+
+#include <stdexcept>
+#include <string>
+
+namespace spinesim::fem {
+
+struct CholmodSolver::Impl {
+  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt;
+  Impl() {
+    llt.cholmod().print = 0;  // errors are reported by our exceptions, not on stderr
+  }
+};
+
+CholmodSolver::CholmodSolver() : impl_(std::make_unique<Impl>()) {}
+CholmodSolver::~CholmodSolver() = default;
+CholmodSolver::CholmodSolver(CholmodSolver&&) noexcept = default;
+CholmodSolver& CholmodSolver::operator=(CholmodSolver&&) noexcept = default;
+
+void CholmodSolver::analyze(const Eigen::SparseMatrix<double>& lower) {
+  if (lower.rows() != lower.cols()) throw std::invalid_argument("CHOLMOD: matrix is not square");
+  if (lower.rows() == 0) throw std::invalid_argument("CHOLMOD: matrix is empty (no free unknowns)");
+  rows_ = lower.rows();
+  factorized_ = false;
+  impl_->llt.analyzePattern(lower);
+  if (impl_->llt.info() != Eigen::Success)
+    throw std::runtime_error("CHOLMOD: symbolic analysis failed (out of memory?)");
+}
+
+void CholmodSolver::factorize(const Eigen::SparseMatrix<double>& lower) {
+  if (lower.rows() != rows_) throw std::logic_error("CHOLMOD: factorize() before analyze()");
+  const Eigen::Map<const Eigen::VectorXd> values(lower.valuePtr(), lower.nonZeros());
+  if (!values.allFinite()) throw std::runtime_error("CHOLMOD: matrix has non-finite entries");
+  factorized_ = false;
+  impl_->llt.factorize(lower);
+  if (impl_->llt.info() != Eigen::Success)
+    throw std::runtime_error("CHOLMOD: matrix is not positive definite (Cholesky factorisation "
+                             "failed; is the body constrained against rigid motion?)");
+  factorized_ = true;
+}
+
+Eigen::MatrixXd CholmodSolver::solve(const Eigen::MatrixXd& rhs) const {
+  if (!factorized_) throw std::logic_error("CHOLMOD: solve() before a successful factorize()");
+  if (rhs.rows() != rows_) throw std::invalid_argument("CHOLMOD: right-hand side has wrong size");
+  if (!rhs.allFinite()) throw std::runtime_error("CHOLMOD: right-hand side is not finite");
+  Eigen::MatrixXd x = impl_->llt.solve(rhs);
+  if (impl_->llt.info() != Eigen::Success || !x.allFinite())
+    throw std::runtime_error("CHOLMOD: solve failed or gave non-finite values (matrix is not "
+                             "positive definite or is too ill-conditioned)");
+  return x;
+}
+
+}  // namespace spinesim::fem
