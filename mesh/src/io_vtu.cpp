@@ -139,7 +139,7 @@ void write_data_array(std::ostream& os, const char* vtk_type, const std::string&
     if (nbytes > 0) std::memcpy(bytes.data() + sizeof nbytes, data.data(), nbytes);
     base64_encode(bytes, os);  // header and data together, as meshio does
   } else {
-    const std::size_t per_line = ncomp > 0 && ncomp <= 12 ? std::size_t(ncomp) : 6;
+    const std::size_t per_line = ncomp > 1 && ncomp <= 12 ? std::size_t(ncomp) : 6;
     for (std::size_t i = 0; i < data.size(); ++i) {
       if (i > 0) {
         if (i % per_line == 0) os << "\n" << indent << "  ";
@@ -264,8 +264,12 @@ std::vector<double> parse_ascii(const Reader& r, const std::string& name, const 
     double x;
     const auto res = std::from_chars(s, end, x);
     if (res.ec != std::errc() || (res.ptr < end && !std::isspace(static_cast<unsigned char>(*res.ptr))))
-      r.fail("DataArray '" + name + "' has a value that is not a number near \"" +
-             std::string(s, std::min<std::size_t>(std::size_t(end - s), 20)) + "\"");
+    {
+      const char* tok_end = s;
+      while (tok_end < end && tok_end - s < 24 && !std::isspace(static_cast<unsigned char>(*tok_end))) ++tok_end;
+      r.fail("DataArray '" + name + "' has a value that is not a number: \"" +
+             std::string(s, tok_end) + "\"");
+    }
     v.push_back(x);
     s = res.ptr;
   }
@@ -346,8 +350,9 @@ std::vector<std::int64_t> as_integers(const Reader& r, const RawArray& a, double
   for (std::size_t i = 0; i < a.v.size(); ++i) {
     const double x = a.v[i];
     if (!(x >= lo && x <= hi) || x != std::floor(x))
-      r.fail("array '" + a.name + "' value #" + std::to_string(i) + " (" + std::to_string(x) +
-             ") is not an integer in range");
+      r.fail("'" + a.name + "' entry #" + std::to_string(i) + " = " + std::to_string(x) +
+             " is not an integer in [" + std::to_string(std::int64_t(lo)) + ", " +
+             std::to_string(std::int64_t(hi)) + "]");
     out[i] = std::int64_t(x);
   }
   return out;

@@ -1,0 +1,439 @@
+// VTU writer/reader: exact round trips, an independent reader (meshio) in both directions, and
+// every kind of bad input giving a one-line std::invalid_argument with no file left behind.
+#include "spinesim/mesh/io.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iterator>
+#include <limits>
+#include <sstream>
+#include <string>
+
+namespace fs = std::filesystem;
+using namespace spinesim::mesh;
+
+namespace {
+
+/// Unit cube split into 6 positively oriented tets (Kuhn split), scaled by an awkward factor so
+/// that the coordinates use all 53 mantissa bits. Surface: y = 0 -> 1, y = top -> 2, else 3.
+TetMesh cube_mesh() {
+  TetMesh m;
+  const double h = 12.345678901234567, o = 1.0 / 3.0;
+  m.V.resize(8, 3);
+  for (int i = 0; i < 8; ++i)
+    m.V.row(i) << o + h * (i & 1), o + h * ((i >> 1) & 1), o + h * ((i >> 2) & 1);
+  const int kuhn[6][4] = {{0, 1, 3, 7}, {0, 1, 5, 7}, {0, 2, 3, 7},
+                          {0, 2, 6, 7}, {0, 4, 5, 7}, {0, 4, 6, 7}};
+  m.T.resize(6, 4);
+  for (int t = 0; t < 6; ++t) {
+    m.T.row(t) << kuhn[t][0], kuhn[t][1], kuhn[t][2], kuhn[t][3];
+    if (tet_volume(m, t) < 0) std::swap(m.T(t, 2), m.T(t, 3));
+  }
+  m.region.resize(6);
+  m.region << 1, 2, 1, 2, 1, 2;
+  m.surface.resize(8);
+  for (int i = 0; i < 8; ++i) m.surface(i) = ((i >> 1) & 1) ? 2 : 1;
+  m.frame.origin_mm << 1.5, -2.25, 1e-7;
+  m.frame.axes << 0, -1, 0, 1, 0, 0, 0, 0, 1;  // a 90° turn about z
+  m.source = "unit test cube <&>";
+  return m;
+}
+
+/// Hand-made fixtures next to this file.
+std::string data_file(const std::string& name) {
+  return (fs::path(__FILE__).parent_path() / "data" / name).string();
+}
+
+std::string tmp_dir(const std::string& name) {
+  const fs::path d = fs::path(SPINESIM_TEST_TMP) / ("io_vtu_" + name);
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d.string();
+}
+
+std::string slurp(const std::string& path) {
+  std::ifstream is(path, std::ios::binary);
+  std::stringstream ss;
+  ss << is.rdbuf();
+  return ss.str();
+}
+
+void spit(const std::string& path, const std::string& text) {
+  std::ofstream os(path, std::ios::binary);
+  os << text;
+}
+
+bool has_meshio() {
+  return fs::exists("/usr/bin/python3") &&
+         std::system("/usr/bin/python3 -c 'import meshio, numpy' >/dev/null 2>&1") == 0;
+}
+
+/// Runs /usr/bin/python3 on `script` with `args`, returns stdout; fails the test on error.
+std::string run_python(const std::string& dir, const std::string& script, const std::string& args) {
+  const std::string py = dir + "/script.py";
+  spit(py, script);
+  const std::string err = dir + "/stderr.txt";
+  const std::string cmd = "/usr/bin/python3 " + py + " " + args + " 2>" + err;
+  std::string out;
+  FILE* p = popen(cmd.c_str(), "r");
+  if (!p) return out;
+  char buf[4096];
+  while (std::fgets(buf, sizeof buf, p)) out += buf;
+  const int rc = pclose(p);
+  EXPECT_EQ(rc, 0) << out << slurp(err);
+  return out;
+}
+
+int count_tmp_files(const std::string& dir) {
+  int n = 0;
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.path().filename().string().find(".tmp-") != std::string::npos) ++n;
+  return n;
+}
+
+std::vector<DataArray> point_arrays(const TetMesh& m) {
+  Eigen::MatrixXd disp(m.num_vertices(), 3), temp(m.num_vertices(), 1);
+  for (Eigen::Index i = 0; i < m.num_vertices(); ++i) {
+    disp.row(i) << 0.1 * i + 1e-17, -std::sqrt(double(i + 2)), std::ldexp(1.0, -int(i) - 40);
+    temp(i) = std::exp(double(i)) / 7.0;
+  }
+  return {{"displacement", disp}, {"temperature", temp}};
+}
+
+void expect_same_mesh(const TetMesh& a, const TetMesh& b) {
+  ASSERT_EQ(a.V.rows(), b.V.rows());
+  EXPECT_TRUE((a.V.array() == b.V.array()).all()) << "coordinates not bit-exact";
+  EXPECT_EQ(a.T, b.T);
+  EXPECT_EQ(a.region, b.region);
+  EXPECT_EQ(a.surface, b.surface);
+  EXPECT_TRUE((a.frame.origin_mm.array() == b.frame.origin_mm.array()).all());
+  EXPECT_TRUE((a.frame.axes.array() == b.frame.axes.array()).all());
+  EXPECT_EQ(a.source, b.source);
+}
+
+void round_trip(VtuEncoding enc, const std::string& name) {
+  const std::string dir = tmp_dir(name);
+  const std::string path = dir + "/cube.vtu";
+  const TetMesh m = cube_mesh();
+  const auto pd = point_arrays(m);
+  Eigen::MatrixXd quality(m.num_tets(), 1);
+  for (Eigen::Index t = 0; t < m.num_tets(); ++t) quality(t) = tet_volume(m, t);
+  write_vtu(path, m, pd, {{"volume", quality}}, {enc});
+
+  std::vector<DataArray> pd2, cd2;
+  const TetMesh r = read_vtu(path, &pd2, &cd2);
+  expect_same_mesh(m, r);
+  ASSERT_EQ(pd2.size(), 2u);
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_EQ(pd2[k].name, pd[k].name);
+    ASSERT_EQ(pd2[k].values.rows(), pd[k].values.rows());
+    ASSERT_EQ(pd2[k].values.cols(), pd[k].values.cols());
+    EXPECT_TRUE((pd2[k].values.array() == pd[k].values.array()).all());
+  }
+  ASSERT_EQ(cd2.size(), 1u);
+  EXPECT_EQ(cd2[0].name, "volume");
+  EXPECT_TRUE((cd2[0].values.array() == quality.array()).all());
+  EXPECT_EQ(count_tmp_files(dir), 0);
+}
+
+}  // namespace
+
+TEST(IoVtu, RoundTripBinaryIsBitExact) { round_trip(VtuEncoding::binary, "rt_binary"); }
+TEST(IoVtu, RoundTripAsciiIsExact) { round_trip(VtuEncoding::ascii, "rt_ascii"); }
+
+TEST(IoVtu, BinaryIsTheDefaultAndDeclaresItsLayout) {
+  const std::string path = tmp_dir("layout") + "/cube.vtu";
+  write_vtu(path, cube_mesh());
+  const std::string text = slurp(path);
+  EXPECT_NE(text.find("type=\"UnstructuredGrid\""), std::string::npos);
+  EXPECT_NE(text.find("byte_order=\"LittleEndian\""), std::string::npos);
+  EXPECT_NE(text.find("header_type=\"UInt64\""), std::string::npos);
+  EXPECT_NE(text.find("format=\"binary\""), std::string::npos);
+  EXPECT_EQ(text.find("compressor"), std::string::npos);
+}
+
+TEST(IoVtu, OverwritesAnExistingFileAtomically) {
+  const std::string dir = tmp_dir("overwrite");
+  const std::string path = dir + "/cube.vtu";
+  spit(path, "old content");
+  write_vtu(path, cube_mesh());
+  EXPECT_NO_THROW(read_vtu(path));
+  EXPECT_EQ(count_tmp_files(dir), 0);
+}
+
+TEST(IoVtu, QuadraticTetKeepsCornersAndDropsMidpoints) {
+  // Hand-made fixture: one VTK_QUADRATIC_TETRA (10 nodes), midpoint nodes carry surface 9.
+  std::vector<DataArray> pd;
+  const TetMesh m = read_vtu(data_file("quadratic_tet.vtu"), &pd);
+  ASSERT_EQ(m.num_vertices(), 4);
+  ASSERT_EQ(m.num_tets(), 1);
+  EXPECT_NEAR(tet_volume(m, 0), 1.0 / 6.0, 1e-15);
+  EXPECT_EQ(m.surface.maxCoeff(), 2);  // midpoints (label 9) dropped
+  ASSERT_EQ(pd.size(), 1u);
+  EXPECT_EQ(pd[0].values.rows(), 4);
+  for (Eigen::Index i = 0; i < 4; ++i) EXPECT_EQ(pd[0].values(i, 0), m.V(i, 0) + 10.0);
+}
+
+TEST(IoVtu, ReadsVtkStyleSeparatelyEncodedBinaryHeaders) {
+  // Hand-made fixture: UInt32 headers base64-encoded apart from the data (VTK's own style),
+  // Float32 points, Int32 connectivity, no region/surface arrays.
+  const TetMesh m = read_vtu(data_file("tet_vtk_style_binary.vtu"));
+  ASSERT_EQ(m.num_vertices(), 4);
+  ASSERT_EQ(m.num_tets(), 1);
+  EXPECT_EQ(m.region(0), 1);                   // missing region -> 1
+  EXPECT_EQ(m.surface, Eigen::VectorXi::Zero(4));  // missing surface -> 0
+  EXPECT_EQ(m.V(1, 0), 2.0);
+  EXPECT_EQ(m.V(3, 2), 2.0);
+  EXPECT_NEAR(tet_volume(m, 0), 8.0 / 6.0, 1e-12);
+}
+
+// --- independent reader: meshio -----------------------------------------------------------
+
+namespace {
+const char* kMeshioSummary = R"PY(
+import sys, meshio, numpy as np
+m = meshio.read(sys.argv[1])
+tets = sum(len(c.data) for c in m.cells if c.type == "tetra")
+print(len(m.points), tets)
+print("%.17g" % np.sum(m.points * np.array([1.0, 2.0, 3.0])))
+print(int(np.sum(np.concatenate(m.cell_data["region"]))), int(np.sum(m.point_data["surface"])))
+print("%.17g" % np.sum(m.point_data["displacement"]))
+print(" ".join("%.17g" % x for x in np.ravel(m.field_data["disc_frame"])))
+)PY";
+}
+
+TEST(IoVtu, MeshioReadsWhatWeWrite) {
+  if (!has_meshio()) GTEST_SKIP() << "/usr/bin/python3 with meshio not available";
+  const TetMesh m = cube_mesh();
+  const auto pd = point_arrays(m);
+  for (VtuEncoding enc : {VtuEncoding::binary, VtuEncoding::ascii}) {
+    const std::string dir = tmp_dir(enc == VtuEncoding::binary ? "meshio_bin" : "meshio_ascii");
+    const std::string path = dir + "/cube.vtu";
+    write_vtu(path, m, pd, {}, {enc});
+    std::istringstream out(run_python(dir, kMeshioSummary, path));
+    long np = -1, nt = -1, region_sum = -1, surface_sum = -1;
+    double weighted = 0, disp_sum = 0;
+    out >> np >> nt >> weighted >> region_sum >> surface_sum >> disp_sum;
+    ASSERT_FALSE(out.fail()) << out.str();
+    EXPECT_EQ(np, m.num_vertices());
+    EXPECT_EQ(nt, m.num_tets());
+    const double expected = m.V.col(0).sum() + 2 * m.V.col(1).sum() + 3 * m.V.col(2).sum();
+    EXPECT_NEAR(weighted, expected, 1e-12 * std::abs(expected));
+    EXPECT_EQ(region_sum, m.region.sum());
+    EXPECT_EQ(surface_sum, m.surface.sum());
+    EXPECT_NEAR(disp_sum, pd[0].values.sum(), 1e-12 * pd[0].values.cwiseAbs().sum());
+    for (int k = 0; k < 12; ++k) {
+      double f;
+      out >> f;
+      const double want = k < 3 ? m.frame.origin_mm(k) : m.frame.axes((k - 3) % 3, (k - 3) / 3);
+      EXPECT_EQ(f, want) << "disc_frame[" << k << "]";
+    }
+  }
+}
+
+TEST(IoVtu, WeReadWhatMeshioWrites) {
+  if (!has_meshio()) GTEST_SKIP() << "/usr/bin/python3 with meshio not available";
+  const std::string dir = tmp_dir("from_meshio");
+  const char* script = R"PY(
+import sys, meshio, numpy as np
+d = sys.argv[1]
+pts = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, 1]], dtype=float) * 0.1 + 1.0 / 3.0
+tets = np.array([[0, 1, 2, 3], [1, 2, 3, 4]])
+# second tet: make it positively oriented
+a, b, c, e = pts[tets[1]]
+if np.dot(b - a, np.cross(c - a, e - a)) < 0: tets[1] = tets[1][[0, 1, 3, 2]]
+mesh = meshio.Mesh(pts, [("tetra", tets)],
+                   point_data={"surface": np.array([1, 1, 3, 2, 2], dtype=np.int32),
+                               "displacement": pts * 2.0},
+                   cell_data={"region": [np.array([1, 2], dtype=np.int32)]})
+meshio.write(d + "/ascii.vtu", mesh, binary=False)
+meshio.write(d + "/binary.vtu", mesh, binary=True, compression=None)
+meshio.write(d + "/zlib.vtu", mesh, binary=True, compression="zlib")
+q = np.vstack([pts[:4], [(pts[i] + pts[j]) / 2 for i, j in [(0,1),(1,2),(0,2),(0,3),(1,3),(2,3)]]])
+meshio.write(d + "/tet10.vtu", meshio.Mesh(q, [("tetra10", np.arange(10)[None, :])]),
+             binary=True, compression=None)
+print("ok")
+)PY";
+  ASSERT_EQ(run_python(dir, script, dir), "ok\n");
+  Eigen::MatrixX3d pts(5, 3);
+  pts << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 1, 1, 1;
+  pts = (pts.array() * 0.1 + 1.0 / 3.0).matrix();
+  for (const char* name : {"ascii.vtu", "binary.vtu"}) {
+    SCOPED_TRACE(name);
+    std::vector<DataArray> pd;
+    const TetMesh m = read_vtu(dir + "/" + name, &pd);
+    ASSERT_EQ(m.num_vertices(), 5);
+    ASSERT_EQ(m.num_tets(), 2);
+    // meshio's ASCII writer prints 11 significant digits; binary must be exact.
+    const double tol = std::string(name) == "binary.vtu" ? 0.0 : 1e-11;
+    EXPECT_LE((m.V - pts).cwiseAbs().maxCoeff(), tol);
+    EXPECT_EQ(m.region(0), 1);
+    EXPECT_EQ(m.region(1), 2);
+    EXPECT_EQ(m.surface.sum(), 9);
+    ASSERT_EQ(pd.size(), 1u);
+    EXPECT_EQ(pd[0].name, "displacement");
+    EXPECT_LE((pd[0].values - 2.0 * pts).cwiseAbs().maxCoeff(), 2 * tol);
+  }
+  const TetMesh q = read_vtu(dir + "/tet10.vtu");
+  EXPECT_EQ(q.num_vertices(), 4);
+  EXPECT_NEAR(mesh_volume(q), 1e-3 / 6.0, 1e-15);
+  try {
+    read_vtu(dir + "/zlib.vtu");
+    FAIL() << "compressed file accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("compression=None"), std::string::npos) << e.what();
+  }
+}
+
+// --- bad input ------------------------------------------------------------------------------
+
+namespace {
+
+/// Writes an ASCII VTU of the cube, applies `edit` to the text, and expects read_vtu to throw a
+/// one-line invalid_argument naming the file and containing `needle`.
+void expect_read_error(const std::string& name, const std::function<void(std::string&)>& edit,
+                       const std::string& needle, VtuEncoding enc = VtuEncoding::ascii) {
+  SCOPED_TRACE(name);
+  const std::string path = tmp_dir("bad_" + name) + "/bad.vtu";
+  write_vtu(path, cube_mesh(), {}, {}, {enc});
+  std::string text = slurp(path);
+  edit(text);
+  spit(path, text);
+  try {
+    read_vtu(path);
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    const std::string msg = e.what();
+    EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+    EXPECT_NE(msg.find(path), std::string::npos) << msg;
+    EXPECT_NE(msg.find(needle), std::string::npos) << msg;
+  }
+}
+
+void replace_once(std::string& s, const std::string& from, const std::string& to) {
+  const auto pos = s.find(from);
+  ASSERT_NE(pos, std::string::npos) << from;
+  s.replace(pos, from.size(), to);
+}
+
+/// Text between the opening tag of the DataArray named `name` and its closing tag.
+std::pair<std::size_t, std::size_t> array_body(const std::string& s, const std::string& name) {
+  const auto a = s.find(">", s.find("Name=\"" + name + "\"")) + 1;
+  const auto b = s.find("</DataArray>", a);
+  return {a, b};
+}
+
+}  // namespace
+
+TEST(IoVtu, MissingFile) {
+  EXPECT_THROW(read_vtu(tmp_dir("missing") + "/nope.vtu"), std::invalid_argument);
+}
+
+TEST(IoVtu, BadFilesGiveOneLineErrors) {
+  expect_read_error("not_xml", [](std::string& s) { s = "solid cube\nthis is not xml"; }, "XML");
+  expect_read_error("polydata", [](std::string& s) {
+    replace_once(s, "type=\"UnstructuredGrid\"", "type=\"PolyData\"");
+  }, "not an UnstructuredGrid");
+  expect_read_error("npoints", [](std::string& s) {
+    replace_once(s, "NumberOfPoints=\"8\"", "NumberOfPoints=\"9\"");
+  }, "NumberOfPoints");
+  expect_read_error("index_range", [](std::string& s) {
+    const auto [a, b] = array_body(s, "connectivity");
+    s.replace(a, b - a, "0 1 3 7 0 1 5 7 0 2 3 7 0 2 6 7 0 4 5 7 0 4 6 8");
+  }, "connectivity");
+  expect_read_error("nan_point", [](std::string& s) {
+    const auto [a, b] = array_body(s, "Points");
+    const auto first = s.find_first_not_of(" \n", a);
+    s.replace(first, s.find(' ', first) - first, "nan");
+  }, "non-finite");
+  expect_read_error("garbage_number", [](std::string& s) {
+    const auto [a, b] = array_body(s, "Points");
+    s.insert(a, " 1.0abc ");
+  }, "not a number");
+  expect_read_error("truncated_base64", [](std::string& s) {
+    const auto [a, b] = array_body(s, "Points");
+    s.erase(a + (b - a) / 2, b - a - (b - a) / 2);
+  }, "truncated", VtuEncoding::binary);
+  expect_read_error("bad_base64_char", [](std::string& s) {
+    const auto [a, b] = array_body(s, "Points");
+    s[a + 20] = '*';
+  }, "base64", VtuEncoding::binary);
+  expect_read_error("appended", [](std::string& s) {
+    replace_once(s, "format=\"ascii\">", "format=\"appended\" offset=\"0\">");
+  }, "appended");
+  expect_read_error("compressor", [](std::string& s) {
+    replace_once(s, "header_type=", "compressor=\"vtkZLibDataCompressor\" header_type=");
+  }, "compressor");
+  expect_read_error("hexahedron", [](std::string& s) {
+    const auto [a, b] = array_body(s, "types");
+    s.replace(a, b - a, "10 10 10 10 10 12");
+  }, "hexahedron");
+  expect_read_error("offsets", [](std::string& s) {
+    const auto [a, b] = array_body(s, "offsets");
+    s.replace(a, b - a, "4 8 12 16 20 23");
+  }, "offsets");
+  expect_read_error("region_size", [](std::string& s) {
+    const auto [a, b] = array_body(s, "region");
+    s.replace(a, b - a, "1 2 1");
+  }, "region");
+  expect_read_error("inverted", [](std::string& s) {
+    const auto [a, b] = array_body(s, "connectivity");
+    const std::string body = s.substr(a, b - a);
+    // swap the last two indices of the first tet
+    std::istringstream is(body);
+    std::vector<std::string> v{std::istream_iterator<std::string>(is), {}};
+    std::swap(v[2], v[3]);
+    std::string out;
+    for (const auto& x : v) out += x + " ";
+    s.replace(a, b - a, out);
+  }, "inverted");
+}
+
+TEST(IoVtu, RefusesNonFiniteDataAndLeavesNoFile) {
+  const std::string dir = tmp_dir("nan_write");
+  const std::string path = dir + "/out.vtu";
+  TetMesh m = cube_mesh();
+  auto pd = point_arrays(m);
+  pd[0].values(3, 1) = std::numeric_limits<double>::quiet_NaN();
+  for (VtuEncoding enc : {VtuEncoding::binary, VtuEncoding::ascii}) {
+    try {
+      write_vtu(path, m, pd, {}, {enc});
+      FAIL() << "NaN accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("contains non-finite values"), std::string::npos) << e.what();
+    }
+  }
+  m.V(2, 2) = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(write_vtu(path, m), std::invalid_argument);
+  EXPECT_FALSE(fs::exists(path));
+  EXPECT_EQ(count_tmp_files(dir), 0);
+  EXPECT_TRUE(fs::is_empty(dir));
+}
+
+TEST(IoVtu, RefusesBadArraysAndLabels) {
+  const std::string dir = tmp_dir("bad_write");
+  const std::string path = dir + "/out.vtu";
+  const TetMesh m = cube_mesh();
+  EXPECT_THROW(write_vtu(path, m, {{"short", Eigen::MatrixXd::Zero(3, 1)}}), std::invalid_argument);
+  EXPECT_THROW(write_vtu(path, m, {{"surface", Eigen::MatrixXd::Zero(8, 1)}}), std::invalid_argument);
+  EXPECT_THROW(write_vtu(path, m, {}, {{"region", Eigen::MatrixXd::Zero(6, 1)}}), std::invalid_argument);
+  EXPECT_THROW(write_vtu(path, m, {{"", Eigen::MatrixXd::Zero(8, 1)}}), std::invalid_argument);
+  TetMesh bad = m;
+  bad.region.resize(2);
+  EXPECT_THROW(write_vtu(path, bad), std::invalid_argument);
+  bad = m;
+  bad.T(0, 0) = 8;
+  EXPECT_THROW(write_vtu(path, bad), std::invalid_argument);
+  EXPECT_TRUE(fs::is_empty(dir));
+}
+
+TEST(IoVtu, MissingFolderIsARuntimeErrorAndLeavesNothing) {
+  const std::string dir = tmp_dir("no_folder");
+  EXPECT_THROW(write_vtu(dir + "/does/not/exist/out.vtu", cube_mesh()), std::runtime_error);
+  EXPECT_TRUE(fs::is_empty(dir));
+}
