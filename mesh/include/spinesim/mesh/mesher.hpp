@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <vector>
 
 namespace spinesim::mesh {
 
@@ -15,6 +16,7 @@ struct MeshOptions {
   double cell_size_mm = 2.0;          ///< upper bound on tet circumradius
   double facet_distance_mm = 0.1;     ///< boundary approximation error bound
   double facet_size_mm = 0.0;         ///< 0: same as cell_size_mm
+  double edge_size_mm = 0.0;          ///< protected sharp edges (rims); 0: same as cell_size_mm
   double facet_angle_deg = 25.0;
   double radius_edge_ratio = 2.5;     ///< cell_radius_edge_ratio
   bool odt = false;
@@ -35,14 +37,19 @@ struct LabeledBody {
   /// Classifies a boundary facet (centroid, outward unit normal) into a Surface label;
   /// may be empty (then every boundary node is labelled outer wall).
   std::function<Surface(const Eigen::Vector3d&, const Eigen::Vector3d&)> classify_facet;
+  /// Sharp edges to protect (CGAL 1D features): polylines of points exactly on the boundary,
+  /// closed ones with the first point repeated last. Keeps rims crisp and volumes accurate.
+  std::vector<std::vector<Eigen::Vector3d>> features;
+  std::string name = "labeled body";  ///< provenance, copied to TetMesh::source
 };
 
 /// Generic labelled-domain mesher (discs, test cylinders, ...). Throws std::runtime_error if
 /// CGAL produces no tetrahedra.
 TetMesh mesh_labeled_body(const LabeledBody& body, const MeshOptions& opt);
 
-/// The parametric disc of a level, upright at the origin (frame = identity) when
-/// `in_spine` is false, otherwise placed by disc_frame_in_spine().
+/// The parametric disc (ParametricDisc) meshed upright at the origin in its local frame, rims
+/// protected as sharp features, then placed by `placement` (x' = origin + axes x); the
+/// returned mesh carries that frame. Pass disc_frame_in_spine(level) to put it in the spine.
 TetMesh mesh_parametric_disc(const DiscDimensions& dims, const MeshOptions& opt,
                              const DiscFrame& placement = DiscFrame());
 

@@ -3,6 +3,9 @@
 
 #include "spinesim/mesh/tet_mesh.hpp"
 
+#include <Eigen/Core>
+
+#include <array>
 #include <limits>
 
 namespace spinesim::mesh {
@@ -22,6 +25,13 @@ struct QualityReport {
   }
 };
 
+/// Counts per region and surface label, interior dihedral angles over all 6 edges of every
+/// tet (deg), radius-edge ratio (circumradius / shortest edge of the tet; regular tet:
+/// sqrt(6)/4 ≈ 0.612), unique edge lengths (mm) and the mesh volume vs `exact_volume_mm3`.
 QualityReport quality_report(const TetMesh& m, double exact_volume_mm3 = -1);
+
+/// The six interior dihedral angles (deg) of tet (a, b, c, d) at edges ab, ac, ad, bc, bd, cd.
+std::array<double, 6> dihedral_angles_deg(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                          const Eigen::Vector3d& c, const Eigen::Vector3d& d);
 
 }  // namespace spinesim::mesh
