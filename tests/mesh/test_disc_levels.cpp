@@ -1,0 +1,137 @@
+// The 17 disc levels: sourced dimensions from data/disc_morphometry.csv and the disc frames
+// placed in the thesis spine (tables F.1/F.2).
+#include "spinesim/mesh/disc_geometry.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace {
+
+using spinesim::mesh::disc_dimensions;
+using spinesim::mesh::disc_frame_in_spine;
+using spinesim::mesh::disc_levels;
+
+const std::string kData = SPINESIM_DATA_DIR;
+
+TEST(DiscLevels, SeventeenInCranialToCaudalOrder) {
+  const auto& levels = disc_levels();
+  ASSERT_EQ(levels.size(), 17u);
+  EXPECT_EQ(levels.front(), "T1-T2");
+  EXPECT_EQ(levels[11], "T12-L1");
+  EXPECT_EQ(levels.back(), "L5-S1");
+  // Each level's inferior vertebra is the next level's superior one.
+  for (std::size_t i = 0; i + 1 < levels.size(); ++i) {
+    const std::string below = levels[i].substr(levels[i].find('-') + 1);
+    EXPECT_EQ(levels[i + 1].substr(0, levels[i + 1].find('-')), below);
+  }
+}
+
+TEST(DiscDimensions, EveryLevelIsPlausible) {
+  for (const auto& level : disc_levels()) {
+    SCOPED_TRACE(level);
+    const auto d = disc_dimensions(level, kData);
+    EXPECT_EQ(d.level, level);
+    for (double w : {d.lower_width_mm, d.upper_width_mm}) {
+      EXPECT_GE(w, 20.0);
+      EXPECT_LE(w, 60.0);
+    }
+    for (double depth : {d.lower_depth_mm, d.upper_depth_mm}) {
+      EXPECT_GE(depth, 10.0);
+      EXPECT_LE(depth, 50.0);
+    }
+    EXPECT_GE(d.height_mm, 3.0);
+    EXPECT_LE(d.height_mm, 15.0);
+  }
+}
+
+TEST(DiscDimensions, LumbarValuesAsInSpec) {
+  // Panjabi 1992 upper-endplate widths; a disc's lower outline is its inferior vertebra's
+  // upper endplate, its upper outline the superior vertebra's lower endplate (taken as wide).
+  const auto l34 = disc_dimensions("L3-L4", kData);
+  const auto l45 = disc_dimensions("L4-L5", kData);
+  EXPECT_DOUBLE_EQ(l34.lower_width_mm, 46.6);
+  EXPECT_DOUBLE_EQ(l45.upper_width_mm, 46.6);
+  EXPECT_DOUBLE_EQ(l45.lower_width_mm, 47.3);
+  EXPECT_DOUBLE_EQ(disc_dimensions("L1-L2", kData).lower_width_mm, 42.6);
+  EXPECT_DOUBLE_EQ(disc_dimensions("T12-L1", kData).lower_width_mm, 41.2);
+  EXPECT_DOUBLE_EQ(disc_dimensions("T11-T12", kData).lower_width_mm, 39.2);
+  EXPECT_DOUBLE_EQ(disc_dimensions("T1-T2", kData).upper_width_mm, 24.5);
+  // Twomey 1985 heights, Busscher 2010 for T12-L1.
+  EXPECT_DOUBLE_EQ(l45.height_mm, 11.3);
+  EXPECT_DOUBLE_EQ(disc_dimensions("L5-S1", kData).height_mm, 10.6);
+  EXPECT_DOUBLE_EQ(disc_dimensions("T12-L1", kData).height_mm, 9.3);
+}
+
+TEST(DiscDimensions, AdjacentDiscsShareTheirVertebra) {
+  // Under the EPWl ~ EPWu assumption the vertebra between two discs gives both widths.
+  const auto& levels = disc_levels();
+  for (std::size_t i = 0; i + 1 < levels.size(); ++i) {
+    SCOPED_TRACE(levels[i]);
+    EXPECT_DOUBLE_EQ(disc_dimensions(levels[i], kData).lower_width_mm,
+                     disc_dimensions(levels[i + 1], kData).upper_width_mm);
+  }
+}
+
+TEST(DiscDimensions, LevelNamesAreCaseInsensitive) {
+  const auto d = disc_dimensions("l4-l5", kData);
+  EXPECT_EQ(d.level, "L4-L5");
+  EXPECT_DOUBLE_EQ(d.height_mm, 11.3);
+  EXPECT_EQ(disc_dimensions(" t12-l1 ", kData).level, "T12-L1");
+}
+
+TEST(DiscDimensions, UnknownLevelIsRefusedWithTheKnownOnes) {
+  for (const char* bad : {"L5-L6", "C7-T1", "L4L5", ""}) {
+    try {
+      disc_dimensions(bad, kData);
+      ADD_FAILURE() << "accepted " << bad;
+    } catch (const std::invalid_argument& e) {
+      const std::string m = e.what();
+      EXPECT_NE(m.find("unknown disc level"), std::string::npos) << m;
+      EXPECT_NE(m.find("T1-T2"), std::string::npos) << m;
+      EXPECT_NE(m.find("L5-S1"), std::string::npos) << m;
+      EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+    }
+  }
+  EXPECT_THROW(disc_frame_in_spine("X1-X2", kData), std::invalid_argument);
+}
+
+TEST(DiscDimensions, MissingDataFolderIsRefused) {
+  EXPECT_THROW(disc_dimensions("L4-L5", "/nonexistent/spinesim-data"), std::invalid_argument);
+  EXPECT_THROW(disc_frame_in_spine("L4-L5", "/nonexistent/spinesim-data"), std::invalid_argument);
+}
+
+TEST(DiscFrame, OrthonormalRightHandedAndAnterior) {
+  for (const auto& level : disc_levels()) {
+    SCOPED_TRACE(level);
+    const auto f = disc_frame_in_spine(level, kData);
+    const Eigen::Matrix3d& r = f.axes;
+    EXPECT_TRUE((r.transpose() * r).isApprox(Eigen::Matrix3d::Identity(), 1e-12));
+    EXPECT_NEAR(r.determinant(), 1.0, 1e-12);
+    EXPECT_GT(r(1, 1), 0.8);  // axial axis points up (within ~37 degrees of global y)
+    EXPECT_GT(r(2, 2), 0.0);  // anterior axis has a positive global-z component
+    EXPECT_NEAR(r(0, 0), 1.0, 1e-12);  // the thesis spine is symmetric: lateral = global x
+  }
+}
+
+TEST(DiscFrame, OriginsAreTheTableF2JointPoints) {
+  const auto l45 = disc_frame_in_spine("L4-L5", kData);
+  EXPECT_TRUE(l45.origin_mm.isApprox(Eigen::Vector3d(0, 93, 0)));
+  EXPECT_TRUE(disc_frame_in_spine("T1-T2", kData).origin_mm.isApprox(Eigen::Vector3d(0, 510, -30)));
+  EXPECT_TRUE(disc_frame_in_spine("L5-S1", kData).origin_mm.isApprox(Eigen::Vector3d(0, 63, -9)));
+}
+
+TEST(DiscFrame, AxisRunsFromInferiorToSuperiorCentre) {
+  // L4-L5: L5 centre (0, 84, -12) -> L4 centre (0, 112, -8.5), table F.1.
+  const Eigen::Vector3d l4l5 = Eigen::Vector3d(0, 28, 3.5).normalized();
+  EXPECT_TRUE(disc_frame_in_spine("L4-L5", kData).axes.col(1).isApprox(l4l5, 1e-12));
+  // L5-S1 has no sacrum centre: from the joint point (0, 63, -9) to L5 (0, 84, -12).
+  const Eigen::Vector3d l5s1 = Eigen::Vector3d(0, 21, -3).normalized();
+  EXPECT_TRUE(disc_frame_in_spine("l5-s1", kData).axes.col(1).isApprox(l5s1, 1e-12));
+}
+
+}  // namespace
