@@ -3,7 +3,8 @@
 // CGAL 5.5 quirks handled here: the readers append to the output and report an empty STL as a
 // success, so emptiness is checked here; the OBJ reader's index check is off by one (an index
 // equal to the vertex count passes) and negative relative indices can wrap, so every face
-// index is range-checked here; OBJ `vn`/`vt` lines and the `/vt/vn` parts of face corners are
+// index is range-checked here; a NaN vertex in a binary STL would be merged away by CGAL, so
+// binary STL is pre-scanned; OBJ `vn`/`vt` lines and the `/vt/vn` parts of face corners are
 // skipped by CGAL.
 #include "spinesim/mesh/io.hpp"
 
@@ -14,7 +15,10 @@
 #include <array>
 #include <cctype>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -38,6 +42,28 @@ Eigen::Vector3d to_spinesim_frame(const Eigen::Vector3d& p, UpAxis up) {
   return p;
 }
 
+/// CGAL merges STL vertices through a std::map keyed on the point, and a NaN key compares
+/// equivalent to anything, so a NaN vertex would silently be merged into another one. A binary
+/// STL is therefore scanned here first; returns the first bad facet or -1. (CGAL's ASCII parser
+/// does not accept "nan"/"inf" tokens, so ASCII STL fails as unreadable instead.)
+long first_nonfinite_binary_stl_facet(const std::string& path) {
+  std::ifstream is(path, std::ios::binary);
+  char header[80];
+  std::uint32_t n = 0;
+  if (!is.read(header, 80) || !is.read(reinterpret_cast<char*>(&n), 4)) return -1;
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(path, ec);
+  if (ec || size != 84 + 50 * std::uint64_t(n)) return -1;  // not binary: CGAL parses it as ASCII
+  char facet[50];
+  for (std::uint32_t f = 0; f < n && is.read(facet, 50); ++f)
+    for (int k = 3; k < 12; ++k) {  // skip the normal (floats 0-2), check the 3 vertices
+      float x;
+      std::memcpy(&x, facet + 4 * k, 4);
+      if (!std::isfinite(x)) return long(f);
+    }
+  return -1;
+}
+
 }  // namespace
 
 TriSurface read_surface(const std::string& path, double units_to_mm, UpAxis up) {
@@ -55,6 +81,11 @@ TriSurface read_surface(const std::string& path, double units_to_mm, UpAxis up) 
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) fail("no such file");
 
+  if (ext == ".stl") {
+    const long bad = first_nonfinite_binary_stl_facet(path);
+    if (bad >= 0) fail("facet #" + std::to_string(bad) + " has non-finite coordinates");
+  }
+
   // 1. Polygon soup (no manifoldness required).
   std::vector<Point> points;
   std::vector<std::vector<std::size_t>> polygons;
@@ -64,7 +95,12 @@ TriSurface read_surface(const std::string& path, double units_to_mm, UpAxis up) 
   } catch (const std::exception& e) {
     fail(std::string("cannot be read (") + e.what() + ")");
   }
-  if (!ok) fail("cannot be read as " + ext.substr(1) + " (corrupt file, or no faces)");
+  if (!ok) {
+    std::string format = ext.substr(1);
+    std::transform(format.begin(), format.end(), format.begin(),
+                   [](unsigned char c) { return char(std::toupper(c)); });
+    fail("cannot be read as " + format + " (corrupt file, or no faces)");
+  }
   if (points.empty() || polygons.empty()) fail("contains no triangles");
 
   // 2. Triangles (fan for polygons), with every index checked.

@@ -1,0 +1,213 @@
+// Surface import: every format on tiny files written here, units and the up-axis maps on known
+// coordinates, the maps being proper rotations, bad input, and the real ArtiSynth L4 surfaces
+// (skipped when the external test data are absent).
+#include "spinesim/mesh/io.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+using namespace spinesim::mesh;
+
+namespace {
+
+std::string tmp_dir(const std::string& name) {
+  const fs::path d = fs::path(SPINESIM_TEST_TMP) / ("io_surface_" + name);
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d.string();
+}
+
+std::string spit(const std::string& path, const std::string& text) {
+  std::ofstream os(path, std::ios::binary);
+  os << text;
+  return path;
+}
+
+/// Binary STL with the given triangles (each 9 floats).
+std::string write_binary_stl(const std::string& path, const std::vector<std::array<float, 9>>& tris) {
+  std::ofstream os(path, std::ios::binary);
+  char header[80] = "binary stl written by test_io_surface";
+  os.write(header, 80);
+  const std::uint32_t n = std::uint32_t(tris.size());
+  os.write(reinterpret_cast<const char*>(&n), 4);
+  for (const auto& t : tris) {
+    const float normal[3] = {0, 0, 0};
+    os.write(reinterpret_cast<const char*>(normal), 12);
+    os.write(reinterpret_cast<const char*>(t.data()), 36);
+    const std::uint16_t attr = 0;
+    os.write(reinterpret_cast<const char*>(&attr), 2);
+  }
+  return path;
+}
+
+/// Row of V closest to p (exact match expected).
+Eigen::Index find_vertex(const TriSurface& s, const Eigen::Vector3d& p) {
+  Eigen::Index best = -1;
+  (s.V.rowwise() - p.transpose()).rowwise().norm().minCoeff(&best);
+  return best;
+}
+
+void expect_error(const std::string& path, double units, const std::string& needle) {
+  SCOPED_TRACE(path);
+  try {
+    read_surface(path, units, UpAxis::y);
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    const std::string msg = e.what();
+    EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+    EXPECT_NE(msg.find(path), std::string::npos) << msg;
+    EXPECT_NE(msg.find(needle), std::string::npos) << msg;
+  }
+}
+
+}  // namespace
+
+TEST(IoSurface, OffWithQuadUnitsAndZUp) {
+  const std::string dir = tmp_dir("off");
+  const std::string path = spit(dir + "/patch.off",
+                                "OFF\n# a quad and a triangle\n5 2 0\n0 0 0\n1 0 0\n1 2 0\n0 2 0\n"
+                                "0 0 3\n4 0 1 2 3\n3 0 1 4\n");
+  const TriSurface s = read_surface(path, 10.0, UpAxis::z);
+  ASSERT_EQ(s.V.rows(), 5);
+  ASSERT_EQ(s.F.rows(), 3);  // quad fanned into 2 triangles
+  // (x, y, z)_file × 10 -> (y, z, x)
+  EXPECT_EQ(s.V.row(2), Eigen::RowVector3d(20, 0, 10));
+  EXPECT_EQ(s.V.row(4), Eigen::RowVector3d(0, 30, 0));  // file z (up) -> +y
+  EXPECT_EQ(s.F.row(0), Eigen::RowVector3i(0, 1, 2));
+  EXPECT_EQ(s.F.row(1), Eigen::RowVector3i(0, 2, 3));
+  EXPECT_EQ(s.F.row(2), Eigen::RowVector3i(0, 1, 4));
+}
+
+TEST(IoSurface, ObjWithNormalsTexturesGroupsAndNegativeIndices) {
+  const std::string dir = tmp_dir("obj");
+  const std::string path = spit(dir + "/patch.OBJ",  // upper-case extension on purpose
+                                "# comment\nmtllib x.mtl\no patch\ng group\n"
+                                "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+                                "vn 0 0 1\nvn 0 0 1\nvt 0 0\nvt 1 0\nusemtl skin\ns off\n"
+                                "f 1/1/1 2/2/2 3/2/2\nf 1//1 3//1 4//1\nf -4 -2 -1\n");
+  const TriSurface s = read_surface(path, 1.0, UpAxis::y);
+  ASSERT_EQ(s.V.rows(), 4);
+  ASSERT_EQ(s.F.rows(), 3);
+  EXPECT_EQ(s.F.row(0), Eigen::RowVector3i(0, 1, 2));
+  EXPECT_EQ(s.F.row(1), Eigen::RowVector3i(0, 2, 3));
+  EXPECT_EQ(s.F.row(2), Eigen::RowVector3i(0, 2, 3));  // relative indices
+  EXPECT_EQ(s.V.row(2), Eigen::RowVector3d(1, 1, 0));  // identity for up = y
+}
+
+TEST(IoSurface, StlAsciiAndBinaryMergeVerticesAndMapXUp) {
+  const std::string dir = tmp_dir("stl");
+  const std::string ascii = spit(dir + "/a.stl",
+                                 "solid t\n facet normal 0 0 1\n  outer loop\n"
+                                 "   vertex 0 0 0\n   vertex 1 0 0\n   vertex 0 2 0\n"
+                                 "  endloop\n endfacet\n facet normal 0 0 1\n  outer loop\n"
+                                 "   vertex 1 0 0\n   vertex 1 2 0\n   vertex 0 2 0\n"
+                                 "  endloop\n endfacet\nendsolid t\n");
+  const std::string binary =
+      write_binary_stl(dir + "/b.stl", {{0, 0, 0, 1, 0, 0, 0, 2, 0}, {1, 0, 0, 1, 2, 0, 0, 2, 0}});
+  for (const std::string& path : {ascii, binary}) {
+    SCOPED_TRACE(path);
+    const TriSurface s = read_surface(path, 1.0, UpAxis::x);
+    ASSERT_EQ(s.V.rows(), 4);  // shared corners merged
+    ASSERT_EQ(s.F.rows(), 2);
+    // (x, y, z) -> (z, x, y): file (1, 2, 0) -> (0, 1, 2)
+    EXPECT_GE(find_vertex(s, {0, 1, 2}), 0);
+    EXPECT_EQ((s.V.row(find_vertex(s, {0, 1, 2})) - Eigen::RowVector3d(0, 1, 2)).norm(), 0.0);
+  }
+}
+
+TEST(IoSurface, PlyAscii) {
+  const std::string dir = tmp_dir("ply");
+  const std::string path = spit(dir + "/t.ply",
+                                "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\n"
+                                "property float y\nproperty float z\nelement face 1\n"
+                                "property list uchar int vertex_indices\nend_header\n"
+                                "0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n");
+  const TriSurface s = read_surface(path, 1000.0, UpAxis::minus_z);
+  ASSERT_EQ(s.V.rows(), 4);
+  ASSERT_EQ(s.F.rows(), 2);
+  // minus_z: (x, y, z) -> (y, -z, -x); file (1, 1, 0) m -> (1000, 0, -1000) mm
+  EXPECT_EQ(s.V.row(2), Eigen::RowVector3d(1000, 0, -1000));
+}
+
+TEST(IoSurface, EveryUpAxisMapIsARotationSendingUpToPlusY) {
+  const std::string dir = tmp_dir("rotations");
+  const std::string path = spit(dir + "/axes.off",
+                                "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n"
+                                "3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n");
+  const struct { UpAxis up; Eigen::Vector3d up_file; } cases[] = {
+      {UpAxis::x, {1, 0, 0}},        {UpAxis::y, {0, 1, 0}},        {UpAxis::z, {0, 0, 1}},
+      {UpAxis::minus_x, {-1, 0, 0}}, {UpAxis::minus_y, {0, -1, 0}}, {UpAxis::minus_z, {0, 0, -1}},
+  };
+  for (const auto& c : cases) {
+    const TriSurface s = read_surface(path, 1.0, c.up);
+    Eigen::Matrix3d R;  // columns: images of the file's unit axes
+    for (int k = 0; k < 3; ++k) R.col(k) = (s.V.row(k + 1) - s.V.row(0)).transpose();
+    EXPECT_NEAR((R.transpose() * R - Eigen::Matrix3d::Identity()).norm(), 0, 1e-15);
+    EXPECT_NEAR(R.determinant(), 1.0, 1e-15);
+    EXPECT_NEAR((R * c.up_file - Eigen::Vector3d::UnitY()).norm(), 0, 1e-15);
+  }
+}
+
+TEST(IoSurface, BadInputGivesOneLineErrors) {
+  const std::string dir = tmp_dir("bad");
+  expect_error(dir + "/missing.stl", 1, "no such file");
+  expect_error(spit(dir + "/cloud.xyz", "0 0 0\n"), 1, "unknown surface file extension");
+  expect_error(spit(dir + "/noext", "0 0 0\n"), 1, "unknown surface file extension");
+  expect_error(spit(dir + "/empty.off", "OFF\n0 0 0\n"), 1, "no triangles");
+  expect_error(spit(dir + "/empty.stl", ""), 1, "no triangles");
+  expect_error(spit(dir + "/empty.obj", ""), 1, "cannot be read");
+  expect_error(spit(dir + "/garbage.obj", "hello world\n"), 1, "cannot be read");
+  expect_error(spit(dir + "/garbage.ply", "not a ply\n"), 1, "cannot be read");
+  // CGAL's own check lets index == vertex count through; ours does not.
+  expect_error(spit(dir + "/range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n"), 1, "out of range");
+  expect_error(spit(dir + "/range.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n"), 1, "cannot be read");
+  expect_error(spit(dir + "/edge.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n"), 1, "fewer than 3");
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  expect_error(write_binary_stl(dir + "/nan.stl", {{0, 0, 0, 1, 0, 0, 0, nan, 0}}), 1, "non-finite");
+  const std::string ok = spit(dir + "/ok.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  EXPECT_NO_THROW(read_surface(ok, 1, UpAxis::y));
+  expect_error(ok, 0, "unit scale");
+  expect_error(ok, -1000, "unit scale");
+  expect_error(ok, std::numeric_limits<double>::quiet_NaN(), "unit scale");
+}
+
+// --- real data: ArtiSynth lumbar surfaces (metres, z up, x anterior-posterior) ----------------
+
+TEST(IoSurface, RealL4BodyBoundingBoxAndAnteriorDirection) {
+  const fs::path root = fs::path(SPINESIM_TESTDATA_DIR) / "artisynth-lss";
+  if (!fs::exists(root / "L4_body.obj") || !fs::exists(root / "L4_Schrumpfverpacken.obj"))
+    GTEST_SKIP() << "external test data not found under " << root;
+  const TriSurface body = read_surface((root / "L4_body.obj").string(), 1000.0, UpAxis::z);
+  const TriSurface whole = read_surface((root / "L4_Schrumpfverpacken.obj").string(), 1000.0, UpAxis::z);
+  EXPECT_EQ(body.V.rows(), 2356);
+  EXPECT_EQ(body.F.rows(), 4078);
+  const Eigen::RowVector3d lo = body.V.colwise().minCoeff(), hi = body.V.colwise().maxCoeff();
+  // Measured once from the file: x (lateral) ±26.1, y (up) 48.2..80.2, z (anterior) -2.8..36.2 mm.
+  EXPECT_NEAR(lo.x(), -26.14, 0.01);
+  EXPECT_NEAR(hi.x(), 26.14, 0.01);
+  EXPECT_NEAR(lo.y(), 48.24, 0.01);
+  EXPECT_NEAR(hi.y(), 80.16, 0.01);
+  EXPECT_NEAR(lo.z(), -2.82, 0.01);
+  EXPECT_NEAR(hi.z(), 36.15, 0.01);
+  // Sanity of size: a lumbar body about 52 mm wide, 39 mm deep, 32 mm tall (incl. endplate rims).
+  EXPECT_GT(hi.x() - lo.x(), 40);
+  EXPECT_LT(hi.x() - lo.x(), 60);
+  // Anterior is +z: the posterior elements (spinous process) of the whole vertebra reach far to
+  // -z behind the body, while the front of the whole vertebra is the front of the body.
+  const double whole_min_z = whole.V.col(2).minCoeff(), whole_max_z = whole.V.col(2).maxCoeff();
+  EXPECT_LT(whole_min_z, lo.z() - 30.0);
+  EXPECT_NEAR(whole_max_z, hi.z(), 2.0);
+  // Left-right symmetric about x = 0 (mid-sagittal plane).
+  EXPECT_NEAR(body.V.col(0).mean(), 0.0, 0.5);
+}
