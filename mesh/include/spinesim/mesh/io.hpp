@@ -12,9 +12,10 @@
 //     codes (not VTK's String type, which meshio cannot read).
 // Writers refuse bad input (non-finite values, wrong array sizes) before touching the disk, write
 // to `path + ".tmp-XXXXXX"` in the same folder and rename it over `path`, so a failure never
-// leaves a partial or stale file. User-input problems throw std::invalid_argument; operating-
-// system failures (folder missing, disk full) throw std::runtime_error. All messages are one line
-// and name the file.
+// leaves a partial file or a stray temporary; a file already at `path` is replaced only by a
+// complete new one (after a refused write it is left as it was). User-input problems throw
+// std::invalid_argument; operating-system failures (folder missing, disk full) throw
+// std::runtime_error. All messages are one line and name the file.
 #pragma once
 
 #include "spinesim/mesh/tet_mesh.hpp"
