@@ -14,8 +14,8 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 
 // Base curve before scaling: polar ellipse (a = 1, b = 0.75) with a posterior notch.
-constexpr double kA = 1.0, kB = 0.75, kNotchDepth = 0.2;
-constexpr int kNotchPower = 8;
+constexpr double kA = 1.0, kB = 0.75, kNotchDepth = 0.3;
+constexpr int kNotchPower = 16;
 
 double base_radius(double theta) {
   const double c = std::cos(theta), s = std::sin(theta);

@@ -122,6 +122,20 @@ TetMesh mesh_labeled_body(const LabeledBody& body, const MeshOptions& opt) {
         "mesh options: need cell size > 0, facet distance > 0, facet angle in (0, 30] deg and "
         "radius-edge ratio >= 2 (CGAL's termination bounds)");
 
+  // CGAL looks for the surface with random rays from the centre and never gives up; make sure
+  // there is a body to find (probe a 24^3 lattice of the bounding cube).
+  bool found = false;
+  for (int i = 0; i < 24 && !found; ++i)
+    for (int j = 0; j < 24 && !found; ++j)
+      for (int k = 0; k < 24 && !found; ++k) {
+        const Eigen::Vector3d q = body.center_mm + body.bounding_radius_mm *
+                                                       (Eigen::Vector3d(i, j, k) / 11.5 - Eigen::Vector3d::Ones());
+        found = body.label(q) > 0;
+      }
+  if (!found)
+    throw std::runtime_error("CGAL Mesh_3 cannot mesh " + body.name +
+                             ": the labelling function is 0 everywhere in its bounding sphere (no tetrahedra)");
+
   CGAL::Random rng(opt.seed);
   CGAL::get_default_random() = CGAL::Random(opt.seed);  // the perturber draws from it
 

@@ -34,7 +34,8 @@ inline constexpr double kNucleusAreaFraction = 0.4;
 ///
 /// Shape: an ellipse in polar form r_e(θ) = ab / sqrt((b cos θ)^2 + (a sin θ)^2), a = 1,
 /// b = 0.75, with a smooth posterior indentation r(θ) = r_e(θ) (1 - δ ((1 - sin θ)/2)^n),
-/// δ = 0.2, n = 8 (≈ 35° wide notch at θ = -90°, the posterior midpoint), then scaled
+/// δ = 0.3, n = 16 (a notch ≈ 7 % of the depth deep, ≈ 50° wide, at θ = -90°, the posterior
+/// midpoint; concave there since r'' > r), then scaled
 /// separately in x and z so that the x-extent is exactly `width_mm` and the z-extent exactly
 /// `depth_mm`, and shifted so that the area centroid is the origin. x = sx r cos θ,
 /// z = sz r sin θ - shift, θ in [0, 2π) counter-clockwise from +x towards +z (anterior).
