@@ -43,7 +43,7 @@ void print_quality(std::ostream& os, const mesh::QualityReport& q, const std::st
   if (q.exact_volume_mm3 > 0)
     os << " (exact " << q.exact_volume_mm3 << " mm^3, error " << std::setprecision(3)
        << 100.0 * q.volume_error() << " %)";
-  os << "\n";
+  os << std::endl;
 }
 
 }  // namespace spinesim::cli

@@ -21,20 +21,20 @@ using spinesim::mesh::TetMesh;
 
 namespace {
 
-struct Run {
+struct CliRun {
   int status = -1;
   std::string out, err;
 };
 
 /// Runs spinesim with `args` (shell words), capturing stdout and stderr.
-Run spinesim(const std::string& args) {
+CliRun run_spinesim(const std::string& args) {
   const fs::path dir = fs::path(SPINESIM_TEST_TMP);
   fs::create_directories(dir);
   const fs::path out = dir / "cli.stdout", err = dir / "cli.stderr";
   const std::string cmd = std::string("'") + SPINESIM_EXE + "' " + args + " >'" + out.string() + "' 2>'" +
                           err.string() + "' </dev/null";
   const int raw = std::system(cmd.c_str());
-  Run r;
+  CliRun r;
   r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
   std::ifstream o(out), e(err);
   std::stringstream so, se;
@@ -48,7 +48,7 @@ Run spinesim(const std::string& args) {
 int count_lines(const std::string& s) { return int(std::count(s.begin(), s.end(), '\n')); }
 
 /// Expect a refused run: non-zero exit, exactly one line on stderr mentioning `needle`.
-void expect_refused(const Run& r, const std::string& needle) {
+void expect_refused(const CliRun& r, const std::string& needle) {
   EXPECT_NE(r.status, 0);
   EXPECT_EQ(count_lines(r.err), 1) << r.err;
   EXPECT_NE(r.err.find(needle), std::string::npos) << "stderr: " << r.err;
@@ -66,7 +66,7 @@ class CliTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     disc_ = tmp("cli-disc.vtu");
-    const Run r = spinesim("mesh disc --level L4-L5 --cell-size 3 --json --out '" + disc_ + "'");
+    const CliRun r = run_spinesim("mesh disc --level L4-L5 --cell-size 3 --json --out '" + disc_ + "'");
     ASSERT_EQ(r.status, 0) << r.err;
     mesh_json_ = nlohmann::json::parse(r.out);
   }
@@ -80,7 +80,7 @@ nlohmann::json CliTest::mesh_json_;
 
 TEST(Cli, HelpOnEveryVerb) {
   for (const char* verb : {"", "mesh", "mesh disc", "fem", "demo", "bench", "bench mesh", "bench fem"}) {
-    const Run r = spinesim(std::string(verb) + " --help");
+    const CliRun r = run_spinesim(std::string(verb) + " --help");
     EXPECT_EQ(r.status, 0) << verb;
     EXPECT_NE(r.out.find("--"), std::string::npos) << verb;
   }
@@ -97,7 +97,7 @@ TEST_F(CliTest, MeshJsonHasQualityFields) {
 
 TEST_F(CliTest, FemCompressionGivesPositiveFyAndSymmetricStiffness) {
   const std::string out = tmp("cli-fem.vtu");
-  const Run r = spinesim("fem --mesh '" + disc_ + "' --order 1 --motion 0,-0.1,0,0,0,0 --json --out '" + out + "'");
+  const CliRun r = run_spinesim("fem --mesh '" + disc_ + "' --order 1 --motion 0,-0.1,0,0,0,0 --json --out '" + out + "'");
   ASSERT_EQ(r.status, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   for (const char* key : {"nodes", "tets", "plate_center", "plate_motion", "reaction_wrench", "stiffness_6x6"})
@@ -125,7 +125,7 @@ TEST_F(CliTest, FemCompressionGivesPositiveFyAndSymmetricStiffness) {
 }
 
 TEST_F(CliTest, FemWrenchIsBalancedByReaction) {
-  const Run r = spinesim("fem --mesh '" + disc_ + "' --order 1 --wrench 10,-500,20,300,-200,100 --json");
+  const CliRun r = run_spinesim("fem --mesh '" + disc_ + "' --order 1 --wrench 10,-500,20,300,-200,100 --json");
   ASSERT_EQ(r.status, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   const double w[6] = {10, -500, 20, 300, -200, 100};
@@ -134,11 +134,11 @@ TEST_F(CliTest, FemWrenchIsBalancedByReaction) {
 
 TEST_F(CliTest, BadLoadsAreRefusedWithoutOutput) {
   const std::string out = tmp("cli-bad.vtu");
-  expect_refused(spinesim("fem --mesh '" + disc_ + "' --wrench 0,nan,0,0,0,0 --out '" + out + "'"), "non-finite");
-  expect_refused(spinesim("fem --mesh '" + disc_ + "' --motion 0,-0.1,0 --out '" + out + "'"), "expected 6");
-  expect_refused(spinesim("fem --mesh '" + disc_ + "' --order 3 --motion 0,-0.1,0,0,0,0 --out '" + out + "'"),
+  expect_refused(run_spinesim("fem --mesh '" + disc_ + "' --wrench 0,nan,0,0,0,0 --out '" + out + "'"), "non-finite");
+  expect_refused(run_spinesim("fem --mesh '" + disc_ + "' --motion 0,-0.1,0 --out '" + out + "'"), "expected 6");
+  expect_refused(run_spinesim("fem --mesh '" + disc_ + "' --order 3 --motion 0,-0.1,0,0,0,0 --out '" + out + "'"),
                  "order");
-  expect_refused(spinesim("fem --mesh '" + disc_ + "' --case squat --out '" + out + "'"), "unknown load case");
+  expect_refused(run_spinesim("fem --mesh '" + disc_ + "' --case squat --out '" + out + "'"), "unknown load case");
   EXPECT_FALSE(fs::exists(out));
 }
 
@@ -153,11 +153,11 @@ TEST_F(CliTest, BadMaterialsAreRefused) {
   for (const auto& [text, needle] : cases) {
     const std::string path = tmp("material.json");
     std::ofstream(path) << text;
-    expect_refused(spinesim("fem --mesh '" + disc_ + "' --material '" + path + "' --motion 0,-0.1,0,0,0,0 --out '" +
+    expect_refused(run_spinesim("fem --mesh '" + disc_ + "' --material '" + path + "' --motion 0,-0.1,0,0,0,0 --out '" +
                             out + "'"),
                    needle);
   }
-  expect_refused(spinesim("fem --mesh '" + disc_ + "' --material unobtainium --motion 0,-0.1,0,0,0,0"),
+  expect_refused(run_spinesim("fem --mesh '" + disc_ + "' --material unobtainium --motion 0,-0.1,0,0,0,0"),
                  "unknown material");
   EXPECT_FALSE(fs::exists(out));
 }
@@ -165,42 +165,42 @@ TEST_F(CliTest, BadMaterialsAreRefused) {
 TEST_F(CliTest, BadMeshesAreRefused) {
   const std::string out = tmp("cli-bad-mesh-out.vtu");
   const std::string motion = " --motion 0,-0.1,0,0,0,0 --out '" + out + "'";
-  expect_refused(spinesim("fem --mesh /nonexistent/disc.vtu" + motion), "disc.vtu");
+  expect_refused(run_spinesim("fem --mesh /nonexistent/disc.vtu" + motion), "disc.vtu");
 
   const std::string corrupt = tmp("corrupt.vtu");
   std::ofstream(corrupt) << "<VTKFile type=\"UnstructuredGrid\"><UnstructuredGrid><Piece NumberOfPoints=";
-  expect_refused(spinesim("fem --mesh '" + corrupt + "'" + motion), "corrupt.vtu");
+  expect_refused(run_spinesim("fem --mesh '" + corrupt + "'" + motion), "corrupt.vtu");
 
   TetMesh m = spinesim::mesh::read_vtu(disc_);
   TetMesh unlabeled = m;
   unlabeled.surface.setZero();
   const std::string no_labels = tmp("no-labels.vtu");
   spinesim::mesh::write_vtu(no_labels, unlabeled);
-  expect_refused(spinesim("fem --mesh '" + no_labels + "'" + motion), "endplate");
+  expect_refused(run_spinesim("fem --mesh '" + no_labels + "'" + motion), "endplate");
 
   TetMesh inverted = m;
   std::swap(inverted.T(0, 0), inverted.T(0, 1));
   const std::string inv = tmp("inverted.vtu");
   spinesim::mesh::write_vtu(inv, inverted);
-  expect_refused(spinesim("fem --mesh '" + inv + "'" + motion), "inverted");
+  expect_refused(run_spinesim("fem --mesh '" + inv + "'" + motion), "inverted");
 
   TetMesh flat = m;
   flat.V.row(flat.T(0, 3)) = flat.V.row(flat.T(0, 0));  // collapse a tet to zero volume
   const std::string zero = tmp("zero-volume.vtu");
   spinesim::mesh::write_vtu(zero, flat);
-  expect_refused(spinesim("fem --mesh '" + zero + "'" + motion), "volume");
+  expect_refused(run_spinesim("fem --mesh '" + zero + "'" + motion), "volume");
   EXPECT_FALSE(fs::exists(out));
 }
 
 TEST(Cli, BadMeshRequestsAreRefused) {
   const std::string out = tmp("cli-no-mesh.vtu");
-  expect_refused(spinesim("mesh disc --level L9-L10 --out '" + out + "'"), "L9-L10");
-  expect_refused(spinesim("mesh disc --level L4-L5 --cell-size -1 --out '" + out + "'"), "cell-size");
+  expect_refused(run_spinesim("mesh disc --level L9-L10 --out '" + out + "'"), "L9-L10");
+  expect_refused(run_spinesim("mesh disc --level L4-L5 --cell-size -1 --out '" + out + "'"), "cell-size");
   const std::string empty = tmp("empty.obj");
   std::ofstream(empty) << "# nothing here\n";
-  expect_refused(spinesim("mesh disc --inferior '" + empty + "' --superior '" + empty + "' --out '" + out + "'"),
+  expect_refused(run_spinesim("mesh disc --inferior '" + empty + "' --superior '" + empty + "' --out '" + out + "'"),
                  "empty.obj");
-  expect_refused(spinesim("mesh disc --level L4-L5 --inferior a.obj --superior b.obj --out '" + out + "'"),
+  expect_refused(run_spinesim("mesh disc --level L4-L5 --inferior a.obj --superior b.obj --out '" + out + "'"),
                  "either");
   EXPECT_FALSE(fs::exists(out));
 }
@@ -210,7 +210,7 @@ TEST(Cli, VertebraeThatDoNotFaceEachOtherAreRefused) {
   if (!fs::exists(dir / "L4_body.obj")) GTEST_SKIP() << "testdata absent: " << dir;
   const std::string out = tmp("cli-swapped.vtu");
   // Inferior and superior swapped: L4 lies above L5, so they face away from each other.
-  expect_refused(spinesim("mesh disc --inferior '" + (dir / "L4_body.obj").string() + "' --superior '" +
+  expect_refused(run_spinesim("mesh disc --inferior '" + (dir / "L4_body.obj").string() + "' --superior '" +
                           (dir / "L5_body.obj").string() + "' --units m --up z --out '" + out + "'"),
                  "face");
   EXPECT_FALSE(fs::exists(out));
