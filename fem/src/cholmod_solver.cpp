@@ -9,12 +9,20 @@ namespace spinesim::fem {
 
 struct CholmodSolver::Impl {
   Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt;
-  Impl() {
-    llt.cholmod().print = 0;  // errors are reported by our exceptions, not on stderr
+  explicit Impl(Ordering ordering) {
+    cholmod_common& c = llt.cholmod();
+    c.print = 0;  // errors are reported by our exceptions, not on stderr
+    if (ordering != Ordering::automatic) {
+      c.nmethods = 1;
+      c.method[0].ordering = ordering == Ordering::amd     ? CHOLMOD_AMD
+                             : ordering == Ordering::metis ? CHOLMOD_METIS
+                                                           : CHOLMOD_NESDIS;
+      c.postorder = 1;
+    }
   }
 };
 
-CholmodSolver::CholmodSolver() : impl_(std::make_unique<Impl>()) {}
+CholmodSolver::CholmodSolver(Ordering ordering) : impl_(std::make_unique<Impl>(ordering)) {}
 CholmodSolver::~CholmodSolver() = default;
 CholmodSolver::CholmodSolver(CholmodSolver&&) noexcept = default;
 CholmodSolver& CholmodSolver::operator=(CholmodSolver&&) noexcept = default;
@@ -39,6 +47,23 @@ void CholmodSolver::factorize(const Eigen::SparseMatrix<double>& lower) {
     throw std::runtime_error("CHOLMOD: matrix is not positive definite (Cholesky factorisation "
                              "failed; is the body constrained against rigid motion?)");
   factorized_ = true;
+}
+
+double CholmodSolver::factor_nonzeros() const { return impl_->llt.cholmod().lnz; }
+double CholmodSolver::factor_flops() const { return impl_->llt.cholmod().fl; }
+
+const char* CholmodSolver::ordering_used() const {
+  const cholmod_common& c = impl_->llt.cholmod();
+  if (c.selected < 0 || c.selected >= CHOLMOD_MAXMETHODS) return "none";
+  switch (c.method[c.selected].ordering) {
+    case CHOLMOD_NATURAL: return "natural";
+    case CHOLMOD_GIVEN: return "given";
+    case CHOLMOD_AMD: return "amd";
+    case CHOLMOD_METIS: return "metis";
+    case CHOLMOD_NESDIS: return "nesdis";
+    case CHOLMOD_COLAMD: return "colamd";
+    default: return "other";
+  }
 }
 
 Eigen::MatrixXd CholmodSolver::solve(const Eigen::MatrixXd& rhs) const {

@@ -12,9 +12,13 @@
 
 namespace spinesim::fem {
 
+/// Fill-reducing ordering: CHOLMOD's default choice (AMD, METIS if AMD fills badly), or one
+/// method forced.
+enum class Ordering { automatic, amd, metis, nesdis };
+
 class CholmodSolver {
  public:
-  CholmodSolver();
+  explicit CholmodSolver(Ordering ordering = Ordering::automatic);
   ~CholmodSolver();
   CholmodSolver(CholmodSolver&&) noexcept;
   CholmodSolver& operator=(CholmodSolver&&) noexcept;
@@ -29,6 +33,12 @@ class CholmodSolver {
   Eigen::MatrixXd solve(const Eigen::MatrixXd& rhs) const;
 
   Eigen::Index rows() const { return rows_; }
+  /// After analyze(): nonzeros of the Cholesky factor and the factorisation flop count, as
+  /// predicted by CHOLMOD's symbolic analysis (to judge orderings and BLAS throughput).
+  double factor_nonzeros() const;
+  double factor_flops() const;
+  /// After analyze(): the ordering actually used ("amd", "metis", ...).
+  const char* ordering_used() const;
 
  private:
   struct Impl;

@@ -1,0 +1,185 @@
+// FEM reference benchmarks: where the time of a 6×6 disc stiffness goes, by stage and size.
+//
+// Meshes: structured Kuhn boxes with lumbar-disc proportions, 46 (x) × 11 (y, height) × 35 (z)
+// mm, cell size h (benchmark argument in µm), P1 or P2. Stages, each timed separately:
+//   Pattern    — P1/P2 node set, boundary roles, K_ff sparsity (DiscFem "setup")
+//   Assembly   — element stiffness + scatter into K_ff, K_fp, K_pp
+//   Analyse    — CHOLMOD fill-reducing ordering + symbolic factorisation
+//   Factorise  — CHOLMOD supernodal numeric factorisation
+//   Solve      — the 6 solves K_ff^-1 K_fp
+//   Full6x6    — the whole DiscFem constructor (validation .. K6)
+// Counters: DOF (free unknowns), peak_rss_MB (process peak resident set, getrusage; it only
+// grows, so read it in the order the benchmarks run: smaller meshes first).
+// Run: build/h-fem/bench/bench_fem [--benchmark_filter=Full6x6]
+#include "spinesim/fem/assembly.hpp"
+#include "spinesim/fem/cholmod_solver.hpp"
+#include "spinesim/fem/disc_fem.hpp"
+#include "spinesim/fem/fe_space.hpp"
+#include "test_meshes.hpp"
+
+#include <benchmark/benchmark.h>
+
+#include <sys/resource.h>
+
+#include <cmath>
+#include <map>
+#include <memory>
+
+using namespace spinesim;
+using namespace spinesim::fem;
+
+namespace {
+
+double peak_rss_mb() {
+  rusage ru{};
+  getrusage(RUSAGE_SELF, &ru);
+  return double(ru.ru_maxrss) / 1024.0;  // Linux: kilobytes
+}
+
+mesh::TetMesh disc_box(double h_mm) {
+  const double lx = 46, ly = 11, lz = 35;
+  const auto cells = [&](double l) { return std::max(1, int(std::lround(l / h_mm))); };
+  return test_meshes::box_mesh(cells(lx), cells(ly), cells(lz), lx, ly, lz,
+                               Eigen::Vector3d(-0.5 * lx, 0, -0.5 * lz));
+}
+
+mesh::RegionMaterials disc_material() {
+  mesh::RegionMaterials m;
+  m.name = "real-disc-like";
+  m.fallback = {3.22, 0.45, 1038.0};
+  return m;
+}
+
+// One prepared problem per (order, h): mesh, node set, roles, pattern, assembled blocks.
+struct Problem {
+  mesh::TetMesh mesh;
+  FeSpace space;
+  std::vector<NodeRole> roles;
+  FreeBlockPattern pattern;
+  PlateCoupling coupling;
+  Eigen::Vector3d center;
+};
+
+Problem& problem(int order, double h_mm) {
+  static std::map<std::pair<int, long>, std::unique_ptr<Problem>> cache;
+  auto& slot = cache[{order, std::lround(h_mm * 1000)}];
+  if (!slot) {
+    cache.clear();  // keep one problem in memory at a time
+    auto p = std::make_unique<Problem>();
+    p->mesh = disc_box(h_mm);
+    p->center = DiscFem::default_plate_center(p->mesh);
+    p->space = make_fe_space(p->mesh, order);
+    const Eigen::VectorXi labels = node_surface_labels(p->space, p->mesh);
+    p->roles.assign(std::size_t(labels.size()), NodeRole::free);
+    for (Eigen::Index i = 0; i < labels.size(); ++i)
+      p->roles[std::size_t(i)] = labels(i) == 1 ? NodeRole::fixed : labels(i) == 2 ? NodeRole::plate : NodeRole::free;
+    p->pattern = build_free_block_pattern(p->space, p->roles);
+    p->coupling = assemble_constrained(p->space, p->mesh.region, disc_material(), p->roles, p->center, p->pattern);
+    cache[{order, std::lround(h_mm * 1000)}] = std::move(p);
+    return *cache[{order, std::lround(h_mm * 1000)}];
+  }
+  return *slot;
+}
+
+void set_counters(benchmark::State& st, const Problem& p) {
+  st.counters["DOF"] = double(p.pattern.lower.rows());
+  st.counters["tets"] = double(p.mesh.num_tets());
+  st.counters["nnz_K"] = double(p.pattern.lower.nonZeros());
+  st.counters["peak_rss_MB"] = peak_rss_mb();
+}
+
+double h_of(const benchmark::State& st) { return double(st.range(1)) * 1e-3; }
+
+void BM_Pattern(benchmark::State& st) {
+  Problem& p = problem(int(st.range(0)), h_of(st));
+  for (auto _ : st) {
+    FeSpace s = make_fe_space(p.mesh, int(st.range(0)));
+    FreeBlockPattern pat = build_free_block_pattern(s, p.roles);
+    benchmark::DoNotOptimize(pat.lower.nonZeros());
+  }
+  set_counters(st, p);
+}
+
+void BM_Assembly(benchmark::State& st) {
+  Problem& p = problem(int(st.range(0)), h_of(st));
+  for (auto _ : st) {
+    PlateCoupling c = assemble_constrained(p.space, p.mesh.region, disc_material(), p.roles, p.center, p.pattern);
+    benchmark::DoNotOptimize(c.K_pp(0, 0));
+  }
+  set_counters(st, p);
+}
+
+void BM_Analyse(benchmark::State& st) {
+  Problem& p = problem(int(st.range(0)), h_of(st));
+  for (auto _ : st) {
+    CholmodSolver s;
+    s.analyze(p.pattern.lower);
+  }
+  set_counters(st, p);
+}
+
+void BM_Factorise(benchmark::State& st) {
+  Problem& p = problem(int(st.range(0)), h_of(st));
+  CholmodSolver s(Ordering(st.range(2)));
+  s.analyze(p.pattern.lower);
+  for (auto _ : st) s.factorize(p.pattern.lower);
+  set_counters(st, p);
+  st.SetLabel(s.ordering_used());
+  st.counters["nnz_L"] = s.factor_nonzeros();
+  st.counters["GFlop"] = s.factor_flops() * 1e-9;
+  st.counters["GFlop/s"] = benchmark::Counter(s.factor_flops() * 1e-9 * double(st.iterations()),
+                                              benchmark::Counter::kIsRate);
+}
+
+void BM_Solve6(benchmark::State& st) {
+  Problem& p = problem(int(st.range(0)), h_of(st));
+  CholmodSolver s;
+  s.compute(p.pattern.lower);
+  for (auto _ : st) {
+    Eigen::MatrixXd Z = s.solve(p.coupling.K_fp);
+    benchmark::DoNotOptimize(Z(0, 0));
+  }
+  set_counters(st, p);
+}
+
+void BM_Full6x6(benchmark::State& st) {
+  Problem& p = problem(int(st.range(0)), h_of(st));
+  Timings t;
+  for (auto _ : st) {
+    DiscFem fem(p.mesh, disc_material(), int(st.range(0)), p.center);
+    benchmark::DoNotOptimize(fem.stiffness_6x6()(0, 0));
+    t = fem.timings();
+  }
+  set_counters(st, p);
+  st.counters["setup_s"] = t.setup_s;
+  st.counters["assembly_s"] = t.assembly_s;
+  st.counters["analyse_s"] = t.analyse_s;
+  st.counters["factorise_s"] = t.factorise_s;
+  st.counters["solve_s"] = t.solve_s;
+}
+
+// (order, h in µm): P1 from ~6k to ~200k DOF, P2 from ~6k to ~210k DOF.
+void sizes_orderings(benchmark::internal::Benchmark* b) {
+  for (long o : {0, 1, 2, 3}) {
+    for (long h : {2000, 1400, 1000, 800, 640}) b->Args({1, h, o});
+    for (long h : {4000, 2800, 2000, 1600, 1300}) b->Args({2, h, o});
+  }
+  b->Unit(benchmark::kMillisecond)->UseRealTime();
+}
+
+void sizes(benchmark::internal::Benchmark* b) {
+  for (long h : {2000, 1400, 1000, 800, 640}) b->Args({1, h});
+  for (long h : {4000, 2800, 2000, 1600, 1300}) b->Args({2, h});
+  b->Unit(benchmark::kMillisecond)->UseRealTime();
+}
+
+}  // namespace
+
+BENCHMARK(BM_Pattern)->Apply(sizes);
+BENCHMARK(BM_Assembly)->Apply(sizes);
+BENCHMARK(BM_Analyse)->Apply(sizes)->Iterations(1);
+BENCHMARK(BM_Factorise)->Apply(sizes_orderings);
+BENCHMARK(BM_Solve6)->Apply(sizes);
+BENCHMARK(BM_Full6x6)->Apply(sizes)->Iterations(1);
+
+BENCHMARK_MAIN();
