@@ -7,7 +7,8 @@
 //   Analyse    — CHOLMOD fill-reducing ordering + symbolic factorisation
 //   Factorise  — CHOLMOD supernodal numeric factorisation
 //   Solve      — the 6 solves K_ff^-1 K_fp
-//   Full6x6    — the whole DiscFem constructor (validation .. K6)
+//   Full6x6    — the whole DiscFem constructor (validation .. K6); third argument 0: direct
+//                CHOLMOD on K_ff, 1: P2 p-multigrid CG (P1 block factorised instead)
 // Counters: DOF (free unknowns), peak_rss_MB (process peak resident set, getrusage; it only
 // grows, so read it in the order the benchmarks run: smaller meshes first).
 // Run: build/h-fem/bench/bench_fem [--benchmark_filter=Full6x6]
@@ -145,8 +146,10 @@ void BM_Solve6(benchmark::State& st) {
 void BM_Full6x6(benchmark::State& st) {
   Problem& p = problem(int(st.range(0)), h_of(st));
   Timings t;
+  SolverOptions opt;
+  opt.solver = st.range(2) ? LinearSolver::p_multigrid_cg : LinearSolver::direct;
   for (auto _ : st) {
-    DiscFem fem(p.mesh, disc_material(), int(st.range(0)), p.center);
+    DiscFem fem(p.mesh, disc_material(), int(st.range(0)), p.center, opt);
     benchmark::DoNotOptimize(fem.stiffness_6x6()(0, 0));
     t = fem.timings();
   }
@@ -156,14 +159,17 @@ void BM_Full6x6(benchmark::State& st) {
   st.counters["analyse_s"] = t.analyse_s;
   st.counters["factorise_s"] = t.factorise_s;
   st.counters["solve_s"] = t.solve_s;
+  st.counters["cg_iterations"] = t.cg_iterations;
+  st.SetLabel(st.range(2) ? "p-multigrid CG" : "direct");
 }
 
 // (order, h in µm): P1 from ~6k to ~200k DOF, P2 from ~6k to ~210k DOF.
+// Orderings (third argument: 0 CHOLMOD's automatic choice, 1 AMD, 3 NESDIS): all sizes with
+// the automatic choice, the alternatives at one mid size each.
 void sizes_orderings(benchmark::internal::Benchmark* b) {
-  for (long o : {0, 1, 2, 3}) {
-    for (long h : {2000, 1400, 1000, 800, 640}) b->Args({1, h, o});
-    for (long h : {4000, 2800, 2000, 1600, 1300}) b->Args({2, h, o});
-  }
+  for (long h : {2000, 1400, 1000, 800, 640}) b->Args({1, h, 0});
+  for (long h : {4000, 2800, 2000, 1600, 1300}) b->Args({2, h, 0});
+  for (long o : {1, 3}) b->Args({1, 1000, o}), b->Args({2, 2000, o});
   b->Unit(benchmark::kMillisecond)->UseRealTime();
 }
 
@@ -180,6 +186,13 @@ BENCHMARK(BM_Assembly)->Apply(sizes);
 BENCHMARK(BM_Analyse)->Apply(sizes)->Iterations(1);
 BENCHMARK(BM_Factorise)->Apply(sizes_orderings);
 BENCHMARK(BM_Solve6)->Apply(sizes);
-BENCHMARK(BM_Full6x6)->Apply(sizes)->Iterations(1);
+void sizes_solvers(benchmark::internal::Benchmark* b) {
+  for (long h : {2000, 1400, 1000, 800, 640}) b->Args({1, h, 0});
+  for (long s : {0, 1})
+    for (long h : {4000, 2800, 2000, 1600, 1300}) b->Args({2, h, s});
+  b->Unit(benchmark::kMillisecond)->UseRealTime();
+}
+
+BENCHMARK(BM_Full6x6)->Apply(sizes_solvers)->Iterations(1);
 
 BENCHMARK_MAIN();

@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <cstdint>
+#include <utility>
 
 namespace spinesim::fem {
 
@@ -17,13 +19,44 @@ Eigen::Matrix<double, 3, 6> plate_map(const Eigen::Vector3d& r) {
   return R;
 }
 
-FreeBlockPattern build_free_block_pattern(const FeSpace& space, const std::vector<NodeRole>& roles) {
+namespace {
+
+// Interleaves the low 21 bits of x, y, z (Morton / Z-order key).
+std::uint64_t morton_key(std::uint32_t x, std::uint32_t y, std::uint32_t z) {
+  const auto spread = [](std::uint64_t v) {
+    v &= 0x1fffff;
+    v = (v | v << 32) & 0x1f00000000ffffULL;
+    v = (v | v << 16) & 0x1f0000ff0000ffULL;
+    v = (v | v << 8) & 0x100f00f00f00f00fULL;
+    v = (v | v << 4) & 0x10c30c30c30c30c3ULL;
+    v = (v | v << 2) & 0x1249249249249249ULL;
+    return v;
+  };
+  return spread(x) | spread(y) << 1 | spread(z) << 2;
+}
+
+}  // namespace
+
+FreeBlockPattern build_free_block_pattern(const FeSpace& space, const std::vector<NodeRole>& roles,
+                                          FreeNodeOrder order) {
   assert(roles.size() == std::size_t(space.num_nodes()));
   FreeBlockPattern p;
   p.free_index.assign(roles.size(), -1);
-  int nf = 0;
+  // Free nodes are numbered along a Z-order curve through space, so that matrix neighbours are
+  // memory neighbours (P2 edge nodes otherwise sit far from their vertices in node order).
+  std::vector<std::pair<std::uint64_t, int>> keyed;
+  keyed.reserve(roles.size());
+  const Eigen::RowVector3d lo = space.X.colwise().minCoeff();
+  const double extent = std::max(1e-300, (space.X.colwise().maxCoeff() - lo).maxCoeff());
+  const double scale = double((1u << 21) - 1) / extent;
   for (std::size_t i = 0; i < roles.size(); ++i)
-    if (roles[i] == NodeRole::free) p.free_index[i] = nf++;
+    if (roles[i] == NodeRole::free) {
+      const Eigen::RowVector3d c = (space.X.row(Eigen::Index(i)) - lo) * scale;
+      keyed.emplace_back(morton_key(std::uint32_t(c.x()), std::uint32_t(c.y()), std::uint32_t(c.z())), int(i));
+    }
+  if (order == FreeNodeOrder::spatial) std::sort(keyed.begin(), keyed.end());
+  int nf = 0;
+  for (const auto& [key, node] : keyed) p.free_index[std::size_t(node)] = nf++;
   p.num_free_nodes = nf;
 
   const Eigen::Index nt = space.elements.rows();
@@ -168,7 +201,7 @@ PlateCoupling assemble_constrained(const FeSpace& space, const Eigen::VectorXi& 
 Eigen::SparseMatrix<double> assemble_stiffness(const FeSpace& space, const Eigen::VectorXi& region,
                                                const mesh::RegionMaterials& materials) {
   const std::vector<NodeRole> roles(std::size_t(space.num_nodes()), NodeRole::free);
-  FreeBlockPattern p = build_free_block_pattern(space, roles);
+  FreeBlockPattern p = build_free_block_pattern(space, roles, FreeNodeOrder::node);
   assemble_constrained(space, region, materials, roles, Eigen::Vector3d::Zero(), p);
   Eigen::SparseMatrix<double> full = p.lower.selfadjointView<Eigen::Lower>();
   return full;

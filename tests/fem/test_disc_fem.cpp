@@ -220,3 +220,25 @@ TEST(DiscFem, RejectsBadInputWithAClearMessage) {
   std::swap(inverted.T(0, 0), inverted.T(0, 1));
   EXPECT_THROW(DiscFem(inverted, two_regions(), 1, c), std::invalid_argument);
 }
+
+TEST(DiscFem, P2MultigridCgMatchesTheDirectSolver) {
+  // A finer box so that the P1 coarse space is a real coarsening.
+  mesh::TetMesh m = with_inner_region(test_meshes::mirrored_box_mesh(4, 4, 6, 30.0, 8.0, 24.0, -9.0));
+  const Eigen::Vector3d c = DiscFem::default_plate_center(m);
+  SolverOptions direct, cg;
+  direct.solver = LinearSolver::direct;
+  cg.solver = LinearSolver::p_multigrid_cg;
+  const DiscFem a(m, two_regions(), 2, c, direct);
+  const DiscFem b(m, two_regions(), 2, c, cg);
+  EXPECT_EQ(a.timings().cg_iterations, 0);
+  EXPECT_GT(b.timings().cg_iterations, 0);
+  std::printf("p-multigrid CG: %d iterations for %ld DOF\n", b.timings().cg_iterations, long(b.num_dofs()));
+  EXPECT_LT(rel(b.stiffness_6x6(), a.stiffness_6x6()), 1e-10);
+  EXPECT_LT(b.stiffness_asymmetry(), 1e-8);
+  const Vector6d q = vec6(0.05, -0.2, 0.1, 0.01, -0.02, 0.005);
+  const PlateSolution sa = a.solve_motion(q), sb = b.solve_motion(q);
+  EXPECT_LT(rel(sb.node_displacement_mm, sa.node_displacement_mm), 1e-8);
+  EXPECT_LT(rel(sb.reaction_wrench, -(b.stiffness_6x6() * q)), 1e-8);
+  const Vector6d w = vec6(10, -300, 25, 800, -150, 400);
+  EXPECT_LT(rel(b.solve_wrench(w).reaction_wrench, -w), 1e-8);
+}

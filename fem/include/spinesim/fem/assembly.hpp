@@ -36,7 +36,12 @@ struct FreeBlockPattern {
   Eigen::SparseMatrix<double> lower;   ///< 3nf×3nf lower-triangular CSC pattern, values zero
 };
 
-FreeBlockPattern build_free_block_pattern(const FeSpace& space, const std::vector<NodeRole>& roles);
+/// How free nodes are numbered: `spatial` along a Z-order curve (memory locality for the
+/// iterative solver's matrix passes), `node` in node order (free index = rank among free nodes).
+enum class FreeNodeOrder { spatial, node };
+
+FreeBlockPattern build_free_block_pattern(const FeSpace& space, const std::vector<NodeRole>& roles,
+                                          FreeNodeOrder order = FreeNodeOrder::spatial);
 
 /// Plate blocks of the reduced stiffness (see header comment).
 struct PlateCoupling {
@@ -52,7 +57,7 @@ PlateCoupling assemble_constrained(const FeSpace& space, const Eigen::VectorXi& 
                                    const Eigen::Vector3d& plate_center_mm,
                                    FreeBlockPattern& pattern);
 
-/// Full symmetric stiffness (both triangles), 3N×3N, N/mm, DOF 3·node + (x, y, z).
+/// Full symmetric stiffness (both triangles), 3N×3N, N/mm, DOF 3·node + (x, y, z) in node order.
 Eigen::SparseMatrix<double> assemble_stiffness(const FeSpace& space, const Eigen::VectorXi& region,
                                                const mesh::RegionMaterials& materials);
 

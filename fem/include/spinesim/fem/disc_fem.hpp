@@ -33,6 +33,20 @@ using Matrix6d = Eigen::Matrix<double, 6, 6>;
 
 struct Timings {
   double setup_s = 0, assembly_s = 0, analyse_s = 0, factorise_s = 0, solve_s = 0;
+  int cg_iterations = 0;  ///< p-multigrid CG iterations (0 with the direct solver)
+};
+
+/// How K_ff^-1 K_fp is computed. `direct`: CHOLMOD on K_ff. `p_multigrid_cg`: CG with a
+/// two-level P2→P1 preconditioner (P2 only; p2_multigrid.hpp) — the P1 block is factorised
+/// instead, and K6 uses the energy form K_pp - 2 sym(K_fp^T Z) + Z^T K_ff Z, whose error is
+/// quadratic in the CG error. `automatic`: CG for P2 above `cg_min_dofs` free DOF, else direct.
+enum class LinearSolver { automatic, direct, p_multigrid_cg };
+
+struct SolverOptions {
+  LinearSolver solver = LinearSolver::automatic;
+  Eigen::Index cg_min_dofs = 30000;
+  double cg_relative_tolerance = 1e-10;  ///< per column, ||r|| <= tol ||b||
+  int cg_max_iterations = 1000;
 };
 
 struct PlateSolution {
@@ -50,7 +64,7 @@ class DiscFem {
   /// Validates the mesh (endplate labels required), the materials and `order` (1 or 2);
   /// throws std::invalid_argument with a one-line message otherwise.
   DiscFem(const mesh::TetMesh& mesh, const mesh::RegionMaterials& materials, int order,
-          const Eigen::Vector3d& plate_center_mm);
+          const Eigen::Vector3d& plate_center_mm, const SolverOptions& options = SolverOptions());
   ~DiscFem();
   DiscFem(DiscFem&&) noexcept;
   DiscFem& operator=(DiscFem&&) noexcept;
