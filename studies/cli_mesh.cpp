@@ -69,10 +69,15 @@ void run_mesh_disc(const MeshArgs& a) {
     const auto superior = mesh::read_surface(a.superior, scale, axis);
     progress.end(std::to_string(inferior.F.rows()) + " + " + std::to_string(superior.F.rows()) + " triangles");
     progress.begin("meshing the disc between the facing endplates");
-    m = mesh::mesh_disc_between_vertebrae(inferior, superior, opt, mesh::VertebraDiscOptions());
+    mesh::VertebraDiscInfo info;
+    m = mesh::mesh_disc_between_vertebrae(inferior, superior, opt, mesh::VertebraDiscOptions(), &info);
     mesh_s = progress.end(std::to_string(m.num_tets()) + " tets");
+    exact_volume = info.volume_mm3;  // quadrature of the endplate gap over the footprint
     j["inferior"] = a.inferior;
     j["superior"] = a.superior;
+    j["disc"] = {{"footprint_area_mm2", info.footprint_area_mm2}, {"center_height_mm", info.center_height_mm},
+                 {"min_height_mm", info.min_height_mm},           {"max_height_mm", info.max_height_mm},
+                 {"width_mm", info.width_mm},                     {"depth_mm", info.depth_mm}};
   } else {
     const auto dims = mesh::disc_dimensions(a.level, data_dir());
     if (a.placement != "spine" && a.placement != "local")
