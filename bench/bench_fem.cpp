@@ -16,6 +16,7 @@
 #include "spinesim/fem/cholmod_solver.hpp"
 #include "spinesim/fem/disc_fem.hpp"
 #include "spinesim/fem/fe_space.hpp"
+#include "spinesim/mesh/mesher.hpp"
 #include "test_meshes.hpp"
 
 #include <benchmark/benchmark.h>
@@ -162,6 +163,52 @@ void BM_Full6x6(benchmark::State& st) {
   st.counters["cg_iterations"] = t.cg_iterations;
   st.SetLabel(st.range(2) ? "p-multigrid CG" : "direct");
 }
+
+// The real case: the parametric L4-L5 disc (Twomey/Panjabi dimensions as in tests/mesh),
+// CGAL-meshed at cell size (µm), annulus/nucleus regions; arguments (order, cell µm, solver).
+void BM_L4L5Disc(benchmark::State& st) {
+  static std::map<long, mesh::TetMesh> meshes;
+  auto it = meshes.find(st.range(1));
+  if (it == meshes.end()) {
+    mesh::MeshOptions opt;
+    opt.cell_size_mm = double(st.range(1)) * 1e-3;
+    it = meshes.emplace(st.range(1), mesh::mesh_parametric_disc({"L4-L5", 47.3, 35.5, 46.6, 35.0, 11.3}, opt)).first;
+  }
+  const mesh::TetMesh& m = it->second;
+  mesh::RegionMaterials mat;
+  mat.name = "annulus-nucleus-like";
+  mat.fallback = {4.2, 0.45, 1038.0};
+  mat.by_region[2] = {1.0, 0.49, 1038.0};
+  SolverOptions opt;
+  opt.solver = st.range(2) ? LinearSolver::p_multigrid_cg : LinearSolver::direct;
+  Timings t;
+  Eigen::Index dofs = 0;
+  for (auto _ : st) {
+    DiscFem fem(m, mat, int(st.range(0)), DiscFem::default_plate_center(m), opt);
+    benchmark::DoNotOptimize(fem.stiffness_6x6()(0, 0));
+    t = fem.timings();
+    dofs = fem.num_dofs();
+  }
+  st.counters["vertices"] = double(m.num_vertices());
+  st.counters["tets"] = double(m.num_tets());
+  st.counters["DOF"] = double(dofs);
+  st.counters["assembly_s"] = t.assembly_s;
+  st.counters["analyse_s"] = t.analyse_s;
+  st.counters["factorise_s"] = t.factorise_s;
+  st.counters["solve_s"] = t.solve_s;
+  st.counters["cg_iterations"] = t.cg_iterations;
+  st.counters["peak_rss_MB"] = peak_rss_mb();
+  st.SetLabel(st.range(2) ? "p-multigrid CG" : "direct");
+}
+BENCHMARK(BM_L4L5Disc)
+    ->Args({1, 1500, 0})
+    ->Args({1, 1000, 0})
+    ->Args({2, 1500, 0})
+    ->Args({2, 1500, 1})
+    ->Args({2, 1000, 1})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
 
 // (order, h in µm): P1 from ~6k to ~200k DOF, P2 from ~6k to ~210k DOF.
 // Orderings (third argument: 0 CHOLMOD's automatic choice, 1 AMD, 3 NESDIS): all sizes with

@@ -13,10 +13,14 @@
 // (N/mm, N, N·mm/rad blocks): reaction = -K6 q.
 //
 // Method: u = T (u_f, q) eliminates the fixed nodes and slaves the plate nodes (assembly.hpp);
-// K_ff is factorised once (CHOLMOD), Z = K_ff^-1 K_fp by 6 solves, and
+// K_ff is factorised once (CHOLMOD; or, for large P2 problems, solved by p-multigrid CG — see
+// SolverOptions), Z = K_ff^-1 K_fp by 6 solves, and
 //   K6 = K_pp - K_fp^T Z,   motion q: u_f = -Z q,   wrench w: q = K6^-1 w.
 // The reaction is evaluated directly from the assembled blocks, -(K_fp^T u_f + K_pp q), which
 // equals -K6 q (and -w for a wrench solve) up to round-off — the tests check that.
+// Cost (bench/bench_fem.cpp, 2 cores, OpenBLAS): assembly is ~2–5 % of the total; the sparse
+// Cholesky factorisation dominates (3-D fill: ~100 GFlop at 100k DOF). P1 on an L4-L5 disc of
+// 4–13k vertices (9–31k DOF) takes 0.14–0.74 s; P2 on 4.2k vertices (80k DOF) ~3.7 s.
 #pragma once
 
 #include "spinesim/mesh/material.hpp"
@@ -40,11 +44,14 @@ struct Timings {
 /// two-level P2→P1 preconditioner (P2 only; p2_multigrid.hpp) — the P1 block is factorised
 /// instead, and K6 uses the energy form K_pp - 2 sym(K_fp^T Z) + Z^T K_ff Z, whose error is
 /// quadratic in the CG error. `automatic`: CG for P2 above `cg_min_dofs` free DOF, else direct.
+/// Measured (bench_fem, 2 cores): on disc-proportioned boxes CG wins from ~60k DOF (176k: 6.5 s
+/// vs 14.3 s, ~0.4 vs ~1.8 GB), but on the CGAL L4-L5 disc with a nu = 0.49 nucleus it needs
+/// ~60 iterations and loses at 80k DOF (5.0 s vs 3.7 s); hence the threshold.
 enum class LinearSolver { automatic, direct, p_multigrid_cg };
 
 struct SolverOptions {
   LinearSolver solver = LinearSolver::automatic;
-  Eigen::Index cg_min_dofs = 30000;
+  Eigen::Index cg_min_dofs = 150000;
   double cg_relative_tolerance = 1e-10;  ///< per column, ||r|| <= tol ||b||
   int cg_max_iterations = 1000;
 };
@@ -77,7 +84,8 @@ class DiscFem {
   /// Condensed plate stiffness (symmetric positive definite), units (N/mm | N/rad ; N | N·mm/rad).
   const Matrix6d& stiffness_6x6() const;
 
-  /// ||K6 - K6^T||_F / ||K6||_F before symmetrisation (round-off level for a correct model).
+  /// ||K6 - K6^T||_F / ||K6||_F before symmetrisation (round-off level for a correct model;
+  /// with the CG solver the energy form is symmetric by construction, so this checks little).
   double stiffness_asymmetry() const;
   const Eigen::Vector3d& plate_center() const;  ///< c, mm
 
