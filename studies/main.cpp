@@ -8,9 +8,16 @@
 // stderr, exit status 1 (2 for a malformed command line), no partial output file.
 #include "cli_common.hpp"
 
+#include <cstdlib>
 #include <iostream>
 
+// OpenBLAS (under supernodal CHOLMOD) busy-waits its worker threads; on these 2-core machines
+// any other load made a P2 factorisation 5-9x slower with 2 threads than with 1 (measured:
+// 35k DOF, 1.0 s vs 4.7-9.2 s). One thread unless the user sets OPENBLAS_NUM_THREADS.
+extern "C" void openblas_set_num_threads(int) __attribute__((weak));
+
 int main(int argc, char** argv) {
+  if (openblas_set_num_threads && !std::getenv("OPENBLAS_NUM_THREADS")) openblas_set_num_threads(1);
   CLI::App app{"spinesim: finite-element-validated intervertebral-disc deformation\n"
                "(CGAL disc meshes, linear FEM reference, mass-spring discs, spine model)"};
   app.set_version_flag("--version", std::string("spinesim ") + SPINESIM_VERSION);
