@@ -2,6 +2,7 @@
 #include "spinesim/mesh/io.hpp"
 
 #include "atomic_file.hpp"
+#include "write_checks.hpp"
 
 #include <algorithm>
 #include <array>
@@ -58,15 +59,7 @@ void put_double(std::ostream& os, double x) {
 void write_medit(const std::string& path, const TetMesh& m) {
   // 1. Refuse bad input before touching the disk.
   const std::string who = "write_medit: " + path + ": ";
-  if (m.num_vertices() == 0 || m.num_tets() == 0)
-    throw std::invalid_argument(who + "mesh is empty (no vertices or no tetrahedra)");
-  if (!m.V.allFinite()) throw std::invalid_argument(who + "vertex coordinates contain non-finite values");
-  if (m.region.size() != m.num_tets())
-    throw std::invalid_argument(who + "region labels: expected one per tetrahedron");
-  if (m.surface.size() != m.num_vertices())
-    throw std::invalid_argument(who + "surface labels: expected one per vertex");
-  if (m.T.minCoeff() < 0 || m.T.maxCoeff() >= m.num_vertices())
-    throw std::invalid_argument(who + "a tetrahedron has a vertex index out of range");
+  detail::check_mesh_for_writing(m, who);
 
   // 2. Boundary triangles and their labels: the label all three vertices share, if nonzero,
   //    else outer wall.
