@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <array>
@@ -21,6 +22,13 @@ using spinesim::mesh::TetMesh;
 
 namespace {
 
+/// ctest runs each test in its own process, in parallel: every process gets its own folder.
+fs::path tmp_dir() {
+  static const fs::path dir = fs::path(SPINESIM_TEST_TMP) / ("cli-" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  return dir;
+}
+
 struct CliRun {
   int status = -1;
   std::string out, err;
@@ -28,8 +36,7 @@ struct CliRun {
 
 /// Runs spinesim with `args` (shell words), capturing stdout and stderr.
 CliRun run_spinesim(const std::string& args) {
-  const fs::path dir = fs::path(SPINESIM_TEST_TMP);
-  fs::create_directories(dir);
+  const fs::path dir = tmp_dir();
   const fs::path out = dir / "cli.stdout", err = dir / "cli.stderr";
   const std::string cmd = std::string("'") + SPINESIM_EXE + "' " + args + " >'" + out.string() + "' 2>'" +
                           err.string() + "' </dev/null";
@@ -56,7 +63,7 @@ void expect_refused(const CliRun& r, const std::string& needle) {
 }
 
 std::string tmp(const std::string& name) {
-  const fs::path p = fs::path(SPINESIM_TEST_TMP) / name;
+  const fs::path p = tmp_dir() / name;
   fs::remove(p);
   return p.string();
 }
