@@ -2,6 +2,8 @@
 // coordinates, an independent reader (meshio), and refusal of bad input without leaving a file.
 #include "spinesim/mesh/io.hpp"
 
+#include "io_fixtures.hpp"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -19,33 +21,9 @@ using namespace spinesim::mesh;
 
 namespace {
 
-/// Cube [o, o+h]^3 in 6 positively oriented tets; surface 1 at the bottom (y = o), 2 at the top.
-TetMesh cube_mesh() {
-  TetMesh m;
-  const double h = 12.345678901234567, o = 1.0 / 3.0;
-  m.V.resize(8, 3);
-  for (int i = 0; i < 8; ++i)
-    m.V.row(i) << o + h * (i & 1), o + h * ((i >> 1) & 1), o + h * ((i >> 2) & 1);
-  const int kuhn[6][4] = {{0, 1, 3, 7}, {0, 1, 5, 7}, {0, 2, 3, 7},
-                          {0, 2, 6, 7}, {0, 4, 5, 7}, {0, 4, 6, 7}};
-  m.T.resize(6, 4);
-  for (int t = 0; t < 6; ++t) {
-    m.T.row(t) << kuhn[t][0], kuhn[t][1], kuhn[t][2], kuhn[t][3];
-    if (tet_volume(m, t) < 0) std::swap(m.T(t, 2), m.T(t, 3));
-  }
-  m.region.resize(6);
-  m.region << 1, 2, 1, 2, 1, 2;
-  m.surface.resize(8);
-  for (int i = 0; i < 8; ++i) m.surface(i) = ((i >> 1) & 1) ? 2 : 1;
-  return m;
-}
+TetMesh cube_mesh() { return test::kuhn_cube_mesh(); }
 
-std::string tmp_dir(const std::string& name) {
-  const fs::path d = fs::path(SPINESIM_TEST_TMP) / ("io_medit_" + name);
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d.string();
-}
+std::string tmp_dir(const std::string& name) { return test::fresh_tmp_dir("io_medit_", name); }
 
 /// The sections of a Medit ASCII file as rows of numbers.
 struct MeditFile {

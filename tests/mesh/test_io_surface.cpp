@@ -3,6 +3,8 @@
 // (skipped when the external test data are absent).
 #include "spinesim/mesh/io.hpp"
 
+#include "io_fixtures.hpp"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -21,12 +23,7 @@ using namespace spinesim::mesh;
 
 namespace {
 
-std::string tmp_dir(const std::string& name) {
-  const fs::path d = fs::path(SPINESIM_TEST_TMP) / ("io_surface_" + name);
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d.string();
-}
+std::string tmp_dir(const std::string& name) { return test::fresh_tmp_dir("io_surface_", name); }
 
 std::string spit(const std::string& path, const std::string& text) {
   std::ofstream os(path, std::ios::binary);
@@ -60,15 +57,7 @@ Eigen::Index find_vertex(const TriSurface& s, const Eigen::Vector3d& p) {
 
 void expect_error(const std::string& path, double units, const std::string& needle) {
   SCOPED_TRACE(path);
-  try {
-    read_surface(path, units, UpAxis::y);
-    FAIL() << "no exception";
-  } catch (const std::invalid_argument& e) {
-    const std::string msg = e.what();
-    EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
-    EXPECT_NE(msg.find(path), std::string::npos) << msg;
-    EXPECT_NE(msg.find(needle), std::string::npos) << msg;
-  }
+  test::expect_one_line_refusal([&] { read_surface(path, units, UpAxis::y); }, path, needle);
 }
 
 }  // namespace

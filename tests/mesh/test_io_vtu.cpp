@@ -2,6 +2,8 @@
 // every kind of bad input giving a one-line std::invalid_argument with no file left behind.
 #include "spinesim/mesh/io.hpp"
 
+#include "io_fixtures.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -19,25 +21,9 @@ using namespace spinesim::mesh;
 
 namespace {
 
-/// Unit cube split into 6 positively oriented tets (Kuhn split), scaled by an awkward factor so
-/// that the coordinates use all 53 mantissa bits. Surface: y = 0 -> 1, y = top -> 2, else 3.
+/// The shared cube with a non-trivial frame and a source string that needs XML escaping.
 TetMesh cube_mesh() {
-  TetMesh m;
-  const double h = 12.345678901234567, o = 1.0 / 3.0;
-  m.V.resize(8, 3);
-  for (int i = 0; i < 8; ++i)
-    m.V.row(i) << o + h * (i & 1), o + h * ((i >> 1) & 1), o + h * ((i >> 2) & 1);
-  const int kuhn[6][4] = {{0, 1, 3, 7}, {0, 1, 5, 7}, {0, 2, 3, 7},
-                          {0, 2, 6, 7}, {0, 4, 5, 7}, {0, 4, 6, 7}};
-  m.T.resize(6, 4);
-  for (int t = 0; t < 6; ++t) {
-    m.T.row(t) << kuhn[t][0], kuhn[t][1], kuhn[t][2], kuhn[t][3];
-    if (tet_volume(m, t) < 0) std::swap(m.T(t, 2), m.T(t, 3));
-  }
-  m.region.resize(6);
-  m.region << 1, 2, 1, 2, 1, 2;
-  m.surface.resize(8);
-  for (int i = 0; i < 8; ++i) m.surface(i) = ((i >> 1) & 1) ? 2 : 1;
+  TetMesh m = test::kuhn_cube_mesh();
   m.frame.origin_mm << 1.5, -2.25, 1e-7;
   m.frame.axes << 0, -1, 0, 1, 0, 0, 0, 0, 1;  // a 90° turn about z
   m.source = "unit test cube <&>";
@@ -49,12 +35,7 @@ std::string data_file(const std::string& name) {
   return (fs::path(__FILE__).parent_path() / "data" / name).string();
 }
 
-std::string tmp_dir(const std::string& name) {
-  const fs::path d = fs::path(SPINESIM_TEST_TMP) / ("io_vtu_" + name);
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d.string();
-}
+std::string tmp_dir(const std::string& name) { return test::fresh_tmp_dir("io_vtu_", name); }
 
 std::string slurp(const std::string& path) {
   std::ifstream is(path, std::ios::binary);
@@ -304,15 +285,7 @@ void expect_read_error(const std::string& name, const std::function<void(std::st
   std::string text = slurp(path);
   edit(text);
   spit(path, text);
-  try {
-    read_vtu(path);
-    FAIL() << "no exception";
-  } catch (const std::invalid_argument& e) {
-    const std::string msg = e.what();
-    EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
-    EXPECT_NE(msg.find(path), std::string::npos) << msg;
-    EXPECT_NE(msg.find(needle), std::string::npos) << msg;
-  }
+  test::expect_one_line_refusal([&] { read_vtu(path); }, path, needle);
 }
 
 void replace_once(std::string& s, const std::string& from, const std::string& to) {
