@@ -367,6 +367,26 @@ Eigen::MatrixXd to_matrix(const RawArray& a) {
   return M;
 }
 
+/// Reads a PointData or CellData section of `count` tuples: the one-component integer label
+/// array `label_name` goes into `labels` (left as it is when absent), every other array into
+/// `others`.
+void read_data_section(const Reader& r, const tinyxml2::XMLElement* section, const std::string& kind,
+                       std::int64_t count, const std::string& label_name, Eigen::VectorXi& labels,
+                       std::vector<DataArray>& others) {
+  for (const RawArray& a : read_arrays(r, section)) {
+    if (std::int64_t(a.v.size()) != count * a.ncomp)
+      r.fail(kind + " '" + a.name + "' has " + std::to_string(a.v.size() / std::size_t(a.ncomp)) +
+             " tuples, expected " + std::to_string(count));
+    if (a.name == label_name) {
+      if (a.ncomp != 1) r.fail(kind + " '" + label_name + "' must have 1 component");
+      const auto s = as_integers(r, a, -2147483648.0, 2147483647.0);
+      for (std::int64_t i = 0; i < count; ++i) labels(i) = int(s[std::size_t(i)]);
+    } else {
+      others.push_back({a.name, to_matrix(a)});
+    }
+  }
+}
+
 constexpr int kVtkTetra = 10;
 constexpr int kVtkQuadraticTetra = 24;
 
@@ -563,30 +583,8 @@ TetMesh read_vtu(const std::string& path, std::vector<DataArray>* point_data,
   m.surface = Eigen::VectorXi::Zero(np);
   m.region = Eigen::VectorXi::Ones(nc);
   std::vector<DataArray> pdata, cdata;
-  for (const RawArray& a : read_arrays(r, piece->FirstChildElement("PointData"))) {
-    if (std::int64_t(a.v.size()) != np * a.ncomp)
-      r.fail("PointData '" + a.name + "' has " + std::to_string(a.v.size() / std::size_t(a.ncomp)) +
-             " tuples, expected " + std::to_string(np));
-    if (a.name == "surface") {
-      if (a.ncomp != 1) r.fail("PointData 'surface' must have 1 component");
-      const auto s = as_integers(r, a, -2147483648.0, 2147483647.0);
-      for (std::int64_t i = 0; i < np; ++i) m.surface(i) = int(s[std::size_t(i)]);
-    } else {
-      pdata.push_back({a.name, to_matrix(a)});
-    }
-  }
-  for (const RawArray& a : read_arrays(r, piece->FirstChildElement("CellData"))) {
-    if (std::int64_t(a.v.size()) != nc * a.ncomp)
-      r.fail("CellData '" + a.name + "' has " + std::to_string(a.v.size() / std::size_t(a.ncomp)) +
-             " tuples, expected " + std::to_string(nc));
-    if (a.name == "region") {
-      if (a.ncomp != 1) r.fail("CellData 'region' must have 1 component");
-      const auto s = as_integers(r, a, -2147483648.0, 2147483647.0);
-      for (std::int64_t i = 0; i < nc; ++i) m.region(i) = int(s[std::size_t(i)]);
-    } else {
-      cdata.push_back({a.name, to_matrix(a)});
-    }
-  }
+  read_data_section(r, piece->FirstChildElement("PointData"), "PointData", np, "surface", m.surface, pdata);
+  read_data_section(r, piece->FirstChildElement("CellData"), "CellData", nc, "region", m.region, cdata);
 
   // 5. FieldData: frame and provenance (other field arrays are ignored, not decoded).
   m.source = path;
