@@ -207,10 +207,13 @@ Eigen::SparseMatrix<double> assemble_stiffness(const FeSpace& space, const Eigen
   return full;
 }
 
-Eigen::VectorXd assemble_body_force(const FeSpace& space, const VectorField& body_force, int n) {
+namespace {
+
+/// Calls fn(t, N, x, w) at every point of the collapsed Gauss rule of order n on every element
+/// t: N = the element's shape-function values there, x = the point (mm), w = weight × volume.
+template <class Fn>
+void for_each_quadrature_point(const FeSpace& space, int n, Fn&& fn) {
   const TetQuadrature q = tet_rule_collapsed(n);
-  Eigen::VectorXd f = Eigen::VectorXd::Zero(3 * space.num_nodes());
-  const int npe = space.nodes_per_element();
   for (Eigen::Index t = 0; t < space.elements.rows(); ++t) {
     TetVertices X;
     for (int a = 0; a < 4; ++a) X.row(a) = space.X.row(space.elements(t, a));
@@ -219,31 +222,33 @@ Eigen::VectorXd assemble_body_force(const FeSpace& space, const VectorField& bod
     for (Eigen::Index k = 0; k < q.weights.size(); ++k) {
       const Eigen::Vector4d L = q.barycentric.row(k).transpose();
       const Eigen::Vector3d x = X.transpose() * L;
-      const Eigen::Vector3d b = body_force(x) * (q.weights(k) * vol);
-      const Eigen::VectorXd N = shape_values(space.order, L);
-      for (int a = 0; a < npe; ++a) f.segment<3>(3 * space.elements(t, a)) += N(a) * b;
+      fn(t, shape_values(space.order, L), x, q.weights(k) * vol);
     }
   }
+}
+
+}  // namespace
+
+Eigen::VectorXd assemble_body_force(const FeSpace& space, const VectorField& body_force, int n) {
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(3 * space.num_nodes());
+  const int npe = space.nodes_per_element();
+  for_each_quadrature_point(space, n, [&](Eigen::Index t, const Eigen::VectorXd& N, const Eigen::Vector3d& x,
+                                          double w) {
+    const Eigen::Vector3d b = body_force(x) * w;
+    for (int a = 0; a < npe; ++a) f.segment<3>(3 * space.elements(t, a)) += N(a) * b;
+  });
   return f;
 }
 
 double l2_error(const FeSpace& space, const Eigen::VectorXd& u_h, const VectorField& u_exact, int n) {
-  const TetQuadrature q = tet_rule_collapsed(n);
   const int npe = space.nodes_per_element();
   double sum = 0;
-  for (Eigen::Index t = 0; t < space.elements.rows(); ++t) {
-    TetVertices X;
-    for (int a = 0; a < 4; ++a) X.row(a) = space.X.row(space.elements(t, a));
-    double vol = 0;
-    barycentric_gradients(X, vol);
-    for (Eigen::Index k = 0; k < q.weights.size(); ++k) {
-      const Eigen::Vector4d L = q.barycentric.row(k).transpose();
-      const Eigen::VectorXd N = shape_values(space.order, L);
-      Eigen::Vector3d uh = Eigen::Vector3d::Zero();
-      for (int a = 0; a < npe; ++a) uh += N(a) * u_h.segment<3>(3 * space.elements(t, a));
-      sum += q.weights(k) * vol * (uh - u_exact(X.transpose() * L)).squaredNorm();
-    }
-  }
+  for_each_quadrature_point(space, n, [&](Eigen::Index t, const Eigen::VectorXd& N, const Eigen::Vector3d& x,
+                                          double w) {
+    Eigen::Vector3d uh = Eigen::Vector3d::Zero();
+    for (int a = 0; a < npe; ++a) uh += N(a) * u_h.segment<3>(3 * space.elements(t, a));
+    sum += w * (uh - u_exact(x)).squaredNorm();
+  });
   return std::sqrt(sum);
 }
 
