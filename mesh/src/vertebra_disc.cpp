@@ -226,7 +226,7 @@ DiscBetween::DiscBetween(const TriSurface& inf, const TriSurface& sup, const Ver
   const Eigen::Vector3d d = c_sup - c_inf;
   if (d.norm() < 1.0)
     throw std::invalid_argument("the vertebrae do not face each other: their centroids coincide (" +
-                                fmt(d.norm()) + " mm apart; the same vertebra twice?)");
+                                fmt(d.norm()) + " mm apart; the same vertebra twice, or the wrong --units?)");
   const Eigen::Vector3d y = d.normalized();
   if (y.y() < std::cos(60.0 * kPi / 180.0))
     throw std::invalid_argument(
