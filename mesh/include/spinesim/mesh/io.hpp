@@ -100,4 +100,19 @@ enum class UpAxis { x, y, z, minus_x, minus_y, minus_z };
 /// non-finite coordinates; also for units_to_mm that is not finite and positive.
 TriSurface read_surface(const std::string& path, double units_to_mm, UpAxis up);
 
+/// One dataset of a ParaView data collection: the time it shows (s) and its file. A relative
+/// `file` is resolved by ParaView against the .pvd file's folder.
+struct PvdEntry {
+  double time_s = 0.0;
+  std::string file;
+};
+
+/// Writes a ParaView data collection (.pvd: VTKFile type="Collection", one
+/// <DataSet timestep=".." group="" part="0" file=".."/> per entry, times in the shortest
+/// round-trip decimal form, names XML-escaped) — the time series of VTU frames. Refuses
+/// (std::invalid_argument, one line naming `path`) an empty list, non-finite or not strictly
+/// increasing times and empty file names; the listed files need not exist yet. Atomic write
+/// as for write_vtu.
+void write_pvd(const std::string& path, const std::vector<PvdEntry>& entries);
+
 }  // namespace spinesim::mesh

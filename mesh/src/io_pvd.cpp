@@ -1,0 +1,72 @@
+// ParaView data collection (.pvd): the index of a VTU time series. Format (VTK file formats,
+// "Collection" / ParaView Data):
+//   <VTKFile type="Collection" version="0.1" byte_order="LittleEndian">
+//     <Collection>
+//       <DataSet timestep="0.001" group="" part="0" file="series/frame_000001.vtu"/>
+//     </Collection>
+//   </VTKFile>
+#include "spinesim/mesh/io.hpp"
+
+#include "atomic_file.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <stdexcept>
+
+namespace spinesim::mesh {
+namespace {
+
+std::string xml_attribute(const std::string& s) {
+  std::string r;
+  for (char c : s) {
+    switch (c) {
+      case '&': r += "&amp;"; break;
+      case '<': r += "&lt;"; break;
+      case '>': r += "&gt;"; break;
+      case '"': r += "&quot;"; break;
+      case '\'': r += "&apos;"; break;
+      default: r += c;
+    }
+  }
+  return r;
+}
+
+std::string shortest(double v) {
+  char buf[64];
+  const auto res = std::to_chars(buf, buf + sizeof buf, v);  // shortest round-trip form
+  return std::string(buf, res.ptr);
+}
+
+}  // namespace
+
+void write_pvd(const std::string& path, const std::vector<PvdEntry>& entries) {
+  // 1. Refuse bad input before touching the disk.
+  const std::string who = "write_pvd: " + path + ": ";
+  if (entries.empty()) throw std::invalid_argument(who + "no datasets to list");
+  for (std::size_t i = 0; i < entries.size(); ++i) {
+    const PvdEntry& e = entries[i];
+    const std::string which = "dataset " + std::to_string(i);
+    if (!std::isfinite(e.time_s)) throw std::invalid_argument(who + which + " has a non-finite time");
+    if (i > 0 && !(e.time_s > entries[i - 1].time_s))
+      throw std::invalid_argument(who + which + ": times must be strictly increasing (" +
+                                  shortest(entries[i - 1].time_s) + " then " + shortest(e.time_s) + ")");
+    if (e.file.empty()) throw std::invalid_argument(who + which + " has an empty file name");
+    for (char c : e.file)
+      if (static_cast<unsigned char>(c) < 0x20)
+        throw std::invalid_argument(who + which + ": control character in the file name");
+  }
+
+  // 2. Write to a temporary file, then rename.
+  detail::write_atomically("write_pvd", path, [&](std::ostream& os) {
+    os << "<?xml version=\"1.0\"?>\n"
+       << "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
+       << "  <Collection>\n";
+    for (const PvdEntry& e : entries)
+      os << "    <DataSet timestep=\"" << shortest(e.time_s) << "\" group=\"\" part=\"0\" file=\""
+         << xml_attribute(e.file) << "\"/>\n";
+    os << "  </Collection>\n"
+       << "</VTKFile>\n";
+  });
+}
+
+}  // namespace spinesim::mesh
