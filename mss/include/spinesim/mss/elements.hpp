@@ -1,0 +1,85 @@
+// Element energies of the tetrahedral mass-spring disc (thesis ch. 5), each with its exact
+// gradient and Hessian. Every internal force in mss/ is the negative gradient of one of these
+// energies, so forces sum to zero force and zero moment and the stiffness is symmetric.
+//
+// Units: positions mm, stiffness N/mm (springs), N·mm/rad (angle springs), N/mm^5 (volume
+// term), energies N·mm, gradients N, Hessians N/mm (angle: N·mm/rad per rad^2 -> N/mm).
+//
+// Sign convention: `grad` is dE/dx (the internal force is -grad); `hess` is d2E/dx2.
+// Point order in grad/hess: the arguments' order, 3 components each.
+//
+// HessianMode::exact is the true second derivative (indefinite under compression or for bent
+// angles: used by the finite-difference tests, static Newton when it is positive definite).
+// HessianMode::projected keeps only the positive semi-definite parts — for edges
+// k[uu^T + max(0, 1 - L0/l)(I - uu^T)], for the summed radial spring
+// k[∇S∇S^T + max(0, S - S0) H_S] (H_S is PSD: S is a sum of norms of linear maps), for angle
+// and volume terms the Gauss–Newton part k ∇θ∇θ^T, k ∇V∇V^T — so Cholesky always succeeds
+// (implicit steps, Newton fallback).
+#pragma once
+
+#include <Eigen/Core>
+
+namespace spinesim::mss {
+
+using Vector6d = Eigen::Matrix<double, 6, 1>;
+using Vector9d = Eigen::Matrix<double, 9, 1>;
+using Vector12d = Eigen::Matrix<double, 12, 1>;
+using Matrix6d = Eigen::Matrix<double, 6, 6>;
+using Matrix9d = Eigen::Matrix<double, 9, 9>;
+using Matrix12d = Eigen::Matrix<double, 12, 12>;
+/// The four vertices of a tetrahedron as columns, mm.
+using TetPoints = Eigen::Matrix<double, 3, 4>;
+
+enum class HessianMode { exact, projected };
+
+/// Main (edge) spring, thesis (5.12):  E = 1/2 k (|x1 - x0| - L0)^2.
+/// k in N/mm (Van Gelder (5.2): k = sum_tets E_j V_j / L0^2), L0 rest length mm.
+double edge_spring(const Eigen::Vector3d& x0, const Eigen::Vector3d& x1, double k_n_per_mm,
+                   double rest_length_mm, Vector6d* grad = nullptr, Matrix6d* hess = nullptr,
+                   HessianMode mode = HessianMode::exact);
+
+/// Radial springs of one tetrahedron, thesis (5.3)-(5.5), as the energy whose gradient's
+/// vertex term is (5.4):  S(x) = sum_j |x_j - x_B|, x_B = (1/4) sum_j x_j,
+///   E = 1/2 k_s (S - S0)^2,   dE/dx_i = k_s (S - S0) (u_i - (1/4) sum_j u_j),
+/// u_j = (x_j - x_B)/|x_j - x_B|. (5.4) keeps only the u_i part; the (1/4) sum u_j part is
+/// the barycentre's reaction, without which the forces of one tet do not sum to zero.
+double radial_springs(const TetPoints& x, double k_s_n_per_mm, double rest_sum_mm,
+                      Vector12d* grad = nullptr, Matrix12d* hess = nullptr,
+                      HessianMode mode = HessianMode::exact);
+
+/// Angle between the arms a = x1 - x0 and b = x2 - x0 at the apex x0, radians in [0, pi].
+double angle_at(const Eigen::Vector3d& x0, const Eigen::Vector3d& x1, const Eigen::Vector3d& x2);
+
+/// Torsional (angle) spring at apex x0 between arms to x1 and x2, thesis (5.6)-(5.8), (5.13):
+///   E = 1/2 k_t (theta - theta0)^2,  theta = angle_at(x0, x1, x2).
+/// The gradient acts on the apex as well as on the arm ends: the apex force is minus the sum
+/// of the arm-end forces, which (5.13) omits.
+double angle_spring(const Eigen::Vector3d& x0, const Eigen::Vector3d& x1,
+                    const Eigen::Vector3d& x2, double k_t_nmm_per_rad, double rest_angle_rad,
+                    Vector9d* grad = nullptr, Matrix9d* hess = nullptr,
+                    HessianMode mode = HessianMode::exact);
+
+/// The thesis's literal torsional force (5.13) for comparison: forces on the two arm ends
+/// only, (f1, f2) stacked, N; the apex gets nothing. Equal to -dE/dx1, -dE/dx2 of
+/// angle_spring, so its net force is -(apex force) != 0 whenever theta != theta0.
+Vector6d thesis_torsion_force(const Eigen::Vector3d& x0, const Eigen::Vector3d& x1,
+                              const Eigen::Vector3d& x2, double k_t_nmm_per_rad,
+                              double rest_angle_rad);
+
+/// Signed volume of a tetrahedron, mm^3: det[x1-x0, x2-x0, x3-x0] / 6.
+double tet_signed_volume(const TetPoints& x);
+
+/// Volume penalty of one tetrahedron (beyond the thesis):  E = 1/2 k_v (V - V0)^2, V signed.
+/// With k_v = K_bulk / V0 this is the linear-elastic volumetric energy 1/2 K (dV/V0)^2 V0.
+double volume_penalty(const TetPoints& x, double k_v_n_per_mm5, double rest_volume_mm3,
+                      Vector12d* grad = nullptr, Matrix12d* hess = nullptr,
+                      HessianMode mode = HessianMode::exact);
+
+/// Rigid spherical probe against one node (penalty contact, beyond the thesis): with
+/// d = |x - c|, penetration p = max(0, r - d),  E = 1/2 k_p p^2, pushing x out radially.
+/// Zero energy, gradient and Hessian when the node is outside the sphere.
+double probe_contact(const Eigen::Vector3d& x, const Eigen::Vector3d& center_mm, double radius_mm,
+                     double k_p_n_per_mm, Eigen::Vector3d* grad = nullptr,
+                     Eigen::Matrix3d* hess = nullptr, HessianMode mode = HessianMode::exact);
+
+}  // namespace spinesim::mss

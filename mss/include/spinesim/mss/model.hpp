@@ -1,0 +1,132 @@
+// MssModel — the thesis's tetrahedral mass-spring disc (ch. 5.2), built from a tet mesh and a
+// material, as one energy E(x) with exact gradient and sparse Hessian.
+//
+//   E(x) = sum_edges   1/2 k_e (|x_j - x_i| - L0)^2                 main springs (5.2), (5.12)
+//        + sum_tets    1/2 k_s (S_t(x) - S0_t)^2                   radial springs (5.3)-(5.5)
+//        + sum_angles  1/2 k_t (theta - theta0)^2                  torsional springs (5.6)-(5.8)
+//        + sum_tets    1/2 k_v (V_t(x) - V0_t)^2                   volume term (beyond thesis)
+// Internal force f_int = -dE/dx; ambient damping f_damp = -K_d v per node (5.11) is applied by
+// the integrators. Element formulas: elements.hpp.
+//
+// Constants:
+//   masses (5.1)   m_i = sum_{tets ∋ i} rho_t V_t / 4                       tonne
+//   main (5.2)     k_e = sum_{tets ∋ e} E_t V_t / L0^2                      N/mm (Van Gelder)
+//   radial         k_s = c_s E_t V_t / S0_t^2, c_s = MssOptions::radial_factor (the thesis gives
+//                  no value for k_s; this is the Van Gelder form applied to the summed length)
+//   torsion (5.8)  k_t = G pi D_m^4 / (32 L_m n_t): D_m = (D_u + D_l)/2 (5.6) with D_u, D_l the
+//                  equal-area diameters of the endplates (surface labels 2, 1), L_m = 4V/(pi D_m^2)
+//                  (5.7), n_t the number of angle springs. Per region: each spring takes the mean
+//                  G of the tetrahedra that share its face (one G for a homogeneous disc, as in
+//                  the thesis).
+//   volume         k_v = c_v K_t / V0_t, K_t = E/(3(1-2 nu)) the bulk modulus, c_v =
+//                  MssOptions::volume_factor; off unless MssOptions::volume_term.
+//   damping (5.11) K_d = MssOptions::damping_n_s_per_mm, or by default 2 zeta omega_1 m_mean with
+//                  omega_1 = (pi / L_m) sqrt(E_mean / rho_mean) (the first axial mode of the
+//                  equivalent cylinder between fixed plates), zeta = MssOptions::damping_ratio.
+// Angle springs (5.6)-(5.8): three per triangle face (one at each corner, in the face's plane),
+// a face shared by two tetrahedra carrying them once — "tetrahedra sharing three vertices share
+// the three torsional springs".
+//
+// Every stiffness is the sum of an annulus part and a nucleus part; MssOptions::scales (and
+// set_scales) multiply them per term and region without rebuilding (the calibration knobs).
+//
+// Positions are flat vectors of 3·#nodes, interleaved (x0, y0, z0, x1, ...), mm; the Hessian
+// is 3#nodes square, both triangles stored, its pattern built once (3×3 blocks of every node
+// pair that shares a tetrahedron) and refilled in place.
+#pragma once
+
+#include "spinesim/mesh/material.hpp"
+#include "spinesim/mesh/tet_mesh.hpp"
+#include "spinesim/mss/elements.hpp"
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+
+#include <array>
+#include <memory>
+
+namespace spinesim::mss {
+
+/// The energy terms of the model.
+enum class Term : int { main = 0, radial = 1, torsion = 2, volume = 3 };
+inline constexpr int kNumTerms = 4;
+
+/// Stiffness multipliers for one term, per region (index 0 annulus = region 1, 1 nucleus =
+/// region 2; any other region label counts as annulus).
+struct RegionScales {
+  std::array<double, 2> by_region{1.0, 1.0};
+};
+
+struct MssOptions {
+  bool radial_springs = true;    ///< thesis (5.3)-(5.5)
+  bool torsion_springs = true;   ///< thesis (5.6)-(5.8)
+  bool volume_term = false;      ///< per-tetrahedron volume penalty (beyond the thesis)
+  double radial_factor = 1.0;    ///< c_s in k_s = c_s E V0 / S0^2 (dimensionless)
+  double volume_factor = 1.0;    ///< c_v in k_v = c_v K_bulk / V0 (dimensionless)
+  double damping_ratio = 1.0;    ///< zeta of the default K_d (dimensionless)
+  double damping_n_s_per_mm = -1.0;  ///< K_d per node; < 0 means the default from damping_ratio
+  std::array<RegionScales, kNumTerms> scales{};  ///< indexed by Term
+};
+
+/// Equivalent cylinder of the thesis (5.6)-(5.8), for reports.
+struct EquivalentCylinder {
+  double upper_diameter_mm = 0, lower_diameter_mm = 0, mean_diameter_mm = 0, length_mm = 0;
+  double volume_mm3 = 0;
+  Eigen::Index num_angle_springs = 0;
+  double k_t_per_shear_modulus = 0;  ///< k_t / G, mm^3 (k_t = G * this), N·mm/rad per MPa
+};
+
+class MssModel {
+ public:
+  /// Validates mesh (mesh::validate) and materials and options (finite, positive
+  /// factors, damping finite); throws std::invalid_argument with a one-line message.
+  MssModel(const mesh::TetMesh& mesh, const mesh::RegionMaterials& materials,
+           const MssOptions& options = MssOptions());
+  ~MssModel();
+  MssModel(MssModel&&) noexcept;
+  MssModel& operator=(MssModel&&) noexcept;
+  MssModel(const MssModel&);
+  MssModel& operator=(const MssModel&);
+
+  const mesh::TetMesh& mesh() const;
+  const MssOptions& options() const;
+  Eigen::Index num_nodes() const;
+  Eigen::Index num_dofs() const { return 3 * num_nodes(); }
+
+  const Eigen::VectorXd& rest_positions_mm() const;  ///< 3#nodes, interleaved
+  const Eigen::VectorXd& node_masses_t() const;      ///< #nodes, tonne (5.1)
+  double total_mass_t() const;
+  double damping_n_s_per_mm() const;                 ///< K_d (5.11)
+  const EquivalentCylinder& cylinder() const;
+
+  Eigen::Index num_edge_springs() const;
+  Eigen::Index num_radial_tets() const;   ///< 0 when radial springs are off
+  Eigen::Index num_angle_springs() const; ///< 0 when torsion springs are off
+  Eigen::Index num_volume_terms() const;  ///< 0 when the volume term is off
+
+  /// Replaces the calibration multipliers (all must be finite and > 0).
+  void set_scales(const std::array<RegionScales, kNumTerms>& scales);
+
+  /// Total energy, N·mm.
+  double energy(const Eigen::VectorXd& x_mm) const;
+  /// Energy of one term with its region scale set to 1 for `region_index` and 0 for the other
+  /// (dE/d scale for calibration), N·mm; region_index 0 annulus, 1 nucleus.
+  double term_energy(const Eigen::VectorXd& x_mm, Term term, int region_index) const;
+  /// Energy, and grad = dE/dx (3#nodes, N; the internal force is -grad).
+  double gradient(const Eigen::VectorXd& x_mm, Eigen::VectorXd& grad) const;
+  /// Gradient of term_energy(x, term, region_index) (for calibration adjoints).
+  void term_gradient(const Eigen::VectorXd& x_mm, Term term, int region_index,
+                     Eigen::VectorXd& grad) const;
+  /// Hessian d2E/dx2, N/mm, into H (pattern built on first use, values refilled after).
+  void hessian(const Eigen::VectorXd& x_mm, HessianMode mode, Eigen::SparseMatrix<double>& H) const;
+
+  /// Sum of signed tetrahedron volumes at x, mm^3.
+  double volume_mm3(const Eigen::VectorXd& x_mm) const;
+  double rest_volume_mm3() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace spinesim::mss

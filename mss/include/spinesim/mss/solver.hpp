@@ -1,0 +1,124 @@
+// Static equilibrium and time integration of the MSS disc under a Boundary.
+//
+// Equations (positions x, velocities v, lumped masses M, ambient damping K_d (5.11)):
+//   M dv/dt = f_int(x) - K_d v + f_ext(x),   dx/dt = v,    f_int = -dE/dx (model.hpp)
+// f_ext: probe contact, nodal forces, and for PlateMode::wrench the wrench on the plate DOF.
+// Unknowns are the free nodes (no endplate label) plus, for PlateMode::wrench, the six plate
+// DOF; endplate nodes in PlateMode::pose follow their poses (Dirichlet).
+//
+// Integrators (Integrator):
+//   explicit_euler    thesis (5.20)-(5.21) exactly: v+ = v + dt a(x, v), x+ = x + dt v (old v).
+//                     For mass-proportional damping c = K_d/m it is stable only when
+//                     dt < c / omega_max^2 — kept for comparison.
+//   symplectic_euler  v+ = v + dt a(x, v), x+ = x + dt v+ ; stable for dt < 2/omega_max.
+//   implicit_euler    backward Euler as the minimiser of the incremental potential
+//                     Phi(x) = |x - x_n - dt v_n|^2_M / (2 dt^2) + K_d |x - x_n|^2/(2 dt) + E(x) - W_ext(x),
+//                     by Newton with backtracking line search on Phi; one iteration from
+//                     x_n + dt v_n is Baraff & Witkin (1998). The matrix M/dt^2 + K_d/dt + K has a
+//                     fixed pattern: the symbolic factorisation is done once and reused;
+//                     MatrixUpdate::frozen also keeps the numeric factor (rest stiffness), so a
+//                     step costs one force evaluation and one pair of triangular solves.
+// Static solve: Newton with backtracking line search on Pi(x) = E(x) - W_ext(x), with the exact
+// Hessian when it factorises and the projected one otherwise.
+//
+// Failure: a step that yields non-finite numbers, or moves a node farther than
+// `divergence_distance_mm` from its rest position, is rejected — the state is left unchanged
+// and StepReport::ok is false with a message. Nothing here writes files.
+#pragma once
+
+#include "spinesim/mss/boundary.hpp"
+#include "spinesim/mss/model.hpp"
+
+#include <Eigen/Core>
+
+#include <memory>
+#include <string>
+
+namespace spinesim::mss {
+
+struct StaticOptions {
+  double relative_tolerance = 1e-9;  ///< |reduced gradient| <= tol * (|f_ext| + |f_ref|), see .cpp
+  int max_iterations = 100;
+};
+
+struct StaticResult {
+  Eigen::VectorXd x_mm;              ///< 3#nodes equilibrium positions
+  Vector6d plate_motion = Vector6d::Zero();  ///< (t mm, theta rad); solved (wrench) or given (pose)
+  Vector6d reaction_wrench = Vector6d::Zero();  ///< force N and moment N·mm the disc exerts on
+                                                ///< the superior plate, about the moved plate centre
+  bool converged = false;
+  int iterations = 0;
+  double residual_n = 0;             ///< final |reduced gradient|, N
+  double seconds = 0;
+  std::string message;               ///< empty when converged, else why not
+};
+
+/// Newton equilibrium. `x_start` (3#nodes) may be empty (start from rest, endplates moved).
+/// Throws std::invalid_argument for an invalid Boundary.
+StaticResult solve_static(const MssModel& model, const Boundary& bc,
+                          const StaticOptions& options = StaticOptions(),
+                          const Eigen::VectorXd& x_start = Eigen::VectorXd());
+
+/// Reaction wrench of the superior-plate nodes at x: sum of their internal forces -dE/dx_i
+/// and the moment about `center_mm` (mm), N and N·mm.
+Vector6d plate_reaction(const MssModel& model, const Eigen::VectorXd& x_mm,
+                        const Eigen::Vector3d& center_mm);
+
+/// Force the disc exerts on each probe at x (N), same order as bc.probes.
+std::vector<Eigen::Vector3d> probe_forces(const MssModel& model, const Boundary& bc,
+                                          const Eigen::VectorXd& x_mm);
+
+enum class Integrator { explicit_euler, symplectic_euler, implicit_euler };
+enum class MatrixUpdate { every_iteration, frozen };
+
+struct DynamicsOptions {
+  Integrator integrator = Integrator::implicit_euler;
+  double dt_s = 1e-3;
+  int newton_iterations = 1;         ///< implicit: max Newton iterations per step (1 = Baraff–Witkin)
+  double newton_relative_tolerance = 1e-6;  ///< implicit: stop early below this residual ratio
+  MatrixUpdate matrix_update = MatrixUpdate::every_iteration;
+  double divergence_distance_mm = 0; ///< 0 → the mesh's bounding-box diagonal
+};
+
+struct State {
+  Eigen::VectorXd x_mm;   ///< 3#nodes
+  Eigen::VectorXd v_mm_s; ///< 3#nodes
+  Vector6d plate_q = Vector6d::Zero();     ///< plate DOF (t mm, theta rad), PlateMode::wrench
+  Vector6d plate_qdot = Vector6d::Zero();  ///< their rates, mm/s, rad/s
+  double time_s = 0;
+};
+
+struct StepReport {
+  bool ok = true;
+  int newton_iterations = 0;
+  std::string message;  ///< why the step was rejected
+};
+
+/// Steps one model under a boundary that may change every step. Holds the factorisation.
+class Simulator {
+ public:
+  /// Throws std::invalid_argument for dt <= 0 or non-finite, newton_iterations < 1.
+  Simulator(const MssModel& model, const DynamicsOptions& options);
+  ~Simulator();
+  Simulator(Simulator&&) noexcept;
+  Simulator& operator=(Simulator&&) noexcept;
+
+  /// Rest state, zero velocity, time 0.
+  State rest_state() const;
+  /// Advances `s` by dt to the boundary `bc_next` (its poses are those at s.time_s + dt; the
+  /// endplate velocities follow from the change of pose). Rejects (s unchanged) on divergence.
+  StepReport step(State& s, const Boundary& bc_next);
+
+  /// Largest stable dt of an integrator, predicted from omega_max^2 = lambda_max(M^-1 K) at
+  /// rest (power iteration on the free nodes, endplates fixed): explicit (K_d/m_max... see .cpp),
+  /// symplectic 2/omega_max, implicit +infinity.
+  double predicted_stable_dt_s(Integrator integrator) const;
+
+  const DynamicsOptions& options() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace spinesim::mss

@@ -1,0 +1,469 @@
+// MssModel: builder (mesh + material -> springs, masses) and the energy/gradient/Hessian loops.
+// Formulas and constants: model.hpp; element kernels: elements.cpp.
+#include "spinesim/mss/model.hpp"
+
+#include "hessian_pattern.hpp"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace spinesim::mss {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+/// Region label -> index into the per-region stiffness parts (0 annulus, 1 nucleus).
+int region_index(int region_label) { return region_label == static_cast<int>(mesh::Region::nucleus) ? 1 : 0; }
+
+struct EdgeSpring {
+  int i, j;
+  double rest_mm;
+  double k_part[2];  ///< annulus / nucleus parts of k, N/mm (unscaled)
+  double k;          ///< scaled total, N/mm
+};
+
+struct AngleSpring {
+  int apex, a, b;
+  double rest_rad;
+  double k_part[2];  ///< N·mm/rad (unscaled)
+  double k;          ///< scaled total
+};
+
+/// Per-tetrahedron terms (radial springs and volume penalty share the vertex set).
+struct TetTerm {
+  int t;
+  int region;        ///< 0 annulus, 1 nucleus
+  double rest;       ///< S0 (mm) for radial springs, V0 (mm^3) for the volume term
+  double k_unscaled; ///< k_s N/mm or k_v N/mm^5
+  double k;          ///< scaled
+};
+
+void require(bool ok, const std::string& message) {
+  if (!ok) throw std::invalid_argument(message);
+}
+
+void validate_options(const MssOptions& o) {
+  auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
+  require(positive(o.radial_factor), "mss: radial_factor must be finite and > 0");
+  require(positive(o.volume_factor), "mss: volume_factor must be finite and > 0");
+  require(std::isfinite(o.damping_ratio) && o.damping_ratio >= 0.0,
+          "mss: damping ratio must be finite and >= 0");
+  require(std::isfinite(o.damping_n_s_per_mm), "mss: damping K_d must be finite");
+  for (const auto& s : o.scales)
+    for (double v : s.by_region) require(positive(v), "mss: stiffness scales must be finite and > 0");
+}
+
+TetPoints tet_points(const Eigen::VectorXd& x, const Eigen::MatrixX4i& T, int t) {
+  TetPoints p;
+  for (int c = 0; c < 4; ++c) p.col(c) = x.segment<3>(3 * T(t, c));
+  return p;
+}
+
+
+void check_size(const Eigen::VectorXd& x, Eigen::Index n) {
+  if (x.size() != 3 * n)
+    throw std::invalid_argument("mss: position vector has " + std::to_string(x.size()) +
+                                " entries, expected 3 x " + std::to_string(n));
+}
+
+/// Stiffness selector: the scaled total, or one region's unscaled part (dE/d scale).
+struct KSelect {
+  int region = -1;  ///< -1: scaled total
+  double edge(const EdgeSpring& e) const { return region < 0 ? e.k : e.k_part[region]; }
+  double angle(const AngleSpring& a) const { return region < 0 ? a.k : a.k_part[region]; }
+  double tet(const TetTerm& t) const {
+    return region < 0 ? t.k : (t.region == region ? t.k_unscaled : 0.0);
+  }
+};
+
+}  // namespace
+
+struct MssModel::Impl {
+  mesh::TetMesh mesh;
+  MssOptions options;
+  Eigen::VectorXd X;        // rest positions, 3n
+  Eigen::VectorXd mass_t;   // n
+  double damping = 0;       // K_d, N·s/mm
+  EquivalentCylinder cylinder;
+  double rest_volume = 0;
+
+  std::vector<EdgeSpring> edges;
+  std::vector<AngleSpring> angles;
+  std::vector<TetTerm> radial;
+  std::vector<TetTerm> volume;
+
+  HessianPattern pattern;   // 3x3 node blocks of every node pair sharing a tet
+  std::vector<int> edge_slots;    // 4 per edge: block (a,b) offsets, a,b in {0,1}
+  std::vector<int> angle_slots;   // 9 per angle spring
+  std::vector<int> tet_slots;     // 16 per tetrahedron
+
+  void build(const mesh::RegionMaterials& materials);
+  void apply_scales();
+  /// Energy and (optionally, grad != nullptr, accumulated) gradient of the selected terms: the
+  /// one loop behind energy, gradient, term_energy and term_gradient.
+  double accumulate(const Eigen::VectorXd& x, const bool* terms, KSelect sel,
+                    Eigen::VectorXd* grad) const;
+};
+
+void MssModel::Impl::build(const mesh::RegionMaterials& materials) {
+  const Eigen::Index n = mesh.num_vertices();
+  const Eigen::Index nt = mesh.num_tets();
+  X.resize(3 * n);
+  for (Eigen::Index i = 0; i < n; ++i) X.segment<3>(3 * i) = mesh.V.row(i).transpose();
+
+  // Materials per tet.
+  std::vector<double> E(nt), G(nt), K(nt), rho(nt), V0(nt);
+  for (Eigen::Index t = 0; t < nt; ++t) {
+    const mesh::IsotropicMaterial& m = materials.at(mesh.region(t));
+    mesh::validate(m, "material of region " + std::to_string(mesh.region(t)));
+    E[t] = m.youngs_modulus_mpa;
+    G[t] = m.shear_modulus_mpa();
+    K[t] = m.youngs_modulus_mpa / (3.0 * (1.0 - 2.0 * m.poisson_ratio));
+    rho[t] = m.density_t_mm3();
+    V0[t] = tet_signed_volume(tet_points(X, mesh.T, static_cast<int>(t)));
+  }
+  rest_volume = std::accumulate(V0.begin(), V0.end(), 0.0);
+
+  // 1. Lumped masses (5.1).
+  mass_t = Eigen::VectorXd::Zero(n);
+  for (Eigen::Index t = 0; t < nt; ++t)
+    for (int c = 0; c < 4; ++c) mass_t(mesh.T(t, c)) += 0.25 * rho[t] * V0[t];
+  for (Eigen::Index i = 0; i < n; ++i)
+    require(mass_t(i) > 0.0, "mss: node " + std::to_string(i) +
+                                 " belongs to no tetrahedron (zero mass); remove unused vertices");
+
+  // 2. Main springs on the unique edges, Van Gelder (5.2): k = sum E_t V_t / L0^2.
+  static constexpr int kEdge[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+  {
+    std::vector<std::pair<std::pair<int, int>, int>> pairs;  // ((lo, hi), tet)
+    pairs.reserve(6 * nt);
+    for (Eigen::Index t = 0; t < nt; ++t)
+      for (const auto& e : kEdge) {
+        int a = mesh.T(t, e[0]), b = mesh.T(t, e[1]);
+        pairs.push_back({{std::min(a, b), std::max(a, b)}, static_cast<int>(t)});
+      }
+    std::sort(pairs.begin(), pairs.end());
+    for (std::size_t s = 0; s < pairs.size();) {
+      EdgeSpring sp{pairs[s].first.first, pairs[s].first.second, 0.0, {0.0, 0.0}, 0.0};
+      sp.rest_mm = (X.segment<3>(3 * sp.j) - X.segment<3>(3 * sp.i)).norm();
+      for (; s < pairs.size() && pairs[s].first == std::make_pair(sp.i, sp.j); ++s) {
+        int t = pairs[s].second;
+        sp.k_part[region_index(mesh.region(t))] += E[t] * V0[t];
+      }
+      for (double& k : sp.k_part) k /= sp.rest_mm * sp.rest_mm;
+      edges.push_back(sp);
+    }
+  }
+
+  // 3. Equivalent cylinder (5.6)-(5.7): endplate diameters from their areas projected on the
+  //    disc axis (equal-area circles), V the mesh volume.
+  std::vector<std::array<int, 4>> faces;  // sorted (v0, v1, v2) + tet
+  faces.reserve(4 * nt);
+  static constexpr int kFace[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};
+  for (Eigen::Index t = 0; t < nt; ++t)
+    for (const auto& f : kFace) {
+      std::array<int, 3> v{mesh.T(t, f[0]), mesh.T(t, f[1]), mesh.T(t, f[2])};
+      std::sort(v.begin(), v.end());
+      faces.push_back({v[0], v[1], v[2], static_cast<int>(t)});
+    }
+  std::sort(faces.begin(), faces.end());
+  const Eigen::Vector3d axis = mesh.frame.axes.col(1).normalized();
+  double area_label[3] = {0, 0, 0};
+  std::vector<std::pair<std::array<int, 3>, std::vector<int>>> unique_faces;
+  for (std::size_t s = 0; s < faces.size();) {
+    std::array<int, 3> v{faces[s][0], faces[s][1], faces[s][2]};
+    std::vector<int> tets;
+    for (; s < faces.size() && faces[s][0] == v[0] && faces[s][1] == v[1] && faces[s][2] == v[2]; ++s)
+      tets.push_back(faces[s][3]);
+    if (tets.size() == 1) {
+      const int l0 = mesh.surface(v[0]), l1 = mesh.surface(v[1]), l2 = mesh.surface(v[2]);
+      if (l0 == l1 && l1 == l2 && (l0 == 1 || l0 == 2)) {
+        const Eigen::Vector3d p0 = X.segment<3>(3 * v[0]);
+        const Eigen::Vector3d n2 =
+            (X.segment<3>(3 * v[1]) - p0).cross(X.segment<3>(3 * v[2]) - p0);
+        area_label[l0] += 0.5 * std::abs(n2.dot(axis));
+      }
+    }
+    unique_faces.push_back({v, std::move(tets)});
+  }
+  cylinder.volume_mm3 = rest_volume;
+  cylinder.upper_diameter_mm = 2.0 * std::sqrt(area_label[2] / kPi);
+  cylinder.lower_diameter_mm = 2.0 * std::sqrt(area_label[1] / kPi);
+  cylinder.mean_diameter_mm = 0.5 * (cylinder.upper_diameter_mm + cylinder.lower_diameter_mm);
+
+  // 4. Torsional springs (5.8): three per unique face; k_t = G pi D_m^4 / (32 L_m n_t), G the mean
+  //    over the face's tetrahedra. Needs both endplates to define the cylinder.
+  if (options.torsion_springs) {
+    require(cylinder.upper_diameter_mm > 0.0 && cylinder.lower_diameter_mm > 0.0,
+            "mss: torsional springs need both endplates (surface labels 1 and 2) for the "
+            "equivalent cylinder (5.6)-(5.8)");
+    const double Dm = cylinder.mean_diameter_mm;
+    cylinder.length_mm = 4.0 * rest_volume / (kPi * Dm * Dm);
+    cylinder.num_angle_springs = static_cast<Eigen::Index>(3 * unique_faces.size());
+    cylinder.k_t_per_shear_modulus = kPi * std::pow(Dm, 4) /
+                                     (32.0 * cylinder.length_mm *
+                                      static_cast<double>(cylinder.num_angle_springs));
+    angles.reserve(3 * unique_faces.size());
+    for (const auto& [v, tets] : unique_faces) {
+      double g_part[2] = {0.0, 0.0};
+      for (int t : tets) g_part[region_index(mesh.region(t))] += G[t] / static_cast<double>(tets.size());
+      for (int corner = 0; corner < 3; ++corner) {
+        AngleSpring sp;
+        sp.apex = v[corner];
+        sp.a = v[(corner + 1) % 3];
+        sp.b = v[(corner + 2) % 3];
+        sp.rest_rad = angle_at(X.segment<3>(3 * sp.apex), X.segment<3>(3 * sp.a),
+                               X.segment<3>(3 * sp.b));
+        for (int r = 0; r < 2; ++r) sp.k_part[r] = g_part[r] * cylinder.k_t_per_shear_modulus;
+        sp.k = 0.0;
+        angles.push_back(sp);
+      }
+    }
+  } else if (cylinder.mean_diameter_mm > 0.0) {
+    const double Dm = cylinder.mean_diameter_mm;
+    cylinder.length_mm = 4.0 * rest_volume / (kPi * Dm * Dm);
+  }
+
+  // 5. Radial springs (5.3)-(5.5) and the volume term, per tetrahedron.
+  for (Eigen::Index t = 0; t < nt; ++t) {
+    const TetPoints p = tet_points(X, mesh.T, static_cast<int>(t));
+    const int r = region_index(mesh.region(t));
+    if (options.radial_springs) {
+      const Eigen::Vector3d xb = 0.25 * p.rowwise().sum();
+      double S0 = 0.0;
+      for (int c = 0; c < 4; ++c) S0 += (p.col(c) - xb).norm();
+      radial.push_back({static_cast<int>(t), r, S0, options.radial_factor * E[t] * V0[t] / (S0 * S0), 0.0});
+    }
+    if (options.volume_term)
+      volume.push_back({static_cast<int>(t), r, V0[t], options.volume_factor * K[t] / V0[t], 0.0});
+  }
+
+  // 6. Ambient damping (5.11).
+  if (options.damping_n_s_per_mm >= 0.0) {
+    damping = options.damping_n_s_per_mm;
+  } else {
+    double EV = 0.0, rhoV = 0.0;
+    for (Eigen::Index t = 0; t < nt; ++t) EV += E[t] * V0[t], rhoV += rho[t] * V0[t];
+    const double length = cylinder.length_mm > 0.0 ? cylinder.length_mm
+                                                   : std::cbrt(rest_volume);
+    const double omega1 = kPi / length * std::sqrt(EV / rhoV);
+    damping = 2.0 * options.damping_ratio * omega1 * mass_t.mean();
+  }
+
+  // 7. Hessian pattern and the value slots of every element block.
+  pattern = HessianPattern(mesh.T, n);
+  edge_slots.resize(4 * edges.size());
+  for (std::size_t e = 0; e < edges.size(); ++e) {
+    const int v[2] = {edges[e].i, edges[e].j};
+    for (int a = 0; a < 2; ++a)
+      for (int b = 0; b < 2; ++b) edge_slots[4 * e + 2 * a + b] = pattern.block(v[a], v[b]);
+  }
+  angle_slots.resize(9 * angles.size());
+  for (std::size_t s = 0; s < angles.size(); ++s) {
+    const int v[3] = {angles[s].apex, angles[s].a, angles[s].b};
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) angle_slots[9 * s + 3 * a + b] = pattern.block(v[a], v[b]);
+  }
+  tet_slots.resize(16 * static_cast<std::size_t>(nt));
+  for (Eigen::Index t = 0; t < nt; ++t)
+    for (int a = 0; a < 4; ++a)
+      for (int b = 0; b < 4; ++b)
+        tet_slots[16 * t + 4 * a + b] = pattern.block(mesh.T(t, a), mesh.T(t, b));
+
+  apply_scales();
+}
+
+void MssModel::Impl::apply_scales() {
+  const auto& s = options.scales;
+  auto scale = [&](Term term, int r) { return s[static_cast<int>(term)].by_region[r]; };
+  for (auto& e : edges)
+    e.k = scale(Term::main, 0) * e.k_part[0] + scale(Term::main, 1) * e.k_part[1];
+  for (auto& a : angles)
+    a.k = scale(Term::torsion, 0) * a.k_part[0] + scale(Term::torsion, 1) * a.k_part[1];
+  for (auto& t : radial) t.k = scale(Term::radial, t.region) * t.k_unscaled;
+  for (auto& t : volume) t.k = scale(Term::volume, t.region) * t.k_unscaled;
+}
+
+MssModel::MssModel(const mesh::TetMesh& mesh, const mesh::RegionMaterials& materials,
+                   const MssOptions& options)
+    : impl_(std::make_unique<Impl>()) {
+  mesh::validate(mesh);
+  validate_options(options);
+  impl_->mesh = mesh;
+  impl_->options = options;
+  impl_->build(materials);
+}
+
+MssModel::~MssModel() = default;
+MssModel::MssModel(MssModel&&) noexcept = default;
+MssModel& MssModel::operator=(MssModel&&) noexcept = default;
+MssModel::MssModel(const MssModel& o) : impl_(std::make_unique<Impl>(*o.impl_)) {}
+MssModel& MssModel::operator=(const MssModel& o) {
+  if (this != &o) impl_ = std::make_unique<Impl>(*o.impl_);
+  return *this;
+}
+
+const mesh::TetMesh& MssModel::mesh() const { return impl_->mesh; }
+const MssOptions& MssModel::options() const { return impl_->options; }
+Eigen::Index MssModel::num_nodes() const { return impl_->mesh.num_vertices(); }
+const Eigen::VectorXd& MssModel::rest_positions_mm() const { return impl_->X; }
+const Eigen::VectorXd& MssModel::node_masses_t() const { return impl_->mass_t; }
+double MssModel::total_mass_t() const { return impl_->mass_t.sum(); }
+double MssModel::damping_n_s_per_mm() const { return impl_->damping; }
+const EquivalentCylinder& MssModel::cylinder() const { return impl_->cylinder; }
+Eigen::Index MssModel::num_edge_springs() const { return static_cast<Eigen::Index>(impl_->edges.size()); }
+Eigen::Index MssModel::num_radial_tets() const { return static_cast<Eigen::Index>(impl_->radial.size()); }
+Eigen::Index MssModel::num_angle_springs() const { return static_cast<Eigen::Index>(impl_->angles.size()); }
+Eigen::Index MssModel::num_volume_terms() const { return static_cast<Eigen::Index>(impl_->volume.size()); }
+double MssModel::rest_volume_mm3() const { return impl_->rest_volume; }
+
+void MssModel::set_scales(const std::array<RegionScales, kNumTerms>& scales) {
+  MssOptions o = impl_->options;
+  o.scales = scales;
+  validate_options(o);
+  impl_->options.scales = scales;
+  impl_->apply_scales();
+}
+
+
+double MssModel::energy(const Eigen::VectorXd& x) const {
+  check_size(x, num_nodes());
+  const bool all[kNumTerms] = {true, true, true, true};
+  return impl_->accumulate(x, all, KSelect{}, nullptr);
+}
+
+double MssModel::gradient(const Eigen::VectorXd& x, Eigen::VectorXd& grad) const {
+  check_size(x, num_nodes());
+  const bool all[kNumTerms] = {true, true, true, true};
+  grad.setZero(x.size());
+  return impl_->accumulate(x, all, KSelect{}, &grad);
+}
+
+double MssModel::term_energy(const Eigen::VectorXd& x, Term term, int region_index) const {
+  check_size(x, num_nodes());
+  if (region_index != 0 && region_index != 1)
+    throw std::invalid_argument("mss: region index must be 0 (annulus) or 1 (nucleus)");
+  bool only[kNumTerms] = {false, false, false, false};
+  only[static_cast<int>(term)] = true;
+  return impl_->accumulate(x, only, KSelect{region_index}, nullptr);
+}
+
+void MssModel::term_gradient(const Eigen::VectorXd& x, Term term, int region_index,
+                             Eigen::VectorXd& grad) const {
+  check_size(x, num_nodes());
+  if (region_index != 0 && region_index != 1)
+    throw std::invalid_argument("mss: region index must be 0 (annulus) or 1 (nucleus)");
+  bool only[kNumTerms] = {false, false, false, false};
+  only[static_cast<int>(term)] = true;
+  grad.setZero(x.size());
+  impl_->accumulate(x, only, KSelect{region_index}, &grad);
+}
+
+double MssModel::Impl::accumulate(const Eigen::VectorXd& x, const bool* terms, KSelect sel,
+                                 Eigen::VectorXd* grad) const {
+  const Impl& m = *this;
+  double energy = 0.0;
+  const double* xp = x.data();
+  auto point = [xp](int i) { return Eigen::Map<const Eigen::Vector3d>(xp + 3 * i); };
+  if (terms[static_cast<int>(Term::main)]) {
+    Vector6d g;
+    for (const EdgeSpring& e : m.edges) {
+      energy += edge_spring(point(e.i), point(e.j), sel.edge(e), e.rest_mm, grad ? &g : nullptr);
+      if (grad) {
+        grad->segment<3>(3 * e.i) += g.head<3>();
+        grad->segment<3>(3 * e.j) += g.tail<3>();
+      }
+    }
+  }
+  if (terms[static_cast<int>(Term::torsion)]) {
+    Vector9d g;
+    for (const AngleSpring& a : m.angles) {
+      energy += angle_spring(point(a.apex), point(a.a), point(a.b), sel.angle(a), a.rest_rad,
+                             grad ? &g : nullptr);
+      if (grad) {
+        grad->segment<3>(3 * a.apex) += g.segment<3>(0);
+        grad->segment<3>(3 * a.a) += g.segment<3>(3);
+        grad->segment<3>(3 * a.b) += g.segment<3>(6);
+      }
+    }
+  }
+  const Eigen::MatrixX4i& T = m.mesh.T;
+  auto tet_loop = [&](const std::vector<TetTerm>& list, auto kernel) {
+    Vector12d g;
+    for (const TetTerm& t : list) {
+      energy += kernel(tet_points(x, T, t.t), sel.tet(t), t.rest, grad ? &g : nullptr);
+      if (grad)
+        for (int c = 0; c < 4; ++c) grad->segment<3>(3 * T(t.t, c)) += g.segment<3>(3 * c);
+    }
+  };
+  if (terms[static_cast<int>(Term::radial)])
+    tet_loop(m.radial, [](const TetPoints& p, double k, double rest, Vector12d* g) {
+      return radial_springs(p, k, rest, g);
+    });
+  if (terms[static_cast<int>(Term::volume)])
+    tet_loop(m.volume, [](const TetPoints& p, double k, double rest, Vector12d* g) {
+      return volume_penalty(p, k, rest, g);
+    });
+  return energy;
+}
+
+void MssModel::hessian(const Eigen::VectorXd& x, HessianMode mode,
+                       Eigen::SparseMatrix<double>& H) const {
+  check_size(x, num_nodes());
+  const Impl& m = *impl_;
+  m.pattern.reset(H);
+  double* val = H.valuePtr();
+  const double* xp = x.data();
+  auto point = [xp](int i) { return Eigen::Map<const Eigen::Vector3d>(xp + 3 * i); };
+  // Scatter a local (3k x 3k) element Hessian into its node blocks.
+  auto scatter = [&](const auto& h, const int* slots, int k, const int* nodes) {
+    for (int a = 0; a < k; ++a)
+      for (int b = 0; b < k; ++b) m.pattern.add_block(val, slots[k * a + b], nodes[b],
+                                                      h.template block<3, 3>(3 * a, 3 * b));
+  };
+  Matrix6d h6;
+  for (std::size_t e = 0; e < m.edges.size(); ++e) {
+    const EdgeSpring& s = m.edges[e];
+    edge_spring(point(s.i), point(s.j), s.k, s.rest_mm, nullptr, &h6, mode);
+    const int nodes[2] = {s.i, s.j};
+    scatter(h6, &m.edge_slots[4 * e], 2, nodes);
+  }
+  Matrix9d h9;
+  for (std::size_t a = 0; a < m.angles.size(); ++a) {
+    const AngleSpring& s = m.angles[a];
+    angle_spring(point(s.apex), point(s.a), point(s.b), s.k, s.rest_rad, nullptr, &h9, mode);
+    const int nodes[3] = {s.apex, s.a, s.b};
+    scatter(h9, &m.angle_slots[9 * a], 3, nodes);
+  }
+  Matrix12d h12;
+  auto tet_hessians = [&](const std::vector<TetTerm>& list, auto kernel) {
+    for (const TetTerm& t : list) {
+      kernel(tet_points(x, m.mesh.T, t.t), t.k, t.rest, &h12);
+      const int nodes[4] = {m.mesh.T(t.t, 0), m.mesh.T(t.t, 1), m.mesh.T(t.t, 2), m.mesh.T(t.t, 3)};
+      scatter(h12, &m.tet_slots[16 * static_cast<std::size_t>(t.t)], 4, nodes);
+    }
+  };
+  tet_hessians(m.radial, [mode](const TetPoints& p, double k, double rest, Matrix12d* h) {
+    radial_springs(p, k, rest, nullptr, h, mode);
+  });
+  tet_hessians(m.volume, [mode](const TetPoints& p, double k, double rest, Matrix12d* h) {
+    volume_penalty(p, k, rest, nullptr, h, mode);
+  });
+}
+
+double MssModel::volume_mm3(const Eigen::VectorXd& x) const {
+  check_size(x, num_nodes());
+  double v = 0.0;
+  for (Eigen::Index t = 0; t < impl_->mesh.num_tets(); ++t)
+    v += tet_signed_volume(tet_points(x, impl_->mesh.T, static_cast<int>(t)));
+  return v;
+}
+
+}  // namespace spinesim::mss
