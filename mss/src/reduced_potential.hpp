@@ -1,0 +1,60 @@
+// The static potential in reduced coordinates (private to mss/):
+//   Pi(y) = E(x(y)) + V_ext(x(y)) - w . q,      r = dPi/dy = P^T (dE/dx + dV_ext/dx) - (0, w)
+// x(y) = x_D + P y (reduced_space.hpp); the Dirichlet nodes of x() are set by the caller.
+// Shared by the static Newton solve and the implicit Euler step (which adds its inertial terms).
+#pragma once
+
+#include "external_loads.hpp"
+#include "reduced_space.hpp"
+#include "spinesim/mss/model.hpp"
+
+#include <Eigen/Core>
+
+namespace spinesim::mss::detail {
+
+class ReducedPotential {
+ public:
+  ReducedPotential(const MssModel& model, const ReducedSpace& space, const ExternalLoads& loads,
+                   const Vector6d& wrench)
+      : model_(model), space_(space), loads_(loads), wrench_(wrench),
+        g_(Eigen::VectorXd::Zero(model.num_dofs())) {}
+
+  /// Full positions; set the Dirichlet nodes here before evaluating.
+  Eigen::VectorXd& x() { return x_; }
+  const Eigen::VectorXd& x() const { return x_; }
+  /// dE/dx of the model at the last value_and_gradient() point, 3#nodes, N.
+  const Eigen::VectorXd& model_gradient() const { return g_; }
+
+  double value(const Eigen::VectorXd& y) {
+    space_.set_unknown_positions(y, x_);
+    return model_.energy(x_) + (loads_.empty() ? 0.0 : loads_.energy(x_)) - plate_work(y);
+  }
+
+  /// Pi(y) and r = dPi/dy (r preallocated to space.size()).
+  double value_and_gradient(const Eigen::VectorXd& y, Eigen::VectorXd& r) {
+    space_.set_unknown_positions(y, x_);
+    double e = model_.gradient(x_, g_);
+    if (loads_.empty()) {
+      space_.reduce_vector(g_, r);
+    } else {
+      gtot_ = g_;
+      e += loads_.add_gradient(x_, gtot_);
+      space_.reduce_vector(gtot_, r);
+    }
+    if (space_.has_plate_dofs()) r.tail<6>() -= wrench_;
+    return e - plate_work(y);
+  }
+
+ private:
+  double plate_work(const Eigen::VectorXd& y) const {
+    return space_.has_plate_dofs() ? wrench_.dot(y.tail<6>()) : 0.0;
+  }
+
+  const MssModel& model_;
+  const ReducedSpace& space_;
+  const ExternalLoads& loads_;
+  Vector6d wrench_;
+  Eigen::VectorXd x_, g_, gtot_;
+};
+
+}  // namespace spinesim::mss::detail

@@ -1,0 +1,350 @@
+// Time integration of the MSS disc (solver.hpp, Simulator): explicit Euler (thesis 5.20-5.21),
+// symplectic Euler and implicit Euler, in the reduced coordinates y = (x_f, q) of
+// reduced_space.hpp, with the reduced lumped mass M_r = P^T M P and ambient damping
+// K_d D_r = K_d P^T P (5.11) (diagonal on the free DOF, a 6x6 block on the plate DOF).
+//
+// Per step, with u the reduced velocity and r(y) = dPi/dy the static residual (reduced_potential):
+//   explicit    u+ = u - dt M_r^-1 (r(y_n) + K_d D_r u),     y+ = y_n + dt u      (old u, 5.21)
+//   symplectic  u+ = the same,                               y+ = y_n + dt u+
+//   implicit    y+ = argmin Phi(y) = Pi(y) + |y - y_n - dt u|^2_{M_r}/(2 dt^2)
+//                                          + K_d |y - y_n|^2_{D_r}/(2 dt),     u+ = (y+ - y_n)/dt
+// The implicit step starts from the predictor y_n + dt u; each Newton iteration solves
+// (K + M_r/dt^2 + K_d D_r/dt) d = -dPhi/dy. With one iteration the full step is taken
+// (Baraff & Witkin 1998); with more, a backtracking line search on Phi guards every step.
+// MatrixUpdate::frozen uses the rest stiffness (exact = projected at rest) and keeps the numeric
+// factor across steps; it is refactorised when the plate mode or centre changes, or when the set
+// of nodes inside a probe changes (each such node adds k_p I to the frozen matrix, the
+// isotropic bound of the contact Hessian, so a penalty contact does not overshoot).
+// MatrixUpdate::every_iteration factorises the current Hessian each iteration (exact, falling
+// back to projected). Dirichlet nodes jump to the poses of the next boundary; their velocity is
+// the displacement over dt.
+#include "spinesim/mss/solver.hpp"
+
+#include "external_loads.hpp"
+#include "reduced_potential.hpp"
+#include "reduced_space.hpp"
+#include "sparse_cholesky.hpp"
+#include "spectrum.hpp"
+#include "tangent.hpp"
+
+#include <Eigen/Cholesky>
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace spinesim::mss {
+
+namespace {
+
+using detail::ExternalLoads;
+using detail::LumpedReduced;
+using detail::ReducedPotential;
+using detail::ReducedSpace;
+
+void require(bool ok, const std::string& message) {
+  if (!ok) throw std::invalid_argument(message);
+}
+
+void validate_options(const DynamicsOptions& o) {
+  require(std::isfinite(o.dt_s) && o.dt_s > 0.0, "mss: time step dt must be finite and > 0 s");
+  require(o.newton_iterations >= 1, "mss: newton_iterations must be >= 1");
+  require(std::isfinite(o.newton_relative_tolerance) && o.newton_relative_tolerance >= 0.0,
+          "mss: newton_relative_tolerance must be finite and >= 0");
+  require(std::isfinite(o.divergence_distance_mm) && o.divergence_distance_mm >= 0.0,
+          "mss: divergence_distance_mm must be finite and >= 0 (0: bounding-box diagonal)");
+}
+
+}  // namespace
+
+struct Simulator::Impl {
+  const MssModel* model = nullptr;
+  DynamicsOptions opt;
+  double kd = 0;               ///< K_d, N·s/mm
+  double divergence_mm = 0;
+  double probe_k_default = 0;  ///< N/mm
+  double floor_n = 0;          ///< round-off floor of residual norms, N
+  Eigen::SparseMatrix<double> H_rest, H;
+
+  // Reduced system of the current plate mode and centre.
+  bool have_space = false;
+  ReducedSpace space;
+  LumpedReduced mass, damp, inertia;  ///< M_r, D_r, M_r/dt^2 + K_d D_r/dt
+  Eigen::LDLT<Matrix6d> plate_mass;   ///< M_r's plate block (explicit integrators)
+  Eigen::SparseMatrix<double> A;
+  detail::SparseCholesky chol;
+  bool frozen_ready = false;
+  std::vector<int> frozen_contacts, contacts;
+
+  // Workspaces (sized once per reduced system): full 3#nodes and reduced vectors.
+  Eigen::VectorXd x, v, g;
+  Eigen::VectorXd y, yn, un, yhat, r, d, y_trial, r_trial, tmp;
+
+  void ensure_space(PlateMode mode, const Eigen::Vector3d& c);
+  void apply_dirichlet(const Boundary& bc, Eigen::VectorXd& xs) const;
+  /// Phi(y) and its gradient into r (implicit Euler).
+  double phi_and_gradient(ReducedPotential& pot, const Eigen::VectorXd& yy, Eigen::VectorXd& rr);
+  bool factor_frozen(const ExternalLoads& loads);
+  StepReport explicit_step(State& s, const Boundary& bc, const ExternalLoads& loads, bool symplectic);
+  StepReport implicit_step(State& s, const Boundary& bc, const ExternalLoads& loads);
+  StepReport commit(State& s, const Boundary& bc, int iterations);
+};
+
+void Simulator::Impl::ensure_space(PlateMode mode, const Eigen::Vector3d& c) {
+  if (have_space && space.mode() == mode && space.center() == c) return;
+  space = ReducedSpace(*model, H_rest, mode, c);
+  const double dt = opt.dt_s;
+  mass = space.lumped(model->node_masses_t());
+  damp = space.lumped(Eigen::VectorXd::Ones(model->num_nodes()));
+  inertia.diagonal = mass.diagonal / (dt * dt) + kd / dt * damp.diagonal;
+  inertia.plate = mass.plate / (dt * dt) + kd / dt * damp.plate;
+  plate_mass.compute(mass.plate);
+  A = space.pattern();
+  chol = detail::SparseCholesky();
+  frozen_ready = false;
+  const Eigen::Index n = space.size();
+  for (Eigen::VectorXd* w : {&y, &yn, &un, &yhat, &r, &d, &y_trial, &r_trial, &tmp}) w->setZero(n);
+  have_space = true;
+}
+
+void Simulator::Impl::apply_dirichlet(const Boundary& bc, Eigen::VectorXd& xs) const {
+  const Eigen::VectorXd& X = model->rest_positions_mm();
+  for (int i : space.inferior_nodes()) xs.segment<3>(3 * i) = bc.inferior.apply(X.segment<3>(3 * i));
+  if (!space.has_plate_dofs())
+    for (int i : space.superior_nodes()) xs.segment<3>(3 * i) = bc.superior.apply(X.segment<3>(3 * i));
+}
+
+double Simulator::Impl::phi_and_gradient(ReducedPotential& pot, const Eigen::VectorXd& yy,
+                                         Eigen::VectorXd& rr) {
+  const double dt = opt.dt_s;
+  double phi = pot.value_and_gradient(yy, rr);
+  tmp = yy - yhat;
+  phi += 0.5 * mass.quadratic_form(tmp) / (dt * dt);
+  mass.apply(tmp, d);  // d is free here: it is set after the gradient
+  rr.noalias() += d / (dt * dt);
+  tmp = yy - yn;
+  phi += 0.5 * kd * damp.quadratic_form(tmp) / dt;
+  damp.apply(tmp, d);
+  rr.noalias() += (kd / dt) * d;
+  return phi;
+}
+
+bool Simulator::Impl::factor_frozen(const ExternalLoads& loads) {
+  if (frozen_ready && contacts == frozen_contacts) return true;
+  space.reduce_matrix(H_rest, A);
+  space.add_lumped(inertia, 1.0, A);
+  for (int i : contacts) {
+    double k = 0;
+    for (const Probe& p : loads.probes()) k = std::max(k, p.stiffness_n_per_mm);
+    space.add_node_block(i, k * Eigen::Matrix3d::Identity(), A);
+  }
+  if (!chol.analyzed()) chol.analyze(A);
+  frozen_ready = chol.factorize(A);
+  frozen_contacts = contacts;
+  return frozen_ready;
+}
+
+StepReport Simulator::Impl::explicit_step(State& s, const Boundary& bc, const ExternalLoads& loads,
+                                          bool symplectic) {
+  const double dt = opt.dt_s;
+  // a(x_n, v_n) = -M_r^-1 (r(y_n) + K_d D_r u_n), forces at the current state (old endplates).
+  const Vector6d wrench = space.has_plate_dofs() ? bc.wrench : Vector6d::Zero();
+  ReducedPotential pot(*model, space, loads, wrench);
+  pot.x() = s.x_mm;
+  pot.value_and_gradient(yn, r);
+  damp.apply(un, d);
+  r.noalias() += kd * d;  // r <- M_r a with a sign flip
+  const Eigen::Index nf3 = space.plate_offset();
+  tmp.head(nf3) = -r.head(nf3).cwiseQuotient(mass.diagonal.head(nf3));  // acceleration
+  if (space.has_plate_dofs()) tmp.tail<6>() = -plate_mass.solve(Vector6d(r.tail<6>()));
+  if (symplectic) {
+    un.noalias() += dt * tmp;  // u+
+    y = yn + dt * un;          // x+ = x + dt v+
+  } else {
+    y = yn + dt * un;          // (5.21): x+ = x + dt v (old v)
+    un.noalias() += dt * tmp;  // (5.20): v+ = v + dt a
+  }
+  x = s.x_mm;
+  apply_dirichlet(bc, x);
+  space.set_unknown_positions(y, x);
+  return commit(s, bc, 0);
+}
+
+StepReport Simulator::Impl::implicit_step(State& s, const Boundary& bc, const ExternalLoads& loads) {
+  const double dt = opt.dt_s;
+  const Vector6d wrench = space.has_plate_dofs() ? bc.wrench : Vector6d::Zero();
+  ReducedPotential pot(*model, space, loads, wrench);
+  pot.x() = s.x_mm;
+  apply_dirichlet(bc, pot.x());
+  yhat = yn + dt * un;
+  y = yhat;
+  double phi = phi_and_gradient(pot, y, r);
+  const double r0 = space.force_norm(r);
+  int it = 0;
+  for (; it < opt.newton_iterations; ++it) {
+    if (!std::isfinite(phi) || !r.allFinite()) return {false, it, "non-finite forces in the implicit step"};
+    const double rn = space.force_norm(r);
+    if (rn <= floor_n || (it > 0 && rn <= opt.newton_relative_tolerance * r0)) break;
+    if (opt.matrix_update == MatrixUpdate::frozen) {
+      if (!loads.probes().empty()) loads.contact_nodes(pot.x(), contacts);
+      if (!factor_frozen(loads)) return {false, it, "the frozen implicit matrix is not positive definite"};
+    } else if (detail::factor_tangent(*model, space, loads, pot.x(), &inertia, 1.0, H, A, chol) ==
+               detail::TangentKind::failed) {
+      return {false, it, "the implicit step matrix could not be factorised"};
+    }
+    d = -r;
+    chol.solve_in_place(d);
+    if (opt.newton_iterations == 1) {  // Baraff-Witkin: one linearised step, no line search
+      y += d;
+      ++it;
+      break;
+    }
+    const double slope = r.dot(d);
+    bool accepted = false;
+    for (double alpha = 1.0; alpha > 1e-10 && !accepted; alpha *= 0.5) {
+      y_trial = y + alpha * d;
+      const double phi_trial = phi_and_gradient(pot, y_trial, r_trial);
+      if (!std::isfinite(phi_trial)) continue;
+      accepted = phi_trial <= phi + 1e-4 * alpha * slope ||
+                 (std::abs(phi_trial - phi) <= 1e-12 * std::abs(phi) &&
+                  space.force_norm(r_trial) < rn);
+      if (accepted) phi = phi_trial;
+    }
+    if (!accepted) return {false, it, "line search failed in the implicit step"};
+    y.swap(y_trial);
+    r.swap(r_trial);
+  }
+  un = (y - yn) / dt;
+  x = pot.x();
+  space.set_unknown_positions(y, x);
+  return commit(s, bc, it);
+}
+
+StepReport Simulator::Impl::commit(State& s, const Boundary& bc, int iterations) {
+  const double dt = opt.dt_s;
+  // Velocities: unknown nodes from u+, Dirichlet nodes from their displacement.
+  v = (x - s.x_mm) / dt;
+  space.set_unknown_rates(un, v);
+  const Eigen::VectorXd& X = model->rest_positions_mm();
+  double worst = 0;
+  for (Eigen::Index i = 0; i < model->num_nodes(); ++i)
+    worst = std::max(worst, (x.segment<3>(3 * i) - X.segment<3>(3 * i)).squaredNorm());
+  if (!x.allFinite() || !v.allFinite() || !std::isfinite(worst))
+    return {false, iterations, "step diverged: non-finite positions or velocities (state kept)"};
+  if (std::sqrt(worst) > divergence_mm)
+    return {false, iterations,
+            "step diverged: a node moved " + std::to_string(std::sqrt(worst)) +
+                " mm from rest, more than " + std::to_string(divergence_mm) + " mm (state kept)"};
+  Vector6d q;
+  if (space.has_plate_dofs()) {
+    q = y.tail<6>();
+    s.plate_qdot = un.tail<6>();
+  } else {
+    q = plate_motion(bc.superior, bc.plate_center_mm);
+    s.plate_qdot = (q - s.plate_q) / dt;
+  }
+  s.plate_q = q;
+  s.x_mm.swap(x);
+  s.v_mm_s.swap(v);
+  s.time_s += dt;
+  return {true, iterations, ""};
+}
+
+Simulator::Simulator(const MssModel& model, const DynamicsOptions& options)
+    : impl_(std::make_unique<Impl>()) {
+  validate_options(options);
+  Impl& d = *impl_;
+  d.model = &model;
+  d.opt = options;
+  d.kd = model.damping_n_s_per_mm();
+  const Eigen::VectorXd& X = model.rest_positions_mm();
+  model.hessian(X, HessianMode::exact, d.H_rest);
+  d.H = d.H_rest;
+  d.probe_k_default = detail::default_probe_stiffness(model, d.H_rest);
+  const Eigen::MatrixX3d& V = model.mesh().V;
+  const double diag = (V.colwise().maxCoeff() - V.colwise().minCoeff()).norm();
+  d.divergence_mm = options.divergence_distance_mm > 0 ? options.divergence_distance_mm : diag;
+  d.floor_n = 100.0 * std::numeric_limits<double>::epsilon() * d.H_rest.diagonal().cwiseAbs().mean() *
+              std::max(1.0, X.cwiseAbs().maxCoeff()) * std::sqrt(double(model.num_dofs()));
+  d.x.resize(model.num_dofs());
+  d.v.resize(model.num_dofs());
+}
+
+Simulator::~Simulator() = default;
+Simulator::Simulator(Simulator&&) noexcept = default;
+Simulator& Simulator::operator=(Simulator&&) noexcept = default;
+
+const DynamicsOptions& Simulator::options() const { return impl_->opt; }
+
+State Simulator::rest_state() const {
+  State s;
+  s.x_mm = impl_->model->rest_positions_mm();
+  s.v_mm_s = Eigen::VectorXd::Zero(s.x_mm.size());
+  return s;
+}
+
+StepReport Simulator::step(State& s, const Boundary& bc) {
+  Impl& d = *impl_;
+  const MssModel& model = *d.model;
+  validate(bc, model.num_nodes());
+  require(s.x_mm.size() == model.num_dofs() && s.v_mm_s.size() == model.num_dofs(),
+          "mss: state vectors must have 3 x #nodes entries");
+  if (!s.x_mm.allFinite() || !s.v_mm_s.allFinite() || !s.plate_q.allFinite() || !s.plate_qdot.allFinite())
+    return {false, 0, "state is not finite"};
+  d.ensure_space(bc.plate_mode, bc.plate_center_mm);
+  const ExternalLoads loads(bc, d.probe_k_default);
+  d.space.gather(s.x_mm, s.plate_q, d.yn);
+  d.space.gather(s.v_mm_s, s.plate_qdot, d.un);
+  switch (d.opt.integrator) {
+    case Integrator::explicit_euler: return d.explicit_step(s, bc, loads, false);
+    case Integrator::symplectic_euler: return d.explicit_step(s, bc, loads, true);
+    default: return d.implicit_step(s, bc, loads);
+  }
+}
+
+double Simulator::predicted_stable_dt_s(Integrator integrator) const {
+  if (integrator == Integrator::implicit_euler) return std::numeric_limits<double>::infinity();
+  const Impl& d = *impl_;
+  const MssModel& model = *d.model;
+  // Free nodes with both endplates fixed, at rest: K_ff and the lumped masses.
+  const ReducedSpace fixed(model, d.H_rest, PlateMode::pose, Eigen::Vector3d::Zero());
+  const Eigen::Index n = fixed.size();
+  if (n == 0) return std::numeric_limits<double>::infinity();
+  Eigen::SparseMatrix<double> K = fixed.pattern();
+  fixed.reduce_matrix(d.H_rest, K);
+  const Eigen::VectorXd m = fixed.lumped(model.node_masses_t()).diagonal;
+  const double kd = d.kd;
+  if (integrator == Integrator::explicit_euler) {
+    // Every eigenpair (lambda, z) of the damped system gives the scalar m_z l^2 + c_z l + k_z = 0
+    // with m_z = z*Mz, c_z = K_d |z|^2, k_z = z*Kz; explicit Euler keeps |1 + l dt| < 1 iff
+    // dt < c_z/k_z (underdamped) and dt < 4 m_z / (c_z + sqrt(c_z^2 - 4 m_z k_z)) (overdamped).
+    // Both hold for dt < min(K_d / lambda_max(K_ff), 2 m_min / K_d): a sufficient bound, exact
+    // for equal masses. Undamped (K_d = 0) explicit Euler is unstable at any dt.
+    if (kd <= 0) return 0.0;
+    const detail::TopEigenpair top = detail::largest_eigenpair(
+        [&](const Eigen::VectorXd& v, Eigen::VectorXd& out) {
+          out.noalias() = K.selfadjointView<Eigen::Lower>() * v;
+        },
+        n);
+    return std::min(kd / top.value, 2.0 * m.minCoeff() / kd);
+  }
+  // Symplectic Euler: for the scalar mode (omega, gamma = c/m) the step is stable iff
+  // omega^2 dt^2 + 2 gamma dt < 4, i.e. dt < 4 / (gamma + sqrt(gamma^2 + 4 omega^2)); taken at
+  // the top mode of M^-1 K_ff (omega_max, and gamma = K_d |phi|^2 / phi^T M phi of its shape).
+  // Undamped this is 2 / omega_max.
+  const Eigen::VectorXd s = m.cwiseSqrt().cwiseInverse();
+  Eigen::VectorXd w(n);
+  const detail::TopEigenpair top = detail::largest_eigenpair(
+      [&](const Eigen::VectorXd& v, Eigen::VectorXd& out) {
+        w = s.cwiseProduct(v);
+        out.noalias() = K.selfadjointView<Eigen::Lower>() * w;
+        out.array() *= s.array();
+      },
+      n);
+  const Eigen::VectorXd phi = s.cwiseProduct(top.vector);
+  const double gamma = kd * phi.squaredNorm() / phi.dot(m.cwiseProduct(phi));
+  return 4.0 / (gamma + std::sqrt(gamma * gamma + 4.0 * top.value));
+}
+
+}  // namespace spinesim::mss
