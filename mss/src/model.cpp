@@ -2,6 +2,7 @@
 // Formulas and constants: model.hpp; element kernels: elements.cpp.
 #include "spinesim/mss/model.hpp"
 
+#include "face_angles.hpp"
 #include "hessian_pattern.hpp"
 
 #include <Eigen/Geometry>
@@ -29,11 +30,13 @@ struct EdgeSpring {
   double k;          ///< scaled total, N/mm
 };
 
-struct AngleSpring {
-  int apex, a, b;
-  double rest_rad;
-  double k_part[2];  ///< N·mm/rad (unscaled)
-  double k;          ///< scaled total
+/// The three angle springs of one face (one per corner), which share one k_t.
+struct AngleFace {
+  int v[3];
+  double rest_rad[3];  ///< rest angle at each corner
+  FaceRest rest;       ///< its cos and sin
+  double k_part[2];    ///< N·mm/rad (unscaled)
+  double k;            ///< scaled total
 };
 
 /// Per-tetrahedron terms (radial springs and volume penalty share the vertex set).
@@ -77,7 +80,7 @@ void check_size(const Eigen::VectorXd& x, Eigen::Index n) {
 struct KSelect {
   int region = -1;  ///< -1: scaled total
   double edge(const EdgeSpring& e) const { return region < 0 ? e.k : e.k_part[region]; }
-  double angle(const AngleSpring& a) const { return region < 0 ? a.k : a.k_part[region]; }
+  double angle(const AngleFace& a) const { return region < 0 ? a.k : a.k_part[region]; }
   double tet(const TetTerm& t) const {
     return region < 0 ? t.k : (t.region == region ? t.k_unscaled : 0.0);
   }
@@ -95,13 +98,13 @@ struct MssModel::Impl {
   double rest_volume = 0;
 
   std::vector<EdgeSpring> edges;
-  std::vector<AngleSpring> angles;
+  std::vector<AngleFace> faces;  // angle springs, three per face
   std::vector<TetTerm> radial;
   std::vector<TetTerm> volume;
 
   HessianPattern pattern;   // 3x3 node blocks of every node pair sharing a tet
   std::vector<int> edge_slots;    // 4 per edge: block (a,b) offsets, a,b in {0,1}
-  std::vector<int> angle_slots;   // 9 per angle spring
+  std::vector<int> face_slots;    // 9 per face
   std::vector<int> tet_slots;     // 16 per tetrahedron
 
   void build(const mesh::RegionMaterials& materials);
@@ -164,24 +167,25 @@ void MssModel::Impl::build(const mesh::RegionMaterials& materials) {
 
   // 3. Equivalent cylinder (5.6)-(5.7): endplate diameters from their areas projected on the
   //    disc axis (equal-area circles), V the mesh volume.
-  std::vector<std::array<int, 4>> faces;  // sorted (v0, v1, v2) + tet
-  faces.reserve(4 * nt);
+  std::vector<std::array<int, 4>> face_list;  // sorted (v0, v1, v2) + tet
+  face_list.reserve(4 * nt);
   static constexpr int kFace[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};
   for (Eigen::Index t = 0; t < nt; ++t)
     for (const auto& f : kFace) {
       std::array<int, 3> v{mesh.T(t, f[0]), mesh.T(t, f[1]), mesh.T(t, f[2])};
       std::sort(v.begin(), v.end());
-      faces.push_back({v[0], v[1], v[2], static_cast<int>(t)});
+      face_list.push_back({v[0], v[1], v[2], static_cast<int>(t)});
     }
-  std::sort(faces.begin(), faces.end());
+  std::sort(face_list.begin(), face_list.end());
   const Eigen::Vector3d axis = mesh.frame.axes.col(1).normalized();
   double area_label[3] = {0, 0, 0};
   std::vector<std::pair<std::array<int, 3>, std::vector<int>>> unique_faces;
-  for (std::size_t s = 0; s < faces.size();) {
-    std::array<int, 3> v{faces[s][0], faces[s][1], faces[s][2]};
+  for (std::size_t s = 0; s < face_list.size();) {
+    const auto& fs = face_list;
+    std::array<int, 3> v{fs[s][0], fs[s][1], fs[s][2]};
     std::vector<int> tets;
-    for (; s < faces.size() && faces[s][0] == v[0] && faces[s][1] == v[1] && faces[s][2] == v[2]; ++s)
-      tets.push_back(faces[s][3]);
+    for (; s < fs.size() && fs[s][0] == v[0] && fs[s][1] == v[1] && fs[s][2] == v[2]; ++s)
+      tets.push_back(fs[s][3]);
     if (tets.size() == 1) {
       const int l0 = mesh.surface(v[0]), l1 = mesh.surface(v[1]), l2 = mesh.surface(v[2]);
       if (l0 == l1 && l1 == l2 && (l0 == 1 || l0 == 2)) {
@@ -210,21 +214,21 @@ void MssModel::Impl::build(const mesh::RegionMaterials& materials) {
     cylinder.k_t_per_shear_modulus = kPi * std::pow(Dm, 4) /
                                      (32.0 * cylinder.length_mm *
                                       static_cast<double>(cylinder.num_angle_springs));
-    angles.reserve(3 * unique_faces.size());
+    faces.reserve(unique_faces.size());
     for (const auto& [v, tets] : unique_faces) {
+      AngleFace f;
       double g_part[2] = {0.0, 0.0};
       for (int t : tets) g_part[region_index(mesh.region(t))] += G[t] / static_cast<double>(tets.size());
+      for (int r = 0; r < 2; ++r) f.k_part[r] = g_part[r] * cylinder.k_t_per_shear_modulus;
+      f.k = 0.0;
       for (int corner = 0; corner < 3; ++corner) {
-        AngleSpring sp;
-        sp.apex = v[corner];
-        sp.a = v[(corner + 1) % 3];
-        sp.b = v[(corner + 2) % 3];
-        sp.rest_rad = angle_at(X.segment<3>(3 * sp.apex), X.segment<3>(3 * sp.a),
-                               X.segment<3>(3 * sp.b));
-        for (int r = 0; r < 2; ++r) sp.k_part[r] = g_part[r] * cylinder.k_t_per_shear_modulus;
-        sp.k = 0.0;
-        angles.push_back(sp);
+        f.v[corner] = v[corner];
+        f.rest_rad[corner] = angle_at(X.segment<3>(3 * v[corner]), X.segment<3>(3 * v[(corner + 1) % 3]),
+                                      X.segment<3>(3 * v[(corner + 2) % 3]));
+        f.rest.cos0[corner] = std::cos(f.rest_rad[corner]);
+        f.rest.sin0[corner] = std::sin(f.rest_rad[corner]);
       }
+      faces.push_back(f);
     }
   } else if (cylinder.mean_diameter_mm > 0.0) {
     const double Dm = cylinder.mean_diameter_mm;
@@ -265,12 +269,10 @@ void MssModel::Impl::build(const mesh::RegionMaterials& materials) {
     for (int a = 0; a < 2; ++a)
       for (int b = 0; b < 2; ++b) edge_slots[4 * e + 2 * a + b] = pattern.block(v[a], v[b]);
   }
-  angle_slots.resize(9 * angles.size());
-  for (std::size_t s = 0; s < angles.size(); ++s) {
-    const int v[3] = {angles[s].apex, angles[s].a, angles[s].b};
+  face_slots.resize(9 * faces.size());
+  for (std::size_t s = 0; s < faces.size(); ++s)
     for (int a = 0; a < 3; ++a)
-      for (int b = 0; b < 3; ++b) angle_slots[9 * s + 3 * a + b] = pattern.block(v[a], v[b]);
-  }
+      for (int b = 0; b < 3; ++b) face_slots[9 * s + 3 * a + b] = pattern.block(faces[s].v[a], faces[s].v[b]);
   tet_slots.resize(16 * static_cast<std::size_t>(nt));
   for (Eigen::Index t = 0; t < nt; ++t)
     for (int a = 0; a < 4; ++a)
@@ -285,7 +287,7 @@ void MssModel::Impl::apply_scales() {
   auto scale = [&](Term term, int r) { return s[static_cast<int>(term)].by_region[r]; };
   for (auto& e : edges)
     e.k = scale(Term::main, 0) * e.k_part[0] + scale(Term::main, 1) * e.k_part[1];
-  for (auto& a : angles)
+  for (auto& a : faces)
     a.k = scale(Term::torsion, 0) * a.k_part[0] + scale(Term::torsion, 1) * a.k_part[1];
   for (auto& t : radial) t.k = scale(Term::radial, t.region) * t.k_unscaled;
   for (auto& t : volume) t.k = scale(Term::volume, t.region) * t.k_unscaled;
@@ -320,7 +322,7 @@ double MssModel::damping_n_s_per_mm() const { return impl_->damping; }
 const EquivalentCylinder& MssModel::cylinder() const { return impl_->cylinder; }
 Eigen::Index MssModel::num_edge_springs() const { return static_cast<Eigen::Index>(impl_->edges.size()); }
 Eigen::Index MssModel::num_radial_tets() const { return static_cast<Eigen::Index>(impl_->radial.size()); }
-Eigen::Index MssModel::num_angle_springs() const { return static_cast<Eigen::Index>(impl_->angles.size()); }
+Eigen::Index MssModel::num_angle_springs() const { return 3 * static_cast<Eigen::Index>(impl_->faces.size()); }
 Eigen::Index MssModel::num_volume_terms() const { return static_cast<Eigen::Index>(impl_->volume.size()); }
 double MssModel::rest_volume_mm3() const { return impl_->rest_volume; }
 
@@ -383,15 +385,16 @@ double MssModel::Impl::accumulate(const Eigen::VectorXd& x, const bool* terms, K
     }
   }
   if (terms[static_cast<int>(Term::torsion)]) {
-    Vector9d g;
-    for (const AngleSpring& a : m.angles) {
-      energy += angle_spring(point(a.apex), point(a.a), point(a.b), sel.angle(a), a.rest_rad,
-                             grad ? &g : nullptr);
-      if (grad) {
-        grad->segment<3>(3 * a.apex) += g.segment<3>(0);
-        grad->segment<3>(3 * a.a) += g.segment<3>(3);
-        grad->segment<3>(3 * a.b) += g.segment<3>(6);
-      }
+    if (grad) {
+      double* g = grad->data();
+      for (const AngleFace& f : m.faces)
+        energy += face_angle_springs<true>(xp + 3 * f.v[0], xp + 3 * f.v[1], xp + 3 * f.v[2],
+                                           sel.angle(f), f.rest, g + 3 * f.v[0], g + 3 * f.v[1],
+                                           g + 3 * f.v[2]);
+    } else {
+      for (const AngleFace& f : m.faces)
+        energy += face_angle_springs<false>(xp + 3 * f.v[0], xp + 3 * f.v[1], xp + 3 * f.v[2],
+                                            sel.angle(f), f.rest, nullptr, nullptr, nullptr);
     }
   }
   const Eigen::MatrixX4i& T = m.mesh.T;
@@ -436,11 +439,17 @@ void MssModel::hessian(const Eigen::VectorXd& x, HessianMode mode,
     scatter(h6, &m.edge_slots[4 * e], 2, nodes);
   }
   Matrix9d h9;
-  for (std::size_t a = 0; a < m.angles.size(); ++a) {
-    const AngleSpring& s = m.angles[a];
-    angle_spring(point(s.apex), point(s.a), point(s.b), s.k, s.rest_rad, nullptr, &h9, mode);
-    const int nodes[3] = {s.apex, s.a, s.b};
-    scatter(h9, &m.angle_slots[9 * a], 3, nodes);
+  for (std::size_t s = 0; s < m.faces.size(); ++s) {
+    const AngleFace& f = m.faces[s];
+    for (int c = 0; c < 3; ++c) {  // corner c: apex v[c], arms to v[c+1], v[c+2]
+      const int nodes[3] = {f.v[c], f.v[(c + 1) % 3], f.v[(c + 2) % 3]};
+      angle_spring(point(nodes[0]), point(nodes[1]), point(nodes[2]), f.k, f.rest_rad[c], nullptr,
+                   &h9, mode);
+      int slots[9];
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) slots[3 * a + b] = m.face_slots[9 * s + 3 * ((c + a) % 3) + (c + b) % 3];
+      scatter(h9, slots, 3, nodes);
+    }
   }
   Matrix12d h12;
   auto tet_hessians = [&](const std::vector<TetTerm>& list, auto kernel) {

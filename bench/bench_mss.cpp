@@ -1,0 +1,177 @@
+// MSS disc benchmarks: what one 1 kHz step costs, by stage and disc size, on the CGAL L4-L5 disc.
+//
+// Meshes: the parametric L4-L5 disc (data/disc_morphometry.csv) meshed by CGAL at a cell size
+// (benchmark argument, µm); the tet count is a counter. Material: real-disc (E 3.22 MPa,
+// nu 0.4557, rho 1038 kg/m^3), thesis springs (main + radial + torsion).
+//   Gradient        — MssModel::gradient (all internal forces), the per-step force evaluation
+//   Hessian         — MssModel::hessian (exact), refilled in its fixed pattern
+//   ImplicitFrozen  — one implicit Euler step, dt 1 ms, one Newton iteration on the rest
+//                     factorisation (MatrixUpdate::frozen): the real-time haptic step
+//   ImplicitNewton  — one implicit Euler step, dt 1 ms, the matrix refactorised (numeric only)
+//   Static          — Newton equilibrium under 10 % axial compression
+//   AllDiscs        — the 17 discs T1-T2 .. L5-S1 (default cell size), one frozen implicit step
+//                     each: real time at 1 kHz needs < 1 ms per iteration
+// Run: build/release/bench/bench_mss [--benchmark_filter=Implicit]
+#include "spinesim/mesh/disc_geometry.hpp"
+#include "spinesim/mesh/material.hpp"
+#include "spinesim/mesh/mesher.hpp"
+#include "spinesim/mss/model.hpp"
+#include "spinesim/mss/solver.hpp"
+
+#include <benchmark/benchmark.h>
+
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+using namespace spinesim;
+using namespace spinesim::mss;
+
+namespace {
+
+mesh::RegionMaterials real_disc() { return mesh::load_material("real-disc", SPINESIM_DATA_DIR); }
+
+const mesh::TetMesh& disc_mesh(const std::string& level, double cell_mm) {
+  static std::map<std::pair<std::string, long>, mesh::TetMesh> cache;
+  const auto key = std::make_pair(level, std::lround(cell_mm * 1000));
+  auto it = cache.find(key);
+  if (it == cache.end()) {
+    mesh::MeshOptions opt;
+    opt.cell_size_mm = cell_mm;
+    it = cache.emplace(key, mesh::mesh_parametric_disc(
+                                mesh::disc_dimensions(level, SPINESIM_DATA_DIR), opt)).first;
+  }
+  return it->second;
+}
+
+const MssModel& disc_model(double cell_mm) {
+  static std::map<long, std::unique_ptr<MssModel>> cache;
+  auto& m = cache[std::lround(cell_mm * 1000)];
+  if (!m) m = std::make_unique<MssModel>(disc_mesh("L4-L5", cell_mm), real_disc());
+  return *m;
+}
+
+void set_counters(benchmark::State& state, const MssModel& model) {
+  state.counters["tets"] = double(model.mesh().num_tets());
+  state.counters["nodes"] = double(model.num_nodes());
+  state.counters["angle_springs"] = double(model.num_angle_springs());
+}
+
+/// Boundary for 10 % axial compression of the plate (pose mode).
+Boundary compression(const MssModel& model, double fraction) {
+  Boundary bc;
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  int n = 0;
+  for (Eigen::Index i = 0; i < model.num_nodes(); ++i)
+    if (model.mesh().surface(i) == 2) c += model.mesh().V.row(i).transpose(), ++n;
+  bc.plate_center_mm = c / n;
+  Vector6d q = Vector6d::Zero();
+  q(1) = -fraction * model.cylinder().length_mm;
+  bc.superior = plate_pose(q, bc.plate_center_mm);
+  return bc;
+}
+
+void Gradient(benchmark::State& state) {
+  const MssModel& model = disc_model(state.range(0) / 1000.0);
+  Eigen::VectorXd x = model.rest_positions_mm(), g;
+  x *= 1.01;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(model.gradient(x, g));
+    benchmark::ClobberMemory();
+  }
+  set_counters(state, model);
+}
+
+void Hessian(benchmark::State& state) {
+  const MssModel& model = disc_model(state.range(0) / 1000.0);
+  Eigen::VectorXd x = model.rest_positions_mm() * 1.01;
+  Eigen::SparseMatrix<double> H;
+  for (auto _ : state) {
+    model.hessian(x, HessianMode::exact, H);
+    benchmark::ClobberMemory();
+  }
+  set_counters(state, model);
+}
+
+void step_benchmark(benchmark::State& state, MatrixUpdate update) {
+  const MssModel& model = disc_model(state.range(0) / 1000.0);
+  DynamicsOptions opt;
+  opt.dt_s = 1e-3;
+  opt.matrix_update = update;
+  Simulator sim(model, opt);
+  State s = sim.rest_state();
+  const Boundary bc = compression(model, 0.02);
+  sim.step(s, bc);  // first step: analysis (+ the frozen factorisation)
+  for (auto _ : state) {
+    const StepReport r = sim.step(s, bc);
+    if (!r.ok) state.SkipWithError(r.message.c_str());
+  }
+  set_counters(state, model);
+}
+
+void ImplicitFrozen(benchmark::State& state) { step_benchmark(state, MatrixUpdate::frozen); }
+void ImplicitNewton(benchmark::State& state) { step_benchmark(state, MatrixUpdate::every_iteration); }
+
+void Static(benchmark::State& state) {
+  const MssModel& model = disc_model(state.range(0) / 1000.0);
+  const Boundary bc = compression(model, 0.10);
+  int iterations = 0;
+  for (auto _ : state) {
+    const StaticResult r = solve_static(model, bc);
+    if (!r.converged) state.SkipWithError(r.message.c_str());
+    iterations = r.iterations;
+  }
+  state.counters["newton_iterations"] = iterations;
+  set_counters(state, model);
+}
+
+void AllDiscs(benchmark::State& state) {
+  struct Disc {
+    std::unique_ptr<MssModel> model;
+    std::unique_ptr<Simulator> sim;
+    State s;
+    Boundary bc;
+  };
+  static std::vector<Disc> discs;
+  double tets = 0;
+  if (discs.empty()) {
+    DynamicsOptions opt;
+    opt.dt_s = 1e-3;
+    opt.matrix_update = MatrixUpdate::frozen;
+    for (const std::string& level : mesh::disc_levels()) {
+      Disc d;
+      d.model = std::make_unique<MssModel>(disc_mesh(level, 2.0), real_disc());
+      d.sim = std::make_unique<Simulator>(*d.model, opt);
+      d.s = d.sim->rest_state();
+      d.bc = compression(*d.model, 0.02);
+      d.sim->step(d.s, d.bc);
+      discs.push_back(std::move(d));
+    }
+  }
+  for (const Disc& d : discs) tets += double(d.model->mesh().num_tets());
+  for (auto _ : state)
+    for (Disc& d : discs) {
+      const StepReport r = d.sim->step(d.s, d.bc);
+      if (!r.ok) state.SkipWithError(r.message.c_str());
+    }
+  state.counters["discs"] = double(discs.size());
+  state.counters["tets"] = tets;
+}
+
+// Cell sizes 4, 3, 2.5, 2, 1.5 mm (µm arguments).
+void sizes(benchmark::internal::Benchmark* b) {
+  for (int um : {4000, 3000, 2500, 2000, 1500}) b->Arg(um);
+  b->Unit(benchmark::kMicrosecond);
+}
+
+}  // namespace
+
+BENCHMARK(Gradient)->Apply(sizes);
+BENCHMARK(Hessian)->Apply(sizes);
+BENCHMARK(ImplicitFrozen)->Apply(sizes);
+BENCHMARK(ImplicitNewton)->Apply(sizes);
+BENCHMARK(Static)->Apply(sizes)->Unit(benchmark::kMillisecond);
+BENCHMARK(AllDiscs)->Unit(benchmark::kMicrosecond);
+
+BENCHMARK_MAIN();
