@@ -56,6 +56,7 @@ void validate_options(const MssOptions& o) {
   auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
   require(positive(o.radial_factor), "mss: radial_factor must be finite and > 0");
   require(positive(o.volume_factor), "mss: volume_factor must be finite and > 0");
+  require(positive(o.disc_volume_factor), "mss: disc_volume_factor must be finite and > 0");
   require(std::isfinite(o.damping_ratio) && o.damping_ratio >= 0.0,
           "mss: damping ratio must be finite and >= 0");
   require(std::isfinite(o.damping_n_s_per_mm), "mss: damping K_d must be finite");
@@ -84,6 +85,9 @@ struct KSelect {
   double tet(const TetTerm& t) const {
     return region < 0 ? t.k : (t.region == region ? t.k_unscaled : 0.0);
   }
+  double disc(double k_scaled, double k_unscaled) const {
+    return region < 0 ? k_scaled : (region == 0 ? k_unscaled : 0.0);
+  }
 };
 
 }  // namespace
@@ -101,6 +105,8 @@ struct MssModel::Impl {
   std::vector<AngleFace> faces;  // angle springs, three per face
   std::vector<TetTerm> radial;
   std::vector<TetTerm> volume;
+  bool disc_volume_on = false;
+  double disc_k_unscaled = 0, disc_k = 0;  // k_g, N/mm^5
 
   HessianPattern pattern;   // 3x3 node blocks of every node pair sharing a tet
   std::vector<int> edge_slots;    // 4 per edge: block (a,b) offsets, a,b in {0,1}
@@ -109,6 +115,8 @@ struct MssModel::Impl {
 
   void build(const mesh::RegionMaterials& materials);
   void apply_scales();
+  /// Disc volume V(x) = sum of signed tet volumes, and dV/dx into *u (3n) when u != nullptr.
+  double volume_and_gradient(const Eigen::VectorXd& x, Eigen::VectorXd* u) const;
   /// Energy and (optionally, grad != nullptr, accumulated) gradient of the selected terms: the
   /// one loop behind energy, gradient, term_energy and term_gradient.
   double accumulate(const Eigen::VectorXd& x, const bool* terms, KSelect sel,
@@ -249,6 +257,14 @@ void MssModel::Impl::build(const mesh::RegionMaterials& materials) {
       volume.push_back({static_cast<int>(t), r, V0[t], options.volume_factor * K[t] / V0[t], 0.0});
   }
 
+  // 5b. Whole-disc volume term: k_g = c_g K_mean / V0.
+  if (options.disc_volume_term) {
+    double KV = 0.0;
+    for (Eigen::Index t = 0; t < nt; ++t) KV += K[t] * V0[t];
+    disc_volume_on = true;
+    disc_k_unscaled = options.disc_volume_factor * (KV / rest_volume) / rest_volume;
+  }
+
   // 6. Ambient damping (5.11).
   if (options.damping_n_s_per_mm >= 0.0) {
     damping = options.damping_n_s_per_mm;
@@ -291,6 +307,7 @@ void MssModel::Impl::apply_scales() {
     a.k = scale(Term::torsion, 0) * a.k_part[0] + scale(Term::torsion, 1) * a.k_part[1];
   for (auto& t : radial) t.k = scale(Term::radial, t.region) * t.k_unscaled;
   for (auto& t : volume) t.k = scale(Term::volume, t.region) * t.k_unscaled;
+  disc_k = scale(Term::disc_volume, 0) * disc_k_unscaled;
 }
 
 MssModel::MssModel(const mesh::TetMesh& mesh, const mesh::RegionMaterials& materials,
@@ -337,13 +354,13 @@ void MssModel::set_scales(const std::array<RegionScales, kNumTerms>& scales) {
 
 double MssModel::energy(const Eigen::VectorXd& x) const {
   check_size(x, num_nodes());
-  const bool all[kNumTerms] = {true, true, true, true};
+  const bool all[kNumTerms] = {true, true, true, true, true};
   return impl_->accumulate(x, all, KSelect{}, nullptr);
 }
 
 double MssModel::gradient(const Eigen::VectorXd& x, Eigen::VectorXd& grad) const {
   check_size(x, num_nodes());
-  const bool all[kNumTerms] = {true, true, true, true};
+  const bool all[kNumTerms] = {true, true, true, true, true};
   grad.setZero(x.size());
   return impl_->accumulate(x, all, KSelect{}, &grad);
 }
@@ -352,7 +369,7 @@ double MssModel::term_energy(const Eigen::VectorXd& x, Term term, int region_ind
   check_size(x, num_nodes());
   if (region_index != 0 && region_index != 1)
     throw std::invalid_argument("mss: region index must be 0 (annulus) or 1 (nucleus)");
-  bool only[kNumTerms] = {false, false, false, false};
+  bool only[kNumTerms] = {false, false, false, false, false};
   only[static_cast<int>(term)] = true;
   return impl_->accumulate(x, only, KSelect{region_index}, nullptr);
 }
@@ -362,7 +379,7 @@ void MssModel::term_gradient(const Eigen::VectorXd& x, Term term, int region_ind
   check_size(x, num_nodes());
   if (region_index != 0 && region_index != 1)
     throw std::invalid_argument("mss: region index must be 0 (annulus) or 1 (nucleus)");
-  bool only[kNumTerms] = {false, false, false, false};
+  bool only[kNumTerms] = {false, false, false, false, false};
   only[static_cast<int>(term)] = true;
   grad.setZero(x.size());
   impl_->accumulate(x, only, KSelect{region_index}, &grad);
@@ -414,6 +431,13 @@ double MssModel::Impl::accumulate(const Eigen::VectorXd& x, const bool* terms, K
     tet_loop(m.volume, [](const TetPoints& p, double k, double rest, Vector12d* g) {
       return volume_penalty(p, k, rest, g);
     });
+  if (terms[static_cast<int>(Term::disc_volume)] && m.disc_volume_on) {
+    const double k = sel.disc(m.disc_k, m.disc_k_unscaled);
+    Eigen::VectorXd u;
+    const double excess = volume_and_gradient(x, grad ? &u : nullptr) - m.rest_volume;
+    energy += 0.5 * k * excess * excess;
+    if (grad) *grad += (k * excess) * u;
+  }
   return energy;
 }
 
@@ -465,6 +489,70 @@ void MssModel::hessian(const Eigen::VectorXd& x, HessianMode mode,
   tet_hessians(m.volume, [mode](const TetPoints& p, double k, double rest, Matrix12d* h) {
     volume_penalty(p, k, rest, nullptr, h, mode);
   });
+  // Whole-disc volume, sparse part k_g (V - V0) H_V (exact mode only; the rank-one part is
+  // disc_volume_rank_one's). H_V is trilinear in the arms a, b, c of each tet:
+  //   d2V/da db = -[c]x/6,  d2V/da dc = [b]x/6,  d2V/db dc = -[a]x/6, zero diagonal blocks.
+  if (m.disc_volume_on && mode == HessianMode::exact) {
+    const double w = m.disc_k * (m.volume_and_gradient(x, nullptr) - m.rest_volume);
+    auto skew = [](const Eigen::Vector3d& v) {
+      Eigen::Matrix3d S;
+      S << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
+      return S;
+    };
+    for (Eigen::Index t = 0; t < m.mesh.num_tets(); ++t) {
+      const TetPoints p = tet_points(x, m.mesh.T, static_cast<int>(t));
+      const Eigen::Matrix3d Sa = skew((p.col(1) - p.col(0)) * (w / 6.0));
+      const Eigen::Matrix3d Sb = skew((p.col(2) - p.col(0)) * (w / 6.0));
+      const Eigen::Matrix3d Sc = skew((p.col(3) - p.col(0)) * (w / 6.0));
+      Eigen::Matrix<double, 9, 9> arms;  // w H_V with respect to (a, b, c)
+      arms << Eigen::Matrix3d::Zero(), -Sc, Sb, Sc, Eigen::Matrix3d::Zero(), -Sa, -Sb, Sa,
+          Eigen::Matrix3d::Zero();
+      // Nodes: x1, x2, x3 are the arm ends, x0 = minus their sum: H = P arms P^T.
+      Matrix12d h = Matrix12d::Zero();
+      h.bottomRightCorner<9, 9>() = arms;
+      for (int i = 0; i < 3; ++i) {
+        Eigen::Matrix3d row = Eigen::Matrix3d::Zero();
+        for (int j = 0; j < 3; ++j) row += arms.block<3, 3>(3 * i, 3 * j);
+        h.block<3, 3>(3 + 3 * i, 0) = -row;  // d/dx_{i+1} d/dx0 = -sum over the arms of x0
+      }
+      h.topRightCorner<3, 9>() = h.bottomLeftCorner<9, 3>().transpose();
+      h.topLeftCorner<3, 3>() = -h.block<3, 3>(3, 0) - h.block<3, 3>(6, 0) - h.block<3, 3>(9, 0);
+      const int nodes[4] = {m.mesh.T(t, 0), m.mesh.T(t, 1), m.mesh.T(t, 2), m.mesh.T(t, 3)};
+      scatter(h, &m.tet_slots[16 * static_cast<std::size_t>(t)], 4, nodes);
+    }
+  }
+}
+
+double MssModel::Impl::volume_and_gradient(const Eigen::VectorXd& x, Eigen::VectorXd* u) const {
+  if (u) u->setZero(x.size());
+  double v = 0.0;
+  for (Eigen::Index t = 0; t < mesh.num_tets(); ++t) {
+    const TetPoints p = tet_points(x, mesh.T, static_cast<int>(t));
+    const Eigen::Vector3d a = p.col(1) - p.col(0), b = p.col(2) - p.col(0), c = p.col(3) - p.col(0);
+    const Eigen::Vector3d bc = b.cross(c);
+    v += a.dot(bc) / 6.0;
+    if (u) {
+      // dV_t/dx_i: a third of the opposite face's area vector, pointing towards x_i.
+      const Eigen::Vector3d g1 = bc / 6.0, g2 = c.cross(a) / 6.0, g3 = a.cross(b) / 6.0;
+      u->segment<3>(3 * mesh.T(t, 0)) -= g1 + g2 + g3;
+      u->segment<3>(3 * mesh.T(t, 1)) += g1;
+      u->segment<3>(3 * mesh.T(t, 2)) += g2;
+      u->segment<3>(3 * mesh.T(t, 3)) += g3;
+    }
+  }
+  return v;
+}
+
+bool MssModel::has_disc_volume_term() const { return impl_->disc_volume_on; }
+
+double MssModel::disc_volume_rank_one(const Eigen::VectorXd& x, Eigen::VectorXd& u) const {
+  check_size(x, num_nodes());
+  if (!impl_->disc_volume_on) {
+    u.setZero(x.size());
+    return 0.0;
+  }
+  impl_->volume_and_gradient(x, &u);
+  return impl_->disc_k;
 }
 
 double MssModel::volume_mm3(const Eigen::VectorXd& x) const {

@@ -43,6 +43,7 @@ mesh::TetMesh two_region_box() {
 MssOptions all_terms() {
   MssOptions o;
   o.volume_term = true;
+  o.disc_volume_term = true;
   return o;
 }
 
@@ -90,6 +91,7 @@ TEST(MssModel, RestIsEquilibriumWithZeroEnergy) {
 //   radial sum_t 1/2 (E_t V_t / S0^2)(eps S0)^2 = 1/2 eps^2 sum_t E_t V_t
 //   angle  0
 //   volume sum_t 1/2 (K_t/V_t) (((1+eps)^3 - 1) V_t)^2
+//   disc   1/2 (K_mean/V) (((1+eps)^3 - 1) V)^2 = the same
 TEST(MssModel, DilationEnergiesMatchVanGelderAndBulkModulus) {
   const mesh::TetMesh m = two_region_box();
   const mesh::RegionMaterials mat = two_regions();
@@ -108,7 +110,10 @@ TEST(MssModel, DilationEnergiesMatchVanGelderAndBulkModulus) {
   EXPECT_NEAR(both(Term::torsion), 0.0, 1e-12 * EV * eps * eps);
   const double dv = std::pow(1.0 + eps, 3) - 1.0;
   EXPECT_NEAR(both(Term::volume), 0.5 * KV * dv * dv, 1e-9 * KV * dv * dv);
-  EXPECT_NEAR(model.energy(x), both(Term::main) + both(Term::radial) + both(Term::volume),
+  EXPECT_NEAR(both(Term::disc_volume), 0.5 * KV * dv * dv, 1e-9 * KV * dv * dv);
+  EXPECT_EQ(model.term_energy(x, Term::disc_volume, 1), 0.0);
+  EXPECT_NEAR(model.energy(x),
+              both(Term::main) + both(Term::radial) + both(Term::volume) + both(Term::disc_volume),
               1e-12 * EV);
 }
 
@@ -153,8 +158,8 @@ TEST(MssModel, TermGradientsAreDerivativesOfTermEnergies) {
   const MssModel model(two_region_box(), two_regions(), all_terms());
   const Eigen::VectorXd x = perturbed(model, 0.4, 8);
   const double h = 1e-6;
-  for (Term term : {Term::main, Term::radial, Term::torsion, Term::volume})
-    for (int r = 0; r < 2; ++r) {
+  for (Term term : {Term::main, Term::radial, Term::torsion, Term::volume, Term::disc_volume})
+    for (int r = 0; r < (term == Term::disc_volume ? 1 : 2); ++r) {
       Eigen::VectorXd g;
       model.term_gradient(x, term, r, g);
       ASSERT_GT(g.norm(), 0.0) << "term " << static_cast<int>(term) << " region " << r;
@@ -174,7 +179,7 @@ TEST(MssModel, EnergyIsLinearInTheScales) {
   MssModel model(two_region_box(), two_regions(), all_terms());
   const Eigen::VectorXd x = perturbed(model, 0.3, 9);
   std::array<RegionScales, kNumTerms> s{};
-  const double values[kNumTerms][2] = {{1.5, 0.7}, {2.0, 3.0}, {0.25, 4.0}, {1.1, 0.9}};
+  const double values[kNumTerms][2] = {{1.5, 0.7}, {2.0, 3.0}, {0.25, 4.0}, {1.1, 0.9}, {2.5, 1.0}};
   double expected = 0.0;
   for (int term = 0; term < kNumTerms; ++term)
     for (int r = 0; r < 2; ++r) {
@@ -214,12 +219,16 @@ TEST(MssModel, EnergyIsInvariantUnderRigidMotion) {
   EXPECT_NEAR(model.energy(rigidly_moved(x, R, t)), e, 1e-11 * e);
 }
 
+// The whole-disc volume term's dense rank-one part comes separately: H + k_g u u^T.
 TEST(MssModel, HessianMatchesFiniteDifferencesOfTheGradient) {
   const MssModel model(two_region_box(), two_regions(), all_terms());
   const Eigen::VectorXd x = perturbed(model, 0.4, 5);
   Eigen::SparseMatrix<double> H;
   model.hessian(x, HessianMode::exact, H);
-  const Eigen::MatrixXd Hd = Eigen::MatrixXd(H);
+  Eigen::VectorXd u;
+  const double kg = model.disc_volume_rank_one(x, u);
+  ASSERT_GT(kg, 0.0);
+  const Eigen::MatrixXd Hd = Eigen::MatrixXd(H) + kg * u * u.transpose();
   const double h = 1e-6;
   double worst = 0.0;
   for (Eigen::Index j = 0; j < x.size(); j += 3) {

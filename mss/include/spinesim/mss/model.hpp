@@ -5,6 +5,7 @@
 //        + sum_tets    1/2 k_s (S_t(x) - S0_t)^2                   radial springs (5.3)-(5.5)
 //        + sum_angles  1/2 k_t (theta - theta0)^2                  torsional springs (5.6)-(5.8)
 //        + sum_tets    1/2 k_v (V_t(x) - V0_t)^2                   volume term (beyond thesis)
+//        + 1/2 k_g (V(x) - V0)^2,  V = sum_t V_t                   whole-disc volume (beyond thesis)
 // Internal force f_int = -dE/dx; ambient damping f_damp = -K_d v per node (5.11) is applied by
 // the integrators. Element formulas: elements.hpp.
 //
@@ -20,6 +21,14 @@
 //                  the thesis).
 //   volume         k_v = c_v K_t / V0_t, K_t = E/(3(1-2 nu)) the bulk modulus, c_v =
 //                  MssOptions::volume_factor; off unless MssOptions::volume_term.
+//   disc volume    k_g = c_g K_mean / V0, K_mean the volume-weighted bulk modulus, c_g =
+//                  MssOptions::disc_volume_factor; off unless MssOptions::disc_volume_term. It
+//                  couples every node, so its Hessian k_g ∇V ∇V^T + k_g (V - V0) H_V is split: the
+//                  sparse part k_g (V - V0) H_V is in hessian() (exact mode), the dense rank-one
+//                  part comes from disc_volume_rank_one() for Sherman–Morrison in the solvers.
+//                  Why both volume terms (measured, tests/mss/test_volume.cpp, L4-L5, 10 %
+//                  compression): per-tet penalties lock — at c_v = 100 the disc is 24x too stiff
+//                  and still loses 1.2 % — while the whole-disc term lets the wall bulge freely.
 //   damping (5.11) K_d = MssOptions::damping_n_s_per_mm, or by default 2 zeta omega_1 m_mean with
 //                  omega_1 = (pi / L_m) sqrt(E_mean / rho_mean) (the first axial mode of the
 //                  equivalent cylinder between fixed plates), zeta = MssOptions::damping_ratio.
@@ -48,8 +57,10 @@
 namespace spinesim::mss {
 
 /// The energy terms of the model.
-enum class Term : int { main = 0, radial = 1, torsion = 2, volume = 3 };
-inline constexpr int kNumTerms = 4;
+/// Term::disc_volume is one term for the whole disc: it uses region index 0 (its scale is
+/// scales[disc_volume].by_region[0]; term_energy(x, disc_volume, 1) is zero).
+enum class Term : int { main = 0, radial = 1, torsion = 2, volume = 3, disc_volume = 4 };
+inline constexpr int kNumTerms = 5;
 
 /// Stiffness multipliers for one term, per region (index 0 annulus = region 1, 1 nucleus =
 /// region 2; any other region label counts as annulus).
@@ -61,8 +72,10 @@ struct MssOptions {
   bool radial_springs = true;    ///< thesis (5.3)-(5.5)
   bool torsion_springs = true;   ///< thesis (5.6)-(5.8)
   bool volume_term = false;      ///< per-tetrahedron volume penalty (beyond the thesis)
+  bool disc_volume_term = false; ///< whole-disc volume penalty (beyond the thesis)
   double radial_factor = 1.0;    ///< c_s in k_s = c_s E V0 / S0^2 (dimensionless)
   double volume_factor = 1.0;    ///< c_v in k_v = c_v K_bulk / V0 (dimensionless)
+  double disc_volume_factor = 1.0;  ///< c_g in k_g = c_g K_mean / V0_disc (dimensionless)
   double damping_ratio = 1.0;    ///< zeta of the default K_d (dimensionless)
   double damping_n_s_per_mm = -1.0;  ///< K_d per node; < 0 means the default from damping_ratio
   std::array<RegionScales, kNumTerms> scales{};  ///< indexed by Term
@@ -117,8 +130,15 @@ class MssModel {
   /// Gradient of term_energy(x, term, region_index) (for calibration adjoints).
   void term_gradient(const Eigen::VectorXd& x_mm, Term term, int region_index,
                      Eigen::VectorXd& grad) const;
-  /// Hessian d2E/dx2, N/mm, into H (pattern built on first use, values refilled after).
+  /// Hessian d2E/dx2, N/mm, into H (pattern built on first use, values refilled after) —
+  /// without the whole-disc volume term's rank-one part (see disc_volume_rank_one).
   void hessian(const Eigen::VectorXd& x_mm, HessianMode mode, Eigen::SparseMatrix<double>& H) const;
+
+  bool has_disc_volume_term() const;
+  /// The rank-one part of the whole-disc volume Hessian: u = dV/dx (3#nodes, mm^2), returns
+  /// k_g (N/mm^5, scaled) so that d2E/dx2 = hessian(x) + k_g u u^T. Returns 0 (u = 0) when the
+  /// term is off.
+  double disc_volume_rank_one(const Eigen::VectorXd& x_mm, Eigen::VectorXd& u) const;
 
   /// Sum of signed tetrahedron volumes at x, mm^3.
   double volume_mm3(const Eigen::VectorXd& x_mm) const;
