@@ -8,13 +8,16 @@
 //   symplectic  u+ = the same,                               y+ = y_n + dt u+
 //   implicit    y+ = argmin Phi(y) = Pi(y) + |y - y_n - dt u|^2_{M_r}/(2 dt^2)
 //                                          + K_d |y - y_n|^2_{D_r}/(2 dt),     u+ = (y+ - y_n)/dt
-// The implicit step starts from the predictor y_n + dt u; each Newton iteration solves
-// (K + M_r/dt^2 + K_d D_r/dt) d = -dPhi/dy. With one iteration the full step is taken
-// (Baraff & Witkin 1998); with more, a backtracking line search on Phi guards every step.
+// The implicit step starts from y_n (free nodes where they are, endplates at their new poses);
+// each Newton iteration solves (K + M_r/dt^2 + K_d D_r/dt) d = -dPhi/dy. With one iteration the
+// full step is taken, and that step is exactly Baraff & Witkin's (1998) linearised backward
+// Euler about x_n; with more, a backtracking line search on Phi guards every step. (Starting from
+// the predictor y_n + dt u instead was tried: with a penalty probe the predictor extrapolates a
+// node out of contact, the step drops it back in, and the contact flips every step.)
 // MatrixUpdate::frozen uses the rest stiffness (exact = projected at rest) and keeps the numeric
 // factor across steps; it is refactorised when the plate mode or centre changes, or when the set
-// of nodes inside a probe changes (each such node adds k_p I to the frozen matrix, the
-// isotropic bound of the contact Hessian, so a penalty contact does not overshoot).
+// of nodes inside a probe changes (each such node adds its projected contact Hessian k_p n n^T
+// at that moment, so a penalty contact does not overshoot).
 // MatrixUpdate::every_iteration factorises the current Hessian each iteration (exact, falling
 // back to projected). Dirichlet nodes jump to the poses of the next boundary; their velocity is
 // the displacement over dt.
@@ -85,7 +88,7 @@ struct Simulator::Impl {
   void apply_dirichlet(const Boundary& bc, Eigen::VectorXd& xs) const;
   /// Phi(y) and its gradient into r (implicit Euler).
   double phi_and_gradient(ReducedPotential& pot, const Eigen::VectorXd& yy, Eigen::VectorXd& rr);
-  bool factor_frozen(const ExternalLoads& loads);
+  bool factor_frozen(const ExternalLoads& loads, const Eigen::VectorXd& xs);
   StepReport explicit_step(State& s, const Boundary& bc, const ExternalLoads& loads, bool symplectic);
   StepReport implicit_step(State& s, const Boundary& bc, const ExternalLoads& loads);
   StepReport commit(State& s, const Boundary& bc, int iterations);
@@ -130,15 +133,11 @@ double Simulator::Impl::phi_and_gradient(ReducedPotential& pot, const Eigen::Vec
   return phi;
 }
 
-bool Simulator::Impl::factor_frozen(const ExternalLoads& loads) {
+bool Simulator::Impl::factor_frozen(const ExternalLoads& loads, const Eigen::VectorXd& xs) {
   if (frozen_ready && contacts == frozen_contacts) return true;
   space.reduce_matrix(H_rest, A);
   space.add_lumped(inertia, 1.0, A);
-  for (int i : contacts) {
-    double k = 0;
-    for (const Probe& p : loads.probes()) k = std::max(k, p.stiffness_n_per_mm);
-    space.add_node_block(i, k * Eigen::Matrix3d::Identity(), A);
-  }
+  if (!contacts.empty()) loads.add_hessian(xs, HessianMode::projected, space, A);
   if (!chol.analyzed()) chol.analyze(A);
   frozen_ready = chol.factorize(A);
   frozen_contacts = contacts;
@@ -178,7 +177,7 @@ StepReport Simulator::Impl::implicit_step(State& s, const Boundary& bc, const Ex
   pot.x() = s.x_mm;
   apply_dirichlet(bc, pot.x());
   yhat = yn + dt * un;
-  y = yhat;
+  y = yn;
   double phi = phi_and_gradient(pot, y, r);
   const double r0 = space.force_norm(r);
   int it = 0;
@@ -188,7 +187,7 @@ StepReport Simulator::Impl::implicit_step(State& s, const Boundary& bc, const Ex
     if (rn <= floor_n || (it > 0 && rn <= opt.newton_relative_tolerance * r0)) break;
     if (opt.matrix_update == MatrixUpdate::frozen) {
       if (!loads.probes().empty()) loads.contact_nodes(pot.x(), contacts);
-      if (!factor_frozen(loads)) return {false, it, "the frozen implicit matrix is not positive definite"};
+      if (!factor_frozen(loads, pot.x())) return {false, it, "the frozen implicit matrix is not positive definite"};
     } else if (detail::factor_tangent(*model, space, loads, pot.x(), &inertia, 1.0, H, A, chol) ==
                detail::TangentKind::failed) {
       return {false, it, "the implicit step matrix could not be factorised"};
@@ -315,12 +314,20 @@ double Simulator::predicted_stable_dt_s(Integrator integrator) const {
   fixed.reduce_matrix(d.H_rest, K);
   const Eigen::VectorXd m = fixed.lumped(model.node_masses_t()).diagonal;
   const double kd = d.kd;
+  // Every eigenpair (l, z) of a step's amplification (mu = 1 + l dt for explicit Euler) makes
+  // the scalar Rayleigh quotients m_z = z*Mz, c_z = K_d |z|^2, k_z = z*Kz satisfy a quadratic
+  // in mu, and the Jury conditions on that quadratic give sufficient matrix conditions:
+  //   explicit    dt k_z < c_z (underdamped modes) and dt^2 k_z - 2 dt c_z + 4 m_z > 0
+  //               (overdamped modes: dt < 2 / |fastest decay rate|)
+  //               <= dt < min(K_d / lambda_max(K_ff), 2 m_min / K_d); the second term is the
+  //               limit of a light, overdamped node (K_d / m >> omega) and binds on CGAL discs
+  //               with sliver-sized rim nodes. K_d = 0: unstable at any dt, 0 is returned;
+  //   symplectic  dt^2 k_z + 2 dt c_z < 4 m_z
+  //               <= lambda_max(dt^2 M^-1/2 K M^-1/2 + 2 dt K_d M^-1) < 4, solved for dt by
+  //               Newton on that convex increasing function of dt (2/omega_max undamped).
+  // Damping lowers the symplectic limit where it is strong: on the lightest nodes (slivers at
+  // the rim), K_d/m is comparable to omega_max.
   if (integrator == Integrator::explicit_euler) {
-    // Every eigenpair (lambda, z) of the damped system gives the scalar m_z l^2 + c_z l + k_z = 0
-    // with m_z = z*Mz, c_z = K_d |z|^2, k_z = z*Kz; explicit Euler keeps |1 + l dt| < 1 iff
-    // dt < c_z/k_z (underdamped) and dt < 4 m_z / (c_z + sqrt(c_z^2 - 4 m_z k_z)) (overdamped).
-    // Both hold for dt < min(K_d / lambda_max(K_ff), 2 m_min / K_d): a sufficient bound, exact
-    // for equal masses. Undamped (K_d = 0) explicit Euler is unstable at any dt.
     if (kd <= 0) return 0.0;
     const detail::TopEigenpair top = detail::largest_eigenpair(
         [&](const Eigen::VectorXd& v, Eigen::VectorXd& out) {
@@ -329,22 +336,42 @@ double Simulator::predicted_stable_dt_s(Integrator integrator) const {
         n);
     return std::min(kd / top.value, 2.0 * m.minCoeff() / kd);
   }
-  // Symplectic Euler: for the scalar mode (omega, gamma = c/m) the step is stable iff
-  // omega^2 dt^2 + 2 gamma dt < 4, i.e. dt < 4 / (gamma + sqrt(gamma^2 + 4 omega^2)); taken at
-  // the top mode of M^-1 K_ff (omega_max, and gamma = K_d |phi|^2 / phi^T M phi of its shape).
-  // Undamped this is 2 / omega_max.
-  const Eigen::VectorXd s = m.cwiseSqrt().cwiseInverse();
+  const Eigen::VectorXd s = m.cwiseSqrt().cwiseInverse();  // M^-1/2
+  const Eigen::VectorXd minv = m.cwiseInverse();
   Eigen::VectorXd w(n);
-  const detail::TopEigenpair top = detail::largest_eigenpair(
+  const auto top_of = [&](double dt) {
+    return detail::largest_eigenpair(
+        [&](const Eigen::VectorXd& v, Eigen::VectorXd& out) {
+          w = s.cwiseProduct(v);
+          out.noalias() = K.selfadjointView<Eigen::Lower>() * w;
+          out = (dt * dt) * s.cwiseProduct(out) + (2.0 * dt * kd) * minv.cwiseProduct(v);
+        },
+        n);
+  };
+  // Undamped start 2/omega_max lies at or right of the root; Newton from the right converges
+  // monotonically for a convex increasing function.
+  const detail::TopEigenpair undamped = detail::largest_eigenpair(
       [&](const Eigen::VectorXd& v, Eigen::VectorXd& out) {
         w = s.cwiseProduct(v);
         out.noalias() = K.selfadjointView<Eigen::Lower>() * w;
         out.array() *= s.array();
       },
       n);
-  const Eigen::VectorXd phi = s.cwiseProduct(top.vector);
-  const double gamma = kd * phi.squaredNorm() / phi.dot(m.cwiseProduct(phi));
-  return 4.0 / (gamma + std::sqrt(gamma * gamma + 4.0 * top.value));
+  double dt = 2.0 / std::sqrt(undamped.value);
+  if (kd <= 0) return dt;
+  for (int it = 0; it < 50; ++it) {
+    const detail::TopEigenpair t = top_of(dt);
+    const Eigen::VectorXd& z = t.vector;
+    // d lambda / d dt = z^T (2 dt S + 2 K_d M^-1) z, S = M^-1/2 K M^-1/2.
+    w = s.cwiseProduct(z);
+    const double zSz = w.dot(K.selfadjointView<Eigen::Lower>() * w);
+    const double zDz = z.dot(minv.cwiseProduct(z));
+    const double slope = 2.0 * dt * zSz + 2.0 * kd * zDz;
+    const double step = (t.value - 4.0) / slope;
+    dt -= step;
+    if (std::abs(step) <= 1e-6 * dt) break;
+  }
+  return dt;
 }
 
 }  // namespace spinesim::mss
