@@ -2,8 +2,9 @@
 // gradient and Hessian. Every internal force in mss/ is the negative gradient of one of these
 // energies, so forces sum to zero force and zero moment and the stiffness is symmetric.
 //
-// Units: positions mm, stiffness N/mm (springs), N·mm/rad (angle springs), N/mm^5 (volume
-// term), energies N·mm, gradients N, Hessians N/mm (angle: N·mm/rad per rad^2 -> N/mm).
+// Units: positions mm, stiffness N/mm (springs), N·mm/rad (angle springs: moment per radian
+// of opening, energy 1/2 k theta^2 in N·mm with theta in rad), N/mm^5 (volume term); energies
+// N·mm, gradients N, Hessians N/mm.
 //
 // Sign convention: `grad` is dE/dx (the internal force is -grad); `hess` is d2E/dx2.
 // Point order in grad/hess: the arguments' order, 3 components each.
@@ -13,8 +14,9 @@
 // HessianMode::projected keeps only the positive semi-definite parts — for edges
 // k[uu^T + max(0, 1 - L0/l)(I - uu^T)], for the summed radial spring
 // k[∇S∇S^T + max(0, S - S0) H_S] (H_S is PSD: S is a sum of norms of linear maps), for angle
-// and volume terms the Gauss–Newton part k ∇θ∇θ^T, k ∇V∇V^T — so Cholesky always succeeds
-// (implicit steps, Newton fallback).
+// and volume terms the Gauss–Newton part k ∇θ∇θ^T, k ∇V∇V^T, for the probe k n n^T (n the
+// outward normal; the edge formula with L0 = r) — so Cholesky always succeeds (implicit steps,
+// Newton fallback).
 #pragma once
 
 #include <Eigen/Core>
