@@ -2,6 +2,8 @@
 //
 //   spinesim mesh disc --level L4-L5 --out disc.vtu
 //   spinesim fem --mesh disc.vtu --material real-disc --motion 0,-0.1,0,0,0,0
+//   spinesim mss --mesh disc.vtu --case compression; spinesim mss compare --mesh disc.vtu
+//   spinesim study probe; spinesim study drive
 //   spinesim demo --out demo-out
 //
 // Every verb has --help and --json (one JSON object on stdout). Bad input: one line on
@@ -16,6 +18,12 @@
 // 35k DOF, 1.0 s vs 4.7-9.2 s). One thread unless the user sets OPENBLAS_NUM_THREADS.
 extern "C" void openblas_set_num_threads(int) __attribute__((weak));
 
+namespace spinesim::cli {
+// Mass-spring verbs (cli_mss.cpp, cli_study.cpp).
+void register_mss(CLI::App& app);
+void register_study(CLI::App& app);
+}  // namespace spinesim::cli
+
 int main(int argc, char** argv) {
   if (openblas_set_num_threads && !std::getenv("OPENBLAS_NUM_THREADS")) openblas_set_num_threads(1);
   CLI::App app{"spinesim: finite-element-validated intervertebral-disc deformation\n"
@@ -24,6 +32,8 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   spinesim::cli::register_mesh(app);
   spinesim::cli::register_fem(app);
+  spinesim::cli::register_mss(app);
+  spinesim::cli::register_study(app);
   spinesim::cli::register_demo(app);
   spinesim::cli::register_bench(app);
   try {

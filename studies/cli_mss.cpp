@@ -1,0 +1,371 @@
+// spinesim mss — the thesis's tetrahedral mass-spring disc (ch. 5.2) under a rigid-plate load,
+// static or in time, and its comparison with the FEM reference.
+//
+//   spinesim mss --mesh disc.vtu --case compression --json
+//   spinesim mss --mesh disc.vtu --motion 0,-0.5,0,0,0,0 --dt 1e-3 --steps 200 --out run.pvd
+//   spinesim mss compare --mesh disc.vtu --cases compression,flexion --csv compare.csv
+//
+// Boundary (same as `fem`): inferior endplate (surface 1) fixed; superior endplate (surface 2)
+// a rigid plate moved by --motion (mm, degrees, exact rigid pose about --center) or loaded by
+// --wrench / --case (N, N·mm about --center, plate DOF solved for).
+//
+//         wrench / motion
+//      ====[ plate ]====   superior endplate, rigid
+//      |    disc MSS   |
+//      =================   inferior endplate, fixed
+//
+// Static (default): Newton equilibrium. Dynamic (--dt/--steps/--integrator): the load is ramped
+// linearly over the first 10 % of the steps (at least one step) and then held, so the plate
+// never jumps (a jump of the prescribed pose in one step would give the endplate nodes a
+// velocity of Δx/dt); K_d ambient damping (5.11). A step that diverges is rejected: the run stops,
+// prints why, says `"diverged": true` in its JSON, writes no file and exits non-zero.
+#include "cli_common.hpp"
+#include "fem_report.hpp"
+#include "mss_report.hpp"
+
+#include "spinesim/fem/disc_fem.hpp"
+#include "spinesim/fem/load_cases.hpp"
+#include "spinesim/mesh/io.hpp"
+#include "spinesim/mesh/material.hpp"
+#include "spinesim/mss/boundary.hpp"
+#include "spinesim/mss/model.hpp"
+#include "spinesim/mss/solver.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+namespace spinesim::cli {
+namespace {
+namespace fs = std::filesystem;
+
+struct MssArgs {
+  std::string mesh_path, material = "real-disc", motion, wrench, load_case, center, out;
+  std::string integrator = "implicit";
+  double dt_s = 1e-3;
+  int steps = 0, frame_every = 0, newton_iterations = 1;
+  bool static_run = false, frozen = false, json = false, quiet = false;
+  ModelFlags model;
+  bool dynamic = false;  ///< set from which options were given
+};
+
+std::string one_line(std::string s) {
+  std::replace(s.begin(), s.end(), '\n', ' ');
+  return s;
+}
+
+/// The plate load of a run: a prescribed motion (pose mode) or a wrench, about `center`.
+struct PlateLoad {
+  bool is_wrench = false;
+  fem::Vector6d value = fem::Vector6d::Zero();  ///< (t mm, theta rad) or (F N, M N·mm), global
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();
+
+  /// The boundary with the load scaled by `factor` (the ramp).
+  mss::Boundary boundary(double factor) const {
+    mss::Boundary b;
+    b.plate_center_mm = center;
+    if (is_wrench) {
+      b.plate_mode = mss::PlateMode::wrench;
+      b.wrench = factor * value;
+    } else {
+      b.superior = mss::plate_pose(factor * value, center);
+    }
+    return b;
+  }
+};
+
+/// Reaction about the moved plate centre c + t, N and N·mm.
+fem::Vector6d reaction_about_plate(const mss::MssModel& model, const Eigen::VectorXd& x, const Eigen::Vector3d& c,
+                                   const fem::Vector6d& q) {
+  return mss::plate_reaction(model, x, c + q.head<3>());
+}
+
+void run_mss(const MssArgs& a) {
+  // 1. Parse and check every option before doing any work: bad input fails fast, writes nothing.
+  if (a.mesh_path.empty()) throw std::invalid_argument("--mesh is required");
+  const int loads = int(!a.motion.empty()) + int(!a.wrench.empty()) + int(!a.load_case.empty());
+  if (loads > 1) throw std::invalid_argument("give at most one of --motion, --wrench and --case");
+  if (a.static_run && a.dynamic) throw std::invalid_argument("give --static or --dt/--steps/--integrator, not both");
+  PlateLoad load;
+  if (!a.motion.empty())
+    load.value = motion_deg_to_rad(parse_numbers(a.motion, 6, "--motion tx,ty,tz,rx,ry,rz (mm, deg)"));
+  if (!a.wrench.empty()) {
+    load.is_wrench = true;
+    load.value = parse_numbers(a.wrench, 6, "--wrench Fx,Fy,Fz,Mx,My,Mz (N, N·mm)");
+  }
+  const fem::LoadCase* named = a.load_case.empty() ? nullptr : &fem::load_case(a.load_case);
+  mss::Integrator integrator = mss::Integrator::implicit_euler;
+  if (a.dynamic) {
+    integrator = parse_integrator(a.integrator);
+    if (!std::isfinite(a.dt_s) || a.dt_s <= 0) throw std::invalid_argument("--dt must be a finite number > 0 s");
+    if (a.steps < 1) throw std::invalid_argument("a dynamic run needs --steps N with N >= 1");
+    if (a.frame_every < 0) throw std::invalid_argument("--frame-every must be >= 0");
+    if (a.newton_iterations < 1) throw std::invalid_argument("--newton must be >= 1");
+  }
+  const mss::MssOptions model_opt = model_options(a.model);
+  const bool series = !a.out.empty() && fs::path(a.out).extension() == ".pvd";
+  if (!a.out.empty()) {
+    if (fs::path(a.out).extension() != ".vtu" && !series)
+      throw std::invalid_argument("--out " + a.out + ": give a .vtu file (or a .pvd time series for a dynamic run)");
+    if (series && !a.dynamic) throw std::invalid_argument("--out " + a.out + ": a .pvd time series needs a dynamic run (--dt/--steps)");
+    require_output_folder(a.out, "--out");
+  }
+  const auto materials = mesh::load_material(a.material, data_dir());
+
+  // 2. Mesh and model.
+  Progress progress(3 + int(!a.out.empty()), a.quiet || a.json);
+  progress.begin("reading " + a.mesh_path);
+  const mesh::TetMesh m = mesh::read_vtu(a.mesh_path);
+  mesh::require_endplate_labels(m);
+  const double read_s = progress.end(std::to_string(m.num_tets()) + " tets");
+  load.center = a.center.empty() ? fem::DiscFem::default_plate_center(m)
+                                 : Eigen::Vector3d(parse_numbers(a.center, 3, "--center x,y,z (mm)"));
+  if (named) {
+    load.is_wrench = true;
+    load.value = fem::global_wrench(*named, m.frame);
+  }
+
+  progress.begin("building the mass-spring model");
+  const mss::MssModel model(m, materials, model_opt);
+  const double build_s = progress.end(std::to_string(model.num_edge_springs()) + " edge springs");
+
+  nlohmann::json j = {{"mesh", a.mesh_path},
+                      {"nodes", m.num_vertices()},
+                      {"tets", m.num_tets()},
+                      {"material", materials.name},
+                      {"plate_center", to_json(Eigen::VectorXd(load.center))},
+                      {"load", load.is_wrench ? "wrench" : "motion"}};
+  j.update(mss_model_json(model, materials));
+  if (named) j["case"] = named->name;
+
+  // 3. Solve: static equilibrium, or steps in time.
+  Eigen::VectorXd x;
+  fem::Vector6d q = fem::Vector6d::Zero();
+  bool failed = false;
+  std::string failure;
+  std::unique_ptr<VtuSeries> frames;
+  if (!a.dynamic) {
+    progress.begin("static equilibrium (Newton)");
+    const mss::StaticResult r = mss::solve_static(model, load.boundary(1.0));
+    progress.end(std::to_string(r.iterations) + " iterations");
+    x = r.x_mm;
+    q = r.plate_motion;
+    j["reaction_wrench"] = to_json(Eigen::VectorXd(r.reaction_wrench));
+    j["converged"] = r.converged;
+    j["iterations"] = r.iterations;
+    j["residual_n"] = r.residual_n;
+    j["timings"] = {{"read_s", read_s}, {"build_s", build_s}, {"solve_s", r.seconds}};
+    failed = !r.converged || !x.allFinite();
+    if (failed) failure = "static solve did not converge after " + std::to_string(r.iterations) + " iterations: " + r.message;
+  } else {
+    mss::DynamicsOptions dopt;
+    dopt.integrator = integrator;
+    dopt.dt_s = a.dt_s;
+    dopt.newton_iterations = a.newton_iterations;
+    dopt.matrix_update = a.frozen ? mss::MatrixUpdate::frozen : mss::MatrixUpdate::every_iteration;
+    mss::Simulator sim(model, dopt);
+    mss::State s = sim.rest_state();
+    const int ramp = std::max(1, int(std::ceil(0.1 * a.steps)));
+    const int every = a.frame_every > 0 ? a.frame_every : std::max(1, a.steps / 100);
+    if (series) {
+      frames = std::make_unique<VtuSeries>(a.out);
+      frames->add(0.0, model, s.x_mm);
+    }
+    progress.begin(std::to_string(a.steps) + " steps of " + a.integrator + " Euler, dt " + std::to_string(a.dt_s) + " s");
+    StepStats stats;
+    for (int k = 1; k <= a.steps; ++k) {
+      if (!stats.step(sim, s, load.boundary(std::min(1.0, double(k) / ramp)))) break;
+      if (frames && (k % every == 0 || k == a.steps)) frames->add(s.time_s, model, s.x_mm);
+    }
+    const double stepping_s = progress.end(std::to_string(stats.steps_done) + " steps");
+    if (stats.diverged) {
+      failed = true;
+      const int k = stats.steps_done + 1;
+      std::ostringstream os;
+      os << "diverged at step " << k << " of " << a.steps << " (t = " << k * a.dt_s << " s, " << a.integrator
+         << " Euler, dt = " << a.dt_s << " s): " << stats.message;
+      if (integrator != mss::Integrator::implicit_euler) {
+        const double stable = sim.predicted_stable_dt_s(integrator);
+        if (std::isfinite(stable)) os << "; predicted stable dt < " << stable << " s";
+      }
+      failure = os.str();
+    }
+    x = s.x_mm;
+    const double applied = std::min(1.0, double(stats.steps_done) / ramp);  // load factor of the last good step
+    q = load.is_wrench ? fem::Vector6d(s.plate_q) : fem::Vector6d(applied * load.value);
+    j["integrator"] = a.integrator;
+    j["dt_s"] = a.dt_s;
+    j["steps"] = a.steps;
+    j["ramp_steps"] = ramp;
+    j["time_s"] = s.time_s;
+    stats.add_to(j);
+    j["matrix_update"] = a.frozen ? "frozen" : "every_iteration";
+    j["reaction_wrench"] = to_json(Eigen::VectorXd(reaction_about_plate(model, x, load.center, q)));
+    j["timings"] = {{"read_s", read_s}, {"build_s", build_s}, {"stepping_s", stepping_s}};
+    if (failed && frames) frames->discard();
+  }
+  j["reaction_wrench_units"] =
+      "Fx,Fy,Fz [N], Mx,My,Mz [N·mm] exerted by the disc on the plate, about the moved plate centre";
+  j["plate_motion"] = to_json(Eigen::VectorXd(motion_rad_to_deg(q)));
+  j["plate_motion_units"] = "tx,ty,tz [mm], rx,ry,rz [deg]";
+  j["volume_mm3"] = model.volume_mm3(x);
+  j["rest_volume_mm3"] = model.rest_volume_mm3();
+  j["volume_change"] = volume_change(model, x);
+  j["max_displacement_mm"] = mss_displacement(model, x).rowwise().norm().maxCoeff();
+
+  // 4. Output files (only for a run that succeeded, so no NaN and no half series).
+  if (!failed && !a.out.empty()) {
+    progress.begin("writing " + a.out);
+    if (frames) {
+      frames->finish();
+      j["frames"] = frames->num_frames();
+    } else {
+      const MssFields f = mss_fields(model, x);
+      mesh::write_vtu(a.out, m, f.point, f.cell);
+    }
+    progress.end();
+    j["out"] = a.out;
+  }
+
+  // 5. Report.
+  if (a.json) {
+    print_json(j);
+  } else {
+    std::cout << std::setprecision(5) << "MSS on " << a.mesh_path << " (" << m.num_vertices() << " nodes, "
+              << m.num_tets() << " tets), material " << materials.name << ", " << model_variant(a.model) << "\n"
+              << "  springs       " << model.num_edge_springs() << " edge, " << model.num_radial_tets() << " radial tets, "
+              << model.num_angle_springs() << " angle, " << model.num_volume_terms() << " volume\n"
+              << "  plate centre  " << load.center.transpose() << " mm\n";
+    if (a.dynamic)
+      std::cout << "  dynamic       " << j["steps_done"] << " of " << a.steps << " steps, dt " << a.dt_s
+                << " s, mean step " << j["step_seconds_mean"].get<double>() * 1e3 << " ms\n";
+    else
+      std::cout << "  static        " << (j["converged"].get<bool>() ? "converged" : "NOT converged") << " in "
+                << j["iterations"] << " Newton iterations\n";
+    const auto qd = motion_rad_to_deg(q);
+    std::cout << "  plate motion  t = " << qd.head<3>().transpose() << " mm, r = " << qd.tail<3>().transpose() << " deg\n"
+              << "  reaction      " << j["reaction_wrench"].dump() << " (N, N·mm)\n"
+              << "  volume        " << j["volume_mm3"].get<double>() << " mm^3, change "
+              << 100.0 * j["volume_change"].get<double>() << " %\n";
+  }
+  if (failed) throw std::runtime_error(one_line(failure));
+}
+
+// --- mss compare -------------------------------------------------------------------------------
+
+struct CompareArgs {
+  std::string mesh_path, material = "real-disc", cases = "all", csv;
+  int order = 2;
+  bool json = false, quiet = false;
+  ModelFlags model;
+};
+
+void run_compare(const CompareArgs& a) {
+  // 1. Options.
+  const auto cases = fem::parse_load_cases(a.cases);
+  const mss::MssOptions model_opt = model_options(a.model);
+  if (!a.csv.empty()) require_output_folder(a.csv, "--csv");
+  const auto materials = mesh::load_material(a.material, data_dir());
+
+  // 2. Mesh, FEM reference and MSS on the same mesh.
+  Progress progress(4, a.quiet || a.json);
+  progress.begin("reading " + a.mesh_path);
+  const mesh::TetMesh m = mesh::read_vtu(a.mesh_path);
+  mesh::require_endplate_labels(m);
+  progress.end(std::to_string(m.num_tets()) + " tets");
+  progress.begin("FEM P" + std::to_string(a.order) + " assembly and factorisation");
+  const fem::DiscFem solver(m, materials, a.order, fem::DiscFem::default_plate_center(m));
+  progress.end(std::to_string(solver.num_dofs()) + " DOF");
+  progress.begin("building the mass-spring model");
+  const mss::MssModel model(m, materials, model_opt);
+  progress.end();
+
+  // 3. The protocol (mss_report.hpp).
+  progress.begin("comparing " + std::to_string(cases.size()) + " load cases");
+  const MssFemComparison cmp = compare_mss_fem(solver, model, cases, materials.name);
+  progress.end();
+
+  if (!a.csv.empty()) write_text_file(a.csv, comparison_csv(cmp));
+  nlohmann::json j = comparison_json(cmp);
+  j["mesh"] = a.mesh_path;
+  j["model_variant"] = model_variant(a.model);
+  if (!a.csv.empty()) j["csv"] = a.csv;
+  if (a.json) {
+    print_json(j);
+    return;
+  }
+  std::cout << "MSS (untuned Van Gelder, " << model_variant(a.model) << ") vs FEM P" << a.order << " on " << a.mesh_path
+            << " (" << m.num_vertices() << " nodes, " << m.num_tets() << " tets), material " << materials.name << "\n\n";
+  print_comparison(std::cout, cmp, false);
+}
+
+constexpr const char* kCompareProtocol = R"(Protocol (same mesh, each named case's wrench w on the superior plate, inferior fixed):
+  (a) wrench-loaded, FEM (vertex displacements) vs MSS static:
+      displacement_error = ||u_mss - u_fem|| / ||u_fem|| over all vertices;
+      plate_motion_error = RMS over plate nodes of |rigid displacement(q_mss - q_fem)|
+                           / RMS |rigid displacement(q_fem)|.
+  (b) motion-loaded: the MSS plate moved by the FEM's plate motion; reaction wrench compared,
+      moments divided by the plate's RMS radius rho:
+      reaction_error = |(dF, dM/rho)| / |(F_fem, M_fem/rho)|, and its force and moment parts
+      over the same denominator.
+  (c) 6x6 plate stiffness diagonal, MSS (rest Hessian condensed onto the plate) / FEM.
+MSS constants are the untuned Van Gelder ones: the baseline calibration must beat.)";
+
+}  // namespace
+
+void register_mss(CLI::App& app) {
+  auto a = std::make_shared<MssArgs>();
+  auto* cmd = app.add_subcommand("mss", "Tetrahedral mass-spring disc (thesis ch. 5): static or dynamic, rigid-plate load");
+  cmd->require_subcommand(0, 1);
+  cmd->add_option("--mesh", a->mesh_path, "Disc mesh (VTU with `surface` endplate labels); required");
+  cmd->add_option("--material", a->material, "Preset (real-disc, annulus-nucleus, rubber, polyethylene) or JSON file")
+      ->capture_default_str();
+  cmd->add_option("--motion", a->motion, "Plate motion tx,ty,tz,rx,ry,rz (mm, degrees)");
+  cmd->add_option("--wrench", a->wrench, "Applied wrench Fx,Fy,Fz,Mx,My,Mz (N, N·mm) about the centre");
+  cmd->add_option("--case", a->load_case,
+                  "Named load case in the disc frame: compression, tension, shear-ap, shear-lat, flexion, "
+                  "extension, lateral-bending, torsion");
+  cmd->add_option("--center", a->center, "Plate centre x,y,z (mm); default: mean of the superior endplate nodes");
+  cmd->add_flag("--static", a->static_run, "Static equilibrium (the default)");
+  auto* dt = cmd->add_option("--dt", a->dt_s, "Time step, s (dynamic run)")->capture_default_str();
+  auto* steps = cmd->add_option("--steps", a->steps, "Number of time steps (dynamic run)");
+  auto* integ = cmd->add_option("--integrator", a->integrator, "implicit, symplectic or explicit (thesis 5.20-5.21)")
+                    ->capture_default_str();
+  cmd->add_option("--newton", a->newton_iterations, "Implicit: max Newton iterations per step (1 = Baraff-Witkin)")
+      ->capture_default_str();
+  cmd->add_flag("--frozen", a->frozen, "Implicit: keep the rest-stiffness factorisation (one solve per step)");
+  cmd->add_option("--frame-every", a->frame_every, "Dynamic .pvd output: a frame every K steps (0: about 100 frames)");
+  add_model_flags(cmd, a->model);
+  cmd->add_option("--out", a->out, "Write the result: .vtu (final state) or .pvd (time series of a dynamic run)");
+  cmd->add_flag("--json", a->json, "Print a JSON summary on stdout");
+  cmd->add_flag("--quiet", a->quiet, "No progress on stderr");
+  cmd->footer(
+      "Dynamic runs ramp the load linearly over the first 10 % of the steps, then hold it. A diverging run\n"
+      "exits 1 with the reason, \"diverged\": true in its JSON and no output file.");
+
+  auto c = std::make_shared<CompareArgs>();
+  auto* cmp = cmd->add_subcommand("compare", "MSS (untuned) vs FEM on the same mesh for the named load cases");
+  cmp->add_option("--mesh", c->mesh_path, "Disc mesh (VTU with `surface` endplate labels)")->required();
+  cmp->add_option("--material", c->material, "Preset or JSON file")->capture_default_str();
+  cmp->add_option("--cases", c->cases, "Comma-separated load cases, or all")->capture_default_str();
+  cmp->add_option("--order", c->order, "FEM element order: 1 (P1) or 2 (P2)")->capture_default_str();
+  add_model_flags(cmp, c->model);
+  cmp->add_option("--csv", c->csv, "Also write one CSV row per case");
+  cmp->add_flag("--json", c->json, "Print a JSON summary on stdout");
+  cmp->add_flag("--quiet", c->quiet, "No progress on stderr");
+  cmp->footer(kCompareProtocol);
+  cmp->callback([c] { run_compare(*c); });
+
+  // CLI11 runs the parent's callback after the sub-command's: skip it for `mss compare`.
+  cmd->callback([a, cmp, dt, steps, integ] {
+    if (cmp->parsed()) return;
+    a->dynamic = dt->count() + steps->count() + integ->count() > 0;
+    run_mss(*a);
+  });
+}
+
+}  // namespace spinesim::cli
