@@ -14,10 +14,17 @@ namespace spinesim::mss::detail {
 
 class ReducedPotential {
  public:
-  ReducedPotential(const MssModel& model, const ReducedSpace& space, const ExternalLoads& loads,
+  ReducedPotential(const MssModel& model, const ReducedSpace& space, const ExternalLoads* loads,
                    const Vector6d& wrench)
-      : model_(model), space_(space), loads_(loads), wrench_(wrench),
-        g_(Eigen::VectorXd::Zero(model.num_dofs())) {}
+      : model_(&model), space_(&space), loads_(loads), wrench_(wrench),
+        x_(model.rest_positions_mm()), g_(Eigen::VectorXd::Zero(model.num_dofs())) {}
+  ReducedPotential() = default;
+
+  /// New loads and wrench, same model and space; keeps the workspaces (no allocation).
+  void set_loads(const ExternalLoads* loads, const Vector6d& wrench) {
+    loads_ = loads;
+    wrench_ = wrench;
+  }
 
   /// Full positions; set the Dirichlet nodes here before evaluating.
   Eigen::VectorXd& x() { return x_; }
@@ -26,34 +33,35 @@ class ReducedPotential {
   const Eigen::VectorXd& model_gradient() const { return g_; }
 
   double value(const Eigen::VectorXd& y) {
-    space_.set_unknown_positions(y, x_);
-    return model_.energy(x_) + (loads_.empty() ? 0.0 : loads_.energy(x_)) - plate_work(y);
+    space_->set_unknown_positions(y, x_);
+    return model_->energy(x_) + (no_loads() ? 0.0 : loads_->energy(x_)) - plate_work(y);
   }
 
   /// Pi(y) and r = dPi/dy (r preallocated to space.size()).
   double value_and_gradient(const Eigen::VectorXd& y, Eigen::VectorXd& r) {
-    space_.set_unknown_positions(y, x_);
-    double e = model_.gradient(x_, g_);
-    if (loads_.empty()) {
-      space_.reduce_vector(g_, r);
+    space_->set_unknown_positions(y, x_);
+    double e = model_->gradient(x_, g_);
+    if (no_loads()) {
+      space_->reduce_vector(g_, r);
     } else {
       gtot_ = g_;
-      e += loads_.add_gradient(x_, gtot_);
-      space_.reduce_vector(gtot_, r);
+      e += loads_->add_gradient(x_, gtot_);
+      space_->reduce_vector(gtot_, r);
     }
-    if (space_.has_plate_dofs()) r.tail<6>() -= wrench_;
+    if (space_->has_plate_dofs()) r.tail<6>() -= wrench_;
     return e - plate_work(y);
   }
 
  private:
+  bool no_loads() const { return loads_ == nullptr || loads_->empty(); }
   double plate_work(const Eigen::VectorXd& y) const {
-    return space_.has_plate_dofs() ? wrench_.dot(y.tail<6>()) : 0.0;
+    return space_->has_plate_dofs() ? wrench_.dot(y.tail<6>()) : 0.0;
   }
 
-  const MssModel& model_;
-  const ReducedSpace& space_;
-  const ExternalLoads& loads_;
-  Vector6d wrench_;
+  const MssModel* model_ = nullptr;
+  const ReducedSpace* space_ = nullptr;
+  const ExternalLoads* loads_ = nullptr;
+  Vector6d wrench_ = Vector6d::Zero();
   Eigen::VectorXd x_, g_, gtot_;
 };
 

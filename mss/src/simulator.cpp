@@ -73,6 +73,7 @@ struct Simulator::Impl {
   // Reduced system of the current plate mode and centre.
   bool have_space = false;
   ReducedSpace space;
+  ReducedPotential potential;         ///< on `space`; loads set per step
   LumpedReduced mass, damp, inertia;  ///< M_r, D_r, M_r/dt^2 + K_d D_r/dt
   Eigen::LDLT<Matrix6d> plate_mass;   ///< M_r's plate block (explicit integrators)
   Eigen::SparseMatrix<double> A;
@@ -103,6 +104,7 @@ void Simulator::Impl::ensure_space(PlateMode mode, const Eigen::Vector3d& c) {
   inertia.diagonal = mass.diagonal / (dt * dt) + kd / dt * damp.diagonal;
   inertia.plate = mass.plate / (dt * dt) + kd / dt * damp.plate;
   plate_mass.compute(mass.plate);
+  potential = ReducedPotential(*model, space, nullptr, Vector6d::Zero());
   A = space.pattern();
   chol = detail::SparseCholesky();
   frozen_ready = false;
@@ -148,8 +150,8 @@ StepReport Simulator::Impl::explicit_step(State& s, const Boundary& bc, const Ex
                                           bool symplectic) {
   const double dt = opt.dt_s;
   // a(x_n, v_n) = -M_r^-1 (r(y_n) + K_d D_r u_n), forces at the current state (old endplates).
-  const Vector6d wrench = space.has_plate_dofs() ? bc.wrench : Vector6d::Zero();
-  ReducedPotential pot(*model, space, loads, wrench);
+  ReducedPotential& pot = potential;
+  pot.set_loads(&loads, space.has_plate_dofs() ? bc.wrench : Vector6d::Zero());
   pot.x() = s.x_mm;
   pot.value_and_gradient(yn, r);
   damp.apply(un, d);
@@ -172,8 +174,8 @@ StepReport Simulator::Impl::explicit_step(State& s, const Boundary& bc, const Ex
 
 StepReport Simulator::Impl::implicit_step(State& s, const Boundary& bc, const ExternalLoads& loads) {
   const double dt = opt.dt_s;
-  const Vector6d wrench = space.has_plate_dofs() ? bc.wrench : Vector6d::Zero();
-  ReducedPotential pot(*model, space, loads, wrench);
+  ReducedPotential& pot = potential;
+  pot.set_loads(&loads, space.has_plate_dofs() ? bc.wrench : Vector6d::Zero());
   pot.x() = s.x_mm;
   apply_dirichlet(bc, pot.x());
   yhat = yn + dt * un;

@@ -77,7 +77,7 @@ StaticResult solve_static(const MssModel& model, const Boundary& bc, const Stati
   const double wrench_scale = wrench.head<3>().norm() + wrench.tail<3>().norm() / L;
 
   // 3. Start: x_start or rest, endplates at their poses (plate DOF fitted to x_start).
-  ReducedPotential pot(model, space, loads, wrench);
+  ReducedPotential pot(model, space, &loads, wrench);
   pot.x() = x_start.size() ? x_start : X;
   apply_dirichlet(space, bc, X, pot.x());
   const Vector6d q0 = space.has_plate_dofs() && x_start.size() ? space.fit_plate_motion(x_start)
