@@ -77,7 +77,8 @@ struct Simulator::Impl {
   LumpedReduced mass, damp, inertia;  ///< M_r, D_r, M_r/dt^2 + K_d D_r/dt
   Eigen::LDLT<Matrix6d> plate_mass;   ///< M_r's plate block (explicit integrators)
   Eigen::SparseMatrix<double> A;
-  detail::SparseCholesky chol;
+  detail::TangentSolver tangent;
+  Eigen::VectorXd u_rank_one, w_rank_one;  ///< workspaces of the rank-one Hessian part
   bool frozen_ready = false;
   std::vector<int> frozen_contacts, contacts;
 
@@ -106,7 +107,7 @@ void Simulator::Impl::ensure_space(PlateMode mode, const Eigen::Vector3d& c) {
   plate_mass.compute(mass.plate);
   potential = ReducedPotential(*model, space, nullptr, Vector6d::Zero());
   A = space.pattern();
-  chol = detail::SparseCholesky();
+  tangent = detail::TangentSolver();
   frozen_ready = false;
   const Eigen::Index n = space.size();
   for (Eigen::VectorXd* w : {&y, &yn, &un, &yhat, &r, &d, &y_trial, &r_trial, &tmp}) w->setZero(n);
@@ -140,9 +141,13 @@ bool Simulator::Impl::factor_frozen(const ExternalLoads& loads, const Eigen::Vec
   space.reduce_matrix(H_rest, A);
   space.add_lumped(inertia, 1.0, A);
   if (!contacts.empty()) loads.add_hessian(xs, HessianMode::projected, space, A);
+  detail::SparseCholesky& chol = tangent.cholesky();
   if (!chol.analyzed()) chol.analyze(A);
   frozen_ready = chol.factorize(A);
   frozen_contacts = contacts;
+  if (frozen_ready)
+    tangent.set_rank_one(detail::reduced_rank_one(*model, space, model->rest_positions_mm(), u_rank_one, w_rank_one),
+                         w_rank_one);
   return frozen_ready;
 }
 
@@ -190,12 +195,12 @@ StepReport Simulator::Impl::implicit_step(State& s, const Boundary& bc, const Ex
     if (opt.matrix_update == MatrixUpdate::frozen) {
       if (!loads.probes().empty()) loads.contact_nodes(pot.x(), contacts);
       if (!factor_frozen(loads, pot.x())) return {false, it, "the frozen implicit matrix is not positive definite"};
-    } else if (detail::factor_tangent(*model, space, loads, pot.x(), &inertia, 1.0, H, A, chol) ==
+    } else if (detail::factor_tangent(*model, space, loads, pot.x(), &inertia, 1.0, H, A, tangent) ==
                detail::TangentKind::failed) {
       return {false, it, "the implicit step matrix could not be factorised"};
     }
     d = -r;
-    chol.solve_in_place(d);
+    tangent.solve_in_place(d);
     if (opt.newton_iterations == 1) {  // Baraff-Witkin: one linearised step, no line search
       y += d;
       ++it;
@@ -314,6 +319,12 @@ double Simulator::predicted_stable_dt_s(Integrator integrator) const {
   if (n == 0) return std::numeric_limits<double>::infinity();
   Eigen::SparseMatrix<double> K = fixed.pattern();
   fixed.reduce_matrix(d.H_rest, K);
+  Eigen::VectorXd u, wk;  // rank-one part k_g wk wk^T of K_ff (whole-disc volume term)
+  const double kg = detail::reduced_rank_one(model, fixed, model.rest_positions_mm(), u, wk);
+  const auto apply_K = [&](const Eigen::VectorXd& v, Eigen::VectorXd& out) {
+    out.noalias() = K.selfadjointView<Eigen::Lower>() * v;
+    if (kg > 0) out.noalias() += (kg * wk.dot(v)) * wk;
+  };
   const Eigen::VectorXd m = fixed.lumped(model.node_masses_t()).diagonal;
   const double kd = d.kd;
   // Every eigenpair (l, z) of a step's amplification (mu = 1 + l dt for explicit Euler) makes
@@ -331,11 +342,7 @@ double Simulator::predicted_stable_dt_s(Integrator integrator) const {
   // the rim), K_d/m is comparable to omega_max.
   if (integrator == Integrator::explicit_euler) {
     if (kd <= 0) return 0.0;
-    const detail::TopEigenpair top = detail::largest_eigenpair(
-        [&](const Eigen::VectorXd& v, Eigen::VectorXd& out) {
-          out.noalias() = K.selfadjointView<Eigen::Lower>() * v;
-        },
-        n);
+    const detail::TopEigenpair top = detail::largest_eigenpair(apply_K, n);
     return std::min(kd / top.value, 2.0 * m.minCoeff() / kd);
   }
   const Eigen::VectorXd s = m.cwiseSqrt().cwiseInverse();  // M^-1/2
@@ -345,7 +352,7 @@ double Simulator::predicted_stable_dt_s(Integrator integrator) const {
     return detail::largest_eigenpair(
         [&](const Eigen::VectorXd& v, Eigen::VectorXd& out) {
           w = s.cwiseProduct(v);
-          out.noalias() = K.selfadjointView<Eigen::Lower>() * w;
+          apply_K(w, out);
           out = (dt * dt) * s.cwiseProduct(out) + (2.0 * dt * kd) * minv.cwiseProduct(v);
         },
         n);
@@ -355,7 +362,7 @@ double Simulator::predicted_stable_dt_s(Integrator integrator) const {
   const detail::TopEigenpair undamped = detail::largest_eigenpair(
       [&](const Eigen::VectorXd& v, Eigen::VectorXd& out) {
         w = s.cwiseProduct(v);
-        out.noalias() = K.selfadjointView<Eigen::Lower>() * w;
+        apply_K(w, out);
         out.array() *= s.array();
       },
       n);
@@ -366,7 +373,9 @@ double Simulator::predicted_stable_dt_s(Integrator integrator) const {
     const Eigen::VectorXd& z = t.vector;
     // d lambda / d dt = z^T (2 dt S + 2 K_d M^-1) z, S = M^-1/2 K M^-1/2.
     w = s.cwiseProduct(z);
-    const double zSz = w.dot(K.selfadjointView<Eigen::Lower>() * w);
+    Eigen::VectorXd Kw(n);
+    apply_K(w, Kw);
+    const double zSz = w.dot(Kw);
     const double zDz = z.dot(minv.cwiseProduct(z));
     const double slope = 2.0 * dt * zSz + 2.0 * kd * zDz;
     const double step = (t.value - 4.0) / slope;

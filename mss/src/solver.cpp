@@ -14,7 +14,6 @@
 #include "external_loads.hpp"
 #include "reduced_potential.hpp"
 #include "reduced_space.hpp"
-#include "sparse_cholesky.hpp"
 #include "tangent.hpp"
 
 #include <chrono>
@@ -88,7 +87,7 @@ StaticResult solve_static(const MssModel& model, const Boundary& bc, const Stati
 
   // 4. Newton with backtracking line search.
   StaticResult res;
-  detail::SparseCholesky chol;
+  detail::TangentSolver tangent;
   double Pi = pot.value_and_gradient(y, r);
   for (int it = 0;; ++it) {
     res.residual_n = space.force_norm(r);
@@ -107,13 +106,13 @@ StaticResult solve_static(const MssModel& model, const Boundary& bc, const Stati
       break;
     }
     const detail::TangentKind kind =
-        detail::factor_tangent(model, space, loads, pot.x(), nullptr, 0.0, H, A, chol);
+        detail::factor_tangent(model, space, loads, pot.x(), nullptr, 0.0, H, A, tangent);
     if (kind == detail::TangentKind::failed) {
       res.message = "the tangent stiffness could not be factorised (is the disc constrained?)";
       break;
     }
     d = -r;
-    chol.solve_in_place(d);
+    tangent.solve_in_place(d);
     const double slope = r.dot(d);
     bool accepted = false;
     double alpha = 1.0, Pi_trial = Pi;

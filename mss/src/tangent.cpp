@@ -1,6 +1,31 @@
 #include "tangent.hpp"
 
+#include <cmath>
+
 namespace spinesim::mss::detail {
+
+void TangentSolver::set_rank_one(double k, const Eigen::VectorXd& w) {
+  k_ = k;
+  if (k_ <= 0.0) return;
+  w_ = w;
+  z_ = w;
+  chol_.solve_in_place(z_);
+  denominator_ = 1.0 + k_ * w_.dot(z_);
+}
+
+void TangentSolver::solve_in_place(Eigen::VectorXd& b) {
+  chol_.solve_in_place(b);
+  if (k_ > 0.0) b.noalias() -= (k_ * w_.dot(b) / denominator_) * z_;
+}
+
+double reduced_rank_one(const MssModel& model, const ReducedSpace& space, const Eigen::VectorXd& x,
+                        Eigen::VectorXd& u, Eigen::VectorXd& w) {
+  if (!model.has_disc_volume_term()) return 0.0;
+  const double k = model.disc_volume_rank_one(x, u);
+  w.resize(space.size());
+  space.reduce_vector(u, w);
+  return k;
+}
 
 const char* to_string(TangentKind k) {
   switch (k) {
@@ -15,7 +40,8 @@ TangentKind factor_tangent(const MssModel& model, const ReducedSpace& space,
                            const ExternalLoads& loads, const Eigen::VectorXd& x,
                            const LumpedReduced* lumped, double lumped_scale,
                            Eigen::SparseMatrix<double>& H, Eigen::SparseMatrix<double>& A,
-                           SparseCholesky& chol) {
+                           TangentSolver& solver) {
+  SparseCholesky& chol = solver.cholesky();
   if (A.nonZeros() != space.pattern().nonZeros()) A = space.pattern();
   const auto assemble = [&](HessianMode mode) {
     model.hessian(x, mode, H);
@@ -24,21 +50,30 @@ TangentKind factor_tangent(const MssModel& model, const ReducedSpace& space,
     if (lumped) space.add_lumped(*lumped, lumped_scale, A);
     if (!chol.analyzed()) chol.analyze(A);
   };
+  TangentKind kind = TangentKind::failed;
   assemble(HessianMode::exact);
-  if (chol.factorize(A)) return TangentKind::exact;
-  assemble(HessianMode::projected);
-  if (chol.factorize(A)) return TangentKind::projected;
-  // Levenberg shift mu * mean|diag| on every reduced DOF, mu = 1e-8, 1e-6, ..., 1.
-  const Eigen::SparseMatrix<double> base = A;
-  double mean_diag = 0;
-  for (Eigen::Index k = 0; k < A.cols(); ++k) mean_diag += std::abs(A.coeff(k, k));
-  mean_diag = mean_diag > 0 ? mean_diag / double(A.cols()) : 1.0;
-  for (double mu = 1e-8; mu <= 1.0; mu *= 100.0) {
-    A = base;
-    for (Eigen::Index k = 0; k < A.cols(); ++k) A.coeffRef(k, k) += mu * mean_diag;
-    if (chol.factorize(A)) return TangentKind::shifted;
+  if (chol.factorize(A)) {
+    kind = TangentKind::exact;
+  } else {
+    assemble(HessianMode::projected);
+    if (chol.factorize(A)) {
+      kind = TangentKind::projected;
+    } else {
+      // Levenberg shift mu * mean|diag| on every reduced DOF, mu = 1e-8, 1e-6, ..., 1.
+      const Eigen::SparseMatrix<double> base = A;
+      const double mean_diag = std::max(1e-300, A.diagonal().cwiseAbs().mean());
+      for (double mu = 1e-8; mu <= 1.0 && kind == TangentKind::failed; mu *= 100.0) {
+        A = base;
+        for (Eigen::Index k = 0; k < A.cols(); ++k) A.coeffRef(k, k) += mu * mean_diag;
+        if (chol.factorize(A)) kind = TangentKind::shifted;
+      }
+    }
   }
-  return TangentKind::failed;
+  if (kind != TangentKind::failed) {
+    Eigen::VectorXd u, w;
+    solver.set_rank_one(reduced_rank_one(model, space, x, u, w), w);
+  }
+  return kind;
 }
 
 }  // namespace spinesim::mss::detail

@@ -1,6 +1,14 @@
-// Factorising the reduced tangent matrix with fallbacks (private to mss/): the exact Hessian
-// when Cholesky succeeds, else the projected (PSD) Hessian, else the projected one plus a
-// growing diagonal shift (Levenberg) — so a Newton step always has a descent direction.
+// The reduced tangent matrix and its solves (private to mss/).
+//
+// The model's Hessian is a sparse part (MssModel::hessian) plus, with the whole-disc volume
+// term, a dense rank-one part k_g u u^T (MssModel::disc_volume_rank_one). In reduced
+// coordinates the operator is A + k w w^T, w = P^T u; A is factorised by sparse Cholesky and
+// the rank-one part is solved by Sherman–Morrison with z = A^-1 w kept per factorisation:
+//   (A + k w w^T)^-1 b = A^-1 b - z k (w . A^-1 b) / (1 + k w . z),
+// one extra solve per factorisation and O(n) per solve.
+//
+// factor_tangent falls back from the exact Hessian to the projected (PSD) one, and then to the
+// projected one plus a growing diagonal shift (Levenberg), so a Newton step always descends.
 #pragma once
 
 #include "external_loads.hpp"
@@ -13,15 +21,36 @@
 
 namespace spinesim::mss::detail {
 
+/// A factorised sparse reduced matrix plus an optional rank-one term k w w^T (k >= 0).
+class TangentSolver {
+ public:
+  SparseCholesky& cholesky() { return chol_; }
+  /// After a successful factorisation: the operator becomes A + k w w^T (k = 0: A alone).
+  void set_rank_one(double k, const Eigen::VectorXd& w);
+  /// b <- (A + k w w^T)^-1 b, no allocation.
+  void solve_in_place(Eigen::VectorXd& b);
+
+ private:
+  SparseCholesky chol_;
+  double k_ = 0, denominator_ = 1;
+  Eigen::VectorXd w_, z_;
+};
+
+/// The reduced rank-one part of the model's Hessian at x: returns k_g and sets w = P^T u
+/// (u: full workspace); 0 when the model has no whole-disc volume term.
+double reduced_rank_one(const MssModel& model, const ReducedSpace& space, const Eigen::VectorXd& x,
+                        Eigen::VectorXd& u, Eigen::VectorXd& w);
+
 enum class TangentKind { exact, projected, shifted, failed };
 const char* to_string(TangentKind k);
 
-/// A <- lower(P^T (d2E + d2V_ext)(x) P) + scale * lumped (if lumped != nullptr), then factorised
-/// by `chol` (analysed on first use). H: workspace for the full Hessian (pattern kept).
+/// A <- lower(P^T (d2E + d2V_ext)(x) P) + scale * lumped (if lumped != nullptr), factorised by
+/// `solver` (analysed on first use), with the model's rank-one part attached. H: workspace for
+/// the full sparse Hessian (pattern kept).
 TangentKind factor_tangent(const MssModel& model, const ReducedSpace& space,
                            const ExternalLoads& loads, const Eigen::VectorXd& x,
                            const LumpedReduced* lumped, double lumped_scale,
                            Eigen::SparseMatrix<double>& H, Eigen::SparseMatrix<double>& A,
-                           SparseCholesky& chol);
+                           TangentSolver& solver);
 
 }  // namespace spinesim::mss::detail
