@@ -242,6 +242,9 @@ void run_probe(ProbeArgs a) {
     if (!std::isfinite(v) || v < 0) throw std::invalid_argument("--hold, --rest and --probe-stiffness must be finite and >= 0");
   const auto site_names = split_list(a.sites);
   if (site_names.empty()) throw std::invalid_argument("--sites: give at least one of anterior, posterior, left, right");
+  for (const auto& name : site_names)
+    if (name != "anterior" && name != "posterior" && name != "left" && name != "right")
+      throw std::invalid_argument("unknown probe site '" + name + "' (anterior, posterior, left, right)");
   const auto materials = mesh::load_material(a.material, data_dir());
   fs::create_directories(c.out);
 
@@ -255,7 +258,7 @@ void run_probe(ProbeArgs a) {
   ProbeSchedule plan{{}, a.depth_mm, a.speed_mm_s, a.hold_s, a.rest_s};
   for (const auto& name : site_names) plan.sites.push_back(pick_site(m, normals, name));
   for (std::size_t i = 0; i < plan.sites.size(); ++i) plan.sites[i].start_s = double(i) * plan.site_s();
-  const int steps = int(std::ceil(plan.total_s() / c.dt_s - 1e-9));
+  const int steps = int(std::ceil(plan.total_s() / c.dt_s - 1e-6));  // round-off must not add a step
 
   // 3. Step: both endplates fixed (identity poses), the probe moving.
   mss::Simulator sim(model, dyn);
@@ -361,10 +364,12 @@ struct Keyframe {
   double time_s, axial_mm, flexion_deg;
 };
 
-std::vector<Keyframe> drive_schedule(double compression_mm, double flexion_deg) {
+std::vector<Keyframe> drive_schedule(double compression_mm, double flexion_deg, double time_scale) {
   const double c = -compression_mm, f = flexion_deg;
-  return {{0.0, 0, 0}, {0.2, c, 0}, {0.3, c, 0}, {0.5, c, f}, {0.6, c, f},
-          {0.8, c, 0}, {0.9, c, 0}, {1.1, 0, 0}, {1.2, 0, 0}};
+  std::vector<Keyframe> keys = {{0.0, 0, 0}, {0.2, c, 0}, {0.3, c, 0}, {0.5, c, f}, {0.6, c, f},
+                                {0.8, c, 0}, {0.9, c, 0}, {1.1, 0, 0}, {1.2, 0, 0}};
+  for (auto& k : keys) k.time_s *= time_scale;
+  return keys;
 }
 
 /// The plate motion (t mm, theta rad) in the disc frame at time t.
@@ -389,7 +394,7 @@ fem::Vector6d rotate6(const Eigen::Matrix3d& r, const fem::Vector6d& v) {
 struct DriveArgs {
   StudyCommon common;
   std::string materials = "real-disc,annulus-nucleus,rubber,polyethylene";
-  double compression_mm = 0.5, flexion_deg = 3.0;
+  double compression_mm = 0.5, flexion_deg = 3.0, time_scale = 1.0;
 };
 
 struct DriveResult {
@@ -406,7 +411,7 @@ DriveResult drive_one(const mesh::TetMesh& m, const mesh::RegionMaterials& mater
   const Eigen::Vector3d center = fem::DiscFem::default_plate_center(m);
   const Eigen::Matrix3d& axes = m.frame.axes;
   const std::string stem = "drive-" + file_stem(materials.name);
-  const int steps = int(std::ceil(keys.back().time_s / c.dt_s - 1e-9));
+  const int steps = int(std::ceil(keys.back().time_s / c.dt_s - 1e-6));
 
   mss::Simulator sim(model, dyn);
   mss::State s = sim.rest_state();
@@ -461,10 +466,11 @@ void run_drive(DriveArgs a) {
   const mss::DynamicsOptions dyn = check_common(c);
   if (!std::isfinite(a.compression_mm) || !std::isfinite(a.flexion_deg))
     throw std::invalid_argument("--compression and --flexion must be finite numbers");
+  if (!std::isfinite(a.time_scale) || a.time_scale <= 0) throw std::invalid_argument("--time-scale must be finite and > 0");
   std::vector<mesh::RegionMaterials> materials;
   for (const auto& name : split_list(a.materials)) materials.push_back(mesh::load_material(name, data_dir()));
   if (materials.empty()) throw std::invalid_argument("--materials: give at least one material");
-  const auto keys = drive_schedule(a.compression_mm, a.flexion_deg);
+  const auto keys = drive_schedule(a.compression_mm, a.flexion_deg, a.time_scale);
   fs::create_directories(c.out);
 
   // 2. Disc.
@@ -555,6 +561,7 @@ void register_drive(CLI::App& study) {
   cmd->add_option("--materials", a->materials, "Comma-separated presets or JSON files")->capture_default_str();
   cmd->add_option("--compression", a->compression_mm, "Axial compression of the schedule, mm")->capture_default_str();
   cmd->add_option("--flexion", a->flexion_deg, "Flexion of the schedule, degrees")->capture_default_str();
+  cmd->add_option("--time-scale", a->time_scale, "Multiply the schedule's times (1.2 s at 1)")->capture_default_str();
   cmd->footer(
       "Schedule (disc frame, linear in between): 0-0.2 s compress; 0.3-0.5 s flex; 0.6-0.8 s unflex;\n"
       "0.9-1.1 s release; hold 0.1 s between. Writes OUT/drive-<material>.pvd (+ frames), OUT/drive-<material>.csv\n"
