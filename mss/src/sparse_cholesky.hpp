@@ -3,8 +3,8 @@
 // triangle only. A matrix that is not positive definite makes factorize() return false (the
 // callers fall back to another Hessian); non-finite values are refused the same way.
 //
-// Backends (measured for the per-step solve, see sparse_cholesky.cpp): CHOLMOD simplicial or
-// supernodal through cholmod_solve2 with reused workspace, or Eigen's SimplicialLLT (AMD).
+// Backends: CHOLMOD simplicial or supernodal through cholmod_solve2 with reused workspace, or
+// Eigen's SimplicialLLT (AMD). Default CHOLMOD supernodal (measurement in sparse_cholesky.cpp).
 #pragma once
 
 #include <Eigen/Core>
