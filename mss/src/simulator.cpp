@@ -97,7 +97,8 @@ struct Simulator::Impl {
 };
 
 void Simulator::Impl::ensure_space(PlateMode mode, const Eigen::Vector3d& c) {
-  if (have_space && space.mode() == mode && space.center() == c) return;
+  // The plate centre shapes the reduced space only through the wrench-mode plate map.
+  if (have_space && space.mode() == mode && (mode == PlateMode::pose || space.center() == c)) return;
   space = ReducedSpace(*model, H_rest, mode, c);
   const double dt = opt.dt_s;
   mass = space.lumped(model->node_masses_t());
@@ -232,16 +233,22 @@ StepReport Simulator::Impl::commit(State& s, const Boundary& bc, int iterations)
   // Velocities: unknown nodes from u+, Dirichlet nodes from their displacement.
   v = (x - s.x_mm) / dt;
   space.set_unknown_rates(un, v);
+  // Divergence: a node farther from rest than the allowance plus the largest displacement of a
+  // Dirichlet node (so a large rigid motion of the vertebrae is not mistaken for a blow-up).
   const Eigen::VectorXd& X = model->rest_positions_mm();
-  double worst = 0;
-  for (Eigen::Index i = 0; i < model->num_nodes(); ++i)
-    worst = std::max(worst, (x.segment<3>(3 * i) - X.segment<3>(3 * i)).squaredNorm());
+  double worst = 0, driven = 0;
+  for (Eigen::Index i = 0; i < model->num_nodes(); ++i) {
+    const double d2 = (x.segment<3>(3 * i) - X.segment<3>(3 * i)).squaredNorm();
+    worst = std::max(worst, d2);
+    if (!space.is_unknown(int(i))) driven = std::max(driven, d2);
+  }
+  const double limit = divergence_mm + std::sqrt(driven);
   if (!x.allFinite() || !v.allFinite() || !std::isfinite(worst))
     return {false, iterations, "step diverged: non-finite positions or velocities (state kept)"};
-  if (std::sqrt(worst) > divergence_mm)
+  if (std::sqrt(worst) > limit)
     return {false, iterations,
-            "step diverged: a node moved " + std::to_string(std::sqrt(worst)) +
-                " mm from rest, more than " + std::to_string(divergence_mm) + " mm (state kept)"};
+            "step diverged: a node moved " + std::to_string(std::sqrt(worst)) + " mm from rest, more than " +
+                std::to_string(limit) + " mm (divergence distance + largest endplate displacement; state kept)"};
   Vector6d q;
   if (space.has_plate_dofs()) {
     q = y.tail<6>();

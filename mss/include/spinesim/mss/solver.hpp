@@ -26,9 +26,10 @@
 // Static solve: Newton with backtracking line search on Pi(x) = E(x) - W_ext(x), with the exact
 // Hessian when it factorises and the projected one otherwise.
 //
-// Failure: a step that yields non-finite numbers, or moves a node farther than
-// `divergence_distance_mm` from its rest position, is rejected — the state is left unchanged
-// and StepReport::ok is false with a message. Nothing here writes files.
+// Failure: a step that yields non-finite numbers, or moves a node farther from its rest position
+// than `divergence_distance_mm` plus the largest displacement of a prescribed endplate node, is
+// rejected — the state is left unchanged and StepReport::ok is false with a message. Nothing
+// here writes files.
 #pragma once
 
 #include "spinesim/mss/boundary.hpp"
@@ -84,7 +85,9 @@ struct DynamicsOptions {
   int newton_iterations = 1;         ///< implicit: max Newton iterations per step (1 = Baraff–Witkin)
   double newton_relative_tolerance = 1e-6;  ///< implicit: stop early below this residual ratio
   MatrixUpdate matrix_update = MatrixUpdate::every_iteration;
-  double divergence_distance_mm = 0; ///< 0 → the mesh's bounding-box diagonal
+  /// Allowed distance from rest beyond the endplates' own displacement; 0 → the mesh's
+  /// bounding-box diagonal.
+  double divergence_distance_mm = 0;
 };
 
 struct State {
