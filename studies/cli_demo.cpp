@@ -4,12 +4,14 @@
 //
 // Steps: 1. mesh the L4-L5 disc between its vertebrae (thesis tables F.1/F.2 placement);
 // 2. FEM reference (real-disc material): the 6x6 disc stiffness and the eight named load
-// cases; 3. the same disc in the other material presets; 4. write VTU results, report.md and
-// summary.json into --out. (The mass-spring disc, its calibration and the spine join the
+// cases; 3. the same disc in the other material presets; 4. the mass-spring disc with the
+// untuned Van Gelder constants against that FEM (mss_report.hpp protocol); 5. write VTU
+// results, report.md and summary.json into --out. (The calibration and the spine join the
 // demo as they are built.)
 #include "cli_common.hpp"
 #include "fem_report.hpp"
 #include "mesh_report.hpp"
+#include "mss_report.hpp"
 
 #include "spinesim/fem/disc_fem.hpp"
 #include "spinesim/fem/load_cases.hpp"
@@ -18,6 +20,7 @@
 #include "spinesim/mesh/material.hpp"
 #include "spinesim/mesh/mesher.hpp"
 #include "spinesim/mesh/quality.hpp"
+#include "spinesim/mss/model.hpp"
 
 #include <filesystem>
 #include <fstream>
@@ -47,7 +50,7 @@ fem::Matrix6d to_disc_frame(const fem::Matrix6d& k, const mesh::DiscFrame& f) {
 void run_demo(const DemoArgs& a) {
   namespace fs = std::filesystem;
   fs::create_directories(a.out);
-  Progress progress(4, a.quiet || a.json);
+  Progress progress(5, a.quiet || a.json);
 
   // 1. Mesh.
   const auto dims = mesh::disc_dimensions(a.level, data_dir());
@@ -118,7 +121,15 @@ void run_demo(const DemoArgs& a) {
   }
   progress.end();
 
-  // 4. Report.
+  // 4. Mass-spring disc (untuned Van Gelder constants) vs the FEM above: the baseline.
+  progress.begin("MSS vs FEM, " + std::to_string(fem::standard_load_cases().size()) + " load cases");
+  const mss::MssModel mss_model(m, real_disc);
+  const MssFemComparison mss_vs_fem = compare_mss_fem(solver, mss_model, fem::standard_load_cases(), real_disc.name);
+  const double mss_s = progress.end();
+  std::ostringstream mss_table;
+  print_comparison(mss_table, mss_vs_fem, true);
+
+  // 5. Report.
   const fem::Matrix6d k_local = to_disc_frame(k6, m.frame);
   std::ostringstream report;
   report << "# spinesim demo — " << dims.level << " disc\n\n"
@@ -132,7 +143,13 @@ void run_demo(const DemoArgs& a) {
          << " s.\n\n### 6x6 disc stiffness in the disc frame (x lateral, y axial, z anterior)\n\n```\n";
   print_stiffness(report, k_local);
   report << "```\n\n### Load cases (wrench on the superior plate, disc frame)\n\n" << case_table.str()
-         << "\n## Material presets (same mesh, P" << a.order << ")\n\n" << material_table.str();
+         << "\n## Material presets (same mesh, P" << a.order << ")\n\n" << material_table.str()
+         << "\n## MSS vs FEM (untuned Van Gelder baseline)\n\n"
+         << "The thesis's mass-spring disc (main, radial and torsional springs, real-disc constants) on the same\n"
+         << "mesh, static, against the FEM above (`spinesim mss compare --help` gives the protocol): displacement\n"
+         << "error under each case's wrench, reaction error under the FEM's plate motion. This is what the\n"
+         << "calibration must beat. " << std::setprecision(3) << mss_s << " s.\n\n"
+         << mss_table.str();
   const std::string report_path = (fs::path(a.out) / "report.md").string();
   {
     std::ofstream f(report_path);
@@ -148,6 +165,7 @@ void run_demo(const DemoArgs& a) {
                       {"stiffness_6x6_units", kStiffnessUnits},
                       {"cases", cases},
                       {"materials", materials},
+                      {"mss_vs_fem", comparison_json(mss_vs_fem)},
                       {"report", report_path},
                       {"files", {mesh_path, result_path}}};
   {

@@ -396,7 +396,11 @@ void print_comparison(std::ostream& os, const MssFemComparison& c, bool markdown
                                "force part", "moment part", "max |u| FEM (mm)", "max |u| MSS (mm)"};
   if (markdown) {
     os << "|";
-    for (const char* h : head) os << " " << h << " |";
+    for (const char* h : head) {
+      os << " ";
+      for (const char* ch = h; *ch; ++ch) os << (*ch == '|' ? "\\|" : std::string(1, *ch));  // | would end the cell
+      os << " |";
+    }
     os << "\n|---|---|---|---|---|---|---|---|\n";
   } else {
     os << pad(head[0], 16, true);
