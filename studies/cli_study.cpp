@@ -522,12 +522,17 @@ void run_drive(DriveArgs a) {
     std::cout << "\n  " << std::left << std::setw(18) << "material" << std::right << std::setw(12) << "E (MPa)"
               << std::setw(16) << "peak |F| (N)" << std::setw(16) << "peak Fy (N)" << std::setw(18) << "peak |M| (N·mm)"
               << std::setw(14) << "max dV/V0" << std::setw(14) << "step (ms)" << "\n";
-    for (const auto& r : results)
+    for (const auto& r : results) {
+      std::ostringstream e;  // "4.2/1" when annulus and nucleus differ
+      const double ea = r.json["E_mpa_annulus"].get<double>(), en = r.json["E_mpa_nucleus"].get<double>();
+      e << ea;
+      if (en != ea) e << "/" << en;
       std::cout << "  " << std::left << std::setw(18) << r.json["material"].get<std::string>() << std::right
-                << std::setw(12) << r.json["E_mpa_annulus"].get<double>() << std::setw(16) << std::setprecision(5)
+                << std::setw(12) << e.str() << std::setw(16) << std::setprecision(5)
                 << r.peak_force_n << std::setw(16) << r.peak_axial_n << std::setw(18) << r.peak_moment_nmm
                 << std::setw(13) << 100 * r.json["max_volume_change"].get<double>() << "%" << std::setw(14)
                 << r.stats.mean_seconds() * 1e3 << (r.stats.diverged ? "  DIVERGED" : "") << "\n";
+    }
     std::cout << "  wrote " << json_path << " and drive-<material>.{pvd,csv} in " << c.out << "\n";
   }
   if (!diverged.empty()) throw std::runtime_error("drive study diverged for: " + diverged);

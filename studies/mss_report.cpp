@@ -86,6 +86,11 @@ void add_model_flags(CLI::App* cmd, ModelFlags& f) {
   cmd->add_flag("--no-radial", f.no_radial, "Without the radial springs (thesis 5.3-5.5)");
   cmd->add_flag("--no-torsion", f.no_torsion, "Without the torsional angle springs (thesis 5.6-5.8)");
   cmd->add_flag("--volume-term", f.volume_term, "Add the per-tetrahedron volume penalty (beyond the thesis)");
+  cmd->add_flag("--disc-volume-term", f.disc_volume_term, "Add the whole-disc volume penalty (beyond the thesis)");
+  cmd->add_option("--volume-factor", f.volume_factor, "c_v of the per-tetrahedron term, k_v = c_v K / V0_t")
+      ->capture_default_str();
+  cmd->add_option("--disc-volume-factor", f.disc_volume_factor, "c_g of the whole-disc term, k_g = c_g K / V0")
+      ->capture_default_str();
   f.damping_option = cmd->add_option("--damping", f.damping_n_s_per_mm,
                                      "Ambient damping K_d per node, N·s/mm (default: critical for the first axial mode)");
 }
@@ -95,6 +100,12 @@ mss::MssOptions model_options(const ModelFlags& f) {
   o.radial_springs = !f.no_radial;
   o.torsion_springs = !f.no_torsion;
   o.volume_term = f.volume_term;
+  o.disc_volume_term = f.disc_volume_term;
+  if (!std::isfinite(f.volume_factor) || f.volume_factor <= 0 || !std::isfinite(f.disc_volume_factor) ||
+      f.disc_volume_factor <= 0)
+    throw std::invalid_argument("--volume-factor and --disc-volume-factor must be finite numbers > 0");
+  o.volume_factor = f.volume_factor;
+  o.disc_volume_factor = f.disc_volume_factor;
   if (f.damping_option && f.damping_option->count() > 0) {
     if (!std::isfinite(f.damping_n_s_per_mm) || f.damping_n_s_per_mm < 0)
       throw std::invalid_argument("--damping must be a finite number >= 0 N·s/mm");
@@ -104,8 +115,9 @@ mss::MssOptions model_options(const ModelFlags& f) {
 }
 
 std::string model_variant(const ModelFlags& f) {
-  std::string v = f.volume_term ? "volume-term" : (f.no_radial ? "no-radial" : "radial");
-  if (f.volume_term && f.no_radial) v += "+no-radial";
+  std::string v = f.no_radial ? "no-radial" : "radial";
+  if (f.volume_term) v += "+volume-term";
+  if (f.disc_volume_term) v += "+disc-volume-term";
   if (f.no_torsion) v += "+no-torsion";
   return v;
 }
@@ -203,8 +215,10 @@ nlohmann::json mss_model_json(const mss::MssModel& model, const mesh::RegionMate
            {{"radial_springs", o.radial_springs},
             {"torsion_springs", o.torsion_springs},
             {"volume_term", o.volume_term},
+            {"disc_volume_term", o.disc_volume_term},
             {"radial_factor", o.radial_factor},
             {"volume_factor", o.volume_factor},
+            {"disc_volume_factor", o.disc_volume_factor},
             {"damping_ratio", o.damping_ratio}}}};
 }
 
@@ -250,11 +264,29 @@ fem::Matrix6d mss_plate_stiffness(const mss::MssModel& model, const Eigen::Vecto
   Eigen::SparseMatrix<double> k(nf, nf);
   k.setFromTriplets(kff.begin(), kff.end());
 
-  // 3. Condense.
+  // 3. The whole-disc volume term's dense rank-one part k_g u u^T (model.hpp), split like the
+  //    blocks: free part u_f, plate part T'u_p.
+  Eigen::VectorXd u;
+  const double kg = model.disc_volume_rank_one(X, u);
+  Eigen::VectorXd u_f = Eigen::VectorXd::Zero(nf);
+  fem::Vector6d u_p = fem::Vector6d::Zero();
+  if (kg != 0.0)
+    for (Eigen::Index dof = 0; dof < ndof; ++dof) {
+      if (free_index[std::size_t(dof)] >= 0) u_f(free_index[std::size_t(dof)]) = u(dof);
+      else if (is_superior(m, dof / 3)) u_p += u(dof) * map.row(dof).transpose();
+    }
+  b += kg * u_f * u_p.transpose();
+  kpp += kg * u_p * u_p.transpose();
+
+  // 4. Condense: K_ff + k_g u_f u_f' inverted by Sherman–Morrison on the sparse factor.
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(k);
   if (ldlt.info() != Eigen::Success)
     throw std::runtime_error("MSS plate stiffness: the free-node stiffness does not factorise");
-  const Eigen::MatrixXd z = ldlt.solve(b);
+  Eigen::MatrixXd z = ldlt.solve(b);
+  if (kg != 0.0) {
+    const Eigen::VectorXd a_u = ldlt.solve(u_f);
+    z -= a_u * (kg * (u_f.transpose() * z)) / (1.0 + kg * u_f.dot(a_u));
+  }
   fem::Matrix6d k6 = kpp - b.transpose() * z;
   k6 = 0.5 * (k6 + k6.transpose()).eval();
   if (!k6.allFinite()) throw std::runtime_error("MSS plate stiffness: non-finite result");

@@ -43,16 +43,19 @@ namespace spinesim::cli {
 
 /// The flags every MSS verb shares: which energy terms, and the ambient damping.
 struct ModelFlags {
-  bool no_radial = false, no_torsion = false, volume_term = false;
+  bool no_radial = false, no_torsion = false, volume_term = false, disc_volume_term = false;
+  double volume_factor = 1.0, disc_volume_factor = 1.0;
   double damping_n_s_per_mm = -1.0;
   CLI::Option* damping_option = nullptr;
 };
-/// Adds --no-radial, --no-torsion, --volume-term and --damping to `cmd`.
+/// Adds --no-radial, --no-torsion, --volume-term, --disc-volume-term, their factors and
+/// --damping to `cmd`.
 void add_model_flags(CLI::App* cmd, ModelFlags& flags);
 /// The model options they select; throws std::invalid_argument for a negative or non-finite
-/// --damping.
+/// --damping or a volume factor that is not finite and > 0.
 mss::MssOptions model_options(const ModelFlags& flags);
-/// "radial" (thesis), "no-radial" or "volume-term" (+ "no-torsion"), for file names and tables.
+/// "radial" (thesis) or "no-radial", "+volume-term", "+disc-volume-term", "+no-torsion": the
+/// variant's name for tables.
 std::string model_variant(const ModelFlags& flags);
 /// "implicit", "symplectic" or "explicit"; throws std::invalid_argument naming the choices.
 mss::Integrator parse_integrator(const std::string& name);
@@ -95,8 +98,9 @@ nlohmann::json mss_model_json(const mss::MssModel& model, const mesh::RegionMate
 
 /// MSS plate stiffness at rest about `center_mm`, by condensing the rest Hessian onto the
 /// superior plate's rigid motion (t mm, theta rad): K6 = T'K_pp T - (K_fp T)' K_ff^-1 (K_fp T),
-/// inferior endplate fixed. Units as fem::DiscFem::stiffness_6x6. Throws std::runtime_error if
-/// K_ff does not factorise.
+/// inferior endplate fixed; the whole-disc volume term's rank-one Hessian part is included
+/// (Sherman–Morrison). Units as fem::DiscFem::stiffness_6x6. Throws std::runtime_error if K_ff
+/// does not factorise.
 fem::Matrix6d mss_plate_stiffness(const mss::MssModel& model, const Eigen::Vector3d& center_mm);
 
 // --- MSS vs FEM (protocol above) --------------------------------------------------------------
