@@ -9,12 +9,14 @@
 //                     factorisation (MatrixUpdate::frozen): the real-time haptic step
 //   ImplicitNewton  — one implicit Euler step, dt 1 ms, the matrix refactorised (numeric only)
 //   Static          — Newton equilibrium under 10 % axial compression
-//   AllDiscs        — the 17 discs T1-T2 .. L5-S1 (default cell size), one frozen implicit step
-//                     each: real time at 1 kHz needs < 1 ms per iteration
+//   AllDiscs        — the 17 discs T1-T2 .. L5-S1 meshed at one cell size (µm), one frozen
+//                     implicit step each (DiscSet, 1 or 2 threads): real time at 1 kHz needs
+//                     < 1 ms per iteration
 // Run: build/release/bench/bench_mss [--benchmark_filter=Implicit]
 #include "spinesim/mesh/disc_geometry.hpp"
 #include "spinesim/mesh/material.hpp"
 #include "spinesim/mesh/mesher.hpp"
+#include "spinesim/mss/disc_set.hpp"
 #include "spinesim/mss/model.hpp"
 #include "spinesim/mss/solver.hpp"
 
@@ -127,36 +129,27 @@ void Static(benchmark::State& state) {
 }
 
 void AllDiscs(benchmark::State& state) {
-  struct Disc {
-    std::unique_ptr<MssModel> model;
-    std::unique_ptr<Simulator> sim;
-    State s;
-    Boundary bc;
-  };
-  static std::vector<Disc> discs;
-  double tets = 0;
-  if (discs.empty()) {
+  static std::map<std::pair<long, long>, std::unique_ptr<DiscSet>> cache;
+  const double cell_mm = state.range(0) / 1000.0;
+  const int threads = int(state.range(1));
+  auto& set = cache[{state.range(0), state.range(1)}];
+  std::vector<Boundary> bcs;
+  if (!set) {
     DynamicsOptions opt;
     opt.dt_s = 1e-3;
     opt.matrix_update = MatrixUpdate::frozen;
-    for (const std::string& level : mesh::disc_levels()) {
-      Disc d;
-      d.model = std::make_unique<MssModel>(disc_mesh(level, 2.0), real_disc());
-      d.sim = std::make_unique<Simulator>(*d.model, opt);
-      d.s = d.sim->rest_state();
-      d.bc = compression(*d.model, 0.02);
-      d.sim->step(d.s, d.bc);
-      discs.push_back(std::move(d));
-    }
+    set = std::make_unique<DiscSet>(threads);
+    for (const std::string& level : mesh::disc_levels())
+      set->add(MssModel(disc_mesh(level, cell_mm), real_disc()), opt);
   }
-  for (const Disc& d : discs) tets += double(d.model->mesh().num_tets());
+  for (int i = 0; i < set->size(); ++i) bcs.push_back(compression(set->model(i), 0.02));
+  set->step(bcs);  // first step: analysis + the frozen factorisations
   for (auto _ : state)
-    for (Disc& d : discs) {
-      const StepReport r = d.sim->step(d.s, d.bc);
+    for (const StepReport& r : set->step(bcs))
       if (!r.ok) state.SkipWithError(r.message.c_str());
-    }
-  state.counters["discs"] = double(discs.size());
-  state.counters["tets"] = tets;
+  state.counters["discs"] = double(set->size());
+  state.counters["tets"] = set->total_tets();
+  state.counters["threads"] = threads;
 }
 
 // Cell sizes 4, 3, 2.5, 2, 1.5 mm (µm arguments).
@@ -172,6 +165,9 @@ BENCHMARK(Hessian)->Apply(sizes);
 BENCHMARK(ImplicitFrozen)->Apply(sizes);
 BENCHMARK(ImplicitNewton)->Apply(sizes);
 BENCHMARK(Static)->Apply(sizes)->Unit(benchmark::kMillisecond);
-BENCHMARK(AllDiscs)->Unit(benchmark::kMicrosecond);
+BENCHMARK(AllDiscs)
+    ->ArgsProduct({{2000, 4000}, {1, 2}})
+    ->ArgNames({"cell_um", "threads"})
+    ->Unit(benchmark::kMicrosecond);
 
 BENCHMARK_MAIN();
