@@ -143,6 +143,12 @@ ReducedSpace::ReducedSpace(const MssModel& model, const Eigen::SparseMatrix<doub
       }
 }
 
+void ReducedSpace::set_dirichlet_positions(const Boundary& bc, Eigen::VectorXd& x) const {
+  for (int i : inferior_nodes_) x.segment<3>(3 * i) = bc.inferior.apply(X_.segment<3>(3 * i));
+  if (!has_plate_dofs())
+    for (int i : superior_nodes_) x.segment<3>(3 * i) = bc.superior.apply(X_.segment<3>(3 * i));
+}
+
 void ReducedSpace::set_unknown_positions(const Eigen::VectorXd& y, Eigen::VectorXd& x) const {
   for (std::size_t k = 0; k < free_nodes_.size(); ++k)
     x.segment<3>(3 * free_nodes_[k]) = y.segment<3>(3 * Eigen::Index(k));

@@ -64,6 +64,9 @@ class ReducedSpace {
     return role(node) == NodeRole::free || (role(node) == NodeRole::superior && has_plate_dofs());
   }
 
+  /// x <- the prescribed positions: label-1 nodes at bc.inferior, and in pose mode label-2 nodes
+  /// at bc.superior (x = R X + t).
+  void set_dirichlet_positions(const Boundary& bc, Eigen::VectorXd& x) const;
   /// x <- positions of the unknown nodes from y (free: y; plate nodes: X + R q). Dirichlet
   /// nodes of x are not touched.
   void set_unknown_positions(const Eigen::VectorXd& y, Eigen::VectorXd& x) const;

@@ -83,11 +83,10 @@ struct Simulator::Impl {
   std::vector<int> frozen_contacts, contacts;
 
   // Workspaces (sized once per reduced system): full 3#nodes and reduced vectors.
-  Eigen::VectorXd x, v, g;
+  Eigen::VectorXd x, v;
   Eigen::VectorXd y, yn, un, yhat, r, d, y_trial, r_trial, tmp;
 
   void ensure_space(PlateMode mode, const Eigen::Vector3d& c);
-  void apply_dirichlet(const Boundary& bc, Eigen::VectorXd& xs) const;
   /// Phi(y) and its gradient into r (implicit Euler).
   double phi_and_gradient(ReducedPotential& pot, const Eigen::VectorXd& yy, Eigen::VectorXd& rr);
   bool factor_frozen(const ExternalLoads& loads, const Eigen::VectorXd& xs);
@@ -113,13 +112,6 @@ void Simulator::Impl::ensure_space(PlateMode mode, const Eigen::Vector3d& c) {
   const Eigen::Index n = space.size();
   for (Eigen::VectorXd* w : {&y, &yn, &un, &yhat, &r, &d, &y_trial, &r_trial, &tmp}) w->setZero(n);
   have_space = true;
-}
-
-void Simulator::Impl::apply_dirichlet(const Boundary& bc, Eigen::VectorXd& xs) const {
-  const Eigen::VectorXd& X = model->rest_positions_mm();
-  for (int i : space.inferior_nodes()) xs.segment<3>(3 * i) = bc.inferior.apply(X.segment<3>(3 * i));
-  if (!space.has_plate_dofs())
-    for (int i : space.superior_nodes()) xs.segment<3>(3 * i) = bc.superior.apply(X.segment<3>(3 * i));
 }
 
 double Simulator::Impl::phi_and_gradient(ReducedPotential& pot, const Eigen::VectorXd& yy,
@@ -173,7 +165,7 @@ StepReport Simulator::Impl::explicit_step(State& s, const Boundary& bc, const Ex
     un.noalias() += dt * tmp;  // (5.20): v+ = v + dt a
   }
   x = s.x_mm;
-  apply_dirichlet(bc, x);
+  space.set_dirichlet_positions(bc, x);
   space.set_unknown_positions(y, x);
   return commit(s, bc, 0);
 }
@@ -183,7 +175,7 @@ StepReport Simulator::Impl::implicit_step(State& s, const Boundary& bc, const Ex
   ReducedPotential& pot = potential;
   pot.set_loads(&loads, space.has_plate_dofs() ? bc.wrench : Vector6d::Zero());
   pot.x() = s.x_mm;
-  apply_dirichlet(bc, pot.x());
+  space.set_dirichlet_positions(bc, pot.x());
   yhat = yn + dt * un;
   y = yn;
   double phi = phi_and_gradient(pot, y, r);

@@ -37,14 +37,6 @@ void check_positions(const Eigen::VectorXd& x, const MssModel& model, const char
   if (!x.allFinite()) throw std::invalid_argument(std::string("mss: ") + what + " is not finite");
 }
 
-/// Moves the Dirichlet nodes of x to their poses: label 1 always, label 2 in pose mode.
-void apply_dirichlet(const ReducedSpace& space, const Boundary& bc, const Eigen::VectorXd& X,
-                     Eigen::VectorXd& x) {
-  for (int i : space.inferior_nodes()) x.segment<3>(3 * i) = bc.inferior.apply(X.segment<3>(3 * i));
-  if (!space.has_plate_dofs())
-    for (int i : space.superior_nodes()) x.segment<3>(3 * i) = bc.superior.apply(X.segment<3>(3 * i));
-}
-
 double round_off_floor(const MssModel& model, const Eigen::SparseMatrix<double>& H_rest) {
   const double mean_diag = H_rest.diagonal().cwiseAbs().mean();
   const double x_max = model.rest_positions_mm().cwiseAbs().maxCoeff();
@@ -78,7 +70,7 @@ StaticResult solve_static(const MssModel& model, const Boundary& bc, const Stati
   // 3. Start: x_start or rest, endplates at their poses (plate DOF fitted to x_start).
   ReducedPotential pot(model, space, &loads, wrench);
   pot.x() = x_start.size() ? x_start : X;
-  apply_dirichlet(space, bc, X, pot.x());
+  space.set_dirichlet_positions(bc, pot.x());
   const Vector6d q0 = space.has_plate_dofs() && x_start.size() ? space.fit_plate_motion(x_start)
                                                                : Vector6d::Zero();
   const Eigen::Index n = space.size();
