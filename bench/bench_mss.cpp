@@ -9,13 +9,15 @@
 //                     factorisation (MatrixUpdate::frozen): the real-time haptic step
 //   ImplicitNewton  — one implicit Euler step, dt 1 ms, the matrix refactorised (numeric only)
 //   Static          — Newton equilibrium under 10 % axial compression
-//   AllDiscs        — the 17 discs T1-T2 .. L5-S1 meshed at one cell size (µm), one frozen
+//   AllDiscs        — the 17 discs T1-T2 .. L5-S1 meshed at one cell size (µm; 0: the structured
+//                     360-tet disc of mesh/structured_disc.hpp), one frozen
 //                     implicit step each (DiscSet, 1 or 2 threads): real time at 1 kHz needs
 //                     < 1 ms per iteration
 // Run: build/release/bench/bench_mss [--benchmark_filter=Implicit]
 #include "spinesim/mesh/disc_geometry.hpp"
 #include "spinesim/mesh/material.hpp"
 #include "spinesim/mesh/mesher.hpp"
+#include "spinesim/mesh/structured_disc.hpp"
 #include "spinesim/mss/disc_set.hpp"
 #include "spinesim/mss/model.hpp"
 #include "spinesim/mss/solver.hpp"
@@ -34,15 +36,18 @@ namespace {
 
 mesh::RegionMaterials real_disc() { return mesh::load_material("real-disc", SPINESIM_DATA_DIR); }
 
+/// CGAL disc at a cell size, or (cell_mm == 0) the structured haptic-resolution disc
+/// (mesh/structured_disc.hpp defaults: 12 sectors x 3 rings x 2 layers, 360 tets).
 const mesh::TetMesh& disc_mesh(const std::string& level, double cell_mm) {
   static std::map<std::pair<std::string, long>, mesh::TetMesh> cache;
   const auto key = std::make_pair(level, std::lround(cell_mm * 1000));
   auto it = cache.find(key);
   if (it == cache.end()) {
+    const mesh::DiscDimensions dims = mesh::disc_dimensions(level, SPINESIM_DATA_DIR);
     mesh::MeshOptions opt;
     opt.cell_size_mm = cell_mm;
-    it = cache.emplace(key, mesh::mesh_parametric_disc(
-                                mesh::disc_dimensions(level, SPINESIM_DATA_DIR), opt)).first;
+    it = cache.emplace(key, cell_mm > 0 ? mesh::mesh_parametric_disc(dims, opt)
+                                        : mesh::mesh_structured_disc(dims)).first;
   }
   return it->second;
 }
@@ -166,7 +171,7 @@ BENCHMARK(ImplicitFrozen)->Apply(sizes);
 BENCHMARK(ImplicitNewton)->Apply(sizes);
 BENCHMARK(Static)->Apply(sizes)->Unit(benchmark::kMillisecond);
 BENCHMARK(AllDiscs)
-    ->ArgsProduct({{2000, 4000}, {1, 2}})
+    ->ArgsProduct({{0, 2000, 4000}, {1, 2}})
     ->ArgNames({"cell_um", "threads"})
     ->Unit(benchmark::kMicrosecond);
 
