@@ -78,10 +78,102 @@ struct PlateLoad {
   }
 };
 
-/// Reaction about the moved plate centre c + t, N and N·mm.
-fem::Vector6d reaction_about_plate(const mss::MssModel& model, const Eigen::VectorXd& x, const Eigen::Vector3d& c,
-                                   const fem::Vector6d& q) {
-  return mss::plate_reaction(model, x, c + q.head<3>());
+/// The end state of a run and whether it failed (not converged / diverged).
+struct Outcome {
+  Eigen::VectorXd x_mm;
+  fem::Vector6d plate_motion = fem::Vector6d::Zero();  ///< (t mm, theta rad)
+  bool failed = false;
+  std::string failure;  ///< one line
+};
+
+/// Static equilibrium under the full load; fills the static JSON fields.
+Outcome solve_static_load(const mss::MssModel& model, const PlateLoad& load, Progress& progress, nlohmann::json& j) {
+  progress.begin("static equilibrium (Newton)");
+  const mss::StaticResult r = mss::solve_static(model, load.boundary(1.0));
+  progress.end(std::to_string(r.iterations) + " iterations");
+  j["reaction_wrench"] = to_json(Eigen::VectorXd(r.reaction_wrench));
+  j["converged"] = r.converged;
+  j["iterations"] = r.iterations;
+  j["residual_n"] = r.residual_n;
+  j["timings"]["solve_s"] = r.seconds;
+  Outcome o{r.x_mm, r.plate_motion};
+  o.failed = !r.converged || !r.x_mm.allFinite();
+  if (o.failed)
+    o.failure = "static solve did not converge after " + std::to_string(r.iterations) + " iterations: " + one_line(r.message);
+  return o;
+}
+
+/// Steps in time: the load ramped over the first 10 % of the steps, then held; frames into
+/// `frames` (may be null) every `every` steps. Fills the dynamic JSON fields.
+Outcome step_in_time(const mss::MssModel& model, const PlateLoad& load, const MssArgs& a, mss::Integrator integrator,
+                     VtuSeries* frames, Progress& progress, nlohmann::json& j) {
+  mss::DynamicsOptions dopt;
+  dopt.integrator = integrator;
+  dopt.dt_s = a.dt_s;
+  dopt.newton_iterations = a.newton_iterations;
+  dopt.matrix_update = a.frozen ? mss::MatrixUpdate::frozen : mss::MatrixUpdate::every_iteration;
+  mss::Simulator sim(model, dopt);
+  mss::State s = sim.rest_state();
+  const int ramp = std::max(1, int(std::ceil(0.1 * a.steps)));
+  const int every = a.frame_every > 0 ? a.frame_every : std::max(1, a.steps / 100);
+  if (frames) frames->add(0.0, model, s.x_mm);
+
+  progress.begin(std::to_string(a.steps) + " steps of " + a.integrator + " Euler, dt " + std::to_string(a.dt_s) + " s");
+  StepStats stats;
+  for (int k = 1; k <= a.steps; ++k) {
+    if (!stats.step(sim, s, load.boundary(std::min(1.0, double(k) / ramp)))) break;
+    if (frames && (k % every == 0 || k == a.steps)) frames->add(s.time_s, model, s.x_mm);
+  }
+  j["timings"]["stepping_s"] = progress.end(std::to_string(stats.steps_done) + " steps");
+
+  Outcome o;
+  o.x_mm = s.x_mm;
+  const double applied = std::min(1.0, double(stats.steps_done) / ramp);  // load factor of the last good step
+  o.plate_motion = load.is_wrench ? fem::Vector6d(s.plate_q) : fem::Vector6d(applied * load.value);
+  if (stats.diverged) {
+    const int k = stats.steps_done + 1;
+    std::ostringstream os;
+    os << "diverged at step " << k << " of " << a.steps << " (t = " << k * a.dt_s << " s, " << a.integrator
+       << " Euler, dt = " << a.dt_s << " s): " << stats.message;
+    if (integrator != mss::Integrator::implicit_euler) {
+      const double stable = sim.predicted_stable_dt_s(integrator);
+      if (std::isfinite(stable)) os << "; predicted stable dt < " << stable << " s";
+    }
+    o.failed = true;
+    o.failure = os.str();
+  }
+  j["integrator"] = a.integrator;
+  j["dt_s"] = a.dt_s;
+  j["steps"] = a.steps;
+  j["ramp_steps"] = ramp;
+  j["time_s"] = s.time_s;
+  j["matrix_update"] = a.frozen ? "frozen" : "every_iteration";
+  stats.add_to(j);
+  // About the moved plate centre, like StaticResult::reaction_wrench.
+  j["reaction_wrench"] =
+      to_json(Eigen::VectorXd(mss::plate_reaction(model, o.x_mm, load.center + o.plate_motion.head<3>())));
+  return o;
+}
+
+void print_summary(std::ostream& os, const MssArgs& a, const mss::MssModel& model, const std::string& material,
+                   const PlateLoad& load, const Outcome& o, const nlohmann::json& j) {
+  const mesh::TetMesh& m = model.mesh();
+  os << std::setprecision(5) << "MSS on " << a.mesh_path << " (" << m.num_vertices() << " nodes, " << m.num_tets()
+     << " tets), material " << material << ", " << model_variant(a.model) << "\n"
+     << "  springs       " << model.num_edge_springs() << " edge, " << model.num_radial_tets() << " radial tets, "
+     << model.num_angle_springs() << " angle, " << model.num_volume_terms() << " volume\n"
+     << "  plate centre  " << load.center.transpose() << " mm\n";
+  if (a.dynamic)
+    os << "  dynamic       " << j["steps_done"] << " of " << a.steps << " steps, dt " << a.dt_s << " s, mean step "
+       << j["step_seconds_mean"].get<double>() * 1e3 << " ms\n";
+  else
+    os << "  static        " << (j["converged"].get<bool>() ? "converged" : "NOT converged") << " in "
+       << j["iterations"] << " Newton iterations\n";
+  const auto qd = motion_rad_to_deg(o.plate_motion);
+  os << "  plate motion  t = " << qd.head<3>().transpose() << " mm, r = " << qd.tail<3>().transpose() << " deg\n"
+     << "  reaction      " << j["reaction_wrench"].dump() << " (N, N·mm)\n"
+     << "  volume        " << j["volume_mm3"].get<double>() << " mm^3, change "
+     << 100.0 * j["volume_change"].get<double>() << " %\n";
 }
 
 void run_mss(const MssArgs& a) {
@@ -98,6 +190,7 @@ void run_mss(const MssArgs& a) {
     load.value = parse_numbers(a.wrench, 6, "--wrench Fx,Fy,Fz,Mx,My,Mz (N, N·mm)");
   }
   const fem::LoadCase* named = a.load_case.empty() ? nullptr : &fem::load_case(a.load_case);
+  const Eigen::VectorXd center = a.center.empty() ? Eigen::VectorXd() : parse_numbers(a.center, 3, "--center x,y,z (mm)");
   mss::Integrator integrator = mss::Integrator::implicit_euler;
   if (a.dynamic) {
     integrator = parse_integrator(a.integrator);
@@ -122,13 +215,11 @@ void run_mss(const MssArgs& a) {
   const mesh::TetMesh m = mesh::read_vtu(a.mesh_path);
   mesh::require_endplate_labels(m);
   const double read_s = progress.end(std::to_string(m.num_tets()) + " tets");
-  load.center = a.center.empty() ? fem::DiscFem::default_plate_center(m)
-                                 : Eigen::Vector3d(parse_numbers(a.center, 3, "--center x,y,z (mm)"));
+  load.center = center.size() == 3 ? Eigen::Vector3d(center) : fem::DiscFem::default_plate_center(m);
   if (named) {
     load.is_wrench = true;
     load.value = fem::global_wrench(*named, m.frame);
   }
-
   progress.begin("building the mass-spring model");
   const mss::MssModel model(m, materials, model_opt);
   const double build_s = progress.end(std::to_string(model.num_edge_springs()) + " edge springs");
@@ -138,121 +229,45 @@ void run_mss(const MssArgs& a) {
                       {"tets", m.num_tets()},
                       {"material", materials.name},
                       {"plate_center", to_json(Eigen::VectorXd(load.center))},
-                      {"load", load.is_wrench ? "wrench" : "motion"}};
+                      {"load", load.is_wrench ? "wrench" : "motion"},
+                      {"timings", {{"read_s", read_s}, {"build_s", build_s}}}};
   j.update(mss_model_json(model, materials));
   if (named) j["case"] = named->name;
 
   // 3. Solve: static equilibrium, or steps in time.
-  Eigen::VectorXd x;
-  fem::Vector6d q = fem::Vector6d::Zero();
-  bool failed = false;
-  std::string failure;
-  std::unique_ptr<VtuSeries> frames;
-  if (!a.dynamic) {
-    progress.begin("static equilibrium (Newton)");
-    const mss::StaticResult r = mss::solve_static(model, load.boundary(1.0));
-    progress.end(std::to_string(r.iterations) + " iterations");
-    x = r.x_mm;
-    q = r.plate_motion;
-    j["reaction_wrench"] = to_json(Eigen::VectorXd(r.reaction_wrench));
-    j["converged"] = r.converged;
-    j["iterations"] = r.iterations;
-    j["residual_n"] = r.residual_n;
-    j["timings"] = {{"read_s", read_s}, {"build_s", build_s}, {"solve_s", r.seconds}};
-    failed = !r.converged || !x.allFinite();
-    if (failed) failure = "static solve did not converge after " + std::to_string(r.iterations) + " iterations: " + r.message;
-  } else {
-    mss::DynamicsOptions dopt;
-    dopt.integrator = integrator;
-    dopt.dt_s = a.dt_s;
-    dopt.newton_iterations = a.newton_iterations;
-    dopt.matrix_update = a.frozen ? mss::MatrixUpdate::frozen : mss::MatrixUpdate::every_iteration;
-    mss::Simulator sim(model, dopt);
-    mss::State s = sim.rest_state();
-    const int ramp = std::max(1, int(std::ceil(0.1 * a.steps)));
-    const int every = a.frame_every > 0 ? a.frame_every : std::max(1, a.steps / 100);
-    if (series) {
-      frames = std::make_unique<VtuSeries>(a.out);
-      frames->add(0.0, model, s.x_mm);
-    }
-    progress.begin(std::to_string(a.steps) + " steps of " + a.integrator + " Euler, dt " + std::to_string(a.dt_s) + " s");
-    StepStats stats;
-    for (int k = 1; k <= a.steps; ++k) {
-      if (!stats.step(sim, s, load.boundary(std::min(1.0, double(k) / ramp)))) break;
-      if (frames && (k % every == 0 || k == a.steps)) frames->add(s.time_s, model, s.x_mm);
-    }
-    const double stepping_s = progress.end(std::to_string(stats.steps_done) + " steps");
-    if (stats.diverged) {
-      failed = true;
-      const int k = stats.steps_done + 1;
-      std::ostringstream os;
-      os << "diverged at step " << k << " of " << a.steps << " (t = " << k * a.dt_s << " s, " << a.integrator
-         << " Euler, dt = " << a.dt_s << " s): " << stats.message;
-      if (integrator != mss::Integrator::implicit_euler) {
-        const double stable = sim.predicted_stable_dt_s(integrator);
-        if (std::isfinite(stable)) os << "; predicted stable dt < " << stable << " s";
-      }
-      failure = os.str();
-    }
-    x = s.x_mm;
-    const double applied = std::min(1.0, double(stats.steps_done) / ramp);  // load factor of the last good step
-    q = load.is_wrench ? fem::Vector6d(s.plate_q) : fem::Vector6d(applied * load.value);
-    j["integrator"] = a.integrator;
-    j["dt_s"] = a.dt_s;
-    j["steps"] = a.steps;
-    j["ramp_steps"] = ramp;
-    j["time_s"] = s.time_s;
-    stats.add_to(j);
-    j["matrix_update"] = a.frozen ? "frozen" : "every_iteration";
-    j["reaction_wrench"] = to_json(Eigen::VectorXd(reaction_about_plate(model, x, load.center, q)));
-    j["timings"] = {{"read_s", read_s}, {"build_s", build_s}, {"stepping_s", stepping_s}};
-    if (failed && frames) frames->discard();
-  }
+  std::unique_ptr<VtuSeries> frames = series ? std::make_unique<VtuSeries>(a.out) : nullptr;
+  const Outcome o = a.dynamic ? step_in_time(model, load, a, integrator, frames.get(), progress, j)
+                              : solve_static_load(model, load, progress, j);
   j["reaction_wrench_units"] =
       "Fx,Fy,Fz [N], Mx,My,Mz [N·mm] exerted by the disc on the plate, about the moved plate centre";
-  j["plate_motion"] = to_json(Eigen::VectorXd(motion_rad_to_deg(q)));
+  j["plate_motion"] = to_json(Eigen::VectorXd(motion_rad_to_deg(o.plate_motion)));
   j["plate_motion_units"] = "tx,ty,tz [mm], rx,ry,rz [deg]";
-  j["volume_mm3"] = model.volume_mm3(x);
+  j["volume_mm3"] = model.volume_mm3(o.x_mm);
   j["rest_volume_mm3"] = model.rest_volume_mm3();
-  j["volume_change"] = volume_change(model, x);
-  j["max_displacement_mm"] = mss_displacement(model, x).rowwise().norm().maxCoeff();
+  j["volume_change"] = volume_change(model, o.x_mm);
+  j["max_displacement_mm"] = mss_displacement(model, o.x_mm).rowwise().norm().maxCoeff();
 
-  // 4. Output files (only for a run that succeeded, so no NaN and no half series).
-  if (!failed && !a.out.empty()) {
+  // 4. Output files, only for a run that succeeded: no NaN, no half series.
+  if (o.failed && frames) frames->discard();
+  if (!o.failed && !a.out.empty()) {
     progress.begin("writing " + a.out);
     if (frames) {
       frames->finish();
       j["frames"] = frames->num_frames();
     } else {
-      const MssFields f = mss_fields(model, x);
+      const MssFields f = mss_fields(model, o.x_mm);
       mesh::write_vtu(a.out, m, f.point, f.cell);
     }
     progress.end();
     j["out"] = a.out;
   }
 
-  // 5. Report.
-  if (a.json) {
+  // 5. Report; a failed run still prints its summary, then exits 1 with the reason.
+  if (a.json)
     print_json(j);
-  } else {
-    std::cout << std::setprecision(5) << "MSS on " << a.mesh_path << " (" << m.num_vertices() << " nodes, "
-              << m.num_tets() << " tets), material " << materials.name << ", " << model_variant(a.model) << "\n"
-              << "  springs       " << model.num_edge_springs() << " edge, " << model.num_radial_tets() << " radial tets, "
-              << model.num_angle_springs() << " angle, " << model.num_volume_terms() << " volume\n"
-              << "  plate centre  " << load.center.transpose() << " mm\n";
-    if (a.dynamic)
-      std::cout << "  dynamic       " << j["steps_done"] << " of " << a.steps << " steps, dt " << a.dt_s
-                << " s, mean step " << j["step_seconds_mean"].get<double>() * 1e3 << " ms\n";
-    else
-      std::cout << "  static        " << (j["converged"].get<bool>() ? "converged" : "NOT converged") << " in "
-                << j["iterations"] << " Newton iterations\n";
-    const auto qd = motion_rad_to_deg(q);
-    std::cout << "  plate motion  t = " << qd.head<3>().transpose() << " mm, r = " << qd.tail<3>().transpose() << " deg\n"
-              << "  reaction      " << j["reaction_wrench"].dump() << " (N, N·mm)\n"
-              << "  volume        " << j["volume_mm3"].get<double>() << " mm^3, change "
-              << 100.0 * j["volume_change"].get<double>() << " %\n";
-  }
-  if (failed) throw std::runtime_error(one_line(failure));
+  else
+    print_summary(std::cout, a, model, materials.name, load, o, j);
+  if (o.failed) throw std::runtime_error(one_line(o.failure));
 }
 
 // --- mss compare -------------------------------------------------------------------------------

@@ -172,10 +172,10 @@ TEST_F(MssCli, WrenchCaseIsBalancedByTheReaction) {
   EXPECT_LT(j["plate_motion"][1].get<double>(), 0.0);
 }
 
-TEST_F(MssCli, VolumeTermKeepsTheVolumeBetter) {
-  double dv[3];
-  const char* flags[] = {"--no-radial", "", "--volume-term"};
-  for (int i = 0; i < 3; ++i) {
+TEST_F(MssCli, VolumeTermsKeepTheVolumeBetter) {
+  double dv[4];
+  const char* flags[] = {"--no-radial", "", "--volume-term", "--disc-volume-term"};
+  for (int i = 0; i < 4; ++i) {
     const CliRun r = run_spinesim("mss --mesh '" + disc_ + "' --motion 0,-1,0,0,0,0 --json " + flags[i]);
     ASSERT_EQ(r.status, 0) << flags[i] << r.err;
     dv[i] = json::parse(r.out)["volume_change"].get<double>();
@@ -183,6 +183,7 @@ TEST_F(MssCli, VolumeTermKeepsTheVolumeBetter) {
   }
   EXPECT_LT(std::abs(dv[2]), std::abs(dv[1]));
   EXPECT_LT(std::abs(dv[2]), std::abs(dv[0]));
+  EXPECT_LT(std::abs(dv[3]), std::abs(dv[1]));
 }
 
 TEST_F(MssCli, ImplicitRunWritesATimeSeries) {
