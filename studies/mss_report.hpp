@@ -44,7 +44,8 @@ namespace spinesim::cli {
 /// The flags every MSS verb shares: which energy terms, and the ambient damping.
 struct ModelFlags {
   bool no_radial = false, no_torsion = false, volume_term = false, disc_volume_term = false;
-  double volume_factor = 1.0, disc_volume_factor = 1.0;
+  double volume_factor = mss::MssOptions().volume_factor;
+  double disc_volume_factor = mss::MssOptions().disc_volume_factor;
   double damping_n_s_per_mm = -1.0;
   CLI::Option* damping_option = nullptr;
 };

@@ -1,0 +1,89 @@
+// Volume under 10 % axial compression (issue 3, item 5): the thesis claims its radial springs
+// (5.3)-(5.5) preserve volume but never measured it. Variants of the same L4-L5 disc, real-disc
+// material (E 3.22 MPa, nu 0.4557), superior plate pushed down by 10 % of the equivalent-cylinder
+// height (static equilibrium, inferior endplate fixed):
+//   springs only        main + torsion
+//   thesis              main + torsion + radial                  (the thesis model)
+//   per-tet volume      + 1/2 k_v (V_t - V0_t)^2, k_v = K/V0_t    (beyond the thesis)
+//   whole-disc volume   + 1/2 k_g (V - V0)^2,    k_g = 10 K/V0 (the default c_g; beyond the thesis)
+// and, as the physical reference, the P2 FEM on the same mesh (volume of the deformed vertices).
+// Measured (this test prints them): -9.3 %, -9.0 %, -4.9 %, -0.69 %; FEM -4.7 %. The radial
+// springs do not preserve volume; the per-tet term at the material's bulk modulus reproduces
+// the FEM's volume change (a homogeneous nu = 0.456 solid is not incompressible), and only the
+// whole-disc term meets the issue's < 1 % — the per-tet term cannot (it locks: c_v = 100 still
+// loses 1.2 % at 24x the FEM's force).
+#include "solver_fixtures.hpp"
+#include "spinesim/fem/disc_fem.hpp"
+#include "spinesim/mss/solver.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+namespace spinesim::mss {
+namespace {
+
+struct Variant {
+  const char* name;
+  bool radial, volume, disc_volume;
+};
+
+struct Outcome {
+  double volume_change, reaction_n;
+};
+
+const mesh::TetMesh& disc() { return fixtures::l4_l5(3.0); }
+
+double ten_percent_mm() { return 0.1 * MssModel(disc(), fixtures::real_disc()).cylinder().length_mm; }
+
+Outcome compress(const Variant& v) {
+  MssOptions o;
+  o.radial_springs = v.radial;
+  o.volume_term = v.volume;
+  o.disc_volume_term = v.disc_volume;
+  const MssModel model(disc(), fixtures::real_disc(), o);
+  const StaticResult r = solve_static(
+      model, fixtures::motion_boundary(disc(), fixtures::vec6(0, -ten_percent_mm(), 0, 0, 0, 0)));
+  EXPECT_TRUE(r.converged) << v.name << ": " << r.message;
+  return {model.volume_mm3(r.x_mm) / model.rest_volume_mm3() - 1.0, r.reaction_wrench(1)};
+}
+
+TEST(MssVolume, TenPercentCompression) {
+  const Variant variants[] = {{"springs only", false, false, false},
+                              {"thesis radial springs", true, false, false},
+                              {"per-tet volume term", true, true, false},
+                              {"whole-disc volume term", true, false, true}};
+  Outcome out[4];
+  for (int i = 0; i < 4; ++i) {
+    out[i] = compress(variants[i]);
+    std::printf("[ volume   ] %-24s dV/V = %+.3f %%   reaction Fy = %7.1f N\n", variants[i].name,
+                100.0 * out[i].volume_change, out[i].reaction_n);
+    RecordProperty(std::string("volume_change_percent_") + std::to_string(i),
+                   std::to_string(100.0 * out[i].volume_change));
+  }
+  // FEM reference on the same mesh: the disc material's own volume change.
+  const fem::DiscFem fem(disc(), fixtures::real_disc(), 2, fem::DiscFem::default_plate_center(disc()));
+  fem::Vector6d q = fem::Vector6d::Zero();
+  q(1) = -ten_percent_mm();
+  const fem::PlateSolution s = fem.solve_motion(q);
+  mesh::TetMesh deformed = disc();
+  deformed.V += s.displacement_mm;
+  const double fem_change = mesh::mesh_volume(deformed) / mesh::mesh_volume(disc()) - 1.0;
+  std::printf("[ volume   ] %-24s dV/V = %+.3f %%   reaction Fy = %7.1f N\n", "FEM P2 (reference)",
+              100.0 * fem_change, s.reaction_wrench(1));
+
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_LT(out[i].volume_change, 0.0) << variants[i].name;  // compression loses volume
+    EXPECT_GT(out[i].reaction_n, 0.0) << variants[i].name;     // and pushes back on the plate
+  }
+  // The thesis's radial springs change little: within 1 point of the springs-only network.
+  EXPECT_LT(std::abs(out[1].volume_change - out[0].volume_change), 0.01);
+  // The per-tet term at the bulk modulus reproduces the FEM's volume change to 1 point.
+  EXPECT_LT(std::abs(out[2].volume_change - fem_change), 0.01);
+  // The issue's target: the whole-disc volume term keeps |dV/V| under 1 %.
+  EXPECT_LT(std::abs(out[3].volume_change), 0.01);
+}
+
+}  // namespace
+}  // namespace spinesim::mss
