@@ -270,6 +270,8 @@ TEST_F(MssCli, BadInputIsRefusedInOneLineWithoutOutput) {
   expect_refused(run_spinesim(mss + "--motion 0,nan,0,0,0,0" + o), "non-finite");
   expect_refused(run_spinesim(mss + "--wrench 0,-500,0" + o), "expected 6");
   expect_refused(run_spinesim(mss + "--case compression --steps 0" + o), "--steps");
+  expect_refused(run_spinesim(mss + "--case compression --dt abc --steps 5" + o), "abc");  // malformed number
+  expect_refused(run_spinesim(mss + "--case compression --dt 1e-3 --steps 2.5" + o), "2.5");
   expect_refused(run_spinesim(mss + "--case compression --dt 1e-3" + o), "--steps");
   expect_refused(run_spinesim(mss + "--case squat" + o), "unknown load case");
   expect_refused(run_spinesim(mss + "--case compression --integrator rk4 --steps 5" + o), "--integrator");
