@@ -22,6 +22,7 @@ class ExternalLoads {
  public:
   /// `default_probe_k`: used for probes whose stiffness is 0.
   ExternalLoads(const Boundary& bc, double default_probe_k);
+  ExternalLoads() = default;  ///< no loads
 
   bool empty() const { return probes_.empty() && forces_ == nullptr; }
   /// V_ext(x), N·mm.

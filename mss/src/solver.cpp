@@ -169,11 +169,7 @@ std::vector<Eigen::Vector3d> probe_forces(const MssModel& model, const Boundary&
   check_positions(x, model, "position vector");
   double k_default = 0;
   for (const Probe& p : bc.probes)
-    if (p.stiffness_n_per_mm == 0.0 && k_default == 0.0) {
-      Eigen::SparseMatrix<double> H;
-      model.hessian(model.rest_positions_mm(), HessianMode::exact, H);
-      k_default = detail::default_probe_stiffness(model, H);
-    }
+    if (p.stiffness_n_per_mm == 0.0 && k_default == 0.0) k_default = default_probe_stiffness(model);
   const ExternalLoads loads(bc, k_default);
   std::vector<Eigen::Vector3d> out;
   Eigen::Vector3d gi;
@@ -186,6 +182,12 @@ std::vector<Eigen::Vector3d> probe_forces(const MssModel& model, const Boundary&
     out.push_back(f);
   }
   return out;
+}
+
+double default_probe_stiffness(const MssModel& model) {
+  Eigen::SparseMatrix<double> H;
+  model.hessian(model.rest_positions_mm(), HessianMode::exact, H);
+  return detail::default_probe_stiffness(model, H);
 }
 
 }  // namespace spinesim::mss

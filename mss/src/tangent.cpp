@@ -5,17 +5,34 @@
 namespace spinesim::mss::detail {
 
 void TangentSolver::set_rank_one(double k, const Eigen::VectorXd& w) {
-  k_ = k;
-  if (k_ <= 0.0) return;
-  w_ = w;
-  z_ = w;
-  chol_.solve_in_place(z_);
-  denominator_ = 1.0 + k_ * w_.dot(z_);
+  if (k <= 0.0) {
+    W_.resize(w.size(), 0);
+    Z_.resize(w.size(), 0);
+    return;
+  }
+  Eigen::VectorXd z = std::sqrt(k) * w;
+  chol_.solve_in_place(z);
+  set_low_rank(std::sqrt(k) * w, z);
+}
+
+void TangentSolver::set_low_rank(const Eigen::Ref<const Eigen::MatrixXd>& W,
+                                 const Eigen::Ref<const Eigen::MatrixXd>& Z) {
+  W_ = W;
+  Z_ = Z;
+  if (W_.cols() == 0) return;
+  const Eigen::MatrixXd S = Eigen::MatrixXd::Identity(W_.cols(), W_.cols()) + W_.transpose() * Z_;
+  S_.compute(0.5 * (S + S.transpose()));
 }
 
 void TangentSolver::solve_in_place(Eigen::VectorXd& b) {
+  if (Z_.cols() == 0) {
+    chol_.solve_in_place(b);
+    return;
+  }
+  t_.noalias() = Z_.transpose() * b;  // Z^T b = W^T A^-1 b
   chol_.solve_in_place(b);
-  if (k_ > 0.0) b.noalias() -= (k_ * w_.dot(b) / denominator_) * z_;
+  t_ = S_.solve(t_);
+  b.noalias() -= Z_ * t_;
 }
 
 double reduced_rank_one(const MssModel& model, const ReducedSpace& space, const Eigen::VectorXd& x,
@@ -46,7 +63,10 @@ TangentKind factor_tangent(const MssModel& model, const ReducedSpace& space,
   const auto assemble = [&](HessianMode mode) {
     model.hessian(x, mode, H);
     space.reduce_matrix(H, A);
-    if (!loads.empty()) loads.add_hessian(x, mode, space, A);
+    // Probe contacts always take their projected Hessian k_p n n^T: the exact one adds a
+    // tangential -k_p (r/d - 1)(I - n n^T) that grows without bound towards the probe centre,
+    // and Newton steps with it carried nodes through the probe (measured: force 20 N -> 0).
+    if (!loads.empty()) loads.add_hessian(x, HessianMode::projected, space, A);
     if (lumped) space.add_lumped(*lumped, lumped_scale, A);
     if (!chol.analyzed()) chol.analyze(A);
   };

@@ -1,11 +1,12 @@
 // The reduced tangent matrix and its solves (private to mss/).
 //
 // The model's Hessian is a sparse part (MssModel::hessian) plus, with the whole-disc volume
-// term, a dense rank-one part k_g u u^T (MssModel::disc_volume_rank_one). In reduced
-// coordinates the operator is A + k w w^T, w = P^T u; A is factorised by sparse Cholesky and
-// the rank-one part is solved by Sherman–Morrison with z = A^-1 w kept per factorisation:
-//   (A + k w w^T)^-1 b = A^-1 b - z k (w . A^-1 b) / (1 + k w . z),
-// one extra solve per factorisation and O(n) per solve.
+// term, a dense rank-one part k_g u u^T (MssModel::disc_volume_rank_one); the frozen implicit
+// step adds the probe contacts as low-rank terms too. In reduced coordinates the operator is
+// A + W W^T (W n×r, small r); A is factorised by sparse Cholesky and the low-rank part is
+// solved by Woodbury (Sherman–Morrison for r = 1) with Z = A^-1 W supplied or computed:
+//   (A + W W^T)^-1 b = A^-1 b - Z (I + W^T Z)^-1 Z^T b,
+// O(n r) per solve once Z is known.
 //
 // factor_tangent falls back from the exact Hessian to the projected (PSD) one, and then to the
 // projected one plus a growing diagonal shift (Levenberg), so a Newton step always descends.
@@ -16,6 +17,7 @@
 #include "sparse_cholesky.hpp"
 #include "spinesim/mss/model.hpp"
 
+#include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
@@ -27,13 +29,19 @@ class TangentSolver {
   SparseCholesky& cholesky() { return chol_; }
   /// After a successful factorisation: the operator becomes A + k w w^T (k = 0: A alone).
   void set_rank_one(double k, const Eigen::VectorXd& w);
-  /// b <- (A + k w w^T)^-1 b, no allocation.
+  /// The operator becomes A + W W^T, Z = A^-1 W given (n×r each, r = 0: A alone).
+  void set_low_rank(const Eigen::Ref<const Eigen::MatrixXd>& W, const Eigen::Ref<const Eigen::MatrixXd>& Z);
+  /// b <- (A + W W^T)^-1 b; allocates nothing when there is no low-rank part.
   void solve_in_place(Eigen::VectorXd& b);
+  /// The current low-rank part (for reuse by the caller), n×r.
+  const Eigen::MatrixXd& low_rank_W() const { return W_; }
+  const Eigen::MatrixXd& low_rank_Z() const { return Z_; }
 
  private:
   SparseCholesky chol_;
-  double k_ = 0, denominator_ = 1;
-  Eigen::VectorXd w_, z_;
+  Eigen::MatrixXd W_, Z_;
+  Eigen::LDLT<Eigen::MatrixXd> S_;  ///< I + W^T Z
+  Eigen::VectorXd t_;
 };
 
 /// The reduced rank-one part of the model's Hessian at x: returns k_g and sets w = P^T u

@@ -19,10 +19,11 @@
 //                     search on Phi; one iteration is exactly Baraff & Witkin's (1998) linearised
 //                     step. The matrix M/dt^2 + K_d/dt + K has a fixed pattern: the symbolic
 //                     factorisation is done once and reused; MatrixUpdate::frozen also keeps the
-//                     numeric factor (rest stiffness, plus the projected contact Hessian of nodes
-//                     inside a probe; refactorised when that set, the plate mode or the plate
-//                     centre changes), so a step costs one force evaluation and one pair of
-//                     triangular solves.
+//                     numeric factor (rest stiffness; refactorised only when the plate mode or
+//                     the wrench-mode centre changes), so a step costs one force evaluation and
+//                     one pair of triangular solves. Probe contacts are resolved inside each
+//                     linear step by an active-set loop on the linearised gaps, as low-rank
+//                     updates of the factor (simulator.cpp): no chatter, no refactorisation.
 // Static solve: Newton with backtracking line search on Pi(x) = E(x) - W_ext(x), with the exact
 // Hessian when it factorises and the projected one otherwise.
 //
@@ -72,9 +73,15 @@ StaticResult solve_static(const MssModel& model, const Boundary& bc,
 Vector6d plate_reaction(const MssModel& model, const Eigen::VectorXd& x_mm,
                         const Eigen::Vector3d& center_mm);
 
-/// Force the disc exerts on each probe at x (N), same order as bc.probes.
+/// Force the disc exerts on each probe at x (N), same order as bc.probes. A probe with
+/// stiffness 0 gets default_probe_stiffness(model), which costs one rest-Hessian evaluation per
+/// call: for repeated calls, fill the stiffness in once.
 std::vector<Eigen::Vector3d> probe_forces(const MssModel& model, const Boundary& bc,
                                           const Eigen::VectorXd& x_mm);
+
+/// The penalty a probe with stiffness 0 gets (boundary.hpp, Probe), N/mm: 100 trace(K_rest) /
+/// (2 #edge springs), K_rest the model's sparse rest Hessian. One Hessian evaluation.
+double default_probe_stiffness(const MssModel& model);
 
 enum class Integrator { explicit_euler, symplectic_euler, implicit_euler };
 enum class MatrixUpdate { every_iteration, frozen };
