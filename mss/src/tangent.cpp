@@ -63,10 +63,7 @@ TangentKind factor_tangent(const MssModel& model, const ReducedSpace& space,
   const auto assemble = [&](HessianMode mode) {
     model.hessian(x, mode, H);
     space.reduce_matrix(H, A);
-    // Probe contacts always take their projected Hessian k_p n n^T: the exact one adds a
-    // tangential -k_p (r/d - 1)(I - n n^T) that grows without bound towards the probe centre,
-    // and Newton steps with it carried nodes through the probe (measured: force 20 N -> 0).
-    if (!loads.empty()) loads.add_hessian(x, HessianMode::projected, space, A);
+    if (!loads.empty()) loads.add_hessian(x, mode, space, A);
     if (lumped) space.add_lumped(*lumped, lumped_scale, A);
     if (!chol.analyzed()) chol.analyze(A);
   };
