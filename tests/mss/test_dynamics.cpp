@@ -134,7 +134,7 @@ TEST_F(DynamicsBox, EndplateVelocityIsItsDisplacementOverDt) {
 
 // The stability limits of the explicit integrators, measured, against the prediction. The
 // predictions are sufficient conditions derived from the Rayleigh quotients of every mode
-// (solver.hpp / simulator.cpp), so the measured limit lies at or above them; they are close to
+// (solver.hpp / stability.cpp), so the measured limit lies at or above them; they are close to
 // tight (explicit: the lightest node's 2 m / K_d or K_d / lambda_max(K); symplectic: the
 // damped top mode), so it should not lie far above: within 25 %.
 TEST_F(DynamicsBox, ExplicitLimitsMatchThePrediction) {

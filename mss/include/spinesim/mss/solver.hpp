@@ -128,7 +128,7 @@ class Simulator {
 
   /// Largest stable dt of an integrator at rest with both endplates fixed (free nodes; Lanczos
   /// for the extreme eigenvalues). Sufficient conditions from the Jury test of every mode's
-  /// Rayleigh quotients (simulator.cpp): explicit min(K_d / lambda_max(K_ff), 2 m_min / K_d)
+  /// Rayleigh quotients (stability.cpp): explicit min(K_d / lambda_max(K_ff), 2 m_min / K_d)
   /// (0 when K_d = 0); symplectic the dt where lambda_max(dt^2 M^-1/2 K M^-1/2 + 2 dt K_d M^-1)
   /// = 4 (2/omega_max undamped); implicit +infinity. Measured limits lie 0-4 % above them.
   double predicted_stable_dt_s(Integrator integrator) const;
