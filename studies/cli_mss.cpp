@@ -246,6 +246,11 @@ void run_mss(const MssArgs& a) {
   j["rest_volume_mm3"] = model.rest_volume_mm3();
   j["volume_change"] = volume_change(model, o.x_mm);
   j["max_displacement_mm"] = mss_displacement(model, o.x_mm).rowwise().norm().maxCoeff();
+  j["inverted_tets"] = model.inverted_tets(o.x_mm);
+  if (j["inverted_tets"].get<Eigen::Index>() > 0)
+    std::cerr << "spinesim: warning: " << j["inverted_tets"].get<Eigen::Index>()
+              << " tetrahedra are inside out at the result: the load is beyond what the spring "
+                 "network holds (try --volume-term or --disc-volume-term)\n";
 
   // 4. Output files, only for a run that succeeded: no NaN, no half series.
   if (o.failed && frames) frames->discard();

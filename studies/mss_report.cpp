@@ -334,6 +334,7 @@ MssFemComparison compare_mss_fem(const fem::DiscFem& fem, const mss::MssModel& m
     r.plate_motion_error =
         safe_ratio(plate_rms(m, c, r.plate_motion_mss - r.plate_motion_fem), plate_rms(m, c, r.plate_motion_fem));
     r.max_displacement_mss_mm = u.rowwise().norm().maxCoeff();
+    r.inverted_tets = model.inverted_tets(sw.x_mm);
 
     // (b) motion-loaded with the FEM's plate motion.
     mss::Boundary bm;
@@ -375,6 +376,7 @@ nlohmann::json comparison_json(const MssFemComparison& c) {
                         {"wrench", to_json(Eigen::VectorXd(r.wrench))},
                         {"displacement_error", r.displacement_error},
                         {"plate_motion_error", r.plate_motion_error},
+                        {"inverted_tets", r.inverted_tets},
                         {"plate_motion_fem", to_json(Eigen::VectorXd(motion_rad_to_deg(r.plate_motion_fem)))},
                         {"plate_motion_mss", to_json(Eigen::VectorXd(motion_rad_to_deg(r.plate_motion_mss)))},
                         {"reaction_error", r.reaction_error},
@@ -440,7 +442,8 @@ void print_comparison(std::ostream& os, const MssFemComparison& c, bool markdown
     os << "\n";
   }
   for (const CaseComparison& r : c.cases) {
-    const std::string cells[] = {r.name + (r.converged ? "" : " (not converged)"),
+    const std::string cells[] = {r.name + (r.converged ? "" : " (not converged)") +
+                                     (r.inverted_tets > 0 ? " (" + std::to_string(r.inverted_tets) + " tets inverted)" : ""),
                                  pct(r.displacement_error),
                                  pct(r.plate_motion_error),
                                  pct(r.reaction_error),

@@ -114,6 +114,7 @@ struct CaseComparison {
   fem::Vector6d reaction_fem = fem::Vector6d::Zero(), reaction_mss = fem::Vector6d::Zero();  ///< (N, N·mm)
   double reaction_error = 0, reaction_force_error = 0, reaction_moment_error = 0;
   double max_displacement_fem_mm = 0, max_displacement_mss_mm = 0;
+  Eigen::Index inverted_tets = 0;  ///< inside-out tets in the MSS wrench-loaded solution
   bool converged = true;  ///< both MSS static solves converged
   int iterations = 0;     ///< Newton iterations of both MSS solves
   std::string message;    ///< why a solve did not converge

@@ -555,6 +555,14 @@ double MssModel::disc_volume_rank_one(const Eigen::VectorXd& x, Eigen::VectorXd&
   return impl_->disc_k;
 }
 
+Eigen::Index MssModel::inverted_tets(const Eigen::VectorXd& x) const {
+  check_size(x, num_nodes());
+  Eigen::Index n = 0;
+  for (Eigen::Index t = 0; t < impl_->mesh.num_tets(); ++t)
+    n += tet_signed_volume(tet_points(x, impl_->mesh.T, static_cast<int>(t))) <= 0.0;
+  return n;
+}
+
 double MssModel::volume_mm3(const Eigen::VectorXd& x) const {
   check_size(x, num_nodes());
   double v = 0.0;

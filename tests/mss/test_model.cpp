@@ -76,6 +76,11 @@ TEST(MssModel, MassesAddUpToDensityTimesVolume) {
   EXPECT_GT(model.node_masses_t().minCoeff(), 0.0);
   EXPECT_NEAR(model.rest_volume_mm3(), 12.0 * 6.0 * 9.0, 1e-9);
   EXPECT_NEAR(model.volume_mm3(model.rest_positions_mm()), model.rest_volume_mm3(), 1e-9);
+  EXPECT_EQ(model.inverted_tets(model.rest_positions_mm()), 0);
+  // Mirroring every node inverts every tetrahedron.
+  Eigen::VectorXd mirrored = model.rest_positions_mm();
+  for (Eigen::Index i = 0; i < model.num_nodes(); ++i) mirrored(3 * i) *= -1.0;
+  EXPECT_EQ(model.inverted_tets(mirrored), m.num_tets());
 }
 
 TEST(MssModel, RestIsEquilibriumWithZeroEnergy) {

@@ -145,6 +145,10 @@ class MssModel {
 
   /// Sum of signed tetrahedron volumes at x, mm^3.
   double volume_mm3(const Eigen::VectorXd& x_mm) const;
+  /// Tetrahedra turned inside out at x (signed volume <= 0). Edge, radial and angle springs
+  /// barely resist inversion, so an overloaded thesis network can reach an "equilibrium" with
+  /// inverted tets (seen: 500 N on a thoracic disc); the volume terms prevent it.
+  Eigen::Index inverted_tets(const Eigen::VectorXd& x_mm) const;
   double rest_volume_mm3() const;
 
  private:
