@@ -247,7 +247,7 @@ void run_mss(const MssArgs& a) {
   j["volume_change"] = volume_change(model, o.x_mm);
   j["max_displacement_mm"] = mss_displacement(model, o.x_mm).rowwise().norm().maxCoeff();
   j["inverted_tets"] = model.inverted_tets(o.x_mm);
-  if (j["inverted_tets"].get<Eigen::Index>() > 0)
+  if (!o.failed && j["inverted_tets"].get<Eigen::Index>() > 0)
     std::cerr << "spinesim: warning: " << j["inverted_tets"].get<Eigen::Index>()
               << " tetrahedra are inside out at the result: the load is beyond what the spring "
                  "network holds (try --volume-term or --disc-volume-term)\n";
