@@ -203,12 +203,11 @@ ProbeSite pick_site(const mesh::TetMesh& m, const Eigen::MatrixX3d& normals, con
 
 struct ProbeArgs {
   StudyCommon common;
-  // Penalty 50 N/mm per node: with the solver's default (100 x the mean main spring, several
-  // hundred N/mm on L4-L5) the contact chattered as the probe withdrew, one implicit step per
-  // ms (force jumping 19 -> 1380 N, nodes springing back through the probe): the per-node
-  // penetration (force per node / k_p) was smaller than the 0.02 mm the probe moves per step.
-  // Measured on L4-L5: 50 N/mm withdraws smoothly and the probe still reaches 1.9 of 2 mm.
-  double radius_mm = 3.0, depth_mm = 2.0, speed_mm_s = 20.0, hold_s = 0.1, rest_s = 0.2, stiffness_n_per_mm = 50.0;
+  // Penalty per node: 0 = the solver's default (mss::default_probe_stiffness, ~540 N/mm on
+  // L4-L5). The implicit step resolves the contacts by an active set inside each step, so the
+  // stiff default withdraws smoothly (L4-L5 2 mm cells: largest step-to-step force change
+  // 0.33 N, peak 19.1 N; a 50 N/mm penalty gives 18.1 N with the probe sinking deeper).
+  double radius_mm = 3.0, depth_mm = 2.0, speed_mm_s = 20.0, hold_s = 0.1, rest_s = 0.2, stiffness_n_per_mm = 0.0;
   std::string material = "real-disc", sites = "anterior,left";
 };
 
@@ -278,13 +277,15 @@ void run_probe(ProbeArgs a) {
   Range dv;
   double max_force = 0, max_u = 0;
   progress.begin(std::to_string(steps) + " steps (" + c.integrator + " Euler, dt " + std::to_string(c.dt_s) + " s)");
+  // The default penalty costs a rest-Hessian evaluation: resolve it once, not per step.
+  const double k_probe = a.stiffness_n_per_mm > 0 ? a.stiffness_n_per_mm : mss::default_probe_stiffness(model);
   for (int k = 1; k <= steps; ++k) {
     const double t = k * c.dt_s;
     const auto cmd = plan.at(t);
     const ProbeSite& site = plan.sites[cmd.site];
     const Eigen::Vector3d center = site.point_mm + (a.radius_mm - cmd.depth_mm) * site.normal;
     mss::Boundary bc;
-    if (cmd.active) bc.probes.push_back({center, a.radius_mm, a.stiffness_n_per_mm});
+    if (cmd.active) bc.probes.push_back({center, a.radius_mm, k_probe});
     if (!stats.step(sim, s, bc)) break;
     const Eigen::Vector3d f = cmd.active ? mss::probe_forces(model, bc, s.x_mm).front() : Eigen::Vector3d::Zero();
     const double v = model.volume_mm3(s.x_mm), u = max_displacement(model, s.x_mm);
@@ -323,7 +324,7 @@ void run_probe(ProbeArgs a) {
                         {"speed_mm_s", a.speed_mm_s},
                         {"hold_s", a.hold_s},
                         {"rest_s", a.rest_s},
-                        {"stiffness_n_per_mm", a.stiffness_n_per_mm},
+                        {"stiffness_n_per_mm", k_probe},
                         {"schedule", "per site: press at speed to depth, hold, withdraw, rest with the probe away"}}},
                       {"sites", sites},
                       {"integrator", c.integrator},
@@ -556,7 +557,7 @@ void register_probe(CLI::App& study) {
   cmd->add_option("--speed", a->speed_mm_s, "Press and withdraw speed, mm/s")->capture_default_str();
   cmd->add_option("--hold", a->hold_s, "Hold at full depth, s")->capture_default_str();
   cmd->add_option("--rest", a->rest_s, "Probe away after each site (recovery), s")->capture_default_str();
-  cmd->add_option("--probe-stiffness", a->stiffness_n_per_mm, "Penalty per node, N/mm (0: the solver's default, 100 x mean main spring)")
+  cmd->add_option("--probe-stiffness", a->stiffness_n_per_mm, "Penalty per node, N/mm (0: the solver's default, 100 x the mean edge stiffness from the rest Hessian)")
       ->capture_default_str();
   cmd->add_option("--sites", a->sites, "Sites in order: anterior, posterior, left, right")->capture_default_str();
   cmd->footer("Writes OUT/probe.pvd (+ OUT/probe/ frames), OUT/probe.csv and OUT/probe.json.");
