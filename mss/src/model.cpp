@@ -403,11 +403,8 @@ double MssModel::Impl::accumulate(const Eigen::VectorXd& x, const bool* terms, K
   }
   if (terms[static_cast<int>(Term::torsion)]) {
     if (grad) {
-      double* g = grad->data();
-      for (const AngleFace& f : m.faces)
-        energy += face_angle_springs<true>(xp + 3 * f.v[0], xp + 3 * f.v[1], xp + 3 * f.v[2],
-                                           sel.angle(f), f.rest, g + 3 * f.v[0], g + 3 * f.v[1],
-                                           g + 3 * f.v[2]);
+      energy += face_angle_springs_all(m.faces, [&sel](const AngleFace& f) { return sel.angle(f); },
+                                       xp, grad->data());
     } else {
       for (const AngleFace& f : m.faces)
         energy += face_angle_springs<false>(xp + 3 * f.v[0], xp + 3 * f.v[1], xp + 3 * f.v[2],

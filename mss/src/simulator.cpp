@@ -340,7 +340,13 @@ StepReport Simulator::Impl::implicit_step(State& s, const Boundary& bc, const Ex
                   space.force_norm(r_trial) < rn);
       if (accepted) phi = phi_trial;
     }
-    if (!accepted) return {false, it, "line search failed in the implicit step"};
+    if (!accepted) {
+      // No decrease of Phi is measurable: converged to round-off if the residual is within a
+      // few hundred ulps of the force floor (a different summation order of the forces — e.g.
+      // the blocked angle-spring kernel — moves the last bits), else a genuine failure.
+      if (rn <= 1e3 * floor_n) break;
+      return {false, it, "line search failed in the implicit step (|r| = " + std::to_string(rn) + " N)"};
+    }
     y.swap(y_trial);
     r.swap(r_trial);
     ++it;

@@ -107,8 +107,9 @@ void expect_derivatives_match(const Element<N>& el, const Vec<N>& X, const char*
   EXPECT_LE(max_abs(fd_g - g), kFdTol * max_abs(g)) << "grad\n" << g.transpose() << "\nfd\n"
                                                     << fd_g.transpose();
   EXPECT_LE(max_abs(fd_H - H), kFdTol * max_abs(H)) << "hess\n" << H << "\nfd\n" << fd_H;
-  // The same numbers whether or not the derivatives are asked for.
-  EXPECT_EQ(el.energy(X, nullptr, nullptr, HessianMode::exact), e);
+  // The same numbers whether or not the derivatives are asked for (to round-off: with FMA
+  // contraction, e.g. -march=native, the two paths differ by a few ulps of theta - theta0).
+  EXPECT_NEAR(el.energy(X, nullptr, nullptr, HessianMode::exact), e, 1e-12 * std::abs(e));
   EXPECT_EQ(gradient(el, X), g);
   EXPECT_EQ(hessian(el, X), H);
 }
@@ -361,14 +362,16 @@ TEST(Elements, ZeroEnergyAndGradientAtRest) {
     Vec<6> ge;
     Vec<12> gr, gv;
     Vec<9> ga;
-    EXPECT_EQ(edge(2.5, edge_length(Xe)).energy(Xe, &ge, nullptr, HessianMode::exact), 0.0);
-    EXPECT_EQ(radial(1.7, radial_sum(Xt)).energy(Xt, &gr, nullptr, HessianMode::exact), 0.0);
-    EXPECT_EQ(angle(40.0, angle_of(Xa)).energy(Xa, &ga, nullptr, HessianMode::exact), 0.0);
-    EXPECT_EQ(volume(3.0, volume_of(Xt)).energy(Xt, &gv, nullptr, HessianMode::exact), 0.0);
-    EXPECT_EQ(max_abs(ge), 0.0);
-    EXPECT_EQ(max_abs(gr), 0.0);
-    EXPECT_EQ(max_abs(ga), 0.0);
-    EXPECT_EQ(max_abs(gv), 0.0);
+    // Zero to round-off: the rest length/angle/volume is recomputed by another code path, which
+    // with FMA contraction (-march=native) can differ in the last bit (angle: E ~ 1e-31 N·mm).
+    EXPECT_LE(edge(2.5, edge_length(Xe)).energy(Xe, &ge, nullptr, HessianMode::exact), 1e-26);
+    EXPECT_LE(radial(1.7, radial_sum(Xt)).energy(Xt, &gr, nullptr, HessianMode::exact), 1e-26);
+    EXPECT_LE(angle(40.0, angle_of(Xa)).energy(Xa, &ga, nullptr, HessianMode::exact), 1e-26);
+    EXPECT_LE(volume(3.0, volume_of(Xt)).energy(Xt, &gv, nullptr, HessianMode::exact), 1e-26);
+    EXPECT_LE(max_abs(ge), 1e-12);
+    EXPECT_LE(max_abs(gr), 1e-12);
+    EXPECT_LE(max_abs(ga), 1e-12);
+    EXPECT_LE(max_abs(gv), 1e-12);
   }
 }
 
