@@ -20,8 +20,10 @@ double default_probe_stiffness(const MssModel& model, const Eigen::SparseMatrix<
 
 class ExternalLoads {
  public:
-  /// `default_probe_k`: used for probes whose stiffness is 0.
-  ExternalLoads(const Boundary& bc, double default_probe_k);
+  /// `default_probe_k`: used for probes whose stiffness is 0. `surface` (#nodes labels, may be
+  /// null): probes touch only nodes with a non-zero surface label — contact is a surface effect,
+  /// and a probe pressed deep must not grab interior nodes directly.
+  ExternalLoads(const Boundary& bc, double default_probe_k, const Eigen::VectorXi* surface = nullptr);
   ExternalLoads() = default;  ///< no loads
 
   bool empty() const { return probes_.empty() && forces_ == nullptr; }
@@ -37,10 +39,13 @@ class ExternalLoads {
   const std::vector<Probe>& probes() const { return probes_; }  ///< stiffness resolved
   /// |f| + |probe forces at x|, N (a force scale for convergence tests).
   double force_scale(const Eigen::VectorXd& x) const;
+  /// May probes touch node i?
+  bool touchable(Eigen::Index i) const { return surface_ == nullptr || (*surface_)(i) != 0; }
 
  private:
   std::vector<Probe> probes_;
   const Eigen::VectorXd* forces_ = nullptr;  ///< points into the Boundary, or null
+  const Eigen::VectorXi* surface_ = nullptr;  ///< the mesh's surface labels, or null (all nodes)
 };
 
 }  // namespace spinesim::mss::detail

@@ -435,7 +435,7 @@ StepReport Simulator::step(State& s, const Boundary& bc) {
   if (!s.x_mm.allFinite() || !s.v_mm_s.allFinite() || !s.plate_q.allFinite() || !s.plate_qdot.allFinite())
     return {false, 0, "state is not finite"};
   d.ensure_space(bc.plate_mode, bc.plate_center_mm);
-  const ExternalLoads loads(bc, d.probe_k_default);
+  const ExternalLoads loads(bc, d.probe_k_default, &model.mesh().surface);
   d.space.gather(s.x_mm, s.plate_q, d.yn);
   d.space.gather(s.v_mm_s, s.plate_qdot, d.un);
   switch (d.opt.integrator) {

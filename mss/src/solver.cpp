@@ -61,7 +61,7 @@ StaticResult solve_static(const MssModel& model, const Boundary& bc, const Stati
   Eigen::SparseMatrix<double> H, A;
   model.hessian(X, HessianMode::exact, H);
   const ReducedSpace space(model, H, bc.plate_mode, bc.plate_center_mm);
-  const ExternalLoads loads(bc, detail::default_probe_stiffness(model, H));
+  const ExternalLoads loads(bc, detail::default_probe_stiffness(model, H), &model.mesh().surface);
   const double floor = round_off_floor(model, H);
   const Vector6d wrench = space.has_plate_dofs() ? bc.wrench : Vector6d::Zero();
   const double L = space.moment_length_mm();
@@ -170,12 +170,13 @@ std::vector<Eigen::Vector3d> probe_forces(const MssModel& model, const Boundary&
   double k_default = 0;
   for (const Probe& p : bc.probes)
     if (p.stiffness_n_per_mm == 0.0 && k_default == 0.0) k_default = default_probe_stiffness(model);
-  const ExternalLoads loads(bc, k_default);
+  const ExternalLoads loads(bc, k_default, &model.mesh().surface);
   std::vector<Eigen::Vector3d> out;
   Eigen::Vector3d gi;
   for (const Probe& p : loads.probes()) {
     Eigen::Vector3d f = Eigen::Vector3d::Zero();
     for (Eigen::Index i = 0; i < model.num_nodes(); ++i) {
+      if (!loads.touchable(i)) continue;
       probe_contact(x.segment<3>(3 * i), p.center_mm, p.radius_mm, p.stiffness_n_per_mm, &gi);
       f += gi;  // the node is pushed with -gi, the probe with +gi
     }

@@ -130,6 +130,26 @@ TEST_F(SolverBox, UnloadedDiscStaysAtRest) {
   EXPECT_LT(r.reaction_wrench.norm(), 1e-10);
 }
 
+// Contact is a surface effect: a probe around an interior node (surface label 0) touches
+// nothing, while the same probe around a wall node pushes it out.
+TEST_F(SolverBox, ProbesTouchOnlySurfaceNodes) {
+  auto probe_at = [&](int label) {
+    Eigen::Index node = 0;
+    while (mesh_.surface(node) != label) ++node;
+    Boundary bc = fixtures::motion_boundary(mesh_, Vector6d::Zero());
+    const Eigen::Vector3d X = model_.rest_positions_mm().segment<3>(3 * node);
+    bc.probes.push_back({X + Eigen::Vector3d(0.05, 0.05, 0.05), 0.5, 0.0});
+    const StaticResult r = solve_static(model_, bc);
+    EXPECT_TRUE(r.converged) << r.message;
+    return std::make_pair((r.x_mm - model_.rest_positions_mm()).norm(), probe_forces(model_, bc, r.x_mm)[0].norm());
+  };
+  const auto interior = probe_at(0), wall = probe_at(3);
+  EXPECT_EQ(interior.first, 0.0);
+  EXPECT_EQ(interior.second, 0.0);
+  EXPECT_GT(wall.first, 1e-3);
+  EXPECT_GT(wall.second, 0.0);
+}
+
 TEST_F(SolverBox, SmallMotionEqualsTheLinearSolveToSecondOrder) {
   const LinearReference lin(model_, c_);
   double previous = 0;

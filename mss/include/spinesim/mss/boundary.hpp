@@ -5,7 +5,8 @@
 //   - nodes labelled 2 (superior endplate) either move rigidly with `superior` (PlateMode::pose,
 //     prescribed motion), or are slaved to a rigid plate loaded by `wrench` (PlateMode::wrench):
 //     x_i = X_i + t + theta x (X_i - c), the FEM's small-rotation map, plate DOF (t, theta) unknown;
-//   - optional spherical probes push nodes out by penalty contact (elements.hpp probe_contact);
+//   - optional spherical probes push surface nodes (label != 0) out by penalty contact
+//     (elements.hpp probe_contact); interior nodes are never touched directly;
 //   - optional nodal forces, N.
 // Poses: x = R X + t in the global (mesh) frame, mm. A 6-DOF plate motion q = (t mm, theta rad)
 // about the plate centre c becomes the exact rigid pose x = c + t + R(theta)(X - c), R the
