@@ -203,7 +203,9 @@ bool Simulator::Impl::contact_direction(const ExternalLoads& loads, const Eigen:
     for (Eigen::Index i = 0; i < model->num_nodes(); ++i) {
       const Eigen::Vector3d a = xs.segment<3>(3 * i) - p.center_mm;
       const double dist = a.norm();
-      if (dist >= 2.0 * p.radius_mm || dist <= 1e-12 * p.radius_mm || !space.is_unknown(int(i))) continue;
+      if (dist >= 2.0 * p.radius_mm || dist <= 1e-12 * p.radius_mm || !space.is_unknown(int(i)) ||
+          !loads.touchable(i))
+        continue;
       pairs.push_back({int(i), a / dist, p.radius_mm - dist, p.stiffness_n_per_mm, false});
     }
   // Reduced image of a node vector v: P^T (e_i v) (3 free rows, or R_i^T v on the plate DOF).
@@ -228,8 +230,10 @@ bool Simulator::Impl::contact_direction(const ExternalLoads& loads, const Eigen:
     Eigen::Index na = 0;
     for (const Pair& c : pairs) na += c.active;
     Eigen::MatrixXd W(space.size(), r0 + na), Z(space.size(), r0 + na);
-    W.leftCols(r0) = base_W;
-    Z.leftCols(r0) = base_Z;
+    if (r0 > 0) {  // (base_W is 0x0 without a rank-one term: no block to copy)
+      W.leftCols(r0) = base_W;
+      Z.leftCols(r0) = base_Z;
+    }
     d = -r;
     Eigen::Index j = r0;
     for (const Pair& c : pairs) {
