@@ -351,10 +351,11 @@ TEST_F(DynamicsDisc, ProbePressHoldAndWithdrawWithoutChatter) {
   ASSERT_GE(node, 0);
   const Eigen::Vector3d p = mesh_.V.row(node).transpose(), n(0.0, 0.0, 1.0);
   const double r = 3.0, depth = 2.0, speed = 20.0, hold = 0.05, press = depth / speed;
+  const double k_probe = default_probe_stiffness(model_);  // one rest-Hessian evaluation, once
   const auto probe_at = [&](double t) {
     double d = t <= press ? speed * t : t <= press + hold ? depth : depth - speed * (t - press - hold);
     Boundary bc;
-    bc.probes.push_back(Probe{p + (r - std::clamp(d, 0.0, depth)) * n, r, default_probe_stiffness(model_)});
+    bc.probes.push_back(Probe{p + (r - std::clamp(d, 0.0, depth)) * n, r, k_probe});
     return bc;
   };
   const StaticResult full = solve_static(model_, probe_at(press));
