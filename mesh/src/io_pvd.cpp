@@ -8,6 +8,7 @@
 #include "spinesim/mesh/io.hpp"
 
 #include "atomic_file.hpp"
+#include "xml_escape.hpp"
 
 #include <charconv>
 #include <cmath>
@@ -16,20 +17,6 @@
 namespace spinesim::mesh {
 namespace {
 
-std::string xml_attribute(const std::string& s) {
-  std::string r;
-  for (char c : s) {
-    switch (c) {
-      case '&': r += "&amp;"; break;
-      case '<': r += "&lt;"; break;
-      case '>': r += "&gt;"; break;
-      case '"': r += "&quot;"; break;
-      case '\'': r += "&apos;"; break;
-      default: r += c;
-    }
-  }
-  return r;
-}
 
 std::string shortest(double v) {
   char buf[64];
@@ -63,7 +50,7 @@ void write_pvd(const std::string& path, const std::vector<PvdEntry>& entries) {
        << "  <Collection>\n";
     for (const PvdEntry& e : entries)
       os << "    <DataSet timestep=\"" << shortest(e.time_s) << "\" group=\"\" part=\"0\" file=\""
-         << xml_attribute(e.file) << "\"/>\n";
+         << detail::xml_escape(e.file) << "\"/>\n";
     os << "  </Collection>\n"
        << "</VTKFile>\n";
   });

@@ -2,6 +2,7 @@
 #include "spinesim/mesh/io.hpp"
 
 #include "atomic_file.hpp"
+#include "xml_escape.hpp"
 #include "write_checks.hpp"
 
 #include <tinyxml2.h>
@@ -104,19 +105,6 @@ bool base64_decode(const char* s, std::vector<unsigned char>& out) {
 // ------------------------------------------------------------------------------------------
 // Writing
 
-std::string xml_escape(const std::string& s) {
-  std::string r;
-  for (char c : s) {
-    switch (c) {
-      case '&': r += "&amp;"; break;
-      case '<': r += "&lt;"; break;
-      case '>': r += "&gt;"; break;
-      case '"': r += "&quot;"; break;
-      default: r += c;
-    }
-  }
-  return r;
-}
 
 template <class T>
 void write_ascii_value(std::ostream& os, T v) {
@@ -129,7 +117,7 @@ void write_ascii_value(std::ostream& os, T v) {
 template <class T>
 void write_data_array(std::ostream& os, const char* vtk_type, const std::string& name, int ncomp,
                       const std::vector<T>& data, VtuEncoding enc, const char* indent) {
-  os << indent << "<DataArray type=\"" << vtk_type << "\" Name=\"" << xml_escape(name)
+  os << indent << "<DataArray type=\"" << vtk_type << "\" Name=\"" << detail::xml_escape(name)
      << "\" NumberOfComponents=\"" << ncomp << "\" format=\""
      << (enc == VtuEncoding::binary ? "binary" : "ascii") << "\">\n"
      << indent << "  ";

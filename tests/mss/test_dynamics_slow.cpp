@@ -11,6 +11,7 @@
 #include "../../mss/src/reduced_space.hpp"
 #include "../../mss/src/sparse_cholesky.hpp"
 #include "solver_fixtures.hpp"
+#include "stability.hpp"
 
 #include <gtest/gtest.h>
 
@@ -23,6 +24,7 @@ namespace spinesim::mss {
 namespace {
 
 using fixtures::vec6;
+using namespace stability;
 using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point t0) {
@@ -41,27 +43,6 @@ double best_time(F&& f, int reps, int batches = 5) {
   return best;
 }
 
-bool stays_stable(const MssModel& model, Integrator integrator, double dt, int steps) {
-  DynamicsOptions o;
-  o.integrator = integrator;
-  o.dt_s = dt;
-  Simulator sim(model, o);
-  State s = sim.rest_state();
-  std::mt19937 rng(7);
-  std::uniform_real_distribution<double> u(-1e-3, 1e-3);
-  const Eigen::VectorXi& label = model.mesh().surface;
-  for (Eigen::Index i = 0; i < model.num_nodes(); ++i)
-    if (label(i) != 1 && label(i) != 2)
-      for (int d = 0; d < 3; ++d) s.x_mm(3 * i + d) += u(rng);
-  const double e0 = model.energy(s.x_mm);
-  for (int k = 0; k < steps; ++k)
-    if (!sim.step(s, Boundary()).ok) return false;
-  double kinetic = 0;
-  for (Eigen::Index i = 0; i < model.num_nodes(); ++i)
-    kinetic += 0.5 * model.node_masses_t()(i) * s.v_mm_s.segment<3>(3 * i).squaredNorm();
-  return model.energy(s.x_mm) + kinetic < e0;
-}
-
 TEST(DynamicsSlow, L4L5ExplicitStabilityLimitsMeasuredAgainstPredicted) {
   const mesh::TetMesh& m = fixtures::l4_l5(3.5);
   const MssModel model(m, fixtures::real_disc());
@@ -71,13 +52,7 @@ TEST(DynamicsSlow, L4L5ExplicitStabilityLimitsMeasuredAgainstPredicted) {
               model.node_masses_t().minCoeff(), model.node_masses_t().maxCoeff());
   for (Integrator integ : {Integrator::explicit_euler, Integrator::symplectic_euler}) {
     const double predicted = sim.predicted_stable_dt_s(integ);
-    double lo = 0.5 * predicted, hi = 2.0 * predicted;
-    ASSERT_TRUE(stays_stable(model, integ, lo, 1500));
-    ASSERT_FALSE(stays_stable(model, integ, hi, 1500));
-    for (int k = 0; k < 10; ++k) {
-      const double mid = std::sqrt(lo * hi);
-      (stays_stable(model, integ, mid, 1500) ? lo : hi) = mid;
-    }
+    const double lo = measured_stable_dt(model, integ, 0.5 * predicted, 2.0 * predicted, 1500, 10);
     std::printf("  %-10s largest stable dt: measured %.4g s (1500 steps, +-0.15 %%), predicted %.4g s, "
                 "ratio %.3f\n", integ == Integrator::explicit_euler ? "explicit" : "symplectic", lo,
                 predicted, lo / predicted);

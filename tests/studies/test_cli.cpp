@@ -2,6 +2,7 @@
 // sign conventions, and bad input -> one line on stderr, non-zero exit, no output file.
 #include "spinesim/mesh/io.hpp"
 #include "spinesim/mesh/tet_mesh.hpp"
+#include "cli_runner.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -22,51 +23,8 @@ using spinesim::mesh::TetMesh;
 
 namespace {
 
-/// ctest runs each test in its own process, in parallel: every process gets its own folder.
-fs::path tmp_dir() {
-  static const fs::path dir = fs::path(SPINESIM_TEST_TMP) / ("cli-" + std::to_string(getpid()));
-  fs::create_directories(dir);
-  return dir;
-}
+using namespace spinesim::test_cli;
 
-struct CliRun {
-  int status = -1;
-  std::string out, err;
-};
-
-/// Runs spinesim with `args` (shell words), capturing stdout and stderr.
-CliRun run_spinesim(const std::string& args) {
-  const fs::path dir = tmp_dir();
-  const fs::path out = dir / "cli.stdout", err = dir / "cli.stderr";
-  const std::string cmd = std::string("'") + SPINESIM_EXE + "' " + args + " >'" + out.string() + "' 2>'" +
-                          err.string() + "' </dev/null";
-  const int raw = std::system(cmd.c_str());
-  CliRun r;
-  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  std::ifstream o(out), e(err);
-  std::stringstream so, se;
-  so << o.rdbuf();
-  se << e.rdbuf();
-  r.out = so.str();
-  r.err = se.str();
-  return r;
-}
-
-int count_lines(const std::string& s) { return int(std::count(s.begin(), s.end(), '\n')); }
-
-/// Expect a refused run: non-zero exit, exactly one line on stderr mentioning `needle`.
-void expect_refused(const CliRun& r, const std::string& needle) {
-  EXPECT_NE(r.status, 0);
-  EXPECT_EQ(count_lines(r.err), 1) << r.err;
-  EXPECT_NE(r.err.find(needle), std::string::npos) << "stderr: " << r.err;
-  EXPECT_TRUE(r.out.empty()) << r.out;
-}
-
-std::string tmp(const std::string& name) {
-  const fs::path p = tmp_dir() / name;
-  fs::remove(p);
-  return p.string();
-}
 
 /// A coarse L4-L5 disc made once for the whole suite.
 class CliTest : public ::testing::Test {

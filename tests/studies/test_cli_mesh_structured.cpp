@@ -5,6 +5,7 @@
 #include "spinesim/mesh/io.hpp"
 #include "spinesim/mesh/material.hpp"
 #include "spinesim/mesh/tet_mesh.hpp"
+#include "cli_runner.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -28,53 +29,14 @@ using namespace spinesim;
 
 namespace {
 
-/// ctest runs each test in its own process, in parallel: every process gets its own folder.
-fs::path tmp_dir() {
-  static const fs::path dir = fs::path(SPINESIM_TEST_TMP) / ("cli-mesh-structured-" + std::to_string(getpid()));
-  fs::create_directories(dir);
-  return dir;
-}
-
-std::string tmp(const std::string& name) {
-  const fs::path p = tmp_dir() / name;
-  fs::remove_all(p);
-  return p.string();
-}
-
-struct CliRun {
-  int status = -1;
-  std::string out, err;
-};
-
-/// Runs spinesim with `args` (shell words), capturing stdout and stderr.
-CliRun run_spinesim(const std::string& args) {
-  const fs::path dir = tmp_dir();
-  const fs::path out = dir / "cli.stdout", err = dir / "cli.stderr";
-  const std::string cmd = std::string("'") + SPINESIM_EXE + "' " + args + " >'" + out.string() + "' 2>'" +
-                          err.string() + "' </dev/null";
-  const int raw = std::system(cmd.c_str());
-  CliRun r;
-  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  std::ifstream o(out), e(err);
-  std::stringstream so, se;
-  so << o.rdbuf();
-  se << e.rdbuf();
-  r.out = so.str();
-  r.err = se.str();
-  return r;
-}
-
-int count_lines(const std::string& s) { return int(std::count(s.begin(), s.end(), '\n')); }
+using namespace spinesim::test_cli;
 
 /// A refused run: non-zero exit, one line on stderr mentioning `needle`, nothing on stdout,
 /// no output file.
 void expect_refused(const std::string& args, const std::string& out, const std::string& needle) {
-  const CliRun r = run_spinesim(args + " --out '" + out + "'");
-  EXPECT_NE(r.status, 0) << args;
-  EXPECT_EQ(count_lines(r.err), 1) << args << ": " << r.err;
-  EXPECT_NE(r.err.find(needle), std::string::npos) << args << ": " << r.err;
-  EXPECT_TRUE(r.out.empty()) << r.out;
-  EXPECT_FALSE(fs::exists(out)) << args;
+  SCOPED_TRACE(args);
+  test_cli::expect_refused(run_spinesim(args + " --out '" + out + "'"), needle);
+  EXPECT_FALSE(fs::exists(out));
 }
 
 /// T7-T8 with the default structured resolution (12 sectors, 3 rings, 2 layers), made once.

@@ -3,6 +3,7 @@
 // input -> exit 1 with one line on stderr. One coarse L4-L5 disc (cell size 4 mm) for all.
 #include "spinesim/mesh/io.hpp"
 #include "spinesim/mesh/tet_mesh.hpp"
+#include "cli_runner.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -25,57 +26,7 @@ using nlohmann::json;
 
 namespace {
 
-/// ctest runs each test in its own process, in parallel: every process gets its own folder.
-fs::path tmp_dir() {
-  static const fs::path dir = fs::path(SPINESIM_TEST_TMP) / ("cli-mss-" + std::to_string(getpid()));
-  fs::create_directories(dir);
-  return dir;
-}
-
-std::string tmp(const std::string& name) {
-  const fs::path p = tmp_dir() / name;
-  fs::remove_all(p);
-  return p.string();
-}
-
-struct CliRun {
-  int status = -1;
-  std::string out, err;
-};
-
-/// Runs spinesim with `args` (shell words), capturing stdout and stderr.
-CliRun run_spinesim(const std::string& args) {
-  const fs::path out = tmp_dir() / "cli.stdout", err = tmp_dir() / "cli.stderr";
-  const std::string cmd = std::string("'") + SPINESIM_EXE + "' " + args + " >'" + out.string() + "' 2>'" +
-                          err.string() + "' </dev/null";
-  const int raw = std::system(cmd.c_str());
-  CliRun r;
-  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  std::ifstream o(out), e(err);
-  std::stringstream so, se;
-  so << o.rdbuf();
-  se << e.rdbuf();
-  r.out = so.str();
-  r.err = se.str();
-  return r;
-}
-
-int count_lines(const std::string& s) { return int(std::count(s.begin(), s.end(), '\n')); }
-
-/// A refused run: exit status 1, exactly one line on stderr mentioning `needle`, nothing on stdout.
-void expect_refused(const CliRun& r, const std::string& needle) {
-  EXPECT_EQ(r.status, 1) << r.err;
-  EXPECT_EQ(count_lines(r.err), 1) << r.err;
-  EXPECT_NE(r.err.find(needle), std::string::npos) << "stderr: " << r.err;
-  EXPECT_TRUE(r.out.empty()) << r.out;
-}
-
-std::string slurp(const std::string& path) {
-  std::ifstream is(path);
-  std::stringstream ss;
-  ss << is.rdbuf();
-  return ss.str();
-}
+using namespace spinesim::test_cli;
 
 /// The files a .pvd lists, resolved against its folder.
 std::vector<fs::path> pvd_files(const std::string& pvd) {

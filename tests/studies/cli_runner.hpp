@@ -1,0 +1,70 @@
+// Running the `spinesim` program from a test: a per-process temp folder, capture of stdout,
+// stderr and exit status, and the "refused bad input" check every CLI suite makes.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace spinesim::test_cli {
+
+namespace fs = std::filesystem;
+
+/// ctest runs each test in its own process, in parallel: every process gets its own folder.
+inline fs::path tmp_dir() {
+  static const fs::path dir = fs::path(SPINESIM_TEST_TMP) / ("cli-" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  return dir;
+}
+
+/// A fresh path in tmp_dir() (whatever was there is removed).
+inline std::string tmp(const std::string& name) {
+  const fs::path p = tmp_dir() / name;
+  fs::remove_all(p);
+  return p.string();
+}
+
+inline std::string slurp(const std::string& path) {
+  std::ifstream is(path);
+  std::stringstream ss;
+  ss << is.rdbuf();
+  return ss.str();
+}
+
+struct CliRun {
+  int status = -1;
+  std::string out, err;
+};
+
+/// Runs spinesim with `args` (shell words), capturing stdout and stderr.
+inline CliRun run_spinesim(const std::string& args) {
+  const fs::path out = tmp_dir() / "cli.stdout", err = tmp_dir() / "cli.stderr";
+  const std::string cmd = std::string("'") + SPINESIM_EXE + "' " + args + " >'" + out.string() + "' 2>'" +
+                          err.string() + "' </dev/null";
+  const int raw = std::system(cmd.c_str());
+  CliRun r;
+  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  r.out = slurp(out.string());
+  r.err = slurp(err.string());
+  return r;
+}
+
+inline int count_lines(const std::string& s) { return int(std::count(s.begin(), s.end(), '\n')); }
+
+/// A refused run: exit status 1, exactly one line on stderr mentioning `needle`, nothing on stdout.
+inline void expect_refused(const CliRun& r, const std::string& needle) {
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_EQ(count_lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find(needle), std::string::npos) << "stderr: " << r.err;
+  EXPECT_TRUE(r.out.empty()) << r.out;
+}
+
+}  // namespace spinesim::test_cli
