@@ -121,6 +121,9 @@ struct MssModel::Impl {
   /// one loop behind energy, gradient, term_energy and term_gradient.
   double accumulate(const Eigen::VectorXd& x, const bool* terms, KSelect sel,
                     Eigen::VectorXd* grad) const;
+  /// Sparse Hessian of the selected terms (the whole-disc term without its rank-one part).
+  void assemble_hessian(const Eigen::VectorXd& x, HessianMode mode, const bool* terms, KSelect sel,
+                        Eigen::SparseMatrix<double>& H) const;
 };
 
 void MssModel::Impl::build(const mesh::RegionMaterials& materials) {
@@ -441,7 +444,23 @@ double MssModel::Impl::accumulate(const Eigen::VectorXd& x, const bool* terms, K
 void MssModel::hessian(const Eigen::VectorXd& x, HessianMode mode,
                        Eigen::SparseMatrix<double>& H) const {
   check_size(x, num_nodes());
-  const Impl& m = *impl_;
+  const bool all[kNumTerms] = {true, true, true, true, true};
+  impl_->assemble_hessian(x, mode, all, KSelect{}, H);
+}
+
+void MssModel::term_hessian(const Eigen::VectorXd& x, Term term, int region_index, HessianMode mode,
+                            Eigen::SparseMatrix<double>& H) const {
+  check_size(x, num_nodes());
+  if (region_index != 0 && region_index != 1)
+    throw std::invalid_argument("mss: region index must be 0 (annulus) or 1 (nucleus)");
+  bool only[kNumTerms] = {false, false, false, false, false};
+  only[static_cast<int>(term)] = true;
+  impl_->assemble_hessian(x, mode, only, KSelect{region_index}, H);
+}
+
+void MssModel::Impl::assemble_hessian(const Eigen::VectorXd& x, HessianMode mode, const bool* terms,
+                                      KSelect sel, Eigen::SparseMatrix<double>& H) const {
+  const Impl& m = *this;
   m.pattern.reset(H);
   double* val = H.valuePtr();
   const double* xp = x.data();
@@ -453,18 +472,18 @@ void MssModel::hessian(const Eigen::VectorXd& x, HessianMode mode,
                                                       h.template block<3, 3>(3 * a, 3 * b));
   };
   Matrix6d h6;
-  for (std::size_t e = 0; e < m.edges.size(); ++e) {
+  for (std::size_t e = 0; e < (terms[static_cast<int>(Term::main)] ? m.edges.size() : 0); ++e) {
     const EdgeSpring& s = m.edges[e];
-    edge_spring(point(s.i), point(s.j), s.k, s.rest_mm, nullptr, &h6, mode);
+    edge_spring(point(s.i), point(s.j), sel.edge(s), s.rest_mm, nullptr, &h6, mode);
     const int nodes[2] = {s.i, s.j};
     scatter(h6, &m.edge_slots[4 * e], 2, nodes);
   }
   Matrix9d h9;
-  for (std::size_t s = 0; s < m.faces.size(); ++s) {
+  for (std::size_t s = 0; s < (terms[static_cast<int>(Term::torsion)] ? m.faces.size() : 0); ++s) {
     const AngleFace& f = m.faces[s];
     for (int c = 0; c < 3; ++c) {  // corner c: apex v[c], arms to v[c+1], v[c+2]
       const int nodes[3] = {f.v[c], f.v[(c + 1) % 3], f.v[(c + 2) % 3]};
-      angle_spring(point(nodes[0]), point(nodes[1]), point(nodes[2]), f.k, f.rest_rad[c], nullptr,
+      angle_spring(point(nodes[0]), point(nodes[1]), point(nodes[2]), sel.angle(f), f.rest_rad[c], nullptr,
                    &h9, mode);
       int slots[9];
       for (int a = 0; a < 3; ++a)
@@ -475,22 +494,26 @@ void MssModel::hessian(const Eigen::VectorXd& x, HessianMode mode,
   Matrix12d h12;
   auto tet_hessians = [&](const std::vector<TetTerm>& list, auto kernel) {
     for (const TetTerm& t : list) {
-      kernel(tet_points(x, m.mesh.T, t.t), t.k, t.rest, &h12);
+      const double k = sel.tet(t);
+      if (k == 0.0) continue;
+      kernel(tet_points(x, m.mesh.T, t.t), k, t.rest, &h12);
       const int nodes[4] = {m.mesh.T(t.t, 0), m.mesh.T(t.t, 1), m.mesh.T(t.t, 2), m.mesh.T(t.t, 3)};
       scatter(h12, &m.tet_slots[16 * static_cast<std::size_t>(t.t)], 4, nodes);
     }
   };
-  tet_hessians(m.radial, [mode](const TetPoints& p, double k, double rest, Matrix12d* h) {
-    radial_springs(p, k, rest, nullptr, h, mode);
-  });
-  tet_hessians(m.volume, [mode](const TetPoints& p, double k, double rest, Matrix12d* h) {
-    volume_penalty(p, k, rest, nullptr, h, mode);
-  });
+  if (terms[static_cast<int>(Term::radial)])
+    tet_hessians(m.radial, [mode](const TetPoints& p, double k, double rest, Matrix12d* h) {
+      radial_springs(p, k, rest, nullptr, h, mode);
+    });
+  if (terms[static_cast<int>(Term::volume)])
+    tet_hessians(m.volume, [mode](const TetPoints& p, double k, double rest, Matrix12d* h) {
+      volume_penalty(p, k, rest, nullptr, h, mode);
+    });
   // Whole-disc volume, sparse part k_g (V - V0) H_V (exact mode only; the rank-one part is
   // disc_volume_rank_one's). H_V is trilinear in the arms a, b, c of each tet:
   //   d2V/da db = -[c]x/6,  d2V/da dc = [b]x/6,  d2V/db dc = -[a]x/6, zero diagonal blocks.
-  if (m.disc_volume_on && mode == HessianMode::exact) {
-    const double w = m.disc_k * (m.volume_and_gradient(x, nullptr) - m.rest_volume);
+  if (terms[static_cast<int>(Term::disc_volume)] && m.disc_volume_on && mode == HessianMode::exact) {
+    const double w = sel.disc(m.disc_k, m.disc_k_unscaled) * (m.volume_and_gradient(x, nullptr) - m.rest_volume);
     auto skew = [](const Eigen::Vector3d& v) {
       Eigen::Matrix3d S;
       S << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;

@@ -198,6 +198,48 @@ TEST(MssModel, EnergyIsLinearInTheScales) {
   EXPECT_THROW(model.set_scales(s), std::invalid_argument);
 }
 
+// dK/d scale for the calibration: term Hessians are the derivatives of the term gradients,
+// and the full Hessian is their scale-weighted sum (the whole-disc rank-one part aside).
+TEST(MssModel, TermHessiansSumToTheHessian) {
+  MssModel model(two_region_box(), two_regions(), all_terms());
+  const Eigen::VectorXd x = perturbed(model, 0.3, 10);
+  std::array<RegionScales, kNumTerms> s{};
+  const double values[kNumTerms][2] = {{1.5, 0.7}, {2.0, 3.0}, {0.25, 4.0}, {1.1, 0.9}, {2.5, 1.0}};
+  for (int term = 0; term < kNumTerms; ++term) s[term].by_region = {values[term][0], values[term][1]};
+  model.set_scales(s);
+  Eigen::SparseMatrix<double> H, Hj;
+  model.hessian(x, HessianMode::exact, H);
+  Eigen::MatrixXd sum = Eigen::MatrixXd::Zero(H.rows(), H.cols());
+  const double h = 1e-6;
+  for (int term = 0; term < kNumTerms; ++term)
+    for (int r = 0; r < 2; ++r) {
+      model.term_hessian(x, static_cast<Term>(term), r, HessianMode::exact, Hj);
+      sum += values[term][r] * Eigen::MatrixXd(Hj);
+      if (term == static_cast<int>(Term::disc_volume) && r == 1) {
+        EXPECT_EQ(Eigen::MatrixXd(Hj).cwiseAbs().maxCoeff(), 0.0);
+        continue;
+      }
+      // One column in 5 against central differences of the term gradient (the whole-disc
+      // term with its rank-one part, unscaled: k_g / scale u u^T).
+      Eigen::MatrixXd Hd(Hj);
+      if (term == static_cast<int>(Term::disc_volume)) {
+        Eigen::VectorXd u;
+        const double kg = model.disc_volume_rank_one(x, u);
+        Hd += (kg / values[term][0]) * u * u.transpose();
+      }
+      double worst = 0.0;
+      for (Eigen::Index j = 2; j < x.size(); j += 5) {
+        Eigen::VectorXd xp = x, xm = x, gp, gm;
+        xp(j) += h, xm(j) -= h;
+        model.term_gradient(xp, static_cast<Term>(term), r, gp);
+        model.term_gradient(xm, static_cast<Term>(term), r, gm);
+        worst = std::max(worst, ((gp - gm) / (2 * h) - Hd.col(j)).cwiseAbs().maxCoeff());
+      }
+      EXPECT_LT(worst, 1e-6 * Hd.cwiseAbs().maxCoeff()) << "term " << term << " region " << r;
+    }
+  EXPECT_LT((sum - Eigen::MatrixXd(H)).cwiseAbs().maxCoeff(), 1e-12 * sum.cwiseAbs().maxCoeff());
+}
+
 TEST(MssModel, InternalForcesBalanceInAnyConfiguration) {
   const MssModel model(two_region_box(), two_regions(), all_terms());
   for (unsigned seed : {1u, 2u, 3u}) {

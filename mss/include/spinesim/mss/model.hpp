@@ -137,6 +137,13 @@ class MssModel {
   /// without the whole-disc volume term's rank-one part (see disc_volume_rank_one).
   void hessian(const Eigen::VectorXd& x_mm, HessianMode mode, Eigen::SparseMatrix<double>& H) const;
 
+  /// Hessian of term_energy(x, term, region_index), same pattern as hessian() (without the
+  /// whole-disc term's rank-one part: that is disc_volume_rank_one(x, u) / its scale). The
+  /// model's energy is linear in the scales, so hessian() = sum over terms and regions of
+  /// scale * term_hessian() — the calibration's dK/d scale.
+  void term_hessian(const Eigen::VectorXd& x_mm, Term term, int region_index, HessianMode mode,
+                    Eigen::SparseMatrix<double>& H) const;
+
   bool has_disc_volume_term() const;
   /// The rank-one part of the whole-disc volume Hessian: u = dV/dx (3#nodes, mm^2), returns
   /// k_g (N/mm^5, scaled) so that d2E/dx2 = hessian(x) + k_g u u^T. Returns 0 (u = 0) when the
