@@ -1,0 +1,94 @@
+// LinearMss — the MSS disc linearised at rest, as a function of its stiffness scales: the
+// fast, exactly differentiable model the calibration fits to the FEM.
+//
+// Why at rest: the reference is the *linear* FEM, so the quantity to match is the MSS's
+// linear response. The MSS energy is linear in its per-term, per-region scales s_j
+// (model.hpp), hence so is its rest Hessian:  K(s) = sum_j s_j K_j,  K_j = term_hessian at
+// rest (+ the whole-disc term's rank-one k_g u u^T). Every response below is then exact in s
+// and its derivatives follow from dK/ds_j = K_j. The nonlinear MSS at the load cases' loads
+// is checked separately (`spinesim mss compare --params`), and agrees to second order in the
+// load (tests/mss/test_solver.cpp).
+//
+// Unknowns z = (u_f, q): the free nodes' displacements (surface label 0 or 3), then the
+// superior plate's rigid motion q = (t mm, theta rad) about `plate_center` (the FEM's small-
+// rotation map u_i = t + theta x (X_i - c)); inferior-endplate nodes (label 1) are fixed.
+// R maps z to all 3#nodes displacements: K(s) = R^T H(s) R.
+//   wrench w:   K z = E_p w   (E_p injects into the plate DOF)
+//   compliance: Z = K^-1 E_p (#z × 6), C = E_p^T Z, K6 = C^-1, condensed modes Phi = Z K6;
+//   so the wrench response is z = Z w, and d K6 / d s_j = Phi^T K_j Phi.
+// Units: mm, N, N·mm, rad; K6 as fem::DiscFem::stiffness_6x6.
+#pragma once
+
+#include "spinesim/mss/model.hpp"
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+
+#include <memory>
+#include <utility>
+#include <vector>
+
+namespace spinesim::calibration {
+
+using Vector6d = Eigen::Matrix<double, 6, 1>;
+using Matrix6d = Eigen::Matrix<double, 6, 6>;
+
+/// One calibration knob: the scale of one energy term in one region (0 annulus, 1 nucleus;
+/// Term::disc_volume has region 0 only).
+struct Knob {
+  mss::Term term = mss::Term::main;
+  int region = 0;
+  bool operator==(const Knob& o) const { return term == o.term && region == o.region; }
+};
+
+/// "main.annulus", "disc_volume", ... (the names in tuned.json).
+std::string knob_name(const Knob& k);
+/// Inverse of knob_name; throws std::invalid_argument for an unknown name.
+Knob knob_from_name(const std::string& name);
+
+/// The knobs a model's switched-on terms offer, in Term order (annulus before nucleus).
+std::vector<Knob> available_knobs(const mss::MssOptions& options);
+
+/// Linear responses of one factorisation K(s).
+struct LinearState {
+  Eigen::MatrixXd Z;    ///< #z × 6, K^-1 E_p
+  Matrix6d k6 = Matrix6d::Zero();  ///< condensed plate stiffness
+  Eigen::MatrixXd Phi;  ///< #z × 6, condensed modes Z K6
+};
+
+class LinearMss {
+ public:
+  /// Precomputes K_j for `knobs` at the rest state of `model` (its current scales are
+  /// irrelevant: every K_j is unscaled). Throws std::invalid_argument if a knob's term is off in
+  /// the model, or the mesh has no superior or no inferior endplate nodes.
+  LinearMss(const mss::MssModel& model, std::vector<Knob> knobs, const Eigen::Vector3d& plate_center_mm);
+  ~LinearMss();
+  LinearMss(LinearMss&&) noexcept;
+  LinearMss& operator=(LinearMss&&) noexcept;
+
+  const std::vector<Knob>& knobs() const;
+  Eigen::Index num_unknowns() const;  ///< #z = #free DOF + 6
+  Eigen::Index num_dofs() const;      ///< 3#nodes
+
+  /// Factorises K(s) (s: one positive scale per knob) and returns Z, K6, Phi. Throws
+  /// std::runtime_error when K(s) is not positive definite.
+  LinearState solve(const Eigen::VectorXd& scales);
+  /// K(s)^-1 B with the factor of the last solve() (B: #z × k).
+  Eigen::MatrixXd solve_again(const Eigen::MatrixXd& rhs) const;
+
+  /// Full displacement vector R z (3#nodes, interleaved, mm).
+  Eigen::VectorXd displacement(const Eigen::VectorXd& z) const;
+  /// R^T v for a 3#nodes vector v (the adjoint of displacement()).
+  Eigen::VectorXd restrict(const Eigen::VectorXd& v) const;
+
+  /// A^T K_j B for every knob j (A: #z × p, B: #z × q): the derivatives of A^T K(s) B.
+  std::vector<Eigen::MatrixXd> knob_gram(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B) const;
+  /// K_j b for knob j (#z), for tests.
+  Eigen::VectorXd knob_product(int j, const Eigen::VectorXd& b) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace spinesim::calibration

@@ -1,0 +1,72 @@
+// The tuned-disc parameter file (tuned.json) that `spinesim calibrate` writes and `spinesim mss`,
+// `mss compare`, the spine scene and the haptic loop load.
+//
+// What it holds: the MSS terms that were on and their factors, one stiffness scale per knob
+// (linear_mss.hpp, e.g. "torsion.nucleus": 0.31), what the scales belong to — disc level,
+// material (name and every region's E, nu, rho), the mesh they were fitted on (counts and a
+// fingerprint) — and the calibration's report (cases with untuned and tuned errors, 6×6
+// diagonals, Ipopt's status), kept verbatim under "report".
+//
+// Region-level scales are properties of a disc and its material, not of one mesh: they apply
+// to any mesh of the same level (a coarse haptic mesh, a fine study mesh) with the same
+// material. Loading checks that: a different material, or a mesh of another level, is refused
+// with a one-line message; a mesh whose level is unknown (e.g. meshed from vertebra surfaces)
+// is accepted, and the caller is told so (`applies_to`'s note).
+#pragma once
+
+#include "spinesim/calibration/linear_mss.hpp"
+#include "spinesim/mesh/material.hpp"
+#include "spinesim/mesh/tet_mesh.hpp"
+#include "spinesim/mss/model.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <map>
+#include <string>
+
+namespace spinesim::calibration {
+
+/// Mesh identity: vertex and tet counts and a 64-bit FNV-1a hash of the connectivity, labels
+/// and coordinates (rounded to 1 nm), as 16 hex digits.
+struct MeshFingerprint {
+  Eigen::Index nodes = 0, tets = 0;
+  std::string hash;
+  bool operator==(const MeshFingerprint& o) const { return nodes == o.nodes && tets == o.tets && hash == o.hash; }
+};
+MeshFingerprint fingerprint(const mesh::TetMesh& mesh);
+
+/// The disc level a mesh was built for ("L4-L5"), read from its provenance; empty if unknown.
+std::string disc_level(const mesh::TetMesh& mesh);
+
+/// Every region's (E MPa, nu, rho kg/m^3) as JSON: {"annulus": {...}, "nucleus": {...}}.
+nlohmann::json material_signature(const mesh::RegionMaterials& materials);
+
+struct TunedDisc {
+  std::string level;            ///< "" when the mesh's level was unknown
+  std::string material_name;
+  nlohmann::json material;      ///< material_signature
+  MeshFingerprint mesh;         ///< the mesh the scales were fitted on
+  int fem_order = 2;
+  mss::MssOptions options;      ///< terms on/off and factors; scales filled from `scales`
+  std::map<std::string, double> scales;  ///< knob name -> scale (> 0)
+  nlohmann::json report;        ///< the calibration's summary (free form)
+
+  /// `options` with its scales set from `scales` (knobs not listed stay 1).
+  mss::MssOptions mss_options() const;
+};
+
+nlohmann::json to_json(const TunedDisc& t);
+/// Parses and validates (format tag, version, positive finite scales, known knob names, terms
+/// of every scale switched on); throws std::invalid_argument with a one-line message.
+TunedDisc tuned_disc_from_json(const nlohmann::json& j);
+/// Reads a tuned.json; throws std::invalid_argument naming the file for unreadable or invalid
+/// content.
+TunedDisc read_tuned_disc(const std::string& path);
+
+/// Throws std::invalid_argument (one line) unless `tuned` applies to `mesh` with `materials`:
+/// same material (name and constants), same level when the mesh's level is known. Returns a
+/// note for the user ("" or e.g. "mesh level unknown: ...").
+std::string check_applies(const TunedDisc& tuned, const mesh::TetMesh& mesh,
+                          const mesh::RegionMaterials& materials);
+
+}  // namespace spinesim::calibration

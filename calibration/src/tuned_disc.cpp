@@ -1,0 +1,181 @@
+#include "spinesim/calibration/tuned_disc.hpp"
+
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <fstream>
+#include <regex>
+#include <stdexcept>
+
+namespace spinesim::calibration {
+
+namespace {
+
+constexpr const char* kFormat = "spinesim-tuned-disc";
+constexpr int kVersion = 1;
+
+struct Fnv1a {
+  std::uint64_t h = 1469598103934665603ull;
+  void add(std::int64_t v) {
+    for (int b = 0; b < 8; ++b) {
+      h ^= std::uint64_t((v >> (8 * b)) & 0xff);
+      h *= 1099511628211ull;
+    }
+  }
+};
+
+bool term_on(const mss::MssOptions& o, mss::Term t) {
+  switch (t) {
+    case mss::Term::main: return true;
+    case mss::Term::radial: return o.radial_springs;
+    case mss::Term::torsion: return o.torsion_springs;
+    case mss::Term::volume: return o.volume_term;
+    case mss::Term::disc_volume: return o.disc_volume_term;
+  }
+  return false;
+}
+
+bool same_number(double a, double b) { return std::abs(a - b) <= 1e-9 * std::max(std::abs(a), std::abs(b)); }
+
+}  // namespace
+
+MeshFingerprint fingerprint(const mesh::TetMesh& m) {
+  Fnv1a f;
+  f.add(m.num_vertices());
+  f.add(m.num_tets());
+  for (Eigen::Index i = 0; i < m.num_vertices(); ++i) {
+    for (int a = 0; a < 3; ++a) f.add(std::llround(m.V(i, a) * 1e6));
+    f.add(m.surface.size() == m.num_vertices() ? m.surface(i) : -1);
+  }
+  for (Eigen::Index t = 0; t < m.num_tets(); ++t) {
+    for (int a = 0; a < 4; ++a) f.add(m.T(t, a));
+    f.add(m.region.size() == m.num_tets() ? m.region(t) : -1);
+  }
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(f.h));
+  return {m.num_vertices(), m.num_tets(), hex};
+}
+
+std::string disc_level(const mesh::TetMesh& m) {
+  static const std::regex level(R"(\b([TLS][0-9]{1,2}-[TLS][0-9]{1,2})\b)");
+  std::smatch match;
+  return std::regex_search(m.source, match, level) ? match[1].str() : std::string();
+}
+
+nlohmann::json material_signature(const mesh::RegionMaterials& materials) {
+  auto one = [](const mesh::IsotropicMaterial& m) {
+    return nlohmann::json{{"E_mpa", m.youngs_modulus_mpa}, {"nu", m.poisson_ratio}, {"density_kg_m3", m.density_kg_m3}};
+  };
+  return {{"annulus", one(materials.at(int(mesh::Region::annulus)))},
+          {"nucleus", one(materials.at(int(mesh::Region::nucleus)))}};
+}
+
+mss::MssOptions TunedDisc::mss_options() const {
+  mss::MssOptions o = options;
+  for (auto& s : o.scales) s.by_region = {1.0, 1.0};
+  for (const auto& [name, value] : scales) {
+    const Knob k = knob_from_name(name);
+    o.scales[int(k.term)].by_region[std::size_t(k.region)] = value;
+  }
+  return o;
+}
+
+nlohmann::json to_json(const TunedDisc& t) {
+  const mss::MssOptions& o = t.options;
+  return {{"format", kFormat},
+          {"version", kVersion},
+          {"kind", "region"},
+          {"level", t.level},
+          {"material", {{"name", t.material_name}, {"regions", t.material}}},
+          {"mesh", {{"nodes", t.mesh.nodes}, {"tets", t.mesh.tets}, {"fingerprint", t.mesh.hash}}},
+          {"fem_order", t.fem_order},
+          {"terms",
+           {{"radial_springs", o.radial_springs},
+            {"torsion_springs", o.torsion_springs},
+            {"volume_term", o.volume_term},
+            {"disc_volume_term", o.disc_volume_term},
+            {"radial_factor", o.radial_factor},
+            {"volume_factor", o.volume_factor},
+            {"disc_volume_factor", o.disc_volume_factor}}},
+          {"scales", t.scales},
+          {"report", t.report}};
+}
+
+TunedDisc tuned_disc_from_json(const nlohmann::json& j) {
+  try {
+    if (!j.is_object() || j.value("format", "") != kFormat)
+      throw std::invalid_argument("not a spinesim tuned-disc file (\"format\": \"" + std::string(kFormat) + "\" missing)");
+    if (j.at("version").get<int>() != kVersion)
+      throw std::invalid_argument("tuned-disc file version " + j.at("version").dump() + " is not supported (expected " +
+                                  std::to_string(kVersion) + ")");
+    const std::string kind = j.value("kind", "region");
+    if (kind != "region")
+      throw std::invalid_argument("tuned-disc kind '" + kind + "' is not supported (only region-level scales)");
+    TunedDisc t;
+    t.level = j.value("level", "");
+    t.material_name = j.at("material").at("name").get<std::string>();
+    t.material = j.at("material").at("regions");
+    t.mesh.nodes = j.at("mesh").at("nodes").get<Eigen::Index>();
+    t.mesh.tets = j.at("mesh").at("tets").get<Eigen::Index>();
+    t.mesh.hash = j.at("mesh").at("fingerprint").get<std::string>();
+    t.fem_order = j.value("fem_order", 2);
+    const auto& terms = j.at("terms");
+    t.options.radial_springs = terms.at("radial_springs").get<bool>();
+    t.options.torsion_springs = terms.at("torsion_springs").get<bool>();
+    t.options.volume_term = terms.at("volume_term").get<bool>();
+    t.options.disc_volume_term = terms.at("disc_volume_term").get<bool>();
+    t.options.radial_factor = terms.at("radial_factor").get<double>();
+    t.options.volume_factor = terms.at("volume_factor").get<double>();
+    t.options.disc_volume_factor = terms.at("disc_volume_factor").get<double>();
+    for (const auto& [name, value] : j.at("scales").items()) {
+      const Knob k = knob_from_name(name);
+      const double s = value.get<double>();
+      if (!std::isfinite(s) || s <= 0) throw std::invalid_argument("scale '" + name + "' must be finite and > 0");
+      if (!term_on(t.options, k.term))
+        throw std::invalid_argument("scale '" + name + "' belongs to a term the file switches off");
+      t.scales[name] = s;
+    }
+    if (t.scales.empty()) throw std::invalid_argument("tuned-disc file has no scales");
+    t.report = j.value("report", nlohmann::json::object());
+    return t;
+  } catch (const nlohmann::json::exception& e) {
+    throw std::invalid_argument(std::string("tuned-disc file: missing or malformed field (") + e.what() + ")");
+  }
+}
+
+TunedDisc read_tuned_disc(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::invalid_argument("cannot read tuned-disc file '" + path + "'");
+  nlohmann::json j;
+  try {
+    in >> j;
+  } catch (const nlohmann::json::exception&) {
+    throw std::invalid_argument("'" + path + "' is not valid JSON");
+  }
+  try {
+    return tuned_disc_from_json(j);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument("'" + path + "': " + e.what());
+  }
+}
+
+std::string check_applies(const TunedDisc& t, const mesh::TetMesh& mesh, const mesh::RegionMaterials& materials) {
+  const nlohmann::json sig = material_signature(materials);
+  bool same = materials.name == t.material_name;
+  for (const char* region : {"annulus", "nucleus"})
+    for (const char* key : {"E_mpa", "nu"})
+      same = same && t.material.contains(region) && t.material[region].contains(key) &&
+             same_number(t.material[region][key].get<double>(), sig[region][key].get<double>());
+  if (!same)
+    throw std::invalid_argument("the tuned parameters were fitted for material '" + t.material_name +
+                                "' and do not apply to material '" + materials.name + "' (calibrate it first)");
+  const std::string level = disc_level(mesh);
+  if (!level.empty() && !t.level.empty() && level != t.level)
+    throw std::invalid_argument("the tuned parameters were fitted for disc " + t.level + " and do not apply to a " +
+                                level + " mesh");
+  if (level.empty() && !t.level.empty())
+    return "mesh level unknown: applying the " + t.level + " parameters as given";
+  return "";
+}
+
+}  // namespace spinesim::calibration
