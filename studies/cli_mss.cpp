@@ -19,6 +19,7 @@
 // never jumps (a jump of the prescribed pose in one step would give the endplate nodes a
 // velocity of Δx/dt); K_d ambient damping (5.11). A step that diverges is rejected: the run stops,
 // prints why, says `"diverged": true` in its JSON, writes no file and exits non-zero.
+#include "calibration_report.hpp"
 #include "cli_common.hpp"
 #include "fem_report.hpp"
 #include "mss_report.hpp"
@@ -44,7 +45,8 @@ namespace {
 namespace fs = std::filesystem;
 
 struct MssArgs {
-  std::string mesh_path, material = "real-disc", motion, wrench, load_case, center, out;
+  std::string mesh_path, material = "real-disc", params, motion, wrench, load_case, center, out;
+  CLI::Option* material_option = nullptr;
   std::string integrator = "implicit";
   double dt_s = 1e-3;
   int steps = 0, frame_every = 0, newton_iterations = 1;
@@ -52,6 +54,50 @@ struct MssArgs {
   ModelFlags model;
   bool dynamic = false;  ///< set from which options were given
 };
+
+/// The model's options and material: from the flags, or from a tuned file (--params), which
+/// fixes the terms and scales and must match the mesh and material (calibration_report.hpp).
+struct ModelChoice {
+  mss::MssOptions options;
+  mesh::RegionMaterials materials;
+  std::string constants = "untuned Van Gelder";
+  std::string variant;
+};
+
+ModelChoice choose_model(const ModelFlags& flags, const std::string& params, const std::string& material,
+                         bool material_given) {
+  ModelChoice c;
+  if (params.empty()) {
+    c.options = model_options(flags);
+    c.materials = mesh::load_material(material, data_dir());
+    c.variant = model_variant(flags);
+    return c;
+  }
+  if (flags.no_radial || flags.no_torsion || flags.volume_term || flags.disc_volume_term)
+    throw std::invalid_argument("--params fixes the model's terms: drop --no-radial/--no-torsion/--volume-term/--disc-volume-term");
+  const calibration::TunedDisc tuned = calibration::read_tuned_disc(params);
+  c.options = tuned.mss_options();
+  const mss::MssOptions damping = model_options(flags);  // --damping still applies
+  c.options.damping_n_s_per_mm = damping.damping_n_s_per_mm;
+  c.materials = mesh::load_material(material_given ? material : tuned.material_name, data_dir());
+  c.constants = "tuned (" + params + ")";
+  c.variant = "tuned " + std::string(c.options.volume_term ? "thesis+volume" : "thesis") +
+              (c.options.disc_volume_term ? "+disc-volume" : "");
+  return c;
+}
+
+/// The MSS for `m`: with a tuned file, only after it was checked against the mesh and material.
+mss::MssModel build_model(const mesh::TetMesh& m, const ModelChoice& c, const std::string& params, bool quiet) {
+  if (params.empty()) return mss::MssModel(m, c.materials, c.options);
+  const calibration::TunedDisc tuned = calibration::read_tuned_disc(params);
+  mss::MssModel model = tuned_model(tuned, m, c.materials, quiet);
+  if (c.options.damping_n_s_per_mm >= 0) {
+    mss::MssOptions o = model.options();
+    o.damping_n_s_per_mm = c.options.damping_n_s_per_mm;
+    return mss::MssModel(m, c.materials, o);
+  }
+  return model;
+}
 
 std::string one_line(std::string s) {
   std::replace(s.begin(), s.end(), '\n', ' ');
@@ -159,7 +205,8 @@ void print_summary(std::ostream& os, const MssArgs& a, const mss::MssModel& mode
                    const PlateLoad& load, const Outcome& o, const nlohmann::json& j) {
   const mesh::TetMesh& m = model.mesh();
   os << std::setprecision(5) << "MSS on " << a.mesh_path << " (" << m.num_vertices() << " nodes, " << m.num_tets()
-     << " tets), material " << material << ", " << model_variant(a.model) << "\n"
+     << " tets), material " << material << ", " << (a.params.empty() ? model_variant(a.model) : "tuned (" + a.params + ")")
+     << "\n"
      << "  springs       " << model.num_edge_springs() << " edge, " << model.num_radial_tets() << " radial tets, "
      << model.num_angle_springs() << " angle, " << model.num_volume_terms() << " volume\n"
      << "  plate centre  " << load.center.transpose() << " mm\n";
@@ -199,7 +246,7 @@ void run_mss(const MssArgs& a) {
     if (a.frame_every < 0) throw std::invalid_argument("--frame-every must be >= 0");
     if (a.newton_iterations < 1) throw std::invalid_argument("--newton must be >= 1");
   }
-  const mss::MssOptions model_opt = model_options(a.model);
+  const ModelChoice choice = choose_model(a.model, a.params, a.material, a.material_option->count() > 0);
   const bool series = !a.out.empty() && fs::path(a.out).extension() == ".pvd";
   if (!a.out.empty()) {
     if (fs::path(a.out).extension() != ".vtu" && !series)
@@ -207,7 +254,7 @@ void run_mss(const MssArgs& a) {
     if (series && !a.dynamic) throw std::invalid_argument("--out " + a.out + ": a .pvd time series needs a dynamic run (--dt/--steps)");
     require_output_folder(a.out, "--out");
   }
-  const auto materials = mesh::load_material(a.material, data_dir());
+  const auto& materials = choice.materials;
 
   // 2. Mesh and model.
   Progress progress(3 + int(!a.out.empty()), a.quiet || a.json);
@@ -221,7 +268,7 @@ void run_mss(const MssArgs& a) {
     load.value = fem::global_wrench(*named, m.frame);
   }
   progress.begin("building the mass-spring model");
-  const mss::MssModel model(m, materials, model_opt);
+  const mss::MssModel model = build_model(m, choice, a.params, a.quiet || a.json);
   const double build_s = progress.end(std::to_string(model.num_edge_springs()) + " edge springs");
 
   nlohmann::json j = {{"mesh", a.mesh_path},
@@ -232,6 +279,8 @@ void run_mss(const MssArgs& a) {
                       {"load", load.is_wrench ? "wrench" : "motion"},
                       {"timings", {{"read_s", read_s}, {"build_s", build_s}}}};
   j.update(mss_model_json(model, materials));
+  j["mss_constants"] = choice.constants;
+  if (!a.params.empty()) j["params"] = a.params;
   if (named) j["case"] = named->name;
 
   // 3. Solve: static equilibrium, or steps in time.
@@ -278,7 +327,9 @@ void run_mss(const MssArgs& a) {
 // --- mss compare -------------------------------------------------------------------------------
 
 struct CompareArgs {
-  std::string mesh_path, material = "real-disc", cases = "all", csv;
+  std::string mesh_path, material = "real-disc", cases = "all", csv, params;
+  CLI::Option* material_option = nullptr;
+  double load_scale = 1.0;
   int order = 2;
   bool json = false, quiet = false;
   ModelFlags model;
@@ -287,9 +338,11 @@ struct CompareArgs {
 void run_compare(const CompareArgs& a) {
   // 1. Options.
   const auto cases = fem::parse_load_cases(a.cases);
-  const mss::MssOptions model_opt = model_options(a.model);
+  const ModelChoice choice = choose_model(a.model, a.params, a.material, a.material_option->count() > 0);
+  if (!std::isfinite(a.load_scale) || a.load_scale <= 0) throw std::invalid_argument("--load-scale must be a finite number > 0");
+  if (a.order != 1 && a.order != 2) throw std::invalid_argument("--order must be 1 or 2");
   if (!a.csv.empty()) require_output_folder(a.csv, "--csv");
-  const auto materials = mesh::load_material(a.material, data_dir());
+  const auto& materials = choice.materials;
 
   // 2. Mesh, FEM reference and MSS on the same mesh.
   Progress progress(4, a.quiet || a.json);
@@ -301,25 +354,28 @@ void run_compare(const CompareArgs& a) {
   const fem::DiscFem solver(m, materials, a.order, fem::DiscFem::default_plate_center(m));
   progress.end(std::to_string(solver.num_dofs()) + " DOF");
   progress.begin("building the mass-spring model");
-  const mss::MssModel model(m, materials, model_opt);
+  const mss::MssModel model = build_model(m, choice, a.params, a.quiet || a.json);
   progress.end();
 
   // 3. The protocol (mss_report.hpp).
   progress.begin("comparing " + std::to_string(cases.size()) + " load cases");
-  const MssFemComparison cmp = compare_mss_fem(solver, model, cases, materials.name);
+  MssFemComparison cmp = compare_mss_fem(solver, model, cases, materials.name, mss::StaticOptions(), a.load_scale);
+  cmp.constants = choice.constants;
   progress.end();
 
   if (!a.csv.empty()) write_text_file(a.csv, comparison_csv(cmp));
   nlohmann::json j = comparison_json(cmp);
   j["mesh"] = a.mesh_path;
-  j["model_variant"] = model_variant(a.model);
+  j["model_variant"] = choice.variant;
+  if (!a.params.empty()) j["params"] = a.params;
   if (!a.csv.empty()) j["csv"] = a.csv;
   if (a.json) {
     print_json(j);
     return;
   }
-  std::cout << "MSS (untuned Van Gelder, " << model_variant(a.model) << ") vs FEM P" << a.order << " on " << a.mesh_path
-            << " (" << m.num_vertices() << " nodes, " << m.num_tets() << " tets), material " << materials.name << "\n\n";
+  std::cout << "MSS (" << choice.constants << ", " << choice.variant << ") vs FEM P" << a.order << " on " << a.mesh_path
+            << " (" << m.num_vertices() << " nodes, " << m.num_tets() << " tets), material " << materials.name
+            << (a.load_scale != 1.0 ? ", loads x " + std::to_string(a.load_scale) : std::string()) << "\n\n";
   print_comparison(std::cout, cmp, false);
 }
 
@@ -333,7 +389,11 @@ constexpr const char* kCompareProtocol = R"(Protocol (same mesh, each named case
       reaction_error = |(dF, dM/rho)| / |(F_fem, M_fem/rho)|, and its force and moment parts
       over the same denominator.
   (c) 6x6 plate stiffness diagonal, MSS (rest Hessian condensed onto the plate) / FEM.
-MSS constants are the untuned Van Gelder ones: the baseline calibration must beat.)";
+MSS constants: the untuned Van Gelder ones (the baseline calibration must beat), or a tuned file
+from `spinesim calibrate` (--params; refused for another material or disc level).
+--load-scale multiplies every case's wrench: the FEM is linear, so small loads show the linear
+regime the calibration fits; the standard loads (7.5 N·m moments) also show the MSS's
+geometric nonlinearity.)";
 
 }  // namespace
 
@@ -342,8 +402,10 @@ void register_mss(CLI::App& app) {
   auto* cmd = app.add_subcommand("mss", "Tetrahedral mass-spring disc (thesis ch. 5): static or dynamic, rigid-plate load");
   cmd->require_subcommand(0, 1);
   cmd->add_option("--mesh", a->mesh_path, "Disc mesh (VTU with `surface` endplate labels); required");
-  cmd->add_option("--material", a->material, "Preset (real-disc, annulus-nucleus, rubber, polyethylene) or JSON file")
-      ->capture_default_str();
+  a->material_option =
+      cmd->add_option("--material", a->material, "Preset (real-disc, annulus-nucleus, rubber, polyethylene) or JSON file")
+          ->capture_default_str();
+  cmd->add_option("--params", a->params, "Tuned disc from `spinesim calibrate` (sets terms, scales and, unless given, the material)");
   cmd->add_option("--motion", a->motion, "Plate motion tx,ty,tz,rx,ry,rz (mm, degrees)");
   cmd->add_option("--wrench", a->wrench, "Applied wrench Fx,Fy,Fz,Mx,My,Mz (N, N·mm) about the centre");
   cmd->add_option("--case", a->load_case,
@@ -368,9 +430,11 @@ void register_mss(CLI::App& app) {
       "exits 1 with the reason, \"diverged\": true in its JSON and no output file.");
 
   auto c = std::make_shared<CompareArgs>();
-  auto* cmp = cmd->add_subcommand("compare", "MSS (untuned) vs FEM on the same mesh for the named load cases");
+  auto* cmp = cmd->add_subcommand("compare", "MSS (untuned, or tuned with --params) vs FEM on the same mesh for the named load cases");
   cmp->add_option("--mesh", c->mesh_path, "Disc mesh (VTU with `surface` endplate labels)")->required();
-  cmp->add_option("--material", c->material, "Preset or JSON file")->capture_default_str();
+  c->material_option = cmp->add_option("--material", c->material, "Preset or JSON file")->capture_default_str();
+  cmp->add_option("--params", c->params, "Tuned disc from `spinesim calibrate` instead of the untuned constants");
+  cmp->add_option("--load-scale", c->load_scale, "Multiply every case's wrench by this factor")->capture_default_str();
   cmp->add_option("--cases", c->cases, "Comma-separated load cases, or all")->capture_default_str();
   cmp->add_option("--order", c->order, "FEM element order: 1 (P1) or 2 (P2)")->capture_default_str();
   add_model_flags(cmp, c->model);

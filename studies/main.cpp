@@ -27,6 +27,7 @@ int main(int argc, char** argv) {
   spinesim::cli::register_mesh(app);
   spinesim::cli::register_fem(app);
   spinesim::cli::register_mss(app);
+  spinesim::cli::register_calibrate(app);
   spinesim::cli::register_study(app);
   spinesim::cli::register_demo(app);
   spinesim::cli::register_bench(app);

@@ -297,12 +297,15 @@ fem::Matrix6d mss_plate_stiffness(const mss::MssModel& model, const Eigen::Vecto
 
 MssFemComparison compare_mss_fem(const fem::DiscFem& fem, const mss::MssModel& model,
                                  const std::vector<fem::LoadCase>& cases, const std::string& material_name,
-                                 const mss::StaticOptions& options) {
+                                 const mss::StaticOptions& options, double load_scale) {
+  if (!std::isfinite(load_scale) || load_scale <= 0)
+    throw std::invalid_argument("the load scale must be a finite number > 0");
   using clock = std::chrono::steady_clock;
   const mesh::TetMesh& m = model.mesh();
   const Eigen::Vector3d c = fem.plate_center();
   MssFemComparison out;
   out.material = material_name;
+  out.load_scale = load_scale;
   out.fem_order = fem.order();
   out.nodes = m.num_vertices();
   out.tets = m.num_tets();
@@ -312,7 +315,7 @@ MssFemComparison compare_mss_fem(const fem::DiscFem& fem, const mss::MssModel& m
   for (const fem::LoadCase& lc : cases) {
     CaseComparison r;
     r.name = lc.name;
-    r.wrench = fem::global_wrench(lc, m.frame);
+    r.wrench = load_scale * fem::global_wrench(lc, m.frame);
 
     auto t0 = clock::now();
     const fem::PlateSolution f = fem.solve_wrench(r.wrench);
@@ -400,7 +403,8 @@ nlohmann::json comparison_json(const MssFemComparison& c) {
           {"fem_order", c.fem_order},
           {"nodes", c.nodes},
           {"tets", c.tets},
-          {"mss_constants", "untuned Van Gelder"},
+          {"mss_constants", c.constants},
+          {"load_scale", c.load_scale},
           {"plate_rms_radius_mm", c.plate_rms_radius_mm},
           {"units",
            {{"wrench", "Fx,Fy,Fz [N], Mx,My,Mz [N·mm], global frame"},

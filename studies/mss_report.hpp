@@ -122,6 +122,8 @@ struct CaseComparison {
 
 struct MssFemComparison {
   std::string material;
+  std::string constants = "untuned Van Gelder";  ///< or "tuned (FILE)"
+  double load_scale = 1.0;
   int fem_order = 2;
   Eigen::Index nodes = 0, tets = 0;
   double plate_rms_radius_mm = 0;
@@ -132,9 +134,11 @@ struct MssFemComparison {
 
 /// Runs the protocol on `fem` (already factorised, its plate centre is used) and `model` (same
 /// mesh) for `cases`. A static solve that does not converge is recorded, not thrown.
+/// `load_scale` multiplies every case's wrench (1: the standard loads of fem/load_cases.hpp; the
+/// FEM is linear, so its relative errors do not depend on it, the nonlinear MSS's do).
 MssFemComparison compare_mss_fem(const fem::DiscFem& fem, const mss::MssModel& model,
                                  const std::vector<fem::LoadCase>& cases, const std::string& material_name,
-                                 const mss::StaticOptions& options = mss::StaticOptions());
+                                 const mss::StaticOptions& options = mss::StaticOptions(), double load_scale = 1.0);
 
 nlohmann::json comparison_json(const MssFemComparison& c);
 /// Readable table (markdown when `markdown`), one row per case, then the K6 diagonal ratios.

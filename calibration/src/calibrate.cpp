@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 
 namespace spinesim::calibration {
@@ -176,7 +177,8 @@ CalibrationResult calibrate(Objective& objective, const Eigen::VectorXd& start_l
   app->Options()->SetIntegerValue("print_level", settings.print_level);
   app->Options()->SetStringValue("sb", "yes");  // no banner
   app->Options()->SetStringValue("mu_strategy", "adaptive");
-  if (app->Initialize() != Ipopt::Solve_Succeeded) {
+  std::istringstream no_option_file;  // never read ./ipopt.opt: runs must not depend on the folder
+  if (app->Initialize(no_option_file) != Ipopt::Solve_Succeeded) {
     out.status = "Ipopt_Initialisation_Failed";
     out.seconds = since(t0);
     return out;
