@@ -1,0 +1,34 @@
+// The shipped tuned discs: one region-level TunedDisc per spine level, one material, in one
+// small JSON file (data/tuned_discs.json, written by `spinesim calibrate --level all`):
+//   {"format": "spinesim-tuned-disc-set", "version": 1, "material": "real-disc",
+//    "generated_by": "...", "levels": {"T1-T2": {tuned disc}, ..., "L5-S1": {...}}}
+// Each entry is exactly a tuned.json (tuned_disc.hpp), so the spine scene and the haptic loop
+// load a level's parameters the same way `spinesim mss --params` loads a file.
+#pragma once
+
+#include "spinesim/calibration/tuned_disc.hpp"
+
+#include <map>
+#include <string>
+
+namespace spinesim::calibration {
+
+struct TunedSet {
+  std::string material_name;
+  std::string generated_by;  ///< the command that wrote it
+  std::map<std::string, TunedDisc> levels;
+};
+
+nlohmann::json to_json(const TunedSet& set);
+/// Parses and validates every entry (tuned_disc_from_json); all entries must share the set's
+/// material and carry their own level. Throws std::invalid_argument with a one-line message.
+TunedSet tuned_set_from_json(const nlohmann::json& j);
+TunedSet read_tuned_set(const std::string& path);
+
+/// The shipped file's path under a data folder: DATA_DIR/tuned_discs.json.
+std::string shipped_tuned_set_path(const std::string& data_dir);
+
+/// One level's entry; throws std::invalid_argument naming the levels present when missing.
+const TunedDisc& tuned_level(const TunedSet& set, const std::string& level);
+
+}  // namespace spinesim::calibration

@@ -1,0 +1,74 @@
+#include "spinesim/calibration/tuned_set.hpp"
+
+#include <fstream>
+#include <stdexcept>
+
+namespace spinesim::calibration {
+
+namespace {
+constexpr const char* kSetFormat = "spinesim-tuned-disc-set";
+constexpr int kSetVersion = 1;
+}  // namespace
+
+nlohmann::json to_json(const TunedSet& set) {
+  nlohmann::json levels = nlohmann::json::object();
+  for (const auto& [level, disc] : set.levels) levels[level] = to_json(disc);
+  return {{"format", kSetFormat},
+          {"version", kSetVersion},
+          {"material", set.material_name},
+          {"generated_by", set.generated_by},
+          {"levels", levels}};
+}
+
+TunedSet tuned_set_from_json(const nlohmann::json& j) {
+  if (!j.is_object() || j.value("format", "") != kSetFormat)
+    throw std::invalid_argument(std::string("not a tuned-disc set (\"format\": \"") + kSetFormat + "\" missing)");
+  if (j.value("version", 0) != kSetVersion)
+    throw std::invalid_argument("tuned-disc set version " + j.value("version", nlohmann::json()).dump() +
+                                " is not supported");
+  TunedSet set;
+  set.material_name = j.value("material", "");
+  set.generated_by = j.value("generated_by", "");
+  if (!j.contains("levels") || !j["levels"].is_object() || j["levels"].empty())
+    throw std::invalid_argument("tuned-disc set has no levels");
+  for (const auto& [level, entry] : j["levels"].items()) {
+    TunedDisc d;
+    try {
+      d = tuned_disc_from_json(entry);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument("level " + level + ": " + e.what());
+    }
+    if (d.level != level) throw std::invalid_argument("level " + level + ": its entry says level '" + d.level + "'");
+    if (d.material_name != set.material_name)
+      throw std::invalid_argument("level " + level + ": material '" + d.material_name + "' is not the set's '" +
+                                  set.material_name + "'");
+    set.levels.emplace(level, std::move(d));
+  }
+  return set;
+}
+
+TunedSet read_tuned_set(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::invalid_argument("cannot read tuned-disc set '" + path + "'");
+  nlohmann::json j;
+  try {
+    in >> j;
+    return tuned_set_from_json(j);
+  } catch (const nlohmann::json::exception&) {
+    throw std::invalid_argument("'" + path + "' is not valid JSON");
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument("'" + path + "': " + e.what());
+  }
+}
+
+std::string shipped_tuned_set_path(const std::string& data_dir) { return data_dir + "/tuned_discs.json"; }
+
+const TunedDisc& tuned_level(const TunedSet& set, const std::string& level) {
+  auto it = set.levels.find(level);
+  if (it != set.levels.end()) return it->second;
+  std::string known;
+  for (const auto& [name, _] : set.levels) known += (known.empty() ? "" : ", ") + name;
+  throw std::invalid_argument("no tuned disc for level '" + level + "' (the set has " + known + ")");
+}
+
+}  // namespace spinesim::calibration
