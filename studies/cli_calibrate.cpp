@@ -13,14 +13,18 @@
 #include "calibration_report.hpp"
 #include "cli_common.hpp"
 
+#include "spinesim/calibration/tuned_set.hpp"
 #include "spinesim/mesh/disc_geometry.hpp"
 #include "spinesim/mesh/io.hpp"
 #include "spinesim/mesh/mesher.hpp"
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <iostream>
+#include <sstream>
 #include <memory>
 
 namespace spinesim::cli {
@@ -48,6 +52,78 @@ std::vector<fem::LoadCase> other_cases(const std::vector<fem::LoadCase>& train) 
   return out;
 }
 
+double worst(const nlohmann::json& rows, const char* key) {
+  double w = 0;
+  for (const auto& r : rows) w = std::max(w, r[key].get<double>());
+  return w;
+}
+
+/// --level all: every level's parametric disc, one tuned set file (tuned_set.hpp), written only
+/// when every level succeeded.
+void run_all_levels(const CalibrateArgs& a, const CalibrationRequest& rq, const mesh::RegionMaterials& materials,
+                    const StatusLine& status) {
+  calibration::TunedSet set;
+  set.material_name = materials.name;
+  std::ostringstream cmd;
+  cmd << "spinesim calibrate --level all --cell-size " << a.cell_size_mm << " --material " << a.material
+      << " --terms " << a.terms << " --train " << a.train << (a.holdout.empty() ? "" : " --holdout " + a.holdout)
+      << " --order " << a.order << " --check-load-scale " << rq.check_load_scale << (a.no_check ? " --no-check" : "");
+  set.generated_by = cmd.str();
+  std::ostringstream table;
+  table << std::left << std::setw(9) << "level" << std::right << std::setw(7) << "tets" << std::setw(13)
+        << "train max" << std::setw(13) << "holdout max" << std::setw(15) << "K6 diag ratio" << std::setw(9)
+        << "Ipopt" << std::setw(9) << "time" << "\n"
+        << std::left << std::setw(9) << "" << std::right << std::setw(7) << "" << std::setw(13) << "untuned>tuned"
+        << std::setw(13) << "untuned>tuned" << std::setw(15) << "tuned min-max" << std::setw(9) << "its" << std::setw(9)
+        << "s" << "\n";
+  std::vector<std::string> failed;
+  for (const std::string& level : mesh::disc_levels()) {
+    mesh::MeshOptions opt;
+    opt.cell_size_mm = a.cell_size_mm;
+    status("== " + level + ": meshing (cell size " + std::to_string(a.cell_size_mm).substr(0, 4) + " mm)");
+    const mesh::TetMesh m = mesh::mesh_parametric_disc(mesh::disc_dimensions(level, data_dir()), opt);
+    const CalibrationOutcome o = calibrate_disc(m, materials, rq, status);
+    if (!o.result.success) {
+      failed.push_back(level + " (" + o.result.status + ")");
+      continue;
+    }
+    const auto& rep = o.tuned.report;
+    const auto& ratio = rep["stiffness_diagonal"]["ratio_tuned"];
+    double lo = 1e300, hi = 0;
+    for (const auto& v : ratio) lo = std::min(lo, v.get<double>()), hi = std::max(hi, v.get<double>());
+    const auto pair = [](double u, double t) {
+      std::ostringstream s;
+      s << std::fixed << std::setprecision(0) << 100 * u << ">" << std::setprecision(1) << 100 * t << "%";
+      return s.str();
+    };
+    table << std::left << std::setw(9) << level << std::right << std::setw(7) << m.num_tets() << std::setw(13)
+          << pair(worst(rep["train"], "untuned_error"), worst(rep["train"], "tuned_error")) << std::setw(13)
+          << (rep["holdout"].empty() ? std::string("-")
+                                     : pair(worst(rep["holdout"], "untuned_error"), worst(rep["holdout"], "tuned_error")))
+          << std::setw(15)
+          << [&] { std::ostringstream s; s << std::fixed << std::setprecision(3) << lo << "-" << hi; return s.str(); }()
+          << std::setw(9) << o.result.iterations << std::setw(9) << std::fixed << std::setprecision(1) << o.total_seconds
+          << "\n";
+    set.levels.emplace(level, o.tuned);
+  }
+  if (!failed.empty()) {
+    std::string list;
+    for (const auto& f : failed) list += (list.empty() ? "" : ", ") + f;
+    throw std::runtime_error("Ipopt did not converge for " + list + ": no " + a.out + " written");
+  }
+  write_text_file(a.out, calibration::to_json(set).dump(1) + "\n");
+  if (a.json) {
+    nlohmann::json j = calibration::to_json(set);
+    j["out"] = a.out;
+    print_json(j);
+    return;
+  }
+  std::cout << "Calibration of all " << set.levels.size() << " levels, material " << materials.name << ", terms "
+            << a.terms << " (errors: relative nodal displacement, nonlinear check at loads x " << rq.check_load_scale
+            << ")\n\n"
+            << table.str() << "\nwrote " << a.out << "\n";
+}
+
 void run_calibrate(const CalibrateArgs& a) {
   // 1. Everything checked before the work starts.
   if (a.out.empty()) throw std::invalid_argument("--out tuned.json is required");
@@ -70,11 +146,13 @@ void run_calibrate(const CalibrateArgs& a) {
   calibration::validate(rq.ipopt);
   const auto materials = mesh::load_material(a.material, data_dir());
 
-  // 2. The mesh: read, or the level's parametric disc.
   const bool chatty = !a.quiet && !a.json && isatty(STDERR_FILENO);
   const auto status = [chatty](const std::string& s) {
     if (chatty) std::cerr << "  " << s << std::endl;
   };
+  if (a.level == "all") return run_all_levels(a, rq, materials, status);
+
+  // 2. The mesh: read, or the level's parametric disc.
   mesh::TetMesh m;
   if (!a.mesh_path.empty()) {
     status("reading " + a.mesh_path);
@@ -110,7 +188,9 @@ void register_calibrate(CLI::App& app) {
   auto a = std::make_shared<CalibrateArgs>();
   auto* cmd = app.add_subcommand("calibrate", "Tune the mass-spring disc's stiffness to the FEM with Ipopt; writes tuned.json");
   cmd->add_option("--mesh", a->mesh_path, "Disc mesh (VTU with endplate labels)");
-  cmd->add_option("--level", a->level, "Or mesh this level's parametric disc (T1-T2 ... L5-S1)");
+  cmd->add_option("--level", a->level,
+                  "Or mesh this level's parametric disc (T1-T2 ... L5-S1); `all`: every level into one tuned-set file "
+                  "(as data/tuned_discs.json)");
   cmd->add_option("--cell-size", a->cell_size_mm, "With --level: CGAL cell size, mm")->capture_default_str();
   cmd->add_option("--material", a->material, "Preset (real-disc, annulus-nucleus, rubber, polyethylene) or JSON file")
       ->capture_default_str();
