@@ -69,6 +69,9 @@ void run_all_levels(const CalibrateArgs& a, const CalibrationRequest& rq, const 
       << " --terms " << a.terms << " --train " << a.train << (a.holdout.empty() ? "" : " --holdout " + a.holdout)
       << " --order " << a.order << " --check-load-scale " << rq.check_load_scale << (a.no_check ? " --no-check" : "");
   set.generated_by = cmd.str();
+  set.settings = {{"cell_size_mm", a.cell_size_mm},
+                  {"mesh", "parametric disc (data/disc_morphometry.csv), CGAL"},
+                  {"check_load_scale", rq.nonlinear_check ? nlohmann::json(rq.check_load_scale) : nlohmann::json(nullptr)}};
   std::ostringstream table;
   table << std::left << std::setw(9) << "level" << std::right << std::setw(7) << "tets" << std::setw(13)
         << "train max" << std::setw(13) << "holdout max" << std::setw(15) << "K6 diag ratio" << std::setw(9)

@@ -17,6 +17,7 @@ nlohmann::json to_json(const TunedSet& set) {
           {"version", kSetVersion},
           {"material", set.material_name},
           {"generated_by", set.generated_by},
+          {"settings", set.settings},
           {"levels", levels}};
 }
 
@@ -29,6 +30,7 @@ TunedSet tuned_set_from_json(const nlohmann::json& j) {
   TunedSet set;
   set.material_name = j.value("material", "");
   set.generated_by = j.value("generated_by", "");
+  set.settings = j.value("settings", nlohmann::json::object());
   if (!j.contains("levels") || !j["levels"].is_object() || j["levels"].empty())
     throw std::invalid_argument("tuned-disc set has no levels");
   for (const auto& [level, entry] : j["levels"].items()) {

@@ -1,7 +1,7 @@
 // The shipped tuned discs: one region-level TunedDisc per spine level, one material, in one
 // small JSON file (data/tuned_discs.json, written by `spinesim calibrate --level all`):
 //   {"format": "spinesim-tuned-disc-set", "version": 1, "material": "real-disc",
-//    "generated_by": "...", "levels": {"T1-T2": {tuned disc}, ..., "L5-S1": {...}}}
+//    "generated_by": "...", "settings": {"cell_size_mm": 2, ...}, "levels": {"T1-T2": {tuned disc}, ..., "L5-S1": {...}}}
 // Each entry is exactly a tuned.json (tuned_disc.hpp), so the spine scene and the haptic loop
 // load a level's parameters the same way `spinesim mss --params` loads a file.
 #pragma once
@@ -16,6 +16,7 @@ namespace spinesim::calibration {
 struct TunedSet {
   std::string material_name;
   std::string generated_by;  ///< the command that wrote it
+  nlohmann::json settings = nlohmann::json::object();  ///< how to regenerate it (mesh cell size, ...)
   std::map<std::string, TunedDisc> levels;
 };
 
