@@ -70,7 +70,7 @@ void run_all_levels(const CalibrateArgs& a, const CalibrationRequest& rq, const 
       << " --order " << a.order << " --check-load-scale " << rq.check_load_scale << (a.no_check ? " --no-check" : "");
   set.generated_by = cmd.str();
   set.settings = {{"cell_size_mm", a.cell_size_mm},
-                  {"mesh", "parametric disc (data/disc_morphometry.csv), CGAL"},
+                  {"mesh", "parametric disc (data/disc_morphometry.csv), CGAL, placed in the spine (as `mesh disc --level`)"},
                   {"check_load_scale", rq.nonlinear_check ? nlohmann::json(rq.check_load_scale) : nlohmann::json(nullptr)}};
   std::ostringstream table;
   table << std::left << std::setw(9) << "level" << std::right << std::setw(7) << "tets" << std::setw(13)
@@ -84,7 +84,8 @@ void run_all_levels(const CalibrateArgs& a, const CalibrationRequest& rq, const 
     mesh::MeshOptions opt;
     opt.cell_size_mm = a.cell_size_mm;
     status("== " + level + ": meshing (cell size " + std::to_string(a.cell_size_mm).substr(0, 4) + " mm)");
-    const mesh::TetMesh m = mesh::mesh_parametric_disc(mesh::disc_dimensions(level, data_dir()), opt);
+    const mesh::TetMesh m = mesh::mesh_parametric_disc(mesh::disc_dimensions(level, data_dir()), opt,
+                                                      mesh::disc_frame_in_spine(level, data_dir()));
     const CalibrationOutcome o = calibrate_disc(m, materials, rq, status);
     if (!o.result.success) {
       failed.push_back(level + " (" + o.result.status + ")");
@@ -164,7 +165,8 @@ void run_calibrate(const CalibrateArgs& a) {
     mesh::MeshOptions opt;
     opt.cell_size_mm = a.cell_size_mm;
     status("meshing " + a.level + " (cell size " + std::to_string(a.cell_size_mm).substr(0, 4) + " mm)");
-    m = mesh::mesh_parametric_disc(mesh::disc_dimensions(a.level, data_dir()), opt);
+    m = mesh::mesh_parametric_disc(mesh::disc_dimensions(a.level, data_dir()), opt,
+                                   mesh::disc_frame_in_spine(a.level, data_dir()));  // as `mesh disc --level`
   }
 
   // 3. Calibrate, report, write only a successful result.
