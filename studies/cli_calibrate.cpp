@@ -22,6 +22,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <iomanip>
 #include <iostream>
 #include <sstream>
@@ -135,10 +136,16 @@ void run_calibrate(const CalibrateArgs& a) {
   if (a.order != 1 && a.order != 2) throw std::invalid_argument("--order must be 1 or 2");
   if (!(a.cell_size_mm > 0)) throw std::invalid_argument("--cell-size must be > 0 mm");
   require_output_folder(a.out, "--out");
+  if (!a.mesh_path.empty() && std::filesystem::exists(a.out) && std::filesystem::exists(a.mesh_path) &&
+      std::filesystem::equivalent(a.out, a.mesh_path))
+    throw std::invalid_argument("--out " + a.out + " is the input mesh: give another file");
   CalibrationRequest rq;
   rq.train = fem::parse_load_cases(a.train);
   rq.holdout = a.holdout.empty() ? other_cases(rq.train)
                : a.holdout == "none" ? std::vector<fem::LoadCase>() : fem::parse_load_cases(a.holdout);
+  for (const auto& h : rq.holdout)  // calibrate_disc checks it too, but only after meshing (17 times for all)
+    for (const auto& t : rq.train)
+      if (h.name == t.name) throw std::invalid_argument("case '" + h.name + "' is both trained on and held out");
   rq.fem_order = a.order;
   rq.terms = parse_term_set(a.terms);
   rq.weights = a.weights;
