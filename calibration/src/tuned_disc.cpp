@@ -57,7 +57,9 @@ MeshFingerprint fingerprint(const mesh::TetMesh& m) {
 }
 
 std::string disc_level(const mesh::TetMesh& m) {
-  static const std::regex level(R"(\b([TLS][0-9]{1,2}-[TLS][0-9]{1,2})\b)");
+  // Only the builders' provenance: a foreign VTU's `source` is its path, and "scans/L4-L5/x.vtu"
+  // would otherwise name a level nobody checked.
+  static const std::regex level(R"(^(?:parametric|structured) disc ([TLS][0-9]{1,2}-[TLS][0-9]{1,2})\b)");
   std::smatch match;
   return std::regex_search(m.source, match, level) ? match[1].str() : std::string();
 }
@@ -78,6 +80,11 @@ mss::MssOptions TunedDisc::mss_options() const {
     o.scales[int(k.term)].by_region[std::size_t(k.region)] = value;
   }
   return o;
+}
+
+mesh::RegionMaterials TunedDisc::materials() const {
+  return mesh::material_from_json(
+      {{"name", material_name}, {"annulus", material.at("annulus")}, {"nucleus", material.at("nucleus")}});
 }
 
 nlohmann::json to_json(const TunedDisc& t) {
@@ -105,7 +112,7 @@ TunedDisc tuned_disc_from_json(const nlohmann::json& j) {
   try {
     if (!j.is_object() || j.value("format", "") != kFormat)
       throw std::invalid_argument("not a spinesim tuned-disc file (\"format\": \"" + std::string(kFormat) + "\" missing)");
-    if (j.at("version").get<int>() != kVersion)
+    if (j.at("version") != kVersion)  // compares the number, not a truncated int (1.5, 2^32 + 1)
       throw std::invalid_argument("tuned-disc file version " + j.at("version").dump() + " is not supported (expected " +
                                   std::to_string(kVersion) + ")");
     const std::string kind = j.value("kind", "region");
@@ -115,10 +122,12 @@ TunedDisc tuned_disc_from_json(const nlohmann::json& j) {
     t.level = j.value("level", "");
     t.material_name = j.at("material").at("name").get<std::string>();
     t.material = j.at("material").at("regions");
+    t.materials();  // every region's constants present and valid (check_applies compares them)
     t.mesh.nodes = j.at("mesh").at("nodes").get<Eigen::Index>();
     t.mesh.tets = j.at("mesh").at("tets").get<Eigen::Index>();
     t.mesh.hash = j.at("mesh").at("fingerprint").get<std::string>();
     t.fem_order = j.value("fem_order", 2);
+    if (t.fem_order != 1 && t.fem_order != 2) throw std::invalid_argument("fem_order must be 1 or 2");
     const auto& terms = j.at("terms");
     t.options.radial_springs = terms.at("radial_springs").get<bool>();
     t.options.torsion_springs = terms.at("torsion_springs").get<bool>();
@@ -127,6 +136,8 @@ TunedDisc tuned_disc_from_json(const nlohmann::json& j) {
     t.options.radial_factor = terms.at("radial_factor").get<double>();
     t.options.volume_factor = terms.at("volume_factor").get<double>();
     t.options.disc_volume_factor = terms.at("disc_volume_factor").get<double>();
+    for (const double f : {t.options.radial_factor, t.options.volume_factor, t.options.disc_volume_factor})
+      if (!std::isfinite(f) || f <= 0) throw std::invalid_argument("term factors must be finite and > 0");
     for (const auto& [name, value] : j.at("scales").items()) {
       const Knob k = knob_from_name(name);
       const double s = value.get<double>();
@@ -170,12 +181,17 @@ std::string check_applies(const TunedDisc& t, const mesh::TetMesh& mesh, const m
     throw std::invalid_argument("the tuned parameters were fitted for material '" + t.material_name +
                                 "' and do not apply to material '" + materials.name + "' (calibrate it first)");
   const std::string level = disc_level(mesh);
-  if (!level.empty() && !t.level.empty() && level != t.level)
-    throw std::invalid_argument("the tuned parameters were fitted for disc " + t.level + " and do not apply to a " +
-                                level + " mesh");
-  if (level.empty() && !t.level.empty())
-    return "mesh level unknown: applying the " + t.level + " parameters as given";
-  return "";
+  if (!level.empty() && !t.level.empty()) {
+    if (level != t.level)
+      throw std::invalid_argument("the tuned parameters were fitted for disc " + t.level + " and do not apply to a " +
+                                  level + " mesh");
+    return "";
+  }
+  if (fingerprint(mesh) == t.mesh) return "";  // the very mesh they were fitted on
+  if (level.empty())
+    return "mesh level unknown: applying the " + (t.level.empty() ? std::string("tuned") : t.level) +
+           " parameters as given";
+  return "the tuned parameters' disc level is unknown: applying them to this " + level + " mesh as given";
 }
 
 }  // namespace spinesim::calibration

@@ -35,7 +35,10 @@ struct MeshFingerprint {
 };
 MeshFingerprint fingerprint(const mesh::TetMesh& mesh);
 
-/// The disc level a mesh was built for ("L4-L5"), read from its provenance; empty if unknown.
+/// The disc level a mesh was built for ("L4-L5"), read from its provenance as spinesim's
+/// builders write it ("parametric disc L4-L5", "structured disc T12-L1 (...)"); empty if
+/// unknown — also when `source` is only the file a foreign mesh was read from, whose name says
+/// nothing reliable about the level.
 std::string disc_level(const mesh::TetMesh& mesh);
 
 /// Every region's (E MPa, nu, rho kg/m^3) as JSON: {"annulus": {...}, "nucleus": {...}}.
@@ -53,19 +56,24 @@ struct TunedDisc {
 
   /// `options` with its scales set from `scales` (knobs not listed stay 1).
   mss::MssOptions mss_options() const;
+  /// The material the scales were fitted with, rebuilt from `material_name` and `material`
+  /// (so a file calibrated with a material JSON file loads without it).
+  mesh::RegionMaterials materials() const;
 };
 
 nlohmann::json to_json(const TunedDisc& t);
-/// Parses and validates (format tag, version, positive finite scales, known knob names, terms
-/// of every scale switched on); throws std::invalid_argument with a one-line message.
+/// Parses and validates (format tag, version, kind, positive finite scales, known knob names,
+/// terms of every scale switched on, positive finite term factors, a valid material per region,
+/// fem_order 1 or 2); throws std::invalid_argument with a one-line message.
 TunedDisc tuned_disc_from_json(const nlohmann::json& j);
 /// Reads a tuned.json; throws std::invalid_argument naming the file for unreadable or invalid
 /// content.
 TunedDisc read_tuned_disc(const std::string& path);
 
 /// Throws std::invalid_argument (one line) unless `tuned` applies to `mesh` with `materials`:
-/// same material (name and constants), same level when the mesh's level is known. Returns a
-/// note for the user ("" or e.g. "mesh level unknown: ...").
+/// same material (name and E, nu per region), same level when both levels are known. Returns a
+/// note for the user when the level could not be checked ("mesh level unknown: ...") — not for
+/// the very mesh the scales were fitted on (same fingerprint) — and "" otherwise.
 std::string check_applies(const TunedDisc& tuned, const mesh::TetMesh& mesh,
                           const mesh::RegionMaterials& materials);
 
