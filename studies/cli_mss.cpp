@@ -73,13 +73,17 @@ ModelChoice choose_model(const ModelFlags& flags, const std::string& params, con
     c.variant = model_variant(flags);
     return c;
   }
-  if (flags.no_radial || flags.no_torsion || flags.volume_term || flags.disc_volume_term)
-    throw std::invalid_argument("--params fixes the model's terms: drop --no-radial/--no-torsion/--volume-term/--disc-volume-term");
+  const mss::MssOptions defaults;
+  if (flags.no_radial || flags.no_torsion || flags.volume_term || flags.disc_volume_term ||
+      flags.volume_factor != defaults.volume_factor || flags.disc_volume_factor != defaults.disc_volume_factor)
+    throw std::invalid_argument(
+        "--params fixes the model's terms: drop --no-radial/--no-torsion/--volume-term/--disc-volume-term and their factors");
   const calibration::TunedDisc tuned = calibration::read_tuned_disc(params);
   c.options = tuned.mss_options();
   const mss::MssOptions damping = model_options(flags);  // --damping still applies
   c.options.damping_n_s_per_mm = damping.damping_n_s_per_mm;
-  c.materials = mesh::load_material(material_given ? material : tuned.material_name, data_dir());
+  // Not the preset of that name: the file may have been fitted with a material JSON file.
+  c.materials = material_given ? mesh::load_material(material, data_dir()) : tuned.materials();
   c.constants = "tuned (" + params + ")";
   c.variant = "tuned " + std::string(c.options.volume_term ? "thesis+volume" : "thesis") +
               (c.options.disc_volume_term ? "+disc-volume" : "");
@@ -350,12 +354,12 @@ void run_compare(const CompareArgs& a) {
   const mesh::TetMesh m = mesh::read_vtu(a.mesh_path);
   mesh::require_endplate_labels(m);
   progress.end(std::to_string(m.num_tets()) + " tets");
+  progress.begin("building the mass-spring model");  // first: a tuned file that does not apply is refused here
+  const mss::MssModel model = build_model(m, choice, a.params, a.quiet || a.json);
+  progress.end();
   progress.begin("FEM P" + std::to_string(a.order) + " assembly and factorisation");
   const fem::DiscFem solver(m, materials, a.order, fem::DiscFem::default_plate_center(m));
   progress.end(std::to_string(solver.num_dofs()) + " DOF");
-  progress.begin("building the mass-spring model");
-  const mss::MssModel model = build_model(m, choice, a.params, a.quiet || a.json);
-  progress.end();
 
   // 3. The protocol (mss_report.hpp).
   progress.begin("comparing " + std::to_string(cases.size()) + " load cases");
