@@ -1,0 +1,326 @@
+// `spinesim calibrate` and the tuned file's use by `spinesim mss` / `mss compare --params`: the
+// JSON report, the promise that tuned.json's errors are the ones `mss compare` reproduces, and
+// every refusal (exit 1, one line on stderr, no tuned file written). One structured L4-L5 disc
+// (360 tets) made once per process, so each calibration takes a fraction of a second.
+#include "cli_runner.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <string>
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+using namespace spinesim::test_cli;
+
+const std::vector<std::string> kTrain = {"compression", "shear-ap", "flexion", "torsion"};  // the default
+const std::vector<std::string> kAllCases = {"compression", "tension",   "shear-ap",        "shear-lat",
+                                            "flexion",     "extension", "lateral-bending", "torsion"};
+
+std::string in_quotes(const std::string& path) { return "'" + path + "'"; }
+
+/// A structured disc of `level`, meshed once per process.
+const std::string& disc(const std::string& level = "L4-L5") {
+  static std::map<std::string, std::string> made;
+  auto it = made.find(level);
+  if (it != made.end()) return it->second;
+  const std::string path = tmp("disc-" + level + ".vtu");
+  const CliRun r = run_spinesim("mesh disc --level " + level + " --structured --out " + in_quotes(path));
+  EXPECT_EQ(r.status, 0) << r.err;
+  return made.emplace(level, path).first->second;
+}
+
+/// One calibration of disc() per process and flavour: `checked` runs the nonlinear check.
+struct Calibrated {
+  std::string path;  ///< the tuned file
+  json printed;      ///< what --json printed
+};
+const Calibrated& calibrated(bool checked) {
+  static std::map<bool, Calibrated> made;
+  auto it = made.find(checked);
+  if (it != made.end()) return it->second;
+  Calibrated c;
+  c.path = tmp(checked ? "tuned-checked.json" : "tuned.json");
+  const CliRun r = run_spinesim("calibrate --mesh " + in_quotes(disc()) + " --out " + in_quotes(c.path) + " --json" +
+                                (checked ? "" : " --no-check"));
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(r.err.empty()) << r.err;
+  c.printed = json::parse(r.out, nullptr, false);
+  return made.emplace(checked, c).first->second;
+}
+
+std::vector<std::string> case_names(const json& rows) {
+  std::vector<std::string> names;
+  for (const auto& r : rows) names.push_back(r.at("name").get<std::string>());
+  return names;
+}
+
+/// A run refused before it wrote `out`.
+void expect_refused_without(const CliRun& r, const std::string& needle, const std::string& out) {
+  expect_refused(r, needle);
+  EXPECT_FALSE(fs::exists(out)) << out << " was written";
+}
+
+}  // namespace
+
+TEST(CalibrateCli, HelpDescribesTheProtocol) {
+  const CliRun r = run_spinesim("calibrate --help");
+  EXPECT_EQ(r.status, 0);
+  for (const char* flag : {"--mesh", "--level", "--train", "--holdout", "--terms", "--out", "--no-check", "--json"})
+    EXPECT_NE(r.out.find(flag), std::string::npos) << flag;
+}
+
+// --json: one object on stdout, the tuned file's contents plus where it went; every case is
+// reported untuned and tuned, and the fit beats Van Gelder on what it was trained on.
+TEST(CalibrateCli, JsonReportsEveryCaseAndTheFileParses) {
+  const Calibrated& c = calibrated(false);
+  const json& j = c.printed;
+  ASSERT_TRUE(j.is_object()) << "stdout is not one JSON object";
+  EXPECT_EQ(j.at("out"), c.path);
+  EXPECT_EQ(j.at("mesh_file"), disc());
+  EXPECT_EQ(j.at("format"), "spinesim-tuned-disc");
+  EXPECT_EQ(j.at("level"), "L4-L5");
+  const json& rep = j.at("report");
+  EXPECT_EQ(rep.at("ipopt").at("status"), "Solve_Succeeded");
+  EXPECT_TRUE(rep.at("ipopt").at("success").get<bool>());
+
+  // Training cases: the default set; held out: every other standard case, each exactly once.
+  EXPECT_EQ(case_names(rep.at("train")), kTrain);
+  std::set<std::string> seen;
+  for (const auto& name : case_names(rep.at("train"))) seen.insert(name);
+  for (const auto& name : case_names(rep.at("holdout"))) EXPECT_TRUE(seen.insert(name).second) << name;
+  EXPECT_EQ(seen, std::set<std::string>(kAllCases.begin(), kAllCases.end()));
+  for (const char* set : {"train", "holdout"})
+    for (const auto& row : rep.at(set)) {
+      SCOPED_TRACE(std::string(set) + " " + row.at("name").get<std::string>());
+      for (const char* key : {"untuned_error", "tuned_error"}) {
+        ASSERT_TRUE(row.contains(key)) << key;
+        const double e = row.at(key).get<double>();
+        EXPECT_TRUE(std::isfinite(e) && e >= 0) << key << " " << e;
+      }
+    }
+  for (const auto& row : rep.at("train"))
+    EXPECT_LT(row.at("tuned_error").get<double>(), row.at("untuned_error").get<double>()) << row.at("name");
+
+  // The file holds what was printed, minus where it came from and went.
+  ASSERT_TRUE(fs::exists(c.path));
+  const json file = json::parse(slurp(c.path), nullptr, false);
+  ASSERT_FALSE(file.is_discarded()) << "tuned file is not JSON";
+  json printed = j;
+  printed.erase("out");
+  printed.erase("mesh_file");
+  EXPECT_EQ(file, printed);
+  EXPECT_FALSE(file.at("scales").empty());
+  for (const auto& [knob, s] : file.at("scales").items()) EXPECT_GT(s.get<double>(), 0.0) << knob;
+}
+
+TEST(CalibrateCli, TrainAndHoldoutAreTheOnesAskedFor) {
+  const std::string out = tmp("tuned-subset.json");
+  const CliRun r = run_spinesim("calibrate --mesh " + in_quotes(disc()) + " --train compression,flexion --holdout torsion" +
+                                " --terms thesis --no-check --json --out " + in_quotes(out));
+  ASSERT_EQ(r.status, 0) << r.err;
+  const json j = json::parse(r.out);
+  EXPECT_EQ(case_names(j["report"]["train"]), (std::vector<std::string>{"compression", "flexion"}));
+  EXPECT_EQ(case_names(j["report"]["holdout"]), (std::vector<std::string>{"torsion"}));
+  EXPECT_FALSE(j["terms"]["volume_term"].get<bool>());
+  EXPECT_EQ(j["scales"].size(), 6u);  // thesis terms: main, radial, torsion per region
+  for (const auto& [knob, s] : j["scales"].items()) EXPECT_EQ(knob.find("volume"), std::string::npos) << knob;
+}
+
+// The tuned file's promise: with the nonlinear check, its `tuned_error` per case is what
+// `mss compare --params` measures on the same mesh at the check's load scale — and its
+// `untuned_error` what plain `mss compare` measures.
+TEST(CalibrateCli, TunedErrorsAreWhatMssCompareReproduces) {
+  const Calibrated& c = calibrated(true);
+  const json& rep = c.printed.at("report");
+  ASSERT_EQ(rep.at("ipopt").at("status"), "Solve_Succeeded");
+  ASSERT_TRUE(rep.at("check_load_scale").is_number()) << "the check ran, so its load scale is reported";
+  const double load_scale = rep.at("check_load_scale").get<double>();
+  std::map<std::string, json> rows;
+  for (const char* set : {"train", "holdout"})
+    for (const auto& row : rep.at(set)) rows[row.at("name").get<std::string>()] = row;
+  ASSERT_EQ(rows.size(), kAllCases.size());
+
+  for (const bool tuned : {true, false}) {
+    SCOPED_TRACE(tuned ? "tuned" : "untuned");
+    std::ostringstream scale;
+    scale.precision(17);
+    scale << load_scale;
+    const CliRun r = run_spinesim("mss compare --mesh " + in_quotes(disc()) + (tuned ? " --params " + in_quotes(c.path) : "") +
+                                  " --load-scale " + scale.str() + " --json");
+    ASSERT_EQ(r.status, 0) << r.err;
+    const json j = json::parse(r.out);
+    EXPECT_EQ(j.at("mss_constants").get<std::string>().rfind("tuned (", 0) == 0, tuned) << j.at("mss_constants");
+    ASSERT_EQ(j.at("cases").size(), kAllCases.size());
+    for (const auto& cs : j.at("cases")) {
+      const std::string name = cs.at("name");
+      ASSERT_TRUE(rows.count(name)) << name;
+      const double expected = rows[name].at(tuned ? "tuned_error" : "untuned_error").get<double>();
+      EXPECT_NEAR(cs.at("displacement_error").get<double>(), expected, 1e-6 * expected) << name;
+    }
+  }
+}
+
+TEST(CalibrateCli, MssWithParamsUsesTheTunedConstants) {
+  const Calibrated& c = calibrated(false);
+  const CliRun tuned = run_spinesim("mss --mesh " + in_quotes(disc()) + " --params " + in_quotes(c.path) +
+                                    " --case compression --json");
+  ASSERT_EQ(tuned.status, 0) << tuned.err;
+  EXPECT_TRUE(tuned.err.empty()) << tuned.err;
+  const json t = json::parse(tuned.out);
+  EXPECT_EQ(t.at("mss_constants"), "tuned (" + c.path + ")");
+  EXPECT_EQ(t.at("params"), c.path);
+  EXPECT_TRUE(t.at("converged").get<bool>());
+  EXPECT_EQ(t.at("material"), "real-disc");  // the file's material, not given on the command line
+  // The file's terms, not the command line's defaults: the volume term is on.
+  EXPECT_TRUE(t.at("options").at("volume_term").get<bool>());
+  EXPECT_GT(t.at("springs").at("volume_terms").get<int>(), 0);
+
+  const CliRun untuned = run_spinesim("mss --mesh " + in_quotes(disc()) + " --case compression --json");
+  ASSERT_EQ(untuned.status, 0) << untuned.err;
+  const json u = json::parse(untuned.out);
+  EXPECT_EQ(u.at("mss_constants"), "untuned Van Gelder");
+  // Same wrench, other stiffness: the plate settles elsewhere.
+  const double dy_tuned = t["plate_motion"][1].get<double>(), dy_untuned = u["plate_motion"][1].get<double>();
+  EXPECT_LT(dy_tuned, 0.0);
+  EXPECT_LT(dy_untuned, 0.0);
+  EXPECT_GT(std::abs(dy_tuned - dy_untuned), 1e-3 * std::abs(dy_untuned));
+}
+
+// A file calibrated with a material JSON file loads without that file: the constants it was
+// fitted with are in it.
+TEST(CalibrateCli, ParamsFittedWithAMaterialFileLoadWithoutIt) {
+  const std::string material = tmp("my-disc.json");
+  std::ofstream(material) << R"({"name": "my-disc", "E_mpa": 5.0, "nu": 0.42, "density_kg_m3": 1100})";
+  const std::string out = tmp("tuned-my-disc.json");
+  const CliRun cal = run_spinesim("calibrate --mesh " + in_quotes(disc()) + " --material " + in_quotes(material) +
+                                  " --no-check --out " + in_quotes(out));
+  ASSERT_EQ(cal.status, 0) << cal.err;
+  const CliRun r = run_spinesim("mss --mesh " + in_quotes(disc()) + " --params " + in_quotes(out) + " --case torsion --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(json::parse(r.out).at("material"), "my-disc");
+  // ... and still refuses the default material when it is asked for.
+  expect_refused(run_spinesim("mss --mesh " + in_quotes(disc()) + " --params " + in_quotes(out) +
+                              " --material real-disc --case torsion"),
+                 "my-disc");
+}
+
+// --- calibrate refuses, and writes nothing ------------------------------------------------------
+
+TEST(CalibrateCliRefuses, IpoptNotConverging) {
+  const std::string out = tmp("tuned-1-iteration.json");
+  const CliRun r = run_spinesim("calibrate --mesh " + in_quotes(disc()) + " --max-iterations 1 --no-check --out " + in_quotes(out));
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_EQ(count_lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("Ipopt did not converge"), std::string::npos) << r.err;
+  EXPECT_NE(r.out.find("Maximum_Iterations_Exceeded"), std::string::npos) << r.out;  // the summary says why
+  EXPECT_FALSE(fs::exists(out));
+
+  // With --json the object on stdout says so too, and names no output file.
+  const CliRun j = run_spinesim("calibrate --mesh " + in_quotes(disc()) + " --max-iterations 1 --no-check --json --out " +
+                                in_quotes(out));
+  EXPECT_EQ(j.status, 1);
+  EXPECT_EQ(count_lines(j.err), 1) << j.err;
+  const json printed = json::parse(j.out);
+  EXPECT_FALSE(printed["report"]["ipopt"]["success"].get<bool>());
+  EXPECT_FALSE(printed.contains("out"));
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST(CalibrateCliRefuses, BadOptions) {
+  const std::string out = tmp("tuned-refused.json");
+  const std::string mesh = " --mesh " + in_quotes(disc());
+  const std::string to = " --out " + in_quotes(out);
+  expect_refused_without(run_spinesim("calibrate" + mesh + " --lower-scale 2 --upper-scale 0.5" + to), "bounds", out);
+  expect_refused_without(run_spinesim("calibrate" + mesh + " --lower-scale 0" + to), "scale", out);
+  expect_refused(run_spinesim("calibrate" + mesh), "--out");
+  expect_refused_without(run_spinesim("calibrate" + mesh + " --level L4-L5" + to), "--mesh and --level", out);
+  expect_refused_without(run_spinesim("calibrate" + to), "--mesh and --level", out);
+  expect_refused_without(run_spinesim("calibrate" + mesh + " --terms springs" + to), "--terms", out);
+  expect_refused_without(run_spinesim("calibrate" + mesh + " --train compression,torsion --holdout torsion" + to),
+                         "torsion", out);
+  expect_refused_without(run_spinesim("calibrate" + mesh + " --train compression,twist" + to), "twist", out);
+  expect_refused_without(run_spinesim("calibrate" + mesh + " --order 3" + to), "--order", out);
+  expect_refused_without(run_spinesim("calibrate" + mesh + " --material unobtainium" + to), "unobtainium", out);
+  expect_refused_without(run_spinesim("calibrate --mesh " + in_quotes(tmp("no-such-disc.vtu")) + to), "no-such-disc", out);
+  expect_refused(run_spinesim("calibrate" + mesh + " --out " + in_quotes(tmp("no-such-folder") + "/t.json")),
+                 "no-such-folder");
+}
+
+// A case both trained and held out is refused before any mesh is read or meshed (--level all
+// meshes 17 discs): here the mesh does not even exist, and the overlap is what is reported.
+TEST(CalibrateCliRefuses, OverlappingCasesBeforeTheMesh) {
+  const std::string out = tmp("tuned-overlap.json");
+  const CliRun r = run_spinesim("calibrate --mesh " + in_quotes(tmp("not-a-disc.vtu")) +
+                                " --train compression,torsion --holdout torsion --out " + in_quotes(out));
+  expect_refused_without(r, "both trained on and held out", out);
+}
+
+TEST(CalibrateCliRefuses, OutputOverTheInputMesh) {
+  const std::string mesh = tmp("disc-copy.vtu");
+  fs::copy_file(disc(), mesh);
+  const std::string before = slurp(mesh);
+  expect_refused(run_spinesim("calibrate --mesh " + in_quotes(mesh) + " --no-check --out " + in_quotes(mesh)), "input mesh");
+  EXPECT_EQ(slurp(mesh), before);
+}
+
+// --- mss / mss compare refuse a tuned file that does not fit ------------------------------------
+
+TEST(MssParamsRefuses, AnotherMaterial) {
+  const std::string params = calibrated(false).path;
+  expect_refused(run_spinesim("mss --mesh " + in_quotes(disc()) + " --params " + in_quotes(params) +
+                              " --material rubber --case compression"),
+                 "rubber");
+  expect_refused(run_spinesim("mss compare --mesh " + in_quotes(disc()) + " --params " + in_quotes(params) +
+                              " --material rubber --cases compression"),
+                 "rubber");
+}
+
+TEST(MssParamsRefuses, AMeshOfAnotherLevel) {
+  const std::string params = calibrated(false).path;
+  const CliRun r = run_spinesim("mss compare --mesh " + in_quotes(disc("L3-L4")) + " --params " + in_quotes(params) +
+                                " --cases compression");
+  expect_refused(r, "L3-L4");
+  EXPECT_NE(r.err.find("L4-L5"), std::string::npos) << r.err;
+  expect_refused(run_spinesim("mss --mesh " + in_quotes(disc("L3-L4")) + " --params " + in_quotes(params) + " --case torsion"),
+                 "L4-L5");
+}
+
+TEST(MssParamsRefuses, ACorruptOrMissingFile) {
+  const std::string good = slurp(calibrated(false).path);
+  const std::string truncated = tmp("truncated-tuned.json");
+  std::ofstream(truncated) << good.substr(0, good.size() / 2);
+  expect_refused(run_spinesim("mss --mesh " + in_quotes(disc()) + " --params " + in_quotes(truncated) + " --case compression"),
+                 "truncated-tuned.json");
+  json j = json::parse(good);
+  j["scales"]["torsion.nucleus"] = -1.0;
+  const std::string negative = tmp("negative-tuned.json");
+  std::ofstream(negative) << j.dump();
+  expect_refused(run_spinesim("mss compare --mesh " + in_quotes(disc()) + " --params " + in_quotes(negative)),
+                 "torsion.nucleus");
+  expect_refused(run_spinesim("mss --mesh " + in_quotes(disc()) + " --params " + in_quotes(disc()) + " --case compression"),
+                 "not valid JSON");  // a mesh given as params
+  expect_refused(run_spinesim("mss --mesh " + in_quotes(disc()) + " --params " + in_quotes(tmp("absent.json")) +
+                              " --case compression"),
+                 "absent.json");
+}
+
+TEST(MssParamsRefuses, TermFlagsBesideParams) {
+  const std::string params = " --params " + in_quotes(calibrated(false).path);
+  for (const char* flag : {"--volume-term", "--disc-volume-term", "--no-radial", "--no-torsion", "--volume-factor 3",
+                           "--disc-volume-factor 2"}) {
+    SCOPED_TRACE(flag);
+    expect_refused(run_spinesim("mss --mesh " + in_quotes(disc()) + params + " " + flag + " --case compression"),
+                   "--params");
+    expect_refused(run_spinesim("mss compare --mesh " + in_quotes(disc()) + params + " " + flag), "--params");
+  }
+}
