@@ -4,12 +4,14 @@
 //
 // Steps: 1. mesh the L4-L5 disc between its vertebrae (thesis tables F.1/F.2 placement);
 // 2. FEM reference (real-disc material): the 6x6 disc stiffness and the eight named load
-// cases; 3. the same disc in the other material presets; 4. the mass-spring disc with the
-// untuned Van Gelder constants against that FEM (mss_report.hpp protocol); 5. write VTU
-// results, report.md and summary.json into --out. (The calibration and the spine join the
-// demo as they are built.)
+// cases; 3. the material study (materials_study.hpp, thesis fig. 5.9): per material preset the
+// FEM, the untuned and the calibrated mass-spring disc under 500 N compression; 4. the
+// mass-spring disc with the untuned Van Gelder constants against that FEM on all eight cases
+// (mss_report.hpp protocol); 5. write VTU results, report.md and summary.json into --out.
+// (The spine joins the demo as it is built.)
 #include "cli_common.hpp"
 #include "fem_report.hpp"
+#include "materials_study.hpp"
 #include "mesh_report.hpp"
 #include "mss_report.hpp"
 
@@ -26,8 +28,10 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <iterator>
 #include <memory>
 #include <sstream>
+#include <vector>
 
 namespace spinesim::cli {
 namespace {
@@ -50,7 +54,8 @@ fem::Matrix6d to_disc_frame(const fem::Matrix6d& k, const mesh::DiscFrame& f) {
 void run_demo(const DemoArgs& a) {
   namespace fs = std::filesystem;
   fs::create_directories(a.out);
-  Progress progress(5, a.quiet || a.json);
+  static const char* kPresets[] = {"real-disc", "annulus-nucleus", "rubber", "polyethylene"};
+  Progress progress(4 + kStagesPerMaterial * int(std::size(kPresets)), a.quiet || a.json);
 
   // 1. Mesh.
   const auto dims = mesh::disc_dimensions(a.level, data_dir());
@@ -101,25 +106,25 @@ void run_demo(const DemoArgs& a) {
   mesh::write_vtu(result_path, m, fields);
   progress.end(std::to_string(fields.size()) + " cases");
 
-  // 3. Material presets: axial stiffness and the displacement under 500 N compression.
-  progress.begin("material presets");
-  std::ostringstream material_table;
-  material_table << "| material | E (MPa) | nu | axial stiffness (N/mm) | compression under 500 N (mm) |\n"
-                 << "|---|---|---|---|---|\n";
-  nlohmann::json materials = nlohmann::json::array();
-  for (const char* name : {"real-disc", "annulus-nucleus", "rubber", "polyethylene"}) {
+  // 3. Material study: FEM, untuned and calibrated MSS per preset, on the same mesh.
+  MaterialsStudyOptions study_options;
+  study_options.fem_order = a.order;
+  StageHooks hooks;
+  hooks.begin = [&](const std::string& what) { progress.begin(what); };
+  hooks.end = [&](const std::string& detail) { progress.end(detail); };
+  const auto t_study = std::chrono::steady_clock::now();
+  std::vector<MaterialResult> study;
+  std::ostringstream constants_table;
+  constants_table << "| material | constants | density (kg/m³) |\n|---|---|---|\n";
+  for (const char* name : kPresets) {
     const auto mat = mesh::load_material(name, data_dir());
-    const fem::DiscFem s(m, mat, a.order, fem::DiscFem::default_plate_center(m));
-    const fem::Matrix6d kl = to_disc_frame(s.stiffness_6x6(), m.frame);
-    const auto sol = s.solve_wrench(fem::global_wrench(fem::load_case("compression"), m.frame));
-    const double dy = -(m.frame.axes.transpose() * sol.plate_motion.head<3>())(1);
-    const auto& e = mat.at(int(mesh::Region::annulus));
-    materials.push_back({{"name", mat.name}, {"axial_stiffness_n_per_mm", kl(1, 1)}, {"compression_500n_mm", dy}});
-    material_table << std::setprecision(4) << "| " << mat.name << " | " << e.youngs_modulus_mpa
-                   << (mat.by_region.empty() ? "" : " (annulus)") << " | " << e.poisson_ratio << " | " << kl(1, 1)
-                   << " | " << dy << " |\n";
+    constants_table << "| " << mat.name << " | " << describe_material(mat) << " | "
+                    << mat.at(int(mesh::Region::annulus)).density_kg_m3 << " |\n";
+    study.push_back(study_material(m, mat, study_options, hooks));
   }
-  progress.end();
+  const double study_s = seconds_since(t_study);
+  std::ostringstream material_table;
+  print_materials(material_table, study, a.order, true);
 
   // 4. Mass-spring disc (untuned Van Gelder constants) vs the FEM above: the baseline.
   progress.begin("MSS vs FEM, " + std::to_string(fem::standard_load_cases().size()) + " load cases");
@@ -143,7 +148,16 @@ void run_demo(const DemoArgs& a) {
          << " s.\n\n### 6x6 disc stiffness in the disc frame (x lateral, y axial, z anterior)\n\n```\n";
   print_stiffness(report, k_local);
   report << "```\n\n### Load cases (wrench on the superior plate, disc frame)\n\n" << case_table.str()
-         << "\n## Material presets (same mesh, P" << a.order << ")\n\n" << material_table.str()
+         << "\n## Material comparison (thesis fig. 5.9): FEM, untuned and tuned MSS\n\n"
+         << "The same mesh (cell size " << opt.cell_size_mm << " mm) in each material preset, side by side: the FEM P"
+         << a.order << "\n(linear); the thesis's mass-spring disc with untuned Van Gelder constants; and the mass-spring\n"
+         << "disc calibrated to that material's FEM (" << term_set_name(study_options.terms)
+         << " stiffness scales per region; Ipopt on compression,\nshear-ap, flexion and torsion). "
+         << "The thesis's fig. 5.9 load, 500 N compression on the superior plate, is\nsolved statically "
+         << "(the MSS nonlinear); stiffnesses are linear at rest. Disc frame: x lateral, y axial,\n"
+         << "z anterior. `spinesim study materials --help` gives the protocol. " << std::setprecision(3) << study_s
+         << " s.\n\n"
+         << constants_table.str() << "\n" << material_table.str()
          << "\n## MSS vs FEM (untuned Van Gelder baseline)\n\n"
          << "The thesis's mass-spring disc (main, radial and torsional springs, real-disc constants) on the same\n"
          << "mesh, static, against the FEM above (`spinesim mss compare --help` gives the protocol): displacement\n"
@@ -164,7 +178,8 @@ void run_demo(const DemoArgs& a) {
                       {"stiffness_6x6_disc_frame", to_json(Eigen::MatrixXd(stiffness_per_degree(k_local)))},
                       {"stiffness_6x6_units", kStiffnessUnits},
                       {"cases", cases},
-                      {"materials", materials},
+                      {"materials", materials_json(study)},
+                      {"materials_seconds", study_s},
                       {"mss_vs_fem", comparison_json(mss_vs_fem)},
                       {"report", report_path},
                       {"files", {mesh_path, result_path}}};

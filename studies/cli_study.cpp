@@ -2,6 +2,7 @@
 //
 //   spinesim study probe [--out study-out] [--radius 3] [--depth 2] [--speed 20] [--no-radial | --volume-term]
 //   spinesim study drive [--out study-out] [--materials real-disc,annulus-nucleus,rubber,polyethylene]
+//   spinesim study materials [--level L4-L5] [--cell-size 2] [--materials …] [--csv materials.csv]
 //
 // probe — thesis 5.3, test 1 (fig. 5.8): a rigid sphere pressed into the outer wall of a disc
 //   whose endplates are both fixed, held, withdrawn, then at a second site while the first
@@ -9,15 +10,19 @@
 // drive — thesis 5.3, test 2 (fig. 5.9): an L2-L3 disc, L3 (inferior) fixed, L2 (superior)
 //   driven by a motion schedule, once per material preset; the reaction shows how stiff each
 //   material is (the thesis: polyethylene stiffest, the real disc softest).
-// Both: implicit Euler, dt 1 ms (the thesis's 1 kHz), a VTU time series (.pvd, frames every
-// --frame-every steps), a CSV per run and a JSON summary in --out. A run whose step diverges
-// stops there: its files hold the finite states up to that step, "diverged": true is in the
-// JSON, and the program exits 1 after the other runs.
+// materials — thesis fig. 5.9 with a reference: per material preset, the linear FEM, the
+//   untuned thesis MSS and the MSS calibrated to that FEM, side by side (materials_study.hpp);
+//   tables on stdout, --csv, --json; no --out folder.
+// probe and drive: implicit Euler, dt 1 ms (the thesis's 1 kHz), a VTU time series (.pvd,
+// frames every --frame-every steps), a CSV per run and a JSON summary in --out. A run whose step
+// diverges stops there: its files hold the finite states up to that step, "diverged": true is
+// in the JSON, and the program exits 1 after the other runs.
 //
 // Adding a study: write its Args struct (with a StudyCommon), run_<name>() and a register
 // function below, and add one line to register_study() at the end of this file.
 #include "cli_common.hpp"
 #include "fem_report.hpp"
+#include "materials_study.hpp"
 #include "mss_report.hpp"
 
 #include "spinesim/fem/disc_fem.hpp"
@@ -29,8 +34,11 @@
 #include "spinesim/mss/model.hpp"
 #include "spinesim/mss/solver.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <iomanip>
@@ -544,6 +552,97 @@ void run_drive(DriveArgs a) {
   if (!diverged.empty()) throw std::runtime_error("drive study diverged for: " + diverged);
 }
 
+// --- study materials ---------------------------------------------------------------------------
+
+struct MaterialsArgs {
+  std::string level = "L4-L5", materials = "real-disc,annulus-nucleus,rubber,polyethylene", csv,
+              terms = "thesis+volume";
+  double cell_size_mm = mesh::MeshOptions().cell_size_mm;
+  bool json = false, quiet = false;
+};
+
+/// Throws std::invalid_argument unless `path` can be created (its folder exists and is writable).
+void require_writable(const std::string& path, const std::string& option) {
+  require_output_folder(path, option);
+  const fs::path dir = fs::path(path).parent_path().empty() ? fs::path(".") : fs::path(path).parent_path();
+  if (::access(dir.c_str(), W_OK) != 0)
+    throw std::invalid_argument(option + " " + path + ": folder " + dir.string() + " is not writable");
+}
+
+void run_materials(const MaterialsArgs& a) {
+  // 1. Options, checked before any work (nothing is written on bad input).
+  if (!std::isfinite(a.cell_size_mm) || a.cell_size_mm <= 0)
+    throw std::invalid_argument("--cell-size must be a finite number > 0 mm");
+  mesh::disc_dimensions(a.level, data_dir());  // throws for an unknown level
+  MaterialsStudyOptions options;
+  options.terms = parse_term_set(a.terms);
+  std::vector<mesh::RegionMaterials> materials;
+  for (const auto& name : split_list(a.materials)) materials.push_back(mesh::load_material(name, data_dir()));
+  if (materials.empty()) throw std::invalid_argument("--materials: give at least one material");
+  if (!a.csv.empty()) require_writable(a.csv, "--csv");
+  const auto t_start = std::chrono::steady_clock::now();
+
+  // 2. One mesh for every material.
+  Progress progress(1 + kStagesPerMaterial * int(materials.size()), a.quiet || a.json);
+  StudyCommon c;
+  c.level = a.level;
+  c.cell_size_mm = a.cell_size_mm;
+  const mesh::TetMesh m = study_mesh(c, progress);
+  if (!a.json) {
+    std::cout << "Material study (thesis fig. 5.9) on " << m.source << ": " << m.num_vertices() << " nodes, "
+              << m.num_tets() << " tets, cell size " << a.cell_size_mm << " mm\n"
+              << "  load: compression, F_y = -500 N on the superior plate (disc frame), inferior endplate fixed\n"
+              << "  FEM P" << options.fem_order << ", linear | untuned MSS: thesis network, Van Gelder constants"
+              << " | tuned MSS: " << term_set_name(options.terms)
+              << " scales calibrated to the FEM | MSS: nonlinear static\n";
+    for (const auto& mat : materials) std::cout << "  " << mat.name << ": " << describe_material(mat) << "\n";
+    std::cout << "\n";
+  }
+
+  // 3. Per material: FEM, calibration, untuned and tuned MSS.
+  StageHooks hooks;
+  hooks.begin = [&](const std::string& what) { progress.begin(what); };
+  hooks.end = [&](const std::string& detail) { progress.end(detail); };
+  std::vector<MaterialResult> results;
+  for (const auto& mat : materials) results.push_back(study_material(m, mat, options, hooks));
+
+  // 4. Tables, CSV, summary.
+  if (!a.csv.empty()) write_text_file(a.csv, materials_csv(results));
+  std::string failed;
+  for (const auto& r : results)
+    if (!r.calibrated) failed += (failed.empty() ? "" : ", ") + r.material;
+  const fem::Vector6d w = fem::load_case("compression").wrench_local;
+  const nlohmann::json j = {
+      {"study", "materials"},
+      {"thesis", "5.3 test 2, fig. 5.9"},
+      {"level", a.level},
+      {"cell_size_mm", a.cell_size_mm},
+      {"mesh", mesh_json(m)},
+      {"fem_order", options.fem_order},
+      {"untuned", "thesis network (main + radial + torsion springs), Van Gelder constants, scales 1"},
+      {"tuned_terms", term_set_name(options.terms)},
+      {"load", {{"case", "compression"}, {"wrench_local", to_json(Eigen::VectorXd(w))}}},
+      {"units",
+       {{"frame", "disc (x lateral, y axial, z anterior)"},
+        {"wrench_local", "Fx,Fy,Fz [N], Mx,My,Mz [N·mm]"},
+        {"stiffness_diagonal", "tx,ty,tz [N/mm], rx,ry,rz [N·mm/deg], linear at rest"},
+        {"plate_axial_displacement_mm", "superior plate u_y under the load, mm, negative towards the inferior endplate"},
+        {"max_displacement_mm", "largest vertex displacement under the load, mm"},
+        {"volume_change", "(V - V0)/V0 under the load; FEM: P1 volume of the mesh with displaced vertices"},
+        {"displacement_error", "|u_MSS - u_FEM|_F / |u_FEM|_F over the vertices, under the load"}}},
+      {"materials", materials_json(results)},
+      {"csv", a.csv.empty() ? nlohmann::json(nullptr) : nlohmann::json(a.csv)},
+      {"seconds", seconds_since(t_start)}};
+  if (a.json) {
+    print_json(j);
+  } else {
+    print_materials(std::cout, results, options.fem_order, false);
+    std::cout << "Total " << std::setprecision(3) << seconds_since(t_start) << " s"
+              << (a.csv.empty() ? "" : "; wrote " + a.csv) << "\n";
+  }
+  if (!failed.empty()) throw std::runtime_error("calibration failed for: " + failed);
+}
+
 // --- registration ------------------------------------------------------------------------------
 
 void register_probe(CLI::App& study) {
@@ -580,13 +679,43 @@ void register_drive(CLI::App& study) {
   cmd->callback([a] { run_drive(*a); });
 }
 
+void register_materials(CLI::App& study) {
+  auto a = std::make_shared<MaterialsArgs>();
+  auto* cmd = study.add_subcommand(
+      "materials", "Thesis fig. 5.9 with a reference: per material, FEM vs untuned vs tuned MSS under the same load");
+  cmd->add_option("--level", a->level, "Disc level, meshed in-process")->capture_default_str();
+  cmd->add_option("--cell-size", a->cell_size_mm, "Mesh cell size, mm")->capture_default_str();
+  cmd->add_option("--materials", a->materials, "Comma-separated presets or JSON files")->capture_default_str();
+  cmd->add_option("--terms", a->terms, "What the calibration tunes: thesis, thesis+volume, all")->capture_default_str();
+  cmd->add_option("--csv", a->csv, "Write a CSV, one row per material x model (fem, untuned, tuned)");
+  cmd->add_flag("--json", a->json, "Print the JSON summary on stdout (instead of the tables)");
+  cmd->add_flag("--quiet", a->quiet, "No progress on stderr");
+  cmd->footer(
+      "Protocol: one mesh of --level for every material; inferior endplate fixed, superior endplate a rigid\n"
+      "plate about the mean of its vertices. Per material:\n"
+      "  1. FEM P2, linear: the 6x6 plate stiffness and the compression case (F_y = -500 N in the disc\n"
+      "     frame, the thesis's fig. 5.9 load);\n"
+      "  2. Ipopt calibrates the MSS stiffness scales (--terms, per region) to that FEM on compression,\n"
+      "     shear-ap, flexion and torsion, linearised (as `spinesim calibrate --no-check`);\n"
+      "  3. the untuned MSS (thesis network: main + radial + torsion springs, Van Gelder constants) and\n"
+      "     the tuned MSS, nonlinear static under the same wrench.\n"
+      "Reported per model, disc frame (x lateral, y axial, z anterior): axial stiffness K6_yy (N/mm) and\n"
+      "the 6x6 diagonal (N/mm, N·mm/deg), linear at rest; under the compression: the superior plate's u_y\n"
+      "(mm), max |u| (mm), the volume change (MSS: signed tet volumes; FEM: the P1 volume of the mesh with\n"
+      "its vertices moved by the FEM displacement) and the nodal displacement error vs the FEM.\n"
+      "Output: tables on stdout (or --json), --csv FILE. Exit 1 if a calibration fails (tables still shown).");
+  cmd->callback([a] { run_materials(*a); });
+}
+
 }  // namespace
 
 void register_study(CLI::App& app) {
-  auto* study = app.add_subcommand("study", "The thesis's studies (5.3 functional tests), written as VTU series, CSV, JSON");
+
+  auto* study = app.add_subcommand("study", "The thesis's studies (5.3 functional tests, material comparison), as VTU series, CSV, JSON");
   study->require_subcommand(1);
   register_probe(*study);
   register_drive(*study);
+  register_materials(*study);
 }
 
 }  // namespace spinesim::cli
