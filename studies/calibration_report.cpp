@@ -86,6 +86,12 @@ CalibrationOutcome calibrate_disc(const mesh::TetMesh& m, const mesh::RegionMate
       if (h.name == t.name) throw std::invalid_argument("case '" + h.name + "' is both trained on and held out");
   calibration::validate(rq.ipopt);
   mesh::require_endplate_labels(m);
+  for (const auto& [label, other] : rq.transfer_meshes) {
+    mesh::require_endplate_labels(other);
+    const std::string a = calibration::disc_level(m), b = calibration::disc_level(other);
+    if (!a.empty() && !b.empty() && a != b)
+      throw std::invalid_argument("transfer mesh " + label + " is a " + b + " disc, the calibration mesh a " + a + " disc");
+  }
 
   CalibrationOutcome out;
   std::vector<fem::LoadCase> all = rq.train;
@@ -147,9 +153,24 @@ CalibrationOutcome calibrate_disc(const mesh::TetMesh& m, const mesh::RegionMate
     out.tuned_check = compare_mss_fem(fem, tuned, all, materials.name, mss::StaticOptions(), rq.check_load_scale);
     out.check_seconds = seconds_since(t0);
   }
+  // 6. The same scales on other meshes of the disc (region scales transfer; how well?).
+  if (out.result.success)
+    for (const auto& [label, other] : rq.transfer_meshes) {
+      say("transfer check on " + label + " (" + std::to_string(other.num_tets()) + " tets): FEM and MSS");
+      t0 = clock_type::now();
+      const fem::DiscFem other_fem(other, materials, rq.fem_order, fem::DiscFem::default_plate_center(other));
+      TransferCheck tc;
+      tc.label = label;
+      tc.untuned = compare_mss_fem(other_fem, mss::MssModel(other, materials, term_set_options(TermSet::thesis)), all,
+                                   materials.name, mss::StaticOptions(), rq.check_load_scale);
+      tc.tuned = compare_mss_fem(other_fem, mss::MssModel(other, materials, t.mss_options()), all, materials.name,
+                                 mss::StaticOptions(), rq.check_load_scale);
+      tc.seconds = seconds_since(t0);
+      out.transfer.push_back(std::move(tc));
+    }
   out.total_seconds = seconds_since(t_start);
 
-  // 6. Report.
+  // 7. Report.
   auto case_rows = [&](const std::vector<fem::LoadCase>& cases) {
     nlohmann::json rows = nlohmann::json::array();
     for (const auto& lc : cases) {
@@ -214,6 +235,26 @@ CalibrationOutcome calibrate_disc(const mesh::TetMesh& m, const mesh::RegionMate
        {{"reaction", rq.weights.reaction},
         {"stiffness", rq.weights.stiffness},
         {"regularisation", rq.weights.regularisation}}},
+      {"transfer",
+       [&] {
+         nlohmann::json rows = nlohmann::json::array();
+         for (const TransferCheck& tc : out.transfer) {
+           nlohmann::json cases = nlohmann::json::array();
+           for (std::size_t i = 0; i < tc.tuned.cases.size(); ++i)
+             cases.push_back({{"name", tc.tuned.cases[i].name},
+                              {"untuned_error", tc.untuned.cases[i].displacement_error},
+                              {"tuned_error", tc.tuned.cases[i].displacement_error}});
+           const Eigen::VectorXd f = diag(tc.tuned.k6_fem), u = diag(tc.untuned.k6_mss), k = diag(tc.tuned.k6_mss);
+           rows.push_back({{"mesh", tc.label},
+                           {"nodes", tc.tuned.nodes},
+                           {"tets", tc.tuned.tets},
+                           {"cases", cases},
+                           {"stiffness_ratio_untuned", to_json(Eigen::VectorXd(u.cwiseQuotient(f)))},
+                           {"stiffness_ratio_tuned", to_json(Eigen::VectorXd(k.cwiseQuotient(f)))},
+                           {"seconds", tc.seconds}});
+         }
+         return rows;
+       }()},
       {"ipopt",
        {{"status", out.result.status},
         {"success", out.result.success},
@@ -228,6 +269,7 @@ CalibrationOutcome calibrate_disc(const mesh::TetMesh& m, const mesh::RegionMate
         {"setup_s", out.setup_seconds},
         {"ipopt_s", out.result.seconds},
         {"nonlinear_check_s", out.check_seconds},
+        {"transfer_s", [&] { double x = 0; for (const auto& tc : out.transfer) x += tc.seconds; return x; }()},
         {"total_s", out.total_seconds}}}};
   return out;
 }
@@ -271,6 +313,17 @@ void print_calibration(std::ostream& os, const CalibrationOutcome& o, const Cali
        << std::setw(12) << kd["fem"][std::size_t(i)].get<double>() << std::fixed << std::setprecision(3)
        << std::setw(12) << kd["ratio_untuned"][std::size_t(i)].get<double>() << std::setw(12)
        << kd["ratio_tuned"][std::size_t(i)].get<double>() << "\n";
+  }
+  for (const auto& tr : rep["transfer"]) {
+    os << "\nSame scales on another mesh: " << tr["mesh"].get<std::string>() << " (" << tr["tets"] << " tets), vs the FEM there:\n\n"
+       << "  " << std::left << std::setw(18) << "case" << std::right << std::setw(24) << "untuned" << std::setw(24) << "tuned"
+       << "\n";
+    for (const auto& c : tr["cases"])
+      os << "  " << std::left << std::setw(18) << c["name"].get<std::string>() << std::right << std::setw(24)
+         << pct(c["untuned_error"].get<double>()) << std::setw(24) << pct(c["tuned_error"].get<double>()) << "\n";
+    os << "  6x6 diagonal MSS/FEM, tuned:";
+    for (const auto& r : tr["stiffness_ratio_tuned"]) os << " " << std::fixed << std::setprecision(3) << r.get<double>();
+    os << std::defaultfloat << "\n";
   }
   os << "\nTuned scales (x Van Gelder constants):";
   for (const auto& [name, s] : o.tuned.scales) os << "  " << name << " " << std::setprecision(3) << s;

@@ -39,6 +39,17 @@ struct CalibrationRequest {
   /// in displacement (measured on L4-L5, tuned: extension 11.3 % at x1, 6.1 % at x0.3, 5.6 % at
   /// x0.1 = the linearised error). 0.1 keeps every level within ~2 deg.
   double check_load_scale = 0.1;
+  /// Other meshes of the same disc on which the tuned region scales are also checked (the
+  /// "second mesh resolution" of the protocol): FEM on each, untuned and tuned MSS, same cases
+  /// and load scale. Labels name them in the report.
+  std::vector<std::pair<std::string, mesh::TetMesh>> transfer_meshes;
+};
+
+/// The tuned scales applied to another mesh of the disc, against the FEM on that mesh.
+struct TransferCheck {
+  std::string label;
+  MssFemComparison untuned, tuned;
+  double seconds = 0;
 };
 
 struct CalibrationOutcome {
@@ -47,6 +58,7 @@ struct CalibrationOutcome {
   calibration::Evaluation untuned_linear;  ///< thesis model, scales 1, linearised
   fem::Matrix6d k6_fem = fem::Matrix6d::Zero(), k6_untuned = fem::Matrix6d::Zero(), k6_tuned = fem::Matrix6d::Zero();
   MssFemComparison untuned_check, tuned_check;  ///< nonlinear, all cases (empty if not requested)
+  std::vector<TransferCheck> transfer;          ///< one per request.transfer_meshes
   double fem_seconds = 0, setup_seconds = 0, check_seconds = 0, total_seconds = 0;
 };
 

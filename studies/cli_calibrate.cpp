@@ -41,6 +41,8 @@ struct CalibrateArgs {
   int order = 2;
   calibration::Weights weights;
   calibration::IpoptSettings ipopt;
+  std::vector<std::string> transfer_meshes;
+  bool no_transfer = false;
   bool no_check = false, json = false, quiet = false;
 };
 
@@ -52,6 +54,17 @@ std::vector<fem::LoadCase> other_cases(const std::vector<fem::LoadCase>& train) 
     if (!used) out.push_back(c);
   }
   return out;
+}
+
+/// The protocol's second mesh resolution for a parametric disc: the same disc at 1.5x the cell
+/// size, labelled with it.
+std::pair<std::string, mesh::TetMesh> coarser_mesh(const mesh::DiscDimensions& dims, mesh::MeshOptions opt,
+                                                   const StatusLine& status) {
+  opt.cell_size_mm *= 1.5;
+  std::ostringstream label;
+  label << "parametric " << dims.level << ", cell size " << std::setprecision(3) << opt.cell_size_mm << " mm";
+  status("meshing the second resolution: " + label.str());
+  return {label.str(), mesh::mesh_parametric_disc(dims, opt, mesh::disc_frame_in_spine(dims.level, data_dir()))};
 }
 
 double worst(const nlohmann::json& rows, const char* key) {
@@ -93,7 +106,9 @@ void run_all_levels(const CalibrateArgs& a, const CalibrationRequest& rq, const 
     cell_by_level[level] = opt.cell_size_mm;
     status("== " + level + ": meshing (cell size " + std::to_string(opt.cell_size_mm).substr(0, 4) + " mm)");
     const mesh::TetMesh m = mesh::mesh_parametric_disc(dims, opt, mesh::disc_frame_in_spine(level, data_dir()));
-    const CalibrationOutcome o = calibrate_disc(m, materials, rq, status);
+    CalibrationRequest level_rq = rq;
+    if (!a.no_transfer) level_rq.transfer_meshes.push_back(coarser_mesh(dims, opt, status));
+    const CalibrationOutcome o = calibrate_disc(m, materials, level_rq, status);
     if (!o.result.success) {
       failed.push_back(level + " (" + o.result.status + ")");
       continue;
@@ -142,6 +157,8 @@ void run_calibrate(const CalibrateArgs& a) {
   if (a.mesh_path.empty() == a.level.empty()) throw std::invalid_argument("give exactly one of --mesh and --level");
   if (a.order != 1 && a.order != 2) throw std::invalid_argument("--order must be 1 or 2");
   if (!(a.cell_size_mm > 0)) throw std::invalid_argument("--cell-size must be > 0 mm");
+  if (a.level == "all" && !a.transfer_meshes.empty())
+    throw std::invalid_argument("--transfer-mesh is one disc's: with --level all each level is checked at 1.5x its cell size");
   require_output_folder(a.out, "--out");
   if (!a.mesh_path.empty() && std::filesystem::exists(a.out) && std::filesystem::exists(a.mesh_path) &&
       std::filesystem::equivalent(a.out, a.mesh_path))
@@ -170,7 +187,11 @@ void run_calibrate(const CalibrateArgs& a) {
   };
   if (a.level == "all") return run_all_levels(a, rq, materials, status);
 
-  // 2. The mesh: read, or the level's parametric disc.
+  // 2. The mesh: read, or the level's parametric disc; and the transfer meshes.
+  for (const std::string& path : a.transfer_meshes) {
+    status("reading transfer mesh " + path);
+    rq.transfer_meshes.emplace_back(path, mesh::read_vtu(path));
+  }
   mesh::TetMesh m;
   if (!a.mesh_path.empty()) {
     status("reading " + a.mesh_path);
@@ -179,8 +200,9 @@ void run_calibrate(const CalibrateArgs& a) {
     mesh::MeshOptions opt;
     opt.cell_size_mm = a.cell_size_mm;
     status("meshing " + a.level + " (cell size " + std::to_string(a.cell_size_mm).substr(0, 4) + " mm)");
-    m = mesh::mesh_parametric_disc(mesh::disc_dimensions(a.level, data_dir()), opt,
-                                   mesh::disc_frame_in_spine(a.level, data_dir()));  // as `mesh disc --level`
+    const mesh::DiscDimensions dims = mesh::disc_dimensions(a.level, data_dir());
+    m = mesh::mesh_parametric_disc(dims, opt, mesh::disc_frame_in_spine(a.level, data_dir()));  // as `mesh disc --level`
+    if (!a.no_transfer && a.transfer_meshes.empty()) rq.transfer_meshes.push_back(coarser_mesh(dims, opt, status));
   }
 
   // 3. Calibrate, report, write only a successful result.
@@ -233,6 +255,10 @@ void register_calibrate(CLI::App& app) {
   cmd->add_option("--check-load-scale", a->check_load_scale,
                   "Nonlinear check at the case loads x this factor (linear regime; 1 = the standard 7.5 N·m / 500 N loads)")
       ->capture_default_str();
+  cmd->add_option("--transfer-mesh", a->transfer_meshes,
+                  "Also check the tuned scales on this mesh of the same disc (repeatable; with --level the default is "
+                  "the same disc at 1.5x the cell size)");
+  cmd->add_flag("--no-transfer", a->no_transfer, "With --level: skip the second-resolution check");
   cmd->add_flag("--no-check", a->no_check, "Skip the nonlinear MSS-vs-FEM check (errors then linearised only)");
   cmd->add_option("--out", a->out, "Tuned parameter file to write (JSON); required");
   cmd->add_flag("--json", a->json, "Print the tuned file's contents as JSON on stdout");
