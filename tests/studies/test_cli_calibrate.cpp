@@ -4,6 +4,7 @@
 // (360 tets) made once per process, so each calibration takes a fraction of a second.
 #include "cli_runner.hpp"
 
+#include <algorithm>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -324,3 +325,44 @@ TEST(MssParamsRefuses, TermFlagsBesideParams) {
     expect_refused(run_spinesim("mss compare --mesh " + in_quotes(disc()) + params + " " + flag), "--params");
   }
 }
+
+namespace spinesim::cli {
+namespace {
+
+// The protocol's second mesh: the tuned scales checked on another mesh of the same disc, the
+// untuned network beside them (the structured disc calibrated, a 4 mm CGAL disc checked).
+TEST(CalibrateCli, TransferMeshIsCheckedUntunedBesideTuned) {
+  const std::string other = tmp("disc-L4-L5-4mm.vtu");
+  ASSERT_EQ(run_spinesim("mesh disc --level L4-L5 --cell-size 4 --out " + in_quotes(other)).status, 0);
+  const std::string out = tmp("tuned-transfer.json");
+  const CliRun r = run_spinesim("calibrate --mesh " + in_quotes(disc()) + " --transfer-mesh " + in_quotes(other) +
+                                " --out " + in_quotes(out) + " --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const json j = json::parse(r.out);
+  ASSERT_EQ(j["report"]["transfer"].size(), 1u);
+  const json& t = j["report"]["transfer"][0];
+  EXPECT_EQ(t["mesh"], other);
+  EXPECT_GT(t["tets"].get<int>(), 360);  // another mesh than the calibrated one
+  std::vector<std::string> names = case_names(t["cases"]), all = kAllCases;
+  std::sort(names.begin(), names.end());
+  std::sort(all.begin(), all.end());
+  EXPECT_EQ(names, all);
+  double untuned = 0, tuned = 0;
+  for (const auto& c : t["cases"]) {
+    EXPECT_GT(c["tuned_error"].get<double>(), 0.0);
+    untuned += c["untuned_error"].get<double>();
+    tuned += c["tuned_error"].get<double>();
+  }
+  EXPECT_LT(tuned, untuned);  // the scales carry over: better than Van Gelder on average
+  EXPECT_EQ(t["stiffness_ratio_tuned"].size(), 6u);
+}
+
+TEST(CalibrateCliRefuses, ATransferMeshOfAnotherLevel) {
+  const std::string out = tmp("tuned-transfer-bad.json");
+  expect_refused_without(run_spinesim("calibrate --mesh " + in_quotes(disc()) + " --transfer-mesh " +
+                                      in_quotes(disc("L3-L4")) + " --out " + in_quotes(out)),
+                         "L3-L4", out);
+}
+
+}  // namespace
+}  // namespace spinesim::cli
