@@ -3,7 +3,8 @@
 //   spinesim mesh disc --level L4-L5 --out disc.vtu
 //   spinesim fem --mesh disc.vtu --material real-disc --motion 0,-0.1,0,0,0,0
 //   spinesim mss --mesh disc.vtu --case compression; spinesim mss compare --mesh disc.vtu
-//   spinesim study probe; spinesim study drive
+//   spinesim calibrate --mesh disc.vtu --out tuned.json; spinesim mss --mesh disc.vtu --params tuned.json
+//   spinesim study probe; spinesim study drive; spinesim study materials
 //   spinesim demo --out demo-out
 //
 // Every verb has --help and --json (one JSON object on stdout). Bad input, a malformed command
