@@ -27,7 +27,8 @@ struct EdgeSpring {
   int i, j;
   double rest_mm;
   double k_part[2];  ///< annulus / nucleus parts of k, N/mm (unscaled)
-  double k;          ///< scaled total, N/mm
+  double mu;         ///< per-spring multiplier (MssOptions::edge_multipliers)
+  double k;          ///< scaled total mu (s_a k_part[0] + s_n k_part[1]), N/mm
 };
 
 /// The three angle springs of one face (one per corner), which share one k_t.
@@ -50,6 +51,14 @@ struct TetTerm {
 
 void require(bool ok, const std::string& message) {
   if (!ok) throw std::invalid_argument(message);
+}
+
+/// The per-spring multipliers: none, or one finite positive value per edge spring.
+void validate_edge_multipliers(const std::vector<double>& mu, std::size_t num_edges) {
+  require(mu.empty() || mu.size() == num_edges,
+          "mss: " + std::to_string(mu.size()) + " edge multipliers for " + std::to_string(num_edges) +
+              " edge springs (per-spring multipliers belong to the mesh they were made for)");
+  for (double v : mu) require(std::isfinite(v) && v > 0.0, "mss: edge multipliers must be finite and > 0");
 }
 
 void validate_options(const MssOptions& o) {
@@ -77,10 +86,11 @@ void check_size(const Eigen::VectorXd& x, Eigen::Index n) {
                                 " entries, expected 3 x " + std::to_string(n));
 }
 
-/// Stiffness selector: the scaled total, or one region's unscaled part (dE/d scale).
+/// Stiffness selector: the scaled total, or one region's unscaled part (dE/d scale; an edge
+/// spring's part keeps its multiplier).
 struct KSelect {
   int region = -1;  ///< -1: scaled total
-  double edge(const EdgeSpring& e) const { return region < 0 ? e.k : e.k_part[region]; }
+  double edge(const EdgeSpring& e) const { return region < 0 ? e.k : e.mu * e.k_part[region]; }
   double angle(const AngleFace& a) const { return region < 0 ? a.k : a.k_part[region]; }
   double tet(const TetTerm& t) const {
     return region < 0 ? t.k : (t.region == region ? t.k_unscaled : 0.0);
@@ -165,7 +175,7 @@ void MssModel::Impl::build(const mesh::RegionMaterials& materials) {
       }
     std::sort(pairs.begin(), pairs.end());
     for (std::size_t s = 0; s < pairs.size();) {
-      EdgeSpring sp{pairs[s].first.first, pairs[s].first.second, 0.0, {0.0, 0.0}, 0.0};
+      EdgeSpring sp{pairs[s].first.first, pairs[s].first.second, 0.0, {0.0, 0.0}, 1.0, 0.0};
       sp.rest_mm = (X.segment<3>(3 * sp.j) - X.segment<3>(3 * sp.i)).norm();
       for (; s < pairs.size() && pairs[s].first == std::make_pair(sp.i, sp.j); ++s) {
         int t = pairs[s].second;
@@ -175,6 +185,8 @@ void MssModel::Impl::build(const mesh::RegionMaterials& materials) {
       edges.push_back(sp);
     }
   }
+
+  validate_edge_multipliers(options.edge_multipliers, edges.size());
 
   // 3. Equivalent cylinder (5.6)-(5.7): endplate diameters from their areas projected on the
   //    disc axis (equal-area circles), V the mesh volume.
@@ -304,8 +316,12 @@ void MssModel::Impl::build(const mesh::RegionMaterials& materials) {
 void MssModel::Impl::apply_scales() {
   const auto& s = options.scales;
   auto scale = [&](Term term, int r) { return s[static_cast<int>(term)].by_region[r]; };
-  for (auto& e : edges)
-    e.k = scale(Term::main, 0) * e.k_part[0] + scale(Term::main, 1) * e.k_part[1];
+  const std::vector<double>& mu = options.edge_multipliers;
+  for (std::size_t i = 0; i < edges.size(); ++i) {
+    EdgeSpring& e = edges[i];
+    e.mu = mu.empty() ? 1.0 : mu[i];
+    e.k = e.mu * (scale(Term::main, 0) * e.k_part[0] + scale(Term::main, 1) * e.k_part[1]);
+  }
   for (auto& a : faces)
     a.k = scale(Term::torsion, 0) * a.k_part[0] + scale(Term::torsion, 1) * a.k_part[1];
   for (auto& t : radial) t.k = scale(Term::radial, t.region) * t.k_unscaled;
@@ -341,6 +357,20 @@ double MssModel::total_mass_t() const { return impl_->mass_t.sum(); }
 double MssModel::damping_n_s_per_mm() const { return impl_->damping; }
 const EquivalentCylinder& MssModel::cylinder() const { return impl_->cylinder; }
 Eigen::Index MssModel::num_edge_springs() const { return static_cast<Eigen::Index>(impl_->edges.size()); }
+std::vector<EdgeSpringInfo> MssModel::edge_springs() const {
+  const auto& s = impl_->options.scales[static_cast<int>(Term::main)].by_region;
+  std::vector<EdgeSpringInfo> out;
+  out.reserve(impl_->edges.size());
+  for (const EdgeSpring& e : impl_->edges) {
+    EdgeSpringInfo info;
+    info.i = e.i, info.j = e.j, info.rest_mm = e.rest_mm;
+    info.k_part = {e.k_part[0], e.k_part[1]};
+    info.k_region = s[0] * e.k_part[0] + s[1] * e.k_part[1];
+    info.multiplier = e.mu;
+    out.push_back(info);
+  }
+  return out;
+}
 Eigen::Index MssModel::num_radial_tets() const { return static_cast<Eigen::Index>(impl_->radial.size()); }
 Eigen::Index MssModel::num_angle_springs() const { return 3 * static_cast<Eigen::Index>(impl_->faces.size()); }
 Eigen::Index MssModel::num_volume_terms() const { return static_cast<Eigen::Index>(impl_->volume.size()); }
@@ -351,6 +381,12 @@ void MssModel::set_scales(const std::array<RegionScales, kNumTerms>& scales) {
   o.scales = scales;
   validate_options(o);
   impl_->options.scales = scales;
+  impl_->apply_scales();
+}
+
+void MssModel::set_edge_multipliers(const std::vector<double>& multipliers) {
+  validate_edge_multipliers(multipliers, impl_->edges.size());
+  impl_->options.edge_multipliers = multipliers;
   impl_->apply_scales();
 }
 

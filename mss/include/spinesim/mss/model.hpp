@@ -38,6 +38,10 @@
 //
 // Every stiffness is the sum of an annulus part and a nucleus part; MssOptions::scales (and
 // set_scales) multiply them per term and region without rebuilding (the calibration knobs).
+// On top of the region scales, each main (edge) spring may carry its own multiplier mu_e
+// (MssOptions::edge_multipliers, the per-spring calibration):
+//   k_e = mu_e (s_main,annulus k_e,annulus + s_main,nucleus k_e,nucleus).
+// Multipliers belong to one mesh: they are indexed in the model's edge order (edge_springs()).
 //
 // Positions are flat vectors of 3·#nodes, interleaved (x0, y0, z0, x1, ...), mm; the Hessian
 // is 3#nodes square, both triangles stored, its pattern built once (3×3 blocks of every node
@@ -53,6 +57,7 @@
 
 #include <array>
 #include <memory>
+#include <vector>
 
 namespace spinesim::mss {
 
@@ -82,6 +87,18 @@ struct MssOptions {
   double damping_ratio = 1.0;    ///< zeta of the default K_d (dimensionless)
   double damping_n_s_per_mm = -1.0;  ///< K_d per node; < 0 means the default from damping_ratio
   std::array<RegionScales, kNumTerms> scales{};  ///< indexed by Term
+  /// Per-spring multipliers mu_e of the main springs, one per edge spring in the model's edge
+  /// order (MssModel::edge_springs), each finite and > 0; empty = all 1.
+  std::vector<double> edge_multipliers;
+};
+
+/// One main (edge) spring as the model holds it (MssModel::edge_springs).
+struct EdgeSpringInfo {
+  int i = 0, j = 0;                        ///< end nodes, i < j
+  double rest_mm = 0;                      ///< L0
+  std::array<double, 2> k_part{0.0, 0.0};  ///< annulus / nucleus parts of k (5.2), N/mm, unscaled
+  double k_region = 0;    ///< s_main,annulus k_part[0] + s_main,nucleus k_part[1], N/mm (no mu_e)
+  double multiplier = 1;  ///< mu_e; the spring's stiffness is multiplier * k_region
 };
 
 /// Equivalent cylinder of the thesis (5.6)-(5.8), for reports.
@@ -95,7 +112,8 @@ struct EquivalentCylinder {
 class MssModel {
  public:
   /// Validates mesh (mesh::validate) and materials and options (finite, positive
-  /// factors, damping finite); throws std::invalid_argument with a one-line message.
+  /// factors, damping finite, one positive multiplier per edge spring if any); throws
+  /// std::invalid_argument with a one-line message.
   MssModel(const mesh::TetMesh& mesh, const mesh::RegionMaterials& materials,
            const MssOptions& options = MssOptions());
   ~MssModel();
@@ -116,17 +134,24 @@ class MssModel {
   const EquivalentCylinder& cylinder() const;
 
   Eigen::Index num_edge_springs() const;
+  /// The main springs in the model's edge order (unique mesh edges sorted by (i, j)) — the
+  /// order of MssOptions::edge_multipliers.
+  std::vector<EdgeSpringInfo> edge_springs() const;
   Eigen::Index num_radial_tets() const;   ///< 0 when radial springs are off
   Eigen::Index num_angle_springs() const; ///< 0 when torsion springs are off
   Eigen::Index num_volume_terms() const;  ///< 0 when the volume term is off
 
   /// Replaces the calibration multipliers (all must be finite and > 0).
   void set_scales(const std::array<RegionScales, kNumTerms>& scales);
+  /// Replaces the per-spring multipliers (empty = all 1; else one finite value > 0 per edge
+  /// spring); throws std::invalid_argument otherwise.
+  void set_edge_multipliers(const std::vector<double>& multipliers);
 
   /// Total energy, N·mm.
   double energy(const Eigen::VectorXd& x_mm) const;
   /// Energy of one term with its region scale set to 1 for `region_index` and 0 for the other
-  /// (dE/d scale for calibration), N·mm; region_index 0 annulus, 1 nucleus.
+  /// (dE/d scale for calibration), N·mm; region_index 0 annulus, 1 nucleus. For Term::main the
+  /// per-spring multipliers stay in (dE/d s_main = sum_e mu_e k_e,region part).
   double term_energy(const Eigen::VectorXd& x_mm, Term term, int region_index) const;
   /// Energy, and grad = dE/dx (3#nodes, N; the internal force is -grad).
   double gradient(const Eigen::VectorXd& x_mm, Eigen::VectorXd& grad) const;
