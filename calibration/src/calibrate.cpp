@@ -1,11 +1,9 @@
 #include "spinesim/calibration/calibrate.hpp"
 
-#include <IpIpoptApplication.hpp>
-#include <IpTNLP.hpp>
+#include "bounded_nlp.hpp"
 
 #include <chrono>
 #include <cmath>
-#include <sstream>
 #include <stdexcept>
 
 namespace spinesim::calibration {
@@ -14,138 +12,6 @@ namespace {
 
 using clock_type = std::chrono::steady_clock;
 double since(clock_type::time_point t0) { return std::chrono::duration<double>(clock_type::now() - t0).count(); }
-
-const char* status_name(Ipopt::ApplicationReturnStatus s) {
-  using namespace Ipopt;
-  switch (s) {
-    case Solve_Succeeded: return "Solve_Succeeded";
-    case Solved_To_Acceptable_Level: return "Solved_To_Acceptable_Level";
-    case Infeasible_Problem_Detected: return "Infeasible_Problem_Detected";
-    case Search_Direction_Becomes_Too_Small: return "Search_Direction_Becomes_Too_Small";
-    case Diverging_Iterates: return "Diverging_Iterates";
-    case User_Requested_Stop: return "User_Requested_Stop";
-    case Feasible_Point_Found: return "Feasible_Point_Found";
-    case Maximum_Iterations_Exceeded: return "Maximum_Iterations_Exceeded";
-    case Restoration_Failed: return "Restoration_Failed";
-    case Error_In_Step_Computation: return "Error_In_Step_Computation";
-    case Maximum_CpuTime_Exceeded: return "Maximum_CpuTime_Exceeded";
-    case Not_Enough_Degrees_Of_Freedom: return "Not_Enough_Degrees_Of_Freedom";
-    case Invalid_Problem_Definition: return "Invalid_Problem_Definition";
-    case Invalid_Option: return "Invalid_Option";
-    case Invalid_Number_Detected: return "Invalid_Number_Detected";
-    case Unrecoverable_Exception: return "Unrecoverable_Exception";
-    case NonIpopt_Exception_Thrown: return "NonIpopt_Exception_Thrown";
-    case Insufficient_Memory: return "Insufficient_Memory";
-    case Internal_Error: return "Internal_Error";
-  }
-  return "Unknown_Status";
-}
-
-/// The bound-constrained problem min J(p), ln lower <= p <= ln upper, for Ipopt.
-class CalibrationNlp : public Ipopt::TNLP {
- public:
-  CalibrationNlp(Objective& objective, Eigen::VectorXd start, const IpoptSettings& settings,
-                 const Progress& progress)
-      : obj_(objective), start_(std::move(start)), settings_(settings), progress_(progress) {}
-
-  bool get_nlp_info(Ipopt::Index& n, Ipopt::Index& m, Ipopt::Index& nnz_jac_g, Ipopt::Index& nnz_h_lag,
-                    IndexStyleEnum& index_style) override {
-    n = Ipopt::Index(start_.size());
-    m = 0, nnz_jac_g = 0;
-    nnz_h_lag = n * (n + 1) / 2;  // dense lower triangle
-    index_style = C_STYLE;
-    return true;
-  }
-  bool get_bounds_info(Ipopt::Index n, Ipopt::Number* x_l, Ipopt::Number* x_u, Ipopt::Index, Ipopt::Number*,
-                       Ipopt::Number*) override {
-    for (Ipopt::Index i = 0; i < n; ++i) {
-      x_l[i] = std::log(settings_.lower_scale);
-      x_u[i] = std::log(settings_.upper_scale);
-    }
-    return true;
-  }
-  bool get_starting_point(Ipopt::Index n, bool init_x, Ipopt::Number* x, bool init_z, Ipopt::Number*,
-                          Ipopt::Number*, Ipopt::Index, bool init_lambda, Ipopt::Number*) override {
-    if (!init_x || init_z || init_lambda) return false;
-    for (Ipopt::Index i = 0; i < n; ++i) x[i] = start_(i);
-    return true;
-  }
-  bool eval_f(Ipopt::Index n, const Ipopt::Number* x, bool, Ipopt::Number& f) override {
-    if (!evaluate(n, x)) return false;
-    f = last_.value;
-    return true;
-  }
-  bool eval_grad_f(Ipopt::Index n, const Ipopt::Number* x, bool, Ipopt::Number* g) override {
-    if (!evaluate(n, x)) return false;
-    for (Ipopt::Index i = 0; i < n; ++i) g[i] = last_.gradient(i);
-    return true;
-  }
-  bool eval_g(Ipopt::Index, const Ipopt::Number*, bool, Ipopt::Index, Ipopt::Number*) override { return true; }
-  bool eval_jac_g(Ipopt::Index, const Ipopt::Number*, bool, Ipopt::Index, Ipopt::Index, Ipopt::Index*,
-                  Ipopt::Index*, Ipopt::Number*) override {
-    return true;
-  }
-  bool eval_h(Ipopt::Index n, const Ipopt::Number* x, bool, Ipopt::Number obj_factor, Ipopt::Index,
-              const Ipopt::Number*, bool, Ipopt::Index, Ipopt::Index* rows, Ipopt::Index* cols,
-              Ipopt::Number* values) override {
-    Ipopt::Index e = 0;
-    if (!values) {
-      for (Ipopt::Index i = 0; i < n; ++i)
-        for (Ipopt::Index j = 0; j <= i; ++j) rows[e] = i, cols[e] = j, ++e;
-      return true;
-    }
-    if (!evaluate(n, x)) return false;
-    for (Ipopt::Index i = 0; i < n; ++i)
-      for (Ipopt::Index j = 0; j <= i; ++j) values[e++] = obj_factor * last_.gauss_newton(i, j);
-    return true;
-  }
-  bool intermediate_callback(Ipopt::AlgorithmMode, Ipopt::Index iter, Ipopt::Number obj_value, Ipopt::Number,
-                             Ipopt::Number inf_du, Ipopt::Number, Ipopt::Number, Ipopt::Number, Ipopt::Number,
-                             Ipopt::Number, Ipopt::Index, const Ipopt::IpoptData*,
-                             Ipopt::IpoptCalculatedQuantities*) override {
-    iterations_ = int(iter);
-    if (progress_) progress_(int(iter), obj_value, inf_du);
-    return true;
-  }
-  void finalize_solution(Ipopt::SolverReturn, Ipopt::Index n, const Ipopt::Number* x, const Ipopt::Number*,
-                         const Ipopt::Number*, Ipopt::Index, const Ipopt::Number*, const Ipopt::Number*,
-                         Ipopt::Number, const Ipopt::IpoptData*, Ipopt::IpoptCalculatedQuantities*) override {
-    final_ = Eigen::Map<const Eigen::VectorXd>(x, n);
-  }
-
-  const Eigen::VectorXd& final_point() const { return final_; }
-  int evaluations() const { return evaluations_; }
-  int iterations() const { return iterations_; }
-  double evaluation_seconds() const { return eval_seconds_; }
-
- private:
-  /// J and dJ/dp at x, cached (Ipopt asks for f and grad f at the same point).
-  bool evaluate(Ipopt::Index n, const Ipopt::Number* x) {
-    const Eigen::Map<const Eigen::VectorXd> p(x, n);
-    if (has_last_ && p == last_p_) return last_ok_;
-    const auto t0 = clock_type::now();
-    last_p_ = p;
-    has_last_ = true;
-    try {
-      last_ = obj_.evaluate(last_p_, true, true);
-      last_ok_ = std::isfinite(last_.value) && last_.gradient.allFinite();
-    } catch (const std::runtime_error&) {
-      last_ok_ = false;  // K(s) not positive definite: Ipopt shortens the step
-    }
-    ++evaluations_;
-    eval_seconds_ += since(t0);
-    return last_ok_;
-  }
-
-  Objective& obj_;
-  Eigen::VectorXd start_, final_, last_p_;
-  IpoptSettings settings_;
-  Progress progress_;
-  Evaluation last_;
-  bool has_last_ = false, last_ok_ = false;
-  int evaluations_ = 0, iterations_ = 0;
-  double eval_seconds_ = 0;
-};
 
 }  // namespace
 
@@ -168,28 +34,18 @@ CalibrationResult calibrate(Objective& objective, const Eigen::VectorXd& start_l
   out.start_log_scales = start_log_scales.cwiseMax(std::log(settings.lower_scale)).cwiseMin(std::log(settings.upper_scale));
   out.start = objective.evaluate(out.start_log_scales, false);  // throws if the start is unusable
 
-  Ipopt::SmartPtr<CalibrationNlp> nlp = new CalibrationNlp(objective, out.start_log_scales, settings, progress);
-  Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
-  app->Options()->SetStringValue("hessian_approximation", "exact");  // Gauss–Newton, objective.hpp
-  app->Options()->SetIntegerValue("max_iter", settings.max_iterations);
-  app->Options()->SetNumericValue("tol", settings.tolerance);
-  app->Options()->SetNumericValue("acceptable_tol", settings.acceptable_tolerance);
-  app->Options()->SetIntegerValue("print_level", settings.print_level);
-  app->Options()->SetStringValue("sb", "yes");  // no banner
-  app->Options()->SetStringValue("mu_strategy", "adaptive");
-  std::istringstream no_option_file;  // never read ./ipopt.opt: runs must not depend on the folder
-  if (app->Initialize(no_option_file) != Ipopt::Solve_Succeeded) {
-    out.status = "Ipopt_Initialisation_Failed";
-    out.seconds = since(t0);
-    return out;
-  }
-  const Ipopt::ApplicationReturnStatus st = app->OptimizeTNLP(nlp);
-  out.status = status_name(st);
-  out.success = st == Ipopt::Solve_Succeeded || st == Ipopt::Solved_To_Acceptable_Level;
-  out.iterations = nlp->iterations();
-  out.evaluations = nlp->evaluations();
-  out.evaluation_seconds = nlp->evaluation_seconds();
-  out.log_scales = nlp->final_point().size() ? nlp->final_point() : out.start_log_scales;
+  const detail::NlpFunction f = [&objective](const Eigen::VectorXd& p) {
+    Evaluation ev = objective.evaluate(p, true, true);
+    return detail::NlpValues{ev.value, std::move(ev.gradient), std::move(ev.gauss_newton)};
+  };
+  const detail::NlpRun run =
+      detail::run_bounded_nlp(f, out.start_log_scales, detail::HessianKind::dense, settings, progress);  // Gauss–Newton
+  out.status = run.status;
+  out.success = run.success;
+  out.iterations = run.iterations;
+  out.evaluations = run.evaluations;
+  out.evaluation_seconds = run.evaluation_seconds;
+  out.log_scales = run.final_point.size() ? run.final_point : out.start_log_scales;
   try {
     out.final = objective.evaluate(out.log_scales, false);
   } catch (const std::runtime_error& e) {

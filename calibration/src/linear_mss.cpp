@@ -4,6 +4,7 @@
 
 #include <Eigen/LU>
 
+#include <algorithm>
 #include <stdexcept>
 #include <string>
 
@@ -76,6 +77,33 @@ struct LinearMss::Impl {
   // Sherman–Morrison for the rank-one part: K_total^-1 b = A^-1 b - a_u (k u.A^-1 b)/(1 + k u.a_u).
   double kg = 0;
   Eigen::VectorXd a_u;
+
+  // Per-spring mode: every edge spring's data, and (built on first use) the entries of its
+  // k_e r_e r_e^T in `assembled`: edge e owns entries [entry_begin[e], entry_begin[e + 1]).
+  struct Edge {
+    int i, j;
+    Eigen::Vector3d n;  // unit rest direction i -> j
+    double k_part[2];   // N/mm, unscaled
+    double mu_model;    // the multiplier baked into the main knobs' K_j
+  };
+  std::vector<Edge> edges;
+  int main_knob[2] = {-1, -1};
+  std::vector<std::size_t> entry_begin;
+  std::vector<Eigen::Index> entry_slot;
+  std::vector<double> entry_coeff;
+
+  void check_scales(const Eigen::VectorXd& s) const;
+  void require_main_knobs() const {
+    if (main_knob[0] < 0 || main_knob[1] < 0)
+      throw std::invalid_argument("calibration: per-spring multipliers need both main-spring knobs");
+  }
+  /// assembled = sum_j s_j K_j (values only).
+  void assemble(const Eigen::VectorXd& s);
+  /// Adds sum_e (mu_e - mu_model,e) k_e(s) r_e r_e^T to `assembled`.
+  void add_edge_multipliers(const Eigen::VectorXd& s, const Eigen::VectorXd& mu);
+  void build_edge_entries();
+  /// Factorises `assembled` (+ the rank-one part at s) and returns Z, K6, Phi.
+  LinearState factorise_and_respond(const Eigen::VectorXd& s);
 
   Eigen::MatrixXd solve(const Eigen::MatrixXd& b) const {
     Eigen::MatrixXd x = cholesky.solve(b);
@@ -150,6 +178,49 @@ LinearMss::LinearMss(const mss::MssModel& model, std::vector<Knob> knobs, const 
       throw std::logic_error("calibration: knob Hessians do not share one pattern");
   }
   m.assembled = pattern;
+
+  // Edge springs, for per-spring multipliers.
+  for (const mss::EdgeSpringInfo& e : model.edge_springs()) {
+    const Eigen::Vector3d d = X.segment<3>(3 * e.j) - X.segment<3>(3 * e.i);
+    m.edges.push_back({e.i, e.j, d / d.norm(), {e.k_part[0], e.k_part[1]}, e.multiplier});
+  }
+  for (std::size_t j = 0; j < m.knobs.size(); ++j)
+    if (m.knobs[j].term == mss::Term::main) m.main_knob[m.knobs[j].region] = int(j);
+}
+
+void LinearMss::Impl::build_edge_entries() {
+  const Eigen::SparseMatrix<double, Eigen::RowMajor> Rr = R;
+  const auto* outer = assembled.outerIndexPtr();
+  const auto* inner = assembled.innerIndexPtr();
+  entry_begin.assign(1, 0);
+  std::vector<std::pair<Eigen::Index, double>> r;  // r_e = R^T b_e, sparse
+  for (const Edge& e : edges) {
+    r.clear();
+    for (int end = 0; end < 2; ++end)
+      for (int a = 0; a < 3; ++a) {
+        const double b = (end == 0 ? -1.0 : 1.0) * e.n(a);
+        for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(Rr, 3 * (end == 0 ? e.i : e.j) + a); it; ++it)
+          r.emplace_back(it.col(), b * it.value());
+      }
+    std::sort(r.begin(), r.end());
+    std::size_t w = 0;  // merge repeated z indices (both ends on the plate)
+    for (std::size_t k = 0; k < r.size(); ++k)
+      if (w > 0 && r[w - 1].first == r[k].first) r[w - 1].second += r[k].second;
+      else r[w++] = r[k];
+    r.resize(w);
+    for (const auto& [col, vc] : r)
+      for (const auto& [row, vr] : r) {
+        if (vr * vc == 0.0) continue;
+        const auto* first = inner + outer[col];
+        const auto* last = inner + outer[col + 1];
+        const auto* hit = std::lower_bound(first, last, row);
+        if (hit == last || *hit != row)
+          throw std::logic_error("calibration: an edge spring's entry is missing from the stiffness pattern");
+        entry_slot.push_back(hit - inner);
+        entry_coeff.push_back(vr * vc);
+      }
+    entry_begin.push_back(entry_slot.size());
+  }
 }
 
 LinearMss::~LinearMss() = default;
@@ -160,38 +231,99 @@ const std::vector<Knob>& LinearMss::knobs() const { return impl_->knobs; }
 Eigen::Index LinearMss::num_unknowns() const { return impl_->nz; }
 Eigen::Index LinearMss::num_dofs() const { return impl_->ndof; }
 
-LinearState LinearMss::solve(const Eigen::VectorXd& s) {
-  Impl& m = *impl_;
-  if (s.size() != Eigen::Index(m.knobs.size()))
+void LinearMss::Impl::check_scales(const Eigen::VectorXd& s) const {
+  if (s.size() != Eigen::Index(knobs.size()))
     throw std::invalid_argument("calibration: " + std::to_string(s.size()) + " scales for " +
-                                std::to_string(m.knobs.size()) + " knobs");
+                                std::to_string(knobs.size()) + " knobs");
   if (!s.allFinite() || (s.array() <= 0).any())
     throw std::invalid_argument("calibration: stiffness scales must be finite and > 0");
-  const Eigen::Index nnz = m.assembled.nonZeros();
-  double* v = m.assembled.valuePtr();
+}
+
+void LinearMss::Impl::assemble(const Eigen::VectorXd& s) {
+  const Eigen::Index nnz = assembled.nonZeros();
+  double* v = assembled.valuePtr();
   std::fill(v, v + nnz, 0.0);
-  for (std::size_t j = 0; j < m.knobs.size(); ++j) {
-    const double* kj = m.K[j].valuePtr();
+  for (std::size_t j = 0; j < knobs.size(); ++j) {
+    const double* kj = K[j].valuePtr();
     const double sj = s(Eigen::Index(j));
     for (Eigen::Index e = 0; e < nnz; ++e) v[e] += sj * kj[e];
   }
-  if (!m.analysed) {
-    m.cholesky.analyze(m.assembled);
-    m.analysed = true;
+}
+
+void LinearMss::Impl::add_edge_multipliers(const Eigen::VectorXd& s, const Eigen::VectorXd& mu) {
+  if (entry_begin.empty()) build_edge_entries();
+  const double sa = s(main_knob[0]), sn = s(main_knob[1]);
+  double* v = assembled.valuePtr();
+  for (std::size_t e = 0; e < edges.size(); ++e) {
+    const Edge& ed = edges[e];
+    const double d = (mu(Eigen::Index(e)) - ed.mu_model) * (sa * ed.k_part[0] + sn * ed.k_part[1]);
+    if (d == 0.0) continue;
+    for (std::size_t k = entry_begin[e]; k < entry_begin[e + 1]; ++k) v[entry_slot[k]] += d * entry_coeff[k];
   }
-  m.cholesky.factorize(m.assembled);  // throws std::runtime_error if not positive definite
-  m.kg = m.rank_one_knob >= 0 ? s(m.rank_one_knob) * m.kg_unscaled : 0.0;
-  if (m.kg != 0.0) m.a_u = m.cholesky.solve(m.u_red);
+}
+
+LinearState LinearMss::Impl::factorise_and_respond(const Eigen::VectorXd& s) {
+  if (!analysed) {
+    cholesky.analyze(assembled);
+    analysed = true;
+  }
+  cholesky.factorize(assembled);  // throws std::runtime_error if not positive definite
+  kg = rank_one_knob >= 0 ? s(rank_one_knob) * kg_unscaled : 0.0;
+  if (kg != 0.0) a_u = cholesky.solve(u_red);
 
   LinearState out;
-  Eigen::MatrixXd Ep = Eigen::MatrixXd::Zero(m.nz, 6);
+  Eigen::MatrixXd Ep = Eigen::MatrixXd::Zero(nz, 6);
   Ep.bottomRows<6>().setIdentity();
-  out.Z = m.solve(Ep);
+  out.Z = solve(Ep);
   const Matrix6d C = 0.5 * (out.Z.bottomRows<6>() + out.Z.bottomRows<6>().transpose());
   out.k6 = C.inverse();
   out.k6 = 0.5 * (out.k6 + out.k6.transpose()).eval();
   out.Phi = out.Z * out.k6;
   if (!out.k6.allFinite()) throw std::runtime_error("calibration: non-finite plate stiffness");
+  return out;
+}
+
+LinearState LinearMss::solve(const Eigen::VectorXd& s) {
+  impl_->check_scales(s);
+  impl_->assemble(s);
+  return impl_->factorise_and_respond(s);
+}
+
+LinearState LinearMss::solve(const Eigen::VectorXd& s, const Eigen::VectorXd& mu) {
+  Impl& m = *impl_;
+  m.check_scales(s);
+  m.require_main_knobs();
+  if (mu.size() != Eigen::Index(m.edges.size()))
+    throw std::invalid_argument("calibration: " + std::to_string(mu.size()) + " edge multipliers for " +
+                                std::to_string(m.edges.size()) + " edge springs");
+  if (!mu.allFinite() || (mu.array() <= 0).any())
+    throw std::invalid_argument("calibration: edge multipliers must be finite and > 0");
+  m.assemble(s);
+  m.add_edge_multipliers(s, mu);
+  return m.factorise_and_respond(s);
+}
+
+Eigen::Index LinearMss::num_edge_springs() const { return Eigen::Index(impl_->edges.size()); }
+
+Eigen::VectorXd LinearMss::edge_stiffness(const Eigen::VectorXd& s) const {
+  const Impl& m = *impl_;
+  m.check_scales(s);
+  m.require_main_knobs();
+  const double sa = s(m.main_knob[0]), sn = s(m.main_knob[1]);
+  Eigen::VectorXd k(Eigen::Index(m.edges.size()));
+  for (std::size_t e = 0; e < m.edges.size(); ++e)
+    k(Eigen::Index(e)) = sa * m.edges[e].k_part[0] + sn * m.edges[e].k_part[1];
+  return k;
+}
+
+Eigen::MatrixXd LinearMss::edge_extensions(const Eigen::MatrixXd& A) const {
+  const Impl& m = *impl_;
+  const Eigen::MatrixXd U = m.R * A;  // 3#nodes × k
+  Eigen::MatrixXd out(Eigen::Index(m.edges.size()), A.cols());
+  for (std::size_t e = 0; e < m.edges.size(); ++e) {
+    const Impl::Edge& ed = m.edges[e];
+    out.row(Eigen::Index(e)) = ed.n.transpose() * (U.middleRows<3>(3 * ed.j) - U.middleRows<3>(3 * ed.i));
+  }
   return out;
 }
 

@@ -59,76 +59,93 @@ Objective::Objective(LinearMss& model, FemReference reference, const std::vector
   }
 }
 
-Evaluation Objective::evaluate(const Eigen::VectorXd& p, bool with_gradient, bool with_hessian) {
-  const Eigen::Index nk = Eigen::Index(model_.knobs().size());
-  if (p.size() != nk) throw std::invalid_argument("calibration: wrong number of parameters");
-  const Eigen::VectorXd s = p.array().exp();
-  const LinearState st = model_.solve(s);
+namespace {
+
+/// S = diag(1, 1, 1, 1/rho, 1/rho, 1/rho): moments in N·mm / rho add to forces in N.
+Vector6d plate_weights(const FemReference& ref) {
+  Vector6d S = Vector6d::Ones();
+  S.tail<3>() /= ref.plate_rms_radius_mm;
+  return S;
+}
+
+/// |S K6* q*|^2, the size of a case's reference reaction.
+double reaction_size2(const FemReference& ref, const CaseReference& c) {
+  return plate_weights(ref).cwiseProduct(ref.k6 * c.plate_motion).squaredNorm();
+}
+
+}  // namespace
+
+Evaluation Objective::measure(const LinearState& st, Adjoint* adjoint) const {
   Evaluation ev;
   ev.k6 = st.k6;
-
-  Vector6d S = Vector6d::Ones();
-  S.tail<3>() /= ref_.plate_rms_radius_mm;
+  const Vector6d S = plate_weights(ref_);
   const double n_train = double(train_.size());
 
-  // Every case's errors; training cases also fill the adjoint right-hand sides.
+  // Every case's errors; training cases also fill the adjoint right-hand sides and dJ_r/dK6.
   const Eigen::Index nc = Eigen::Index(ref_.cases.size());
   Eigen::MatrixXd z(model_.num_unknowns(), nc), g(model_.num_unknowns(), nc);
   g.setZero();
+  Matrix6d g6_reaction = Matrix6d::Zero();
   std::vector<bool> is_train(std::size_t(nc), false);
   for (int c : train_) is_train[std::size_t(c)] = true;
-  std::vector<Vector6d> react_d(static_cast<std::size_t>(nc));
-  std::vector<double> react_size2(static_cast<std::size_t>(nc));
   for (Eigen::Index c = 0; c < nc; ++c) {
     const CaseReference& r = ref_.cases[std::size_t(c)];
     z.col(c) = st.Z * r.wrench;
     const Eigen::VectorXd diff = model_.displacement(z.col(c)) - r.displacement_mm;
     const double u2 = r.displacement_mm.squaredNorm();
     const Vector6d d = S.cwiseProduct((st.k6 - ref_.k6) * r.plate_motion);
-    const double size2 = S.cwiseProduct(ref_.k6 * r.plate_motion).squaredNorm();
-    react_d[std::size_t(c)] = d;
-    react_size2[std::size_t(c)] = size2;
+    const double size2 = reaction_size2(ref_, r);
     ev.cases.push_back({r.name, std::sqrt(diff.squaredNorm() / u2), std::sqrt(d.squaredNorm() / size2)});
     if (is_train[std::size_t(c)]) {
       ev.displacement += diff.squaredNorm() / u2 / n_train;
       ev.reaction += d.squaredNorm() / size2 / n_train;
       g.col(c) = model_.restrict(diff) * (2.0 / (n_train * u2));
+      g6_reaction += (2.0 / (n_train * size2)) * S.cwiseProduct(d) * r.plate_motion.transpose();  // d|d|^2/dK6
     }
   }
   Vector6d log_ratio;
   for (int i = 0; i < 6; ++i) log_ratio(i) = std::log(st.k6(i, i) / ref_.k6(i, i));
   ev.stiffness = log_ratio.squaredNorm() / 6.0;
+  ev.value = ev.displacement + w_.reaction * ev.reaction + w_.stiffness * ev.stiffness;
+  if (!adjoint) return ev;
+
+  adjoint->z = std::move(z);
+  adjoint->lambda = model_.solve_again(g);
+  adjoint->Phi = st.Phi;
+  Matrix6d g6 = w_.reaction * g6_reaction;
+  for (int i = 0; i < 6; ++i) g6(i, i) += w_.stiffness * 2.0 * log_ratio(i) / st.k6(i, i) / 6.0;
+  adjoint->g6 = 0.5 * (g6 + g6.transpose());  // it meets only symmetric dK6
+  return ev;
+}
+
+Evaluation Objective::evaluate(const Eigen::VectorXd& p, bool with_gradient, bool with_hessian) {
+  const Eigen::Index nk = Eigen::Index(model_.knobs().size());
+  if (p.size() != nk) throw std::invalid_argument("calibration: wrong number of parameters");
+  const Eigen::VectorXd s = p.array().exp();
+  const LinearState st = model_.solve(s);
+  Adjoint adj;
+  Evaluation ev = measure(st, with_gradient || with_hessian ? &adj : nullptr);
   ev.regularisation = p.squaredNorm() / double(nk);
-  ev.value = ev.displacement + w_.reaction * ev.reaction + w_.stiffness * ev.stiffness +
-             w_.regularisation * ev.regularisation;
+  ev.value += w_.regularisation * ev.regularisation;
   if (!with_gradient && !with_hessian) return ev;
 
-  // Adjoint solves for the displacement term, then every knob's bilinear forms.
-  const Eigen::MatrixXd lambda = model_.solve_again(g);
-  const std::vector<Eigen::MatrixXd> disp = model_.knob_gram(lambda, z);   // nc × nc per knob
-  const std::vector<Eigen::MatrixXd> dk6 = model_.knob_gram(st.Phi, st.Phi);  // 6 × 6 per knob
+  // Every knob's bilinear forms: dJ/ds_j = -sum_c lambda_c^T K_j z_c + <G6, Phi^T K_j Phi>.
+  const std::vector<Eigen::MatrixXd> disp = model_.knob_gram(adj.lambda, adj.z);  // nc × nc per knob
+  const std::vector<Eigen::MatrixXd> dk6 = model_.knob_gram(st.Phi, st.Phi);      // 6 × 6 per knob
   ev.gradient.resize(nk);
   for (Eigen::Index j = 0; j < nk; ++j) {
-    const Matrix6d& dK = dk6[std::size_t(j)];
-    double d_u = -disp[std::size_t(j)].trace();  // columns of non-training cases have lambda = 0
-    double d_r = 0;
-    for (int c : train_) {
-      const CaseReference& r = ref_.cases[std::size_t(c)];
-      d_r += 2.0 * react_d[std::size_t(c)].dot(S.cwiseProduct(dK * r.plate_motion)) / react_size2[std::size_t(c)];
-    }
-    d_r /= n_train;
-    double d_k = 0;
-    for (int i = 0; i < 6; ++i) d_k += 2.0 * log_ratio(i) * dK(i, i) / st.k6(i, i) / 6.0;
-    const double d_s = d_u + w_.reaction * d_r + w_.stiffness * d_k;
+    const double d_s = -disp[std::size_t(j)].trace() + adj.g6.cwiseProduct(dk6[std::size_t(j)]).sum();
     ev.gradient(j) = s(j) * d_s + w_.regularisation * 2.0 * p(j) / double(nk);
   }
   if (!with_hessian) return ev;
 
   // Gauss–Newton: rows of dr/dp stacked per residual group, then 2 sum w D^T D.
+  const Vector6d S = plate_weights(ref_);
+  const double n_train = double(train_.size());
   const Eigen::Index nt = Eigen::Index(train_.size());
   Eigen::MatrixXd kz(model_.num_unknowns(), nk * nt);
   for (Eigen::Index j = 0; j < nk; ++j)
-    for (Eigen::Index t = 0; t < nt; ++t) kz.col(j * nt + t) = model_.knob_product(int(j), z.col(train_[std::size_t(t)]));
+    for (Eigen::Index t = 0; t < nt; ++t) kz.col(j * nt + t) = model_.knob_product(int(j), adj.z.col(train_[std::size_t(t)]));
   const Eigen::MatrixXd dz = model_.solve_again(kz);  // K^-1 K_j z_c = -dz_c/ds_j
   Eigen::MatrixXd gn = Eigen::MatrixXd::Zero(nk, nk);
   for (Eigen::Index t = 0; t < nt; ++t) {
@@ -139,8 +156,7 @@ Evaluation Objective::evaluate(const Eigen::VectorXd& p, bool with_gradient, boo
     gn += 2.0 * du.transpose() * du;
     Eigen::MatrixXd dr(6, nk);
     for (Eigen::Index j = 0; j < nk; ++j)
-      dr.col(j) = S.cwiseProduct(dk6[std::size_t(j)] * r.plate_motion) *
-                  (s(j) / std::sqrt(react_size2[std::size_t(train_[std::size_t(t)])] * n_train));
+      dr.col(j) = S.cwiseProduct(dk6[std::size_t(j)] * r.plate_motion) * (s(j) / std::sqrt(reaction_size2(ref_, r) * n_train));
     gn += 2.0 * w_.reaction * dr.transpose() * dr;
   }
   Eigen::MatrixXd dk(6, nk);

@@ -34,11 +34,11 @@ inline mss::MssOptions all_terms() {
   return o;
 }
 
-/// A reference computed by the linearised MSS itself at scales `s`: a calibration from any
-/// start must find a zero objective.
+/// A reference computed by the linearised MSS itself at scales `s` (and per-spring multipliers
+/// `mu` when given): a calibration with the same freedom must find a zero objective.
 inline FemReference synthetic_reference(LinearMss& lin, const mesh::TetMesh& m, const Eigen::VectorXd& s,
-                                        const Eigen::Vector3d& center) {
-  const LinearState st = lin.solve(s);
+                                        const Eigen::Vector3d& center, const Eigen::VectorXd& mu = Eigen::VectorXd()) {
+  const LinearState st = mu.size() ? lin.solve(s, mu) : lin.solve(s);
   FemReference ref;
   ref.plate_center_mm = center;
   ref.plate_rms_radius_mm = plate_rms_radius(m, center);

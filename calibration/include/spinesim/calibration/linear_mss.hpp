@@ -16,6 +16,12 @@
 //   wrench w:   K z = E_p w   (E_p injects into the plate DOF)
 //   compliance: Z = K^-1 E_p (#z × 6), C = E_p^T Z, K6 = C^-1, condensed modes Phi = Z K6;
 //   so the wrench response is z = Z w, and d K6 / d s_j = Phi^T K_j Phi.
+// Per-spring multipliers (per_spring.hpp): at rest an edge spring's Hessian is k_e n nᵀ on its
+// two end nodes (n the unit rest direction), so in z it is the rank-one k_e r_e r_eᵀ with
+// r_e = Rᵀ b_e, b_e = (−n at node i, +n at node j). With the main springs' region scales s_a, s_n
+// and multipliers mu_e:  K(s, mu) = sum_{j not main} s_j K_j + sum_e mu_e k_e(s) r_e r_eᵀ,
+// k_e(s) = s_a k_e,a + s_n k_e,n; so dK/d mu_e = k_e(s) r_e r_eᵀ and every derivative is local to
+// the edge: aᵀ (dK/d mu_e) b = k_e (n·Δa)(n·Δb), Δa = (R a)_j − (R a)_i (edge_extensions).
 // Units: mm, N, N·mm, rad; K6 as fem::DiscFem::stiffness_6x6.
 #pragma once
 
@@ -70,9 +76,14 @@ class LinearMss {
   Eigen::Index num_unknowns() const;  ///< #z = #free DOF + 6
   Eigen::Index num_dofs() const;      ///< 3#nodes
 
-  /// Factorises K(s) (s: one positive scale per knob) and returns Z, K6, Phi. Throws
-  /// std::runtime_error when K(s) is not positive definite.
+  /// Factorises K(s) (s: one positive scale per knob; the main springs keep the model's own
+  /// multipliers) and returns Z, K6, Phi. Throws std::runtime_error when K(s) is not positive
+  /// definite.
   LinearState solve(const Eigen::VectorXd& scales);
+  /// The same with per-spring multipliers mu (#edge springs, finite > 0, model edge order) in
+  /// place of the model's: K(s, mu) above. Needs both main-spring knobs (throws
+  /// std::invalid_argument otherwise). K(s, mu)'s values are refilled on the pattern of K(s).
+  LinearState solve(const Eigen::VectorXd& scales, const Eigen::VectorXd& edge_multipliers);
   /// K(s)^-1 B with the factor of the last solve() (B: #z × k).
   Eigen::MatrixXd solve_again(const Eigen::MatrixXd& rhs) const;
 
@@ -80,6 +91,14 @@ class LinearMss {
   Eigen::VectorXd displacement(const Eigen::VectorXd& z) const;
   /// R^T v for a 3#nodes vector v (the adjoint of displacement()).
   Eigen::VectorXd restrict(const Eigen::VectorXd& v) const;
+
+  Eigen::Index num_edge_springs() const;
+  /// k_e(s) = s_a k_e,a + s_n k_e,n for every edge spring (N/mm, #edges): the stiffness at
+  /// multiplier 1 under the region scales s.
+  Eigen::VectorXd edge_stiffness(const Eigen::VectorXd& scales) const;
+  /// r_eᵀ A for every edge spring and column of A (#z × k): n_e·((R a)_j − (R a)_i), the
+  /// spring's extension under each column, mm per unit (#edges × k).
+  Eigen::MatrixXd edge_extensions(const Eigen::MatrixXd& A) const;
 
   /// A^T K_j B for every knob j (A: #z × p, B: #z × q): the derivatives of A^T K(s) B.
   std::vector<Eigen::MatrixXd> knob_gram(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B) const;

@@ -12,6 +12,9 @@
 // Gradient (adjoint of K z = E_p w, one extra solve per case):
 //   K lambda_c = dJ_u/dz_c = 2 R^T (R z_c - u*_c) / (N |u*_c|^2),
 //   dJ_u/ds_j = -sum_c lambda_c^T K_j z_c,   dK6/ds_j = Phi^T K_j Phi,   dJ/dp_j = s_j dJ/ds_j.
+// In general, for any parameter theta of K (a scale, a per-spring multiplier) the data terms
+// change by  dJ/dtheta = -sum_c lambda_c^T K_theta z_c + <G6, Phi^T K_theta Phi>,  K_theta = dK/dtheta,
+// G6 = d(w_r J_r + w_k J_k)/dK6 (Adjoint; measure()).
 // Hessian for Ipopt: J is a weighted sum of squared residuals r (displacement differences,
 // scaled reaction differences, log stiffness ratios, p), so the Gauss–Newton matrix
 // 2 sum w (dr/dp)^T (dr/dp) is used; dr/dp needs dz_c/ds_j = -K^-1 K_j z_c (one multi-column
@@ -73,6 +76,15 @@ struct Evaluation {
   Matrix6d k6 = Matrix6d::Zero();   ///< the linearised MSS's plate stiffness
 };
 
+/// The data terms' derivative with respect to K in adjoint form (see the header comment):
+/// dJ/dtheta = -sum_c lambda_c^T K_theta z_c + <g6, Phi^T K_theta Phi>.
+struct Adjoint {
+  Eigen::MatrixXd z;       ///< #z × #cases, every reference case's response Z w_c
+  Eigen::MatrixXd lambda;  ///< #z × #cases, adjoint solutions (zero columns for untrained cases)
+  Eigen::MatrixXd Phi;     ///< #z × 6, condensed modes
+  Matrix6d g6 = Matrix6d::Zero();  ///< d(w_r J_r + w_k J_k)/dK6, symmetric
+};
+
 class Objective {
  public:
   /// `train`: names of the reference cases J sums over (each must be in `reference`).
@@ -85,8 +97,14 @@ class Objective {
   /// `with_hessian`). Throws std::runtime_error when K(s) is not positive definite.
   Evaluation evaluate(const Eigen::VectorXd& log_scales, bool with_gradient, bool with_hessian = false);
 
+  /// The data terms of J (value = J_u + w_r J_r + w_k J_k, no regulariser) and every case's
+  /// errors for `state`, the model's last solve; with `adjoint`, also dJ/dK in adjoint form
+  /// (one multi-column solve with the same factor).
+  Evaluation measure(const LinearState& state, Adjoint* adjoint = nullptr) const;
+
   const FemReference& reference() const { return ref_; }
   const std::vector<int>& training_cases() const { return train_; }
+  const Weights& weights() const { return w_; }
   LinearMss& model() { return model_; }
 
  private:
