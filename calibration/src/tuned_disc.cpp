@@ -79,6 +79,7 @@ mss::MssOptions TunedDisc::mss_options() const {
     const Knob k = knob_from_name(name);
     o.scales[int(k.term)].by_region[std::size_t(k.region)] = value;
   }
+  o.edge_multipliers = edge_multipliers;
   return o;
 }
 
@@ -89,23 +90,28 @@ mesh::RegionMaterials TunedDisc::materials() const {
 
 nlohmann::json to_json(const TunedDisc& t) {
   const mss::MssOptions& o = t.options;
-  return {{"format", kFormat},
-          {"version", kVersion},
-          {"kind", "region"},
-          {"level", t.level},
-          {"material", {{"name", t.material_name}, {"regions", t.material}}},
-          {"mesh", {{"nodes", t.mesh.nodes}, {"tets", t.mesh.tets}, {"fingerprint", t.mesh.hash}}},
-          {"fem_order", t.fem_order},
-          {"terms",
-           {{"radial_springs", o.radial_springs},
-            {"torsion_springs", o.torsion_springs},
-            {"volume_term", o.volume_term},
-            {"disc_volume_term", o.disc_volume_term},
-            {"radial_factor", o.radial_factor},
-            {"volume_factor", o.volume_factor},
-            {"disc_volume_factor", o.disc_volume_factor}}},
-          {"scales", t.scales},
-          {"report", t.report}};
+  nlohmann::json j = {{"format", kFormat},
+                      {"version", kVersion},
+                      {"kind", t.kind()},
+                      {"level", t.level},
+                      {"material", {{"name", t.material_name}, {"regions", t.material}}},
+                      {"mesh", {{"nodes", t.mesh.nodes}, {"tets", t.mesh.tets}, {"fingerprint", t.mesh.hash}}},
+                      {"fem_order", t.fem_order},
+                      {"terms",
+                       {{"radial_springs", o.radial_springs},
+                        {"torsion_springs", o.torsion_springs},
+                        {"volume_term", o.volume_term},
+                        {"disc_volume_term", o.disc_volume_term},
+                        {"radial_factor", o.radial_factor},
+                        {"volume_factor", o.volume_factor},
+                        {"disc_volume_factor", o.disc_volume_factor}}},
+                      {"scales", t.scales},
+                      {"report", t.report}};
+  if (t.per_spring()) {
+    j["edge_springs"] = t.edge_multipliers.size();
+    j["edge_multipliers"] = t.edge_multipliers;
+  }
+  return j;
 }
 
 TunedDisc tuned_disc_from_json(const nlohmann::json& j) {
@@ -116,8 +122,8 @@ TunedDisc tuned_disc_from_json(const nlohmann::json& j) {
       throw std::invalid_argument("tuned-disc file version " + j.at("version").dump() + " is not supported (expected " +
                                   std::to_string(kVersion) + ")");
     const std::string kind = j.value("kind", "region");
-    if (kind != "region")
-      throw std::invalid_argument("tuned-disc kind '" + kind + "' is not supported (only region-level scales)");
+    if (kind != "region" && kind != "per-spring")
+      throw std::invalid_argument("tuned-disc kind '" + kind + "' is not supported (region, per-spring)");
     TunedDisc t;
     t.level = j.value("level", "");
     t.material_name = j.at("material").at("name").get<std::string>();
@@ -147,6 +153,17 @@ TunedDisc tuned_disc_from_json(const nlohmann::json& j) {
       t.scales[name] = s;
     }
     if (t.scales.empty()) throw std::invalid_argument("tuned-disc file has no scales");
+    if (kind == "region" && j.contains("edge_multipliers"))
+      throw std::invalid_argument("a region-level tuned-disc file has edge_multipliers (kind 'per-spring' expected)");
+    if (kind == "per-spring") {
+      t.edge_multipliers = j.at("edge_multipliers").get<std::vector<double>>();
+      if (t.edge_multipliers.empty()) throw std::invalid_argument("per-spring tuned-disc file has no edge_multipliers");
+      for (const double mu : t.edge_multipliers)
+        if (!std::isfinite(mu) || mu <= 0) throw std::invalid_argument("edge_multipliers must be finite and > 0");
+      if (j.at("edge_springs").get<std::size_t>() != t.edge_multipliers.size())
+        throw std::invalid_argument("edge_springs (" + j.at("edge_springs").dump() + ") does not match the " +
+                                    std::to_string(t.edge_multipliers.size()) + " edge_multipliers");
+    }
     t.report = j.value("report", nlohmann::json::object());
     return t;
   } catch (const nlohmann::json::exception& e) {
@@ -180,6 +197,13 @@ std::string check_applies(const TunedDisc& t, const mesh::TetMesh& mesh, const m
   if (!same)
     throw std::invalid_argument("the tuned parameters were fitted for material '" + t.material_name +
                                 "' and do not apply to material '" + materials.name + "' (calibrate it first)");
+  const MeshFingerprint here = fingerprint(mesh);
+  if (t.per_spring() && !(here == t.mesh))
+    throw std::invalid_argument("per-spring tuned parameters belong to the mesh they were fitted on (" +
+                                std::to_string(t.mesh.nodes) + " nodes, " + std::to_string(t.mesh.tets) +
+                                " tets, fingerprint " + t.mesh.hash + ") and do not apply to this mesh (" +
+                                std::to_string(here.nodes) + " nodes, " + std::to_string(here.tets) + " tets, fingerprint " +
+                                here.hash + "): region-level tuned files transfer to other meshes of the disc, per-spring ones do not");
   const std::string level = disc_level(mesh);
   if (!level.empty() && !t.level.empty()) {
     if (level != t.level)
@@ -187,7 +211,7 @@ std::string check_applies(const TunedDisc& t, const mesh::TetMesh& mesh, const m
                                   level + " mesh");
     return "";
   }
-  if (fingerprint(mesh) == t.mesh) return "";  // the very mesh they were fitted on
+  if (here == t.mesh) return "";  // the very mesh they were fitted on
   if (level.empty())
     return "mesh level unknown: applying the " + (t.level.empty() ? std::string("tuned") : t.level) +
            " parameters as given";

@@ -40,6 +40,9 @@ TunedSet tuned_set_from_json(const nlohmann::json& j) {
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument("level " + level + ": " + e.what());
     }
+    if (d.per_spring())
+      throw std::invalid_argument("level " + level +
+                                  ": per-spring scales belong to one mesh; a tuned set holds region-level scales that transfer");
     if (d.level != level) throw std::invalid_argument("level " + level + ": its entry says level '" + d.level + "'");
     if (d.material_name != set.material_name)
       throw std::invalid_argument("level " + level + ": material '" + d.material_name + "' is not the set's '" +

@@ -1,6 +1,7 @@
 // The tuned-disc file (tuned.json): what it keeps through JSON, how it identifies meshes and
 // levels, what it refuses to load, and when it refuses to apply.
 #include "spinesim/calibration/tuned_disc.hpp"
+#include "spinesim/calibration/tuned_set.hpp"
 #include "spinesim/mesh/io.hpp"
 
 #include "calibration_fixtures.hpp"
@@ -55,6 +56,8 @@ void expect_same(const TunedDisc& a, const TunedDisc& b) {
   EXPECT_EQ(a.mesh, b.mesh);
   EXPECT_EQ(a.fem_order, b.fem_order);
   EXPECT_EQ(a.scales, b.scales);  // bit-exact: JSON numbers round-trip doubles
+  EXPECT_EQ(a.edge_multipliers, b.edge_multipliers);
+  EXPECT_EQ(a.kind(), b.kind());
   EXPECT_EQ(a.report, b.report);
   EXPECT_EQ(a.options.radial_springs, b.options.radial_springs);
   EXPECT_EQ(a.options.torsion_springs, b.options.torsion_springs);
@@ -224,7 +227,7 @@ TEST(TunedDiscRefuses, ScaleOfASwitchedOffTerm) {
   EXPECT_FALSE(tuned_disc_from_json(j).mss_options().volume_term);
 }
 
-TEST(TunedDiscRefuses, KindOtherThanRegion) {
+TEST(TunedDiscRefuses, UnknownKind) {
   expect_refused([](json& j) { j["kind"] = "spring"; }, "kind 'spring'");
   expect_refused([](json& j) { j["kind"] = 3; }, "malformed");
 }
@@ -395,6 +398,112 @@ TEST(TunedDisc, MssOptionsScaleTheNamedTermAndRegion) {
     const double part = base.term_energy(x, k.term, k.region);
     EXPECT_GT(part, 0.0) << knob_name(k);
     EXPECT_NEAR(scaled.energy(x) - base.energy(x), part, 1e-9 * base.energy(x)) << knob_name(k);
+  }
+}
+
+// --- per-spring files ---------------------------------------------------------------------------
+
+/// The sample file for `m` with one distinct multiplier per edge spring of the model on `m`.
+TunedDisc sample_per_spring(const mesh::TetMesh& m) {
+  TunedDisc t = sample_tuned(m);
+  const mss::MssModel model(m, two_materials(), t.mss_options());
+  for (Eigen::Index e = 0; e < model.num_edge_springs(); ++e) t.edge_multipliers.push_back(0.5 + 1.0 / double(e + 3));
+  return t;
+}
+
+TEST(PerSpringFile, RoundTripKeepsEveryMultiplier) {
+  const TunedDisc t = sample_per_spring(l4l5_mesh());
+  ASSERT_TRUE(t.per_spring());
+  const json j = to_json(t);
+  EXPECT_EQ(j.at("kind"), "per-spring");
+  EXPECT_EQ(j.at("version"), 1);
+  EXPECT_EQ(j.at("edge_springs").get<std::size_t>(), t.edge_multipliers.size());
+  expect_same(t, tuned_disc_from_json(j));
+  expect_same(t, tuned_disc_from_json(json::parse(j.dump(2))));  // through text, bit-exact
+  const std::string path = temp_path("per-spring.json");
+  std::ofstream(path) << j.dump(2);
+  expect_same(t, read_tuned_disc(path));
+
+  // A region-level file says so and carries no multipliers.
+  const json region = to_json(sample_tuned(l4l5_mesh()));
+  EXPECT_EQ(region.at("kind"), "region");
+  EXPECT_FALSE(region.contains("edge_multipliers"));
+  EXPECT_FALSE(tuned_disc_from_json(region).per_spring());
+}
+
+/// tuned_disc_from_json of the per-spring sample after `edit` throws, mentioning `needle`.
+void expect_per_spring_refused(const std::function<void(json&)>& edit, const std::string& needle) {
+  json j = to_json(sample_per_spring(l4l5_mesh()));
+  edit(j);
+  try {
+    tuned_disc_from_json(j);
+    ADD_FAILURE() << "accepted; expected a refusal mentioning '" << needle << "'";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+    EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
+  }
+}
+
+TEST(PerSpringFile, RefusesBadMultipliers) {
+  expect_per_spring_refused([](json& j) { j.erase("edge_multipliers"); }, "edge_multipliers");
+  expect_per_spring_refused([](json& j) { j["edge_multipliers"] = json::array(); }, "no edge_multipliers");
+  for (const double bad : {0.0, -1.0, std::numeric_limits<double>::infinity()})
+    expect_per_spring_refused([bad](json& j) { j["edge_multipliers"][3] = bad; }, "finite and > 0");
+  expect_per_spring_refused([](json& j) { j["edge_multipliers"][3] = nullptr; }, "malformed");  // a NaN written to text
+  expect_per_spring_refused([](json& j) { j["edge_multipliers"][3] = "1"; }, "malformed");
+  expect_per_spring_refused([](json& j) { j["edge_springs"] = j["edge_springs"].get<int>() + 1; }, "edge_springs");
+  expect_per_spring_refused([](json& j) { j.erase("edge_springs"); }, "edge_springs");
+  // The kind decides: multipliers in a region-level file are an error, not silently ignored.
+  expect_per_spring_refused([](json& j) { j["kind"] = "region"; }, "per-spring");
+}
+
+TEST(PerSpringFile, AppliesToTheFittedMeshOnly) {
+  const mesh::TetMesh m = l4l5_mesh();
+  const TunedDisc t = sample_per_spring(m);
+  EXPECT_EQ(check_applies(t, m, two_materials()), "");
+  const mss::MssOptions o = t.mss_options();
+  EXPECT_EQ(o.edge_multipliers, t.edge_multipliers);
+  const mss::MssModel model(m, two_materials(), o);
+  EXPECT_EQ(model.edge_springs()[5].multiplier, t.edge_multipliers[5]);
+
+  // Another mesh of the same disc level: a region-level file transfers, a per-spring one not.
+  mesh::TetMesh finer = fem::test_meshes::box_mesh(7, 4, 5, 20.0, 8.0, 16.0, Eigen::Vector3d(-10.0, 0.0, -8.0));
+  finer.source = "structured disc L4-L5 (12 sectors, 3 rings, 2 layers)";
+  EXPECT_EQ(check_applies(sample_tuned(m), finer, two_materials()), "");
+  expect_not_applicable(t, finer, two_materials(),
+                        {"per-spring", "region-level tuned files transfer", "fingerprint " + t.mesh.hash,
+                         "fingerprint " + fingerprint(finer).hash});
+  // Same counts, one vertex moved by a micrometre: another mesh all the same.
+  mesh::TetMesh moved = m;
+  moved.V(moved.num_vertices() / 2, 1) += 1e-3;
+  expect_not_applicable(t, moved, two_materials(), {"per-spring", "do not apply"});
+  // A mesh of unknown level is no exception.
+  mesh::TetMesh unknown = finer;
+  unknown.source = "disc between vertebrae";
+  expect_not_applicable(t, unknown, two_materials(), {"per-spring"});
+  // The refusal is one line.
+  try {
+    check_applies(t, finer, two_materials());
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos);
+  }
+  // The material is still checked on the fitted mesh.
+  mesh::RegionMaterials renamed = two_materials();
+  renamed.name = "rubber";
+  expect_not_applicable(t, m, renamed, {"rubber"});
+}
+
+TEST(PerSpringFile, ATunedSetRefusesIt) {
+  TunedSet set;
+  set.material_name = two_materials().name;
+  set.levels.emplace("L4-L5", sample_tuned(l4l5_mesh()));
+  EXPECT_NO_THROW(tuned_set_from_json(to_json(set)));
+  set.levels["L4-L5"] = sample_per_spring(l4l5_mesh());
+  try {
+    tuned_set_from_json(to_json(set));
+    ADD_FAILURE() << "a tuned set took a per-spring entry";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("per-spring"), std::string::npos) << e.what();
   }
 }
 

@@ -7,11 +7,18 @@
 // fingerprint) — and the calibration's report (cases with untuned and tuned errors, 6×6
 // diagonals, Ipopt's status), kept verbatim under "report".
 //
-// Region-level scales are properties of a disc and its material, not of one mesh: they apply
-// to any mesh of the same level (a coarse haptic mesh, a fine study mesh) with the same
-// material. Loading checks that: a different material, or a mesh of another level, is refused
-// with a one-line message; a mesh whose level is unknown (e.g. meshed from vertebra surfaces)
-// is accepted, and the caller is told so (`applies_to`'s note).
+// Two kinds (the "kind" field; format version 1 for both — a reader that knows only region-level
+// files refuses a per-spring one by its kind):
+//   "region"      per-region scales only. They are properties of a disc and its material, not of
+//                 one mesh: they apply to any mesh of the same level (a coarse haptic mesh, a
+//                 fine study mesh) with the same material.
+//   "per-spring"  the region scales plus one multiplier per main (edge) spring
+//                 ("edge_multipliers", the mesh's edge order; per_spring.hpp). They belong to the
+//                 mesh they were fitted on and apply to no other.
+// Loading checks that: a different material, a mesh of another level, or — for a per-spring
+// file — any mesh with another fingerprint is refused with a one-line message; a mesh whose
+// level is unknown (e.g. meshed from vertebra surfaces) is accepted for a region-level file, and
+// the caller is told so (`check_applies`'s note).
 #pragma once
 
 #include "spinesim/calibration/linear_mss.hpp"
@@ -23,6 +30,7 @@
 
 #include <map>
 #include <string>
+#include <vector>
 
 namespace spinesim::calibration {
 
@@ -52,9 +60,17 @@ struct TunedDisc {
   int fem_order = 2;
   mss::MssOptions options;      ///< terms on/off and factors; scales filled from `scales`
   std::map<std::string, double> scales;  ///< knob name -> scale (> 0)
+  /// Kind "per-spring": one multiplier mu_e > 0 per edge spring of the fitted mesh, in the
+  /// model's edge order; empty for a region-level file.
+  std::vector<double> edge_multipliers;
   nlohmann::json report;        ///< the calibration's summary (free form)
 
-  /// `options` with its scales set from `scales` (knobs not listed stay 1).
+  bool per_spring() const { return !edge_multipliers.empty(); }
+  /// "region" or "per-spring".
+  std::string kind() const { return per_spring() ? "per-spring" : "region"; }
+
+  /// `options` with its scales set from `scales` (knobs not listed stay 1) and the per-spring
+  /// multipliers (if any).
   mss::MssOptions mss_options() const;
   /// The material the scales were fitted with, rebuilt from `material_name` and `material`
   /// (so a file calibrated with a material JSON file loads without it).
@@ -64,14 +80,16 @@ struct TunedDisc {
 nlohmann::json to_json(const TunedDisc& t);
 /// Parses and validates (format tag, version, kind, positive finite scales, known knob names,
 /// terms of every scale switched on, positive finite term factors, a valid material per region,
-/// fem_order 1 or 2); throws std::invalid_argument with a one-line message.
+/// fem_order 1 or 2; per-spring: a non-empty array of positive finite multipliers, matching
+/// "edge_springs"); throws std::invalid_argument with a one-line message.
 TunedDisc tuned_disc_from_json(const nlohmann::json& j);
 /// Reads a tuned.json; throws std::invalid_argument naming the file for unreadable or invalid
 /// content.
 TunedDisc read_tuned_disc(const std::string& path);
 
 /// Throws std::invalid_argument (one line) unless `tuned` applies to `mesh` with `materials`:
-/// same material (name and E, nu per region), same level when both levels are known. Returns a
+/// same material (name and E, nu per region), same level when both levels are known, and for a
+/// per-spring file the very mesh it was fitted on (same fingerprint). Returns a
 /// note for the user when the level could not be checked ("mesh level unknown: ...") — not for
 /// the very mesh the scales were fitted on (same fingerprint) — and "" otherwise.
 std::string check_applies(const TunedDisc& tuned, const mesh::TetMesh& mesh,

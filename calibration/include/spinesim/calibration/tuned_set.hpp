@@ -22,7 +22,8 @@ struct TunedSet {
 
 nlohmann::json to_json(const TunedSet& set);
 /// Parses and validates every entry (tuned_disc_from_json); all entries must share the set's
-/// material and carry their own level. Throws std::invalid_argument with a one-line message.
+/// material, carry their own level and be region-level (a per-spring entry would not transfer to
+/// the meshes the set is used on). Throws std::invalid_argument with a one-line message.
 TunedSet tuned_set_from_json(const nlohmann::json& j);
 TunedSet read_tuned_set(const std::string& path);
 
