@@ -3,7 +3,9 @@
 #include "cli_common.hpp"
 #include "fem_report.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <iomanip>
 #include <iostream>
 #include <sstream>
@@ -42,6 +44,43 @@ const CaseComparison* case_check(const MssFemComparison& c, const std::string& n
 }
 
 Eigen::VectorXd diag(const fem::Matrix6d& k) { return stiffness_per_degree(k).diagonal(); }
+
+/// The per-spring stage in the report: weights, Ipopt, J at both ends, where the multipliers went.
+nlohmann::json per_spring_json(const calibration::PerSpringResult& r, const CalibrationRequest& rq, Eigen::Index edges) {
+  std::vector<double> q(r.log_multipliers.data(), r.log_multipliers.data() + r.log_multipliers.size());
+  std::sort(q.begin(), q.end());
+  const double lo = std::log(rq.per_spring_ipopt.lower_scale), hi = std::log(rq.per_spring_ipopt.upper_scale);
+  const auto count = [&q](auto pred) { return std::count_if(q.begin(), q.end(), pred); };
+  const auto objective = [](const calibration::PerSpringEvaluation& e) {
+    nlohmann::json j = evaluation_json(e.data);
+    j["J"] = e.value;
+    j["data"] = e.data.value;
+    j["smoothness"] = e.smoothness;
+    j["prior"] = e.prior;
+    j.erase("regularisation");
+    return j;
+  };
+  return {{"edge_springs", edges},
+          {"weights", {{"smoothness", rq.per_spring_weights.smoothness}, {"prior", rq.weights.regularisation}}},
+          {"multiplier_bounds", {rq.per_spring_ipopt.lower_scale, rq.per_spring_ipopt.upper_scale}},
+          {"multipliers",
+           {{"min", std::exp(q.front())},
+            {"median", std::exp(q[q.size() / 2])},
+            {"max", std::exp(q.back())},
+            {"at_lower_bound", count([lo](double v) { return v <= lo + 1e-6; })},
+            {"at_upper_bound", count([hi](double v) { return v >= hi - 1e-6; })}}},
+          {"kept_region_fit", r.kept_start},
+          {"objective", {{"start", objective(r.start)}, {"final", objective(r.final)}}},
+          {"ipopt",
+           {{"status", r.status},
+            {"success", r.success},
+            {"iterations", r.iterations},
+            {"evaluations", r.evaluations},
+            {"seconds", r.seconds},
+            {"seconds_per_evaluation", r.evaluations ? r.evaluation_seconds / r.evaluations : 0.0},
+            {"hessian", "limited-memory BFGS"}}},
+          {"transfer", "per-spring multipliers belong to this mesh; other meshes get the region-level scales"}};
+}
 
 std::string pct(double e) {
   std::ostringstream s;
@@ -85,6 +124,12 @@ CalibrationOutcome calibrate_disc(const mesh::TetMesh& m, const mesh::RegionMate
     for (const auto& t : rq.train)
       if (h.name == t.name) throw std::invalid_argument("case '" + h.name + "' is both trained on and held out");
   calibration::validate(rq.ipopt);
+  if (rq.per_spring) {
+    calibration::validate(rq.per_spring_ipopt);
+    const auto& w = rq.per_spring_weights;
+    if (!std::isfinite(w.smoothness) || w.smoothness < 0 || !std::isfinite(w.prior) || w.prior < 0)
+      throw std::invalid_argument("per-spring weights (--smoothness) must be finite and >= 0");
+  }
   mesh::require_endplate_labels(m);
   for (const auto& [label, other] : rq.transfer_meshes) {
     mesh::require_endplate_labels(other);
@@ -124,14 +169,30 @@ CalibrationOutcome calibrate_disc(const mesh::TetMesh& m, const mesh::RegionMate
   // 3. Ipopt from Van Gelder (all scales 1).
   say("Ipopt: " + std::to_string(lin.knobs().size()) + " stiffness scales, " + std::to_string(rq.train.size()) +
       " training cases");
+  const auto ipopt_progress = [&](const std::string& stage) {
+    return [&say, stage](int it, double J, double inf_du) {
+      std::ostringstream s;
+      s << stage << "Ipopt iteration " << it << ": J = " << std::setprecision(4) << J << ", dual infeasibility "
+        << std::setprecision(2) << inf_du;
+      say(s.str());
+    };
+  };
   out.result = calibration::calibrate(obj, Eigen::VectorXd::Zero(Eigen::Index(lin.knobs().size())), rq.ipopt,
-                                      [&](int it, double J, double inf_du) {
-                                        std::ostringstream s;
-                                        s << "Ipopt iteration " << it << ": J = " << std::setprecision(4) << J
-                                          << ", dual infeasibility " << std::setprecision(2) << inf_du;
-                                        say(s.str());
-                                      });
-  out.k6_tuned = out.result.final.k6;
+                                      ipopt_progress(""));
+  out.k6_region = out.k6_tuned = out.result.final.k6;
+  out.success = out.result.success;
+
+  // 3b. Per-spring multipliers on top of the fitted region scales.
+  if (rq.per_spring && out.result.success) {
+    say("per-spring stage: " + std::to_string(model.num_edge_springs()) + " edge springs, Ipopt limited-memory BFGS");
+    calibration::PerSpringWeights w = rq.per_spring_weights;
+    w.prior = rq.weights.regularisation;
+    calibration::PerSpringObjective ps(obj, model, out.result.log_scales, w);
+    out.per_spring = calibration::calibrate_per_spring(ps, rq.per_spring_ipopt, ipopt_progress("per-spring "));
+    out.per_spring_ran = true;
+    out.k6_tuned = out.per_spring.final.data.k6;
+    out.success = out.per_spring.success;
+  }
 
   // 4. The tuned file's contents.
   calibration::TunedDisc& t = out.tuned;
@@ -143,18 +204,29 @@ CalibrationOutcome calibrate_disc(const mesh::TetMesh& m, const mesh::RegionMate
   t.options = options;
   for (std::size_t j = 0; j < lin.knobs().size(); ++j)
     t.scales[calibration::knob_name(lin.knobs()[j])] = std::exp(out.result.log_scales(Eigen::Index(j)));
+  const mss::MssOptions region_options = t.mss_options();  // before the multipliers: what transfers
+  if (out.per_spring_ran) {
+    const Eigen::VectorXd mu = out.per_spring.log_multipliers.array().exp();
+    t.edge_multipliers.assign(mu.data(), mu.data() + mu.size());
+  }
 
   // 5. Nonlinear checks at the cases' loads (as `mss compare`).
-  if (rq.nonlinear_check && out.result.success) {
+  if (rq.nonlinear_check && out.success) {
     say("nonlinear check: untuned and tuned MSS vs FEM, " + std::to_string(all.size()) + " cases");
     t0 = clock_type::now();
     out.untuned_check = compare_mss_fem(fem, thesis_model, all, materials.name, mss::StaticOptions(), rq.check_load_scale);
     mss::MssModel tuned(m, materials, t.mss_options());
     out.tuned_check = compare_mss_fem(fem, tuned, all, materials.name, mss::StaticOptions(), rq.check_load_scale);
+    if (out.per_spring_ran) {
+      say("nonlinear check: the region-only fit, " + std::to_string(all.size()) + " cases");
+      out.region_check = compare_mss_fem(fem, mss::MssModel(m, materials, region_options), all, materials.name,
+                                         mss::StaticOptions(), rq.check_load_scale);
+    }
     out.check_seconds = seconds_since(t0);
   }
-  // 6. The same scales on other meshes of the disc (region scales transfer; how well?).
-  if (out.result.success)
+  // 6. The region scales on other meshes of the disc (they transfer; how well? Per-spring
+  //    multipliers belong to this mesh and are not carried over).
+  if (out.success)
     for (const auto& [label, other] : rq.transfer_meshes) {
       say("transfer check on " + label + " (" + std::to_string(other.num_tets()) + " tets): FEM and MSS");
       t0 = clock_type::now();
@@ -163,7 +235,7 @@ CalibrationOutcome calibrate_disc(const mesh::TetMesh& m, const mesh::RegionMate
       tc.label = label;
       tc.untuned = compare_mss_fem(other_fem, mss::MssModel(other, materials, term_set_options(TermSet::thesis)), all,
                                    materials.name, mss::StaticOptions(), rq.check_load_scale);
-      tc.tuned = compare_mss_fem(other_fem, mss::MssModel(other, materials, t.mss_options()), all, materials.name,
+      tc.tuned = compare_mss_fem(other_fem, mss::MssModel(other, materials, region_options), all, materials.name,
                                  mss::StaticOptions(), rq.check_load_scale);
       tc.seconds = seconds_since(t0);
       out.transfer.push_back(std::move(tc));
@@ -173,9 +245,10 @@ CalibrationOutcome calibrate_disc(const mesh::TetMesh& m, const mesh::RegionMate
   // 7. Report.
   auto case_rows = [&](const std::vector<fem::LoadCase>& cases) {
     nlohmann::json rows = nlohmann::json::array();
+    const calibration::Evaluation& tuned_linear = out.per_spring_ran ? out.per_spring.final.data : out.result.final;
     for (const auto& lc : cases) {
       const auto& u = case_error(out.untuned_linear, lc.name);
-      const auto& f = case_error(out.result.final, lc.name);
+      const auto& f = case_error(tuned_linear, lc.name);
       nlohmann::json r = {{"name", lc.name},
                           {"untuned_error_linear", u.displacement_error},
                           {"tuned_error_linear", f.displacement_error},
@@ -184,6 +257,14 @@ CalibrationOutcome calibrate_disc(const mesh::TetMesh& m, const mesh::RegionMate
       for (const auto& ref_case : ref.cases)
         if (ref_case.name == lc.name)
           r["fem_plate_rotation_deg"] = ref_case.plate_motion.tail<3>().norm() * 180.0 / 3.14159265358979323846;
+      if (out.per_spring_ran) {  // the region-only fit beside the per-spring one
+        const auto& g = case_error(out.result.final, lc.name);
+        r["region_error_linear"] = g.displacement_error;
+        r["region_reaction_error_linear"] = g.reaction_error;
+        const CaseComparison* rn = case_check(out.region_check, lc.name);
+        r["region_error"] = rn ? rn->displacement_error : g.displacement_error;
+        if (rn) r["region_reaction_error"] = rn->reaction_error;
+      }
       const CaseComparison* un = case_check(out.untuned_check, lc.name);
       const CaseComparison* tn = case_check(out.tuned_check, lc.name);
       if (un && tn) {
@@ -202,7 +283,8 @@ CalibrationOutcome calibrate_disc(const mesh::TetMesh& m, const mesh::RegionMate
     }
     return rows;
   };
-  const Eigen::VectorXd kf = diag(out.k6_fem), ku = diag(out.k6_untuned), kt = diag(out.k6_tuned);
+  const Eigen::VectorXd kf = diag(out.k6_fem), ku = diag(out.k6_untuned), kt = diag(out.k6_tuned),
+                        kr = diag(out.k6_region);
   nlohmann::json knobs = nlohmann::json::array();
   for (const auto& k : lin.knobs()) knobs.push_back(calibration::knob_name(k));
   t.report = {
@@ -210,7 +292,8 @@ CalibrationOutcome calibrate_disc(const mesh::TetMesh& m, const mesh::RegionMate
        "Ipopt on the MSS linearised at rest (exact adjoint gradient, Gauss-Newton Hessian); errors "
        "`untuned_error`/`tuned_error`: nonlinear static MSS vs FEM at the case loads x check_load_scale, as "
        "`spinesim mss compare --load-scale`; `fem_plate_rotation_deg`: the FEM plate's rotation at the full case load; "
-       "`*_linear`: the linearised MSS the optimiser fitted"},
+       "`*_linear`: the linearised MSS the optimiser fitted. With --per-spring, `tuned_*` is the per-spring model "
+       "(region scales x one multiplier per main spring) and `region_*` the region-only fit it started from"},
       {"untuned", "thesis network (main + radial + torsion springs), Van Gelder constants, scales 1"},
       {"check_load_scale", rq.nonlinear_check ? nlohmann::json(rq.check_load_scale) : nlohmann::json(nullptr)},
       {"terms", term_set_name(rq.terms)},
@@ -226,6 +309,8 @@ CalibrationOutcome calibrate_disc(const mesh::TetMesh& m, const mesh::RegionMate
         {"tuned", to_json(kt)},
         {"ratio_untuned", to_json(Eigen::VectorXd(ku.cwiseQuotient(kf)))},
         {"ratio_tuned", to_json(Eigen::VectorXd(kt.cwiseQuotient(kf)))},
+        {"region", to_json(kr)},
+        {"ratio_region", to_json(Eigen::VectorXd(kr.cwiseQuotient(kf)))},
         {"units", "tx,ty,tz [N/mm], rx,ry,rz [N·mm/deg], global frame, linear (rest)"}}},
       {"objective",
        {{"untuned", evaluation_json(out.untuned_linear)},
@@ -238,7 +323,7 @@ CalibrationOutcome calibrate_disc(const mesh::TetMesh& m, const mesh::RegionMate
       {"transfer",
        [&] {
          nlohmann::json rows = nlohmann::json::array();
-         for (const TransferCheck& tc : out.transfer) {
+         for (const TransferCheck& tc : out.transfer) {  // region-level scales only
            nlohmann::json cases = nlohmann::json::array();
            for (std::size_t i = 0; i < tc.tuned.cases.size(); ++i)
              cases.push_back({{"name", tc.tuned.cases[i].name},
@@ -246,6 +331,11 @@ CalibrationOutcome calibrate_disc(const mesh::TetMesh& m, const mesh::RegionMate
                               {"tuned_error", tc.tuned.cases[i].displacement_error}});
            const Eigen::VectorXd f = diag(tc.tuned.k6_fem), u = diag(tc.untuned.k6_mss), k = diag(tc.tuned.k6_mss);
            rows.push_back({{"mesh", tc.label},
+                           {"scales", "region-level"},
+                           {"load_scale", rq.check_load_scale},
+                           {"note", out.per_spring_ran ? "per-spring multipliers do not transfer to another mesh: the "
+                                                         "region-level scales are checked here"
+                                                       : "region-level scales transfer to other meshes of the disc"},
                            {"nodes", tc.tuned.nodes},
                            {"tets", tc.tuned.tets},
                            {"cases", cases},
@@ -268,9 +358,11 @@ CalibrationOutcome calibrate_disc(const mesh::TetMesh& m, const mesh::RegionMate
        {{"fem_s", out.fem_seconds},
         {"setup_s", out.setup_seconds},
         {"ipopt_s", out.result.seconds},
+        {"per_spring_s", out.per_spring_ran ? out.per_spring.seconds : 0.0},
         {"nonlinear_check_s", out.check_seconds},
         {"transfer_s", [&] { double x = 0; for (const auto& tc : out.transfer) x += tc.seconds; return x; }()},
         {"total_s", out.total_seconds}}}};
+  if (out.per_spring_ran) t.report["per_spring"] = per_spring_json(out.per_spring, rq, model.num_edge_springs());
   return out;
 }
 
@@ -283,41 +375,63 @@ mss::MssModel tuned_model(const calibration::TunedDisc& tuned, const mesh::TetMe
 
 void print_calibration(std::ostream& os, const CalibrationOutcome& o, const CalibrationRequest& rq) {
   const auto& rep = o.tuned.report;
+  const bool ps = o.per_spring_ran;
   os << "Calibration of " << (o.tuned.level.empty() ? "disc" : o.tuned.level) << " (" << rep["nodes"] << " nodes, "
      << rep["tets"] << " tets), material " << o.tuned.material_name << ", terms " << term_set_name(rq.terms)
-     << ", FEM P" << rq.fem_order << "\n"
-     << "Ipopt: " << o.result.status << " after " << o.result.iterations << " iterations, " << o.result.evaluations
-     << " evaluations, " << std::fixed << std::setprecision(2) << o.result.seconds << " s ("
-     << std::setprecision(1) << 1e3 * rep["ipopt"]["seconds_per_evaluation"].get<double>()
-     << " ms per objective + gradient + Hessian)\n\n";
-  os << (rq.nonlinear_check ? "Relative nodal displacement error vs FEM (nonlinear MSS at the case loads x " +
+     << ", FEM P" << rq.fem_order << (ps ? ", region scales then per-spring multipliers" : "") << "\n"
+     << "Ipopt" << (ps ? " (region scales)" : "") << ": " << o.result.status << " after " << o.result.iterations
+     << " iterations, " << o.result.evaluations << " evaluations, " << std::fixed << std::setprecision(2)
+     << o.result.seconds << " s (" << std::setprecision(1) << 1e3 * rep["ipopt"]["seconds_per_evaluation"].get<double>()
+     << " ms per objective + gradient + Hessian)\n";
+  if (ps) {
+    const auto& p = rep["per_spring"];
+    os << "Ipopt (per-spring, " << p["edge_springs"] << " multipliers in [" << std::defaultfloat << std::setprecision(6)
+       << rq.per_spring_ipopt.lower_scale << ", " << rq.per_spring_ipopt.upper_scale << "], smoothness weight "
+       << rq.per_spring_weights.smoothness << ", limited-memory BFGS): " << o.per_spring.status << " after "
+       << o.per_spring.iterations << " iterations, " << o.per_spring.evaluations << " evaluations, " << std::fixed
+       << std::setprecision(2) << o.per_spring.seconds << " s; J " << std::setprecision(3) << std::scientific
+       << o.per_spring.start.value << " -> " << o.per_spring.final.value << std::fixed
+       << (o.per_spring.kept_start ? " (Ipopt ended higher: the region fit is kept)" : "") << "; multipliers "
+       << std::setprecision(2) << p["multipliers"]["min"].get<double>() << " .. " << p["multipliers"]["max"].get<double>()
+       << ", median " << p["multipliers"]["median"].get<double>() << "\n";
+  }
+  os << "\n"
+     << (rq.nonlinear_check ? "Relative nodal displacement error vs FEM (nonlinear MSS at the case loads x " +
                                  std::to_string(rq.check_load_scale).substr(0, 4) + "; linearised in brackets):\n\n"
                              : "Relative nodal displacement error vs FEM (linearised MSS only: --no-check):\n\n")
      << "  " << std::left << std::setw(18) << "case" << std::setw(10) << "set" << std::right << std::setw(24)
-     << "untuned (Van Gelder)" << std::setw(24) << "tuned" << "\n";
+     << "untuned (Van Gelder)";
+  if (ps) os << std::setw(24) << "region scales";
+  os << std::setw(24) << (ps ? "per-spring" : "tuned") << "\n";
   for (const char* set : {"train", "holdout"})
     for (const auto& r : rep[set]) {
       const auto cell = [&](const char* nl, const char* lin) {
         return pct(r[nl].get<double>()) + " (" + pct(r[lin].get<double>()) + ")";
       };
       os << "  " << std::left << std::setw(18) << r["name"].get<std::string>() << std::setw(10) << set << std::right
-         << std::setw(24) << cell("untuned_error", "untuned_error_linear") << std::setw(24)
-         << cell("tuned_error", "tuned_error_linear") << "\n";
+         << std::setw(24) << cell("untuned_error", "untuned_error_linear");
+      if (ps) os << std::setw(24) << cell("region_error", "region_error_linear");
+      os << std::setw(24) << cell("tuned_error", "tuned_error_linear") << "\n";
     }
   static const char* dof[] = {"tx [N/mm]", "ty [N/mm]", "tz [N/mm]", "rx [N·mm/deg]", "ry [N·mm/deg]", "rz [N·mm/deg]"};
   const auto& kd = rep["stiffness_diagonal"];
   os << "\n6x6 plate stiffness diagonal (linear), MSS / FEM:\n\n  " << std::left << std::setw(16) << "DOF" << std::right
-     << std::setw(12) << "FEM" << std::setw(12) << "untuned" << std::setw(12) << "tuned" << "\n";
+     << std::setw(12) << "FEM" << std::setw(12) << "untuned";
+  if (ps) os << std::setw(12) << "region";
+  os << std::setw(12) << (ps ? "per-spring" : "tuned") << "\n";
   for (int i = 0; i < 6; ++i) {
     os << "  " << std::left << std::setw(16) << dof[i] << std::right << std::defaultfloat << std::setprecision(4)
        << std::setw(12) << kd["fem"][std::size_t(i)].get<double>() << std::fixed << std::setprecision(3)
-       << std::setw(12) << kd["ratio_untuned"][std::size_t(i)].get<double>() << std::setw(12)
-       << kd["ratio_tuned"][std::size_t(i)].get<double>() << "\n";
+       << std::setw(12) << kd["ratio_untuned"][std::size_t(i)].get<double>();
+    if (ps) os << std::setw(12) << kd["ratio_region"][std::size_t(i)].get<double>();
+    os << std::setw(12) << kd["ratio_tuned"][std::size_t(i)].get<double>() << "\n";
   }
   for (const auto& tr : rep["transfer"]) {
-    os << "\nSame scales on another mesh: " << tr["mesh"].get<std::string>() << " (" << tr["tets"] << " tets), vs the FEM there:\n\n"
-       << "  " << std::left << std::setw(18) << "case" << std::right << std::setw(24) << "untuned" << std::setw(24) << "tuned"
-       << "\n";
+    os << "\n" << (ps ? "Region-level scales" : "Same scales") << " on another mesh: " << tr["mesh"].get<std::string>()
+       << " (" << tr["tets"] << " tets), vs the FEM there"
+       << (ps ? " (per-spring multipliers do not transfer to another mesh)" : "") << ":\n\n"
+       << "  " << std::left << std::setw(18) << "case" << std::right << std::setw(24) << "untuned" << std::setw(24)
+       << (ps ? "region scales" : "tuned") << "\n";
     for (const auto& c : tr["cases"])
       os << "  " << std::left << std::setw(18) << c["name"].get<std::string>() << std::right << std::setw(24)
          << pct(c["untuned_error"].get<double>()) << std::setw(24) << pct(c["tuned_error"].get<double>()) << "\n";
@@ -325,9 +439,12 @@ void print_calibration(std::ostream& os, const CalibrationOutcome& o, const Cali
     for (const auto& r : tr["stiffness_ratio_tuned"]) os << " " << std::fixed << std::setprecision(3) << r.get<double>();
     os << std::defaultfloat << "\n";
   }
-  os << "\nTuned scales (x Van Gelder constants):";
+  os << "\nTuned " << (ps ? "region " : "") << "scales (x Van Gelder constants):";
   for (const auto& [name, s] : o.tuned.scales) os << "  " << name << " " << std::setprecision(3) << s;
   os << std::defaultfloat << "\n";
+  if (ps)
+    os << "Per-spring multipliers: " << o.tuned.edge_multipliers.size()
+       << " (this mesh only: `mss --params` refuses the file on any other mesh)\n";
 }
 
 }  // namespace spinesim::cli

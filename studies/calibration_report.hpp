@@ -2,12 +2,15 @@
 // demo): FEM reference on the mesh, the untuned (Van Gelder) baseline, Ipopt, and the checks —
 // training and held-out cases by the *nonlinear* MSS at the cases' loads (the same protocol as
 // `spinesim mss compare`, so the numbers in tuned.json are the ones `mss compare --params`
-// reproduces) beside the linearised errors the optimiser saw.
+// reproduces) beside the linearised errors the optimiser saw. Optionally a second stage
+// (per_spring.hpp): one multiplier per main spring on top of the region fit, reported beside
+// the region-only fit; its multipliers belong to the mesh and are not carried to transfer meshes.
 #pragma once
 
 #include "mss_report.hpp"
 
 #include "spinesim/calibration/calibrate.hpp"
+#include "spinesim/calibration/per_spring.hpp"
 #include "spinesim/calibration/tuned_disc.hpp"
 
 #include <functional>
@@ -43,9 +46,15 @@ struct CalibrationRequest {
   /// "second mesh resolution" of the protocol): FEM on each, untuned and tuned MSS, same cases
   /// and load scale. Labels name them in the report.
   std::vector<std::pair<std::string, mesh::TetMesh>> transfer_meshes;
+  /// Second stage after a successful region fit: per-spring multipliers (per_spring.hpp); the
+  /// prior weight is weights.regularisation, the smoothness weight per_spring_weights.smoothness.
+  bool per_spring = false;
+  calibration::PerSpringWeights per_spring_weights;
+  calibration::IpoptSettings per_spring_ipopt = calibration::per_spring_ipopt_defaults();
 };
 
-/// The tuned scales applied to another mesh of the disc, against the FEM on that mesh.
+/// The tuned region-level scales applied to another mesh of the disc (per-spring multipliers
+/// do not transfer), against the FEM on that mesh.
 struct TransferCheck {
   std::string label;
   MssFemComparison untuned, tuned;
@@ -53,11 +62,18 @@ struct TransferCheck {
 };
 
 struct CalibrationOutcome {
-  calibration::TunedDisc tuned;            ///< report filled; written only if result.success
-  calibration::CalibrationResult result;
+  calibration::TunedDisc tuned;            ///< report filled; written only if `success`
+  bool success = false;                    ///< every requested stage succeeded
+  calibration::CalibrationResult result;   ///< the region fit
+  calibration::PerSpringResult per_spring; ///< the per-spring stage (if requested and the region fit succeeded)
+  bool per_spring_ran = false;
   calibration::Evaluation untuned_linear;  ///< thesis model, scales 1, linearised
-  fem::Matrix6d k6_fem = fem::Matrix6d::Zero(), k6_untuned = fem::Matrix6d::Zero(), k6_tuned = fem::Matrix6d::Zero();
-  MssFemComparison untuned_check, tuned_check;  ///< nonlinear, all cases (empty if not requested)
+  /// k6_tuned: the tuned file's model (per-spring when that stage ran); k6_region: the region fit.
+  fem::Matrix6d k6_fem = fem::Matrix6d::Zero(), k6_untuned = fem::Matrix6d::Zero(), k6_tuned = fem::Matrix6d::Zero(),
+                k6_region = fem::Matrix6d::Zero();
+  /// Nonlinear, all cases (empty if not requested): tuned_check is the tuned file's model,
+  /// region_check the region-only fit when the per-spring stage ran.
+  MssFemComparison untuned_check, tuned_check, region_check;
   std::vector<TransferCheck> transfer;          ///< one per request.transfer_meshes
   double fem_seconds = 0, setup_seconds = 0, check_seconds = 0, total_seconds = 0;
 };
@@ -66,8 +82,9 @@ struct CalibrationOutcome {
 using StatusLine = std::function<void(const std::string&)>;
 
 /// Calibrates `mesh` with `materials`. Throws std::invalid_argument for bad requests (no
-/// training case, a case both trained and held out, bad Ipopt settings). A failed Ipopt run is
-/// returned (result.success false, result.status why), not thrown.
+/// training case, a case both trained and held out, bad Ipopt settings or per-spring weights).
+/// A failed Ipopt run is returned (success false; result / per_spring say which stage and why),
+/// not thrown.
 CalibrationOutcome calibrate_disc(const mesh::TetMesh& mesh, const mesh::RegionMaterials& materials,
                                   const CalibrationRequest& request, const StatusLine& status = StatusLine());
 
@@ -76,7 +93,8 @@ CalibrationOutcome calibrate_disc(const mesh::TetMesh& mesh, const mesh::RegionM
 mss::MssModel tuned_model(const calibration::TunedDisc& tuned, const mesh::TetMesh& mesh,
                           const mesh::RegionMaterials& materials, bool quiet);
 
-/// Readable summary: every case untuned vs tuned (nonlinear and linear), K6 diagonals, Ipopt.
+/// Readable summary: every case untuned vs tuned (nonlinear and linear; region-only beside
+/// per-spring when that stage ran), K6 diagonals, Ipopt.
 void print_calibration(std::ostream& os, const CalibrationOutcome& o, const CalibrationRequest& request);
 
 }  // namespace spinesim::cli

@@ -86,11 +86,12 @@ ModelChoice choose_model(const ModelFlags& flags, const std::string& params, con
   c.materials = material_given ? mesh::load_material(material, data_dir()) : tuned.materials();
   c.constants = "tuned (" + params + ")";
   c.variant = "tuned " + std::string(c.options.volume_term ? "thesis+volume" : "thesis") +
-              (c.options.disc_volume_term ? "+disc-volume" : "");
+              (c.options.disc_volume_term ? "+disc-volume" : "") + (tuned.per_spring() ? ", per-spring" : "");
   return c;
 }
 
-/// The MSS for `m`: with a tuned file, only after it was checked against the mesh and material.
+/// The MSS for `m`: with a tuned file, only after it was checked against the mesh and material
+/// (a per-spring file: the very mesh it was fitted on).
 mss::MssModel build_model(const mesh::TetMesh& m, const ModelChoice& c, const std::string& params, bool quiet) {
   if (params.empty()) return mss::MssModel(m, c.materials, c.options);
   const calibration::TunedDisc tuned = calibration::read_tuned_disc(params);
@@ -394,7 +395,8 @@ constexpr const char* kCompareProtocol = R"(Protocol (same mesh, each named case
       over the same denominator.
   (c) 6x6 plate stiffness diagonal, MSS (rest Hessian condensed onto the plate) / FEM.
 MSS constants: the untuned Van Gelder ones (the baseline calibration must beat), or a tuned file
-from `spinesim calibrate` (--params; refused for another material or disc level).
+from `spinesim calibrate` (--params; refused for another material or disc level, and a per-spring
+file on any mesh but the one it was fitted on).
 --load-scale multiplies every case's wrench: the FEM is linear, so small loads show the linear
 regime the calibration fits; the standard loads (7.5 N·m moments) also show the MSS's
 geometric nonlinearity.)";

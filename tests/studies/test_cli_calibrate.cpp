@@ -76,7 +76,8 @@ void expect_refused_without(const CliRun& r, const std::string& needle, const st
 TEST(CalibrateCli, HelpDescribesTheProtocol) {
   const CliRun r = run_spinesim("calibrate --help");
   EXPECT_EQ(r.status, 0);
-  for (const char* flag : {"--mesh", "--level", "--train", "--holdout", "--terms", "--out", "--no-check", "--json"})
+  for (const char* flag : {"--mesh", "--level", "--train", "--holdout", "--terms", "--out", "--no-check", "--json",
+                           "--per-spring", "--smoothness"})
     EXPECT_NE(r.out.find(flag), std::string::npos) << flag;
 }
 
@@ -324,6 +325,190 @@ TEST(MssParamsRefuses, TermFlagsBesideParams) {
                    "--params");
     expect_refused(run_spinesim("mss compare --mesh " + in_quotes(disc()) + params + " " + flag), "--params");
   }
+}
+
+// --- --per-spring: region fit, then one multiplier per main spring --------------------------------
+
+/// A per-spring calibration of disc() per process (`checked`: with the nonlinear check).
+const Calibrated& per_spring_calibrated(bool checked) {
+  static std::map<bool, Calibrated> made;
+  auto it = made.find(checked);
+  if (it != made.end()) return it->second;
+  Calibrated c;
+  c.path = tmp(checked ? "tuned-per-spring-checked.json" : "tuned-per-spring.json");
+  const CliRun r = run_spinesim("calibrate --mesh " + in_quotes(disc()) + " --per-spring --out " + in_quotes(c.path) +
+                                " --json" + (checked ? "" : " --no-check"));
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(r.err.empty()) << r.err;
+  c.printed = json::parse(r.out, nullptr, false);
+  return made.emplace(checked, c).first->second;
+}
+
+// Both stages reported (region-only beside per-spring, train and holdout, linearised and
+// nonlinear), the file is kind per-spring with one multiplier per main spring, and its
+// tuned_error is what `mss compare --params` measures on the same mesh.
+TEST(CalibrateCliPerSpring, ReportsBothStagesAndMssCompareReproducesThem) {
+  const Calibrated& c = per_spring_calibrated(true);
+  const json& j = c.printed;
+  ASSERT_TRUE(j.is_object());
+  EXPECT_EQ(j.at("kind"), "per-spring");
+  const std::size_t n = j.at("edge_springs").get<std::size_t>();
+  ASSERT_GT(n, 100u);
+  ASSERT_EQ(j.at("edge_multipliers").size(), n);
+  for (const auto& mu : j.at("edge_multipliers")) {
+    EXPECT_GE(mu.get<double>(), 0.1 - 1e-9);
+    EXPECT_LE(mu.get<double>(), 10.0 + 1e-9);
+  }
+  const json& rep = j.at("report");
+  EXPECT_TRUE(rep.at("ipopt").at("success").get<bool>());
+  const json& ps = rep.at("per_spring");
+  EXPECT_TRUE(ps.at("ipopt").at("success").get<bool>()) << ps.at("ipopt");
+  EXPECT_EQ(ps.at("edge_springs").get<std::size_t>(), n);
+  EXPECT_LE(ps.at("objective").at("final").at("J").get<double>(), ps.at("objective").at("start").at("J").get<double>());
+  // The start of the second stage is the region fit: same data terms.
+  EXPECT_NEAR(ps.at("objective").at("start").at("data").get<double>(),
+              rep.at("objective").at("final").at("J").get<double>() -
+                  rep.at("weights").at("regularisation").get<double>() *
+                      rep.at("objective").at("final").at("regularisation").get<double>(),
+              1e-9);
+  double region_sum = 0, per_spring_sum = 0;
+  for (const char* set : {"train", "holdout"})
+    for (const auto& row : rep.at(set)) {
+      SCOPED_TRACE(std::string(set) + " " + row.at("name").get<std::string>());
+      for (const char* key : {"untuned_error", "region_error", "tuned_error", "region_error_linear", "tuned_error_linear"}) {
+        ASSERT_TRUE(row.contains(key)) << key;
+        EXPECT_TRUE(std::isfinite(row.at(key).get<double>())) << key;
+      }
+      if (std::string(set) == "train") {
+        region_sum += row.at("region_error_linear").get<double>();
+        per_spring_sum += row.at("tuned_error_linear").get<double>();
+      }
+    }
+  EXPECT_LT(per_spring_sum, region_sum);  // more freedom fits the training cases closer
+  EXPECT_EQ(rep.at("stiffness_diagonal").at("ratio_region").size(), 6u);
+
+  // The file is what was printed; the region-level scales are in it too.
+  const json file = json::parse(slurp(c.path));
+  json printed = j;
+  printed.erase("out");
+  printed.erase("mesh_file");
+  EXPECT_EQ(file, printed);
+  EXPECT_EQ(file.at("scales").size(), 8u);
+
+  // mss compare --params on the same mesh reproduces the per-spring nonlinear errors.
+  std::ostringstream scale;
+  scale.precision(17);
+  scale << rep.at("check_load_scale").get<double>();
+  const CliRun r = run_spinesim("mss compare --mesh " + in_quotes(disc()) + " --params " + in_quotes(c.path) +
+                                " --load-scale " + scale.str() + " --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::map<std::string, double> expected;
+  for (const char* set : {"train", "holdout"})
+    for (const auto& row : rep.at(set)) expected[row.at("name")] = row.at("tuned_error").get<double>();
+  for (const auto& cs : json::parse(r.out).at("cases")) {
+    const double e = expected.at(cs.at("name").get<std::string>());
+    EXPECT_NEAR(cs.at("displacement_error").get<double>(), e, 1e-6 * e) << cs.at("name");
+  }
+}
+
+// On a transfer mesh only the region-level scales are checked, and the report says why.
+TEST(CalibrateCliPerSpring, TransferMeshGetsTheRegionScalesAndTheReportSaysSo) {
+  const std::string other = tmp("disc-L4-L5-10-sectors.vtu");
+  ASSERT_EQ(run_spinesim("mesh disc --level L4-L5 --structured --sectors 10 --out " + in_quotes(other)).status, 0);
+  const std::string out = tmp("tuned-per-spring-transfer.json");
+  const CliRun r = run_spinesim("calibrate --mesh " + in_quotes(disc()) + " --per-spring --no-check --transfer-mesh " +
+                                in_quotes(other) + " --out " + in_quotes(out));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("per-spring multipliers do not transfer"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("Region-level scales on another mesh"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("region scales"), std::string::npos) << r.out;  // the region-only column
+  const json file = json::parse(slurp(out));
+  ASSERT_EQ(file["report"]["transfer"].size(), 1u);
+  const json& t = file["report"]["transfer"][0];
+  EXPECT_EQ(t.at("scales"), "region-level");
+  EXPECT_NE(t.at("note").get<std::string>().find("do not transfer"), std::string::npos);
+  // The errors there are those of the region-level scales: a region-only file gives the same.
+  json region = file;
+  region["kind"] = "region";
+  region.erase("edge_multipliers");
+  region.erase("edge_springs");
+  const std::string region_path = tmp("tuned-per-spring-transfer-region.json");
+  std::ofstream(region_path) << region.dump();
+  std::ostringstream scale;
+  scale.precision(17);
+  scale << t.at("load_scale").get<double>();  // the transfer check's, with or without --no-check
+  const CliRun cmp = run_spinesim("mss compare --mesh " + in_quotes(other) + " --params " + in_quotes(region_path) +
+                                  " --load-scale " + scale.str() + " --json");
+  ASSERT_EQ(cmp.status, 0) << cmp.err;
+  std::map<std::string, double> expected;
+  for (const auto& c : t.at("cases")) expected[c.at("name")] = c.at("tuned_error").get<double>();
+  for (const auto& cs : json::parse(cmp.out).at("cases")) {
+    const double e = expected.at(cs.at("name").get<std::string>());
+    EXPECT_NEAR(cs.at("displacement_error").get<double>(), e, 1e-6 * e) << cs.at("name");
+  }
+  // ... and the per-spring file itself is refused there.
+  const CliRun refused = run_spinesim("mss compare --mesh " + in_quotes(other) + " --params " + in_quotes(out));
+  expect_refused(refused, "per-spring");
+  EXPECT_NE(refused.err.find("region-level tuned files transfer"), std::string::npos) << refused.err;
+}
+
+TEST(MssParamsPerSpring, TheModelGetsTheMultipliersOnItsMeshOnly) {
+  const Calibrated& c = per_spring_calibrated(false);
+  const CliRun ps = run_spinesim("mss --mesh " + in_quotes(disc()) + " --params " + in_quotes(c.path) +
+                                 " --case compression --json");
+  ASSERT_EQ(ps.status, 0) << ps.err;
+  EXPECT_TRUE(ps.err.empty()) << ps.err;
+  // The same region scales without the multipliers settle elsewhere: the multipliers are used.
+  json region = json::parse(slurp(c.path));
+  region["kind"] = "region";
+  region.erase("edge_multipliers");
+  region.erase("edge_springs");
+  const std::string region_path = tmp("tuned-per-spring-as-region.json");
+  std::ofstream(region_path) << region.dump();
+  const CliRun rg = run_spinesim("mss --mesh " + in_quotes(disc()) + " --params " + in_quotes(region_path) +
+                                 " --case compression --json");
+  ASSERT_EQ(rg.status, 0) << rg.err;
+  const double dy_ps = json::parse(ps.out)["plate_motion"][1].get<double>();
+  const double dy_rg = json::parse(rg.out)["plate_motion"][1].get<double>();
+  EXPECT_GT(std::abs(dy_ps - dy_rg), 1e-4 * std::abs(dy_rg));
+
+  // Another mesh of the same level: the region file applies, the per-spring one is refused.
+  const std::string other = tmp("disc-L4-L5-3-layers.vtu");
+  ASSERT_EQ(run_spinesim("mesh disc --level L4-L5 --structured --layers 3 --out " + in_quotes(other)).status, 0);
+  EXPECT_EQ(run_spinesim("mss --mesh " + in_quotes(other) + " --params " + in_quotes(region_path) + " --case compression")
+                .status,
+            0);
+  for (const std::string verb : {"mss --case compression", "mss compare --cases compression"}) {
+    SCOPED_TRACE(verb);
+    const std::string sub = verb.substr(0, verb.find(" --"));
+    const std::string flags = verb.substr(verb.find(" --"));
+    const CliRun r = run_spinesim(sub + " --mesh " + in_quotes(other) + " --params " + in_quotes(c.path) + flags);
+    expect_refused(r, "per-spring");
+    EXPECT_NE(r.err.find("do not"), std::string::npos) << r.err;
+    EXPECT_TRUE(r.out.empty()) << r.out;
+  }
+}
+
+TEST(CalibrateCliPerSpringRefuses, BadOptionsAndAFailedSecondStage) {
+  const std::string out = tmp("tuned-per-spring-refused.json");
+  const std::string mesh = " --mesh " + in_quotes(disc());
+  const std::string to = " --out " + in_quotes(out);
+  expect_refused_without(run_spinesim("calibrate" + mesh + " --smoothness 0.1" + to), "--per-spring", out);
+  expect_refused_without(run_spinesim("calibrate" + mesh + " --per-spring --smoothness -1" + to), "--smoothness", out);
+  expect_refused_without(run_spinesim("calibrate --level all --per-spring" + to), "--per-spring", out);
+
+  // The region fit succeeds, the per-spring stage hits its iteration limit: exit 1, one line,
+  // no file; the JSON on stdout says which stage failed.
+  const CliRun r = run_spinesim("calibrate" + mesh + " --per-spring --per-spring-max-iterations 2 --no-check --json" + to);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(count_lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("per-spring stage"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  const json j = json::parse(r.out);
+  EXPECT_TRUE(j["report"]["ipopt"]["success"].get<bool>());
+  EXPECT_FALSE(j["report"]["per_spring"]["ipopt"]["success"].get<bool>());
+  EXPECT_EQ(j["report"]["per_spring"]["ipopt"]["status"], "Maximum_Iterations_Exceeded");
+  EXPECT_FALSE(j.contains("out"));
 }
 
 namespace spinesim::cli {
