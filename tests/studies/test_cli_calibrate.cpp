@@ -40,23 +40,24 @@ const std::string& disc(const std::string& level = "L4-L5") {
   return made.emplace(level, path).first->second;
 }
 
-/// One calibration of disc() per process and flavour: `checked` runs the nonlinear check.
+/// One calibration of disc() per process and flavour: `checked` runs the nonlinear check,
+/// `per_spring` the second stage.
 struct Calibrated {
   std::string path;  ///< the tuned file
   json printed;      ///< what --json printed
 };
-const Calibrated& calibrated(bool checked) {
-  static std::map<bool, Calibrated> made;
-  auto it = made.find(checked);
+const Calibrated& calibrated(bool checked, bool per_spring = false) {
+  static std::map<std::pair<bool, bool>, Calibrated> made;
+  auto it = made.find({checked, per_spring});
   if (it != made.end()) return it->second;
   Calibrated c;
-  c.path = tmp(checked ? "tuned-checked.json" : "tuned.json");
+  c.path = tmp(std::string("tuned") + (per_spring ? "-per-spring" : "") + (checked ? "-checked" : "") + ".json");
   const CliRun r = run_spinesim("calibrate --mesh " + in_quotes(disc()) + " --out " + in_quotes(c.path) + " --json" +
-                                (checked ? "" : " --no-check"));
+                                (checked ? "" : " --no-check") + (per_spring ? " --per-spring" : ""));
   EXPECT_EQ(r.status, 0) << r.err;
   EXPECT_TRUE(r.err.empty()) << r.err;
   c.printed = json::parse(r.out, nullptr, false);
-  return made.emplace(checked, c).first->second;
+  return made.emplace(std::make_pair(checked, per_spring), c).first->second;
 }
 
 std::vector<std::string> case_names(const json& rows) {
@@ -329,26 +330,11 @@ TEST(MssParamsRefuses, TermFlagsBesideParams) {
 
 // --- --per-spring: region fit, then one multiplier per main spring --------------------------------
 
-/// A per-spring calibration of disc() per process (`checked`: with the nonlinear check).
-const Calibrated& per_spring_calibrated(bool checked) {
-  static std::map<bool, Calibrated> made;
-  auto it = made.find(checked);
-  if (it != made.end()) return it->second;
-  Calibrated c;
-  c.path = tmp(checked ? "tuned-per-spring-checked.json" : "tuned-per-spring.json");
-  const CliRun r = run_spinesim("calibrate --mesh " + in_quotes(disc()) + " --per-spring --out " + in_quotes(c.path) +
-                                " --json" + (checked ? "" : " --no-check"));
-  EXPECT_EQ(r.status, 0) << r.err;
-  EXPECT_TRUE(r.err.empty()) << r.err;
-  c.printed = json::parse(r.out, nullptr, false);
-  return made.emplace(checked, c).first->second;
-}
-
 // Both stages reported (region-only beside per-spring, train and holdout, linearised and
 // nonlinear), the file is kind per-spring with one multiplier per main spring, and its
 // tuned_error is what `mss compare --params` measures on the same mesh.
 TEST(CalibrateCliPerSpring, ReportsBothStagesAndMssCompareReproducesThem) {
-  const Calibrated& c = per_spring_calibrated(true);
+  const Calibrated& c = calibrated(true, true);
   const json& j = c.printed;
   ASSERT_TRUE(j.is_object());
   EXPECT_EQ(j.at("kind"), "per-spring");
@@ -453,7 +439,7 @@ TEST(CalibrateCliPerSpring, TransferMeshGetsTheRegionScalesAndTheReportSaysSo) {
 }
 
 TEST(MssParamsPerSpring, TheModelGetsTheMultipliersOnItsMeshOnly) {
-  const Calibrated& c = per_spring_calibrated(false);
+  const Calibrated& c = calibrated(false, true);
   const CliRun ps = run_spinesim("mss --mesh " + in_quotes(disc()) + " --params " + in_quotes(c.path) +
                                  " --case compression --json");
   ASSERT_EQ(ps.status, 0) << ps.err;

@@ -1,7 +1,8 @@
 // Fits the MSS stiffness scales to the FEM with Ipopt (interior point, bound constraints
 // ln lower <= p_j <= ln upper; the exact gradient and the Gauss–Newton Hessian from
 // objective.hpp — limited-memory BFGS needed 170 iterations and ~1,900 evaluations on the
-// synthetic test problem, Gauss–Newton 8 iterations and 9 evaluations). Ipopt's C++ TNLP interface stays inside calibrate.cpp.
+// synthetic test problem, Gauss–Newton 8 iterations and 9 evaluations). Ipopt's C++ TNLP
+// interface stays private (src/bounded_nlp.*, shared with the per-spring stage, per_spring.hpp).
 #pragma once
 
 #include "spinesim/calibration/objective.hpp"
