@@ -45,6 +45,18 @@ const CaseComparison* case_check(const MssFemComparison& c, const std::string& n
 
 Eigen::VectorXd diag(const fem::Matrix6d& k) { return stiffness_per_degree(k).diagonal(); }
 
+/// An Ipopt run in the report (either stage's result), plus `extra` fields.
+template <class Result>
+nlohmann::json ipopt_json(const Result& r, nlohmann::json extra) {
+  extra.update({{"status", r.status},
+                {"success", r.success},
+                {"iterations", r.iterations},
+                {"evaluations", r.evaluations},
+                {"seconds", r.seconds},
+                {"seconds_per_evaluation", r.evaluations ? r.evaluation_seconds / r.evaluations : 0.0}});
+  return extra;
+}
+
 /// The per-spring stage in the report: weights, Ipopt, J at both ends, where the multipliers went.
 nlohmann::json per_spring_json(const calibration::PerSpringResult& r, const CalibrationRequest& rq, Eigen::Index edges) {
   std::vector<double> q(r.log_multipliers.data(), r.log_multipliers.data() + r.log_multipliers.size());
@@ -71,14 +83,7 @@ nlohmann::json per_spring_json(const calibration::PerSpringResult& r, const Cali
             {"at_upper_bound", count([hi](double v) { return v >= hi - 1e-6; })}}},
           {"kept_region_fit", r.kept_start},
           {"objective", {{"start", objective(r.start)}, {"final", objective(r.final)}}},
-          {"ipopt",
-           {{"status", r.status},
-            {"success", r.success},
-            {"iterations", r.iterations},
-            {"evaluations", r.evaluations},
-            {"seconds", r.seconds},
-            {"seconds_per_evaluation", r.evaluations ? r.evaluation_seconds / r.evaluations : 0.0},
-            {"hessian", "limited-memory BFGS"}}},
+          {"ipopt", ipopt_json(r, {{"hessian", "limited-memory BFGS"}})},
           {"transfer", "per-spring multipliers belong to this mesh; other meshes get the region-level scales"}};
 }
 
@@ -345,15 +350,7 @@ CalibrationOutcome calibrate_disc(const mesh::TetMesh& m, const mesh::RegionMate
          }
          return rows;
        }()},
-      {"ipopt",
-       {{"status", out.result.status},
-        {"success", out.result.success},
-        {"iterations", out.result.iterations},
-        {"evaluations", out.result.evaluations},
-        {"seconds", out.result.seconds},
-        {"seconds_per_evaluation",
-         out.result.evaluations ? out.result.evaluation_seconds / out.result.evaluations : 0.0},
-        {"scale_bounds", {rq.ipopt.lower_scale, rq.ipopt.upper_scale}}}},
+      {"ipopt", ipopt_json(out.result, {{"scale_bounds", {rq.ipopt.lower_scale, rq.ipopt.upper_scale}}})},
       {"timings",
        {{"fem_s", out.fem_seconds},
         {"setup_s", out.setup_seconds},
