@@ -213,6 +213,7 @@ CalibrationOutcome calibrate_disc(const mesh::TetMesh& m, const mesh::RegionMate
   if (out.per_spring_ran) {
     const Eigen::VectorXd mu = out.per_spring.log_multipliers.array().exp();
     t.edge_multipliers.assign(mu.data(), mu.data() + mu.size());
+    t.edge_order = calibration::edge_order_hash(model);
   }
 
   // 5. Nonlinear checks at the cases' loads (as `mss compare`).
@@ -367,7 +368,7 @@ mss::MssModel tuned_model(const calibration::TunedDisc& tuned, const mesh::TetMe
                           const mesh::RegionMaterials& materials, bool quiet) {
   const std::string note = calibration::check_applies(tuned, mesh, materials);
   if (!note.empty() && !quiet) std::cerr << "spinesim: note: " << note << "\n";
-  return mss::MssModel(mesh, materials, tuned.mss_options());
+  return calibration::build_tuned_model(tuned, mesh, materials);
 }
 
 void print_calibration(std::ostream& os, const CalibrationOutcome& o, const CalibrationRequest& rq) {

@@ -110,6 +110,7 @@ nlohmann::json to_json(const TunedDisc& t) {
   if (t.per_spring()) {
     j["edge_springs"] = t.edge_multipliers.size();
     j["edge_multipliers"] = t.edge_multipliers;
+    j["edge_order"] = t.edge_order;
   }
   return j;
 }
@@ -160,6 +161,7 @@ TunedDisc tuned_disc_from_json(const nlohmann::json& j) {
       if (t.edge_multipliers.empty()) throw std::invalid_argument("per-spring tuned-disc file has no edge_multipliers");
       for (const double mu : t.edge_multipliers)
         if (!std::isfinite(mu) || mu <= 0) throw std::invalid_argument("edge_multipliers must be finite and > 0");
+      t.edge_order = j.at("edge_order").get<std::string>();
       if (j.at("edge_springs").get<std::size_t>() != t.edge_multipliers.size())
         throw std::invalid_argument("edge_springs (" + j.at("edge_springs").dump() + ") does not match the " +
                                     std::to_string(t.edge_multipliers.size()) + " edge_multipliers");
@@ -169,6 +171,23 @@ TunedDisc tuned_disc_from_json(const nlohmann::json& j) {
   } catch (const nlohmann::json::exception& e) {
     throw std::invalid_argument(std::string("tuned-disc file: missing or malformed field (") + e.what() + ")");
   }
+}
+
+std::string edge_order_hash(const mss::MssModel& model) {
+  Fnv1a f;
+  for (const mss::EdgeSpringInfo& e : model.edge_springs()) f.add(e.i), f.add(e.j);
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(f.h));
+  return hex;
+}
+
+mss::MssModel build_tuned_model(const TunedDisc& t, const mesh::TetMesh& mesh, const mesh::RegionMaterials& materials) {
+  check_applies(t, mesh, materials);
+  mss::MssModel model(mesh, materials, t.mss_options());
+  if (t.per_spring() && edge_order_hash(model) != t.edge_order)
+    throw std::invalid_argument("the per-spring multipliers were fitted on another ordering of the edge springs (edge order " +
+                                t.edge_order + ", this model " + edge_order_hash(model) + "): refit them");
+  return model;
 }
 
 TunedDisc read_tuned_disc(const std::string& path) {

@@ -408,6 +408,7 @@ TunedDisc sample_per_spring(const mesh::TetMesh& m) {
   TunedDisc t = sample_tuned(m);
   const mss::MssModel model(m, two_materials(), t.mss_options());
   for (Eigen::Index e = 0; e < model.num_edge_springs(); ++e) t.edge_multipliers.push_back(0.5 + 1.0 / double(e + 3));
+  t.edge_order = edge_order_hash(model);
   return t;
 }
 
@@ -483,6 +484,23 @@ TEST(PerSpringFile, AppliesToTheFittedMeshOnly) {
   mesh::RegionMaterials renamed = two_materials();
   renamed.name = "rubber";
   expect_not_applicable(t, m, renamed, {"rubber"});
+}
+
+// The multipliers are indexed by the model's edge order: a file whose recorded order is not the
+// model's is refused when the model is built, never applied to the wrong springs.
+TEST(PerSpringFile, AnotherEdgeOrderIsRefusedWhenTheModelIsBuilt) {
+  const mesh::TetMesh m = l4l5_mesh();
+  TunedDisc t = sample_per_spring(m);
+  const mss::MssModel model = build_tuned_model(t, m, two_materials());
+  EXPECT_EQ(model.edge_springs()[7].multiplier, t.edge_multipliers[7]);
+  t.edge_order = "0123456789abcdef";
+  try {
+    build_tuned_model(t, m, two_materials());
+    FAIL() << "a per-spring file with another edge order was applied";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("ordering of the edge springs"), std::string::npos) << e.what();
+  }
+  expect_per_spring_refused([](json& j) { j.erase("edge_order"); }, "edge_order");
 }
 
 TEST(PerSpringFile, ATunedSetRefusesIt) {

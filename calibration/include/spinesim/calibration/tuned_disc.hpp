@@ -63,6 +63,9 @@ struct TunedDisc {
   /// Kind "per-spring": one multiplier mu_e > 0 per edge spring of the fitted mesh, in the
   /// model's edge order; empty for a region-level file.
   std::vector<double> edge_multipliers;
+  /// Kind "per-spring": edge_order_hash() of the model the multipliers were fitted on, so a
+  /// change of the MSS's edge ordering can never put them on the wrong springs silently.
+  std::string edge_order;
   nlohmann::json report;        ///< the calibration's summary (free form)
 
   bool per_spring() const { return !edge_multipliers.empty(); }
@@ -76,6 +79,14 @@ struct TunedDisc {
   /// (so a file calibrated with a material JSON file loads without it).
   mesh::RegionMaterials materials() const;
 };
+
+/// 64-bit FNV-1a hash (16 hex digits) of a model's edge springs' end nodes, in its edge order.
+std::string edge_order_hash(const mss::MssModel& model);
+
+/// The MSS of `mesh` with the tuned options, after check_applies; for a per-spring file also
+/// checks that the model orders its springs as the fitted one did (std::invalid_argument).
+mss::MssModel build_tuned_model(const TunedDisc& tuned, const mesh::TetMesh& mesh,
+                                const mesh::RegionMaterials& materials);
 
 nlohmann::json to_json(const TunedDisc& t);
 /// Parses and validates (format tag, version, kind, positive finite scales, known knob names,
