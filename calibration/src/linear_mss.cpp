@@ -23,17 +23,6 @@ const char* term_name(mss::Term t) {
   return "?";
 }
 
-bool term_on(const mss::MssOptions& o, mss::Term t) {
-  switch (t) {
-    case mss::Term::main: return true;
-    case mss::Term::radial: return o.radial_springs;
-    case mss::Term::torsion: return o.torsion_springs;
-    case mss::Term::volume: return o.volume_term;
-    case mss::Term::disc_volume: return o.disc_volume_term;
-  }
-  return false;
-}
-
 }  // namespace
 
 std::string knob_name(const Knob& k) {
@@ -56,7 +45,7 @@ std::vector<Knob> available_knobs(const mss::MssOptions& o) {
   std::vector<Knob> out;
   for (int t = 0; t < mss::kNumTerms; ++t) {
     const auto term = static_cast<mss::Term>(t);
-    if (!term_on(o, term)) continue;
+    if (!mss::term_enabled(o, term)) continue;
     out.push_back({term, 0});
     if (term != mss::Term::disc_volume) out.push_back({term, 1});
   }
@@ -122,7 +111,7 @@ LinearMss::LinearMss(const mss::MssModel& model, std::vector<Knob> knobs, const 
   const Eigen::VectorXd& X = model.rest_positions_mm();
   if (knobs.empty()) throw std::invalid_argument("calibration: no stiffness knobs to tune");
   for (const Knob& k : knobs)
-    if (!term_on(model.options(), k.term))
+    if (!mss::term_enabled(model.options(), k.term))
       throw std::invalid_argument("calibration: knob " + knob_name(k) + " belongs to a term that is switched off");
   m.knobs = std::move(knobs);
   m.ndof = model.num_dofs();

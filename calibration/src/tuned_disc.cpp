@@ -24,17 +24,6 @@ struct Fnv1a {
   }
 };
 
-bool term_on(const mss::MssOptions& o, mss::Term t) {
-  switch (t) {
-    case mss::Term::main: return true;
-    case mss::Term::radial: return o.radial_springs;
-    case mss::Term::torsion: return o.torsion_springs;
-    case mss::Term::volume: return o.volume_term;
-    case mss::Term::disc_volume: return o.disc_volume_term;
-  }
-  return false;
-}
-
 bool same_number(double a, double b) { return std::abs(a - b) <= 1e-9 * std::max(std::abs(a), std::abs(b)); }
 
 }  // namespace
@@ -149,7 +138,7 @@ TunedDisc tuned_disc_from_json(const nlohmann::json& j) {
       const Knob k = knob_from_name(name);
       const double s = value.get<double>();
       if (!std::isfinite(s) || s <= 0) throw std::invalid_argument("scale '" + name + "' must be finite and > 0");
-      if (!term_on(t.options, k.term))
+      if (!mss::term_enabled(t.options, k.term))
         throw std::invalid_argument("scale '" + name + "' belongs to a term the file switches off");
       t.scales[name] = s;
     }

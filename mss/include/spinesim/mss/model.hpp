@@ -101,6 +101,18 @@ struct EdgeSpringInfo {
   double multiplier = 1;  ///< mu_e; the spring's stiffness is multiplier * k_region
 };
 
+/// Whether `options` switch `term` on (the main springs always are).
+inline bool term_enabled(const MssOptions& options, Term term) {
+  switch (term) {
+    case Term::main: return true;
+    case Term::radial: return options.radial_springs;
+    case Term::torsion: return options.torsion_springs;
+    case Term::volume: return options.volume_term;
+    case Term::disc_volume: return options.disc_volume_term;
+  }
+  return false;
+}
+
 /// Equivalent cylinder of the thesis (5.6)-(5.8), for reports.
 struct EquivalentCylinder {
   double upper_diameter_mm = 0, lower_diameter_mm = 0, mean_diameter_mm = 0, length_mm = 0;
