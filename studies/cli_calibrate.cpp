@@ -299,7 +299,7 @@ void register_calibrate(CLI::App& app) {
       "the FEM's plate motion + w_k mean ln^2(K6_ii MSS/FEM) + w_p mean ln^2(scale), the MSS linearised at\n"
       "rest; exact adjoint gradient. Reported: untuned (Van Gelder) and tuned errors on training and\n"
       "held-out cases by the nonlinear MSS at the case loads x --check-load-scale (as `spinesim mss compare\n"
-      "--load-scale`; the FEM is linear, the standard loads turn the plate by up to ~9 deg on L4-L5 and ~20 deg\n"
+      "--load-scale`; the FEM is linear, the standard loads turn the plate by up to 15 deg on L4-L5 and ~20 deg\n"
       "on thoracic discs), beside the linearised errors. A failed Ipopt run exits 1 and writes no file.\n"
       "--per-spring: then q_e = ln mu_e per main spring, J + w_s smoothness + w_p mean q^2, mu in [0.1, 10]; the\n"
       "region-only fit is reported beside it, transfer meshes get the region-level scales (per-spring ones do not\n"
