@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 
 namespace spinesim::calibration {
 namespace {
@@ -36,10 +37,17 @@ TEST(ShippedTunedDiscs, EveryLevelIsThereAndBeatsVanGelder) {
   }
 }
 
-// Regenerate T12-L1 (the smallest mesh: 6,965 tets) with the shipped settings: same mesher, FEM, knobs,
-// cases and weights. The scales agree to 5 %: a build with other compiler flags meshes the disc
-// differently in the last bits (CGAL), which moves the optimum slightly; the fit itself is
-// deterministic (same build: identical to ~1e-6).
+// Regenerate T12-L1 (the smallest mesh: 6,965 tets) with the shipped settings: same mesher, FEM,
+// knobs, cases and weights.
+//  - Same mesh as the shipped fit (same fingerprint: a build like the one that wrote the file):
+//    the fit is deterministic, so the scales and J agree to 1e-4.
+//  - Another mesh (a build with other compiler flags — the debug+sanitizer preset is generic,
+//    the release build -march=native — meshes the disc differently in the last bits, CGAL):
+//    the raw scales then move by up to ~12 % (measured: main.annulus 0.122 -> 0.111), because J
+//    is flat along a trade-off between the main springs and the other terms. What the file
+//    promises is what the scales do, so that is checked: on the new mesh the shipped scales
+//    reach J within 10 % of a fresh fit's, every case's error within 1 point of it, and the
+//    6x6 diagonal within 2 %.
 TEST(ShippedTunedDiscs, RegeneratingOneLevelReproducesItsScales) {
   const std::string level = "T12-L1";
   const TunedDisc& shipped_disc = tuned_level(shipped(), level);
@@ -69,14 +77,25 @@ TEST(ShippedTunedDiscs, RegeneratingOneLevelReproducesItsScales) {
   const CalibrationResult r = calibrate(obj, Eigen::VectorXd::Zero(Eigen::Index(lin.knobs().size())));
   ASSERT_TRUE(r.success) << r.status;
   ASSERT_EQ(lin.knobs().size(), shipped_disc.scales.size());
-  for (std::size_t j = 0; j < lin.knobs().size(); ++j) {
-    const std::string name = knob_name(lin.knobs()[j]);
-    const double again = std::exp(r.log_scales(Eigen::Index(j)));
-    EXPECT_NEAR(again, shipped_disc.scales.at(name), 0.05 * shipped_disc.scales.at(name)) << name;
+  Eigen::VectorXd shipped_p(Eigen::Index(lin.knobs().size()));
+  for (std::size_t j = 0; j < lin.knobs().size(); ++j)
+    shipped_p(Eigen::Index(j)) = std::log(shipped_disc.scales.at(knob_name(lin.knobs()[j])));
+  const double shipped_J = shipped_disc.report["objective"]["final"]["J"].get<double>();
+
+  if (fingerprint(m) == shipped_disc.mesh) {
+    for (std::size_t j = 0; j < lin.knobs().size(); ++j)
+      EXPECT_NEAR(r.log_scales(Eigen::Index(j)), shipped_p(Eigen::Index(j)), 1e-4) << knob_name(lin.knobs()[j]);
+    EXPECT_NEAR(r.final.value, shipped_J, 1e-4 * shipped_J);
+    return;
   }
-  // The objective it reaches is the shipped one's.
-  EXPECT_NEAR(r.final.value, shipped_disc.report["objective"]["final"]["J"].get<double>(),
-              0.05 * shipped_disc.report["objective"]["final"]["J"].get<double>());
+  std::printf("another build's mesh (%lld tets, shipped %lld): comparing what the scales do\n",
+              static_cast<long long>(m.num_tets()), static_cast<long long>(shipped_disc.mesh.tets));
+  const Evaluation with_shipped = obj.evaluate(shipped_p, false);
+  EXPECT_LT(with_shipped.value, 1.10 * r.final.value);
+  for (std::size_t k = 0; k < with_shipped.cases.size(); ++k)
+    EXPECT_NEAR(with_shipped.cases[k].displacement_error, r.final.cases[k].displacement_error, 0.01)
+        << with_shipped.cases[k].name;
+  for (int i = 0; i < 6; ++i) EXPECT_NEAR(with_shipped.k6(i, i) / r.final.k6(i, i), 1.0, 0.02) << "K6 " << i;
 }
 
 }  // namespace

@@ -391,7 +391,8 @@ TEST(CalibrateCliPerSpring, ReportsBothStagesAndMssCompareReproducesThem) {
   std::map<std::string, double> expected;
   for (const char* set : {"train", "holdout"})
     for (const auto& row : rep.at(set)) expected[row.at("name")] = row.at("tuned_error").get<double>();
-  for (const auto& cs : json::parse(r.out).at("cases")) {
+  const json compared = json::parse(r.out);  // named: a range-for over parse(...).at(...) dangles
+  for (const auto& cs : compared.at("cases")) {
     const double e = expected.at(cs.at("name").get<std::string>());
     EXPECT_NEAR(cs.at("displacement_error").get<double>(), e, 1e-6 * e) << cs.at("name");
   }
@@ -428,7 +429,8 @@ TEST(CalibrateCliPerSpring, TransferMeshGetsTheRegionScalesAndTheReportSaysSo) {
   ASSERT_EQ(cmp.status, 0) << cmp.err;
   std::map<std::string, double> expected;
   for (const auto& c : t.at("cases")) expected[c.at("name")] = c.at("tuned_error").get<double>();
-  for (const auto& cs : json::parse(cmp.out).at("cases")) {
+  const json compared = json::parse(cmp.out);  // named: a range-for over parse(...).at(...) dangles
+  for (const auto& cs : compared.at("cases")) {
     const double e = expected.at(cs.at("name").get<std::string>());
     EXPECT_NEAR(cs.at("displacement_error").get<double>(), e, 1e-6 * e) << cs.at("name");
   }
