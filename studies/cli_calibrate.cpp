@@ -185,6 +185,9 @@ void run_calibrate(const CalibrateArgs& a) {
   rq.fem_order = a.order;
   rq.terms = parse_term_set(a.terms);
   rq.weights = a.weights;
+  for (const double w : {a.weights.reaction, a.weights.stiffness, a.weights.regularisation})
+    if (!std::isfinite(w) || w < 0)
+      throw std::invalid_argument("--reaction-weight, --stiffness-weight and --regularisation must be finite and >= 0");
   rq.ipopt = a.ipopt;
   rq.nonlinear_check = !a.no_check;
   if (!std::isfinite(a.check_load_scale) || a.check_load_scale <= 0)
