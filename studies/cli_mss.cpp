@@ -24,6 +24,7 @@
 #include "fem_report.hpp"
 #include "mss_report.hpp"
 
+#include "spinesim/calibration/tuned_set.hpp"
 #include "spinesim/fem/disc_fem.hpp"
 #include "spinesim/fem/load_cases.hpp"
 #include "spinesim/mesh/io.hpp"
@@ -78,7 +79,7 @@ ModelChoice choose_model(const ModelFlags& flags, const std::string& params, con
       flags.volume_factor != defaults.volume_factor || flags.disc_volume_factor != defaults.disc_volume_factor)
     throw std::invalid_argument(
         "--params fixes the model's terms: drop --no-radial/--no-torsion/--volume-term/--disc-volume-term and their factors");
-  const calibration::TunedDisc tuned = calibration::read_tuned_disc(params);
+  const calibration::TunedDisc tuned = calibration::read_tuned_for_mesh(params, nullptr);
   c.options = tuned.mss_options();
   const mss::MssOptions damping = model_options(flags);  // --damping still applies
   c.options.damping_n_s_per_mm = damping.damping_n_s_per_mm;
@@ -94,7 +95,7 @@ ModelChoice choose_model(const ModelFlags& flags, const std::string& params, con
 /// (a per-spring file: the very mesh it was fitted on).
 mss::MssModel build_model(const mesh::TetMesh& m, const ModelChoice& c, const std::string& params, bool quiet) {
   if (params.empty()) return mss::MssModel(m, c.materials, c.options);
-  const calibration::TunedDisc tuned = calibration::read_tuned_disc(params);
+  const calibration::TunedDisc tuned = calibration::read_tuned_for_mesh(params, &m);
   mss::MssModel model = tuned_model(tuned, m, c.materials, quiet);
   if (c.options.damping_n_s_per_mm >= 0) {
     mss::MssOptions o = model.options();
@@ -411,7 +412,8 @@ void register_mss(CLI::App& app) {
   a->material_option =
       cmd->add_option("--material", a->material, "Preset (real-disc, annulus-nucleus, rubber, polyethylene) or JSON file")
           ->capture_default_str();
-  cmd->add_option("--params", a->params, "Tuned disc from `spinesim calibrate` (sets terms, scales and, unless given, the material)");
+  cmd->add_option("--params", a->params, "Tuned disc from `spinesim calibrate` (sets terms, scales and, unless given, the material); or a "
+                  "tuned set such as data/tuned_discs.json (the mesh's level is used)");
   cmd->add_option("--motion", a->motion, "Plate motion tx,ty,tz,rx,ry,rz (mm, degrees)");
   cmd->add_option("--wrench", a->wrench, "Applied wrench Fx,Fy,Fz,Mx,My,Mz (N, N·mm) about the centre");
   cmd->add_option("--case", a->load_case,
@@ -439,7 +441,8 @@ void register_mss(CLI::App& app) {
   auto* cmp = cmd->add_subcommand("compare", "MSS (untuned, or tuned with --params) vs FEM on the same mesh for the named load cases");
   cmp->add_option("--mesh", c->mesh_path, "Disc mesh (VTU with `surface` endplate labels)")->required();
   c->material_option = cmp->add_option("--material", c->material, "Preset or JSON file")->capture_default_str();
-  cmp->add_option("--params", c->params, "Tuned disc from `spinesim calibrate` instead of the untuned constants");
+  cmp->add_option("--params", c->params, "Tuned disc from `spinesim calibrate` instead of the untuned constants (or a tuned set: the "
+                  "mesh's level)");
   cmp->add_option("--load-scale", c->load_scale, "Multiply every case's wrench by this factor")->capture_default_str();
   cmp->add_option("--cases", c->cases, "Comma-separated load cases, or all")->capture_default_str();
   cmp->add_option("--order", c->order, "FEM element order: 1 (P1) or 2 (P2)")->capture_default_str();

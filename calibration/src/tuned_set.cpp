@@ -76,4 +76,27 @@ const TunedDisc& tuned_level(const TunedSet& set, const std::string& level) {
   throw std::invalid_argument("no tuned disc for level '" + level + "' (the set has " + known + ")");
 }
 
+TunedDisc read_tuned_for_mesh(const std::string& path, const mesh::TetMesh* mesh) {
+  std::ifstream in(path);
+  if (!in) throw std::invalid_argument("cannot read tuned-disc file '" + path + "'");
+  nlohmann::json j;
+  try {
+    in >> j;
+  } catch (const nlohmann::json::exception&) {
+    throw std::invalid_argument("'" + path + "' is not valid JSON");
+  }
+  if (!j.is_object() || j.value("format", "") != kSetFormat) return read_tuned_disc(path);
+  const TunedSet set = read_tuned_set(path);
+  if (!mesh) return set.levels.begin()->second;
+  const std::string level = disc_level(*mesh);
+  if (level.empty())
+    throw std::invalid_argument("'" + path + "' holds one tuned disc per level, and this mesh's level is unknown: give "
+                                "that level's tuned.json");
+  try {
+    return tuned_level(set, level);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument("'" + path + "': " + e.what());
+  }
+}
+
 }  // namespace spinesim::calibration

@@ -4,6 +4,8 @@
 // (360 tets) made once per process, so each calibration takes a fraction of a second.
 #include "cli_runner.hpp"
 
+#include "spinesim/mesh/io.hpp"
+
 #include <algorithm>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -535,6 +537,36 @@ TEST(CalibrateCliRefuses, ATransferMeshOfAnotherLevel) {
   expect_refused_without(run_spinesim("calibrate --mesh " + in_quotes(disc()) + " --transfer-mesh " +
                                       in_quotes(disc("L3-L4")) + " --out " + in_quotes(out)),
                          "L3-L4", out);
+}
+
+}  // namespace
+}  // namespace spinesim::cli
+
+namespace spinesim::cli {
+namespace {
+
+// --params with the shipped tuned set: the mesh's level picks the entry; a mesh of unknown level
+// cannot pick one and is refused.
+TEST(MssParamsTunedSet, TheMeshLevelPicksTheEntry) {
+  const std::string set = std::string(SPINESIM_DATA_DIR) + "/tuned_discs.json";
+  const CliRun r = run_spinesim("mss compare --mesh " + in_quotes(disc("L3-L4")) + " --params " + in_quotes(set) +
+                                " --cases compression --load-scale 0.1 --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const json j = json::parse(r.out);
+  EXPECT_EQ(j.at("mss_constants"), "tuned (" + set + ")");
+  const CliRun untuned = run_spinesim("mss compare --mesh " + in_quotes(disc("L3-L4")) +
+                                      " --cases compression --load-scale 0.1 --json");
+  ASSERT_EQ(untuned.status, 0) << untuned.err;
+  // The L3-L4 entry's scales, not Van Gelder's: a different (and better) answer.
+  EXPECT_LT(j.at("cases")[0].at("displacement_error").get<double>(),
+            json::parse(untuned.out).at("cases")[0].at("displacement_error").get<double>());
+
+  mesh::TetMesh unknown = mesh::read_vtu(disc("L3-L4"));
+  unknown.source = "disc between vertebrae";
+  const std::string path = tmp("unknown-level.vtu");
+  mesh::write_vtu(path, unknown);
+  expect_refused(run_spinesim("mss --mesh " + in_quotes(path) + " --params " + in_quotes(set) + " --case torsion"),
+                 "level is unknown");
 }
 
 }  // namespace

@@ -33,4 +33,11 @@ std::string shipped_tuned_set_path(const std::string& data_dir);
 /// One level's entry; throws std::invalid_argument naming the levels present when missing.
 const TunedDisc& tuned_level(const TunedSet& set, const std::string& level);
 
+/// What `--params FILE` means: a tuned.json, or a tuned set from which the entry of `mesh`'s disc
+/// level is taken (so `--params data/tuned_discs.json` works for any level's mesh). Without a
+/// mesh (nullptr) a set gives its first entry (every entry has the same terms and material).
+/// Throws std::invalid_argument for an unreadable file, or a set and a mesh of unknown or
+/// missing level.
+TunedDisc read_tuned_for_mesh(const std::string& path, const mesh::TetMesh* mesh);
+
 }  // namespace spinesim::calibration
