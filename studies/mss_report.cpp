@@ -3,6 +3,7 @@
 #include "cli_common.hpp"
 #include "fem_report.hpp"
 
+#include "spinesim/calibration/tuned_disc.hpp"
 #include "spinesim/mss/elements.hpp"
 
 #include <Eigen/SparseCholesky>
@@ -211,15 +212,11 @@ nlohmann::json mss_model_json(const mss::MssModel& model, const mesh::RegionMate
             {"k_t_per_shear_modulus_mm3", cyl.k_t_per_shear_modulus},
             {"k_t_nmm_per_rad",
              {{"annulus", g_annulus * cyl.k_t_per_shear_modulus}, {"nucleus", g_nucleus * cyl.k_t_per_shear_modulus}}}}},
-          {"options",
-           {{"radial_springs", o.radial_springs},
-            {"torsion_springs", o.torsion_springs},
-            {"volume_term", o.volume_term},
-            {"disc_volume_term", o.disc_volume_term},
-            {"radial_factor", o.radial_factor},
-            {"volume_factor", o.volume_factor},
-            {"disc_volume_factor", o.disc_volume_factor},
-            {"damping_ratio", o.damping_ratio}}}};
+          {"options", [&o] {
+             nlohmann::json j = calibration::terms_json(o);
+             j["damping_ratio"] = o.damping_ratio;
+             return j;
+           }()}};
 }
 
 fem::Matrix6d mss_plate_stiffness(const mss::MssModel& model, const Eigen::Vector3d& center_mm) {

@@ -1,5 +1,7 @@
 #include "spinesim/calibration/tuned_disc.hpp"
 
+#include "json_file.hpp"
+
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -77,6 +79,13 @@ mesh::RegionMaterials TunedDisc::materials() const {
       {{"name", material_name}, {"annulus", material.at("annulus")}, {"nucleus", material.at("nucleus")}});
 }
 
+nlohmann::json terms_json(const mss::MssOptions& o) {
+  return {{"radial_springs", o.radial_springs},       {"torsion_springs", o.torsion_springs},
+          {"volume_term", o.volume_term},             {"disc_volume_term", o.disc_volume_term},
+          {"radial_factor", o.radial_factor},         {"volume_factor", o.volume_factor},
+          {"disc_volume_factor", o.disc_volume_factor}};
+}
+
 nlohmann::json to_json(const TunedDisc& t) {
   const mss::MssOptions& o = t.options;
   nlohmann::json j = {{"format", kFormat},
@@ -86,14 +95,7 @@ nlohmann::json to_json(const TunedDisc& t) {
                       {"material", {{"name", t.material_name}, {"regions", t.material}}},
                       {"mesh", {{"nodes", t.mesh.nodes}, {"tets", t.mesh.tets}, {"fingerprint", t.mesh.hash}}},
                       {"fem_order", t.fem_order},
-                      {"terms",
-                       {{"radial_springs", o.radial_springs},
-                        {"torsion_springs", o.torsion_springs},
-                        {"volume_term", o.volume_term},
-                        {"disc_volume_term", o.disc_volume_term},
-                        {"radial_factor", o.radial_factor},
-                        {"volume_factor", o.volume_factor},
-                        {"disc_volume_factor", o.disc_volume_factor}}},
+                      {"terms", terms_json(o)},
                       {"scales", t.scales},
                       {"report", t.report}};
   if (t.per_spring()) {
@@ -180,19 +182,8 @@ mss::MssModel build_tuned_model(const TunedDisc& t, const mesh::TetMesh& mesh, c
 }
 
 TunedDisc read_tuned_disc(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::invalid_argument("cannot read tuned-disc file '" + path + "'");
-  nlohmann::json j;
-  try {
-    in >> j;
-  } catch (const nlohmann::json::exception&) {
-    throw std::invalid_argument("'" + path + "' is not valid JSON");
-  }
-  try {
-    return tuned_disc_from_json(j);
-  } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument("'" + path + "': " + e.what());
-  }
+  const nlohmann::json j = detail::read_json_file(path, "tuned-disc file");
+  return detail::naming_file(path, [&] { return tuned_disc_from_json(j); });
 }
 
 std::string check_applies(const TunedDisc& t, const mesh::TetMesh& mesh, const mesh::RegionMaterials& materials) {

@@ -1,5 +1,7 @@
 #include "spinesim/calibration/tuned_set.hpp"
 
+#include "json_file.hpp"
+
 #include <fstream>
 #include <stdexcept>
 
@@ -53,17 +55,8 @@ TunedSet tuned_set_from_json(const nlohmann::json& j) {
 }
 
 TunedSet read_tuned_set(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::invalid_argument("cannot read tuned-disc set '" + path + "'");
-  nlohmann::json j;
-  try {
-    in >> j;
-    return tuned_set_from_json(j);
-  } catch (const nlohmann::json::exception&) {
-    throw std::invalid_argument("'" + path + "' is not valid JSON");
-  } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument("'" + path + "': " + e.what());
-  }
+  const nlohmann::json j = detail::read_json_file(path, "tuned-disc set");
+  return detail::naming_file(path, [&] { return tuned_set_from_json(j); });
 }
 
 std::string shipped_tuned_set_path(const std::string& data_dir) { return data_dir + "/tuned_discs.json"; }
@@ -77,16 +70,10 @@ const TunedDisc& tuned_level(const TunedSet& set, const std::string& level) {
 }
 
 TunedDisc read_tuned_for_mesh(const std::string& path, const mesh::TetMesh* mesh) {
-  std::ifstream in(path);
-  if (!in) throw std::invalid_argument("cannot read tuned-disc file '" + path + "'");
-  nlohmann::json j;
-  try {
-    in >> j;
-  } catch (const nlohmann::json::exception&) {
-    throw std::invalid_argument("'" + path + "' is not valid JSON");
-  }
-  if (!j.is_object() || j.value("format", "") != kSetFormat) return read_tuned_disc(path);
-  const TunedSet set = read_tuned_set(path);
+  const nlohmann::json j = detail::read_json_file(path, "tuned-disc file");  // read once, whichever kind
+  if (!j.is_object() || j.value("format", "") != kSetFormat)
+    return detail::naming_file(path, [&] { return tuned_disc_from_json(j); });
+  const TunedSet set = detail::naming_file(path, [&] { return tuned_set_from_json(j); });
   if (!mesh) return set.levels.begin()->second;
   const std::string level = disc_level(*mesh);
   if (level.empty())

@@ -88,6 +88,10 @@ std::string edge_order_hash(const mss::MssModel& model);
 mss::MssModel build_tuned_model(const TunedDisc& tuned, const mesh::TetMesh& mesh,
                                 const mesh::RegionMaterials& materials);
 
+/// Which terms `options` switch on and their factors, as tuned files ("terms") and the MSS
+/// reports write them.
+nlohmann::json terms_json(const mss::MssOptions& options);
+
 nlohmann::json to_json(const TunedDisc& t);
 /// Parses and validates (format tag, version, kind, positive finite scales, known knob names,
 /// terms of every scale switched on, positive finite term factors, a valid material per region,
