@@ -1,0 +1,99 @@
+// Quasi-static equilibrium of the spine under gravity and external loads (SPEC "spine/"):
+//  1. recruitment (recruitment.hpp) in the reference posture: the lumbar muscles balance the
+//     moments of gravity and the external loads about the recruited joints;
+//  2. Newton with a backtracking line search on the total potential energy Π(θ) over the joint
+//     coordinates (finite rotations, kinematics.hpp): joint springs with ROM bumps, tension-only
+//     ligaments, the IAP bushing, the recruited muscles as springs T = F·(1 + q·(L − L0)/L0)
+//     (short-range stiffness k = q F / L0, Bergmark 1989), dead loads. The gradient is
+//     analytic; the Hessian is its central finite difference (symmetrised), shifted when not
+//     positive definite so every step descends.
+// Returns every vertebra's 6-DOF displacement, joint reactions, ligament and muscle forces.
+#pragma once
+
+#include "spinesim/spine/kinematics.hpp"
+#include "spinesim/spine/model.hpp"
+#include "spinesim/spine/recruitment.hpp"
+
+#include <Eigen/Core>
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace spinesim::spine {
+
+/// External load on a vertebra: force (N) at `point_mm` (reference posture; default the
+/// vertebra's F.1 centre) and a couple (N·mm). The force is a dead load (constant direction and
+/// magnitude). The couple is made conservative as the potential −M·φ_b (φ_b the vertebra's
+/// rotation vector): a dead couple to second order in the rotation.
+struct ExternalLoad {
+  int vertebra = 0;
+  Eigen::Vector3d force_n = Eigen::Vector3d::Zero();
+  Eigen::Vector3d moment_nmm = Eigen::Vector3d::Zero();
+  bool has_point = false;
+  Eigen::Vector3d point_mm = Eigen::Vector3d::Zero();
+};
+
+struct SolveOptions {
+  bool recruit = true;  ///< false: muscles off (passive spine)
+  RecruitmentOptions recruitment;
+  double tolerance = 1e-3;   ///< on max |∂Π/∂θ| in N·mm (generalised moments; 1e-3 N·mm = 1 µN·m)
+  int max_iterations = 60;
+  double fd_step = 1e-7;     ///< rad, for the finite-difference Hessian
+  bool warn_above_600n = true;  ///< SolveResult::warnings names forces beyond 600 N (thesis limit)
+};
+
+/// Force the lower side of a joint exerts on everything above it, and the moment it carries.
+struct JointReaction {
+  std::string joint;
+  Eigen::Vector3d force_world_n, moment_world_nmm;  ///< about the (moved) joint point
+  /// In the lower vertebra's axes (the thesis's joint frame: F.1 orientations are 0):
+  double axial_n = 0;     ///< +y component: compression > 0
+  double shear_ap_n = 0;  ///< +z component (the lower body pushes the upper one forward)
+  double shear_lat_n = 0; ///< +x component
+  /// In the disc's mid-plane frame (axis from the lower to the upper vertebra centre, as mesh/
+  /// places the disc): compression and the shear magnitude in the disc plane.
+  double disc_axial_n = 0, disc_shear_n = 0;
+  Eigen::Vector3d moment_local_nmm;  ///< x flexion(+)/extension, y torsion, z lateral bending
+};
+
+struct SpineSolution {
+  bool converged = false;
+  int iterations = 0;
+  double gradient_norm = 0;  ///< max |∂Π/∂θ| at the end, N·mm
+  Eigen::VectorXd theta;     ///< joint coordinates, rad
+  std::vector<Pose> poses;
+  /// Per vertebra: translation of its F.1 centre (mm) and rotation vector (deg), world axes.
+  Eigen::Matrix<double, Eigen::Dynamic, 6> displacement;
+  std::vector<JointReaction> joints;
+  Eigen::VectorXd ligament_force_n, muscle_force_n;  ///< tensions in the final posture
+  Recruitment recruitment;                          ///< the recruited forces F (reference posture)
+  Eigen::Matrix<double, 6, 1> bushing_wrench;       ///< IAP force (N) and moment (N·mm) on the ribs
+  std::vector<std::string> warnings;
+  double seconds_recruitment = 0, seconds_equilibrium = 0;
+};
+
+/// Thrown when Newton does not reach the tolerance: what() gives iterations, the remaining
+/// gradient, the worst joint; no partial result is returned.
+struct SolveError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// Throws std::invalid_argument for a non-finite load or an unknown vertebra index, SolveError
+/// for a non-converged Newton solve.
+SpineSolution solve_spine(const SpineModel& m, const std::vector<ExternalLoad>& loads,
+                          const SolveOptions& options = SolveOptions());
+
+// --- pieces, exposed for tests and the database ---------------------------------------------
+
+/// Total potential energy Π(θ) (N·mm) and its gradient for fixed muscle forces `muscle_force_n`
+/// (recruited F; empty = muscles off). Fused joints' coordinates get zero gradient.
+double potential(const SpineModel& m, const std::vector<ExternalLoad>& loads, const Eigen::VectorXd& muscle_force_n,
+                 const Eigen::VectorXd& theta, Eigen::VectorXd* gradient = nullptr);
+
+/// Moment arms (3 per recruited, non-fused joint × muscles) and load moments in the reference
+/// posture, as recruit() takes them.
+void recruitment_problem(const SpineModel& m, const std::vector<ExternalLoad>& loads, Eigen::MatrixXd& arm,
+                         Eigen::VectorXd& load_moment_nmm, std::vector<int>& joints);
+
+}  // namespace spinesim::spine

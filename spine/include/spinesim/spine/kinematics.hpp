@@ -1,0 +1,37 @@
+// Finite-rotation kinematics of the vertebra chain. Joint coordinates θ ∈ R^{3·17}: θ_j is the
+// rotation vector of vertebra j relative to the one below (R_j = R_{j+1} · exp(θ_j)), about the
+// joint point; the sacrum (below L5-S1) is fixed. Translations at the joints are constrained.
+#pragma once
+
+#include "spinesim/spine/model.hpp"
+
+#include <Eigen/Core>
+
+#include <vector>
+
+namespace spinesim::spine {
+
+/// Rigid motion of a vertebra from the reference posture: x = R·X + t for a reference point X.
+struct Pose {
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d t = Eigen::Vector3d::Zero();
+  Eigen::Vector3d apply(const Eigen::Vector3d& X) const { return R * X + t; }
+};
+
+/// exp: rotation vector (rad) → rotation matrix; log: the inverse (|φ| < π).
+Eigen::Matrix3d rotation_exp(const Eigen::Vector3d& phi);
+Eigen::Vector3d rotation_log(const Eigen::Matrix3d& R);
+/// Right Jacobian of exp (exp(φ+δ) ≈ exp(φ)·exp(J_r(φ)δ)) and the inverse of the left Jacobian
+/// (log(exp(δ)R) ≈ log(R) + J_l^{-1}(log R) δ).
+Eigen::Matrix3d right_jacobian(const Eigen::Vector3d& phi);
+Eigen::Matrix3d left_jacobian_inverse(const Eigen::Vector3d& phi);
+
+/// Poses of the 17 vertebrae for joint coordinates θ (size dof_count(m)).
+std::vector<Pose> vertebra_poses(const SpineModel& m, const Eigen::VectorXd& theta);
+
+/// World position of reference point X on `body` (kGround: X itself).
+inline Eigen::Vector3d place(const std::vector<Pose>& poses, int body, const Eigen::Vector3d& X) {
+  return body == kGround ? X : poses[std::size_t(body)].apply(X);
+}
+
+}  // namespace spinesim::spine

@@ -1,0 +1,133 @@
+// The thoracolumbar spine model (SPEC "spine/", thesis 3.3): 17 rigid vertebrae T1…L5 in a
+// chain above the fixed sacrum, joined by spherical joints at the table F.2 points with F.4
+// rotational stiffness and F.5 range-of-motion limits; ligaments (F.6/F.7), the lumbar
+// muscles (F.8–F.19, mirrored), the intra-abdominal-pressure bushing (appendix C) between
+// the rib cage (fixed to T6) and the pelvis; gravity on the vertebrae, the head and the arms.
+// Everything numeric comes from data/ (thesis/ tables and spine/spine_model.json).
+//
+// Units: mm, N, N·mm, kg; angles in radians inside (degrees in files and reports).
+// Frame (thesis tables): x lateral (the body's right is −x), y superior, z anterior.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <string>
+#include <vector>
+
+namespace spinesim::spine {
+
+/// Body index of everything fixed to the pelvis (sacrum, ilium, femur, lower torso, rectus sheath).
+inline constexpr int kGround = -1;
+
+/// "T1" … "L5", top to bottom; vertebra i sits on joint i.
+const std::vector<std::string>& vertebra_names();
+/// "T1-T2" … "L5-S1"; joint i connects vertebra i (above) to vertebra i+1 (or the sacrum).
+const std::vector<std::string>& joint_names();
+/// Index of a vertebra name ("t7" accepted); throws std::invalid_argument listing the names.
+int vertebra_index(const std::string& name);
+/// Index of a joint name ("l4-l5" accepted); throws std::invalid_argument listing the names.
+int joint_index(const std::string& name);
+/// Fusion levels: "L3-L4" → {joint L3-L4}; "L3-L4-L5" → {L3-L4, L4-L5}; several separated
+/// by commas. Throws std::invalid_argument for an unknown or non-adjacent level.
+std::vector<int> parse_fusion(const std::string& levels);
+
+struct Vertebra {
+  std::string name;
+  Eigen::Vector3d centre_mm;  ///< table F.1 centre of mass (reference posture)
+  double mass_kg = 0;         ///< per-level trunk mass (Bruno et al. 2015, % of body mass)
+};
+
+/// Spherical joint with a rotational spring; θ (rotation vector of the upper vertebra relative
+/// to the lower one, in the lower one's axes) has components x = flexion (+) / extension (−),
+/// y = axial torsion, z = lateral bending.
+struct Joint {
+  std::string name;
+  Eigen::Vector3d point_mm;  ///< table F.2
+  double k_flexion = 0, k_extension = 0, k_lateral = 0, k_torsion = 0;  ///< N·mm/rad (F.4)
+  double rom_flexion = 0, rom_extension = 0, rom_lateral = 0, rom_torsion = 0;  ///< rad (F.5)
+  bool fused = false;  ///< fixed joint (spinal fusion): θ ≡ 0
+};
+
+/// A straight line element between two bodies (attachment points in the reference posture).
+struct Line {
+  std::string name;
+  int body_a = kGround, body_b = kGround;  ///< vertebra index or kGround
+  Eigen::Vector3d a_mm, b_mm;
+  double rest_length_mm = 0;  ///< |a − b| in the reference posture
+};
+
+/// Tension-only linear spring (N/mm), slack-free in the reference posture.
+struct Ligament : Line {
+  std::string type;  ///< ISL, LF, ALL, PLL, JC
+  int joint = -1;    ///< the joint it spans
+  double k_n_per_mm = 0;
+};
+
+/// Muscle fascicle: recruited force F (0 ≤ F ≤ pcsa·σmax) at the reference length, with the
+/// short-range stiffness k = q·F/L0 (Bergmark 1989) about it, tension only.
+struct Muscle : Line {
+  std::string group;  ///< multifidus, erector spinae, psoas major, quadratus lumborum, ...
+  std::string side;   ///< "right" (as printed) or "left" (mirrored x → −x)
+  double pcsa_mm2 = 0, max_stress_mpa = 0;
+  double max_force_n() const { return pcsa_mm2 * max_stress_mpa; }
+};
+
+/// Six-DOF linear bushing (appendix C) between body_a and the ground at `point_mm`.
+struct Bushing {
+  int body = kGround;
+  Eigen::Vector3d point_mm;
+  Eigen::Vector3d k_translation_n_per_mm;  ///< k'x, k'y, k'z
+  Eigen::Vector3d k_rotation_nmm_per_rad;  ///< M'x, M'y, M'z (appendix C gives N·mm/deg)
+};
+
+/// A constant (dead) force on a body, e.g. a weight.
+struct PointLoad {
+  std::string name;
+  int body = kGround;
+  Eigen::Vector3d point_mm;
+  Eigen::Vector3d force_n;
+};
+
+/// Appendix C recomputed from its inputs (SPEC: never pasted).
+struct IapStiffness {
+  double s_mean_mm2 = 0, h_l1l5_mm = 0, h_mm = 0, a_mm = 0, pressure_mpa = 0;
+  double k_x = 0, k_y = 0;          ///< spring structure, N/mm (as the thesis writes them)
+  double bushing_k_xz = 0, bushing_k_y = 0;      ///< k'x = k'z = 4 k_x, k'y = 4 k_y (N/mm)
+  double bushing_m_xz_per_deg = 0, bushing_m_y_per_deg = 0;  ///< M'x = M'z, M'y (N·mm/deg)
+};
+IapStiffness iap_from_appendix_c(const std::string& appendix_c_json_path);
+
+struct ModelOptions {
+  std::vector<int> fused_joints;  ///< joint indices (parse_fusion)
+  bool ligaments = true, muscles = true, iap = true, gravity = true;
+  bool arms_forward = false;      ///< arms reaching forward (crate case) instead of hanging
+  double body_mass_kg = 0;        ///< 0: spine_model.json's value
+};
+
+struct SpineModel {
+  std::vector<Vertebra> vertebrae;  ///< 17, T1…L5
+  std::vector<Joint> joints;        ///< 17, T1-T2…L5-S1
+  std::vector<Ligament> ligaments;
+  std::vector<Muscle> muscles;
+  bool has_bushing = false;
+  Bushing bushing;                  ///< IAP: rib cage (T6) to pelvis
+  IapStiffness iap;
+  std::vector<PointLoad> weights;   ///< gravity on vertebrae, head+neck, arms (empty without gravity)
+  std::vector<int> recruited_joints;  ///< joints whose equilibrium the muscles are recruited for
+  double muscle_q = 10;             ///< short-range stiffness factor (k = q F / L0)
+  double rom_bump_factor = 100;     ///< joint stiffness multiplier beyond the F.5 range
+  double body_mass_kg = 70, gravity_mm_s2 = 9810;
+  Eigen::Vector3d chest_front_mm;   ///< for loads held "in front of the chest"
+  int ribs_body = 5;                ///< T6
+  std::string data_dir;
+};
+
+/// Builds the model from `data_dir` (thesis/ tables, disc_morphometry.csv, spine/spine_model.json).
+/// Throws std::runtime_error naming the file for missing or malformed data.
+SpineModel load_spine_model(const std::string& data_dir, const ModelOptions& options = ModelOptions());
+
+/// Number of joint coordinates (3 per joint, fused joints included and held at zero).
+inline int dof_count(const SpineModel& m) { return 3 * int(m.joints.size()); }
+
+}  // namespace spinesim::spine

@@ -1,0 +1,389 @@
+// Quasi-static equilibrium of the spine (equilibrium.hpp): total potential energy over the joint
+// coordinates, its analytic gradient by accumulating every element's force on the vertebrae
+// above each joint, and a modified Newton method with a finite-difference Hessian.
+#include "spinesim/spine/equilibrium.hpp"
+
+#include <Eigen/Cholesky>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+namespace spinesim::spine {
+namespace {
+using Eigen::Vector3d;
+using Eigen::VectorXd;
+
+constexpr double kRadToDeg = 180.0 / M_PI;
+constexpr double kThesisForceLimitN = 600.0;  // thesis 3.3.5: the largest force it validated
+
+/// Forces and couples on each vertebra, accumulated as the resultant force and the moment about
+/// the origin (so the moment about any joint point c is M0 − c × F).
+struct BodyLoads {
+  std::vector<Vector3d> force, moment0;
+  explicit BodyLoads(std::size_t n) : force(n, Vector3d::Zero()), moment0(n, Vector3d::Zero()) {}
+  void add(int body, const Vector3d& x, const Vector3d& f) {
+    if (body == kGround) return;
+    force[std::size_t(body)] += f;
+    moment0[std::size_t(body)] += x.cross(f);
+  }
+  void couple(int body, const Vector3d& tau) {
+    if (body != kGround) moment0[std::size_t(body)] += tau;
+  }
+};
+
+/// One-sided quadratic spring with a stiff quadratic bump beyond the limit.
+double axis_energy(double x, double k_pos, double k_neg, double lim_pos, double lim_neg, double bump, double& dE) {
+  const double k = x > 0 ? k_pos : k_neg;
+  double E = 0.5 * k * x * x;
+  dE = k * x;
+  if (x > lim_pos) {
+    const double kb = bump * k_pos, s = x - lim_pos;
+    E += 0.5 * kb * s * s;
+    dE += kb * s;
+  } else if (x < -lim_neg) {
+    const double kb = bump * k_neg, s = x + lim_neg;
+    E += 0.5 * kb * s * s;
+    dE += kb * s;
+  }
+  return E;
+}
+
+/// Joint spring energy and its gradient in θ (x flexion/extension, y torsion, z lateral bending).
+double joint_energy(const Joint& j, const Vector3d& th, double bump, Vector3d& dE) {
+  return axis_energy(th.x(), j.k_flexion, j.k_extension, j.rom_flexion, j.rom_extension, bump, dE.x()) +
+         axis_energy(th.y(), j.k_torsion, j.k_torsion, j.rom_torsion, j.rom_torsion, bump, dE.y()) +
+         axis_energy(th.z(), j.k_lateral, j.k_lateral, j.rom_lateral, j.rom_lateral, bump, dE.z());
+}
+
+Vector3d load_point(const SpineModel& m, const ExternalLoad& l) {
+  return l.has_point ? l.point_mm : m.vertebrae[std::size_t(l.vertebra)].centre_mm;
+}
+
+/// Everything the energy, the gradient and the report need at one posture.
+struct State {
+  double energy = 0;
+  std::vector<Pose> poses;
+  BodyLoads loads;
+  VectorXd ligament_t, muscle_t;
+  Eigen::Matrix<double, 6, 1> bushing = Eigen::Matrix<double, 6, 1>::Zero();
+  explicit State(std::size_t n) : loads(n) {}
+};
+
+State evaluate(const SpineModel& m, const std::vector<ExternalLoad>& ext, const VectorXd& F, const VectorXd& theta) {
+  const std::size_t n = m.joints.size();
+  State s(n);
+  s.poses = vertebra_poses(m, theta);
+  const auto& P = s.poses;
+  for (std::size_t k = 0; k < n; ++k) {
+    Vector3d dE;
+    s.energy += joint_energy(m.joints[k], theta.segment<3>(3 * Eigen::Index(k)), m.rom_bump_factor, dE);
+  }
+  // Dead loads: Π = −f·(x − X).
+  for (const auto& w : m.weights) {
+    const Vector3d x = place(P, w.body, w.point_mm);
+    s.energy -= w.force_n.dot(x - w.point_mm);
+    s.loads.add(w.body, x, w.force_n);
+  }
+  for (const auto& l : ext) {
+    const Vector3d X = load_point(m, l), x = place(P, l.vertebra, X);
+    s.energy -= l.force_n.dot(x - X);
+    s.loads.add(l.vertebra, x, l.force_n);
+    if (!l.moment_nmm.isZero()) {  // Π = −M·φ_b; its torque is J_l^{-T}(φ_b) M
+      const Vector3d phi = rotation_log(P[std::size_t(l.vertebra)].R);
+      s.energy -= l.moment_nmm.dot(phi);
+      s.loads.couple(l.vertebra, left_jacobian_inverse(phi).transpose() * l.moment_nmm);
+    }
+  }
+  // Tension-only ligaments: Π = ½ k (L − L0)₊².
+  s.ligament_t = VectorXd::Zero(Eigen::Index(m.ligaments.size()));
+  for (std::size_t i = 0; i < m.ligaments.size(); ++i) {
+    const Ligament& l = m.ligaments[i];
+    const Vector3d xa = place(P, l.body_a, l.a_mm), xb = place(P, l.body_b, l.b_mm);
+    const double L = (xa - xb).norm(), stretch = L - l.rest_length_mm;
+    if (stretch <= 0) continue;
+    const double T = l.k_n_per_mm * stretch;
+    s.energy += 0.5 * T * stretch;
+    const Vector3d u = (xa - xb) / L;
+    s.loads.add(l.body_a, xa, -T * u);
+    s.loads.add(l.body_b, xb, T * u);
+    s.ligament_t[Eigen::Index(i)] = T;
+  }
+  // Muscles: T = F (1 + q (L − L0)/L0), tension only; Π = F s + ½ (qF/L0) s², s = L − L0.
+  s.muscle_t = VectorXd::Zero(Eigen::Index(m.muscles.size()));
+  if (F.size() == Eigen::Index(m.muscles.size())) {
+    for (std::size_t i = 0; i < m.muscles.size(); ++i) {
+      const double f = F[Eigen::Index(i)];
+      if (!(f > 0)) continue;
+      const Muscle& mu = m.muscles[i];
+      const Vector3d xa = place(P, mu.body_a, mu.a_mm), xb = place(P, mu.body_b, mu.b_mm);
+      const double L = (xa - xb).norm(), L0 = mu.rest_length_mm, s_mm = L - L0;
+      const double k = m.muscle_q * f / L0;
+      if (s_mm <= -L0 / m.muscle_q) {
+        s.energy -= f * L0 / (2 * m.muscle_q);
+        continue;
+      }
+      const double T = f + k * s_mm;
+      s.energy += f * s_mm + 0.5 * k * s_mm * s_mm;
+      const Vector3d u = (xa - xb) / L;
+      s.loads.add(mu.body_a, xa, -T * u);
+      s.loads.add(mu.body_b, xb, T * u);
+      s.muscle_t[Eigen::Index(i)] = T;
+    }
+  }
+  // IAP bushing (ribs to pelvis): ½ dᵀ K_t d + ½ φᵀ K_r φ, world axes.
+  if (m.has_bushing) {
+    const Bushing& b = m.bushing;
+    const Pose& pose = P[std::size_t(b.body)];
+    const Vector3d x = pose.apply(b.point_mm), d = x - b.point_mm;
+    const Vector3d f = -b.k_translation_n_per_mm.cwiseProduct(d);
+    const Vector3d phi = rotation_log(pose.R);
+    const Vector3d Kphi = b.k_rotation_nmm_per_rad.cwiseProduct(phi);
+    s.energy += 0.5 * d.dot(-f) + 0.5 * phi.dot(Kphi);
+    s.loads.add(b.body, x, f);
+    const Vector3d tau = -left_jacobian_inverse(phi).transpose() * Kphi;
+    s.loads.couple(b.body, tau);
+    s.bushing << f, tau;
+  }
+  return s;
+}
+
+/// World position of joint k's point (it moves with the vertebra below).
+Vector3d joint_point(const SpineModel& m, const std::vector<Pose>& P, std::size_t k) {
+  const Vector3d& J = m.joints[k].point_mm;
+  return k + 1 < P.size() ? P[k + 1].apply(J) : J;
+}
+
+/// For every joint: the resultant force on, and moment about the joint of, everything above it.
+void resultants_above(const SpineModel& m, const State& s, std::vector<Vector3d>& force, std::vector<Vector3d>& moment) {
+  const std::size_t n = m.joints.size();
+  force.assign(n, Vector3d::Zero());
+  moment.assign(n, Vector3d::Zero());
+  Vector3d F = Vector3d::Zero(), M0 = Vector3d::Zero();
+  for (std::size_t k = 0; k < n; ++k) {
+    F += s.loads.force[k];
+    M0 += s.loads.moment0[k];
+    force[k] = F;
+    moment[k] = M0 - joint_point(m, s.poses, k).cross(F);
+  }
+}
+
+VectorXd gradient_of(const SpineModel& m, const State& s, const VectorXd& theta) {
+  std::vector<Vector3d> F, M;
+  resultants_above(m, s, F, M);
+  VectorXd g(theta.size());
+  for (std::size_t k = 0; k < m.joints.size(); ++k) {
+    const Eigen::Index o = 3 * Eigen::Index(k);
+    if (m.joints[k].fused) {
+      g.segment<3>(o).setZero();
+      continue;
+    }
+    const Vector3d th = theta.segment<3>(o);
+    Vector3d dE;
+    joint_energy(m.joints[k], th, m.rom_bump_factor, dE);
+    // δx = (R_k J_r δθ) × (x − c_k) for every point above joint k.
+    g.segment<3>(o) = dE - right_jacobian(th).transpose() * s.poses[k].R.transpose() * M[k];
+  }
+  return g;
+}
+
+void check_loads(const SpineModel& m, const std::vector<ExternalLoad>& loads, std::vector<std::string>* warnings) {
+  for (const auto& l : loads) {
+    if (l.vertebra < 0 || l.vertebra >= int(m.vertebrae.size()))
+      throw std::invalid_argument("external load on vertebra index " + std::to_string(l.vertebra) +
+                                  " (valid: 0.." + std::to_string(m.vertebrae.size() - 1) + ", T1..L5)");
+    if (!l.force_n.allFinite() || !l.moment_nmm.allFinite() || (l.has_point && !l.point_mm.allFinite()))
+      throw std::invalid_argument("external load on " + m.vertebrae[std::size_t(l.vertebra)].name + " is not finite");
+    if (warnings && l.force_n.norm() > kThesisForceLimitN) {
+      std::ostringstream w;
+      w << "force of " << l.force_n.norm() << " N on " << m.vertebrae[std::size_t(l.vertebra)].name
+        << " exceeds the 600 N the thesis validated (3.3.5)";
+      warnings->push_back(w.str());
+    }
+  }
+}
+
+}  // namespace
+
+double potential(const SpineModel& m, const std::vector<ExternalLoad>& loads, const VectorXd& muscle_force_n,
+                 const VectorXd& theta, VectorXd* gradient) {
+  check_loads(m, loads, nullptr);
+  const State s = evaluate(m, loads, muscle_force_n, theta);
+  if (gradient) *gradient = gradient_of(m, s, theta);
+  return s.energy;
+}
+
+void recruitment_problem(const SpineModel& m, const std::vector<ExternalLoad>& loads, Eigen::MatrixXd& arm,
+                         VectorXd& load_moment_nmm, std::vector<int>& joints) {
+  check_loads(m, loads, nullptr);
+  joints.clear();
+  for (int j : m.recruited_joints)
+    if (!m.joints[std::size_t(j)].fused) joints.push_back(j);
+  // Reference posture: joints, ligaments and the bushing are unloaded; gravity and the external
+  // loads (and nothing else) must be balanced by the muscles about each recruited joint.
+  const VectorXd theta0 = VectorXd::Zero(dof_count(m));
+  const State s = evaluate(m, loads, VectorXd(), theta0);
+  std::vector<Vector3d> F, M;
+  resultants_above(m, s, F, M);
+  const Eigen::Index nm = Eigen::Index(m.muscles.size());
+  arm = Eigen::MatrixXd::Zero(3 * Eigen::Index(joints.size()), nm);
+  load_moment_nmm.resize(3 * Eigen::Index(joints.size()));
+  for (std::size_t r = 0; r < joints.size(); ++r) {
+    const int j = joints[r];
+    const Vector3d c = m.joints[std::size_t(j)].point_mm;
+    load_moment_nmm.segment<3>(3 * Eigen::Index(r)) = -M[std::size_t(j)];
+    auto above = [j](int body) { return body != kGround && body <= j; };
+    for (Eigen::Index i = 0; i < nm; ++i) {
+      const Muscle& mu = m.muscles[std::size_t(i)];
+      if (above(mu.body_a) == above(mu.body_b)) continue;  // does not cross joint j
+      const Vector3d u = (mu.a_mm - mu.b_mm) / mu.rest_length_mm;  // unit tension pulls a towards b
+      arm.block<3, 1>(3 * Eigen::Index(r), i) =
+          above(mu.body_a) ? Vector3d((mu.a_mm - c).cross(-u)) : Vector3d((mu.b_mm - c).cross(u));
+    }
+  }
+}
+
+SpineSolution solve_spine(const SpineModel& m, const std::vector<ExternalLoad>& loads, const SolveOptions& o) {
+  SpineSolution out;
+  check_loads(m, loads, o.warn_above_600n ? &out.warnings : nullptr);
+  if (!(o.tolerance > 0) || o.max_iterations < 1 || !(o.fd_step > 0))
+    throw std::invalid_argument("solve_spine: tolerance and finite-difference step must be > 0, iterations >= 1");
+  const auto t0 = std::chrono::steady_clock::now();
+
+  VectorXd F;  // recruited muscle forces (empty: muscles off)
+  if (o.recruit && !m.muscles.empty()) {
+    Eigen::MatrixXd arm;
+    VectorXd b;
+    std::vector<int> joints;
+    recruitment_problem(m, loads, arm, b, joints);
+    out.recruitment = recruit(m, arm, b, o.recruitment);
+    if (!out.recruitment.success)
+      throw SolveError("muscle recruitment failed (Ipopt: " + out.recruitment.status + ")");
+    F = out.recruitment.force_n;
+  }
+  const auto t1 = std::chrono::steady_clock::now();
+  out.seconds_recruitment = std::chrono::duration<double>(t1 - t0).count();
+
+  std::vector<Eigen::Index> free;
+  for (std::size_t k = 0; k < m.joints.size(); ++k)
+    if (!m.joints[k].fused)
+      for (int a = 0; a < 3; ++a) free.push_back(3 * Eigen::Index(k) + a);
+  const Eigen::Index nf = Eigen::Index(free.size());
+
+  VectorXd theta = VectorXd::Zero(dof_count(m));
+  auto energy_grad = [&](const VectorXd& th, VectorXd& g) {
+    const State s = evaluate(m, loads, F, th);
+    g = gradient_of(m, s, th);
+    return s.energy;
+  };
+  VectorXd g;
+  double E = energy_grad(theta, g);
+  auto worst = [&](const VectorXd& grad) { return grad.cwiseAbs().maxCoeff(); };
+  int it = 0;
+  for (; it < o.max_iterations && worst(g) > o.tolerance; ++it) {
+    // Hessian: central differences of the analytic gradient over the free coordinates.
+    Eigen::MatrixXd H(nf, nf);
+    VectorXd gp, gm;
+    for (Eigen::Index c = 0; c < nf; ++c) {
+      VectorXd tp = theta, tm = theta;
+      tp[free[std::size_t(c)]] += o.fd_step;
+      tm[free[std::size_t(c)]] -= o.fd_step;
+      energy_grad(tp, gp);
+      energy_grad(tm, gm);
+      for (Eigen::Index r = 0; r < nf; ++r) H(r, c) = (gp[free[std::size_t(r)]] - gm[free[std::size_t(r)]]) / (2 * o.fd_step);
+    }
+    H = 0.5 * (H + H.transpose()).eval();
+    VectorXd gf(nf);
+    for (Eigen::Index r = 0; r < nf; ++r) gf[r] = g[free[std::size_t(r)]];
+    // Modified Newton: shift the Hessian until it is positive definite, so the step descends.
+    double shift = 0;
+    const double scale = std::max(1.0, H.diagonal().cwiseAbs().maxCoeff());
+    Eigen::LLT<Eigen::MatrixXd> llt;
+    for (int tries = 0; tries < 30; ++tries) {
+      llt.compute(H + shift * Eigen::MatrixXd::Identity(nf, nf));
+      if (llt.info() == Eigen::Success) break;
+      shift = shift == 0 ? 1e-8 * scale : 10 * shift;
+    }
+    if (llt.info() != Eigen::Success) break;
+    const VectorXd step = -llt.solve(gf);
+    const double slope = gf.dot(step);
+    double alpha = 1;
+    VectorXd trial = theta, gt;
+    double Et = 0;
+    bool accepted = false;
+    for (int ls = 0; ls < 40; ++ls) {
+      trial = theta;
+      for (Eigen::Index r = 0; r < nf; ++r) trial[free[std::size_t(r)]] += alpha * step[r];
+      Et = energy_grad(trial, gt);
+      if (Et <= E + 1e-4 * alpha * slope) {
+        accepted = true;
+        break;
+      }
+      alpha *= 0.5;
+    }
+    if (!accepted) {
+      // At round-off level of Π the Armijo test cannot tell; accept a step that lowers |g|.
+      if (worst(gt) < worst(g)) accepted = true;
+      else break;
+    }
+    theta = trial;
+    g = gt;
+    E = Et;
+  }
+  out.iterations = it;
+  out.gradient_norm = worst(g);
+  if (!(out.gradient_norm <= o.tolerance)) {
+    Eigen::Index at = 0;
+    g.cwiseAbs().maxCoeff(&at);
+    static const char* axes[] = {"flexion/extension", "torsion", "lateral bending"};
+    std::ostringstream msg;
+    msg << "spine equilibrium did not converge: " << it << " Newton iterations, max |dPi/dtheta| = "
+        << out.gradient_norm << " N*mm (tolerance " << o.tolerance << ") at joint "
+        << m.joints[std::size_t(at / 3)].name << " (" << axes[at % 3] << ")";
+    throw SolveError(msg.str());
+  }
+  out.converged = true;
+  out.seconds_equilibrium = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+
+  // Report: poses, displacements, joint reactions, element forces.
+  const State s = evaluate(m, loads, F, theta);
+  out.theta = theta;
+  out.poses = s.poses;
+  const std::size_t n = m.vertebrae.size();
+  out.displacement.resize(Eigen::Index(n), 6);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vector3d& C = m.vertebrae[i].centre_mm;
+    out.displacement.row(Eigen::Index(i)).head<3>() = (s.poses[i].apply(C) - C).transpose();
+    out.displacement.row(Eigen::Index(i)).tail<3>() = (rotation_log(s.poses[i].R) * kRadToDeg).transpose();
+  }
+  std::vector<Vector3d> Fa, Ma;
+  resultants_above(m, s, Fa, Ma);
+  for (std::size_t k = 0; k < m.joints.size(); ++k) {
+    JointReaction r;
+    r.joint = m.joints[k].name;
+    r.force_world_n = -Fa[k];  // what the lower side pushes on everything above
+    r.moment_world_nmm = -Ma[k];
+    const Eigen::Matrix3d R_low = k + 1 < n ? s.poses[k + 1].R : Eigen::Matrix3d::Identity();
+    const Vector3d local = R_low.transpose() * r.force_world_n;
+    r.shear_lat_n = local.x();
+    r.axial_n = local.y();
+    r.shear_ap_n = local.z();
+    r.moment_local_nmm = R_low.transpose() * r.moment_world_nmm;
+    // Disc frame: from the lower vertebra's centre (the sacrum: L5's mirrored) to the upper one's.
+    const Vector3d& J = m.joints[k].point_mm;
+    const Vector3d up = s.poses[k].apply(m.vertebrae[k].centre_mm);
+    const Vector3d low = k + 1 < n ? s.poses[k + 1].apply(m.vertebrae[k + 1].centre_mm)
+                                   : Vector3d(2 * J - m.vertebrae[k].centre_mm);
+    const Vector3d axis = (up - low).normalized();
+    r.disc_axial_n = r.force_world_n.dot(axis);
+    r.disc_shear_n = (r.force_world_n - r.disc_axial_n * axis).norm();
+    out.joints.push_back(r);
+  }
+  out.ligament_force_n = s.ligament_t;
+  out.muscle_force_n = s.muscle_t;
+  out.bushing_wrench = s.bushing;
+  return out;
+}
+
+}  // namespace spinesim::spine

@@ -1,0 +1,230 @@
+// Static-optimisation muscle recruitment through Ipopt's TNLP interface (recruitment.hpp).
+// Variables x = [F (muscles, N), r (reserve moments, N·mm), t (min–max only)]; constraints
+// arm·F + r = b (one per recruited joint axis) and, for min–max, F_i/F_max,i − t ≤ 0.
+#include "spinesim/spine/recruitment.hpp"
+
+#include <IpIpoptApplication.hpp>
+#include <IpTNLP.hpp>
+
+#include <chrono>
+#include <cmath>
+#include <mutex>
+#include <sstream>
+#include <stdexcept>
+
+namespace spinesim::spine {
+namespace {
+
+constexpr double kReserveUnitNmm = 1000.0;  // reserves are penalised per N·m
+constexpr double kMinMaxRegularisation = 1e-3;  // makes the min–max optimum unique
+
+class RecruitmentNlp : public Ipopt::TNLP {
+ public:
+  RecruitmentNlp(const Eigen::MatrixXd& arm, const Eigen::VectorXd& b, const Eigen::VectorXd& fmax,
+                 const RecruitmentOptions& o)
+      : arm_(arm), b_(b), fmax_(fmax), o_(o), nm_(int(fmax.size())), nr_(int(b.size())),
+        minmax_(o.criterion == Criterion::MinMax) {
+    for (int c = 0; c < nm_; ++c)
+      for (int r = 0; r < nr_; ++r)
+        if (arm_(r, c) != 0) nz_.push_back({r, c});
+  }
+
+  bool get_nlp_info(Ipopt::Index& n, Ipopt::Index& m, Ipopt::Index& nnz_jac, Ipopt::Index& nnz_h,
+                    IndexStyleEnum& style) override {
+    n = nm_ + nr_ + (minmax_ ? 1 : 0);
+    m = nr_ + (minmax_ ? nm_ : 0);
+    nnz_jac = Ipopt::Index(nz_.size()) + nr_ + (minmax_ ? 2 * nm_ : 0);
+    nnz_h = nm_ + nr_;  // diagonal
+    style = C_STYLE;
+    return true;
+  }
+
+  bool get_bounds_info(Ipopt::Index n, Ipopt::Number* xl, Ipopt::Number* xu, Ipopt::Index m, Ipopt::Number* gl,
+                       Ipopt::Number* gu) override {
+    for (int i = 0; i < nm_; ++i) { xl[i] = 0; xu[i] = fmax_[i]; }
+    for (int i = nm_; i < nm_ + nr_; ++i) { xl[i] = -2e19; xu[i] = 2e19; }
+    if (minmax_) { xl[n - 1] = 0; xu[n - 1] = 2e19; }
+    for (int k = 0; k < nr_; ++k) gl[k] = gu[k] = b_[k];
+    for (int k = nr_; k < m; ++k) { gl[k] = -2e19; gu[k] = 0; }
+    return true;
+  }
+
+  bool get_starting_point(Ipopt::Index n, bool, Ipopt::Number* x, bool, Ipopt::Number*, Ipopt::Number*,
+                          Ipopt::Index, bool, Ipopt::Number*) override {
+    for (int i = 0; i < nm_; ++i) x[i] = 0.05 * fmax_[i];
+    for (int i = nm_; i < nm_ + nr_; ++i) x[i] = 0;
+    if (minmax_) x[n - 1] = 0.1;
+    return true;
+  }
+
+  bool eval_f(Ipopt::Index, const Ipopt::Number* x, bool, Ipopt::Number& f) override {
+    f = 0;
+    for (int i = 0; i < nm_; ++i) {
+      const double a = x[i] / fmax_[i];
+      f += minmax_ ? kMinMaxRegularisation * a * a : std::pow(std::max(a, 0.0), o_.power);
+    }
+    for (int k = 0; k < nr_; ++k) f += o_.reserve_weight * std::pow(x[nm_ + k] / kReserveUnitNmm, 2);
+    if (minmax_) f += x[nm_ + nr_];
+    return true;
+  }
+
+  bool eval_grad_f(Ipopt::Index, const Ipopt::Number* x, bool, Ipopt::Number* g) override {
+    for (int i = 0; i < nm_; ++i) {
+      const double a = std::max(x[i] / fmax_[i], 0.0);
+      g[i] = minmax_ ? 2 * kMinMaxRegularisation * a / fmax_[i] : o_.power * std::pow(a, o_.power - 1) / fmax_[i];
+    }
+    for (int k = 0; k < nr_; ++k) g[nm_ + k] = 2 * o_.reserve_weight * x[nm_ + k] / (kReserveUnitNmm * kReserveUnitNmm);
+    if (minmax_) g[nm_ + nr_] = 1;
+    return true;
+  }
+
+  bool eval_g(Ipopt::Index, const Ipopt::Number* x, bool, Ipopt::Index, Ipopt::Number* g) override {
+    for (int k = 0; k < nr_; ++k) g[k] = x[nm_ + k];
+    for (const auto& [r, c] : nz_) g[r] += arm_(r, c) * x[c];
+    if (minmax_)
+      for (int i = 0; i < nm_; ++i) g[nr_ + i] = x[i] / fmax_[i] - x[nm_ + nr_];
+    return true;
+  }
+
+  bool eval_jac_g(Ipopt::Index, const Ipopt::Number*, bool, Ipopt::Index, Ipopt::Index, Ipopt::Index* rows,
+                  Ipopt::Index* cols, Ipopt::Number* values) override {
+    std::size_t e = 0;
+    if (values == nullptr) {
+      for (const auto& [r, c] : nz_) { rows[e] = r; cols[e] = c; ++e; }
+      for (int k = 0; k < nr_; ++k) { rows[e] = k; cols[e] = nm_ + k; ++e; }
+      if (minmax_)
+        for (int i = 0; i < nm_; ++i) {
+          rows[e] = nr_ + i; cols[e] = i; ++e;
+          rows[e] = nr_ + i; cols[e] = nm_ + nr_; ++e;
+        }
+    } else {
+      for (const auto& [r, c] : nz_) values[e++] = arm_(r, c);
+      for (int k = 0; k < nr_; ++k) values[e++] = 1;
+      if (minmax_)
+        for (int i = 0; i < nm_; ++i) { values[e++] = 1 / fmax_[i]; values[e++] = -1; }
+    }
+    return true;
+  }
+
+  bool eval_h(Ipopt::Index, const Ipopt::Number* x, bool, Ipopt::Number sigma, Ipopt::Index, const Ipopt::Number*,
+              bool, Ipopt::Index, Ipopt::Index* rows, Ipopt::Index* cols, Ipopt::Number* values) override {
+    if (values == nullptr) {
+      for (int i = 0; i < nm_ + nr_; ++i) rows[i] = cols[i] = i;
+      return true;
+    }
+    for (int i = 0; i < nm_; ++i) {
+      const double a = std::max(x[i] / fmax_[i], 0.0);
+      const double h = minmax_ ? 2 * kMinMaxRegularisation
+                               : o_.power * (o_.power - 1) * std::pow(a, o_.power - 2);
+      values[i] = sigma * h / (fmax_[i] * fmax_[i]);
+    }
+    for (int k = 0; k < nr_; ++k) values[nm_ + k] = sigma * 2 * o_.reserve_weight / (kReserveUnitNmm * kReserveUnitNmm);
+    return true;
+  }
+
+  bool intermediate_callback(Ipopt::AlgorithmMode, Ipopt::Index iter, Ipopt::Number, Ipopt::Number, Ipopt::Number,
+                             Ipopt::Number, Ipopt::Number, Ipopt::Number, Ipopt::Number, Ipopt::Number,
+                             Ipopt::Index, const Ipopt::IpoptData*, Ipopt::IpoptCalculatedQuantities*) override {
+    iterations = iter;
+    return true;
+  }
+
+  void finalize_solution(Ipopt::SolverReturn, Ipopt::Index n, const Ipopt::Number* x, const Ipopt::Number*,
+                         const Ipopt::Number*, Ipopt::Index m, const Ipopt::Number* g, const Ipopt::Number*,
+                         Ipopt::Number obj, const Ipopt::IpoptData*, Ipopt::IpoptCalculatedQuantities*) override {
+    solution = Eigen::Map<const Eigen::VectorXd>(x, n);
+    objective = obj;
+    violation = 0;
+    for (int k = 0; k < nr_ && k < m; ++k) violation = std::max(violation, std::abs(g[k] - b_[k]));
+  }
+
+  Eigen::VectorXd solution;
+  double objective = 0, violation = 0;
+  int iterations = 0;
+
+ private:
+  const Eigen::MatrixXd& arm_;
+  const Eigen::VectorXd& b_;
+  const Eigen::VectorXd& fmax_;
+  RecruitmentOptions o_;
+  int nm_, nr_;
+  bool minmax_;
+  std::vector<std::pair<int, int>> nz_;
+};
+
+std::string status_name(Ipopt::ApplicationReturnStatus s) {
+  switch (s) {
+    case Ipopt::Solve_Succeeded: return "Solve_Succeeded";
+    case Ipopt::Solved_To_Acceptable_Level: return "Solved_To_Acceptable_Level";
+    case Ipopt::Infeasible_Problem_Detected: return "Infeasible_Problem_Detected";
+    case Ipopt::Maximum_Iterations_Exceeded: return "Maximum_Iterations_Exceeded";
+    case Ipopt::Restoration_Failed: return "Restoration_Failed";
+    case Ipopt::Error_In_Step_Computation: return "Error_In_Step_Computation";
+    case Ipopt::Invalid_Number_Detected: return "Invalid_Number_Detected";
+    default: return "Ipopt_status_" + std::to_string(int(s));
+  }
+}
+
+// Debian's Ipopt solves with sequential MUMPS, whose Fortran state is not safe to share between
+// threads; recruitment is a few milliseconds, so concurrent solves take turns here.
+std::mutex& ipopt_mutex() {
+  static std::mutex m;
+  return m;
+}
+
+}  // namespace
+
+Recruitment recruit(const SpineModel& m, const Eigen::MatrixXd& arm, const Eigen::VectorXd& load_moment_nmm,
+                    const RecruitmentOptions& options) {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (!(options.power >= 2 && options.power <= 10))
+    throw std::invalid_argument("recruitment power must be in [2, 10], got " + std::to_string(options.power));
+  if (!(options.reserve_weight > 0) || options.max_iterations < 1 || !(options.tolerance > 0))
+    throw std::invalid_argument("recruitment: reserve weight and tolerance must be > 0, iterations >= 1");
+  const Eigen::Index nm = Eigen::Index(m.muscles.size());
+  if (arm.cols() != nm || arm.rows() != load_moment_nmm.size())
+    throw std::invalid_argument("recruit: arm must be (3·joints) × muscles, matching the load moments");
+  if (!arm.allFinite() || !load_moment_nmm.allFinite()) throw std::invalid_argument("recruit: non-finite input");
+  Eigen::VectorXd fmax(nm);
+  for (Eigen::Index i = 0; i < nm; ++i) fmax[i] = m.muscles[std::size_t(i)].max_force_n();
+
+  Recruitment out;
+  out.force_n = Eigen::VectorXd::Zero(nm);
+  out.activation = Eigen::VectorXd::Zero(nm);
+  out.reserve_nmm = load_moment_nmm;
+  if (nm == 0 || arm.rows() == 0) {  // nothing to recruit: every moment is left to the joints
+    out.success = true;
+    out.status = nm == 0 ? "no muscles" : "no recruited joints";
+    return out;
+  }
+  Ipopt::SmartPtr<RecruitmentNlp> nlp = new RecruitmentNlp(arm, load_moment_nmm, fmax, options);
+  {
+    std::lock_guard<std::mutex> lock(ipopt_mutex());
+    Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
+    app->Options()->SetIntegerValue("print_level", 0);
+    app->Options()->SetStringValue("sb", "yes");
+    app->Options()->SetIntegerValue("max_iter", options.max_iterations);
+    app->Options()->SetNumericValue("tol", options.tolerance);
+    app->Options()->SetStringValue("mu_strategy", "adaptive");
+    std::istringstream no_option_file;  // never read ./ipopt.opt
+    if (app->Initialize(no_option_file) != Ipopt::Solve_Succeeded) {
+      out.status = "Ipopt_Initialisation_Failed";
+      return out;
+    }
+    const Ipopt::ApplicationReturnStatus st = app->OptimizeTNLP(nlp);
+    out.status = status_name(st);
+    out.success = st == Ipopt::Solve_Succeeded || st == Ipopt::Solved_To_Acceptable_Level;
+  }
+  out.iterations = nlp->iterations;
+  if (nlp->solution.size() >= nm + arm.rows()) {
+    out.force_n = nlp->solution.head(nm).cwiseMax(0.0).cwiseMin(fmax);
+    out.activation = out.force_n.cwiseQuotient(fmax);
+    out.reserve_nmm = nlp->solution.segment(nm, arm.rows());
+    out.objective = nlp->objective;
+    out.max_constraint_violation_nmm = nlp->violation;
+  }
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return out;
+}
+
+}  // namespace spinesim::spine
