@@ -280,8 +280,9 @@ SpineSolution solve_spine(const SpineModel& m, const std::vector<ExternalLoad>& 
   VectorXd g;
   double E = energy_grad(theta, g);
   auto worst = [&](const VectorXd& grad) { return grad.cwiseAbs().maxCoeff(); };
+  const double tolerance = std::max(o.tolerance, o.relative_tolerance * worst(g));
   int it = 0;
-  for (; it < o.max_iterations && worst(g) > o.tolerance; ++it) {
+  for (; it < o.max_iterations && worst(g) > tolerance; ++it) {
     // Hessian: central differences of the analytic gradient over the free coordinates.
     Eigen::MatrixXd H(nf, nf);
     VectorXd gp, gm;
@@ -333,13 +334,13 @@ SpineSolution solve_spine(const SpineModel& m, const std::vector<ExternalLoad>& 
   }
   out.iterations = it;
   out.gradient_norm = worst(g);
-  if (!(out.gradient_norm <= o.tolerance)) {
+  if (!(out.gradient_norm <= tolerance)) {
     Eigen::Index at = 0;
     g.cwiseAbs().maxCoeff(&at);
     static const char* axes[] = {"flexion/extension", "torsion", "lateral bending"};
     std::ostringstream msg;
     msg << "spine equilibrium did not converge: " << it << " Newton iterations, max |dPi/dtheta| = "
-        << out.gradient_norm << " N*mm (tolerance " << o.tolerance << ") at joint "
+        << out.gradient_norm << " N*mm (tolerance " << tolerance << ") at joint "
         << m.joints[std::size_t(at / 3)].name << " (" << axes[at % 3] << ")";
     throw SolveError(msg.str());
   }
@@ -363,7 +364,7 @@ SpineSolution solve_spine(const SpineModel& m, const std::vector<ExternalLoad>& 
     JointReaction r;
     r.joint = m.joints[k].name;
     r.force_world_n = -Fa[k];  // what the lower side pushes on everything above
-    r.moment_world_nmm = -Ma[k];
+    r.moment_world_nmm = Ma[k];
     const Eigen::Matrix3d R_low = k + 1 < n ? s.poses[k + 1].R : Eigen::Matrix3d::Identity();
     const Vector3d local = R_low.transpose() * r.force_world_n;
     r.shear_lat_n = local.x();

@@ -1,6 +1,7 @@
 // Static-optimisation muscle recruitment through Ipopt's TNLP interface (recruitment.hpp).
-// Variables x = [F (muscles, N), r (reserve moments, N·mm), t (min–max only)]; constraints
-// arm·F + r = b (one per recruited joint axis) and, for min–max, F_i/F_max,i − t ≤ 0.
+// Variables x = [F (muscles, N), r (joint shares, N·mm), t (min–max only)]; constraints
+// arm·F + r = b (one per recruited joint axis) and, for min–max, F_i/F_max,i − t ≤ 0,
+// r/R⁺ − t ≤ 0 and −r/R⁻ − t ≤ 0.
 #include "spinesim/spine/recruitment.hpp"
 
 #include <IpIpoptApplication.hpp>
@@ -15,14 +16,20 @@
 namespace spinesim::spine {
 namespace {
 
-constexpr double kReserveUnitNmm = 1000.0;  // reserves are penalised per N·m
 constexpr double kMinMaxRegularisation = 1e-3;  // makes the min–max optimum unique
+
+/// Activation of a joint axis carrying r: r/R⁺ (flexion side) or −r/R⁻, and its derivatives.
+struct JointStrength {
+  double pos = 1, neg = 1;  // N·mm
+  double activation(double r) const { return r >= 0 ? r / pos : -r / neg; }
+  double slope(double r) const { return r >= 0 ? 1 / pos : -1 / neg; }  // d activation / dr
+};
 
 class RecruitmentNlp : public Ipopt::TNLP {
  public:
   RecruitmentNlp(const Eigen::MatrixXd& arm, const Eigen::VectorXd& b, const Eigen::VectorXd& fmax,
-                 const RecruitmentOptions& o)
-      : arm_(arm), b_(b), fmax_(fmax), o_(o), nm_(int(fmax.size())), nr_(int(b.size())),
+                 std::vector<JointStrength> strength, const RecruitmentOptions& o)
+      : arm_(arm), b_(b), fmax_(fmax), strength_(std::move(strength)), o_(o), nm_(int(fmax.size())), nr_(int(b.size())),
         minmax_(o.criterion == Criterion::MinMax) {
     for (int c = 0; c < nm_; ++c)
       for (int r = 0; r < nr_; ++r)
@@ -32,8 +39,8 @@ class RecruitmentNlp : public Ipopt::TNLP {
   bool get_nlp_info(Ipopt::Index& n, Ipopt::Index& m, Ipopt::Index& nnz_jac, Ipopt::Index& nnz_h,
                     IndexStyleEnum& style) override {
     n = nm_ + nr_ + (minmax_ ? 1 : 0);
-    m = nr_ + (minmax_ ? nm_ : 0);
-    nnz_jac = Ipopt::Index(nz_.size()) + nr_ + (minmax_ ? 2 * nm_ : 0);
+    m = nr_ + (minmax_ ? nm_ + 2 * nr_ : 0);
+    nnz_jac = Ipopt::Index(nz_.size()) + nr_ + (minmax_ ? 2 * nm_ + 4 * nr_ : 0);
     nnz_h = nm_ + nr_;  // diagonal
     style = C_STYLE;
     return true;
@@ -63,7 +70,10 @@ class RecruitmentNlp : public Ipopt::TNLP {
       const double a = x[i] / fmax_[i];
       f += minmax_ ? kMinMaxRegularisation * a * a : std::pow(std::max(a, 0.0), o_.power);
     }
-    for (int k = 0; k < nr_; ++k) f += o_.reserve_weight * std::pow(x[nm_ + k] / kReserveUnitNmm, 2);
+    for (int k = 0; k < nr_; ++k) {
+      const double a = strength_[std::size_t(k)].activation(x[nm_ + k]);
+      f += minmax_ ? kMinMaxRegularisation * a * a : std::pow(a, o_.power);
+    }
     if (minmax_) f += x[nm_ + nr_];
     return true;
   }
@@ -73,7 +83,11 @@ class RecruitmentNlp : public Ipopt::TNLP {
       const double a = std::max(x[i] / fmax_[i], 0.0);
       g[i] = minmax_ ? 2 * kMinMaxRegularisation * a / fmax_[i] : o_.power * std::pow(a, o_.power - 1) / fmax_[i];
     }
-    for (int k = 0; k < nr_; ++k) g[nm_ + k] = 2 * o_.reserve_weight * x[nm_ + k] / (kReserveUnitNmm * kReserveUnitNmm);
+    for (int k = 0; k < nr_; ++k) {
+      const JointStrength& s = strength_[std::size_t(k)];
+      const double r = x[nm_ + k], a = s.activation(r);
+      g[nm_ + k] = (minmax_ ? 2 * kMinMaxRegularisation * a : o_.power * std::pow(a, o_.power - 1)) * s.slope(r);
+    }
     if (minmax_) g[nm_ + nr_] = 1;
     return true;
   }
@@ -81,8 +95,14 @@ class RecruitmentNlp : public Ipopt::TNLP {
   bool eval_g(Ipopt::Index, const Ipopt::Number* x, bool, Ipopt::Index, Ipopt::Number* g) override {
     for (int k = 0; k < nr_; ++k) g[k] = x[nm_ + k];
     for (const auto& [r, c] : nz_) g[r] += arm_(r, c) * x[c];
-    if (minmax_)
-      for (int i = 0; i < nm_; ++i) g[nr_ + i] = x[i] / fmax_[i] - x[nm_ + nr_];
+    if (minmax_) {
+      const double t = x[nm_ + nr_];
+      for (int i = 0; i < nm_; ++i) g[nr_ + i] = x[i] / fmax_[i] - t;
+      for (int k = 0; k < nr_; ++k) {
+        g[nr_ + nm_ + 2 * k] = x[nm_ + k] / strength_[std::size_t(k)].pos - t;
+        g[nr_ + nm_ + 2 * k + 1] = -x[nm_ + k] / strength_[std::size_t(k)].neg - t;
+      }
+    }
     return true;
   }
 
@@ -92,16 +112,26 @@ class RecruitmentNlp : public Ipopt::TNLP {
     if (values == nullptr) {
       for (const auto& [r, c] : nz_) { rows[e] = r; cols[e] = c; ++e; }
       for (int k = 0; k < nr_; ++k) { rows[e] = k; cols[e] = nm_ + k; ++e; }
-      if (minmax_)
+      if (minmax_) {
         for (int i = 0; i < nm_; ++i) {
           rows[e] = nr_ + i; cols[e] = i; ++e;
           rows[e] = nr_ + i; cols[e] = nm_ + nr_; ++e;
         }
+        for (int k = 0; k < 2 * nr_; ++k) {
+          rows[e] = nr_ + nm_ + k; cols[e] = nm_ + k / 2; ++e;
+          rows[e] = nr_ + nm_ + k; cols[e] = nm_ + nr_; ++e;
+        }
+      }
     } else {
       for (const auto& [r, c] : nz_) values[e++] = arm_(r, c);
       for (int k = 0; k < nr_; ++k) values[e++] = 1;
-      if (minmax_)
+      if (minmax_) {
         for (int i = 0; i < nm_; ++i) { values[e++] = 1 / fmax_[i]; values[e++] = -1; }
+        for (int k = 0; k < nr_; ++k) {
+          values[e++] = 1 / strength_[std::size_t(k)].pos; values[e++] = -1;
+          values[e++] = -1 / strength_[std::size_t(k)].neg; values[e++] = -1;
+        }
+      }
     }
     return true;
   }
@@ -118,7 +148,12 @@ class RecruitmentNlp : public Ipopt::TNLP {
                                : o_.power * (o_.power - 1) * std::pow(a, o_.power - 2);
       values[i] = sigma * h / (fmax_[i] * fmax_[i]);
     }
-    for (int k = 0; k < nr_; ++k) values[nm_ + k] = sigma * 2 * o_.reserve_weight / (kReserveUnitNmm * kReserveUnitNmm);
+    for (int k = 0; k < nr_; ++k) {
+      const JointStrength& s = strength_[std::size_t(k)];
+      const double r = x[nm_ + k], a = s.activation(r), d = s.slope(r);
+      const double h = minmax_ ? 2 * kMinMaxRegularisation : o_.power * (o_.power - 1) * std::pow(a, o_.power - 2);
+      values[nm_ + k] = sigma * h * d * d;
+    }
     return true;
   }
 
@@ -146,6 +181,7 @@ class RecruitmentNlp : public Ipopt::TNLP {
   const Eigen::MatrixXd& arm_;
   const Eigen::VectorXd& b_;
   const Eigen::VectorXd& fmax_;
+  std::vector<JointStrength> strength_;
   RecruitmentOptions o_;
   int nm_, nr_;
   bool minmax_;
@@ -179,11 +215,24 @@ Recruitment recruit(const SpineModel& m, const Eigen::MatrixXd& arm, const Eigen
   const auto t0 = std::chrono::steady_clock::now();
   if (!(options.power >= 2 && options.power <= 10))
     throw std::invalid_argument("recruitment power must be in [2, 10], got " + std::to_string(options.power));
-  if (!(options.reserve_weight > 0) || options.max_iterations < 1 || !(options.tolerance > 0))
-    throw std::invalid_argument("recruitment: reserve weight and tolerance must be > 0, iterations >= 1");
+  if (!(options.passive_strength_scale > 0) || options.max_iterations < 1 || !(options.tolerance > 0))
+    throw std::invalid_argument("recruitment: passive strength scale and tolerance must be > 0, iterations >= 1");
+  // The rows are the recruited, non-fused joints in order (recruitment_problem); each axis's
+  // strength is its spring's moment at the range-of-motion limit.
+  std::vector<JointStrength> strength;
+  for (int j : m.recruited_joints) {
+    const Joint& jt = m.joints[std::size_t(j)];
+    if (jt.fused) continue;
+    const double s = options.passive_strength_scale;
+    strength.push_back({s * jt.k_flexion * jt.rom_flexion, s * jt.k_extension * jt.rom_extension});
+    strength.push_back({s * jt.k_torsion * jt.rom_torsion, s * jt.k_torsion * jt.rom_torsion});
+    strength.push_back({s * jt.k_lateral * jt.rom_lateral, s * jt.k_lateral * jt.rom_lateral});
+  }
+  for (const auto& st : strength)
+    if (!(st.pos > 0 && st.neg > 0)) throw std::invalid_argument("recruit: a recruited joint has zero range of motion");
   const Eigen::Index nm = Eigen::Index(m.muscles.size());
-  if (arm.cols() != nm || arm.rows() != load_moment_nmm.size())
-    throw std::invalid_argument("recruit: arm must be (3·joints) × muscles, matching the load moments");
+  if (arm.cols() != nm || arm.rows() != load_moment_nmm.size() || arm.rows() != Eigen::Index(strength.size()))
+    throw std::invalid_argument("recruit: arm must be (3·recruited joints) × muscles, matching the load moments");
   if (!arm.allFinite() || !load_moment_nmm.allFinite()) throw std::invalid_argument("recruit: non-finite input");
   Eigen::VectorXd fmax(nm);
   for (Eigen::Index i = 0; i < nm; ++i) fmax[i] = m.muscles[std::size_t(i)].max_force_n();
@@ -192,12 +241,13 @@ Recruitment recruit(const SpineModel& m, const Eigen::MatrixXd& arm, const Eigen
   out.force_n = Eigen::VectorXd::Zero(nm);
   out.activation = Eigen::VectorXd::Zero(nm);
   out.reserve_nmm = load_moment_nmm;
+  out.passive_activation = Eigen::VectorXd::Zero(load_moment_nmm.size());
   if (nm == 0 || arm.rows() == 0) {  // nothing to recruit: every moment is left to the joints
     out.success = true;
     out.status = nm == 0 ? "no muscles" : "no recruited joints";
     return out;
   }
-  Ipopt::SmartPtr<RecruitmentNlp> nlp = new RecruitmentNlp(arm, load_moment_nmm, fmax, options);
+  Ipopt::SmartPtr<RecruitmentNlp> nlp = new RecruitmentNlp(arm, load_moment_nmm, fmax, strength, options);
   {
     std::lock_guard<std::mutex> lock(ipopt_mutex());
     Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
@@ -220,6 +270,9 @@ Recruitment recruit(const SpineModel& m, const Eigen::MatrixXd& arm, const Eigen
     out.force_n = nlp->solution.head(nm).cwiseMax(0.0).cwiseMin(fmax);
     out.activation = out.force_n.cwiseQuotient(fmax);
     out.reserve_nmm = nlp->solution.segment(nm, arm.rows());
+    out.passive_activation.resize(arm.rows());
+    for (Eigen::Index k = 0; k < arm.rows(); ++k)
+      out.passive_activation[k] = strength[std::size_t(k)].activation(out.reserve_nmm[k]);
     out.objective = nlp->objective;
     out.max_constraint_violation_nmm = nlp->violation;
   }

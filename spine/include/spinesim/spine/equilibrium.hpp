@@ -37,8 +37,9 @@ struct ExternalLoad {
 struct SolveOptions {
   bool recruit = true;  ///< false: muscles off (passive spine)
   RecruitmentOptions recruitment;
-  double tolerance = 1e-3;   ///< on max |∂Π/∂θ| in N·mm (generalised moments; 1e-3 N·mm = 1 µN·m)
-  int max_iterations = 60;
+  double tolerance = 1e-2;   ///< on max |∂Π/∂θ| in N·mm (generalised moments; 1e-2 N·mm = 10 µN·m)
+  double relative_tolerance = 1e-8;  ///< or max |∂Π/∂θ| ≤ this × its value at θ = 0 (round-off floor)
+  int max_iterations = 200;
   double fd_step = 1e-7;     ///< rad, for the finite-difference Hessian
   bool warn_above_600n = true;  ///< SolveResult::warnings names forces beyond 600 N (thesis limit)
 };
@@ -46,7 +47,10 @@ struct SolveOptions {
 /// Force the lower side of a joint exerts on everything above it, and the moment it carries.
 struct JointReaction {
   std::string joint;
-  Eigen::Vector3d force_world_n, moment_world_nmm;  ///< about the (moved) joint point
+  Eigen::Vector3d force_world_n;     ///< force of the lower side on everything above, N
+  /// Moment about the (moved) joint point of everything acting on the part above: the moment
+  /// the joint's spring carries (x > 0: flexion), N·mm.
+  Eigen::Vector3d moment_world_nmm;
   /// In the lower vertebra's axes (the thesis's joint frame: F.1 orientations are 0):
   double axial_n = 0;     ///< +y component: compression > 0
   double shear_ap_n = 0;  ///< +z component (the lower body pushes the upper one forward)

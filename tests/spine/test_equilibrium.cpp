@@ -1,0 +1,192 @@
+// Equilibrium of the spine: the gradient against finite differences of the energy, analytic
+// single-joint solutions at finite rotation, minimality, fusion, recruitment properties, bad input.
+#include "spinesim/spine/equilibrium.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace sp = spinesim::spine;
+using Eigen::Vector3d;
+using Eigen::VectorXd;
+
+namespace {
+
+const sp::SpineModel& full() {
+  static const sp::SpineModel m = sp::load_spine_model(SPINESIM_DATA_DIR);
+  return m;
+}
+
+/// Joints only: no gravity, ligaments, muscles or bushing.
+sp::SpineModel bare() {
+  sp::ModelOptions o;
+  o.gravity = o.ligaments = o.muscles = o.iap = false;
+  return sp::load_spine_model(SPINESIM_DATA_DIR, o);
+}
+
+sp::ExternalLoad force_on(const std::string& vertebra, const Vector3d& f) {
+  sp::ExternalLoad l;
+  l.vertebra = sp::vertebra_index(vertebra);
+  l.force_n = f;
+  return l;
+}
+
+}  // namespace
+
+TEST(SpineEquilibrium, GradientMatchesFiniteDifferencesOfThePotential) {
+  const auto& m = full();
+  VectorXd theta(sp::dof_count(m));
+  for (Eigen::Index i = 0; i < theta.size(); ++i) theta[i] = 0.04 * std::cos(0.7 * double(i) + 0.3);
+  VectorXd F = VectorXd::Constant(Eigen::Index(m.muscles.size()), 25.0);
+  sp::ExternalLoad l = force_on("T4", Vector3d(40, -30, 120));
+  l.moment_nmm = Vector3d(2000, -1500, 800);  // exercises the conservative couple
+  VectorXd g;
+  sp::potential(m, {l}, F, theta, &g);
+  const double h = 1e-6;
+  for (Eigen::Index i = 0; i < theta.size(); ++i) {
+    VectorXd tp = theta, tm = theta;
+    tp[i] += h;
+    tm[i] -= h;
+    const double fd = (sp::potential(m, {l}, F, tp) - sp::potential(m, {l}, F, tm)) / (2 * h);
+    EXPECT_NEAR(g[i], fd, 1e-6 * (1 + std::abs(fd))) << "coordinate " << i;
+  }
+}
+
+TEST(SpineEquilibrium, CoupleOnOneJointRotatesItByMOverKFlexionExtensionAndBump) {
+  const sp::SpineModel m = bare();
+  const sp::Joint& j = m.joints[16];  // L5-S1
+  for (double M : {1000.0, -1000.0, 20000.0, 150000.0}) {
+    sp::ExternalLoad l;
+    l.vertebra = sp::vertebra_index("L5");
+    l.moment_nmm = Vector3d(M, 0, 0);
+    const sp::SpineSolution s = sp::solve_spine(m, {l});
+    const double k = M > 0 ? j.k_flexion : j.k_extension, rom = M > 0 ? j.rom_flexion : j.rom_extension;
+    double expect = M / k;
+    if (std::abs(expect) > rom) {  // k θ + b k (θ − rom) = M
+      const double kb = m.rom_bump_factor * k;
+      expect = (std::abs(M) + kb * rom) / (k + kb) * (M > 0 ? 1 : -1);
+    }
+    EXPECT_NEAR(s.theta[3 * 16], expect, 1e-9) << "M = " << M;
+    EXPECT_NEAR(s.theta.head(3 * 16).norm(), 0, 1e-12);  // nothing above L5 is loaded
+    EXPECT_NEAR(s.joints[16].moment_local_nmm.x(), M, 1e-6 * std::abs(M));
+  }
+}
+
+TEST(SpineEquilibrium, DeadForceAtFiniteRotationSatisfiesTheExactMomentBalance) {
+  const sp::SpineModel m = bare();
+  const double F = 300;  // N forward on L5's centre
+  const sp::SpineSolution s = sp::solve_spine(m, {force_on("L5", Vector3d(0, 0, F))});
+  const double th = s.theta[3 * 16];
+  const Vector3d r = m.vertebrae[16].centre_mm - m.joints[16].point_mm;
+  // k θ (+ bump) = F (r_y cos θ − r_z sin θ): the lever arm shortens as the vertebra turns.
+  const sp::Joint& j = m.joints[16];
+  double spring = j.k_flexion * th;
+  if (th > j.rom_flexion) spring += m.rom_bump_factor * j.k_flexion * (th - j.rom_flexion);
+  EXPECT_GT(th, 0.01);
+  EXPECT_NEAR(spring, F * (r.y() * std::cos(th) - r.z() * std::sin(th)), 1e-6 * spring);
+  // The joint carries the whole load: its reaction balances the applied force.
+  EXPECT_NEAR((s.joints[16].force_world_n + Vector3d(0, 0, F)).norm(), 0, 1e-9);
+}
+
+TEST(SpineEquilibrium, SolutionIsAMinimumOfThePotential) {
+  const auto& m = full();
+  const std::vector<sp::ExternalLoad> loads = {force_on("T1", Vector3d(-150, 0, 200))};
+  const sp::SpineSolution s = sp::solve_spine(m, loads);
+  ASSERT_TRUE(s.converged);
+  const VectorXd& F = s.recruitment.force_n;
+  const double E0 = sp::potential(m, loads, F, s.theta);
+  for (int trial = 0; trial < 20; ++trial) {
+    const VectorXd d = 1e-3 * VectorXd::Random(s.theta.size());
+    EXPECT_GE(sp::potential(m, loads, F, s.theta + d), E0 - 1e-6) << "trial " << trial;
+  }
+}
+
+TEST(SpineEquilibrium, LateralForceGivesAMirrorImageResponse) {
+  const auto& m = full();
+  const sp::SpineSolution a = sp::solve_spine(m, {force_on("T1", Vector3d(200, 0, 0))});
+  const sp::SpineSolution b = sp::solve_spine(m, {force_on("T1", Vector3d(-200, 0, 0))});
+  // Mirror x → −x: x translation and y, z rotations change sign; y, z translations and x rotation do not.
+  const Eigen::Matrix<double, 1, 6> sign = (Eigen::Matrix<double, 1, 6>() << -1, 1, 1, 1, -1, -1).finished();
+  for (Eigen::Index i = 0; i < a.displacement.rows(); ++i)
+    EXPECT_NEAR((a.displacement.row(i) - b.displacement.row(i).cwiseProduct(sign)).norm(), 0, 1e-4) << "vertebra " << i;
+  EXPECT_GT(std::abs(a.displacement(0, 0)), 1.0);  // T1 moves sideways, in mm
+}
+
+TEST(SpineEquilibrium, SagittalLoadRecruitsLeftAndRightAlikeAndSatisfiesTheConstraints) {
+  const auto& m = full();
+  const std::vector<sp::ExternalLoad> loads = {force_on("T7", Vector3d(0, 0, 300))};
+  Eigen::MatrixXd arm;
+  VectorXd b;
+  std::vector<int> joints;
+  sp::recruitment_problem(m, loads, arm, b, joints);
+  EXPECT_EQ(joints.size(), m.recruited_joints.size());
+  for (auto criterion : {sp::Criterion::Polynomial, sp::Criterion::MinMax}) {
+    sp::RecruitmentOptions o;
+    o.criterion = criterion;
+    const sp::Recruitment r = sp::recruit(m, arm, b, o);
+    ASSERT_TRUE(r.success) << r.status;
+    EXPECT_LT((arm * r.force_n + r.reserve_nmm - b).cwiseAbs().maxCoeff(), 1e-6 * b.cwiseAbs().maxCoeff());
+    for (std::size_t i = 0; i < m.muscles.size(); i += 2)
+      EXPECT_NEAR(r.force_n[Eigen::Index(i)], r.force_n[Eigen::Index(i + 1)], 1e-3 * m.muscles[i].max_force_n())
+          << m.muscles[i].name;
+    EXPECT_GE(r.activation.minCoeff(), 0.0);
+    EXPECT_LE(r.activation.maxCoeff(), 1.0);
+  }
+}
+
+TEST(SpineEquilibrium, MinMaxCriterionLowersThePeakActivationOfMusclesAndJoints) {
+  const auto& m = full();
+  const std::vector<sp::ExternalLoad> loads = {force_on("T7", Vector3d(0, 0, 100))};
+  Eigen::MatrixXd arm;
+  VectorXd b;
+  std::vector<int> joints;
+  sp::recruitment_problem(m, loads, arm, b, joints);
+  sp::RecruitmentOptions cubic, minmax;
+  minmax.criterion = sp::Criterion::MinMax;
+  const sp::Recruitment a = sp::recruit(m, arm, b, cubic), c = sp::recruit(m, arm, b, minmax);
+  ASSERT_TRUE(a.success && c.success);
+  ASSERT_LT(a.activation.maxCoeff(), 1.0);  // not saturated, so the criteria differ
+  // Min–max minimises the largest activation over muscles and joint axes together.
+  const double peak_cubic = std::max(a.activation.maxCoeff(), a.passive_activation.maxCoeff());
+  const double peak_minmax = std::max(c.activation.maxCoeff(), c.passive_activation.maxCoeff());
+  EXPECT_LE(peak_minmax, peak_cubic + 1e-6);
+  EXPECT_LT(c.activation.minCoeff(), 1.0);
+  sp::RecruitmentOptions bad;
+  bad.power = 1;
+  EXPECT_THROW(sp::recruit(m, arm, b, bad), std::invalid_argument);
+}
+
+// With the muscles off, a fused joint can only stiffen the spine. (With recruitment the muscle
+// forces, and with them the muscles' stiffness, change too: `spinesim study fusion` reports that.)
+TEST(SpineEquilibrium, FusionHoldsTheJointAndStiffensThePassiveSpine) {
+  sp::ModelOptions o;
+  o.fused_joints = sp::parse_fusion("L3-L4-L5");
+  const sp::SpineModel fused = sp::load_spine_model(SPINESIM_DATA_DIR, o);
+  const std::vector<sp::ExternalLoad> loads = {force_on("T1", Vector3d(0, 0, 100))};
+  sp::SolveOptions passive;
+  passive.recruit = false;
+  const sp::SpineSolution f = sp::solve_spine(fused, loads, passive), n = sp::solve_spine(full(), loads, passive);
+  EXPECT_EQ(f.theta.segment<6>(3 * 14).norm(), 0.0);
+  EXPECT_GT(n.theta.segment<6>(3 * 14).norm(), 1e-4);
+  EXPECT_LT(f.displacement.row(0).head<3>().norm(), n.displacement.row(0).head<3>().norm());
+}
+
+TEST(SpineEquilibrium, BadInputAndNonConvergenceAreReportedNotReturned) {
+  const auto& m = full();
+  sp::ExternalLoad l = force_on("T1", Vector3d(0, 0, 100));
+  l.vertebra = 17;
+  EXPECT_THROW(sp::solve_spine(m, {l}), std::invalid_argument);
+  l = force_on("T1", Vector3d(0, std::nan(""), 0));
+  EXPECT_THROW(sp::solve_spine(m, {l}), std::invalid_argument);
+  const sp::SpineSolution big = sp::solve_spine(m, {force_on("T7", Vector3d(0, 0, 650))});
+  ASSERT_EQ(big.warnings.size(), 1u);
+  EXPECT_NE(big.warnings[0].find("600 N"), std::string::npos);
+  sp::SolveOptions one;
+  one.max_iterations = 1;
+  try {
+    sp::solve_spine(m, {force_on("T1", Vector3d(0, 0, 500))}, one);
+    FAIL() << "one Newton iteration cannot converge";
+  } catch (const sp::SolveError& e) {
+    EXPECT_NE(std::string(e.what()).find("did not converge"), std::string::npos);
+  }
+}
