@@ -49,6 +49,7 @@ void register_fem(CLI::App& app);
 void register_mss(CLI::App& app);    ///< mss, mss compare (cli_mss.cpp)
 void register_calibrate(CLI::App& app);  ///< calibrate (cli_calibrate.cpp)
 void register_study(CLI::App& app);  ///< study probe|drive (cli_study.cpp)
+void register_spine(CLI::App& app);  ///< spine solve (cli_spine.cpp)
 void register_demo(CLI::App& app);
 void register_bench(CLI::App& app);
 

@@ -8,15 +8,17 @@
 // FEM, the untuned and the calibrated mass-spring disc under 500 N compression; 4. the
 // mass-spring disc with the untuned Van Gelder constants against that FEM on all eight cases
 // (mss_report.hpp protocol); 5. the calibration protocol (calibration_report.hpp): Ipopt on four
-// training cases, four held out, untuned beside tuned; 6. write VTU results, report.md and
-// summary.json into --out.
-// (The spine joins the demo as it is built.)
+// training cases, four held out, untuned beside tuned; 6. the spine (spine_studies.hpp): the
+// validation cases of thesis 3.4 beside their targets, fusion vs the normal spine (6.1) and the
+// relative vertebra motions under a force on T1 against the thesis's trends (6.3-6.4); 7. write
+// VTU results, report.md and summary.json into --out.
 #include "calibration_report.hpp"
 #include "cli_common.hpp"
 #include "fem_report.hpp"
 #include "materials_study.hpp"
 #include "mesh_report.hpp"
 #include "mss_report.hpp"
+#include "spine_studies.hpp"
 
 #include "spinesim/fem/disc_fem.hpp"
 #include "spinesim/fem/load_cases.hpp"
@@ -58,7 +60,8 @@ void run_demo(const DemoArgs& a) {
   namespace fs = std::filesystem;
   fs::create_directories(a.out);
   static const char* kPresets[] = {"real-disc", "annulus-nucleus", "rubber", "polyethylene"};
-  Progress progress(5 + kStagesPerMaterial * int(std::size(kPresets)), a.quiet || a.json);
+  Progress progress(5 + kStagesPerMaterial * int(std::size(kPresets)) + kValidationStages + kFusionStages + kTrendsStages,
+                    a.quiet || a.json);
 
   // 1. Mesh.
   const auto dims = mesh::disc_dimensions(a.level, data_dir());
@@ -151,7 +154,20 @@ void run_demo(const DemoArgs& a) {
   std::ostringstream calibration_text;
   print_calibration(calibration_text, calibrated, calibration_request);
 
-  // 6. Report.
+  // 6. The spine: validation (thesis 3.4), fusion (6.1), trends (6.3-6.4), on the default model.
+  SpineStageHooks spine_hooks;
+  spine_hooks.begin = [&](const std::string& what) { progress.begin(what); };
+  spine_hooks.end = [&](const std::string& detail) { progress.end(detail); };
+  constexpr double kSpineStudyForceN = 300;  // the studies' default force on T1
+  const ValidationStudy spine_validation = run_validation_study(data_dir(), spine_hooks);
+  const FusionStudy spine_fusion = run_fusion_study(data_dir(), kSpineStudyForceN, spine_hooks);
+  const TrendsStudy spine_trends = run_trends_study(data_dir(), kSpineStudyForceN, spine_hooks);
+  std::ostringstream validation_text, fusion_text, trends_text;
+  print_validation(validation_text, spine_validation, true);
+  print_fusion(fusion_text, spine_fusion, true);
+  print_trends(trends_text, spine_trends, true);
+
+  // 7. Report.
   const fem::Matrix6d k_local = to_disc_frame(k6, m.frame);
   std::ostringstream report;
   report << "# spinesim demo — " << dims.level << " disc\n\n"
@@ -187,7 +203,19 @@ void run_demo(const DemoArgs& a) {
          << "displacement, nonlinear MSS at the case loads x " << calibration_request.check_load_scale
          << " (the linear regime the FEM describes),\nthe linearised errors in brackets. `spinesim calibrate --help` "
          << "and calibration/README.md give the protocol. " << std::setprecision(3) << calibration_s << " s.\n\n```\n"
-         << calibration_text.str() << "```\n";
+         << calibration_text.str() << "```\n"
+         << "\n## Spine: validation (thesis 3.4)\n\n"
+         << "The open thoracolumbar spine (spine/: 17 vertebrae, F.4 joint springs with F.5 limits, ligaments, lumbar\n"
+         << "muscles recruited by Ipopt, the IAP bushing, gravity), nothing tuned to these targets. "
+         << "`spinesim study validation --help` gives the protocol. " << std::setprecision(3) << spine_validation.seconds
+         << " s.\n\n"
+         << validation_text.str()
+         << "\n## Spine: fusion vs the normal spine (thesis 6.1)\n\n"
+         << "`spinesim study fusion --help` gives the protocol. " << std::setprecision(3) << spine_fusion.seconds << " s.\n\n"
+         << fusion_text.str()
+         << "\n## Spine: relative vertebra motion under a force on T1 vs the thesis's trends (6.3-6.4)\n\n"
+         << "`spinesim study trends --help` gives the protocol. " << std::setprecision(3) << spine_trends.seconds << " s.\n\n"
+         << trends_text.str();
   const std::string report_path = (fs::path(a.out) / "report.md").string();
   {
     std::ofstream f(report_path);
@@ -207,6 +235,9 @@ void run_demo(const DemoArgs& a) {
                       {"mss_vs_fem", comparison_json(mss_vs_fem)},
                       {"calibration", calibrated.tuned.report},
                       {"calibration_scales", calibrated.tuned.scales},
+                      {"spine_validation", validation_json(spine_validation)},
+                      {"spine_fusion", fusion_json(spine_fusion)},
+                      {"spine_trends", trends_json(spine_trends)},
                       {"report", report_path},
                       {"files", {mesh_path, result_path}}};
   {

@@ -3,6 +3,9 @@
 //   spinesim study probe [--out study-out] [--radius 3] [--depth 2] [--speed 20] [--no-radial | --volume-term]
 //   spinesim study drive [--out study-out] [--materials real-disc,annulus-nucleus,rubber,polyethylene]
 //   spinesim study materials [--level L4-L5] [--cell-size 2] [--materials …] [--csv materials.csv]
+//   spinesim study validation [--csv validation.csv] [--json]
+//   spinesim study fusion [--force 300] [--csv fusion.csv] [--json]
+//   spinesim study trends [--force 300] [--csv trends.csv] [--json]
 //
 // probe — thesis 5.3, test 1 (fig. 5.8): a rigid sphere pressed into the outer wall of a disc
 //   whose endplates are both fixed, held, withdrawn, then at a second site while the first
@@ -17,6 +20,9 @@
 // frames every --frame-every steps), a CSV per run and a JSON summary in --out. A run whose step
 // diverges stops there: its files hold the finite states up to that step, "diverged": true is
 // in the JSON, and the program exits 1 after the other runs.
+// validation, fusion, trends — the spine (spine_studies.hpp): thesis 3.4's two validation cases
+//   beside their targets, 6.1's fusion comparison and 6.3-6.4's relative vertebra motions under a
+//   force on T1, each thesis statement reported as MATCH or DIFFERS; tables, --csv, --json.
 //
 // Adding a study: write its Args struct (with a StudyCommon), run_<name>() and a register
 // function below, and add one line to register_study() at the end of this file.
@@ -24,6 +30,7 @@
 #include "fem_report.hpp"
 #include "materials_study.hpp"
 #include "mss_report.hpp"
+#include "spine_studies.hpp"
 
 #include "spinesim/fem/disc_fem.hpp"
 #include "spinesim/mesh/disc_geometry.hpp"
@@ -707,6 +714,115 @@ void register_materials(CLI::App& study) {
   cmd->callback([a] { run_materials(*a); });
 }
 
+// --- study validation | fusion | trends (the spine; spine_studies.hpp) ------------------------
+
+struct SpineStudyArgs {
+  double force_n = 300;
+  std::string csv;
+  bool json = false, quiet = false;
+};
+
+void add_spine_study_options(CLI::App* cmd, SpineStudyArgs& a, bool with_force) {
+  if (with_force) cmd->add_option("--force", a.force_n, "Force on the T1 centre, N")->capture_default_str();
+  cmd->add_option("--csv", a.csv, "Write the study's CSV");
+  cmd->add_flag("--json", a.json, "Print the JSON summary on stdout (instead of the tables)");
+  cmd->add_flag("--quiet", a.quiet, "No progress on stderr");
+}
+
+/// Checks shared by the spine studies before any work; returns the progress hooks.
+SpineStageHooks spine_study_hooks(const SpineStudyArgs& a, Progress& progress) {
+  if (!std::isfinite(a.force_n) || a.force_n <= 0) throw std::invalid_argument("--force must be a finite number > 0 N");
+  if (a.force_n > 600)
+    std::cerr << "spinesim: warning: --force " << a.force_n << " N is beyond the 600 N the thesis validated; solving anyway"
+              << std::endl;
+  if (!a.csv.empty()) require_writable(a.csv, "--csv");
+  SpineStageHooks hooks;
+  hooks.begin = [&progress](const std::string& what) { progress.begin(what); };
+  hooks.end = [&progress](const std::string& detail) { progress.end(detail); };
+  return hooks;
+}
+
+void run_validation(const SpineStudyArgs& a) {
+  Progress progress(kValidationStages, a.quiet || a.json);
+  const ValidationStudy s = run_validation_study(data_dir(), spine_study_hooks(a, progress));
+  if (!a.csv.empty()) write_text_file(a.csv, validation_csv(s));
+  nlohmann::json j = validation_json(s);
+  j["csv"] = a.csv.empty() ? nlohmann::json(nullptr) : nlohmann::json(a.csv);
+  if (a.json) {
+    print_json(j);
+    return;
+  }
+  std::cout << "Spine validation (thesis 3.4): McGill & Norman 1987 at L5-S1, Wilke et al. 2001 at L4-L5\n\n";
+  print_validation(std::cout, s, false);
+  std::cout << "Total " << fixed(s.seconds, 2) << " s" << (a.csv.empty() ? "" : "; wrote " + a.csv) << "\n";
+}
+
+void run_fusion(const SpineStudyArgs& a) {
+  Progress progress(kFusionStages, a.quiet || a.json);
+  const FusionStudy s = run_fusion_study(data_dir(), a.force_n, spine_study_hooks(a, progress));
+  if (!a.csv.empty()) write_text_file(a.csv, fusion_csv(s));
+  nlohmann::json j = fusion_json(s);
+  j["csv"] = a.csv.empty() ? nlohmann::json(nullptr) : nlohmann::json(a.csv);
+  if (a.json) {
+    print_json(j);
+    return;
+  }
+  std::cout << "Spinal fusion vs the normal spine (thesis 6.1)\n\n";
+  print_fusion(std::cout, s, false);
+  std::cout << "Total " << fixed(s.seconds, 2) << " s" << (a.csv.empty() ? "" : "; wrote " + a.csv) << "\n";
+}
+
+void run_trends(const SpineStudyArgs& a) {
+  Progress progress(kTrendsStages, a.quiet || a.json);
+  const TrendsStudy s = run_trends_study(data_dir(), a.force_n, spine_study_hooks(a, progress));
+  if (!a.csv.empty()) write_text_file(a.csv, trends_csv(s));
+  nlohmann::json j = trends_json(s);
+  j["csv"] = a.csv.empty() ? nlohmann::json(nullptr) : nlohmann::json(a.csv);
+  if (a.json) {
+    print_json(j);
+    return;
+  }
+  std::cout << "Relative motion of adjacent vertebrae under a force on T1 (thesis 6.3-6.4)\n\n";
+  print_trends(std::cout, s, false);
+  std::cout << "Total " << fixed(s.seconds, 2) << " s" << (a.csv.empty() ? "" : "; wrote " + a.csv) << "\n";
+}
+
+void register_validation(CLI::App& study) {
+  auto a = std::make_shared<SpineStudyArgs>();
+  auto* cmd = study.add_subcommand("validation", "Thesis 3.4: L5-S1 forces at a 238 N·m extension moment, L4-L5 force holding a crate");
+  add_spine_study_options(cmd, *a, false);
+  cmd->footer(
+      "(a) McGill & Norman 1987: a +z force on the T7 centre raised until the net external moment about the\n"
+      "    L5-S1 joint point (T7 force and every weight above, in the equilibrium posture) is 238 N·m; L5-S1\n"
+      "    axial and shear force (joint and disc frames) against 3929-4688 N and <= 650 N.\n"
+      "(b) Wilke et al. 2001: 19.8 kg crate 600 mm in front of the chest, arms forward; L4-L5 axial force\n"
+      "    against 3240 N +- 15 %. Targets: data/spine/spine_model.json \"validation\". Nothing is tuned.\n"
+      "Output: table (or --json with each case's forces beside its targets), --csv FILE. A missed target is\n"
+      "reported (exit 0); a failed solve is an error (exit 1).");
+  cmd->callback([a] { run_validation(*a); });
+}
+
+void register_fusion(CLI::App& study) {
+  auto a = std::make_shared<SpineStudyArgs>();
+  auto* cmd = study.add_subcommand("fusion", "Thesis 6.1: normal spine vs fusion at L3-L4, L4-L5, L3-L4-L5 under forces on T1");
+  add_spine_study_options(cmd, *a, true);
+  cmd->footer(
+      "The same forward (+z), backward (-z) and lateral (-x) force on the T1 centre, per model: T1 motion (the\n"
+      "force's effect, minus the model's gravity-only equilibrium; mm, deg) and the L2-L3 and L5-S1 joint\n"
+      "forces (totals, joint frame; N). The thesis's findings are checked: MATCH or DIFFERS, not forced.");
+  cmd->callback([a] { run_fusion(*a); });
+}
+
+void register_trends(CLI::App& study) {
+  auto a = std::make_shared<SpineStudyArgs>();
+  auto* cmd = study.add_subcommand("trends", "Thesis 6.3-6.4: relative motion of adjacent vertebrae under forces on T1, vs the thesis's trends");
+  add_spine_study_options(cmd, *a, true);
+  cmd->footer(
+      "Lateral (-x), forward (+z) and backward (-z) force on the T1 centre. Per pair T1-T2 ... L4-L5: relative\n"
+      "translation of the centres (upper minus lower, world axes, mm) and the joint rotation (deg), each minus its\n"
+      "gravity-only value. Each trend the thesis states is printed as MATCH or DIFFERS with our numbers.");
+  cmd->callback([a] { run_trends(*a); });
+}
 }  // namespace
 
 void register_study(CLI::App& app) {
@@ -716,6 +832,9 @@ void register_study(CLI::App& app) {
   register_probe(*study);
   register_drive(*study);
   register_materials(*study);
+  register_validation(*study);
+  register_fusion(*study);
+  register_trends(*study);
 }
 
 }  // namespace spinesim::cli

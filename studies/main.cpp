@@ -29,6 +29,7 @@ int main(int argc, char** argv) {
   spinesim::cli::register_fem(app);
   spinesim::cli::register_mss(app);
   spinesim::cli::register_calibrate(app);
+  spinesim::cli::register_spine(app);
   spinesim::cli::register_study(app);
   spinesim::cli::register_demo(app);
   spinesim::cli::register_bench(app);

@@ -1,0 +1,277 @@
+// `spinesim spine solve` and the spine studies (`study validation|fusion|trends`): the JSON
+// contract, physical properties of the answers (no load → no motion, a fused joint does not
+// move, equal loads on a symmetric spine give a sagittal answer), every refusal (exit 1, one line
+// on stderr, no file), the two validation windows of thesis 3.4 and the thesis's fusion findings
+// (6.1). Each solve takes tens of milliseconds; each study a fraction of a second.
+#include "cli_runner.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+using namespace spinesim::test_cli;
+
+std::string in_quotes(const std::string& path) { return "'" + path + "'"; }
+
+json solve_json(const std::string& args) {
+  const CliRun r = run_spinesim("spine solve " + args + " --json");
+  EXPECT_EQ(r.status, 0) << r.err;
+  if (r.status != 0) return json::object();
+  return json::parse(r.out);
+}
+
+/// One run of a study's --json per process.
+const json& study(const std::string& name) {
+  static std::map<std::string, json> made;
+  auto it = made.find(name);
+  if (it != made.end()) return it->second;
+  const CliRun r = run_spinesim("study " + name + " --json");
+  EXPECT_EQ(r.status, 0) << r.err;
+  return made.emplace(name, r.status == 0 ? json::parse(r.out) : json::object()).first->second;
+}
+
+double vec_norm(const json& v) { return std::sqrt(v[0].get<double>() * v[0].get<double>() + v[1].get<double>() * v[1].get<double>() + v[2].get<double>() * v[2].get<double>()); }
+
+const json& joint(const json& j, const std::string& name) {
+  for (const auto& x : j["joints"])
+    if (x["joint"] == name) return x;
+  ADD_FAILURE() << "joint " << name << " missing";
+  static const json none;
+  return none;
+}
+
+}  // namespace
+
+// --- spine solve -------------------------------------------------------------------------------
+
+TEST(SpineSolveCli, HelpOnEveryVerb) {
+  for (const char* verb : {"spine", "spine solve", "study validation", "study fusion", "study trends"}) {
+    const CliRun r = run_spinesim(std::string(verb) + " --help");
+    EXPECT_EQ(r.status, 0) << verb;
+    EXPECT_NE(r.out.find("--"), std::string::npos) << verb;
+  }
+}
+
+TEST(SpineSolveCli, JsonGivesEveryVertebraJointMuscleAndLigament) {
+  const std::string csv = tmp("spine.csv");
+  const CliRun r = run_spinesim("spine solve --force T7:0,0,300 --json --csv " + in_quotes(csv));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(r.err.empty()) << r.err;
+  const json j = json::parse(r.out);
+  EXPECT_TRUE(j["converged"].get<bool>());
+  ASSERT_EQ(j["vertebrae"].size(), 17u);
+  ASSERT_EQ(j["joints"].size(), 17u);
+  EXPECT_EQ(j["vertebrae"][0]["name"], "T1");
+  EXPECT_EQ(j["joints"][16]["joint"], "L5-S1");
+  for (const auto& v : j["vertebrae"]) {
+    EXPECT_EQ(v["translation_mm"].size(), 3u);
+    EXPECT_EQ(v["rotation_deg"].size(), 3u);
+  }
+  for (const char* key : {"force_world_n", "moment_world_nmm", "axial_n", "shear_ap_n", "shear_lat_n", "disc_axial_n",
+                          "disc_shear_n", "moment_local_nmm", "resultant_n"})
+    EXPECT_TRUE(j["joints"][0].contains(key)) << key;
+  ASSERT_FALSE(j["muscles"].empty());
+  for (const auto& m : j["muscles"]) {
+    const double f = m["recruited_force_n"], fmax = m["max_force_n"];
+    EXPECT_GE(f, -1e-6) << m["name"];
+    EXPECT_LE(f, fmax * (1 + 1e-6) + 1e-6) << m["name"];
+    EXPECT_GE(m["tension_n"].get<double>(), 0.0) << m["name"];
+  }
+  ASSERT_FALSE(j["ligaments"].empty());
+  for (const auto& l : j["ligaments"]) EXPECT_GE(l["force_n"].get<double>(), 0.0) << l["name"];  // tension only
+  EXPECT_TRUE(j["recruitment"]["success"].get<bool>());
+  EXPECT_EQ(j["bushing"]["force_n"].size(), 3u);
+  EXPECT_GT(j["seconds"]["total"].get<double>(), 0.0);
+  // The load as understood: T7, at its F.1 centre (0, 384, -65) mm.
+  ASSERT_EQ(j["loads"].size(), 1u);
+  EXPECT_EQ(j["loads"][0]["vertebra"], "T7");
+  EXPECT_DOUBLE_EQ(j["loads"][0]["point_mm"][1].get<double>(), 384.0);
+  // A forward push on T7 moves the upper trunk forward; the lumbar joints are in compression.
+  EXPECT_GT(j["vertebrae"][0]["translation_mm"][2].get<double>(), 0.0);
+  EXPECT_GT(joint(j, "L5-S1")["axial_n"].get<double>(), 0.0);
+  // The CSV: a header and one row per vertebra.
+  EXPECT_EQ(count_lines(slurp(csv)), 18);
+  EXPECT_EQ(j["csv"], csv);
+}
+
+TEST(SpineSolveCli, NoLoadNoGravityNoMusclesStaysAtRest) {
+  const json j = solve_json("--no-gravity --no-muscles");
+  ASSERT_FALSE(j.empty());
+  for (const auto& v : j["vertebrae"]) {
+    EXPECT_LT(vec_norm(v["translation_mm"]), 1e-9) << v["name"];
+    EXPECT_LT(vec_norm(v["rotation_deg"]), 1e-9) << v["name"];
+  }
+  for (const auto& x : j["joints"]) EXPECT_LT(vec_norm(x["force_world_n"]), 1e-9) << x["joint"];
+}
+
+TEST(SpineSolveCli, FusedJointDoesNotMove) {
+  const json j = solve_json("--force T1:0,0,200 --fusion L3-L4");
+  ASSERT_FALSE(j.empty());
+  const json& l3 = j["vertebrae"][14];
+  const json& l4 = j["vertebrae"][15];
+  ASSERT_EQ(l3["name"], "L3");
+  for (int k = 0; k < 3; ++k)
+    EXPECT_NEAR(l3["rotation_deg"][k].get<double>(), l4["rotation_deg"][k].get<double>(), 1e-9) << k;
+  EXPECT_GT(std::abs(j["vertebrae"][13]["rotation_deg"][0].get<double>() - l3["rotation_deg"][0].get<double>()), 1e-3)
+      << "L2-L3 (not fused) should bend";
+}
+
+// The model is left-right symmetric: a load in the sagittal plane gives a sagittal answer.
+TEST(SpineSolveCli, SagittalLoadsGiveSagittalAnswers) {
+  for (const char* force : {"T1:0,0,300", "T1:0,0,-300", "T7:0,-300,0"}) {
+    const json j = solve_json(std::string("--force ") + force);
+    ASSERT_FALSE(j.empty()) << force;
+    for (const auto& v : j["vertebrae"]) {
+      EXPECT_NEAR(v["translation_mm"][0].get<double>(), 0.0, 1e-6) << force << " " << v["name"];
+      EXPECT_NEAR(v["rotation_deg"][2].get<double>(), 0.0, 1e-6) << force << " " << v["name"];
+    }
+  }
+}
+
+TEST(SpineSolveCli, ForceBeyond600NIsSolvedWithAWarning) {
+  const CliRun r = run_spinesim("spine solve --force T1:0,0,700 --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("warning"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("600 N"), std::string::npos) << r.err;
+  EXPECT_TRUE(json::parse(r.out)["converged"].get<bool>());
+}
+
+TEST(SpineSolveCliRefuses, BadLoads) {
+  expect_refused(run_spinesim("spine solve --force X9:0,0,1"), "X9");
+  expect_refused(run_spinesim("spine solve --force T7:nan,0,0"), "non-finite");
+  expect_refused(run_spinesim("spine solve --force T7:inf,0,0"), "non-finite");
+  expect_refused(run_spinesim("spine solve --force T7:1,2"), "3 comma-separated");
+  expect_refused(run_spinesim("spine solve --force T7:1,2,abc"), "not a number");
+  expect_refused(run_spinesim("spine solve --force T7"), "VERTEBRA:");
+  expect_refused(run_spinesim("spine solve --moment S1:0,0,1"), "S1");
+  expect_refused(run_spinesim("spine solve --force T7:0,0,1 --at 0,1"), "--at");
+  expect_refused(run_spinesim("spine solve --force T7:0,0,1 --force T8:0,0,1 --at 0,0,0"), "--at");
+}
+
+TEST(SpineSolveCliRefuses, BadOptions) {
+  expect_refused(run_spinesim("spine solve --force T7:0,0,1 --criterion best"), "--criterion");
+  expect_refused(run_spinesim("spine solve --force T7:0,0,1 --power 0.5"), "--power");
+  expect_refused(run_spinesim("spine solve --force T7:0,0,1 --fusion L3-L9"), "L3-L9");
+  expect_refused(run_spinesim("spine solve --force T7:0,0,1 --csv /no/such/folder/x.csv"), "--csv");
+}
+
+TEST(SpineSolveCliRefuses, NonConvergedSolveWritesNothing) {
+  const std::string csv = tmp("not-converged.csv");
+  const CliRun r = run_spinesim("spine solve --force T7:0,0,300 --max-iterations 1 --csv " + in_quotes(csv));
+  expect_refused(r, "equilibrium");
+  EXPECT_FALSE(fs::exists(csv));
+}
+
+// --- study validation (thesis 3.4) ------------------------------------------------------------
+
+TEST(ValidationStudy, TargetsAreTheLiteraturesAndTheMomentIsReached) {
+  const json& j = study("validation");
+  ASSERT_FALSE(j.empty());
+  const json& a = j["mcgill"];
+  EXPECT_DOUBLE_EQ(a["target"]["axial_range_n"][0].get<double>(), 3929.0);
+  EXPECT_DOUBLE_EQ(a["target"]["axial_range_n"][1].get<double>(), 4688.0);
+  EXPECT_DOUBLE_EQ(a["target"]["shear_max_n"].get<double>(), 650.0);
+  EXPECT_NEAR(a["external_moment_nmm"].get<double>(), 238000.0, 1.0);
+  EXPECT_GT(a["t7_force_n"].get<double>(), 0.0);
+  // The trunk's free body above L5-S1: the external moment is carried by the joint's spring and
+  // by the muscles, ligaments and IAP.
+  EXPECT_NEAR(a["external_moment_nmm"].get<double>(),
+              a["joint_moment_nmm"].get<double>() + a["muscles_ligaments_iap_moment_nmm"].get<double>(), 1e-6);
+  const json& b = j["wilke"];
+  EXPECT_DOUBLE_EQ(b["target"]["axial_n"].get<double>(), 3240.0);
+  EXPECT_DOUBLE_EQ(b["target"]["tolerance"].get<double>(), 0.15);
+  EXPECT_DOUBLE_EQ(b["crate"]["mass_kg"].get<double>(), 19.8);
+}
+
+TEST(ValidationStudy, McGillAndNormanL5S1Window) {
+  const json& a = study("validation")["mcgill"];
+  ASSERT_FALSE(a.is_null());
+  const double axial = a["axial_n"], shear = a["shear_n"];
+  EXPECT_GE(axial, 3929.0) << "L5-S1 axial (joint frame) at 238 N·m, T7 force " << a["t7_force_n"];
+  EXPECT_LE(axial, 4688.0) << "L5-S1 axial (joint frame) at 238 N·m, T7 force " << a["t7_force_n"];
+  EXPECT_LE(shear, 650.0);
+}
+
+TEST(ValidationStudy, WilkeCrateL4L5Window) {
+  const json& b = study("validation")["wilke"];
+  ASSERT_FALSE(b.is_null());
+  EXPECT_NEAR(b["axial_n"].get<double>(), 3240.0, 0.15 * 3240.0) << "L4-L5 axial (joint frame), crate held";
+}
+
+// --- study fusion (thesis 6.1) ----------------------------------------------------------------
+
+namespace {
+const json& fusion_run(const std::string& fusion, const std::string& load) {
+  for (const auto& r : study("fusion")["runs"])
+    if (r["fusion"] == fusion && r["load"] == load) return r;
+  ADD_FAILURE() << "fusion run " << fusion << " / " << load << " missing";
+  static const json none;
+  return none;
+}
+double t1_motion(const std::string& f, const std::string& l) { return fusion_run(f, l)["t1_translation_norm_mm"]; }
+double force(const std::string& f, const std::string& l, const char* joint) { return fusion_run(f, l)[joint]["resultant_n"]; }
+const std::vector<std::string> kFused = {"L3-L4", "L4-L5", "L3-L4-L5"};
+}  // namespace
+
+TEST(FusionStudy, TablesAndCsvCoverEveryFusionAndLoad) {
+  const std::string csv = tmp("fusion.csv");
+  const CliRun r = run_spinesim("study fusion --force 300 --csv " + in_quotes(csv) + " --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const json j = json::parse(r.out);
+  EXPECT_EQ(j["runs"].size(), 12u);
+  EXPECT_EQ(count_lines(slurp(csv)), 13);
+  EXPECT_FALSE(j["findings"].empty());
+  for (const auto& f : j["findings"]) EXPECT_TRUE(f["match"].is_boolean());
+}
+
+// "spinal fusion at L3-L4-L5 will restrict the range of motion of the whole spine the most ...
+// The same results are achieved when applying equal backward and lateral forces".
+TEST(FusionStudy, FusionReducesT1Motion) {
+  for (const char* load : {"forward", "backward", "lateral"})
+    for (const auto& f : kFused) EXPECT_LT(t1_motion(f, load), t1_motion("normal", load)) << f << ", " << load;
+}
+
+// Figures 6.4-6.6 (forward force): the joints next to the fusion carry more than in the
+// normal spine, and most with L3-L4-L5 fused.
+TEST(FusionStudy, AdjacentLevelForcesRiseMostWithL3L4L5) {
+  const std::string load = "forward";
+  for (const char* joint : {"l2l3", "l5s1"}) {
+    for (const auto& f : kFused) EXPECT_GT(force(f, load, joint), force("normal", load, joint)) << f << " " << joint;
+    EXPECT_GT(force("L3-L4-L5", load, joint), force("L3-L4", load, joint)) << joint;
+    EXPECT_GT(force("L3-L4-L5", load, joint), force("L4-L5", load, joint)) << joint;
+  }
+}
+
+// --- study trends (thesis 6.3-6.4) -------------------------------------------------------------
+
+TEST(TrendsStudy, EveryPairAndEveryStatementIsReported) {
+  const json& j = study("trends");
+  ASSERT_FALSE(j.empty());
+  ASSERT_EQ(j["runs"].size(), 3u);
+  for (const auto& r : j["runs"]) {
+    ASSERT_EQ(r["pairs"].size(), 16u) << r["load"];
+    EXPECT_EQ(r["pairs"][0]["pair"], "T1-T2");
+    EXPECT_EQ(r["pairs"][15]["pair"], "L4-L5");
+  }
+  EXPECT_GE(j["findings"].size(), 30u);
+  int matches = 0;
+  for (const auto& f : j["findings"]) matches += f["match"].get<bool>();
+  EXPECT_EQ(j["matches"].get<int>(), matches);
+}
+
+TEST(SpineStudiesRefuse, BadForce) {
+  expect_refused(run_spinesim("study fusion --force -5"), "--force");
+  expect_refused(run_spinesim("study trends --force nan"), "--force");
+  expect_refused(run_spinesim("study validation --csv /no/such/folder/v.csv"), "--csv");
+}
