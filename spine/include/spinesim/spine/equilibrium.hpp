@@ -41,7 +41,7 @@ struct SolveOptions {
   double relative_tolerance = 1e-8;  ///< or max |∂Π/∂θ| ≤ this × its value at θ = 0 (round-off floor)
   int max_iterations = 200;
   double fd_step = 1e-7;     ///< rad, for the finite-difference Hessian
-  bool warn_above_600n = true;  ///< SolveResult::warnings names forces beyond 600 N (thesis limit)
+  bool warn_above_600n = true;  ///< SpineSolution::warnings names forces beyond 600 N (thesis limit)
 };
 
 /// Force the lower side of a joint exerts on everything above it, and the moment it carries.

@@ -1,0 +1,103 @@
+// Issue 5's targets that the model does NOT meet yet (measured, not loosened): the McGill and
+// Wilke validation windows, "fusion reduces motion" under the forward force, and a symmetric
+// answer to a backward force on T1. Label `targets`: left out of the default and sanitizer runs
+// so main stays green; run them with `ctest --test-dir build/release -L targets`.
+// `spinesim spine solve` and the spine studies (`study validation|fusion|trends`): the JSON
+// contract, physical properties of the answers (no load → no motion, a fused joint does not
+// move, equal loads on a symmetric spine give a sagittal answer), every refusal (exit 1, one line
+// on stderr, no file), the two validation windows of thesis 3.4 and the thesis's fusion findings
+// (6.1). Each solve takes tens of milliseconds; each study a fraction of a second.
+#include "cli_runner.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+using namespace spinesim::test_cli;
+
+std::string in_quotes(const std::string& path) { return "'" + path + "'"; }
+
+json solve_json(const std::string& args) {
+  const CliRun r = run_spinesim("spine solve " + args + " --json");
+  EXPECT_EQ(r.status, 0) << r.err;
+  if (r.status != 0) return json::object();
+  return json::parse(r.out);
+}
+
+/// One run of a study's --json per process.
+const json& study(const std::string& name) {
+  static std::map<std::string, json> made;
+  auto it = made.find(name);
+  if (it != made.end()) return it->second;
+  const CliRun r = run_spinesim("study " + name + " --json");
+  EXPECT_EQ(r.status, 0) << r.err;
+  return made.emplace(name, r.status == 0 ? json::parse(r.out) : json::object()).first->second;
+}
+
+double vec_norm(const json& v) { return std::sqrt(v[0].get<double>() * v[0].get<double>() + v[1].get<double>() * v[1].get<double>() + v[2].get<double>() * v[2].get<double>()); }
+
+const json& joint(const json& j, const std::string& name) {
+  for (const auto& x : j["joints"])
+    if (x["joint"] == name) return x;
+  ADD_FAILURE() << "joint " << name << " missing";
+  static const json none;
+  return none;
+}
+
+}  // namespace
+
+// --- spine solve -------------------------------------------------------------------------------
+
+namespace {
+const json& fusion_run(const std::string& fusion, const std::string& load) {
+  for (const auto& r : study("fusion")["runs"])
+    if (r["fusion"] == fusion && r["load"] == load) return r;
+  ADD_FAILURE() << "fusion run " << fusion << " / " << load << " missing";
+  static const json none;
+  return none;
+}
+double t1_motion(const std::string& f, const std::string& l) { return fusion_run(f, l)["t1_translation_norm_mm"]; }
+const std::vector<std::string> kFused = {"L3-L4", "L4-L5", "L3-L4-L5"};
+}  // namespace
+
+// The model is left-right symmetric, but under a backward force of 300 N on T1 the symmetric
+// equilibrium is unstable in lateral bending and Newton finds a buckled minimum.
+TEST(SpineTargets, BackwardForceOnT1GivesASagittalAnswer) {
+  const json j = solve_json("--force T1:0,0,-300");
+  ASSERT_FALSE(j.empty());
+  for (const auto& v : j["vertebrae"]) EXPECT_NEAR(v["translation_mm"][0].get<double>(), 0.0, 1e-6) << v["name"];
+}
+
+TEST(SpineTargets, McGillAndNormanL5S1Window) {
+  const json& a = study("validation")["mcgill"];
+  ASSERT_FALSE(a.is_null());
+  const double axial = a["axial_n"], shear = a["shear_n"];
+  EXPECT_GE(axial, 3929.0) << "L5-S1 axial (joint frame) at 238 N·m, T7 force " << a["t7_force_n"];
+  EXPECT_LE(axial, 4688.0) << "L5-S1 axial (joint frame) at 238 N·m, T7 force " << a["t7_force_n"];
+  EXPECT_LE(shear, 650.0);
+}
+
+TEST(SpineTargets, WilkeCrateL4L5Window) {
+  const json& b = study("validation")["wilke"];
+  ASSERT_FALSE(b.is_null());
+  EXPECT_NEAR(b["axial_n"].get<double>(), 3240.0, 0.15 * 3240.0) << "L4-L5 axial (joint frame), crate held";
+}
+
+// "spinal fusion at L3-L4-L5 will restrict the range of motion of the whole spine the most ...
+// The same results are achieved when applying equal backward and lateral forces".
+TEST(SpineTargets, FusionReducesT1Motion) {
+  for (const char* load : {"forward", "backward", "lateral"})
+    for (const auto& f : kFused) EXPECT_LT(t1_motion(f, load), t1_motion("normal", load)) << f << ", " << load;
+}
+
