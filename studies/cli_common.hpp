@@ -52,5 +52,6 @@ void register_study(CLI::App& app);  ///< study probe|drive (cli_study.cpp)
 void register_spine(CLI::App& app);  ///< spine solve (cli_spine.cpp)
 void register_demo(CLI::App& app);
 void register_bench(CLI::App& app);
+void register_spine_database(CLI::App& spine);  ///< spine database, under `spine` (cli_spine_database.cpp)
 
 }  // namespace spinesim::cli

@@ -64,6 +64,15 @@ Eigen::Vector3d direction_vector(int d) {
 
 // --- fitting ---------------------------------------------------------------------------------
 
+double round_to_quantum(double x, double quantum) {
+  if (!(quantum > 0)) return x;
+  // n / (1/q) with an integral 1/q is the double nearest the decimal n·q, so the file prints it
+  // short ("0.12346", not "0.12345999999999999"); + 0.0 turns −0 into 0.
+  const double inverse = std::round(1.0 / quantum);
+  const double n = std::round(x / quantum);
+  return (std::abs(inverse * quantum - 1.0) < 1e-12 ? n / inverse : n * quantum) + 0.0;
+}
+
 double evaluate_polynomial(const double* c, int n, double s) {
   double p = 0;
   for (int k = n - 1; k >= 0; --k) p = p * s + c[k];
@@ -100,8 +109,7 @@ PolynomialFit fit_by_residual(const Eigen::VectorXd& force_n, const Eigen::Vecto
   for (int d = 1; d <= top; ++d) {
     PolynomialFit f;
     f.coefficients = fit_zero_intercept(force_n, y, d, scale_n);
-    if (tol.quantum > 0)
-      for (Eigen::Index k = 0; k < d; ++k) f.coefficients[k] = std::round(f.coefficients[k] / tol.quantum) * tol.quantum;
+    for (Eigen::Index k = 0; k < d; ++k) f.coefficients[k] = round_to_quantum(f.coefficients[k], tol.quantum);
     double sum2 = 0;
     for (Eigen::Index i = 0; i < y.size(); ++i) {
       const double r = evaluate_polynomial(f.coefficients.data(), d, force_n[i] / scale_n) - y[i];
@@ -230,7 +238,12 @@ ResponseSamples sample_responses(const SpineModel& m, const GenerationOptions& o
   for (std::size_t i = 1; i < loads.size(); ++i) {
     const auto [v, d, k] = index[i];
     if (errors[i].empty()) {
-      s.responses[std::size_t(v)][std::size_t(d)][std::size_t(k)] = disp[i] - s.baseline;
+      const VertebraResponse r = disp[i] - s.baseline;
+      s.responses[std::size_t(v)][std::size_t(d)][std::size_t(k)] = r;
+      if (d >= 2) {  // ±y, ±z: tx, ry, rz are zero at the symmetric equilibrium
+        const double mm = r.col(0).cwiseAbs().maxCoeff(), deg = r.rightCols<2>().rowwise().norm().maxCoeff();
+        if (mm > 1e-3 || deg > 1e-3) s.out_of_plane.push_back({v, d, s.forces_n[std::size_t(k)], mm, deg});
+      }
     } else {
       s.solved[std::size_t(v)][std::size_t(d)][std::size_t(k)] = false;
       s.failed.push_back({v, d, s.forces_n[std::size_t(k)], errors[i]});
@@ -286,6 +299,7 @@ DisplacementDatabase DisplacementDatabase::fit(const ResponseSamples& s, const F
   db.info.tolerance = tol;
   db.info.solve = s.solve;
   db.info.failed = s.failed;
+  db.info.out_of_plane = s.out_of_plane;
   db.info.generation_seconds = s.seconds;
   db.info.solves = s.solves;
   db.info.workers = s.workers;
@@ -312,11 +326,17 @@ DisplacementDatabase DisplacementDatabase::fit(const ResponseSamples& s, const F
           for (std::size_t i = 0; i < used.size(); ++i) y[Eigen::Index(i)] = r[used[i]](j, c);
           const PolynomialFit pf = fit_by_residual(f, y, db.force_max_n_, tol);
           db.set_fit(v, d, c * kDbVertebrae + j, pf.coefficients);
-          auto& worst = c < 3 ? db.residual_t_ : db.residual_r_;
-          worst[std::size_t(v)][std::size_t(d)] = std::max(worst[std::size_t(v)][std::size_t(d)], pf.max_residual);
           all.add(db.info.residuals, c, pf, int(used.size()));
           per_direction[std::size_t(d)].add(db.info.residuals_per_direction[std::size_t(d)], c, pf, int(used.size()));
         }
+      // Per (v, d), as max_response_difference() measures: |Δ translation| and |Δ rotation| per vertebra.
+      for (std::size_t k : used) {
+        VertebraResponse fitted;
+        db.evaluate(v, s.forces_n[k] * direction_vector(d), fitted);
+        const auto [mm, deg] = max_response_difference(fitted, r[k]);
+        db.residual_t_[std::size_t(v)][std::size_t(d)] = std::max(db.residual_t_[std::size_t(v)][std::size_t(d)], mm);
+        db.residual_r_[std::size_t(v)][std::size_t(d)] = std::max(db.residual_r_[std::size_t(v)][std::size_t(d)], deg);
+      }
     }
   }
   all.finish(db.info.residuals);
@@ -554,6 +574,9 @@ void DisplacementDatabase::save(const std::string& path) const {
   head["response"] = "displacement(force on the vertebra's F.1 centre, with gravity) - displacement(gravity only), "
                      "componentwise; the gravity-only displacement is 'baseline'";
   head["basis"] = "value(f) = sum_{k=1..degree} c[k-1] * s^k, s = f / force_max_n (no constant term)";
+  head["fit_fields"] = "per loaded vertebra and direction: solved_max_n (largest force solved), max_residual_mm / "
+                       "max_residual_deg (worst |fit - sample| of a vertebra's translation / rotation vector over the "
+                       "solved forces and the 17 vertebrae), c[responding vertebra][component] = c_1..c_degree";
   head["model"] = model_json(info);
   head["force_max_n"] = force_max_n_;
   head["forces_n"] = forces_n_;
@@ -574,6 +597,16 @@ void DisplacementDatabase::save(const std::string& path) const {
                       {"direction", f.direction >= 0 ? direction_names()[std::size_t(f.direction)] : ""},
                       {"force_n", f.force_n}, {"message", f.message}});
   head["failed_solves"] = failed;
+  json out_of_plane = json::array();
+  for (const auto& o : info.out_of_plane)
+    out_of_plane.push_back({{"vertebra", vertebra_names()[std::size_t(o.vertebra)]},
+                            {"direction", direction_names()[std::size_t(o.direction)]}, {"force_n", o.force_n},
+                            {"lateral_mm", o.lateral_mm}, {"lateral_deg", o.lateral_deg}});
+  head["out_of_plane_solves"] = {
+      {"what", "sagittal-plane forces (+-y, +-z) whose solution left the sagittal plane (max |tx| > 0.001 mm or "
+               "|(ry, rz)| > 0.001 deg over the vertebrae): the model is symmetric about x = 0, so these solves found "
+               "a non-symmetric equilibrium; they are kept in the fits"},
+      {"solves", out_of_plane}};
   head["superposition_check"] = info.has_superposition ? superposition_json(info.superposition) : json(nullptr);
   head["generation"] = {{"seconds", info.generation_seconds}, {"solves", info.solves}, {"workers", info.workers}};
   head["baseline"] = matrix_json(baseline_);
@@ -656,6 +689,10 @@ DisplacementDatabase DisplacementDatabase::load(const std::string& path) {
       db.info.failed.push_back({v == "baseline" ? -1 : vertebra_index(v), d.empty() ? -1 : direction_index(d),
                                 f.at("force_n").get<double>(), f.at("message").get<std::string>()});
     }
+    for (const auto& o : j.at("out_of_plane_solves").at("solves"))
+      db.info.out_of_plane.push_back({vertebra_index(o.at("vertebra").get<std::string>()),
+                                      direction_index(o.at("direction").get<std::string>()), finite(o.at("force_n")),
+                                      finite(o.at("lateral_mm")), finite(o.at("lateral_deg"))});
     if (!j.at("superposition_check").is_null()) {
       db.info.has_superposition = true;
       db.info.superposition = superposition_from_json(j.at("superposition_check"));

@@ -56,7 +56,7 @@ struct FitTolerance {
   int max_degree = kDbMaxDegree;
   /// Coefficients are rounded to this quantum (mm or deg) before the residuals are computed,
   /// so the saved file is what the residuals describe.
-  double quantum = 1e-6;
+  double quantum = 1e-5;
 };
 
 struct PolynomialFit {
@@ -76,6 +76,10 @@ Eigen::VectorXd fit_zero_intercept(const Eigen::VectorXd& force_n, const Eigen::
 PolynomialFit fit_by_residual(const Eigen::VectorXd& force_n, const Eigen::VectorXd& y, double scale_n,
                               const FitTolerance& tol = FitTolerance());
 
+/// x rounded to a multiple of `quantum` (> 0; otherwise x), as the nearest double to that
+/// decimal so the file stores it in few digits.
+double round_to_quantum(double x, double quantum);
+
 /// Σ_{k=1..n} c_k s^k by Horner.
 double evaluate_polynomial(const double* c, int n, double s);
 
@@ -87,13 +91,23 @@ struct FailedSolve {
   std::string message;  ///< SolveError::what() (or the exception's message)
 };
 
+/// A sagittal-plane force (±y, ±z) whose solution left the sagittal plane. The model is
+/// symmetric about x = 0, so a symmetric equilibrium exists; such a solve found another one
+/// (the symmetric one buckled, or Newton took another branch). Kept in the fit, listed.
+struct OutOfPlaneSolve {
+  int vertebra = 0, direction = 0;
+  double force_n = 0;
+  double lateral_mm = 0, lateral_deg = 0;  ///< max |tx| (mm), max |(ry, rz)| (deg) over the vertebrae
+};
+
 struct GenerationOptions {
   SolveOptions solve;                 ///< recruitment on by default, as in the thesis's LifeMOD runs
   std::vector<int> loaded_vertebrae;  ///< empty: all 17
   double force_step_n = 50, force_max_n = 600;
   FitTolerance tolerance;
   /// Threads solving load cases side by side: solve_spine is const on the model, and recruit()
-  /// lets one Ipopt run at a time (Debian's sequential MUMPS is not thread-safe). 0: one per core.
+  /// lets one Ipopt run at a time (Debian's sequential MUMPS is not thread-safe). Recruitment is
+  /// ~90 % of a solve, so 2 threads gain ~10 % (bench_spine); passive solves scale. 0: one per core.
   int workers = 0;
   /// Called in the calling thread after each finished solve (done, total).
   std::function<void(int, int)> progress;
@@ -108,6 +122,7 @@ struct ResponseSamples {
   std::vector<std::array<std::vector<VertebraResponse>, kDbDirections>> responses;
   std::vector<std::array<std::vector<bool>, kDbDirections>> solved;  ///< false: see failed
   std::vector<FailedSolve> failed;
+  std::vector<OutOfPlaneSolve> out_of_plane;  ///< beyond 1e-3 mm or 1e-3 deg
   SolveOptions solve;  ///< as used
   double seconds = 0;  ///< wall clock of all solves
   int solves = 0;      ///< attempted, baseline included
@@ -127,7 +142,8 @@ void solve_cases(const SpineModel& m, const std::vector<std::vector<ExternalLoad
 
 // --- the database ----------------------------------------------------------------------------
 
-/// Residuals over a set of fits: translations (mm) and rotations (deg) apart.
+/// Residuals over a set of fits, per component (each series on its own): translations (mm) and
+/// rotations (deg) apart.
 struct ResidualSummary {
   double max_translation_mm = 0, rms_translation_mm = 0;
   double max_rotation_deg = 0, rms_rotation_deg = 0;
@@ -176,6 +192,7 @@ struct DatabaseInfo {
   ResidualSummary residuals;
   std::array<ResidualSummary, kDbDirections> residuals_per_direction;
   std::vector<FailedSolve> failed;
+  std::vector<OutOfPlaneSolve> out_of_plane;
   bool has_superposition = false;
   SuperpositionReport superposition;
   double generation_seconds = 0;
@@ -215,7 +232,8 @@ class DisplacementDatabase {
   /// Coefficients c_1…c_d of one fit (d = degree; zero-padded storage is hidden).
   Eigen::VectorXd coefficients(int vertebra, int direction, int responding, int component) const;
   int degree(int vertebra, int direction, int responding, int component) const;
-  /// Largest max-residual of (vertebra, direction)'s fits: translations (mm), rotations (deg).
+  /// Worst fit residual of (vertebra, direction) over its solved forces and the 17 vertebrae,
+  /// as max_response_difference() measures it: |Δ translation| (mm), |Δ rotation vector| (deg).
   double max_residual_translation_mm(int vertebra, int direction) const;
   double max_residual_rotation_deg(int vertebra, int direction) const;
   /// Largest solved force of (vertebra, direction) (< force_max_n() when solves failed).
