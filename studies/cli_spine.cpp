@@ -376,9 +376,8 @@ void register_spine(CLI::App& app) {
       "converge is an error (exit 1, nothing written).");
   cmd->callback([a] { run_spine_solve(*a); });
 
-  // TODO(lead): `spinesim spine database` lives in cli_spine_database.cpp (another helper);
-  // uncomment once register_spine_database is declared in cli_common.hpp.
-  // register_spine_database(*spine_cmd);
+  // `spinesim spine database` (thesis 3.5) lives in cli_spine_database.cpp.
+  register_spine_database(*spine_cmd);
 }
 
 }  // namespace spinesim::cli
