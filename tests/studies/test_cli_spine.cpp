@@ -3,7 +3,7 @@
 // move, equal loads on a symmetric spine give a sagittal answer), every refusal (exit 1, one line
 // on stderr, no file), the two validation windows of thesis 3.4 and the thesis's fusion findings
 // (6.1). Each solve takes tens of milliseconds; each study a fraction of a second.
-#include "cli_runner.hpp"
+#include "spine_cli_fixtures.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -22,24 +22,6 @@ namespace {
 
 using namespace spinesim::test_cli;
 
-std::string in_quotes(const std::string& path) { return "'" + path + "'"; }
-
-json solve_json(const std::string& args) {
-  const CliRun r = run_spinesim("spine solve " + args + " --json");
-  EXPECT_EQ(r.status, 0) << r.err;
-  if (r.status != 0) return json::object();
-  return json::parse(r.out);
-}
-
-/// One run of a study's --json per process.
-const json& study(const std::string& name) {
-  static std::map<std::string, json> made;
-  auto it = made.find(name);
-  if (it != made.end()) return it->second;
-  const CliRun r = run_spinesim("study " + name + " --json");
-  EXPECT_EQ(r.status, 0) << r.err;
-  return made.emplace(name, r.status == 0 ? json::parse(r.out) : json::object()).first->second;
-}
 
 double vec_norm(const json& v) { return std::sqrt(v[0].get<double>() * v[0].get<double>() + v[1].get<double>() * v[1].get<double>() + v[2].get<double>() * v[2].get<double>()); }
 
