@@ -234,6 +234,11 @@ void run_spine_solve(const SpineSolveArgs& a) {
         {"converged", s.converged},
         {"iterations", s.iterations},
         {"gradient_norm_nmm", s.gradient_norm},
+        {"stability",
+         {{"min_stiffness_nmm_per_rad", s.min_stiffness_nmm_per_rad},
+          {"stable", s.min_stiffness_nmm_per_rad > 0},
+          {"softest_mode", s.softest_mode},
+          {"left_sagittal_plane", s.left_sagittal_plane}}},
         {"vertebrae", vertebrae},
         {"joints", joints},
         {"muscles", muscles},
@@ -278,7 +283,10 @@ void run_spine_solve(const SpineSolveArgs& a) {
   }
   if (loads.empty()) std::cout << "  no external load (gravity only)\n";
   std::cout << "  converged in " << s.iterations << " Newton iterations, max |dPi/dtheta| " << std::setprecision(2)
-            << std::scientific << s.gradient_norm << std::defaultfloat << " N·mm\n\n";
+            << std::scientific << s.gradient_norm << std::defaultfloat << " N·mm\n";
+  std::cout << "  tangent stiffness: smallest eigenvalue " << std::setprecision(4) << s.min_stiffness_nmm_per_rad / 1000
+            << " N·m/rad (" << (s.min_stiffness_nmm_per_rad > 0 ? "stable" : "NOT stable") << "), softest mode "
+            << s.softest_mode << "\n\n";
 
   TextTable v({"vertebra", "tx (mm)", "ty (mm)", "tz (mm)", "rx (deg)", "ry (deg)", "rz (deg)"});
   for (std::size_t i = 0; i < names.size(); ++i) {

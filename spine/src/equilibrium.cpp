@@ -4,6 +4,7 @@
 #include "spinesim/spine/equilibrium.hpp"
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 
 #include <algorithm>
 #include <chrono>
@@ -282,19 +283,22 @@ SpineSolution solve_spine(const SpineModel& m, const std::vector<ExternalLoad>& 
   auto worst = [&](const VectorXd& grad) { return grad.cwiseAbs().maxCoeff(); };
   const double tolerance = std::max(o.tolerance, o.relative_tolerance * worst(g));
   int it = 0;
-  for (; it < o.max_iterations && worst(g) > tolerance; ++it) {
-    // Hessian: central differences of the analytic gradient over the free coordinates.
+  // Tangent stiffness: central differences of the analytic gradient over the free coordinates.
+  auto hessian = [&](const VectorXd& th) {
     Eigen::MatrixXd H(nf, nf);
     VectorXd gp, gm;
     for (Eigen::Index c = 0; c < nf; ++c) {
-      VectorXd tp = theta, tm = theta;
+      VectorXd tp = th, tm = th;
       tp[free[std::size_t(c)]] += o.fd_step;
       tm[free[std::size_t(c)]] -= o.fd_step;
       energy_grad(tp, gp);
       energy_grad(tm, gm);
       for (Eigen::Index r = 0; r < nf; ++r) H(r, c) = (gp[free[std::size_t(r)]] - gm[free[std::size_t(r)]]) / (2 * o.fd_step);
     }
-    H = 0.5 * (H + H.transpose()).eval();
+    return Eigen::MatrixXd(0.5 * (H + H.transpose()));
+  };
+  for (; it < o.max_iterations && worst(g) > tolerance; ++it) {
+    const Eigen::MatrixXd H = hessian(theta);
     VectorXd gf(nf);
     for (Eigen::Index r = 0; r < nf; ++r) gf[r] = g[free[std::size_t(r)]];
     // Modified Newton: shift the Hessian until it is positive definite, so the step descends.
@@ -345,6 +349,32 @@ SpineSolution solve_spine(const SpineModel& m, const std::vector<ExternalLoad>& 
     throw SolveError(msg.str());
   }
   out.converged = true;
+  // Stability: the smallest eigenvalue of the tangent stiffness at the solution. A sagittal load on
+  // the symmetric model that comes out of the sagittal plane is the buckled branch of an unstable
+  // symmetric equilibrium (with static-optimisation muscles, which do not co-contract).
+  if (nf > 0) {
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(hessian(theta));
+    out.min_stiffness_nmm_per_rad = eig.eigenvalues()[0];
+    Eigen::Index at = 0;
+    eig.eigenvectors().col(0).cwiseAbs().maxCoeff(&at);
+    static const char* axes[] = {"flexion/extension", "torsion", "lateral bending"};
+    const Eigen::Index dof = free[std::size_t(at)];
+    out.softest_mode = m.joints[std::size_t(dof / 3)].name + " " + axes[dof % 3];
+    if (!(out.min_stiffness_nmm_per_rad > 0))
+      out.warnings.push_back("the equilibrium is not stable: smallest tangent stiffness " +
+                             std::to_string(out.min_stiffness_nmm_per_rad) + " N*mm/rad, mostly " + out.softest_mode);
+  }
+  bool sagittal = true;
+  for (const auto& l : loads)
+    sagittal = sagittal && l.force_n.x() == 0 && l.moment_nmm.y() == 0 && l.moment_nmm.z() == 0 &&
+               (!l.has_point || l.point_mm.x() == 0);
+  out.left_sagittal_plane = false;
+  if (sagittal)
+    for (Eigen::Index k = 0; k < theta.size(); k += 3)
+      out.left_sagittal_plane = out.left_sagittal_plane || std::abs(theta[k + 1]) > 1e-6 || std::abs(theta[k + 2]) > 1e-6;
+  if (out.left_sagittal_plane)
+    out.warnings.push_back("a load in the sagittal plane gave an out-of-plane answer: the symmetric equilibrium is "
+                           "unstable in lateral bending and torsion, and this is the buckled one");
   out.seconds_equilibrium = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
 
   // Report: poses, displacements, joint reactions, element forces.

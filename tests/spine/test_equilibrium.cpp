@@ -190,3 +190,27 @@ TEST(SpineEquilibrium, BadInputAndNonConvergenceAreReportedNotReturned) {
     EXPECT_NE(std::string(e.what()).find("did not converge"), std::string::npos);
   }
 }
+
+// Stability of the equilibrium (the smallest eigenvalue of the tangent stiffness): upright under
+// gravity the spine is stable; a growing backward force on T1 softens L1-L2 in lateral bending
+// (the recruited flexors compress the lumbar spine without co-contraction) until the symmetric
+// equilibrium is lost and the answer leaves the sagittal plane. The passive spine stays stable.
+TEST(SpineEquilibrium, StabilityIsReportedAndBucklingUnderSagittalLoadsIsFlagged) {
+  const auto& m = full();
+  const sp::SpineSolution upright = sp::solve_spine(m, {});
+  EXPECT_GT(upright.min_stiffness_nmm_per_rad, 0);
+  EXPECT_FALSE(upright.left_sagittal_plane);
+  EXPECT_TRUE(upright.warnings.empty());
+  const sp::SpineSolution soft = sp::solve_spine(m, {force_on("T1", Vector3d(0, 0, -200))});
+  EXPECT_LT(soft.min_stiffness_nmm_per_rad, upright.min_stiffness_nmm_per_rad);
+  const sp::SpineSolution buckled = sp::solve_spine(m, {force_on("T1", Vector3d(0, 0, -300))});
+  EXPECT_TRUE(buckled.left_sagittal_plane);
+  EXPECT_GT(std::abs(buckled.displacement(0, 0)), 0.1);  // T1 moves sideways, mm
+  ASSERT_FALSE(buckled.warnings.empty());
+  EXPECT_NE(buckled.warnings.back().find("sagittal"), std::string::npos);
+  sp::SolveOptions passive;
+  passive.recruit = false;
+  const sp::SpineSolution p = sp::solve_spine(m, {force_on("T1", Vector3d(0, 0, -300))}, passive);
+  EXPECT_GT(p.min_stiffness_nmm_per_rad, 0);
+  EXPECT_FALSE(p.left_sagittal_plane);
+}

@@ -73,7 +73,14 @@ struct SpineSolution {
   Eigen::VectorXd ligament_force_n, muscle_force_n;  ///< tensions in the final posture
   Recruitment recruitment;                          ///< the recruited forces F (reference posture)
   Eigen::Matrix<double, 6, 1> bushing_wrench;       ///< IAP force (N) and moment (N·mm) on the ribs
-  std::vector<std::string> warnings;
+  /// Smallest eigenvalue of the tangent stiffness ∂²Π/∂θ² at the solution (N·mm/rad; ≤ 0: not
+  /// stable) and the joint axis that dominates its mode.
+  double min_stiffness_nmm_per_rad = 0;
+  std::string softest_mode;
+  /// A load in the sagittal plane (the model is symmetric) gave lateral bending or torsion: the
+  /// symmetric equilibrium is unstable and this is a buckled one (also in `warnings`).
+  bool left_sagittal_plane = false;
+  std::vector<std::string> warnings;  ///< forces beyond 600 N, instability, buckling
   double seconds_recruitment = 0, seconds_equilibrium = 0;
 };
 
