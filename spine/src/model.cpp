@@ -290,10 +290,11 @@ SpineModel load_spine_model(const std::string& data_dir, const ModelOptions& opt
   m.gravity_mm_s2 = number(config, "gravity_m_s2", config_file) * 1000.0;
   m.muscle_q = number(config, "muscle_short_range_stiffness_q", config_file);
   m.rom_bump_factor = number(config, "joint_rom_bump_factor", config_file);
+  m.rom_bump_onset = number(config, "joint_rom_bump_onset_deg", config_file) * kDeg;
   m.chest_front_mm = vec3(config, "chest_front_mm", config_file);
   m.ribs_body = vertebra_index(config.at("ribs").at("fixed_to").get<std::string>());
-  if (!(m.muscle_q > 0) || !(m.rom_bump_factor >= 1))
-    throw std::runtime_error(config_file + ": need muscle q > 0 and a ROM bump factor >= 1");
+  if (!(m.muscle_q > 0) || !(m.rom_bump_factor >= 1) || !(m.rom_bump_onset > 0))
+    throw std::runtime_error(config_file + ": need muscle q > 0, a ROM bump factor >= 1 and a bump onset > 0");
 
   try {
     const CsvTable cm = read_csv((thesis / "F1_vertebra_cm.csv").string());

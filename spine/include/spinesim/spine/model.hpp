@@ -117,6 +117,7 @@ struct SpineModel {
   std::vector<int> recruited_joints;  ///< joints whose equilibrium the muscles are recruited for
   double muscle_q = 10;             ///< short-range stiffness factor (k = q F / L0)
   double rom_bump_factor = 100;     ///< joint stiffness multiplier beyond the F.5 range
+  double rom_bump_onset = 0;        ///< rad over which the bump's stiffness ramps up (C² energy)
   double body_mass_kg = 70, gravity_mm_s2 = 9810;
   Eigen::Vector3d chest_front_mm;   ///< for loads held "in front of the chest"
   int ribs_body = 5;                ///< T6
