@@ -236,3 +236,28 @@ TEST(SpineStudiesRefuse, BadForce) {
   expect_refused(run_spinesim("study trends --force nan"), "--force");
   expect_refused(run_spinesim("study validation --csv /no/such/folder/v.csv"), "--csv");
 }
+
+// --- spine database (thesis 3.5) -------------------------------------------------------------
+
+// A small generation (one loaded vertebra) writes a file that --check then confirms against
+// direct solves (tests/spine/test_database.cpp checks the shipped file against the model).
+TEST(SpineDatabaseCli, SmallGenerationWritesAFileThatChecks) {
+  const std::string out = tmp("db-T7.json");
+  const CliRun gen = run_spinesim("spine database --quiet --vertebrae T7 --superposition-on T7 --magnitudes 300 --out " +
+                                  in_quotes(out) + " --json");
+  ASSERT_EQ(gen.status, 0) << gen.err;
+  const json meta = json::parse(gen.out);
+  EXPECT_EQ(meta["generation"]["solves"].get<int>(), 1 + 6 * 12);  // baseline + 6 directions × 12 forces
+  ASSERT_TRUE(fs::exists(out));
+  const CliRun check = run_spinesim("spine database --check --quiet --vertebrae T7 --superposition-on T7 "
+                                    "--magnitudes 300 --out " + in_quotes(out) + " --json");
+  EXPECT_EQ(check.status, 0) << check.err;
+}
+
+TEST(SpineDatabaseCli, RefusesBadInput) {
+  expect_refused(run_spinesim("spine database --quiet --out /nonexistent-folder/db.json"), "--out");
+  expect_refused(run_spinesim("spine database --quiet --vertebrae C3 --out " + in_quotes(tmp("db.json"))), "C3");
+  expect_refused(run_spinesim("spine database --quiet --magnitudes -5 --out " + in_quotes(tmp("db.json"))),
+                 "--magnitudes");
+  expect_refused(run_spinesim("spine database --check --quiet --out " + in_quotes(tmp("missing.json"))), "missing.json");
+}
