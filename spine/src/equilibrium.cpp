@@ -234,6 +234,186 @@ void check_loads(const SpineModel& m, const std::vector<ExternalLoad>& loads, st
   }
 }
 
+const char* const kAxisNames[] = {"flexion/extension", "torsion", "lateral bending"};
+
+/// The potential over the free (non-fused) joint coordinates for fixed muscle forces: energy,
+/// gradient, finite-difference tangent stiffness, and the modified Newton method on them.
+class Newton {
+ public:
+  Newton(const SpineModel& m, const std::vector<ExternalLoad>& loads, const VectorXd& F, const SolveOptions& o)
+      : m_(m), loads_(loads), F_(F), o_(o) {
+    for (std::size_t k = 0; k < m.joints.size(); ++k)
+      if (!m.joints[k].fused)
+        for (int a = 0; a < 3; ++a) free_.push_back(3 * Eigen::Index(k) + a);
+  }
+
+  double energy_grad(const VectorXd& th, VectorXd& g) const {
+    const State s = evaluate(m_, loads_, F_, th);
+    g = gradient_of(m_, s, th);
+    return s.energy;
+  }
+
+  /// Central differences of the analytic gradient over the free coordinates, symmetrised.
+  Eigen::MatrixXd hessian(const VectorXd& th) const {
+    const Eigen::Index nf = size();
+    Eigen::MatrixXd H(nf, nf);
+    VectorXd gp, gm;
+    for (Eigen::Index c = 0; c < nf; ++c) {
+      VectorXd tp = th, tm = th;
+      tp[free_[std::size_t(c)]] += o_.fd_step;
+      tm[free_[std::size_t(c)]] -= o_.fd_step;
+      energy_grad(tp, gp);
+      energy_grad(tm, gm);
+      for (Eigen::Index r = 0; r < nf; ++r)
+        H(r, c) = (gp[free_[std::size_t(r)]] - gm[free_[std::size_t(r)]]) / (2 * o_.fd_step);
+    }
+    return Eigen::MatrixXd(0.5 * (H + H.transpose()));
+  }
+
+  /// Minimises Π from θ = 0; throws SolveError when the gradient does not reach the tolerance.
+  VectorXd solve(int& iterations, double& gradient_norm) const {
+    VectorXd theta = VectorXd::Zero(dof_count(m_)), g;
+    double E = energy_grad(theta, g);
+    const double tolerance = std::max(o_.tolerance, o_.relative_tolerance * worst(g));
+    int it = 0;
+    for (; it < o_.max_iterations && worst(g) > tolerance; ++it)
+      if (!step(theta, g, E)) break;
+    iterations = it;
+    gradient_norm = worst(g);
+    if (!(gradient_norm <= tolerance)) {
+      Eigen::Index at = 0;
+      g.cwiseAbs().maxCoeff(&at);
+      std::ostringstream msg;
+      msg << "spine equilibrium did not converge: " << it << " Newton iterations, max |dPi/dtheta| = " << gradient_norm
+          << " N*mm (tolerance " << tolerance << ") at joint " << m_.joints[std::size_t(at / 3)].name << " ("
+          << kAxisNames[at % 3] << ")";
+      throw SolveError(msg.str());
+    }
+    return theta;
+  }
+
+  Eigen::Index size() const { return Eigen::Index(free_.size()); }
+  Eigen::Index coordinate(Eigen::Index free_index) const { return free_[std::size_t(free_index)]; }
+
+ private:
+  static double worst(const VectorXd& g) { return g.cwiseAbs().maxCoeff(); }
+
+  /// One modified-Newton step with line search; false when no step is accepted.
+  bool step(VectorXd& theta, VectorXd& g, double& E) const {
+    const Eigen::Index nf = size();
+    const Eigen::MatrixXd H = hessian(theta);
+    VectorXd gf(nf);
+    for (Eigen::Index r = 0; r < nf; ++r) gf[r] = g[coordinate(r)];
+    // Shift the Hessian until it is positive definite, so the step descends.
+    double shift = 0;
+    const double scale = std::max(1.0, H.diagonal().cwiseAbs().maxCoeff());
+    Eigen::LLT<Eigen::MatrixXd> llt;
+    for (int tries = 0; tries < 30; ++tries) {
+      llt.compute(H + shift * Eigen::MatrixXd::Identity(nf, nf));
+      if (llt.info() == Eigen::Success) break;
+      shift = shift == 0 ? 1e-8 * scale : 10 * shift;
+    }
+    if (llt.info() != Eigen::Success) return false;
+    const VectorXd dir = -llt.solve(gf);
+    const double slope = gf.dot(dir);
+    auto step_to = [&](double alpha, VectorXd& th) {
+      th = theta;
+      for (Eigen::Index r = 0; r < nf; ++r) th[coordinate(r)] += alpha * dir[r];
+    };
+    // Near the solution the energy change of a Newton step, ~g²/H, drops below Π's round-off
+    // (stiff ROM bumps, H ~ 1e7 N·mm/rad: |g| = 0.01 N·mm is a 1e-11 N·mm change of a Π of 1e4):
+    // then the Armijo test cannot tell, and the full step is taken when it lowers |g|.
+    const double roundoff = 1e-12 * std::max(1.0, std::abs(E));
+    VectorXd trial, gt;
+    step_to(1.0, trial);
+    double Et = energy_grad(trial, gt);
+    bool accepted = Et <= E + 1e-4 * slope || (-slope < 100 * roundoff && worst(gt) < worst(g));
+    for (double alpha = 0.5; !accepted && alpha > 1e-12; alpha *= 0.5) {
+      step_to(alpha, trial);
+      Et = energy_grad(trial, gt);
+      accepted = Et <= E + 1e-4 * alpha * slope;
+    }
+    if (!accepted) return false;
+    theta = trial;
+    g = gt;
+    E = Et;
+    return true;
+  }
+
+  const SpineModel& m_;
+  const std::vector<ExternalLoad>& loads_;
+  const VectorXd& F_;
+  const SolveOptions& o_;
+  std::vector<Eigen::Index> free_;
+};
+
+/// Stability at the solution: the smallest eigenvalue of the tangent stiffness and its mode; a
+/// sagittal load on the symmetric model that came out of the sagittal plane is the buckled
+/// branch of an unstable symmetric equilibrium (static-optimisation muscles do not co-contract).
+void assess_stability(const SpineModel& m, const std::vector<ExternalLoad>& loads, const Newton& newton,
+                      const VectorXd& theta, SpineSolution& out) {
+  if (newton.size() > 0) {
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(newton.hessian(theta));
+    out.min_stiffness_nmm_per_rad = eig.eigenvalues()[0];
+    Eigen::Index at = 0;
+    eig.eigenvectors().col(0).cwiseAbs().maxCoeff(&at);
+    const Eigen::Index dof = newton.coordinate(at);
+    out.softest_mode = m.joints[std::size_t(dof / 3)].name + " " + kAxisNames[dof % 3];
+    if (!(out.min_stiffness_nmm_per_rad > 0))
+      out.warnings.push_back("the equilibrium is not stable: smallest tangent stiffness " +
+                             std::to_string(out.min_stiffness_nmm_per_rad) + " N*mm/rad, mostly " + out.softest_mode);
+  }
+  bool sagittal = true;
+  for (const auto& l : loads)
+    sagittal = sagittal && l.force_n.x() == 0 && l.moment_nmm.y() == 0 && l.moment_nmm.z() == 0 &&
+               (!l.has_point || l.point_mm.x() == 0);
+  out.left_sagittal_plane = false;
+  if (sagittal)
+    for (Eigen::Index k = 0; k < theta.size(); k += 3)
+      out.left_sagittal_plane = out.left_sagittal_plane || std::abs(theta[k + 1]) > 1e-6 || std::abs(theta[k + 2]) > 1e-6;
+  if (out.left_sagittal_plane)
+    out.warnings.push_back("a load in the sagittal plane gave an out-of-plane answer: the symmetric equilibrium is "
+                           "unstable in lateral bending and torsion, and this is the buckled one");
+}
+
+/// Poses, displacements, joint reactions and element forces at the solution.
+void report(const SpineModel& m, const State& s, SpineSolution& out) {
+  out.poses = s.poses;
+  const std::size_t n = m.vertebrae.size();
+  out.displacement.resize(Eigen::Index(n), 6);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vector3d& C = m.vertebrae[i].centre_mm;
+    out.displacement.row(Eigen::Index(i)).head<3>() = (s.poses[i].apply(C) - C).transpose();
+    out.displacement.row(Eigen::Index(i)).tail<3>() = (rotation_log(s.poses[i].R) * kRadToDeg).transpose();
+  }
+  std::vector<Vector3d> Fa, Ma;
+  resultants_above(m, s, Fa, Ma);
+  for (std::size_t k = 0; k < m.joints.size(); ++k) {
+    JointReaction r;
+    r.joint = m.joints[k].name;
+    r.force_world_n = -Fa[k];  // what the lower side pushes on everything above
+    r.moment_world_nmm = Ma[k];
+    const Eigen::Matrix3d R_low = k + 1 < n ? s.poses[k + 1].R : Eigen::Matrix3d::Identity();
+    const Vector3d local = R_low.transpose() * r.force_world_n;
+    r.shear_lat_n = local.x();
+    r.axial_n = local.y();
+    r.shear_ap_n = local.z();
+    r.moment_local_nmm = R_low.transpose() * r.moment_world_nmm;
+    // Disc frame: from the lower vertebra's centre (the sacrum: L5's mirrored) to the upper one's.
+    const Vector3d& J = m.joints[k].point_mm;
+    const Vector3d up = s.poses[k].apply(m.vertebrae[k].centre_mm);
+    const Vector3d low = k + 1 < n ? s.poses[k + 1].apply(m.vertebrae[k + 1].centre_mm)
+                                   : Vector3d(2 * J - m.vertebrae[k].centre_mm);
+    const Vector3d axis = (up - low).normalized();
+    r.disc_axial_n = r.force_world_n.dot(axis);
+    r.disc_shear_n = (r.force_world_n - r.disc_axial_n * axis).norm();
+    out.joints.push_back(r);
+  }
+  out.ligament_force_n = s.ligament_t;
+  out.muscle_force_n = s.muscle_t;
+  out.bushing_wrench = s.bushing;
+}
+
 }  // namespace
 
 double potential(const SpineModel& m, const std::vector<ExternalLoad>& loads, const VectorXd& muscle_force_n,
@@ -295,153 +475,12 @@ SpineSolution solve_spine(const SpineModel& m, const std::vector<ExternalLoad>& 
   const auto t1 = std::chrono::steady_clock::now();
   out.seconds_recruitment = std::chrono::duration<double>(t1 - t0).count();
 
-  std::vector<Eigen::Index> free;
-  for (std::size_t k = 0; k < m.joints.size(); ++k)
-    if (!m.joints[k].fused)
-      for (int a = 0; a < 3; ++a) free.push_back(3 * Eigen::Index(k) + a);
-  const Eigen::Index nf = Eigen::Index(free.size());
-
-  VectorXd theta = VectorXd::Zero(dof_count(m));
-  auto energy_grad = [&](const VectorXd& th, VectorXd& g) {
-    const State s = evaluate(m, loads, F, th);
-    g = gradient_of(m, s, th);
-    return s.energy;
-  };
-  VectorXd g;
-  double E = energy_grad(theta, g);
-  auto worst = [&](const VectorXd& grad) { return grad.cwiseAbs().maxCoeff(); };
-  const double tolerance = std::max(o.tolerance, o.relative_tolerance * worst(g));
-  int it = 0;
-  // Tangent stiffness: central differences of the analytic gradient over the free coordinates.
-  auto hessian = [&](const VectorXd& th) {
-    Eigen::MatrixXd H(nf, nf);
-    VectorXd gp, gm;
-    for (Eigen::Index c = 0; c < nf; ++c) {
-      VectorXd tp = th, tm = th;
-      tp[free[std::size_t(c)]] += o.fd_step;
-      tm[free[std::size_t(c)]] -= o.fd_step;
-      energy_grad(tp, gp);
-      energy_grad(tm, gm);
-      for (Eigen::Index r = 0; r < nf; ++r) H(r, c) = (gp[free[std::size_t(r)]] - gm[free[std::size_t(r)]]) / (2 * o.fd_step);
-    }
-    return Eigen::MatrixXd(0.5 * (H + H.transpose()));
-  };
-  for (; it < o.max_iterations && worst(g) > tolerance; ++it) {
-    const Eigen::MatrixXd H = hessian(theta);
-    VectorXd gf(nf);
-    for (Eigen::Index r = 0; r < nf; ++r) gf[r] = g[free[std::size_t(r)]];
-    // Modified Newton: shift the Hessian until it is positive definite, so the step descends.
-    double shift = 0;
-    const double scale = std::max(1.0, H.diagonal().cwiseAbs().maxCoeff());
-    Eigen::LLT<Eigen::MatrixXd> llt;
-    for (int tries = 0; tries < 30; ++tries) {
-      llt.compute(H + shift * Eigen::MatrixXd::Identity(nf, nf));
-      if (llt.info() == Eigen::Success) break;
-      shift = shift == 0 ? 1e-8 * scale : 10 * shift;
-    }
-    if (llt.info() != Eigen::Success) break;
-    const VectorXd step = -llt.solve(gf);
-    const double slope = gf.dot(step);
-    auto step_to = [&](double alpha, VectorXd& th) {
-      th = theta;
-      for (Eigen::Index r = 0; r < nf; ++r) th[free[std::size_t(r)]] += alpha * step[r];
-    };
-    // Near the solution the energy change of a Newton step, ~g²/H, drops below Π's round-off
-    // (stiff ROM bumps, H ~ 1e7 N·mm/rad: |g| = 0.01 N·mm is a 1e-11 N·mm change of a Π of 1e4):
-    // then the Armijo test cannot tell, and the full step is taken when it lowers |g|.
-    const double roundoff = 1e-12 * std::max(1.0, std::abs(E));
-    VectorXd trial, gt;
-    step_to(1.0, trial);
-    double Et = energy_grad(trial, gt);
-    bool accepted = Et <= E + 1e-4 * slope || (-slope < 100 * roundoff && worst(gt) < worst(g));
-    for (double alpha = 0.5; !accepted && alpha > 1e-12; alpha *= 0.5) {
-      step_to(alpha, trial);
-      Et = energy_grad(trial, gt);
-      accepted = Et <= E + 1e-4 * alpha * slope;
-    }
-    if (!accepted) break;
-    theta = trial;
-    g = gt;
-    E = Et;
-  }
-  out.iterations = it;
-  out.gradient_norm = worst(g);
-  if (!(out.gradient_norm <= tolerance)) {
-    Eigen::Index at = 0;
-    g.cwiseAbs().maxCoeff(&at);
-    static const char* axes[] = {"flexion/extension", "torsion", "lateral bending"};
-    std::ostringstream msg;
-    msg << "spine equilibrium did not converge: " << it << " Newton iterations, max |dPi/dtheta| = "
-        << out.gradient_norm << " N*mm (tolerance " << tolerance << ") at joint "
-        << m.joints[std::size_t(at / 3)].name << " (" << axes[at % 3] << ")";
-    throw SolveError(msg.str());
-  }
+  const Newton newton(m, loads, F, o);
+  out.theta = newton.solve(out.iterations, out.gradient_norm);
   out.converged = true;
-  // Stability: the smallest eigenvalue of the tangent stiffness at the solution. A sagittal load on
-  // the symmetric model that comes out of the sagittal plane is the buckled branch of an unstable
-  // symmetric equilibrium (with static-optimisation muscles, which do not co-contract).
-  if (nf > 0) {
-    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(hessian(theta));
-    out.min_stiffness_nmm_per_rad = eig.eigenvalues()[0];
-    Eigen::Index at = 0;
-    eig.eigenvectors().col(0).cwiseAbs().maxCoeff(&at);
-    static const char* axes[] = {"flexion/extension", "torsion", "lateral bending"};
-    const Eigen::Index dof = free[std::size_t(at)];
-    out.softest_mode = m.joints[std::size_t(dof / 3)].name + " " + axes[dof % 3];
-    if (!(out.min_stiffness_nmm_per_rad > 0))
-      out.warnings.push_back("the equilibrium is not stable: smallest tangent stiffness " +
-                             std::to_string(out.min_stiffness_nmm_per_rad) + " N*mm/rad, mostly " + out.softest_mode);
-  }
-  bool sagittal = true;
-  for (const auto& l : loads)
-    sagittal = sagittal && l.force_n.x() == 0 && l.moment_nmm.y() == 0 && l.moment_nmm.z() == 0 &&
-               (!l.has_point || l.point_mm.x() == 0);
-  out.left_sagittal_plane = false;
-  if (sagittal)
-    for (Eigen::Index k = 0; k < theta.size(); k += 3)
-      out.left_sagittal_plane = out.left_sagittal_plane || std::abs(theta[k + 1]) > 1e-6 || std::abs(theta[k + 2]) > 1e-6;
-  if (out.left_sagittal_plane)
-    out.warnings.push_back("a load in the sagittal plane gave an out-of-plane answer: the symmetric equilibrium is "
-                           "unstable in lateral bending and torsion, and this is the buckled one");
+  assess_stability(m, loads, newton, out.theta, out);
   out.seconds_equilibrium = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
-
-  // Report: poses, displacements, joint reactions, element forces.
-  const State s = evaluate(m, loads, F, theta);
-  out.theta = theta;
-  out.poses = s.poses;
-  const std::size_t n = m.vertebrae.size();
-  out.displacement.resize(Eigen::Index(n), 6);
-  for (std::size_t i = 0; i < n; ++i) {
-    const Vector3d& C = m.vertebrae[i].centre_mm;
-    out.displacement.row(Eigen::Index(i)).head<3>() = (s.poses[i].apply(C) - C).transpose();
-    out.displacement.row(Eigen::Index(i)).tail<3>() = (rotation_log(s.poses[i].R) * kRadToDeg).transpose();
-  }
-  std::vector<Vector3d> Fa, Ma;
-  resultants_above(m, s, Fa, Ma);
-  for (std::size_t k = 0; k < m.joints.size(); ++k) {
-    JointReaction r;
-    r.joint = m.joints[k].name;
-    r.force_world_n = -Fa[k];  // what the lower side pushes on everything above
-    r.moment_world_nmm = Ma[k];
-    const Eigen::Matrix3d R_low = k + 1 < n ? s.poses[k + 1].R : Eigen::Matrix3d::Identity();
-    const Vector3d local = R_low.transpose() * r.force_world_n;
-    r.shear_lat_n = local.x();
-    r.axial_n = local.y();
-    r.shear_ap_n = local.z();
-    r.moment_local_nmm = R_low.transpose() * r.moment_world_nmm;
-    // Disc frame: from the lower vertebra's centre (the sacrum: L5's mirrored) to the upper one's.
-    const Vector3d& J = m.joints[k].point_mm;
-    const Vector3d up = s.poses[k].apply(m.vertebrae[k].centre_mm);
-    const Vector3d low = k + 1 < n ? s.poses[k + 1].apply(m.vertebrae[k + 1].centre_mm)
-                                   : Vector3d(2 * J - m.vertebrae[k].centre_mm);
-    const Vector3d axis = (up - low).normalized();
-    r.disc_axial_n = r.force_world_n.dot(axis);
-    r.disc_shear_n = (r.force_world_n - r.disc_axial_n * axis).norm();
-    out.joints.push_back(r);
-  }
-  out.ligament_force_n = s.ligament_t;
-  out.muscle_force_n = s.muscle_t;
-  out.bushing_wrench = s.bushing;
+  report(m, evaluate(m, loads, F, out.theta), out);
   return out;
 }
 
