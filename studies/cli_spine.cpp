@@ -238,7 +238,7 @@ void run_spine_solve(const SpineSolveArgs& a) {
          {{"min_stiffness_nmm_per_rad", s.min_stiffness_nmm_per_rad},
           {"stable", s.min_stiffness_nmm_per_rad > 0},
           {"softest_mode", s.softest_mode},
-          {"left_sagittal_plane", s.left_sagittal_plane}}},
+          {"sagittal_solve", s.sagittal_solve}}},
         {"vertebrae", vertebrae},
         {"joints", joints},
         {"muscles", muscles},

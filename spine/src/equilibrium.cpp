@@ -240,11 +240,13 @@ const char* const kAxisNames[] = {"flexion/extension", "torsion", "lateral bendi
 /// gradient, finite-difference tangent stiffness, and the modified Newton method on them.
 class Newton {
  public:
-  Newton(const SpineModel& m, const std::vector<ExternalLoad>& loads, const VectorXd& F, const SolveOptions& o)
+  /// `sagittal_only`: flexion/extension coordinates only (a symmetric model under sagittal loads).
+  Newton(const SpineModel& m, const std::vector<ExternalLoad>& loads, const VectorXd& F, const SolveOptions& o,
+         bool sagittal_only)
       : m_(m), loads_(loads), F_(F), o_(o) {
     for (std::size_t k = 0; k < m.joints.size(); ++k)
       if (!m.joints[k].fused)
-        for (int a = 0; a < 3; ++a) free_.push_back(3 * Eigen::Index(k) + a);
+        for (int a = 0; a < (sagittal_only ? 1 : 3); ++a) free_.push_back(3 * Eigen::Index(k) + a);
   }
 
   double energy_grad(const VectorXd& th, VectorXd& g) const {
@@ -347,33 +349,61 @@ class Newton {
   std::vector<Eigen::Index> free_;
 };
 
-/// Stability at the solution: the smallest eigenvalue of the tangent stiffness and its mode; a
-/// sagittal load on the symmetric model that came out of the sagittal plane is the buckled
-/// branch of an unstable symmetric equilibrium (static-optimisation muscles do not co-contract).
-void assess_stability(const SpineModel& m, const std::vector<ExternalLoad>& loads, const Newton& newton,
-                      const VectorXd& theta, SpineSolution& out) {
-  if (newton.size() > 0) {
-    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(newton.hessian(theta));
-    out.min_stiffness_nmm_per_rad = eig.eigenvalues()[0];
-    Eigen::Index at = 0;
-    eig.eigenvectors().col(0).cwiseAbs().maxCoeff(&at);
-    const Eigen::Index dof = newton.coordinate(at);
-    out.softest_mode = m.joints[std::size_t(dof / 3)].name + " " + kAxisNames[dof % 3];
-    if (!(out.min_stiffness_nmm_per_rad > 0))
-      out.warnings.push_back("the equilibrium is not stable: smallest tangent stiffness " +
-                             std::to_string(out.min_stiffness_nmm_per_rad) + " N*mm/rad, mostly " + out.softest_mode);
-  }
-  bool sagittal = true;
+/// Loads in the sagittal plane x = 0: forces without x component at x = 0, moments about x only.
+bool sagittal(const std::vector<ExternalLoad>& loads) {
   for (const auto& l : loads)
-    sagittal = sagittal && l.force_n.x() == 0 && l.moment_nmm.y() == 0 && l.moment_nmm.z() == 0 &&
-               (!l.has_point || l.point_mm.x() == 0);
-  out.left_sagittal_plane = false;
-  if (sagittal)
-    for (Eigen::Index k = 0; k < theta.size(); k += 3)
-      out.left_sagittal_plane = out.left_sagittal_plane || std::abs(theta[k + 1]) > 1e-6 || std::abs(theta[k + 2]) > 1e-6;
-  if (out.left_sagittal_plane)
-    out.warnings.push_back("a load in the sagittal plane gave an out-of-plane answer: the symmetric equilibrium is "
-                           "unstable in lateral bending and torsion, and this is the buckled one");
+    if (l.force_n.x() != 0 || l.moment_nmm.y() != 0 || l.moment_nmm.z() != 0 || (l.has_point && l.point_mm.x() != 0))
+      return false;
+  return true;
+}
+
+/// A point and its mirror image x → −x are the same to round-off.
+bool mirrored(const Vector3d& a, const Vector3d& b) {
+  return std::abs(a.x() + b.x()) < 1e-9 && std::abs(a.y() - b.y()) < 1e-9 && std::abs(a.z() - b.z()) < 1e-9;
+}
+
+/// Is the model its own mirror image in x → −x? (Joints, vertebrae and the bushing lie in x = 0
+/// with diagonal stiffness; every line element and weight needs a mirrored twin.)
+bool mirror_symmetric(const SpineModel& m) {
+  for (const auto& v : m.vertebrae)
+    if (v.centre_mm.x() != 0) return false;
+  for (const auto& j : m.joints)
+    if (j.point_mm.x() != 0) return false;
+  if (m.has_bushing && m.bushing.point_mm.x() != 0) return false;
+  auto has_twin = [](const auto& items, const auto& same) {
+    for (const auto& a : items) {
+      bool found = false;
+      for (const auto& b : items) found = found || same(a, b);
+      if (!found) return false;
+    }
+    return true;
+  };
+  auto line_twin = [](const Line& a, const Line& b) {
+    return a.body_a == b.body_a && a.body_b == b.body_b && mirrored(a.a_mm, b.a_mm) && mirrored(a.b_mm, b.b_mm);
+  };
+  return has_twin(m.muscles, [&](const Muscle& a, const Muscle& b) { return line_twin(a, b) && a.pcsa_mm2 == b.pcsa_mm2 && a.max_stress_mpa == b.max_stress_mpa; }) &&
+         has_twin(m.ligaments, [&](const Ligament& a, const Ligament& b) { return line_twin(a, b) && a.k_n_per_mm == b.k_n_per_mm; }) &&
+         has_twin(m.weights, [](const PointLoad& a, const PointLoad& b) {
+           return a.body == b.body && mirrored(a.point_mm, b.point_mm) && a.force_n.x() == -b.force_n.x() &&
+                  a.force_n.y() == b.force_n.y() && a.force_n.z() == b.force_n.z();
+         });
+}
+
+/// Stability at the solution: the smallest eigenvalue of the tangent stiffness over all free
+/// coordinates and its mode. Not stable: a warning (a sagittal solve there is the symmetric
+/// equilibrium the spine would buckle away from; static-optimisation muscles do not co-contract).
+void assess_stability(const SpineModel& m, const Newton& full, const VectorXd& theta, SpineSolution& out) {
+  if (full.size() == 0) return;
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(full.hessian(theta));
+  out.min_stiffness_nmm_per_rad = eig.eigenvalues()[0];
+  Eigen::Index at = 0;
+  eig.eigenvectors().col(0).cwiseAbs().maxCoeff(&at);
+  const Eigen::Index dof = full.coordinate(at);
+  out.softest_mode = m.joints[std::size_t(dof / 3)].name + " " + kAxisNames[dof % 3];
+  if (!(out.min_stiffness_nmm_per_rad > 0))
+    out.warnings.push_back("the equilibrium is not stable: smallest tangent stiffness " +
+                           std::to_string(out.min_stiffness_nmm_per_rad) + " N*mm/rad, mostly " + out.softest_mode +
+                           (out.sagittal_solve ? " (the spine would buckle out of the sagittal plane)" : ""));
 }
 
 /// Poses, displacements, joint reactions and element forces at the solution.
@@ -475,10 +505,14 @@ SpineSolution solve_spine(const SpineModel& m, const std::vector<ExternalLoad>& 
   const auto t1 = std::chrono::steady_clock::now();
   out.seconds_recruitment = std::chrono::duration<double>(t1 - t0).count();
 
-  const Newton newton(m, loads, F, o);
+  // A symmetric model under sagittal loads has a symmetric equilibrium: solve for it in the
+  // sagittal plane (deterministic; where it is unstable, which way the spine would buckle is
+  // decided by round-off otherwise) and judge its stability over all coordinates.
+  out.sagittal_solve = sagittal(loads) && mirror_symmetric(m);
+  const Newton newton(m, loads, F, o, out.sagittal_solve), full(m, loads, F, o, false);
   out.theta = newton.solve(out.iterations, out.gradient_norm);
   out.converged = true;
-  assess_stability(m, loads, newton, out.theta, out);
+  assess_stability(m, full, out.theta, out);
   out.seconds_equilibrium = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
   report(m, evaluate(m, loads, F, out.theta), out);
   return out;

@@ -111,10 +111,12 @@ TEST(SpineSolveCli, FusedJointDoesNotMove) {
 
 // The model is left-right symmetric: a load in the sagittal plane gives a sagittal answer.
 TEST(SpineSolveCli, SagittalLoadsGiveSagittalAnswers) {
-  // (T1:0,0,-300 buckles sideways: test_cli_spine_targets.cpp)
-  for (const char* force : {"T1:0,0,300", "T7:0,-300,0"}) {
+  // (T1:0,0,-300 is solved in the plane too, but that equilibrium is not stable: the warning
+  // says so, and test_cli_spine_targets.cpp holds the thesis's claim that it is.)
+  for (const char* force : {"T1:0,0,300", "T7:0,-300,0", "T1:0,0,-300"}) {
     const json j = solve_json(std::string("--force ") + force);
     ASSERT_FALSE(j.empty()) << force;
+    EXPECT_TRUE(j["stability"]["sagittal_solve"].get<bool>()) << force;
     for (const auto& v : j["vertebrae"]) {
       EXPECT_NEAR(v["translation_mm"][0].get<double>(), 0.0, 1e-6) << force << " " << v["name"];
       EXPECT_NEAR(v["rotation_deg"][2].get<double>(), 0.0, 1e-6) << force << " " << v["name"];

@@ -53,12 +53,13 @@ double t1_motion(const std::string& f, const std::string& l) { return fusion_run
 const std::vector<std::string> kFused = {"L3-L4", "L4-L5", "L3-L4-L5"};
 }  // namespace
 
-// The model is left-right symmetric, but under a backward force of 300 N on T1 the symmetric
-// equilibrium is unstable in lateral bending and Newton finds a buckled minimum.
-TEST(SpineTargets, BackwardForceOnT1GivesASagittalAnswer) {
+// Thesis 3.3.4: with the lumbar muscles in, the spine reached equilibrium under backward forces.
+// Ours does, but under 300 N backward on T1 that equilibrium is not stable (negative tangent
+// stiffness in lumbar lateral bending): minimal-effort recruitment does not co-contract.
+TEST(SpineTargets, BackwardForceOnT1GivesAStableEquilibrium) {
   const json j = solve_json("--force T1:0,0,-300");
   ASSERT_FALSE(j.empty());
-  for (const auto& v : j["vertebrae"]) EXPECT_NEAR(v["translation_mm"][0].get<double>(), 0.0, 1e-6) << v["name"];
+  EXPECT_GT(j["stability"]["min_stiffness_nmm_per_rad"].get<double>(), 0.0) << j["stability"]["softest_mode"];
 }
 
 TEST(SpineTargets, McGillAndNormanL5S1Window) {

@@ -77,10 +77,11 @@ struct SpineSolution {
   /// stable) and the joint axis that dominates its mode.
   double min_stiffness_nmm_per_rad = 0;
   std::string softest_mode;
-  /// A load in the sagittal plane (the model is symmetric) gave lateral bending or torsion: the
-  /// symmetric equilibrium is unstable and this is a buckled one (also in `warnings`).
-  bool left_sagittal_plane = false;
-  std::vector<std::string> warnings;  ///< forces beyond 600 N, instability, buckling
+  /// Solved in the sagittal plane (flexion/extension coordinates only): the model is its own
+  /// mirror image and every load lies in x = 0, so the equilibrium is symmetric. Its stability is
+  /// still judged over all coordinates: not stable means the spine would buckle sideways.
+  bool sagittal_solve = false;
+  std::vector<std::string> warnings;  ///< forces beyond 600 N, an unstable equilibrium
   double seconds_recruitment = 0, seconds_equilibrium = 0;
 };
 
