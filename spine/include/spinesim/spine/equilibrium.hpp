@@ -1,12 +1,14 @@
 // Quasi-static equilibrium of the spine under gravity and external loads (SPEC "spine/"):
-//  1. recruitment (recruitment.hpp) in the reference posture: the lumbar muscles balance the
-//     moments of gravity and the external loads about the recruited joints;
+//  1. recruitment (recruitment.hpp) in the reference posture: the lumbar muscles and the
+//     recruited joints' springs share the moments of gravity and the external loads;
 //  2. Newton with a backtracking line search on the total potential energy Π(θ) over the joint
 //     coordinates (finite rotations, kinematics.hpp): joint springs with ROM bumps, tension-only
 //     ligaments, the IAP bushing, the recruited muscles as springs T = F·(1 + q·(L − L0)/L0)
 //     (short-range stiffness k = q F / L0, Bergmark 1989), dead loads. The gradient is
 //     analytic; the Hessian is its central finite difference (symmetrised), shifted when not
-//     positive definite so every step descends.
+//     positive definite so every step descends. Π is C² (stiffness changes ramp in over narrow
+//     bands). Sagittal loads on the mirror-symmetric model are solved in the sagittal plane;
+//  3. stability: the smallest eigenvalue of the tangent stiffness over all coordinates.
 // Returns every vertebra's 6-DOF displacement, joint reactions, ligament and muscle forces.
 #pragma once
 
