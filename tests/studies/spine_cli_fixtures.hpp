@@ -9,6 +9,7 @@
 #include <cmath>
 #include <map>
 #include <string>
+#include <vector>
 
 namespace spinesim::test_cli {
 
@@ -30,6 +31,25 @@ inline const nlohmann::json& study(const std::string& name) {
   const CliRun r = run_spinesim("study " + name + " --json");
   EXPECT_EQ(r.status, 0) << r.err;
   return made.emplace(name, r.status == 0 ? nlohmann::json::parse(r.out) : nlohmann::json::object()).first->second;
+}
+
+/// One run of `study fusion --json` by fusion ("normal", "L3-L4", …) and load ("forward", …).
+inline const nlohmann::json& fusion_run(const std::string& fusion, const std::string& load) {
+  for (const auto& r : study("fusion")["runs"])
+    if (r["fusion"] == fusion && r["load"] == load) return r;
+  ADD_FAILURE() << "fusion run " << fusion << " / " << load << " missing";
+  static const nlohmann::json none;
+  return none;
+}
+
+/// |T1 translation| (mm) in a fusion run.
+inline double t1_motion(const std::string& fusion, const std::string& load) {
+  return fusion_run(fusion, load)["t1_translation_norm_mm"];
+}
+
+inline const std::vector<std::string>& fused_levels() {
+  static const std::vector<std::string> levels = {"L3-L4", "L4-L5", "L3-L4-L5"};
+  return levels;
 }
 
 }  // namespace spinesim::test_cli

@@ -182,16 +182,7 @@ TEST(ValidationStudy, TargetsAreTheLiteraturesAndTheMomentIsReached) {
 // --- study fusion (thesis 6.1) ----------------------------------------------------------------
 
 namespace {
-const json& fusion_run(const std::string& fusion, const std::string& load) {
-  for (const auto& r : study("fusion")["runs"])
-    if (r["fusion"] == fusion && r["load"] == load) return r;
-  ADD_FAILURE() << "fusion run " << fusion << " / " << load << " missing";
-  static const json none;
-  return none;
-}
-double t1_motion(const std::string& f, const std::string& l) { return fusion_run(f, l)["t1_translation_norm_mm"]; }
 double force(const std::string& f, const std::string& l, const char* joint) { return fusion_run(f, l)[joint]["resultant_n"]; }
-const std::vector<std::string> kFused = {"L3-L4", "L4-L5", "L3-L4-L5"};
 }  // namespace
 
 TEST(FusionStudy, TablesAndCsvCoverEveryFusionAndLoad) {
@@ -210,7 +201,7 @@ TEST(FusionStudy, TablesAndCsvCoverEveryFusionAndLoad) {
 TEST(FusionStudy, AdjacentLevelForcesRiseMostWithL3L4L5) {
   const std::string load = "forward";
   for (const char* joint : {"l2l3", "l5s1"}) {
-    for (const auto& f : kFused) EXPECT_GT(force(f, load, joint), force("normal", load, joint)) << f << " " << joint;
+    for (const auto& f : fused_levels()) EXPECT_GT(force(f, load, joint), force("normal", load, joint)) << f << " " << joint;
     EXPECT_GT(force("L3-L4-L5", load, joint), force("L3-L4", load, joint)) << joint;
     EXPECT_GT(force("L3-L4-L5", load, joint), force("L4-L5", load, joint)) << joint;
   }
