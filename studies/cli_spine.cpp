@@ -50,7 +50,7 @@ struct SpineSolveArgs {
   double tolerance_nmm = spine::SolveOptions().tolerance;
   int max_iterations = spine::SolveOptions().max_iterations;
   int top = 10;
-  bool no_muscles = false, no_gravity = false, json = false;
+  bool no_muscles = false, no_trunk_muscles = false, no_gravity = false, json = false;
 };
 
 /// "T7:0,0,300" → vertebra index and three finite numbers; errors name the option.
@@ -158,6 +158,7 @@ void run_spine_solve(const SpineSolveArgs& a) {
     throw std::invalid_argument("--fusion " + a.fusion + ": " + e.what());
   }
   model_options.muscles = !a.no_muscles;
+  model_options.trunk_muscles = !a.no_trunk_muscles;
   model_options.gravity = !a.no_gravity;
   if (!a.csv.empty()) require_output_folder(a.csv, "--csv");
 
@@ -367,6 +368,8 @@ void register_spine(CLI::App& app) {
   cmd->add_option("--criterion", a->criterion, "Muscle recruitment: polynomial or minmax")->capture_default_str();
   cmd->add_option("--power", a->power, "Power p of the polynomial criterion sum (F/Fmax)^p")->capture_default_str();
   cmd->add_flag("--no-muscles", a->no_muscles, "Passive spine: no muscles");
+  cmd->add_flag("--no-trunk-muscles", a->no_trunk_muscles,
+                "Lumbar muscles F.8-F.19 only: leave out the restored thoracic erector spinae and rectus abdominis");
   cmd->add_flag("--no-gravity", a->no_gravity, "No weights (vertebrae, head, arms)");
   cmd->add_option("--tolerance", a->tolerance_nmm, "Newton tolerance on max |dPi/dtheta|, N·mm")->capture_default_str();
   cmd->add_option("--max-iterations", a->max_iterations, "Newton iterations before giving up")->capture_default_str();
@@ -376,7 +379,9 @@ void register_spine(CLI::App& app) {
   cmd->footer(
       "Loads are dead loads (constant direction and size) given in the reference posture. Gravity acts on the\n"
       "vertebrae (Bruno et al. 2015 masses), the head and neck (on T1) and the arms (on the rib cage, T6).\n"
-      "The muscles are recruited for the lumbar joints T12-L1 ... L5-S1 in the reference posture, then act as\n"
+      "Muscles: the thesis's lumbar set (tables F.8-F.19) and the LifeMOD trunk muscles it names without data\n"
+      "(thoracic erector spinae, rectus abdominis; data/spine/trunk_muscles.csv). They are recruited for the\n"
+      "lumbar joints T12-L1 ... L5-S1 in the reference posture, then act as\n"
       "springs with short-range stiffness while Newton finds the equilibrium (spine/README.md).\n"
       "Joint reaction: the force the lower side exerts on everything above (compression > 0), in the lower\n"
       "vertebra's axes (the thesis's Fy axial, Fz AP shear) and in the disc mid-plane; moments in N·m.\n"

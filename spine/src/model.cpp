@@ -91,7 +91,39 @@ void add_line_geometry(Line& line) {
   if (!(line.rest_length_mm > 1e-6)) throw std::runtime_error("line element " + line.name + " has zero length");
 }
 
-void load_muscles(SpineModel& m, const fs::path& thesis, const json& config, const std::string& config_file) {
+/// One muscle table (F.8-F.19 layout): the right side as listed, the left its mirror image.
+/// `group` names the muscle group; empty means the table has a "group" column.
+void load_muscle_table(SpineModel& m, const fs::path& file, const std::string& group, const json& config,
+                       const std::string& config_file) {
+  const CsvTable t = read_csv(file.string());
+  for (std::size_t r = 0; r < t.rows.size(); ++r) {
+    Muscle right;
+    right.group = group.empty() ? t.text(r, "group") : group;
+    right.side = "right";
+    right.name = t.text(r, "muscle") + "_R";
+    right.body_a = segment_body(t.text(r, "proximal_segment"), config, config_file);
+    right.body_b = segment_body(t.text(r, "distal_segment"), config, config_file);
+    right.a_mm = row_point(t, r, "proximal_");
+    right.b_mm = row_point(t, r, "distal_");
+    right.pcsa_mm2 = t.number(r, "pcsa_mm2");
+    right.max_stress_mpa = t.number(r, "max_stress_mpa");
+    if (!(right.pcsa_mm2 > 0) || !(right.max_stress_mpa > 0))
+      throw std::runtime_error(t.path + ": " + right.name + " needs pCSA > 0 and max stress > 0");
+    add_line_geometry(right);
+    Muscle left = right;  // the tables list the right side; the left is its mirror image
+    left.side = "left";
+    left.name = t.text(r, "muscle") + "_L";
+    left.a_mm.x() = -left.a_mm.x();
+    left.b_mm.x() = -left.b_mm.x();
+    m.muscles.push_back(right);
+    m.muscles.push_back(left);
+  }
+}
+
+/// The thesis's lumbar muscles (F.8-F.19) and, unless switched off, the LifeMOD default trunk muscles that
+/// appendix F names without data (spine_model.json "trunk_muscles": data/spine/trunk_muscles.csv, sourced there).
+void load_muscles(SpineModel& m, const fs::path& data, const json& config, const std::string& config_file,
+                  bool trunk_muscles) {
   static const std::pair<const char*, const char*> files[] = {
       {"F8_F9_multifidus.csv", "multifidus"},
       {"F10_F11_erector_spinae.csv", "erector spinae"},
@@ -99,31 +131,9 @@ void load_muscles(SpineModel& m, const fs::path& thesis, const json& config, con
       {"F14_F15_quadratus_lumborum.csv", "quadratus lumborum"},
       {"F16_F17_external_oblique.csv", "external oblique"},
       {"F18_F19_internal_oblique.csv", "internal oblique"}};
-  for (const auto& [file, group] : files) {
-    const CsvTable t = read_csv((thesis / file).string());
-    for (std::size_t r = 0; r < t.rows.size(); ++r) {
-      Muscle right;
-      right.group = group;
-      right.side = "right";
-      right.name = t.text(r, "muscle") + "_R";
-      right.body_a = segment_body(t.text(r, "proximal_segment"), config, config_file);
-      right.body_b = segment_body(t.text(r, "distal_segment"), config, config_file);
-      right.a_mm = row_point(t, r, "proximal_");
-      right.b_mm = row_point(t, r, "distal_");
-      right.pcsa_mm2 = t.number(r, "pcsa_mm2");
-      right.max_stress_mpa = t.number(r, "max_stress_mpa");
-      if (!(right.pcsa_mm2 > 0) || !(right.max_stress_mpa > 0))
-        throw std::runtime_error(t.path + ": " + right.name + " needs pCSA > 0 and max stress > 0");
-      add_line_geometry(right);
-      Muscle left = right;  // the tables list the right side; the left is its mirror image
-      left.side = "left";
-      left.name = t.text(r, "muscle") + "_L";
-      left.a_mm.x() = -left.a_mm.x();
-      left.b_mm.x() = -left.b_mm.x();
-      m.muscles.push_back(right);
-      m.muscles.push_back(left);
-    }
-  }
+  for (const auto& [file, group] : files) load_muscle_table(m, data / "thesis" / file, group, config, config_file);
+  if (trunk_muscles)
+    load_muscle_table(m, data / "spine" / config.at("trunk_muscles").get<std::string>(), "", config, config_file);
 }
 
 /// Ligaments across every joint (geometry: spine_model.json "ligaments", an assumption there).
@@ -330,7 +340,7 @@ SpineModel load_spine_model(const std::string& data_dir, const ModelOptions& opt
 
     if (options.gravity) load_weights(m, config, config_file, options.arms_forward);
     if (options.ligaments) load_ligaments(m, data, config);
-    if (options.muscles) load_muscles(m, thesis, config, config_file);
+    if (options.muscles) load_muscles(m, data, config, config_file, options.trunk_muscles);
     m.iap = iap_from_appendix_c((thesis / "appendix_c_iap.json").string());
     if (options.iap) {
       const json c = read_json(thesis / "appendix_c_iap.json");

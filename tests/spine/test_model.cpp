@@ -78,7 +78,8 @@ TEST(SpineModel, MassesFromBrunoAndDeLevaSumToTheUpperBody) {
 
 TEST(SpineModel, MusclesAreTheRightSideTablesMirrored) {
   const auto& m = model();
-  ASSERT_EQ(m.muscles.size(), 2u * (19 + 9 + 11 + 5 + 6 + 6));
+  // F.8-F.19 (19 + 9 + 11 + 5 + 6 + 6 per side) and the three restored LifeMOD trunk muscles per side.
+  ASSERT_EQ(m.muscles.size(), 2u * (19 + 9 + 11 + 5 + 6 + 6 + 3));
   for (std::size_t i = 0; i < m.muscles.size(); i += 2) {
     const auto& r = m.muscles[i];
     const auto& l = m.muscles[i + 1];
@@ -91,6 +92,73 @@ TEST(SpineModel, MusclesAreTheRightSideTablesMirrored) {
     EXPECT_GT(r.rest_length_mm, 0);
   }
   EXPECT_DOUBLE_EQ(m.muscles[0].max_force_n(), 40 * 0.7);  // NStiss_121: 40 mm² × 0.7 MPa
+}
+
+namespace {
+const sp::Muscle& muscle(const sp::SpineModel& m, const std::string& name) {
+  for (const auto& mu : m.muscles)
+    if (mu.name == name) return mu;
+  throw std::runtime_error("no muscle " + name);
+}
+const Eigen::Vector3d& centre(const sp::SpineModel& m, const std::string& vertebra) {
+  for (const auto& v : m.vertebrae)
+    if (v.name == vertebra) return v.centre_mm;
+  throw std::runtime_error("no vertebra " + vertebra);
+}
+Eigen::Vector3d mean_insertion(const sp::SpineModel& m, int first, int last) {
+  Eigen::Vector3d s = Eigen::Vector3d::Zero();
+  for (int i = first; i <= last; ++i) s += muscle(m, "NStiss_" + std::to_string(i) + "_R").b_mm;
+  return s / double(last - first + 1);
+}
+}  // namespace
+
+// data/spine/trunk_muscles.csv states the rules its numbers follow; check the numbers against the rules.
+TEST(SpineModel, TrunkMusclesFollowTheRulesTheirFileStates) {
+  const auto& m = model();
+  const double tol = 0.06;  // the file prints one decimal
+  const auto& lt = muscle(m, "LTpT_T7_R");
+  const auto& il = muscle(m, "ILpT_T7_R");
+  const auto& ra = muscle(m, "RA_R");
+  // pars thoracis origins: T7 at the offset the F.10 pars lumborum origins have from L1.
+  EXPECT_TRUE(lt.a_mm.isApprox(centre(m, "T7") + muscle(m, "NStiss_144_R").a_mm - centre(m, "L1"), 1e-12));
+  EXPECT_TRUE(il.a_mm.isApprox(centre(m, "T7") + muscle(m, "NStiss_140_R").a_mm - centre(m, "L1"), 1e-12));
+  EXPECT_EQ(lt.body_a, 6);  // T7
+  // insertions: the mean of the same column's F.10 insertions, on the ground.
+  EXPECT_LT((lt.b_mm - mean_insertion(m, 144, 148)).cwiseAbs().maxCoeff(), tol);
+  EXPECT_LT((il.b_mm - mean_insertion(m, 140, 143)).cwiseAbs().maxCoeff(), tol);
+  EXPECT_EQ(lt.body_b, sp::kGround);
+  EXPECT_EQ(il.body_b, sp::kGround);
+  // Delp et al. 2001: erector spinae 11.6 cm² split equally, rectus abdominis 2.6 cm²; thesis max stress.
+  EXPECT_DOUBLE_EQ(lt.pcsa_mm2 + il.pcsa_mm2, 1160.0);
+  EXPECT_DOUBLE_EQ(ra.pcsa_mm2, 260.0);
+  EXPECT_DOUBLE_EQ(ra.max_stress_mpa, muscle(m, "NStiss_121_R").max_stress_mpa);
+  // rectus abdominis: chest front to the lowest rectus-sheath point, at the sheath's mean lateral offset.
+  EXPECT_DOUBLE_EQ(ra.a_mm.y(), m.chest_front_mm.y());
+  EXPECT_DOUBLE_EQ(ra.a_mm.z(), m.chest_front_mm.z());
+  EXPECT_EQ(ra.body_a, m.ribs_body);
+  EXPECT_TRUE(ra.b_mm.isApprox(muscle(m, "NStiss_176_R").b_mm, 1e-12));
+  const double sheath_x = (muscle(m, "NStiss_167_R").b_mm.x() + muscle(m, "NStiss_174_R").b_mm.x() +
+                           muscle(m, "NStiss_175_R").b_mm.x() + muscle(m, "NStiss_176_R").b_mm.x()) / 4;
+  EXPECT_NEAR(ra.a_mm.x(), sheath_x, tol);
+  // The pars thoracis pass behind every lumbar joint and the rectus abdominis in front of it.
+  for (const auto& j : m.joints) {
+    if (j.point_mm.y() > 231.0 + 1e-9) continue;  // T12-L1 and below
+    auto line_z = [&](const sp::Muscle& mu) {
+      const double t = (j.point_mm.y() - mu.b_mm.y()) / (mu.a_mm.y() - mu.b_mm.y());
+      return mu.b_mm.z() + t * (mu.a_mm.z() - mu.b_mm.z());
+    };
+    EXPECT_LT(line_z(lt), j.point_mm.z() - 40) << j.name;
+    EXPECT_LT(line_z(il), j.point_mm.z() - 25) << j.name;  // 30 mm at L5-S1, below its insertion
+    EXPECT_GT(line_z(ra), j.point_mm.z() + 60) << j.name;
+  }
+}
+
+TEST(SpineModel, TrunkMusclesCanBeLeftOut) {
+  sp::ModelOptions o;
+  o.trunk_muscles = false;
+  const auto m = sp::load_spine_model(SPINESIM_DATA_DIR, o);
+  EXPECT_EQ(m.muscles.size(), 2u * (19 + 9 + 11 + 5 + 6 + 6));
+  for (const auto& mu : m.muscles) EXPECT_EQ(mu.name.rfind("NStiss_", 0), 0u) << mu.name;
 }
 
 TEST(SpineModel, LigamentsSpanEveryJointThoracicTakesTheMeanOfCervicalAndLumbar) {

@@ -101,6 +101,9 @@ IapStiffness iap_from_appendix_c(const std::string& appendix_c_json_path);
 struct ModelOptions {
   std::vector<int> fused_joints;  ///< joint indices (parse_fusion)
   bool ligaments = true, muscles = true, iap = true, gravity = true;
+  /// The LifeMOD default trunk muscles appendix F names without data (thoracic erector spinae, rectus
+  /// abdominis), restored in data/spine/trunk_muscles.csv; false: the F.8-F.19 lumbar muscles only.
+  bool trunk_muscles = true;
   bool arms_forward = false;      ///< arms reaching forward (crate case) instead of hanging
   double body_mass_kg = 0;        ///< 0: spine_model.json's value
 };
