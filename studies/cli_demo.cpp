@@ -205,8 +205,10 @@ void run_demo(const DemoArgs& a) {
          << "and calibration/README.md give the protocol. " << std::setprecision(3) << calibration_s << " s.\n\n```\n"
          << calibration_text.str() << "```\n"
          << "\n## Spine: validation (thesis 3.4)\n\n"
-         << "The open thoracolumbar spine (spine/: 17 vertebrae, F.4 joint springs with F.5 limits, ligaments, lumbar\n"
-         << "muscles recruited by Ipopt, the IAP bushing, gravity), nothing tuned to these targets. "
+         << "The open thoracolumbar spine (spine/: 17 vertebrae, F.4 joint springs with F.5 limits, ligaments, the\n"
+         << "F.8-F.19 lumbar muscles and the LifeMOD trunk muscles the thesis names without data (restored in\n"
+         << "data/spine/trunk_muscles.csv by stated rules), recruited by Ipopt, the IAP bushing, gravity), nothing tuned\n"
+         << "to these targets. "
          << "`spinesim study validation --help` gives the protocol. " << std::setprecision(3) << spine_validation.seconds
          << " s.\n\n"
          << validation_text.str()
