@@ -159,9 +159,9 @@ void run_demo(const DemoArgs& a) {
   spine_hooks.begin = [&](const std::string& what) { progress.begin(what); };
   spine_hooks.end = [&](const std::string& detail) { progress.end(detail); };
   constexpr double kSpineStudyForceN = 300;  // the studies' default force on T1
-  const ValidationStudy spine_validation = run_validation_study(data_dir(), spine_hooks);
-  const FusionStudy spine_fusion = run_fusion_study(data_dir(), kSpineStudyForceN, spine_hooks);
-  const TrendsStudy spine_trends = run_trends_study(data_dir(), kSpineStudyForceN, spine_hooks);
+  const ValidationStudy spine_validation = run_validation_study(data_dir(), {}, spine_hooks);
+  const FusionStudy spine_fusion = run_fusion_study(data_dir(), kSpineStudyForceN, {}, spine_hooks);
+  const TrendsStudy spine_trends = run_trends_study(data_dir(), kSpineStudyForceN, {}, spine_hooks);
   std::ostringstream validation_text, fusion_text, trends_text;
   print_validation(validation_text, spine_validation, true);
   print_fusion(fusion_text, spine_fusion, true);

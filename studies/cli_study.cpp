@@ -719,13 +719,26 @@ void register_materials(CLI::App& study) {
 struct SpineStudyArgs {
   double force_n = 300;
   std::string csv;
-  bool json = false, quiet = false;
+  bool json = false, quiet = false, no_trunk_muscles = false;
+  spine::ModelOptions model() const {
+    spine::ModelOptions o;
+    o.trunk_muscles = !no_trunk_muscles;
+    return o;
+  }
 };
+
+/// A line under the title when the study runs on the lumbar muscles only.
+void print_muscle_set(const SpineStudyArgs& a) {
+  if (a.no_trunk_muscles)
+    std::cout << "Muscles: F.8-F.19 only (--no-trunk-muscles: no thoracic erector spinae, no rectus abdominis)\n\n";
+}
 
 void add_spine_study_options(CLI::App* cmd, SpineStudyArgs& a, bool with_force) {
   if (with_force) cmd->add_option("--force", a.force_n, "Force on the T1 centre, N")->capture_default_str();
   cmd->add_option("--csv", a.csv, "Write the study's CSV");
   cmd->add_flag("--json", a.json, "Print the JSON summary on stdout (instead of the tables)");
+  cmd->add_flag("--no-trunk-muscles", a.no_trunk_muscles,
+                "Lumbar muscles F.8-F.19 only: leave out the restored thoracic erector spinae and rectus abdominis");
   cmd->add_flag("--quiet", a.quiet, "No progress on stderr");
 }
 
@@ -744,7 +757,7 @@ SpineStageHooks spine_study_hooks(const SpineStudyArgs& a, Progress& progress) {
 
 void run_validation(const SpineStudyArgs& a) {
   Progress progress(kValidationStages, a.quiet || a.json);
-  const ValidationStudy s = run_validation_study(data_dir(), spine_study_hooks(a, progress));
+  const ValidationStudy s = run_validation_study(data_dir(), a.model(), spine_study_hooks(a, progress));
   if (!a.csv.empty()) write_text_file(a.csv, validation_csv(s));
   nlohmann::json j = validation_json(s);
   j["csv"] = a.csv.empty() ? nlohmann::json(nullptr) : nlohmann::json(a.csv);
@@ -753,13 +766,14 @@ void run_validation(const SpineStudyArgs& a) {
     return;
   }
   std::cout << "Spine validation (thesis 3.4): McGill & Norman 1987 at L5-S1, Wilke et al. 2001 at L4-L5\n\n";
+  print_muscle_set(a);
   print_validation(std::cout, s, false);
   std::cout << "Total " << fixed(s.seconds, 2) << " s" << (a.csv.empty() ? "" : "; wrote " + a.csv) << "\n";
 }
 
 void run_fusion(const SpineStudyArgs& a) {
   Progress progress(kFusionStages, a.quiet || a.json);
-  const FusionStudy s = run_fusion_study(data_dir(), a.force_n, spine_study_hooks(a, progress));
+  const FusionStudy s = run_fusion_study(data_dir(), a.force_n, a.model(), spine_study_hooks(a, progress));
   if (!a.csv.empty()) write_text_file(a.csv, fusion_csv(s));
   nlohmann::json j = fusion_json(s);
   j["csv"] = a.csv.empty() ? nlohmann::json(nullptr) : nlohmann::json(a.csv);
@@ -768,13 +782,14 @@ void run_fusion(const SpineStudyArgs& a) {
     return;
   }
   std::cout << "Spinal fusion vs the normal spine (thesis 6.1)\n\n";
+  print_muscle_set(a);
   print_fusion(std::cout, s, false);
   std::cout << "Total " << fixed(s.seconds, 2) << " s" << (a.csv.empty() ? "" : "; wrote " + a.csv) << "\n";
 }
 
 void run_trends(const SpineStudyArgs& a) {
   Progress progress(kTrendsStages, a.quiet || a.json);
-  const TrendsStudy s = run_trends_study(data_dir(), a.force_n, spine_study_hooks(a, progress));
+  const TrendsStudy s = run_trends_study(data_dir(), a.force_n, a.model(), spine_study_hooks(a, progress));
   if (!a.csv.empty()) write_text_file(a.csv, trends_csv(s));
   nlohmann::json j = trends_json(s);
   j["csv"] = a.csv.empty() ? nlohmann::json(nullptr) : nlohmann::json(a.csv);
@@ -783,6 +798,7 @@ void run_trends(const SpineStudyArgs& a) {
     return;
   }
   std::cout << "Relative motion of adjacent vertebrae under a force on T1 (thesis 6.3-6.4)\n\n";
+  print_muscle_set(a);
   print_trends(std::cout, s, false);
   std::cout << "Total " << fixed(s.seconds, 2) << " s" << (a.csv.empty() ? "" : "; wrote " + a.csv) << "\n";
 }

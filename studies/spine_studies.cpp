@@ -194,7 +194,7 @@ double external_moment_x(const SpineModel& m, const std::vector<ExternalLoad>& l
   return moment.x();
 }
 
-McGillCase mcgill_case(const std::string& data_dir, const nlohmann::json& v) {
+McGillCase mcgill_case(const std::string& data_dir, const spine::ModelOptions& model, const nlohmann::json& v) {
   McGillCase c;
   c.target_moment_nmm = required(v, "validation", "mcgill_extension_moment_nmm");
   const auto& range = v.at("mcgill_axial_range_n");
@@ -209,7 +209,7 @@ McGillCase mcgill_case(const std::string& data_dir, const nlohmann::json& v) {
   c.dezee_shear_n = optional(v, "dezee_mcgill_shear_n");
   c.source = v.value("mcgill_source", "");
 
-  const SpineModel m = spine::load_spine_model(data_dir);
+  const SpineModel m = spine::load_spine_model(data_dir, model);
   const int t7 = spine::vertebra_index("T7");
   const int l5s1 = spine::joint_index("L5-S1");
   const Eigen::Vector3d p = m.joints[std::size_t(l5s1)].point_mm;
@@ -251,7 +251,7 @@ McGillCase mcgill_case(const std::string& data_dir, const nlohmann::json& v) {
   return c;
 }
 
-WilkeCase wilke_case(const std::string& data_dir, const nlohmann::json& j) {
+WilkeCase wilke_case(const std::string& data_dir, const spine::ModelOptions& model, const nlohmann::json& j) {
   const nlohmann::json& v = j.at("validation");
   if (!j.contains("crate")) throw std::runtime_error("spine_model.json: the crate block is missing");
   const nlohmann::json& crate = j.at("crate");
@@ -264,7 +264,7 @@ WilkeCase wilke_case(const std::string& data_dir, const nlohmann::json& j) {
   c.carried_by = crate.value("carried_by", "");
   c.source = crate.value("source", "");
 
-  spine::ModelOptions mo;
+  spine::ModelOptions mo = model;
   mo.arms_forward = true;
   const SpineModel m = spine::load_spine_model(data_dir, mo);
   c.crate_point_mm = m.chest_front_mm + Eigen::Vector3d(0, 0, c.distance_from_chest_mm);
@@ -280,16 +280,18 @@ WilkeCase wilke_case(const std::string& data_dir, const nlohmann::json& j) {
 
 }  // namespace
 
-ValidationStudy run_validation_study(const std::string& data_dir, const SpineStageHooks& hooks) {
+ValidationStudy run_validation_study(const std::string& data_dir, const spine::ModelOptions& model,
+                                     const SpineStageHooks& hooks) {
   const auto t0 = std::chrono::steady_clock::now();
   const nlohmann::json j = read_spine_json(data_dir);
   if (!j.contains("validation")) throw std::runtime_error("spine_model.json: the validation block is missing");
   ValidationStudy s;
   begin(hooks, "McGill & Norman: force on T7 for the L5-S1 moment");
-  s.mcgill = mcgill_case(data_dir, j.at("validation"));
+  s.mcgill = mcgill_case(data_dir, model, j.at("validation"));
   end(hooks, std::to_string(s.mcgill.solves) + " solves");
   begin(hooks, "Wilke: crate held in front of the chest");
-  s.wilke = wilke_case(data_dir, j);
+  s.wilke = wilke_case(data_dir, model, j);
+  s.trunk_muscles = model.trunk_muscles;
   end(hooks, "");
   s.seconds = seconds_from(t0);
   return s;
@@ -374,6 +376,7 @@ nlohmann::json validation_json(const ValidationStudy& s) {
       {"newton_iterations", b.iterations}};
   return {{"study", "validation"},
           {"thesis", "3.4"},
+          {"trunk_muscles", s.trunk_muscles},
           {"units", {{"force", "N"}, {"moment", "N·mm"}, {"frame", "x lateral (body's right -x), y superior, z anterior"},
                      {"joint_frame", "the lower vertebra's axes: axial +y (compression > 0), shear_ap +z, shear_lat +x"},
                      {"disc_frame", "disc mid-plane: axis from the lower to the upper vertebra centre"}}},
@@ -475,10 +478,12 @@ std::vector<Finding> fusion_findings(const FusionStudy& s) {
 
 }  // namespace
 
-FusionStudy run_fusion_study(const std::string& data_dir, double force_n, const SpineStageHooks& hooks) {
+FusionStudy run_fusion_study(const std::string& data_dir, double force_n, const spine::ModelOptions& model,
+                             const SpineStageHooks& hooks) {
   if (!std::isfinite(force_n) || force_n <= 0) throw std::invalid_argument("fusion study: the force must be finite and > 0 N");
   const auto t0 = std::chrono::steady_clock::now();
   FusionStudy s;
+  s.trunk_muscles = model.trunk_muscles;
   s.force_n = force_n;
   s.fusions = {"normal", "L3-L4", "L4-L5", "L3-L4-L5"};
   for (const auto& d : t1_load_directions()) s.loads.push_back(d.name);
@@ -487,7 +492,8 @@ FusionStudy run_fusion_study(const std::string& data_dir, double force_n, const 
   const std::size_t l2l3 = std::size_t(spine::joint_index("L2-L3")), l5s1 = std::size_t(spine::joint_index("L5-S1"));
   for (const auto& fusion : s.fusions) {
     begin(hooks, "fusion " + fusion + ": gravity only and " + std::to_string(s.loads.size()) + " loads on T1");
-    spine::ModelOptions mo;
+    spine::ModelOptions mo = model;
+    mo.fused_joints.clear();
     if (fusion != "normal") mo.fused_joints = spine::parse_fusion(fusion);
     const SpineModel m = spine::load_spine_model(data_dir, mo);
     const SpineSolution base = spine::solve_spine(m, {}, options);
@@ -553,6 +559,7 @@ nlohmann::json fusion_json(const FusionStudy& s) {
   }
   return {{"study", "fusion"},
           {"thesis", "6.1, fig. 6.1-6.6"},
+          {"trunk_muscles", s.trunk_muscles},
           {"force_n", s.force_n},
           {"fusions", s.fusions},
           {"loads", s.loads},
@@ -782,13 +789,15 @@ std::vector<Finding> trend_findings(const TrendsStudy& s) {
 
 }  // namespace
 
-TrendsStudy run_trends_study(const std::string& data_dir, double force_n, const SpineStageHooks& hooks) {
+TrendsStudy run_trends_study(const std::string& data_dir, double force_n, const spine::ModelOptions& model,
+                             const SpineStageHooks& hooks) {
   if (!std::isfinite(force_n) || force_n <= 0) throw std::invalid_argument("trends study: the force must be finite and > 0 N");
   const auto t0 = std::chrono::steady_clock::now();
   TrendsStudy s;
   s.force_n = force_n;
   begin(hooks, "trends: gravity only and 3 loads on T1");
-  const SpineModel m = spine::load_spine_model(data_dir);
+  s.trunk_muscles = model.trunk_muscles;
+  const SpineModel m = spine::load_spine_model(data_dir, model);
   const spine::SolveOptions options = study_solve_options();
   const int t1 = spine::vertebra_index("T1");
   const int n_pairs = int(m.vertebrae.size()) - 1;  // T1-T2 … L4-L5: joints 0 … 15
@@ -861,6 +870,7 @@ nlohmann::json trends_json(const TrendsStudy& s) {
   for (const auto& f : s.findings) matches += f.match;
   return {{"study", "trends"},
           {"thesis", "6.3 (relative translations), 6.4 (relative rotations)"},
+          {"trunk_muscles", s.trunk_muscles},
           {"force_n", s.force_n},
           {"units", {{"translation_mm", "upper minus lower F.1 centre, world axes, minus the gravity-only value, mm"},
                      {"rotation_deg", "joint rotation vector (lower vertebra's axes: x flexion +, y torsion, z lateral "

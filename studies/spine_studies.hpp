@@ -126,9 +126,12 @@ struct WilkeCase {
 struct ValidationStudy {
   McGillCase mcgill;
   WilkeCase wilke;
+  bool trunk_muscles = true;  ///< the model's muscle set (spine::ModelOptions::trunk_muscles)
   double seconds = 0;
 };
-ValidationStudy run_validation_study(const std::string& data_dir, const SpineStageHooks& hooks = SpineStageHooks());
+/// `model` gives the muscle set (trunk_muscles); each case sets its own loads and arm posture.
+ValidationStudy run_validation_study(const std::string& data_dir, const spine::ModelOptions& model = {},
+                                     const SpineStageHooks& hooks = SpineStageHooks());
 void print_validation(std::ostream& os, const ValidationStudy& s, bool markdown);
 nlohmann::json validation_json(const ValidationStudy& s);
 std::string validation_csv(const ValidationStudy& s);  ///< one row per case × quantity
@@ -159,10 +162,13 @@ struct FusionStudy {
   std::vector<std::string> fusions, loads;
   std::vector<FusionRun> runs;  ///< fusion-major
   std::vector<Finding> findings;
+  bool trunk_muscles = true;  ///< the model's muscle set (spine::ModelOptions::trunk_muscles)
   double seconds = 0;
   const FusionRun& run(const std::string& fusion, const std::string& load) const;
 };
-FusionStudy run_fusion_study(const std::string& data_dir, double force_n, const SpineStageHooks& hooks = SpineStageHooks());
+/// `model` gives the muscle set; the study sets the fused joints itself.
+FusionStudy run_fusion_study(const std::string& data_dir, double force_n, const spine::ModelOptions& model = {},
+                             const SpineStageHooks& hooks = SpineStageHooks());
 void print_fusion(std::ostream& os, const FusionStudy& s, bool markdown);
 nlohmann::json fusion_json(const FusionStudy& s);
 std::string fusion_csv(const FusionStudy& s);  ///< one row per fusion × load
@@ -182,9 +188,11 @@ struct TrendsStudy {
   double force_n = 0;
   std::vector<TrendRun> runs;  ///< lateral, forward, backward
   std::vector<Finding> findings;
+  bool trunk_muscles = true;  ///< the model's muscle set (spine::ModelOptions::trunk_muscles)
   double seconds = 0;
 };
-TrendsStudy run_trends_study(const std::string& data_dir, double force_n, const SpineStageHooks& hooks = SpineStageHooks());
+TrendsStudy run_trends_study(const std::string& data_dir, double force_n, const spine::ModelOptions& model = {},
+                             const SpineStageHooks& hooks = SpineStageHooks());
 void print_trends(std::ostream& os, const TrendsStudy& s, bool markdown);
 nlohmann::json trends_json(const TrendsStudy& s);
 std::string trends_csv(const TrendsStudy& s);  ///< one row per load × pair

@@ -195,6 +195,23 @@ TEST(ValidationStudy, WilkeCrateL4L5Window) {
   EXPECT_NEAR(b["axial_n"].get<double>(), 3240.0, 0.15 * 3240.0) << "L4-L5 axial (joint frame), crate held";
 }
 
+// The lumbar-only model (--no-trunk-muscles) is the thesis's F.8-F.19 set: the flag reaches the model
+// and the JSON says which set ran. Without the pars thoracis the lumbar extensors carry the moment
+// with shorter levers, so the spine is compressed harder.
+TEST(ValidationStudy, NoTrunkMusclesRunsTheLumbarSetAndSaysSo) {
+  const CliRun r = run_spinesim("study validation --no-trunk-muscles --json --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const json lumbar = json::parse(r.out);
+  const json& full = study("validation");
+  EXPECT_FALSE(lumbar["trunk_muscles"].get<bool>());
+  EXPECT_TRUE(full["trunk_muscles"].get<bool>());
+  EXPECT_GT(lumbar["mcgill"]["axial_n"].get<double>(), full["mcgill"]["axial_n"].get<double>());
+  EXPECT_GT(lumbar["wilke"]["axial_n"].get<double>(), full["wilke"]["axial_n"].get<double>());
+  const CliRun t = run_spinesim("study validation --no-trunk-muscles");
+  ASSERT_EQ(t.status, 0) << t.err;
+  EXPECT_NE(t.out.find("--no-trunk-muscles"), std::string::npos) << "the table names the muscle set";
+}
+
 // --- study fusion (thesis 6.1) ----------------------------------------------------------------
 
 namespace {
