@@ -1,7 +1,8 @@
 // The thoracolumbar spine model (SPEC "spine/", thesis 3.3): 17 rigid vertebrae T1…L5 in a
 // chain above the fixed sacrum, joined by spherical joints at the table F.2 points with F.4
 // rotational stiffness and F.5 range-of-motion limits; ligaments (F.6/F.7), the lumbar
-// muscles (F.8–F.19, mirrored), the intra-abdominal-pressure bushing (appendix C) between
+// muscles (F.8–F.19, mirrored) and the LifeMOD trunk muscles the thesis names without data
+// (data/spine/trunk_muscles.csv), the intra-abdominal-pressure bushing (appendix C) between
 // the rib cage (fixed to T6) and the pelvis; gravity on the vertebrae, the head and the arms.
 // Everything numeric comes from data/ (thesis/ tables and spine/spine_model.json).
 //
