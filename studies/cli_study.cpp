@@ -755,52 +755,41 @@ SpineStageHooks spine_study_hooks(const SpineStudyArgs& a, Progress& progress) {
   return hooks;
 }
 
-void run_validation(const SpineStudyArgs& a) {
-  Progress progress(kValidationStages, a.quiet || a.json);
-  const ValidationStudy s = run_validation_study(data_dir(), a.model(), spine_study_hooks(a, progress));
-  if (!a.csv.empty()) write_text_file(a.csv, validation_csv(s));
-  nlohmann::json j = validation_json(s);
-  j["csv"] = a.csv.empty() ? nlohmann::json(nullptr) : nlohmann::json(a.csv);
+/// Writes the CSV (--csv), then prints the JSON summary (--json) or the title, the muscle set and the table.
+template <class Study>
+void emit_spine_study(const SpineStudyArgs& a, const Study& s, const char* title, std::string (*to_csv)(const Study&),
+                      nlohmann::json (*to_json)(const Study&), void (*print)(std::ostream&, const Study&, bool)) {
+  if (!a.csv.empty()) write_text_file(a.csv, to_csv(s));
   if (a.json) {
+    nlohmann::json j = to_json(s);
+    j["csv"] = a.csv.empty() ? nlohmann::json(nullptr) : nlohmann::json(a.csv);
     print_json(j);
     return;
   }
-  std::cout << "Spine validation (thesis 3.4): McGill & Norman 1987 at L5-S1, Wilke et al. 2001 at L4-L5\n\n";
+  std::cout << title << "\n\n";
   print_muscle_set(a);
-  print_validation(std::cout, s, false);
+  print(std::cout, s, false);
   std::cout << "Total " << fixed(s.seconds, 2) << " s" << (a.csv.empty() ? "" : "; wrote " + a.csv) << "\n";
+}
+
+void run_validation(const SpineStudyArgs& a) {
+  Progress progress(kValidationStages, a.quiet || a.json);
+  const ValidationStudy s = run_validation_study(data_dir(), a.model(), spine_study_hooks(a, progress));
+  emit_spine_study(a, s, "Spine validation (thesis 3.4): McGill & Norman 1987 at L5-S1, Wilke et al. 2001 at L4-L5",
+                   validation_csv, validation_json, print_validation);
 }
 
 void run_fusion(const SpineStudyArgs& a) {
   Progress progress(kFusionStages, a.quiet || a.json);
   const FusionStudy s = run_fusion_study(data_dir(), a.force_n, a.model(), spine_study_hooks(a, progress));
-  if (!a.csv.empty()) write_text_file(a.csv, fusion_csv(s));
-  nlohmann::json j = fusion_json(s);
-  j["csv"] = a.csv.empty() ? nlohmann::json(nullptr) : nlohmann::json(a.csv);
-  if (a.json) {
-    print_json(j);
-    return;
-  }
-  std::cout << "Spinal fusion vs the normal spine (thesis 6.1)\n\n";
-  print_muscle_set(a);
-  print_fusion(std::cout, s, false);
-  std::cout << "Total " << fixed(s.seconds, 2) << " s" << (a.csv.empty() ? "" : "; wrote " + a.csv) << "\n";
+  emit_spine_study(a, s, "Spinal fusion vs the normal spine (thesis 6.1)", fusion_csv, fusion_json, print_fusion);
 }
 
 void run_trends(const SpineStudyArgs& a) {
   Progress progress(kTrendsStages, a.quiet || a.json);
   const TrendsStudy s = run_trends_study(data_dir(), a.force_n, a.model(), spine_study_hooks(a, progress));
-  if (!a.csv.empty()) write_text_file(a.csv, trends_csv(s));
-  nlohmann::json j = trends_json(s);
-  j["csv"] = a.csv.empty() ? nlohmann::json(nullptr) : nlohmann::json(a.csv);
-  if (a.json) {
-    print_json(j);
-    return;
-  }
-  std::cout << "Relative motion of adjacent vertebrae under a force on T1 (thesis 6.3-6.4)\n\n";
-  print_muscle_set(a);
-  print_trends(std::cout, s, false);
-  std::cout << "Total " << fixed(s.seconds, 2) << " s" << (a.csv.empty() ? "" : "; wrote " + a.csv) << "\n";
+  emit_spine_study(a, s, "Relative motion of adjacent vertebrae under a force on T1 (thesis 6.3-6.4)", trends_csv,
+                   trends_json, print_trends);
 }
 
 void register_validation(CLI::App& study) {
