@@ -493,8 +493,7 @@ FusionStudy run_fusion_study(const std::string& data_dir, double force_n, const 
   for (const auto& fusion : s.fusions) {
     begin(hooks, "fusion " + fusion + ": gravity only and " + std::to_string(s.loads.size()) + " loads on T1");
     spine::ModelOptions mo = model;
-    mo.fused_joints.clear();
-    if (fusion != "normal") mo.fused_joints = spine::parse_fusion(fusion);
+    mo.fused_joints = fusion == "normal" ? std::vector<int>{} : spine::parse_fusion(fusion);
     const SpineModel m = spine::load_spine_model(data_dir, mo);
     const SpineSolution base = spine::solve_spine(m, {}, options);
     const Eigen::Vector3d c = m.vertebrae[std::size_t(t1)].centre_mm;

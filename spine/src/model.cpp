@@ -82,7 +82,9 @@ int segment_body(const std::string& segment, const json& config, const std::stri
     if (g.get<std::string>() == name) return kGround;
   const auto& names = vertebra_names();
   const auto it = std::find(names.begin(), names.end(), name);
-  if (it == names.end()) throw std::runtime_error(file + ": muscle segment '" + segment + "' is not a known body");
+  if (it == names.end())
+    throw std::runtime_error(file + ": muscle segment '" + segment +
+                             "' is not a vertebra, a ground segment or an alias (spine_model.json)");
   return int(it - names.begin());
 }
 
@@ -93,16 +95,15 @@ void add_line_geometry(Line& line) {
 
 /// One muscle table (F.8-F.19 layout): the right side as listed, the left its mirror image.
 /// `group` names the muscle group; empty means the table has a "group" column.
-void load_muscle_table(SpineModel& m, const fs::path& file, const std::string& group, const json& config,
-                       const std::string& config_file) {
+void load_muscle_table(SpineModel& m, const fs::path& file, const std::string& group, const json& config) {
   const CsvTable t = read_csv(file.string());
   for (std::size_t r = 0; r < t.rows.size(); ++r) {
     Muscle right;
     right.group = group.empty() ? t.text(r, "group") : group;
     right.side = "right";
     right.name = t.text(r, "muscle") + "_R";
-    right.body_a = segment_body(t.text(r, "proximal_segment"), config, config_file);
-    right.body_b = segment_body(t.text(r, "distal_segment"), config, config_file);
+    right.body_a = segment_body(t.text(r, "proximal_segment"), config, t.path);
+    right.body_b = segment_body(t.text(r, "distal_segment"), config, t.path);
     right.a_mm = row_point(t, r, "proximal_");
     right.b_mm = row_point(t, r, "distal_");
     right.pcsa_mm2 = t.number(r, "pcsa_mm2");
@@ -122,8 +123,7 @@ void load_muscle_table(SpineModel& m, const fs::path& file, const std::string& g
 
 /// The thesis's lumbar muscles (F.8-F.19) and, unless switched off, the LifeMOD default trunk muscles that
 /// appendix F names without data (spine_model.json "trunk_muscles": data/spine/trunk_muscles.csv, sourced there).
-void load_muscles(SpineModel& m, const fs::path& data, const json& config, const std::string& config_file,
-                  bool trunk_muscles) {
+void load_muscles(SpineModel& m, const fs::path& data, const json& config, bool trunk_muscles) {
   static const std::pair<const char*, const char*> files[] = {
       {"F8_F9_multifidus.csv", "multifidus"},
       {"F10_F11_erector_spinae.csv", "erector spinae"},
@@ -131,9 +131,9 @@ void load_muscles(SpineModel& m, const fs::path& data, const json& config, const
       {"F14_F15_quadratus_lumborum.csv", "quadratus lumborum"},
       {"F16_F17_external_oblique.csv", "external oblique"},
       {"F18_F19_internal_oblique.csv", "internal oblique"}};
-  for (const auto& [file, group] : files) load_muscle_table(m, data / "thesis" / file, group, config, config_file);
+  for (const auto& [file, group] : files) load_muscle_table(m, data / "thesis" / file, group, config);
   if (trunk_muscles)
-    load_muscle_table(m, data / "spine" / config.at("trunk_muscles").get<std::string>(), "", config, config_file);
+    load_muscle_table(m, data / "spine" / config.at("trunk_muscles").get<std::string>(), "", config);
 }
 
 /// Ligaments across every joint (geometry: spine_model.json "ligaments", an assumption there).
@@ -340,7 +340,7 @@ SpineModel load_spine_model(const std::string& data_dir, const ModelOptions& opt
 
     if (options.gravity) load_weights(m, config, config_file, options.arms_forward);
     if (options.ligaments) load_ligaments(m, data, config);
-    if (options.muscles) load_muscles(m, data, config, config_file, options.trunk_muscles);
+    if (options.muscles) load_muscles(m, data, config, options.trunk_muscles);
     m.iap = iap_from_appendix_c((thesis / "appendix_c_iap.json").string());
     if (options.iap) {
       const json c = read_json(thesis / "appendix_c_iap.json");

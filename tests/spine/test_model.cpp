@@ -2,10 +2,13 @@
 #include "spinesim/spine/model.hpp"
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <unistd.h>
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
-#include <nlohmann/json.hpp>
+#include <iterator>
 
 namespace sp = spinesim::spine;
 
@@ -203,4 +206,48 @@ TEST(SpineModel, MissingDataFolderNamesTheFile) {
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("spine_model.json"), std::string::npos);
   }
+}
+
+// A data folder whose trunk-muscle table is broken: the error names the file and what is wrong.
+TEST(SpineModel, BrokenTrunkMuscleTableIsRefusedNamingTheFile) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("spinesim_trunk_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::copy(SPINESIM_DATA_DIR, dir, fs::copy_options::recursive);
+  const fs::path table = dir / "spine" / "trunk_muscles.csv";
+  std::string text;
+  {
+    std::ifstream in(table);
+    text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  auto write_with = [&](const std::string& from, const std::string& to) {
+    std::string t = text;
+    const auto at = t.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    t.replace(at, from.size(), to);
+    std::ofstream(table) << t;
+  };
+  auto message = [&]() -> std::string {
+    try {
+      (void)sp::load_spine_model(dir.string());
+    } catch (const std::runtime_error& e) {
+      return e.what();
+    }
+    return "";
+  };
+  write_with("RA,rectus abdominis,Ribs", "RA,rectus abdominis,Sternum");
+  std::string what = message();
+  EXPECT_NE(what.find("trunk_muscles.csv"), std::string::npos) << what;
+  EXPECT_NE(what.find("'Sternum'"), std::string::npos) << what;
+  write_with(",260,0.7", ",0,0.7");
+  what = message();
+  EXPECT_NE(what.find("RA_R needs pCSA > 0"), std::string::npos) << what;
+  fs::remove(table);
+  what = message();
+  EXPECT_NE(what.find("trunk_muscles.csv"), std::string::npos) << what;
+  // Without the trunk muscles the table is not read at all.
+  sp::ModelOptions lumbar;
+  lumbar.trunk_muscles = false;
+  EXPECT_NO_THROW((void)sp::load_spine_model(dir.string(), lumbar));
+  fs::remove_all(dir);
 }
