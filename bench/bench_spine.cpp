@@ -1,4 +1,4 @@
-// Spine costs against issue 5's targets: one equilibrium + recruitment ≤ 100 ms; the whole
+// Spine costs against the real-time targets: one equilibrium + recruitment ≤ 100 ms; the whole
 // displacement–force database in < 5 min; evaluating all 17 vertebra poses for one force from
 // the fits in ≤ 10 µs (it runs inside the 1 kHz haptic loop).
 //   SolveSpine/0           solve_spine, gravity only (recruitment + Newton)

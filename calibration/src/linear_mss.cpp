@@ -1,6 +1,7 @@
 #include "spinesim/calibration/linear_mss.hpp"
 
 #include "spinesim/fem/cholmod_solver.hpp"
+#include "spinesim/mesh/rigid_plate.hpp"
 
 #include <Eigen/LU>
 
@@ -131,12 +132,12 @@ LinearMss::LinearMss(const mss::MssModel& model, std::vector<Knob> knobs, const 
     throw std::invalid_argument("calibration: the mesh needs superior (2) and inferior (1) endplate labels");
   m.nz = nf + 6;
   for (Eigen::Index i : plate_nodes) {
-    const Eigen::Vector3d d = X.segment<3>(3 * i) - c;
-    // u = t + theta x d:  row a of [I, -[d]x].
-    for (int a = 0; a < 3; ++a) r.emplace_back(3 * i + a, nf + a, 1.0);
-    r.emplace_back(3 * i + 0, nf + 4, d.z()), r.emplace_back(3 * i + 0, nf + 5, -d.y());
-    r.emplace_back(3 * i + 1, nf + 3, -d.z()), r.emplace_back(3 * i + 1, nf + 5, d.x());
-    r.emplace_back(3 * i + 2, nf + 3, d.y()), r.emplace_back(3 * i + 2, nf + 4, -d.x());
+    // u = t + theta x (X - c): the entries of mesh::plate_map that are not structurally zero
+    // (an arm component that happens to be 0 keeps its slot, so the pattern is the mesh's).
+    const mesh::PlateMap P = mesh::plate_map(X.segment<3>(3 * i) - c);
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 6; ++b)
+        if (b == a || (b >= 3 && b - 3 != a)) r.emplace_back(3 * i + a, nf + b, P(a, b));
   }
   m.R.resize(m.ndof, m.nz);
   m.R.setFromTriplets(r.begin(), r.end());

@@ -10,15 +10,6 @@
 
 namespace spinesim::fem {
 
-Eigen::Matrix<double, 3, 6> plate_map(const Eigen::Vector3d& r) {
-  Eigen::Matrix<double, 3, 6> R;
-  // theta × r = −[r]× theta
-  R << 1, 0, 0, 0, r.z(), -r.y(),
-       0, 1, 0, -r.z(), 0, r.x(),
-       0, 0, 1, r.y(), -r.x(), 0;
-  return R;
-}
-
 namespace {
 
 // Interleaves the low 21 bits of x, y, z (Morton / Z-order key).

@@ -1,7 +1,7 @@
 // Medit .mesh writer (ASCII); contract in io.hpp.
 #include "spinesim/mesh/io.hpp"
 
-#include "atomic_file.hpp"
+#include "spinesim/common/atomic_file.hpp"
 #include "write_checks.hpp"
 
 #include <algorithm>
@@ -71,7 +71,7 @@ void write_medit(const std::string& path, const TetMesh& m) {
   }
 
   // 3. Write (1-based indices).
-  detail::write_atomically("write_medit", path, [&](std::ostream& os) {
+  write_atomically("write_medit", path, [&](std::ostream& os) {
     os << "MeshVersionFormatted 2\n\nDimension 3\n\nVertices\n" << m.num_vertices() << "\n";
     for (Eigen::Index i = 0; i < m.num_vertices(); ++i) {
       for (int j = 0; j < 3; ++j) {

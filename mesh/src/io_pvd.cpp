@@ -7,7 +7,7 @@
 //   </VTKFile>
 #include "spinesim/mesh/io.hpp"
 
-#include "atomic_file.hpp"
+#include "spinesim/common/atomic_file.hpp"
 #include "xml_escape.hpp"
 
 #include <charconv>
@@ -44,7 +44,7 @@ void write_pvd(const std::string& path, const std::vector<PvdEntry>& entries) {
   }
 
   // 2. Write to a temporary file, then rename.
-  detail::write_atomically("write_pvd", path, [&](std::ostream& os) {
+  write_atomically("write_pvd", path, [&](std::ostream& os) {
     os << "<?xml version=\"1.0\"?>\n"
        << "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
        << "  <Collection>\n";

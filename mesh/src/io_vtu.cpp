@@ -1,7 +1,7 @@
 // VTU (VTK XML UnstructuredGrid) writer and reader; layout and contract in io.hpp.
 #include "spinesim/mesh/io.hpp"
 
-#include "atomic_file.hpp"
+#include "spinesim/common/atomic_file.hpp"
 #include "xml_escape.hpp"
 #include "write_checks.hpp"
 
@@ -427,7 +427,7 @@ void write_vtu(const std::string& path, const TetMesh& m, const std::vector<Data
   const VtuEncoding enc = options.encoding;
 
   // 3. Write to a temporary file, then rename.
-  detail::write_atomically("write_vtu", path, [&](std::ostream& os) {
+  write_atomically("write_vtu", path, [&](std::ostream& os) {
     os << "<?xml version=\"1.0\"?>\n"
        << "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" "
           "header_type=\"UInt64\">\n"

@@ -93,7 +93,7 @@ TetMesh to_tet_mesh(const C3t3& c3t3, const LabeledBody& body) {
     m.region(Eigen::Index(t)) = regions[t];
   }
   // Node labels by priority: superior endplate > inferior endplate > wall > interior, so that
-  // rim nodes carry the endplate label (SPEC command-line contract).
+  // rim nodes carry the endplate label (docs/units-and-frame.md).
   auto priority = [](int s) {
     switch (Surface(s)) {
       case Surface::superior_endplate: return 3;

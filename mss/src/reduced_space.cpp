@@ -8,15 +8,6 @@
 
 namespace spinesim::mss::detail {
 
-Matrix36d plate_map(const Eigen::Vector3d& r) {
-  Matrix36d R;
-  // theta x r = -[r]x theta
-  R << 1, 0, 0, 0, r.z(), -r.y(),  //
-      0, 1, 0, -r.z(), 0, r.x(),   //
-      0, 0, 1, r.y(), -r.x(), 0;
-  return R;
-}
-
 void LumpedReduced::apply(const Eigen::VectorXd& y, Eigen::VectorXd& out) const {
   out.noalias() = diagonal.cwiseProduct(y);
   if (y.size() >= 6 && !plate.isZero(0.0)) out.tail<6>().noalias() += plate * y.tail<6>();

@@ -16,6 +16,7 @@
 
 #include "spinesim/mss/boundary.hpp"
 #include "spinesim/mss/model.hpp"
+#include "spinesim/mesh/rigid_plate.hpp"
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
@@ -29,7 +30,7 @@ using Matrix36d = Eigen::Matrix<double, 3, 6>;
 enum class NodeRole : signed char { free, inferior, superior };
 
 /// R_i of the small-rotation plate map for the arm r = X_i - c: R q = t + theta x r.
-Matrix36d plate_map(const Eigen::Vector3d& arm_mm);
+using mesh::plate_map;
 
 /// Mass-like reduced matrix P^T diag(w) P for per-node weights w (masses, or ones for the
 /// ambient damping): a diagonal over the free DOF and a dense 6x6 plate block.

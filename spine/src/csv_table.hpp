@@ -1,5 +1,5 @@
 // The data/ CSV convention (data/README.md): '#' comment lines, one header row, cells without
-// commas or quotes. Private to spine/ (the module stands alone, SPEC "Layout").
+// commas or quotes. Private to spine/ (the module stands alone, docs/architecture.md).
 #pragma once
 
 #include <Eigen/Core>

@@ -2,6 +2,8 @@
 // evaluation, the JSON file, and the superposition check. See database.hpp.
 #include "spinesim/spine/database.hpp"
 
+#include "spinesim/common/atomic_file.hpp"
+
 #include <Eigen/QR>
 #include <nlohmann/json.hpp>
 
@@ -639,24 +641,7 @@ void DisplacementDatabase::save(const std::string& path) const {
   }
   text << "\n ]\n}\n";
 
-  // Write beside the target and rename, so a failure never leaves a half file.
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    if (!out) throw std::runtime_error("cannot write " + path);
-    out << text.str();
-    out.close();
-    if (!out) {
-      std::remove(tmp.c_str());
-      throw std::runtime_error("cannot write " + path);
-    }
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    std::remove(tmp.c_str());
-    throw std::runtime_error("cannot write " + path + ": " + ec.message());
-  }
+  write_text_atomically(path, text.str());  // a failure never leaves a half file
 }
 
 DisplacementDatabase DisplacementDatabase::load(const std::string& path) {

@@ -1,4 +1,4 @@
-// Builds the spine model from data/ (SPEC "spine/"): no number of the model is in this file.
+// Builds the spine model from data/ (spine/README.md): no number of the model is in this file.
 #include "spinesim/spine/model.hpp"
 
 #include "csv_table.hpp"

@@ -1,5 +1,5 @@
 // The transcribed thesis tables in data/thesis/ against values read off the thesis text
-// (seed/000_a3b68c6ea447bc46.txt, Appendix F, Appendix C, tables 3.2/3.3/5.1), plus the
+// (docs/references.md [Thesis], Appendix F, Appendix C, tables 3.2/3.3/5.1), plus the
 // structure every shipped CSV must have (a '# source:' line, a header, no empty cells).
 // Expected numbers are written here from the thesis; actual numbers come from the files.
 #include <gtest/gtest.h>

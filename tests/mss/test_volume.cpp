@@ -1,4 +1,4 @@
-// Volume under 10 % axial compression (issue 3, item 5): the thesis claims its radial springs
+// Volume under 10 % axial compression : the thesis claims its radial springs
 // (5.3)-(5.5) preserve volume but never measured it. Variants of the same L4-L5 disc, real-disc
 // material (E 3.22 MPa, nu 0.4557), superior plate pushed down by 10 % of the equivalent-cylinder
 // height (static equilibrium, inferior endplate fixed):

@@ -72,7 +72,7 @@ TEST(SpineModel, MassesFromBrunoAndDeLevaSumToTheUpperBody) {
   const auto& m = model();
   double vertebrae = 0;
   for (const auto& v : m.vertebrae) vertebrae += v.mass_kg;
-  EXPECT_NEAR(vertebrae, 0.3278 * 70, 1e-9);  // Σ of SPEC's per-level % of 70 kg
+  EXPECT_NEAR(vertebrae, 0.3278 * 70, 1e-9);  // Σ of Bruno et al. 2015's per-level % of 70 kg
   double weight = 0;
   for (const auto& w : m.weights) weight -= w.force_n.y();
   // + head and neck 6.94 % and two arms 4.94 % each

@@ -1,4 +1,4 @@
-// The `spinesim` command-line contract (SPEC "Command-line contract"): JSON fields, units,
+// The `spinesim` command-line contract (docs/cli.md): JSON fields, units,
 // sign conventions, and bad input -> one line on stderr, non-zero exit, no output file.
 #include "spinesim/mesh/io.hpp"
 #include "spinesim/mesh/tet_mesh.hpp"

@@ -179,7 +179,7 @@ TEST(ValidationStudy, TargetsAreTheLiteraturesAndTheMomentIsReached) {
   EXPECT_DOUBLE_EQ(b["crate"]["mass_kg"].get<double>(), 19.8);
 }
 
-// The validation windows of issue 5, with the restored LifeMOD trunk muscles (data/spine/trunk_muscles.csv).
+// The validation windows (McGill & Norman, Wilke), with the restored LifeMOD trunk muscles (data/spine/trunk_muscles.csv).
 TEST(ValidationStudy, McGillAndNormanL5S1Window) {
   const json& a = study("validation")["mcgill"];
   ASSERT_FALSE(a.is_null());

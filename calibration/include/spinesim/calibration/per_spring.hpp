@@ -1,5 +1,5 @@
 // The per-spring stage of the calibration: after the region fit (calibrate.hpp), one stiffness
-// multiplier mu_e per main (edge) spring, on top of the fitted region scales s — the SPEC's
+// multiplier mu_e per main (edge) spring, on top of the fitted region scales s — the protocol's
 // "optionally finer (per-spring scales with a smoothness regulariser)".
 //
 // Unknowns q_e = ln mu_e, one per edge spring in the model's edge order (MssModel::edge_springs;

@@ -12,6 +12,7 @@
 #include "spinesim/fem/elasticity.hpp"
 #include "spinesim/fem/fe_space.hpp"
 #include "spinesim/mesh/material.hpp"
+#include "spinesim/mesh/rigid_plate.hpp"
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
@@ -23,8 +24,8 @@ namespace spinesim::fem {
 
 enum class NodeRole : signed char { free = 0, fixed = 1, plate = 2 };
 
-/// 3×6 map from plate DOF (t, theta) to the displacement of a point at offset r = x − c (mm).
-Eigen::Matrix<double, 3, 6> plate_map(const Eigen::Vector3d& r_mm);
+/// The plate map R_i (3×6) is mesh::plate_map (spinesim/mesh/rigid_plate.hpp).
+using mesh::plate_map;
 
 /// Sparsity of the free–free block (lower triangle) and per-element scatter slots.
 struct FreeBlockPattern {

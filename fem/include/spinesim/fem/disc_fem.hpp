@@ -1,7 +1,7 @@
 // Linear FEM reference for a disc between a fixed inferior endplate and a rigid superior plate.
 //
 // Small-strain isotropic linear elasticity, P1 or P2 tetrahedra, material per region.
-// Boundary conditions (SPEC "fem/", command-line contract):
+// Boundary conditions (docs/units-and-frame.md):
 //   - nodes with surface == 1 (inferior endplate) are fixed;
 //   - nodes with surface == 2 (superior endplate; for P2 also edge midpoints whose two ends
 //     are both labelled 2) move rigidly with the plate: u_i = t + theta x (x_i - c), small

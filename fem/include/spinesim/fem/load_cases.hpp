@@ -1,4 +1,4 @@
-// Named disc load cases (SPEC command-line contract): compression, tension, shear-ap,
+// Named disc load cases (docs/units-and-frame.md): compression, tension, shear-ap,
 // shear-lat, flexion, extension, lateral-bending, torsion.
 //
 // Each case is a wrench applied to the superior plate, given in the disc's local frame

@@ -1,6 +1,6 @@
 // Mesh and result files: VTU (VTK XML UnstructuredGrid), Medit .mesh, and surface meshes.
 //
-// VTU layout (SPEC "mesh/"), written as VTKFile version 1.0, LittleEndian, header_type UInt64:
+// VTU layout (docs/cli.md), written as VTKFile version 1.0, LittleEndian, header_type UInt64:
 //   - Points: Float64 ×3, mm, full precision (binary is bit-exact; ASCII uses the shortest
 //     round-trip decimal form, so it is exact too);
 //   - Cells: connectivity/offsets Int64, types UInt8 = 10 (VTK_TETRA);

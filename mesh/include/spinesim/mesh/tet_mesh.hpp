@@ -1,6 +1,6 @@
 // TetMesh — the tetrahedral disc mesh every module shares.
 //
-// Conventions (SPEC "Units and frame", "mesh/"):
+// Conventions (docs/units-and-frame.md):
 //   - coordinates in mm, frame x lateral (body's right is -x), y superior, z anterior;
 //   - tets are positively oriented: det[v1-v0, v2-v0, v3-v0] > 0;
 //   - cell label `region`: 1 annulus, 2 nucleus (other positive labels allowed for

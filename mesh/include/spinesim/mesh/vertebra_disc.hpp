@@ -1,4 +1,4 @@
-// A disc between two user-supplied vertebrae (patient-specific disc; SPEC "mesh/").
+// A disc between two user-supplied vertebrae (a patient-specific disc).
 //
 // Input: the inferior and the superior vertebra as triangle surfaces in mm with +y up
 // (read_surface has done units and axes) — endplate patches, vertebral bodies or whole

@@ -39,7 +39,7 @@ RigidPose plate_pose(const Vector6d& motion, const Eigen::Vector3d& center_mm);
 /// Inverse of plate_pose: q = (pose(c) - c, rotation vector of pose.rotation), |theta| <= pi.
 Vector6d plate_motion(const RigidPose& pose, const Eigen::Vector3d& center_mm);
 
-/// Default plate centre (SPEC command-line contract): the mean of the vertices labelled 2.
+/// Default plate centre (docs/units-and-frame.md): the mean of the vertices labelled 2.
 /// Throws std::invalid_argument if there are none.
 Eigen::Vector3d default_plate_center(const mesh::TetMesh& mesh);
 
@@ -59,7 +59,7 @@ struct Boundary {
   PlateMode plate_mode = PlateMode::pose;
   Vector6d wrench = Vector6d::Zero(); ///< (F N, M N·mm about plate_center) for PlateMode::wrench
   /// Centre c of the plate map, wrench and reported moments, mm; taken as given (set it to
-  /// default_plate_center(mesh) for the SPEC default).
+  /// default_plate_center(mesh) for the documented default).
   Eigen::Vector3d plate_center_mm = Eigen::Vector3d::Zero();
   std::vector<Probe> probes;
   Eigen::VectorXd nodal_forces_n;     ///< empty, or 3#nodes external forces, N

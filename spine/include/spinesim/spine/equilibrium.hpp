@@ -1,4 +1,4 @@
-// Quasi-static equilibrium of the spine under gravity and external loads (SPEC "spine/"):
+// Quasi-static equilibrium of the spine under gravity and external loads (spine/README.md):
 //  1. recruitment (recruitment.hpp) in the reference posture: the muscles and the
 //     recruited joints' springs share the moments of gravity and the external loads;
 //  2. Newton with a backtracking line search on the total potential energy Π(θ) over the joint

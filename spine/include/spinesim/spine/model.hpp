@@ -1,4 +1,4 @@
-// The thoracolumbar spine model (SPEC "spine/", thesis 3.3): 17 rigid vertebrae T1…L5 in a
+// The thoracolumbar spine model (thesis 3.3; spine/README.md): 17 rigid vertebrae T1…L5 in a
 // chain above the fixed sacrum, joined by spherical joints at the table F.2 points with F.4
 // rotational stiffness and F.5 range-of-motion limits; ligaments (F.6/F.7), the lumbar
 // muscles (F.8–F.19, mirrored) and the LifeMOD trunk muscles the thesis names without data
@@ -90,7 +90,7 @@ struct PointLoad {
   Eigen::Vector3d force_n;
 };
 
-/// Appendix C recomputed from its inputs (SPEC: never pasted).
+/// Appendix C recomputed from its inputs (never pasted).
 struct IapStiffness {
   double s_mean_mm2 = 0, h_l1l5_mm = 0, h_mm = 0, a_mm = 0, pressure_mpa = 0;
   double k_x = 0, k_y = 0;          ///< spring structure, N/mm (as the thesis writes them)

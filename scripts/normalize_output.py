@@ -1,0 +1,123 @@
+#!/usr/bin/env python3
+"""Compares two records of scripts/compare-outputs.sh, timing fields taken out.
+
+A record is a folder: NAME.json (stdout of one command), NAME.status (its exit status),
+NAME.stderr, and files/ (everything the commands wrote). JSON is compared as data, with the
+keys in TIMING_KEYS dropped wherever they stand; text files are compared line by line after
+TIMING_TEXT masks durations; VTU/PVD/CSV files must be identical. Prints one line per
+difference and a summary; exit 1 when anything differs.
+"""
+import json
+import os
+import re
+import sys
+
+# Measured durations and rates: they differ from run to run of the same binary.
+TIMING_KEYS = re.compile(
+    r"(^|_)(seconds|timings?)($|_)|_s$|_ms$|_us$|^elapsed|per_second|_rate_hz$|^generated_at$")
+# Durations in readable text ("2.31 s", "0.42 ms", "(1.2 s)", "Total 3.1 s", "12 s/it").
+TIMING_TEXT = re.compile(r"\d+(\.\d+)?(e[-+]?\d+)?\s?(s|ms|us|µs|min)\b")
+# Inputs that look like timings but are not (kept).
+NOT_TIMING = {"speed_mm_s", "dt_s", "time_s", "hold_s", "rest_s", "duration_s", "start_s", "t_s", "end_s", "frame_dt_s"}
+
+
+def strip(value):
+    if isinstance(value, dict):
+        return {k: strip(v) for k, v in value.items()
+                if k in NOT_TIMING or not TIMING_KEYS.search(k)}
+    if isinstance(value, list):
+        return [strip(v) for v in value]
+    return value
+
+
+def diff(a, b, path, out):
+    if type(a) != type(b) and not (isinstance(a, (int, float)) and isinstance(b, (int, float))):
+        out.append(f"{path}: {json.dumps(a)[:80]} != {json.dumps(b)[:80]}")
+    elif isinstance(a, dict):
+        for k in sorted(set(a) | set(b)):
+            if k not in a or k not in b:
+                out.append(f"{path}.{k}: only in {'second' if k not in a else 'first'}")
+            else:
+                diff(a[k], b[k], f"{path}.{k}", out)
+    elif isinstance(a, list):
+        if len(a) != len(b):
+            out.append(f"{path}: length {len(a)} != {len(b)}")
+        for i, (x, y) in enumerate(zip(a, b)):
+            diff(x, y, f"{path}[{i}]", out)
+    elif a != b:
+        out.append(f"{path}: {a!r} != {b!r}")
+
+
+def load_json(path):
+    with open(path, encoding="utf-8") as f:
+        text = f.read()
+    if not text.strip():
+        return None
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError:
+        return {"not_json": text}
+
+
+def mask(text):
+    return [TIMING_TEXT.sub("<time>", line) for line in text.splitlines()]
+
+
+def compare_text(pa, pb, name, out):
+    with open(pa, encoding="utf-8", errors="replace") as f:
+        a = mask(f.read())
+    with open(pb, encoding="utf-8", errors="replace") as f:
+        b = mask(f.read())
+    if len(a) != len(b):
+        out.append(f"{name}: {len(a)} lines != {len(b)} lines")
+    for i, (x, y) in enumerate(zip(a, b)):
+        if x != y:
+            out.append(f"{name}:{i + 1}: {x.strip()[:100]!r} != {y.strip()[:100]!r}")
+            break
+
+
+def files_of(root):
+    found = set()
+    for d, _, names in os.walk(root):
+        for n in names:
+            found.add(os.path.relpath(os.path.join(d, n), root))
+    return found
+
+
+def main(a_dir, b_dir):
+    problems = []
+    names = sorted(n[:-7] for n in os.listdir(a_dir) if n.endswith(".status"))
+    for name in names:
+        for suffix in (".status",):
+            with open(os.path.join(a_dir, name + suffix)) as f1, open(os.path.join(b_dir, name + suffix)) as f2:
+                if f1.read() != f2.read():
+                    problems.append(f"{name}: exit status differs")
+        ja, jb = load_json(os.path.join(a_dir, name + ".json")), load_json(os.path.join(b_dir, name + ".json"))
+        if isinstance(ja, dict) and "not_json" in ja:  # a readable report on stdout
+            compare_text(os.path.join(a_dir, name + ".json"), os.path.join(b_dir, name + ".json"), name, problems)
+            continue
+        out = []
+        diff(strip(ja), strip(jb), name, out)
+        problems += out
+    fa, fb = files_of(os.path.join(a_dir, "files")), files_of(os.path.join(b_dir, "files"))
+    for f in sorted(fa ^ fb):
+        problems.append(f"files/{f}: only in {'first' if f in fa else 'second'}")
+    for f in sorted(fa & fb):
+        pa, pb = os.path.join(a_dir, "files", f), os.path.join(b_dir, "files", f)
+        if f.endswith(".json"):
+            out = []
+            diff(strip(load_json(pa)), strip(load_json(pb)), "files/" + f, out)
+            problems += out
+        else:
+            compare_text(pa, pb, "files/" + f, problems)
+    for p in problems[:200]:
+        print(p)
+    print(f"compare-outputs: {len(names)} commands, {len(fa & fb)} files: "
+          + ("identical up to timing fields" if not problems else f"{len(problems)} differences"))
+    return 1 if problems else 0
+
+
+if __name__ == "__main__":
+    if len(sys.argv) != 3:
+        sys.exit("usage: normalize_output.py RECORD_A RECORD_B")
+    sys.exit(main(sys.argv[1], sys.argv[2]))

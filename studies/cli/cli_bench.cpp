@@ -1,0 +1,203 @@
+// spinesim bench — measured speed and memory of meshing and of the FEM reference.
+//
+//   spinesim bench mesh [--level L4-L5] [--cell-sizes 3,2,1.5,1]
+//   spinesim bench fem  [--level L4-L5] [--orders 1,2] [--cell-sizes 3,2,1.5,1.2,1]
+//
+// Each measurement runs in a fresh child process (this program, re-executed), so the peak
+// resident memory it reports (getrusage ru_maxrss) belongs to that one run. Times are wall
+// clock on this machine; nothing here is asserted in tests.
+#include "cli_common.hpp"
+
+#include "spinesim/common/timer.hpp"
+
+#include "spinesim/fem/disc_fem.hpp"
+#include "spinesim/mesh/disc_geometry.hpp"
+#include "spinesim/mesh/io.hpp"
+#include "spinesim/mesh/material.hpp"
+#include "spinesim/mesh/mesher.hpp"
+#include "spinesim/mesh/quality.hpp"
+
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+
+namespace spinesim::cli {
+namespace {
+
+double peak_rss_mb() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return double(u.ru_maxrss) / 1024.0;  // Linux reports KiB
+}
+
+std::string self_exe() { return std::filesystem::read_symlink("/proc/self/exe").string(); }
+
+/// Runs this program with `args` and parses the one JSON object it prints.
+nlohmann::json run_child(const std::string& args) {
+  const std::string cmd = "'" + self_exe() + "' " + args + " 2>/dev/null";
+  FILE* pipe = popen(cmd.c_str(), "r");
+  if (!pipe) throw std::runtime_error("bench: cannot start " + cmd);
+  std::string text;
+  char buf[4096];
+  while (std::size_t n = fread(buf, 1, sizeof buf, pipe)) text.append(buf, n);
+  if (pclose(pipe) != 0) throw std::runtime_error("bench: child run failed: " + args);
+  return nlohmann::json::parse(text);
+}
+
+std::vector<double> parse_list(const std::string& text, const std::string& what) {
+  const auto n = std::count(text.begin(), text.end(), ',') + 1;
+  const Eigen::VectorXd v = parse_numbers(text, int(n), what);
+  return std::vector<double>(v.data(), v.data() + v.size());
+}
+
+// --- one measurement per process -----------------------------------------------------------
+
+struct OneArgs {
+  std::string level = "L4-L5", mesh_out, mesh_in;
+  double cell_size_mm = 2.0;
+  int order = 1;
+};
+
+void mesh_one(const OneArgs& a) {
+  const auto dims = mesh::disc_dimensions(a.level, data_dir());
+  mesh::MeshOptions opt;
+  opt.cell_size_mm = a.cell_size_mm;
+  const Timer t0;
+  const auto m = mesh::mesh_parametric_disc(dims, opt);
+  const double s = t0.seconds();
+  const auto q = mesh::quality_report(m, mesh::parametric_disc_volume(dims));
+  if (!a.mesh_out.empty()) mesh::write_vtu(a.mesh_out, m);
+  print_json({{"cell_size_mm", a.cell_size_mm},
+              {"nodes", q.vertices},
+              {"tets", q.tets},
+              {"seconds", s},
+              {"min_dihedral_deg", q.min_dihedral_deg},
+              {"max_dihedral_deg", q.max_dihedral_deg},
+              {"volume_error", q.volume_error()},
+              {"peak_rss_mb", peak_rss_mb()}});
+}
+
+void fem_one(const OneArgs& a) {
+  const auto m = mesh::read_vtu(a.mesh_in);
+  const double rss_mesh = peak_rss_mb();
+  const auto mat = mesh::load_material("real-disc", data_dir());
+  const Timer t0;
+  const fem::DiscFem solver(m, mat, a.order, fem::DiscFem::default_plate_center(m));
+  const double stiffness_s = t0.seconds();
+  fem::Vector6d w = fem::Vector6d::Zero();
+  w(1) = -500.0;
+  const Timer t1;
+  (void)solver.solve_wrench(w);
+  const double load_s = t1.seconds();
+  const auto& t = solver.timings();
+  print_json({{"order", a.order},
+              {"tets", m.num_tets()},
+              {"dofs", solver.num_dofs()},
+              {"setup_s", t.setup_s},
+              {"assembly_s", t.assembly_s},
+              {"analyse_s", t.analyse_s},
+              {"factorise_s", t.factorise_s},
+              {"stiffness_solves_s", t.solve_s},
+              {"stiffness_total_s", stiffness_s},
+              {"load_solve_s", load_s},
+              {"peak_rss_mb", peak_rss_mb()},
+              {"rss_after_mesh_read_mb", rss_mesh}});
+}
+
+// --- drivers ---------------------------------------------------------------------------------
+
+struct BenchArgs {
+  std::string level = "L4-L5", cell_sizes = "3,2,1.5,1", orders = "1,2";
+  bool json = false;
+};
+
+void bench_mesh(const BenchArgs& a) {
+  nlohmann::json rows = nlohmann::json::array();
+  if (!a.json)
+    std::cout << "Meshing " << a.level << " (CGAL Mesh_3, default options)\n"
+              << " cell mm     tets    nodes   seconds  min dihedral  volume err %  peak MB\n";
+  for (double h : parse_list(a.cell_sizes, "--cell-sizes")) {
+    std::ostringstream args;
+    args << "bench-mesh-one --level " << a.level << " --cell-size " << h;
+    const auto r = run_child(args.str());
+    rows.push_back(r);
+    if (!a.json)
+      std::cout << std::fixed << std::setprecision(2) << std::setw(8) << h << std::setw(9) << r["tets"].get<long>()
+                << std::setw(9) << r["nodes"].get<long>() << std::setw(10) << r["seconds"].get<double>()
+                << std::setw(14) << r["min_dihedral_deg"].get<double>() << std::setw(14) << std::setprecision(3)
+                << 100 * r["volume_error"].get<double>() << std::setw(9) << std::setprecision(0)
+                << r["peak_rss_mb"].get<double>() << std::endl;
+  }
+  if (a.json) print_json({{"level", a.level}, {"runs", rows}});
+}
+
+void bench_fem(const BenchArgs& a) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("spinesim-bench-" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  nlohmann::json rows = nlohmann::json::array();
+  if (!a.json)
+    std::cout << "FEM reference on " << a.level << " meshes (real-disc), one process per run\n"
+              << " order     DOF  assembly  analyse  factorise  6 solves  6x6 total  1 load  peak MB\n";
+  for (double h : parse_list(a.cell_sizes, "--cell-sizes")) {
+    const fs::path mesh_path = dir / ("disc-" + std::to_string(h) + ".vtu");
+    std::ostringstream margs;
+    margs << "bench-mesh-one --level " << a.level << " --cell-size " << h << " --mesh-out '" << mesh_path.string()
+          << "'";
+    run_child(margs.str());
+    for (double order : parse_list(a.orders, "--orders")) {
+      std::ostringstream fargs;
+      fargs << "bench-fem-one --mesh '" << mesh_path.string() << "' --order " << int(order);
+      auto r = run_child(fargs.str());
+      r["cell_size_mm"] = h;
+      rows.push_back(r);
+      if (!a.json)
+        std::cout << std::fixed << std::setprecision(3) << std::setw(6) << int(order) << std::setw(8)
+                  << r["dofs"].get<long>() << std::setw(10) << r["assembly_s"].get<double>() << std::setw(9)
+                  << r["analyse_s"].get<double>() << std::setw(11) << r["factorise_s"].get<double>() << std::setw(10)
+                  << r["stiffness_solves_s"].get<double>() << std::setw(11) << r["stiffness_total_s"].get<double>()
+                  << std::setw(8) << r["load_solve_s"].get<double>() << std::setw(9) << std::setprecision(0)
+                  << r["peak_rss_mb"].get<double>() << std::endl;
+    }
+  }
+  fs::remove_all(dir);
+  if (a.json) print_json({{"level", a.level}, {"runs", rows}});
+}
+
+}  // namespace
+
+void register_bench(CLI::App& app) {
+  auto a = std::make_shared<BenchArgs>();
+  auto* cmd = app.add_subcommand("bench", "Measure meshing and FEM speed and memory (each run in its own process)");
+  cmd->require_subcommand(1);
+  auto* m = cmd->add_subcommand("mesh", "Meshing time, tet count and quality vs cell size");
+  auto* f = cmd->add_subcommand("fem", "FEM assembly / factorisation / solve time and peak memory vs DOF");
+  for (auto* sub : {m, f}) {
+    sub->add_option("--level", a->level, "Disc level")->capture_default_str();
+    sub->add_option("--cell-sizes", a->cell_sizes, "Comma-separated cell sizes, mm")->capture_default_str();
+    sub->add_flag("--json", a->json, "Print a JSON summary on stdout");
+  }
+  f->add_option("--orders", a->orders, "Comma-separated element orders")->capture_default_str();
+  m->callback([a] { bench_mesh(*a); });
+  f->callback([a] { bench_fem(*a); });
+
+  // Hidden single-run verbs used by the drivers above.
+  auto one = std::make_shared<OneArgs>();
+  auto* mo = app.add_subcommand("bench-mesh-one")->group("");
+  mo->add_option("--level", one->level);
+  mo->add_option("--cell-size", one->cell_size_mm);
+  mo->add_option("--mesh-out", one->mesh_out);
+  mo->callback([one] { mesh_one(*one); });
+  auto* fo = app.add_subcommand("bench-fem-one")->group("");
+  fo->add_option("--mesh", one->mesh_in)->required();
+  fo->add_option("--order", one->order);
+  fo->callback([one] { fem_one(*one); });
+}
+
+}  // namespace spinesim::cli

@@ -1,0 +1,40 @@
+// Shared pieces of the `spinesim` command line: value parsing with clear errors and the verbs'
+// registration. Everything else a verb needs (drivers, reports, tables, progress, files) is in
+// the studies library (spinesim/studies/).
+#pragma once
+
+#include "spinesim/studies/data.hpp"
+#include "spinesim/studies/files.hpp"
+#include "spinesim/studies/format.hpp"
+#include "spinesim/studies/json.hpp"
+#include "spinesim/studies/progress.hpp"
+#include "spinesim/studies/table.hpp"
+
+#include <CLI/CLI.hpp>
+#include <Eigen/Core>
+
+#include <string>
+#include <vector>
+
+namespace spinesim::cli {
+
+using namespace spinesim::studies;  // the command line is a thin layer over the studies library
+
+/// Parses "a,b,c" into exactly n finite numbers; throws std::invalid_argument naming `what`.
+Eigen::VectorXd parse_numbers(const std::string& text, int n, const std::string& what);
+
+/// "a,b,,c" -> {"a", "b", "c"} (empty items dropped).
+std::vector<std::string> split_list(const std::string& text);
+
+// Sub-command registration; each lives in its own cli_<verb>.cpp.
+void register_mesh(CLI::App& app);
+void register_fem(CLI::App& app);
+void register_mss(CLI::App& app);    ///< mss, mss compare (cli_mss.cpp)
+void register_calibrate(CLI::App& app);  ///< calibrate (cli_calibrate.cpp)
+void register_study(CLI::App& app);  ///< study probe|drive|materials|validation|fusion|trends (cli_study.cpp)
+void register_spine(CLI::App& app);  ///< spine solve (cli_spine.cpp)
+void register_demo(CLI::App& app);
+void register_bench(CLI::App& app);
+void register_spine_database(CLI::App& spine);  ///< spine database, under `spine` (cli_spine_database.cpp)
+
+}  // namespace spinesim::cli

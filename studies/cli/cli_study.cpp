@@ -1,0 +1,842 @@
+// spinesim study — the thesis's studies as runnable programs that write what they measured.
+//
+//   spinesim study probe [--out study-out] [--radius 3] [--depth 2] [--speed 20] [--no-radial | --volume-term]
+//   spinesim study drive [--out study-out] [--materials real-disc,annulus-nucleus,rubber,polyethylene]
+//   spinesim study materials [--level L4-L5] [--cell-size 2] [--materials …] [--csv materials.csv]
+//   spinesim study validation [--csv validation.csv] [--json]
+//   spinesim study fusion [--force 300] [--csv fusion.csv] [--json]
+//   spinesim study trends [--force 300] [--csv trends.csv] [--json]
+//
+// probe — thesis 5.3, test 1 (fig. 5.8): a rigid sphere pressed into the outer wall of a disc
+//   whose endplates are both fixed, held, withdrawn, then at a second site while the first
+//   recovers; the disc volume is tracked (the thesis claimed it is preserved, never measured).
+// drive — thesis 5.3, test 2 (fig. 5.9): an L2-L3 disc, L3 (inferior) fixed, L2 (superior)
+//   driven by a motion schedule, once per material preset; the reaction shows how stiff each
+//   material is (the thesis: polyethylene stiffest, the real disc softest).
+// materials — thesis fig. 5.9 with a reference: per material preset, the linear FEM, the
+//   untuned thesis MSS and the MSS calibrated to that FEM, side by side (materials_study.hpp);
+//   tables on stdout, --csv, --json; no --out folder.
+// probe and drive: implicit Euler, dt 1 ms (the thesis's 1 kHz), a VTU time series (.pvd,
+// frames every --frame-every steps), a CSV per run and a JSON summary in --out. A run whose step
+// diverges stops there: its files hold the finite states up to that step, "diverged": true is
+// in the JSON, and the program exits 1 after the other runs.
+// validation, fusion, trends — the spine (spine_studies.hpp): thesis 3.4's two validation cases
+//   beside their targets, 6.1's fusion comparison and 6.3-6.4's relative vertebra motions under a
+//   force on T1, each thesis statement reported as MATCH or DIFFERS; tables, --csv, --json.
+//
+// Adding a study: write its Args struct (with a StudyCommon), run_<name>() and a register
+// function below, and add one line to register_study() at the end of this file.
+#include "cli_common.hpp"
+
+#include "spinesim/mss/quantities.hpp"
+
+#include "spinesim/common/timer.hpp"
+#include "spinesim/studies/fem_report.hpp"
+#include "spinesim/studies/materials_study.hpp"
+#include "model_flags.hpp"
+#include "spinesim/studies/comparison_report.hpp"
+#include "spinesim/studies/mss_run.hpp"
+#include "spinesim/studies/spine_studies.hpp"
+
+#include "spinesim/fem/disc_fem.hpp"
+#include "spinesim/mesh/disc_geometry.hpp"
+#include "spinesim/mesh/io.hpp"
+#include "spinesim/mesh/material.hpp"
+#include "spinesim/mesh/mesher.hpp"
+#include "spinesim/mss/boundary.hpp"
+#include "spinesim/mss/model.hpp"
+#include "spinesim/mss/solver.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <sstream>
+#include <unordered_map>
+
+namespace spinesim::cli {
+namespace {
+namespace fs = std::filesystem;
+
+// --- shared by every study ---------------------------------------------------------------------
+
+/// Options every study has: where to write, which disc, how to step, which model terms.
+struct StudyCommon {
+  std::string out = "study-out", mesh_path, level, integrator = "implicit";
+  double cell_size_mm = mesh::MeshOptions().cell_size_mm;
+  double dt_s = 1e-3;
+  int frame_every = 10, newton_iterations = 1;
+  bool frozen = false, json = false, quiet = false;
+  ModelFlags model;
+};
+
+void add_common_options(CLI::App* cmd, StudyCommon& c) {
+  cmd->add_option("--out", c.out, "Output folder (created)")->capture_default_str();
+  cmd->add_option("--mesh", c.mesh_path, "Disc mesh VTU (default: mesh --level in-process)");
+  cmd->add_option("--level", c.level, "Disc level meshed when no --mesh is given")->capture_default_str();
+  cmd->add_option("--cell-size", c.cell_size_mm, "Mesh cell size, mm")->capture_default_str();
+  cmd->add_option("--dt", c.dt_s, "Time step, s")->capture_default_str();
+  cmd->add_option("--integrator", c.integrator, "implicit, symplectic or explicit")->capture_default_str();
+  cmd->add_option("--newton", c.newton_iterations, "Implicit: max Newton iterations per step")->capture_default_str();
+  cmd->add_flag("--frozen", c.frozen, "Implicit: keep the rest-stiffness factorisation (one solve per step)");
+  cmd->add_option("--frame-every", c.frame_every, "A VTU frame every K steps")->capture_default_str();
+  add_model_flags(cmd, c.model);
+  cmd->add_flag("--json", c.json, "Print the JSON summary on stdout");
+  cmd->add_flag("--quiet", c.quiet, "No progress on stderr");
+}
+
+/// Checks the shared options (before any work) and returns the dynamics options.
+mss::DynamicsOptions check_common(const StudyCommon& c) {
+  if (!std::isfinite(c.dt_s) || c.dt_s <= 0) throw std::invalid_argument("--dt must be a finite number > 0 s");
+  if (c.frame_every < 1) throw std::invalid_argument("--frame-every must be >= 1");
+  if (c.newton_iterations < 1) throw std::invalid_argument("--newton must be >= 1");
+  if (c.mesh_path.empty() && (!std::isfinite(c.cell_size_mm) || c.cell_size_mm <= 0))
+    throw std::invalid_argument("--cell-size must be a finite number > 0 mm");
+  model_options(c.model);  // validates --damping
+  mss::DynamicsOptions o;
+  o.integrator = parse_integrator(c.integrator);
+  o.dt_s = c.dt_s;
+  o.newton_iterations = c.newton_iterations;
+  o.matrix_update = c.frozen ? mss::MatrixUpdate::frozen : mss::MatrixUpdate::every_iteration;
+  return o;
+}
+
+/// The study's disc: read --mesh, or mesh --level in-process (as `demo` does).
+mesh::TetMesh study_mesh(const StudyCommon& c, Progress& progress) {
+  if (!c.mesh_path.empty()) {
+    progress.begin("reading " + c.mesh_path);
+    mesh::TetMesh m = mesh::read_vtu(c.mesh_path);
+    mesh::require_endplate_labels(m);
+    progress.end(std::to_string(m.num_tets()) + " tets");
+    return m;
+  }
+  const auto dims = mesh::disc_dimensions(c.level, data_dir());
+  mesh::MeshOptions opt;
+  opt.cell_size_mm = c.cell_size_mm;
+  progress.begin("meshing the " + dims.level + " disc");
+  mesh::TetMesh m = mesh::mesh_parametric_disc(dims, opt, mesh::disc_frame_in_spine(dims.level, data_dir()));
+  progress.end(std::to_string(m.num_tets()) + " tets");
+  return m;
+}
+
+nlohmann::json mesh_json(const mesh::TetMesh& m) {
+  return {{"source", m.source}, {"nodes", m.num_vertices()}, {"tets", m.num_tets()}, {"volume_mm3", mesh::mesh_volume(m)}};
+}
+
+double max_displacement(const mss::MssModel& model, const Eigen::VectorXd& x) {
+  return mss::max_displacement_mm(model, x);
+}
+
+/// A file-name-safe version of a material name.
+std::string file_stem(const std::string& name) {
+  std::string s = name;
+  for (char& ch : s)
+    if (!std::isalnum(static_cast<unsigned char>(ch)) && ch != '-' && ch != '_') ch = '_';
+  return s.empty() ? "material" : s;
+}
+
+/// Min and max of a signed quantity, and the value of largest magnitude.
+struct Range {
+  double lo = INFINITY, hi = -INFINITY;
+  void add(double v) { lo = std::min(lo, v), hi = std::max(hi, v); }
+  double extreme() const { return std::abs(lo) > std::abs(hi) ? lo : hi; }
+};
+
+// --- study probe -------------------------------------------------------------------------------
+
+/// Outward area-weighted normals (unnormalised) at the boundary vertices; zero inside.
+Eigen::MatrixX3d boundary_normals(const mesh::TetMesh& m) {
+  static const int face[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};  // opposite vertex k
+  struct Seen {
+    int count = 0;
+    Eigen::Index tet = 0;
+    int local = 0;
+  };
+  std::unordered_map<std::uint64_t, Seen> faces;
+  faces.reserve(std::size_t(2 * m.num_tets()));
+  for (Eigen::Index t = 0; t < m.num_tets(); ++t)
+    for (int k = 0; k < 4; ++k) {
+      std::array<std::uint64_t, 3> v{std::uint64_t(m.T(t, face[k][0])), std::uint64_t(m.T(t, face[k][1])),
+                                     std::uint64_t(m.T(t, face[k][2]))};
+      std::sort(v.begin(), v.end());
+      Seen& s = faces[(v[0] << 42) | (v[1] << 21) | v[2]];
+      ++s.count;
+      s.tet = t;
+      s.local = k;
+    }
+  Eigen::MatrixX3d n = Eigen::MatrixX3d::Zero(m.num_vertices(), 3);
+  for (const auto& [key, s] : faces) {
+    if (s.count != 1) continue;
+    const auto a = m.T(s.tet, face[s.local][0]), b = m.T(s.tet, face[s.local][1]), c = m.T(s.tet, face[s.local][2]);
+    Eigen::Vector3d nf = (m.V.row(b) - m.V.row(a)).transpose().cross((m.V.row(c) - m.V.row(a)).transpose());
+    if (nf.dot((m.V.row(m.T(s.tet, s.local)) - m.V.row(a)).transpose()) > 0) nf = -nf;  // point away from the tet
+    for (auto i : {a, b, c}) n.row(i) += nf.transpose();
+  }
+  return n;
+}
+
+struct ProbeSite {
+  std::string name;
+  Eigen::Index node = 0;
+  Eigen::Vector3d point_mm, normal;  ///< surface point and outward unit normal, global
+  double start_s = 0;
+};
+
+/// The outer-wall node where the ray from the disc centre in the disc-frame direction named
+/// `name` (anterior, posterior, left, right) leaves the disc: the wall node closest to the ray.
+ProbeSite pick_site(const mesh::TetMesh& m, const Eigen::MatrixX3d& normals, const std::string& name) {
+  Eigen::Vector3d d_local;
+  if (name == "anterior") d_local << 0, 0, 1;
+  else if (name == "posterior") d_local << 0, 0, -1;
+  else if (name == "left") d_local << 1, 0, 0;  // the body's right is -x
+  else if (name == "right") d_local << -1, 0, 0;
+  else throw std::invalid_argument("unknown probe site '" + name + "' (anterior, posterior, left, right)");
+  ProbeSite site;
+  site.name = name;
+  double best = INFINITY;
+  for (Eigen::Index i = 0; i < m.num_vertices(); ++i) {
+    if (m.surface(i) != int(mesh::Surface::outer_wall)) continue;
+    const Eigen::Vector3d p = m.frame.axes.transpose() * (m.V.row(i).transpose() - m.frame.origin_mm);
+    const double along = p.dot(d_local);
+    const double off = (p - along * d_local).norm();
+    if (along > 0 && off < best) best = off, site.node = i;
+  }
+  if (!std::isfinite(best)) throw std::invalid_argument("probe site " + name + ": the mesh has no outer-wall node there");
+  site.point_mm = m.V.row(site.node).transpose();
+  site.normal = normals.row(site.node).transpose().normalized();
+  return site;
+}
+
+struct ProbeArgs {
+  StudyCommon common;
+  // Penalty per node: 0 = the solver's default (mss::default_probe_stiffness, ~540 N/mm on
+  // L4-L5). The implicit step resolves the contacts by an active set inside each step, so the
+  // stiff default withdraws smoothly (L4-L5 2 mm cells: largest step-to-step force change
+  // 0.33 N, peak 19.1 N; a 50 N/mm penalty gives 18.1 N with the probe sinking deeper).
+  double radius_mm = 3.0, depth_mm = 2.0, speed_mm_s = 20.0, hold_s = 0.1, rest_s = 0.2, stiffness_n_per_mm = 0.0;
+  std::string material = "real-disc", sites = "anterior,left";
+};
+
+/// Where the probe is at time t: per site, press at `speed` to `depth`, hold, withdraw, then
+/// rest with the probe away (the dent recovers).
+struct ProbeSchedule {
+  std::vector<ProbeSite> sites;
+  double depth_mm, speed_mm_s, hold_s, rest_s;
+  double press_s() const { return depth_mm / speed_mm_s; }
+  double site_s() const { return 2 * press_s() + hold_s + rest_s; }
+  double total_s() const { return site_s() * double(sites.size()); }
+  struct Command {
+    bool active = false;
+    std::size_t site = 0;
+    double depth_mm = 0;
+  };
+  Command at(double t) const {
+    Command c;
+    c.site = std::min(sites.size() - 1, std::size_t(std::max(0.0, t) / site_s()));
+    const double s = t - double(c.site) * site_s(), p = press_s();
+    if (s <= p) c.active = true, c.depth_mm = speed_mm_s * s;
+    else if (s <= p + hold_s) c.active = true, c.depth_mm = depth_mm;
+    else if (s <= 2 * p + hold_s) c.active = true, c.depth_mm = depth_mm - speed_mm_s * (s - p - hold_s);
+    c.depth_mm = std::clamp(c.depth_mm, 0.0, depth_mm);
+    return c;
+  }
+};
+
+void run_probe(ProbeArgs a) {
+  // 1. Options, checked before any work.
+  StudyCommon& c = a.common;
+  const mss::DynamicsOptions dyn = check_common(c);
+  for (double v : {a.radius_mm, a.depth_mm, a.speed_mm_s})
+    if (!std::isfinite(v) || v <= 0) throw std::invalid_argument("--radius, --depth and --speed must be finite and > 0");
+  for (double v : {a.hold_s, a.rest_s, a.stiffness_n_per_mm})
+    if (!std::isfinite(v) || v < 0) throw std::invalid_argument("--hold, --rest and --probe-stiffness must be finite and >= 0");
+  const auto site_names = split_list(a.sites);
+  if (site_names.empty()) throw std::invalid_argument("--sites: give at least one of anterior, posterior, left, right");
+  for (const auto& name : site_names)
+    if (name != "anterior" && name != "posterior" && name != "left" && name != "right")
+      throw std::invalid_argument("unknown probe site '" + name + "' (anterior, posterior, left, right)");
+  const auto materials = mesh::load_material(a.material, data_dir());
+  fs::create_directories(c.out);
+
+  // 2. Disc, model, probe sites.
+  Progress progress(4, c.quiet || c.json);
+  const mesh::TetMesh m = study_mesh(c, progress);
+  progress.begin("building the mass-spring model (" + model_variant(c.model) + ")");
+  const mss::MssModel model(m, materials, model_options(c.model));
+  progress.end();
+  const Eigen::MatrixX3d normals = boundary_normals(m);
+  ProbeSchedule plan{{}, a.depth_mm, a.speed_mm_s, a.hold_s, a.rest_s};
+  for (const auto& name : site_names) plan.sites.push_back(pick_site(m, normals, name));
+  for (std::size_t i = 0; i < plan.sites.size(); ++i) plan.sites[i].start_s = double(i) * plan.site_s();
+  const int steps = int(std::ceil(plan.total_s() / c.dt_s - 1e-6));  // round-off must not add a step
+
+  // 3. Step: both endplates fixed (identity poses), the probe moving.
+  mss::Simulator sim(model, dyn);
+  mss::State s = sim.rest_state();
+  VtuSeries frames((fs::path(c.out) / "probe.pvd").string());
+  frames.add(0.0, model, s.x_mm);
+  std::ostringstream csv;
+  csv << std::setprecision(10)
+      << "time_s,site,probe_active,probe_x_mm,probe_y_mm,probe_z_mm,depth_mm,force_x_n,force_y_n,force_z_n,force_n,"
+         "volume_mm3,volume_change,max_displacement_mm\n";
+  StepStats stats;
+  Range dv;
+  double max_force = 0, max_u = 0;
+  progress.begin(std::to_string(steps) + " steps (" + c.integrator + " Euler, dt " + std::to_string(c.dt_s) + " s)");
+  // The default penalty costs a rest-Hessian evaluation: resolve it once, not per step.
+  const double k_probe = a.stiffness_n_per_mm > 0 ? a.stiffness_n_per_mm : mss::default_probe_stiffness(model);
+  for (int k = 1; k <= steps; ++k) {
+    const double t = k * c.dt_s;
+    const auto cmd = plan.at(t);
+    const ProbeSite& site = plan.sites[cmd.site];
+    const Eigen::Vector3d center = site.point_mm + (a.radius_mm - cmd.depth_mm) * site.normal;
+    mss::Boundary bc;
+    if (cmd.active) bc.probes.push_back({center, a.radius_mm, k_probe});
+    if (!stats.step(sim, s, bc)) break;
+    const Eigen::Vector3d f = cmd.active ? mss::probe_forces(model, bc, s.x_mm).front() : Eigen::Vector3d::Zero();
+    const double v = model.volume_mm3(s.x_mm), u = max_displacement(model, s.x_mm);
+    dv.add(mss::volume_change(model, s.x_mm));
+    max_force = std::max(max_force, f.norm());
+    max_u = std::max(max_u, u);
+    csv << s.time_s << "," << site.name << "," << int(cmd.active) << "," << center.x() << "," << center.y() << ","
+        << center.z() << "," << cmd.depth_mm << "," << f.x() << "," << f.y() << "," << f.z() << "," << f.norm() << "," << v
+        << "," << mss::volume_change(model, s.x_mm) << "," << u << "\n";
+    if (k % c.frame_every == 0 || k == steps) frames.add(s.time_s, model, s.x_mm);
+  }
+  progress.end(std::to_string(stats.steps_done) + " steps");
+
+  // 4. Files and summary.
+  progress.begin("writing " + c.out);
+  frames.finish();
+  const std::string csv_path = (fs::path(c.out) / "probe.csv").string();
+  const std::string json_path = (fs::path(c.out) / "probe.json").string();
+  write_text_file(csv_path, csv.str());
+  nlohmann::json sites = nlohmann::json::array();
+  for (const auto& p : plan.sites)
+    sites.push_back({{"name", p.name},
+                     {"node", p.node},
+                     {"point_mm", to_json(Eigen::VectorXd(p.point_mm))},
+                     {"normal", to_json(Eigen::VectorXd(p.normal))},
+                     {"start_s", p.start_s}});
+  nlohmann::json j = {{"study", "probe"},
+                      {"thesis", "5.3 test 1, fig. 5.8"},
+                      {"mesh", mesh_json(m)},
+                      {"material", materials.name},
+                      {"model_variant", model_variant(c.model)},
+                      {"model", mss_model_json(model, materials)},
+                      {"probe",
+                       {{"radius_mm", a.radius_mm},
+                        {"depth_mm", a.depth_mm},
+                        {"speed_mm_s", a.speed_mm_s},
+                        {"hold_s", a.hold_s},
+                        {"rest_s", a.rest_s},
+                        {"stiffness_n_per_mm", k_probe},
+                        {"schedule", "per site: press at speed to depth, hold, withdraw, rest with the probe away"}}},
+                      {"sites", sites},
+                      {"integrator", c.integrator},
+                      {"dt_s", c.dt_s},
+                      {"steps", steps},
+                      {"max_force_n", max_force},
+                      {"max_volume_change", std::isfinite(dv.lo) ? dv.extreme() : 0.0},
+                      {"volume_change_range", {std::isfinite(dv.lo) ? dv.lo : 0.0, std::isfinite(dv.hi) ? dv.hi : 0.0}},
+                      {"max_displacement_mm", max_u},
+                      {"files", {{"pvd", frames.pvd_path()}, {"csv", csv_path}, {"json", json_path}}},
+                      {"frames", frames.num_frames()}};
+  stats.add_to(j);
+  write_text_file(json_path, j.dump(2) + "\n");
+  progress.end();
+
+  if (c.json) {
+    print_json(j);
+  } else {
+    std::cout << std::setprecision(4) << "Probe study (thesis 5.3, test 1) on " << m.source << " (" << m.num_tets()
+              << " tets), material " << materials.name << ", MSS " << model_variant(c.model) << "\n"
+              << "  probe radius " << a.radius_mm << " mm, depth " << a.depth_mm << " mm at " << a.speed_mm_s
+              << " mm/s, hold " << a.hold_s << " s, rest " << a.rest_s << " s; both endplates fixed\n";
+    for (const auto& p : plan.sites)
+      std::cout << "  site " << std::left << std::setw(10) << p.name << std::right << " from t = " << p.start_s
+                << " s at (" << p.point_mm.transpose() << ") mm, normal (" << p.normal.transpose() << ")\n";
+    std::cout << "  " << stats.steps_done << " of " << steps << " steps, mean step " << stats.mean_seconds() * 1e3
+              << " ms\n"
+              << "  max probe force " << max_force << " N, max |u| " << max_u << " mm\n"
+              << "  volume change " << 100 * j["volume_change_range"][0].get<double>() << " % .. "
+              << 100 * j["volume_change_range"][1].get<double>() << " %\n"
+              << "  wrote " << frames.pvd_path() << " (" << frames.num_frames() << " frames), " << csv_path << ", "
+              << json_path << "\n";
+  }
+  if (stats.diverged)
+    throw std::runtime_error("probe study diverged at step " + std::to_string(stats.steps_done + 1) + ": " + stats.message);
+}
+
+// --- study drive -------------------------------------------------------------------------------
+
+/// Superior-plate motion keyframes in the disc frame: axial translation (mm, negative =
+/// compression) and flexion rotation about the lateral axis (deg); linear in between.
+struct Keyframe {
+  double time_s, axial_mm, flexion_deg;
+};
+
+std::vector<Keyframe> drive_schedule(double compression_mm, double flexion_deg, double time_scale) {
+  const double c = -compression_mm, f = flexion_deg;
+  std::vector<Keyframe> keys = {{0.0, 0, 0}, {0.2, c, 0}, {0.3, c, 0}, {0.5, c, f}, {0.6, c, f},
+                                {0.8, c, 0}, {0.9, c, 0}, {1.1, 0, 0}, {1.2, 0, 0}};
+  for (auto& k : keys) k.time_s *= time_scale;
+  return keys;
+}
+
+/// The plate motion (t mm, theta rad) in the disc frame at time t.
+fem::Vector6d schedule_motion(const std::vector<Keyframe>& keys, double t) {
+  std::size_t i = 1;
+  while (i + 1 < keys.size() && keys[i].time_s < t) ++i;
+  const Keyframe &k0 = keys[i - 1], &k1 = keys[i];
+  const double w = std::clamp((t - k0.time_s) / (k1.time_s - k0.time_s), 0.0, 1.0);
+  fem::Vector6d q = fem::Vector6d::Zero();
+  q(1) = k0.axial_mm + w * (k1.axial_mm - k0.axial_mm);
+  q(3) = (k0.flexion_deg + w * (k1.flexion_deg - k0.flexion_deg)) * M_PI / 180.0;
+  return q;
+}
+
+/// Rotates a 6-vector of two 3-vectors by `axes` (local -> global) or its transpose.
+fem::Vector6d rotate6(const Eigen::Matrix3d& r, const fem::Vector6d& v) {
+  fem::Vector6d out;
+  out << r * v.head<3>(), r * v.tail<3>();
+  return out;
+}
+
+struct DriveArgs {
+  StudyCommon common;
+  std::string materials = "real-disc,annulus-nucleus,rubber,polyethylene";
+  double compression_mm = 0.5, flexion_deg = 3.0, time_scale = 1.0;
+};
+
+struct DriveResult {
+  nlohmann::json json;
+  double peak_force_n = 0, peak_axial_n = 0, peak_moment_nmm = 0;
+  Range dv;
+  StepStats stats;
+};
+
+/// One material through the schedule; writes drive-<name>.pvd, its frames and drive-<name>.csv.
+DriveResult drive_one(const mesh::TetMesh& m, const mesh::RegionMaterials& materials, const StudyCommon& c,
+                      const mss::DynamicsOptions& dyn, const std::vector<Keyframe>& keys) {
+  const mss::MssModel model(m, materials, model_options(c.model));
+  const Eigen::Vector3d center = fem::DiscFem::default_plate_center(m);
+  const Eigen::Matrix3d& axes = m.frame.axes;
+  const std::string stem = "drive-" + file_stem(materials.name);
+  const int steps = int(std::ceil(keys.back().time_s / c.dt_s - 1e-6));
+
+  mss::Simulator sim(model, dyn);
+  mss::State s = sim.rest_state();
+  VtuSeries frames((fs::path(c.out) / (stem + ".pvd")).string());
+  frames.add(0.0, model, s.x_mm);
+  std::ostringstream csv;
+  csv << std::setprecision(10)
+      << "time_s,tx_mm,ty_mm,tz_mm,rx_deg,ry_deg,rz_deg,Fx_n,Fy_n,Fz_n,Mx_nmm,My_nmm,Mz_nmm,volume_mm3,volume_change,"
+         "max_displacement_mm\n";
+  DriveResult r;
+  for (int k = 1; k <= steps; ++k) {
+    const fem::Vector6d q_local = schedule_motion(keys, k * c.dt_s);
+    const fem::Vector6d q = rotate6(axes, q_local);
+    mss::Boundary bc;  // inferior (L3) fixed
+    bc.superior = mss::plate_pose(q, center);
+    bc.plate_center_mm = center;
+    if (!r.stats.step(sim, s, bc)) break;
+    const fem::Vector6d w = rotate6(axes.transpose(), mss::plate_reaction(model, s.x_mm, center + q.head<3>()));
+    const double dv = mss::volume_change(model, s.x_mm);
+    r.peak_force_n = std::max(r.peak_force_n, w.head<3>().norm());
+    r.peak_axial_n = std::max(r.peak_axial_n, w(1));
+    r.peak_moment_nmm = std::max(r.peak_moment_nmm, w.tail<3>().norm());
+    r.dv.add(dv);
+    const fem::Vector6d qd = motion_rad_to_deg(q_local);
+    csv << s.time_s;
+    for (int i = 0; i < 6; ++i) csv << "," << qd(i);
+    for (int i = 0; i < 6; ++i) csv << "," << w(i);
+    csv << "," << model.volume_mm3(s.x_mm) << "," << dv << "," << max_displacement(model, s.x_mm) << "\n";
+    if (k % c.frame_every == 0 || k == steps) frames.add(s.time_s, model, s.x_mm);
+  }
+  frames.finish();
+  const std::string csv_path = (fs::path(c.out) / (stem + ".csv")).string();
+  write_text_file(csv_path, csv.str());
+  r.json = {{"material", materials.name},
+            {"E_mpa_annulus", materials.at(int(mesh::Region::annulus)).youngs_modulus_mpa},
+            {"E_mpa_nucleus", materials.at(int(mesh::Region::nucleus)).youngs_modulus_mpa},
+            {"peak_force_n", r.peak_force_n},
+            {"peak_axial_force_n", r.peak_axial_n},
+            {"peak_moment_nmm", r.peak_moment_nmm},
+            {"max_volume_change", std::isfinite(r.dv.lo) ? r.dv.extreme() : 0.0},
+            {"K_d_n_s_per_mm", model.damping_n_s_per_mm()},
+            {"steps", steps},
+            {"files", {{"pvd", frames.pvd_path()}, {"csv", csv_path}}},
+            {"frames", frames.num_frames()}};
+  r.stats.add_to(r.json);
+  return r;
+}
+
+void run_drive(DriveArgs a) {
+  // 1. Options, checked before any work.
+  StudyCommon& c = a.common;
+  const mss::DynamicsOptions dyn = check_common(c);
+  if (!std::isfinite(a.compression_mm) || !std::isfinite(a.flexion_deg))
+    throw std::invalid_argument("--compression and --flexion must be finite numbers");
+  if (!std::isfinite(a.time_scale) || a.time_scale <= 0) throw std::invalid_argument("--time-scale must be finite and > 0");
+  std::vector<mesh::RegionMaterials> materials;
+  for (const auto& name : split_list(a.materials)) materials.push_back(mesh::load_material(name, data_dir()));
+  if (materials.empty()) throw std::invalid_argument("--materials: give at least one material");
+  const auto keys = drive_schedule(a.compression_mm, a.flexion_deg, a.time_scale);
+  fs::create_directories(c.out);
+
+  // 2. Disc.
+  Progress progress(1 + int(materials.size()), c.quiet || c.json);
+  const mesh::TetMesh m = study_mesh(c, progress);
+  if (!c.json) {
+    std::cout << "Drive study (thesis 5.3, test 2) on " << m.source << " (" << m.num_tets()
+              << " tets): inferior endplate (L3) fixed, superior (L2) driven, disc frame (x lateral, y axial, z "
+                 "anterior), "
+              << model_variant(c.model) << " MSS, " << c.integrator << " Euler dt " << c.dt_s << " s\n"
+              << "  schedule: time (s)   axial (mm)   flexion (deg), linear in between\n";
+    for (const auto& k : keys)
+      std::cout << "            " << std::setw(8) << k.time_s << std::setw(13) << k.axial_mm << std::setw(15)
+                << k.flexion_deg << "\n";
+  }
+
+  // 3. One run per material.
+  nlohmann::json runs = nlohmann::json::array();
+  std::vector<DriveResult> results;
+  for (const auto& mat : materials) {
+    progress.begin("material " + mat.name);
+    results.push_back(drive_one(m, mat, c, dyn, keys));
+    progress.end(std::to_string(results.back().stats.steps_done) + " steps");
+    runs.push_back(results.back().json);
+  }
+
+  // 4. Summary.
+  nlohmann::json schedule = nlohmann::json::array();
+  for (const auto& k : keys) schedule.push_back({{"time_s", k.time_s}, {"axial_mm", k.axial_mm}, {"flexion_deg", k.flexion_deg}});
+  std::string diverged;
+  for (const auto& r : results)
+    if (r.stats.diverged) diverged += (diverged.empty() ? "" : ", ") + r.json["material"].get<std::string>();
+  const std::string json_path = (fs::path(c.out) / "drive.json").string();
+  nlohmann::json j = {{"study", "drive"},
+                      {"thesis", "5.3 test 2, fig. 5.9"},
+                      {"mesh", mesh_json(m)},
+                      {"model_variant", model_variant(c.model)},
+                      {"integrator", c.integrator},
+                      {"dt_s", c.dt_s},
+                      {"frame", "disc (x lateral, y axial, z anterior); reaction about the moved plate centre"},
+                      {"schedule", schedule},
+                      {"materials", runs},
+                      {"diverged", !diverged.empty()},
+                      {"json", json_path}};
+  write_text_file(json_path, j.dump(2) + "\n");
+  if (c.json) {
+    print_json(j);
+  } else {
+    std::cout << "\n  " << std::left << std::setw(18) << "material" << std::right << std::setw(12) << "E (MPa)"
+              << std::setw(16) << "peak |F| (N)" << std::setw(16) << "peak Fy (N)" << std::setw(18) << "peak |M| (N·mm)"
+              << std::setw(14) << "max dV/V0" << std::setw(14) << "step (ms)" << "\n";
+    for (const auto& r : results) {
+      std::ostringstream e;  // "4.2/1" when annulus and nucleus differ
+      const double ea = r.json["E_mpa_annulus"].get<double>(), en = r.json["E_mpa_nucleus"].get<double>();
+      e << ea;
+      if (en != ea) e << "/" << en;
+      std::cout << "  " << std::left << std::setw(18) << r.json["material"].get<std::string>() << std::right
+                << std::setw(12) << e.str() << std::setw(16) << std::setprecision(5)
+                << r.peak_force_n << std::setw(16) << r.peak_axial_n << std::setw(18) << r.peak_moment_nmm
+                << std::setw(13) << 100 * r.json["max_volume_change"].get<double>() << "%" << std::setw(14)
+                << r.stats.mean_seconds() * 1e3 << (r.stats.diverged ? "  DIVERGED" : "") << "\n";
+    }
+    std::cout << "  wrote " << json_path << " and drive-<material>.{pvd,csv} in " << c.out << "\n";
+  }
+  if (!diverged.empty()) throw std::runtime_error("drive study diverged for: " + diverged);
+}
+
+// --- study materials ---------------------------------------------------------------------------
+
+struct MaterialsArgs {
+  std::string level = "L4-L5", materials = "real-disc,annulus-nucleus,rubber,polyethylene", csv,
+              terms = "thesis+volume";
+  double cell_size_mm = mesh::MeshOptions().cell_size_mm;
+  bool json = false, quiet = false;
+};
+
+/// Throws std::invalid_argument unless `path` can be created (its folder exists and is writable).
+void require_writable(const std::string& path, const std::string& option) {
+  require_output_folder(path, option);
+  const fs::path dir = fs::path(path).parent_path().empty() ? fs::path(".") : fs::path(path).parent_path();
+  if (::access(dir.c_str(), W_OK) != 0)
+    throw std::invalid_argument(option + " " + path + ": folder " + dir.string() + " is not writable");
+}
+
+void run_materials(const MaterialsArgs& a) {
+  // 1. Options, checked before any work (nothing is written on bad input).
+  if (!std::isfinite(a.cell_size_mm) || a.cell_size_mm <= 0)
+    throw std::invalid_argument("--cell-size must be a finite number > 0 mm");
+  mesh::disc_dimensions(a.level, data_dir());  // throws for an unknown level
+  MaterialsStudyOptions options;
+  options.terms = parse_term_set(a.terms);
+  std::vector<mesh::RegionMaterials> materials;
+  for (const auto& name : split_list(a.materials)) materials.push_back(mesh::load_material(name, data_dir()));
+  if (materials.empty()) throw std::invalid_argument("--materials: give at least one material");
+  if (!a.csv.empty()) require_writable(a.csv, "--csv");
+  const Timer t_start;
+
+  // 2. One mesh for every material.
+  Progress progress(1 + kStagesPerMaterial * int(materials.size()), a.quiet || a.json);
+  StudyCommon c;
+  c.level = a.level;
+  c.cell_size_mm = a.cell_size_mm;
+  const mesh::TetMesh m = study_mesh(c, progress);
+  if (!a.json) {
+    std::cout << "Material study (thesis fig. 5.9) on " << m.source << ": " << m.num_vertices() << " nodes, "
+              << m.num_tets() << " tets, cell size " << a.cell_size_mm << " mm\n"
+              << "  load: compression, F_y = -500 N on the superior plate (disc frame), inferior endplate fixed\n"
+              << "  FEM P" << options.fem_order << ", linear | untuned MSS: thesis network, Van Gelder constants"
+              << " | tuned MSS: " << term_set_name(options.terms)
+              << " scales calibrated to the FEM | MSS: nonlinear static\n";
+    for (const auto& mat : materials) std::cout << "  " << mat.name << ": " << describe_material(mat) << "\n";
+    std::cout << "\n";
+  }
+
+  // 3. Per material: FEM, calibration, untuned and tuned MSS.
+  StageHooks hooks;
+  hooks.begin = [&](const std::string& what) { progress.begin(what); };
+  hooks.end = [&](const std::string& detail) { progress.end(detail); };
+  std::vector<MaterialResult> results;
+  for (const auto& mat : materials) results.push_back(study_material(m, mat, options, hooks));
+
+  // 4. Tables, CSV, summary.
+  if (!a.csv.empty()) write_text_file(a.csv, materials_csv(results));
+  std::string failed;
+  for (const auto& r : results)
+    if (!r.calibrated) failed += (failed.empty() ? "" : ", ") + r.material;
+  const fem::Vector6d w = fem::load_case("compression").wrench_local;
+  const nlohmann::json j = {
+      {"study", "materials"},
+      {"thesis", "5.3 test 2, fig. 5.9"},
+      {"level", a.level},
+      {"cell_size_mm", a.cell_size_mm},
+      {"mesh", mesh_json(m)},
+      {"fem_order", options.fem_order},
+      {"untuned", "thesis network (main + radial + torsion springs), Van Gelder constants, scales 1"},
+      {"tuned_terms", term_set_name(options.terms)},
+      {"load", {{"case", "compression"}, {"wrench_local", to_json(Eigen::VectorXd(w))}}},
+      {"units",
+       {{"frame", "disc (x lateral, y axial, z anterior)"},
+        {"wrench_local", "Fx,Fy,Fz [N], Mx,My,Mz [N·mm]"},
+        {"stiffness_diagonal", "tx,ty,tz [N/mm], rx,ry,rz [N·mm/deg], linear at rest"},
+        {"plate_axial_displacement_mm", "superior plate u_y under the load, mm, negative towards the inferior endplate"},
+        {"max_displacement_mm", "largest vertex displacement under the load, mm"},
+        {"volume_change", "(V - V0)/V0 under the load; FEM: P1 volume of the mesh with displaced vertices"},
+        {"displacement_error", "|u_MSS - u_FEM|_F / |u_FEM|_F over the vertices, under the load"}}},
+      {"materials", materials_json(results)},
+      {"csv", a.csv.empty() ? nlohmann::json(nullptr) : nlohmann::json(a.csv)},
+      {"seconds", t_start.seconds()}};
+  if (a.json) {
+    print_json(j);
+  } else {
+    print_materials(std::cout, results, options.fem_order, false);
+    std::cout << "Total " << std::setprecision(3) << t_start.seconds() << " s"
+              << (a.csv.empty() ? "" : "; wrote " + a.csv) << "\n";
+  }
+  if (!failed.empty()) throw std::runtime_error("calibration failed for: " + failed);
+}
+
+// --- registration ------------------------------------------------------------------------------
+
+void register_probe(CLI::App& study) {
+  auto a = std::make_shared<ProbeArgs>();
+  a->common.level = "L4-L5";
+  auto* cmd = study.add_subcommand("probe", "Thesis 5.3 test 1: a rigid sphere pressed into the disc wall, volume tracked");
+  add_common_options(cmd, a->common);
+  cmd->add_option("--material", a->material, "Preset or JSON file")->capture_default_str();
+  cmd->add_option("--radius", a->radius_mm, "Probe radius, mm")->capture_default_str();
+  cmd->add_option("--depth", a->depth_mm, "Indentation depth into the undeformed surface, mm")->capture_default_str();
+  cmd->add_option("--speed", a->speed_mm_s, "Press and withdraw speed, mm/s")->capture_default_str();
+  cmd->add_option("--hold", a->hold_s, "Hold at full depth, s")->capture_default_str();
+  cmd->add_option("--rest", a->rest_s, "Probe away after each site (recovery), s")->capture_default_str();
+  cmd->add_option("--probe-stiffness", a->stiffness_n_per_mm, "Penalty per node, N/mm (0: the solver's default, 100 x the mean edge stiffness from the rest Hessian)")
+      ->capture_default_str();
+  cmd->add_option("--sites", a->sites, "Sites in order: anterior, posterior, left, right")->capture_default_str();
+  cmd->footer("Writes OUT/probe.pvd (+ OUT/probe/ frames), OUT/probe.csv and OUT/probe.json.");
+  cmd->callback([a] { run_probe(*a); });
+}
+
+void register_drive(CLI::App& study) {
+  auto a = std::make_shared<DriveArgs>();
+  a->common.level = "L2-L3";
+  auto* cmd = study.add_subcommand("drive", "Thesis 5.3 test 2: L2-L3 disc, L3 fixed, L2 driven, per material");
+  add_common_options(cmd, a->common);
+  cmd->add_option("--materials", a->materials, "Comma-separated presets or JSON files")->capture_default_str();
+  cmd->add_option("--compression", a->compression_mm, "Axial compression of the schedule, mm")->capture_default_str();
+  cmd->add_option("--flexion", a->flexion_deg, "Flexion of the schedule, degrees")->capture_default_str();
+  cmd->add_option("--time-scale", a->time_scale, "Multiply the schedule's times (1.2 s at 1)")->capture_default_str();
+  cmd->footer(
+      "Schedule (disc frame, linear in between): 0-0.2 s compress; 0.3-0.5 s flex; 0.6-0.8 s unflex;\n"
+      "0.9-1.1 s release; hold 0.1 s between. Writes OUT/drive-<material>.pvd (+ frames), OUT/drive-<material>.csv\n"
+      "(time, plate motion mm/deg, reaction N and N·mm in the disc frame, volume) and OUT/drive.json.");
+  cmd->callback([a] { run_drive(*a); });
+}
+
+void register_materials(CLI::App& study) {
+  auto a = std::make_shared<MaterialsArgs>();
+  auto* cmd = study.add_subcommand(
+      "materials", "Thesis fig. 5.9 with a reference: per material, FEM vs untuned vs tuned MSS under the same load");
+  cmd->add_option("--level", a->level, "Disc level, meshed in-process")->capture_default_str();
+  cmd->add_option("--cell-size", a->cell_size_mm, "Mesh cell size, mm")->capture_default_str();
+  cmd->add_option("--materials", a->materials, "Comma-separated presets or JSON files")->capture_default_str();
+  cmd->add_option("--terms", a->terms, "What the calibration tunes: thesis, thesis+volume, all")->capture_default_str();
+  cmd->add_option("--csv", a->csv, "Write a CSV, one row per material x model (fem, untuned, tuned)");
+  cmd->add_flag("--json", a->json, "Print the JSON summary on stdout (instead of the tables)");
+  cmd->add_flag("--quiet", a->quiet, "No progress on stderr");
+  cmd->footer(
+      "Protocol: one mesh of --level for every material; inferior endplate fixed, superior endplate a rigid\n"
+      "plate about the mean of its vertices. Per material:\n"
+      "  1. FEM P2, linear: the 6x6 plate stiffness and the compression case (F_y = -500 N in the disc\n"
+      "     frame, the thesis's fig. 5.9 load);\n"
+      "  2. Ipopt calibrates the MSS stiffness scales (--terms, per region) to that FEM on compression,\n"
+      "     shear-ap, flexion and torsion, linearised (as `spinesim calibrate --no-check`);\n"
+      "  3. the untuned MSS (thesis network: main + radial + torsion springs, Van Gelder constants) and\n"
+      "     the tuned MSS, nonlinear static under the same wrench.\n"
+      "Reported per model, disc frame (x lateral, y axial, z anterior): axial stiffness K6_yy (N/mm) and\n"
+      "the 6x6 diagonal (N/mm, N·mm/deg), linear at rest; under the compression: the superior plate's u_y\n"
+      "(mm), max |u| (mm), the volume change (MSS: signed tet volumes; FEM: the P1 volume of the mesh with\n"
+      "its vertices moved by the FEM displacement) and the nodal displacement error vs the FEM.\n"
+      "Output: tables on stdout (or --json), --csv FILE. Exit 1 if a calibration fails (tables still shown).");
+  cmd->callback([a] { run_materials(*a); });
+}
+
+// --- study validation | fusion | trends (the spine; spine_studies.hpp) ------------------------
+
+struct SpineStudyArgs {
+  double force_n = 300;
+  std::string csv;
+  bool json = false, quiet = false, no_trunk_muscles = false;
+  spine::ModelOptions model() const {
+    spine::ModelOptions o;
+    o.trunk_muscles = !no_trunk_muscles;
+    return o;
+  }
+};
+
+/// A line under the title when the study runs on the lumbar muscles only.
+void print_muscle_set(const SpineStudyArgs& a) {
+  if (a.no_trunk_muscles)
+    std::cout << "Muscles: F.8-F.19 only (--no-trunk-muscles: no thoracic erector spinae, no rectus abdominis)\n\n";
+}
+
+void add_spine_study_options(CLI::App* cmd, SpineStudyArgs& a, bool with_force) {
+  if (with_force) cmd->add_option("--force", a.force_n, "Force on the T1 centre, N")->capture_default_str();
+  cmd->add_option("--csv", a.csv, "Write the study's CSV");
+  cmd->add_flag("--json", a.json, "Print the JSON summary on stdout (instead of the tables)");
+  cmd->add_flag("--no-trunk-muscles", a.no_trunk_muscles,
+                "Lumbar muscles F.8-F.19 only: leave out the restored thoracic erector spinae and rectus abdominis");
+  cmd->add_flag("--quiet", a.quiet, "No progress on stderr");
+}
+
+/// Checks shared by the spine studies before any work; returns the progress hooks.
+StageHooks spine_study_hooks(const SpineStudyArgs& a, Progress& progress) {
+  if (!std::isfinite(a.force_n) || a.force_n <= 0) throw std::invalid_argument("--force must be a finite number > 0 N");
+  if (a.force_n > 600)
+    std::cerr << "spinesim: warning: --force " << a.force_n << " N is beyond the 600 N the thesis validated; solving anyway"
+              << std::endl;
+  if (!a.csv.empty()) require_writable(a.csv, "--csv");
+  StageHooks hooks;
+  hooks.begin = [&progress](const std::string& what) { progress.begin(what); };
+  hooks.end = [&progress](const std::string& detail) { progress.end(detail); };
+  return hooks;
+}
+
+/// Writes the CSV (--csv), then prints the JSON summary (--json) or the title, the muscle set and the table.
+template <class Study>
+void emit_spine_study(const SpineStudyArgs& a, const Study& s, const char* title, std::string (*to_csv)(const Study&),
+                      nlohmann::json (*to_json)(const Study&), void (*print)(std::ostream&, const Study&, bool)) {
+  if (!a.csv.empty()) write_text_file(a.csv, to_csv(s));
+  if (a.json) {
+    nlohmann::json j = to_json(s);
+    j["csv"] = a.csv.empty() ? nlohmann::json(nullptr) : nlohmann::json(a.csv);
+    print_json(j);
+    return;
+  }
+  std::cout << title << "\n\n";
+  print_muscle_set(a);
+  print(std::cout, s, false);
+  std::cout << "Total " << fixed(s.seconds, 2) << " s" << (a.csv.empty() ? "" : "; wrote " + a.csv) << "\n";
+}
+
+void run_validation(const SpineStudyArgs& a) {
+  Progress progress(kValidationStages, a.quiet || a.json);
+  const ValidationStudy s = run_validation_study(data_dir(), a.model(), spine_study_hooks(a, progress));
+  emit_spine_study(a, s, "Spine validation (thesis 3.4): McGill & Norman 1987 at L5-S1, Wilke et al. 2001 at L4-L5",
+                   validation_csv, validation_json, print_validation);
+}
+
+void run_fusion(const SpineStudyArgs& a) {
+  Progress progress(kFusionStages, a.quiet || a.json);
+  const FusionStudy s = run_fusion_study(data_dir(), a.force_n, a.model(), spine_study_hooks(a, progress));
+  emit_spine_study(a, s, "Spinal fusion vs the normal spine (thesis 6.1)", fusion_csv, fusion_json, print_fusion);
+}
+
+void run_trends(const SpineStudyArgs& a) {
+  Progress progress(kTrendsStages, a.quiet || a.json);
+  const TrendsStudy s = run_trends_study(data_dir(), a.force_n, a.model(), spine_study_hooks(a, progress));
+  emit_spine_study(a, s, "Relative motion of adjacent vertebrae under a force on T1 (thesis 6.3-6.4)", trends_csv,
+                   trends_json, print_trends);
+}
+
+void register_validation(CLI::App& study) {
+  auto a = std::make_shared<SpineStudyArgs>();
+  auto* cmd = study.add_subcommand("validation", "Thesis 3.4: L5-S1 forces at a 238 N·m extension moment, L4-L5 force holding a crate");
+  add_spine_study_options(cmd, *a, false);
+  cmd->footer(
+      "(a) McGill & Norman 1987: a +z force on the T7 centre raised until the net external moment about the\n"
+      "    L5-S1 joint point (T7 force and every weight above, in the equilibrium posture) is 238 N·m; L5-S1\n"
+      "    axial and shear force (joint and disc frames) against 3929-4688 N and <= 650 N.\n"
+      "(b) Wilke et al. 2001: 19.8 kg crate 600 mm in front of the chest, arms forward; L4-L5 axial force\n"
+      "    against 3240 N +- 15 %. Targets: data/spine/spine_model.json \"validation\". Nothing is tuned.\n"
+      "Output: table (or --json with each case's forces beside its targets), --csv FILE. A missed target is\n"
+      "reported (exit 0); a failed solve is an error (exit 1).");
+  cmd->callback([a] { run_validation(*a); });
+}
+
+void register_fusion(CLI::App& study) {
+  auto a = std::make_shared<SpineStudyArgs>();
+  auto* cmd = study.add_subcommand("fusion", "Thesis 6.1: normal spine vs fusion at L3-L4, L4-L5, L3-L4-L5 under forces on T1");
+  add_spine_study_options(cmd, *a, true);
+  cmd->footer(
+      "The same forward (+z), backward (-z) and lateral (-x) force on the T1 centre, per model: T1 motion (the\n"
+      "force's effect, minus the model's gravity-only equilibrium; mm, deg) and the L2-L3 and L5-S1 joint\n"
+      "forces (totals, joint frame; N). The thesis's findings are checked: MATCH or DIFFERS, not forced.");
+  cmd->callback([a] { run_fusion(*a); });
+}
+
+void register_trends(CLI::App& study) {
+  auto a = std::make_shared<SpineStudyArgs>();
+  auto* cmd = study.add_subcommand("trends", "Thesis 6.3-6.4: relative motion of adjacent vertebrae under forces on T1, vs the thesis's trends");
+  add_spine_study_options(cmd, *a, true);
+  cmd->footer(
+      "Lateral (-x), forward (+z) and backward (-z) force on the T1 centre. Per pair T1-T2 ... L4-L5: relative\n"
+      "translation of the centres (upper minus lower, world axes, mm) and the joint rotation (deg), each minus its\n"
+      "gravity-only value. Each trend the thesis states is printed as MATCH or DIFFERS with our numbers.");
+  cmd->callback([a] { run_trends(*a); });
+}
+}  // namespace
+
+void register_study(CLI::App& app) {
+
+  auto* study = app.add_subcommand("study", "The thesis's studies (5.3 functional tests, material comparison), as VTU series, CSV, JSON");
+  study->require_subcommand(1);
+  register_probe(*study);
+  register_drive(*study);
+  register_materials(*study);
+  register_validation(*study);
+  register_fusion(*study);
+  register_trends(*study);
+}
+
+}  // namespace spinesim::cli
