@@ -11,6 +11,7 @@ packages=(
   libcgal-dev              # CGAL 5.5 Mesh_3
   coinor-libipopt-dev      # Ipopt 3.11
   libcli11-dev nlohmann-json3-dev libtinyxml2-dev
+  zlib1g-dev liblzma-dev   # compressed VTU files (VTK's zlib and LZMA compressors)
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-meshio python3-numpy   # independent VTU reader used by the tests
 )

@@ -3,9 +3,12 @@
 
 #include "spinesim/common/atomic_file.hpp"
 #include "xml_escape.hpp"
+#include "vtk_grid.hpp"
 #include "write_checks.hpp"
 
+#include <lzma.h>
 #include <tinyxml2.h>
+#include <zlib.h>
 
 #include <algorithm>
 #include <charconv>
@@ -13,6 +16,8 @@
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <limits>
 #include <ostream>
 #include <stdexcept>
@@ -70,10 +75,10 @@ int b64_value(char c) {
 /// the block header and the data separately, meshio encodes them together; both decode to the
 /// same byte sequence here. Returns false on an invalid character or a dangling partial quartet
 /// (truncated text).
-bool base64_decode(const char* s, std::vector<unsigned char>& out) {
+bool base64_decode(const char* s, std::size_t n, std::vector<unsigned char>& out) {
   int quad[4];
   int nq = 0;
-  for (; *s; ++s) {
+  for (const char* end = s + n; s < end; ++s) {
     const char c = *s;
     if (c == ' ' || c == '\n' || c == '\r' || c == '\t') continue;
     if (c == '=') {
@@ -172,21 +177,20 @@ void check_arrays(const std::string& path, const std::vector<DataArray>& arrays,
 // ------------------------------------------------------------------------------------------
 // Reading
 
-struct Reader {
-  std::string path;
+using detail::RawArray;
+
+/// How the binary arrays of a file are compressed (VTKFile compressor=…).
+enum class Compressor { none, zlib, lzma };
+
+struct Reader : detail::FileError {
   bool swap_bytes = false;
   int header_bytes = 4;  // UInt32 by default (VTK XML format 0.1 and 1.0)
-
-  [[noreturn]] void fail(const std::string& msg) const {
-    throw std::invalid_argument("read_vtu: " + path + ": " + msg);
-  }
-};
-
-/// A DataArray decoded to doubles (exact for every integer below 2^53 and every Float64).
-struct RawArray {
-  std::string name;
-  int ncomp = 1;
-  std::vector<double> v;
+  Compressor compressor = Compressor::none;
+  // <AppendedData>: the bytes after its '_' marker (raw bytes, or base64 text), and the sorted
+  // offsets of every appended array (a base64 array ends where the next one starts).
+  bool has_appended = false, appended_base64 = false;
+  std::string appended;
+  std::vector<std::int64_t> appended_offsets;
 };
 
 struct VtkType {
@@ -265,26 +269,104 @@ std::vector<double> parse_ascii(const Reader& r, const std::string& name, const 
   return v;
 }
 
-std::vector<double> decode_binary(const Reader& r, const std::string& name, const char* text,
-                                  VtkType t) {
-  std::vector<unsigned char> bytes;
-  if (!text || !base64_decode(text, bytes))
-    r.fail("DataArray '" + name + "' has invalid or truncated base64 data");
-  if (bytes.size() < std::size_t(r.header_bytes))
-    r.fail("DataArray '" + name + "' binary data is truncated (no block header)");
-  std::uint64_t nbytes =
-      std::uint64_t(decode_value(bytes.data(), VtkType{r.header_bytes, 'u'}, r.swap_bytes));
-  if (bytes.size() - std::size_t(r.header_bytes) < nbytes)
-    r.fail("DataArray '" + name + "' binary data is truncated (header says " +
-           std::to_string(nbytes) + " bytes, found " +
-           std::to_string(bytes.size() - std::size_t(r.header_bytes)) + ")");
-  if (nbytes % std::uint64_t(t.size) != 0)
-    r.fail("DataArray '" + name + "' byte count " + std::to_string(nbytes) +
+/// The largest uncompressed array a file may announce: a guard against a corrupt or hostile
+/// header making the reader allocate without bound (a 10M-tet mesh's connectivity is 320 MB).
+constexpr std::uint64_t kMaxArrayBytes = std::uint64_t(4) << 30;
+
+std::uint64_t header_value(const Reader& r, const unsigned char* p) {
+  return std::uint64_t(decode_value(p, VtkType{r.header_bytes, 'u'}, r.swap_bytes));
+}
+
+/// Decompresses one block of `csize` bytes at `src` into exactly `usize` bytes at `dst`.
+void inflate_block(const Reader& r, const std::string& name, const unsigned char* src, std::uint64_t csize,
+                   unsigned char* dst, std::uint64_t usize) {
+  bool ok = false;
+  if (r.compressor == Compressor::zlib) {
+    uLongf dlen = uLongf(usize);
+    ok = ::uncompress(dst, &dlen, src, uLong(csize)) == Z_OK && dlen == usize;
+  } else {
+    lzma_stream z = LZMA_STREAM_INIT;
+    if (lzma_auto_decoder(&z, UINT64_MAX, 0) == LZMA_OK) {
+      z.next_in = src, z.avail_in = std::size_t(csize);
+      z.next_out = dst, z.avail_out = std::size_t(usize);
+      const lzma_ret rc = lzma_code(&z, LZMA_FINISH);
+      ok = (rc == LZMA_STREAM_END || rc == LZMA_OK) && z.avail_out == 0;
+      lzma_end(&z);
+    }
+  }
+  if (!ok) r.fail("DataArray '" + name + "' has a compressed block that does not decompress to its " +
+                  std::to_string(usize) + " bytes (corrupt data)");
+}
+
+/// The payload of one binary array stored at `p` (`n` bytes available): VTK's header — the byte
+/// count, or with a compressor [#blocks, block size, last block size, compressed sizes…], each
+/// of header_type — then the data, decompressed.
+std::vector<unsigned char> read_block(const Reader& r, const std::string& name, const unsigned char* p, std::size_t n) {
+  const std::size_t hb = std::size_t(r.header_bytes);
+  const auto truncated = [&](const std::string& what) {
+    r.fail("DataArray '" + name + "' binary data is truncated (" + what + ")");
+  };
+  if (r.compressor == Compressor::none) {
+    if (n < hb) truncated("no block header");
+    const std::uint64_t nbytes = header_value(r, p);
+    if (n - hb < nbytes)
+      truncated("header says " + std::to_string(nbytes) + " bytes, found " + std::to_string(n - hb));
+    return std::vector<unsigned char>(p + hb, p + hb + nbytes);
+  }
+  if (n < 3 * hb) truncated("no compression header");
+  const std::uint64_t nblocks = header_value(r, p), block = header_value(r, p + hb), last = header_value(r, p + 2 * hb);
+  if (nblocks > n / hb - 3) truncated("the compression header counts " + std::to_string(nblocks) + " blocks");
+  if (nblocks > 0 && (block == 0 || last > block))
+    r.fail("DataArray '" + name + "' has an inconsistent compression header (block size " + std::to_string(block) +
+           ", last block " + std::to_string(last) + ")");
+  const std::uint64_t total = nblocks == 0 ? 0 : (nblocks - 1) * block + (last > 0 ? last : block);
+  if (block > kMaxArrayBytes || total > kMaxArrayBytes)
+    r.fail("DataArray '" + name + "' announces " + std::to_string(total) +
+           " uncompressed bytes, more than a mesh array may hold (4 GiB)");
+  std::vector<unsigned char> out(static_cast<std::size_t>(total));
+  const unsigned char* data = p + (3 + nblocks) * hb;
+  std::size_t avail = n - std::size_t(3 + nblocks) * hb, pos = 0;
+  for (std::uint64_t k = 0; k < nblocks; ++k) {
+    const std::uint64_t csize = header_value(r, p + (3 + k) * hb);
+    if (csize > avail) truncated("block " + std::to_string(k) + " of " + std::to_string(nblocks));
+    const std::uint64_t usize = (k + 1 == nblocks && last > 0) ? last : block;
+    inflate_block(r, name, data, csize, out.data() + pos, usize);
+    data += csize, avail -= std::size_t(csize), pos += std::size_t(usize);
+  }
+  return out;
+}
+
+std::vector<double> to_values(const Reader& r, const std::string& name, const std::vector<unsigned char>& bytes,
+                              VtkType t) {
+  if (bytes.size() % std::size_t(t.size) != 0)
+    r.fail("DataArray '" + name + "' byte count " + std::to_string(bytes.size()) +
            " is not a multiple of the value size");
-  std::vector<double> v(nbytes / std::uint64_t(t.size));
-  const unsigned char* p = bytes.data() + r.header_bytes;
-  for (std::size_t i = 0; i < v.size(); ++i) v[i] = decode_value(p + i * std::size_t(t.size), t, r.swap_bytes);
+  std::vector<double> v(bytes.size() / std::size_t(t.size));
+  for (std::size_t i = 0; i < v.size(); ++i) v[i] = decode_value(bytes.data() + i * std::size_t(t.size), t, r.swap_bytes);
   return v;
+}
+
+std::vector<unsigned char> decode_base64(const Reader& r, const std::string& name, const char* text, std::size_t n) {
+  std::vector<unsigned char> bytes;
+  if (!text || !base64_decode(text, n, bytes)) r.fail("DataArray '" + name + "' has invalid or truncated base64 data");
+  return bytes;
+}
+
+/// An array in <AppendedData> at `offset` (bytes into the raw data, or characters into the
+/// base64 text, after the '_' marker).
+std::vector<unsigned char> appended_block(const Reader& r, const std::string& name, std::int64_t offset) {
+  if (!r.has_appended) r.fail("DataArray '" + name + "' is appended but the file has no <AppendedData>");
+  if (offset < 0 || std::size_t(offset) >= r.appended.size())
+    r.fail("DataArray '" + name + "' offset " + std::to_string(offset) + " is outside the appended data (" +
+           std::to_string(r.appended.size()) + " bytes)");
+  if (!r.appended_base64) {
+    const auto* p = reinterpret_cast<const unsigned char*>(r.appended.data()) + offset;
+    return read_block(r, name, p, r.appended.size() - std::size_t(offset));
+  }
+  auto next = std::upper_bound(r.appended_offsets.begin(), r.appended_offsets.end(), offset);
+  const std::size_t end = next == r.appended_offsets.end() ? r.appended.size() : std::size_t(*next);
+  const auto bytes = decode_base64(r, name, r.appended.data() + offset, end - std::size_t(offset));
+  return read_block(r, name, bytes.data(), bytes.size());
 }
 
 RawArray read_array(const Reader& r, const tinyxml2::XMLElement* da) {
@@ -303,10 +385,14 @@ RawArray read_array(const Reader& r, const tinyxml2::XMLElement* da) {
   if (format == "ascii") {
     a.v = parse_ascii(r, label, da->GetText());
   } else if (format == "binary") {
-    a.v = decode_binary(r, label, da->GetText(), t);
+    const char* text = da->GetText();
+    const auto bytes = decode_base64(r, label, text, text ? std::strlen(text) : 0);
+    a.v = to_values(r, label, read_block(r, label, bytes.data(), bytes.size()), t);
   } else if (format == "appended") {
-    r.fail("uses appended data (format=\"appended\"), which is not supported; re-save it as ASCII "
-           "or inline binary (ParaView: Data Mode Ascii or Binary; meshio: binary=False)");
+    std::int64_t offset = -1;
+    if (da->QueryInt64Attribute("offset", &offset) != tinyxml2::XML_SUCCESS)
+      r.fail("DataArray '" + label + "' is appended but has no offset");
+    a.v = to_values(r, label, appended_block(r, label, offset), t);
   } else {
     r.fail("DataArray '" + label + "' has unknown format '" + format + "'");
   }
@@ -333,63 +419,58 @@ const tinyxml2::XMLElement* find_named(const tinyxml2::XMLElement* parent, const
   return nullptr;
 }
 
-/// Integer view of an array that must hold integers in [lo, hi].
-std::vector<std::int64_t> as_integers(const Reader& r, const RawArray& a, double lo, double hi) {
-  std::vector<std::int64_t> out(a.v.size());
-  for (std::size_t i = 0; i < a.v.size(); ++i) {
-    const double x = a.v[i];
-    if (!(x >= lo && x <= hi) || x != std::floor(x))
-      r.fail("'" + a.name + "' entry #" + std::to_string(i) + " = " + std::to_string(x) +
-             " is not an integer in [" + std::to_string(std::int64_t(lo)) + ", " +
-             std::to_string(std::int64_t(hi)) + "]");
-    out[i] = std::int64_t(x);
+/// The file's text with the raw or base64 payload of <AppendedData> cut out (into r.appended):
+/// raw bytes are not XML, so the XML parser sees `<AppendedData …>_</AppendedData>`.
+std::string split_appended(Reader& r, std::string text) {
+  const std::size_t open = text.find("<AppendedData");
+  if (open == std::string::npos) return text;
+  const std::size_t tag_end = text.find('>', open);
+  const std::size_t close = text.rfind("</AppendedData>");
+  if (tag_end == std::string::npos || close == std::string::npos || close < tag_end)
+    r.fail("<AppendedData> is not closed (truncated file?)");
+  const std::string tag = text.substr(open, tag_end - open);
+  const std::size_t enc = tag.find("encoding=\"");
+  const std::string encoding = enc == std::string::npos ? "raw" : tag.substr(enc + 10, tag.find('"', enc + 10) - enc - 10);
+  if (encoding != "raw" && encoding != "base64")
+    r.fail("<AppendedData> has unknown encoding '" + encoding + "' (raw or base64)");
+  const std::size_t marker = text.find('_', tag_end);
+  if (marker == std::string::npos || marker > close) r.fail("<AppendedData> has no '_' marker before its data");
+  r.has_appended = true;
+  r.appended_base64 = encoding == "base64";
+  r.appended = text.substr(marker + 1, close - marker - 1);
+  return text.substr(0, marker + 1) + text.substr(close);
+}
+
+/// Byte order, header size and compressor from <VTKFile>.
+void read_envelope(Reader& r, const tinyxml2::XMLElement* root) {
+  const char* ftype = root->Attribute("type");
+  if (!ftype || std::strcmp(ftype, "UnstructuredGrid") != 0)
+    r.fail(std::string("not an UnstructuredGrid (VTKFile type=\"") + (ftype ? ftype : "") + "\")");
+  if (const char* comp = root->Attribute("compressor")) {
+    if (std::strcmp(comp, "vtkZLibDataCompressor") == 0) r.compressor = Compressor::zlib;
+    else if (std::strcmp(comp, "vtkLZMADataCompressor") == 0) r.compressor = Compressor::lzma;
+    else
+      r.fail(std::string("data compressed with ") + comp +
+             ", which is not supported; re-save it with zlib or LZMA compression, or uncompressed "
+             "(ParaView: Compressor Type ZLib or None)");
   }
-  return out;
-}
-
-Eigen::MatrixXd to_matrix(const RawArray& a) {
-  const Eigen::Index rows = Eigen::Index(a.v.size()) / a.ncomp;
-  Eigen::MatrixXd M(rows, a.ncomp);
-  for (Eigen::Index i = 0; i < rows; ++i)
-    for (int j = 0; j < a.ncomp; ++j) M(i, j) = a.v[std::size_t(i * a.ncomp + j)];
-  return M;
-}
-
-/// Reads a PointData or CellData section of `count` tuples: the one-component integer label
-/// array `label_name` goes into `labels` (left as it is when absent), every other array into
-/// `others`.
-void read_data_section(const Reader& r, const tinyxml2::XMLElement* section, const std::string& kind,
-                       std::int64_t count, const std::string& label_name, Eigen::VectorXi& labels,
-                       std::vector<DataArray>& others) {
-  for (const RawArray& a : read_arrays(r, section)) {
-    if (std::int64_t(a.v.size()) != count * a.ncomp)
-      r.fail(kind + " '" + a.name + "' has " + std::to_string(a.v.size() / std::size_t(a.ncomp)) +
-             " tuples, expected " + std::to_string(count));
-    if (a.name == label_name) {
-      if (a.ncomp != 1) r.fail(kind + " '" + label_name + "' must have 1 component");
-      const auto s = as_integers(r, a, -2147483648.0, 2147483647.0);
-      for (std::int64_t i = 0; i < count; ++i) labels(i) = int(s[std::size_t(i)]);
-    } else {
-      others.push_back({a.name, to_matrix(a)});
-    }
+  const char* order = root->Attribute("byte_order");
+  const bool file_little = !order || std::strcmp(order, "BigEndian") != 0;
+  r.swap_bytes = file_little != host_is_little_endian();
+  if (const char* ht = root->Attribute("header_type")) {
+    if (std::strcmp(ht, "UInt32") == 0) r.header_bytes = 4;
+    else if (std::strcmp(ht, "UInt64") == 0) r.header_bytes = 8;
+    else r.fail(std::string("unsupported header_type \"") + ht + "\"");
   }
 }
 
-constexpr int kVtkTetra = 10;
-constexpr int kVtkQuadraticTetra = 24;
-
-std::string cell_type_name(std::int64_t type) {
-  switch (type) {
-    case 1: return "vertex (1)";
-    case 3: return "line (3)";
-    case 5: return "triangle (5)";
-    case 9: return "quad (9)";
-    case 12: return "hexahedron (12)";
-    case 13: return "wedge (13)";
-    case 14: return "pyramid (14)";
-    case 22: return "quadratic triangle (22)";
-    case 25: return "quadratic hexahedron (25)";
-    default: return "VTK type " + std::to_string(type);
+/// The offsets of every appended DataArray below `e`, sorted (r.appended_offsets).
+void collect_offsets(Reader& r, const tinyxml2::XMLElement* e) {
+  for (const auto* c = e->FirstChildElement(); c; c = c->NextSiblingElement()) {
+    std::int64_t off = 0;
+    if (std::strcmp(c->Name(), "DataArray") == 0 && c->QueryInt64Attribute("offset", &off) == tinyxml2::XML_SUCCESS)
+      r.appended_offsets.push_back(off);
+    collect_offsets(r, c);
   }
 }
 
@@ -412,7 +493,7 @@ void write_vtu(const std::string& path, const TetMesh& m, const std::vector<Data
   // 2. Flatten everything into VTK order.
   const std::size_t nt = std::size_t(m.num_tets());
   std::vector<std::int64_t> connectivity(4 * nt), offsets(nt);
-  std::vector<std::uint8_t> types(nt, std::uint8_t(kVtkTetra));
+  std::vector<std::uint8_t> types(nt, std::uint8_t(10));  // VTK_TETRA
   for (std::size_t t = 0; t < nt; ++t) {
     for (int k = 0; k < 4; ++k) connectivity[4 * t + std::size_t(k)] = m.T(Eigen::Index(t), k);
     offsets[t] = std::int64_t(4 * (t + 1));
@@ -469,171 +550,64 @@ TetMesh read_vtu(const std::string& path, std::vector<DataArray>* point_data,
                  std::vector<DataArray>* cell_data) {
   using tinyxml2::XMLElement;
   Reader r;
+  r.who = "read_vtu";
   r.path = path;
 
-  // 1. File and XML envelope.
+  // 1. File and XML envelope; the appended payload is cut out before XML parsing.
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) r.fail("no such file");
+  std::ifstream in(path, std::ios::binary);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (!in && !in.eof()) r.fail("cannot read the file");
+  text = split_appended(r, std::move(text));
   tinyxml2::XMLDocument doc;
-  if (doc.LoadFile(path.c_str()) != tinyxml2::XML_SUCCESS) {
+  if (doc.Parse(text.data(), text.size()) != tinyxml2::XML_SUCCESS) {
     std::string err = doc.ErrorStr() ? doc.ErrorStr() : "unknown error";
     std::replace(err.begin(), err.end(), '\n', ' ');
     r.fail("not a readable XML file (" + err + ")");
   }
   const XMLElement* root = doc.RootElement();
   if (!root || std::strcmp(root->Name(), "VTKFile") != 0) r.fail("not a VTK XML file (no <VTKFile>)");
-  const char* ftype = root->Attribute("type");
-  if (!ftype || std::strcmp(ftype, "UnstructuredGrid") != 0)
-    r.fail(std::string("not an UnstructuredGrid (VTKFile type=\"") + (ftype ? ftype : "") + "\")");
-  if (const char* comp = root->Attribute("compressor"))
-    r.fail(std::string("compressed data (compressor=\"") + comp +
-           "\") is not supported; re-save it uncompressed (ParaView: Compressor Type None; "
-           "meshio: compression=None) or as ASCII");
-  if (root->FirstChildElement("AppendedData"))
-    r.fail("uses appended data (<AppendedData>), which is not supported; re-save it as ASCII or "
-           "inline binary (ParaView: Data Mode Ascii or Binary; meshio: binary=False)");
-  const char* order = root->Attribute("byte_order");
-  const bool file_little = !order || std::strcmp(order, "BigEndian") != 0;
-  r.swap_bytes = file_little != host_is_little_endian();
-  if (const char* ht = root->Attribute("header_type")) {
-    if (std::strcmp(ht, "UInt32") == 0) r.header_bytes = 4;
-    else if (std::strcmp(ht, "UInt64") == 0) r.header_bytes = 8;
-    else r.fail(std::string("unsupported header_type \"") + ht + "\"");
-  }
+  read_envelope(r, root);
+  collect_offsets(r, root);
+  std::sort(r.appended_offsets.begin(), r.appended_offsets.end());
   const XMLElement* grid = root->FirstChildElement("UnstructuredGrid");
   if (!grid) r.fail("no <UnstructuredGrid> element");
   const XMLElement* piece = grid->FirstChildElement("Piece");
   if (!piece) r.fail("no <Piece> element");
   if (piece->NextSiblingElement("Piece")) r.fail("has more than one Piece; merge them into one first");
 
-  std::int64_t np = -1, nc = -1;
-  if (piece->QueryInt64Attribute("NumberOfPoints", &np) != tinyxml2::XML_SUCCESS || np < 0)
+  // 2. The grid's arrays, decoded.
+  detail::RawGrid g;
+  if (piece->QueryInt64Attribute("NumberOfPoints", &g.num_points) != tinyxml2::XML_SUCCESS || g.num_points < 0)
     r.fail("Piece has no valid NumberOfPoints");
-  if (piece->QueryInt64Attribute("NumberOfCells", &nc) != tinyxml2::XML_SUCCESS || nc < 0)
+  if (piece->QueryInt64Attribute("NumberOfCells", &g.num_cells) != tinyxml2::XML_SUCCESS || g.num_cells < 0)
     r.fail("Piece has no valid NumberOfCells");
-  if (np == 0 || nc == 0) r.fail("mesh is empty (NumberOfPoints or NumberOfCells is 0)");
-
-  // 2. Points.
+  if (g.num_points == 0 || g.num_cells == 0) r.fail("mesh is empty (NumberOfPoints or NumberOfCells is 0)");
   const XMLElement* points_el = piece->FirstChildElement("Points");
   const XMLElement* pda = points_el ? points_el->FirstChildElement("DataArray") : nullptr;
   if (!pda) r.fail("no <Points> DataArray");
-  RawArray pts = read_array(r, pda);
-  if (pts.ncomp != 3) r.fail("Points must have 3 components, found " + std::to_string(pts.ncomp));
-  if (std::int64_t(pts.v.size()) != 3 * np)
-    r.fail("Points has " + std::to_string(pts.v.size() / 3) + " points, NumberOfPoints says " +
-           std::to_string(np));
-  for (double x : pts.v)
-    if (!std::isfinite(x)) r.fail("point coordinates contain non-finite values");
-
-  // 3. Cells.
+  g.points = read_array(r, pda);
   const XMLElement* cells_el = piece->FirstChildElement("Cells");
   if (!cells_el) r.fail("no <Cells> element");
-  auto cell_array = [&](const char* name) {
+  auto cell_array = [&](const char* name, double hi) {
     const XMLElement* da = find_named(cells_el, name);
     if (!da) r.fail(std::string("Cells has no '") + name + "' DataArray");
     RawArray a = read_array(r, da);
     a.name = name;
-    return a;
+    return detail::as_integers(r, a, 0, hi);
   };
-  const auto conn = as_integers(r, cell_array("connectivity"), 0, double(np - 1));
-  const auto offs = as_integers(r, cell_array("offsets"), 0, 9e15);
-  const auto types = as_integers(r, cell_array("types"), 0, 255);
-  if (std::int64_t(offs.size()) != nc || std::int64_t(types.size()) != nc)
-    r.fail("Cells offsets/types have " + std::to_string(offs.size()) + "/" +
-           std::to_string(types.size()) + " entries, NumberOfCells says " + std::to_string(nc));
-  bool any_quadratic = false;
-  TetMesh m;
-  m.T.resize(nc, 4);
-  std::int64_t start = 0;
-  for (std::int64_t c = 0; c < nc; ++c) {
-    const std::int64_t type = types[std::size_t(c)];
-    std::int64_t want = 0;
-    if (type == kVtkTetra) want = 4;
-    else if (type == kVtkQuadraticTetra) want = 10, any_quadratic = true;
-    else
-      r.fail("cell #" + std::to_string(c) + " is a " + cell_type_name(type) +
-             "; only tetrahedra (VTK types 10 and 24) are supported");
-    const std::int64_t end = offs[std::size_t(c)];
-    if (end - start != want || end > std::int64_t(conn.size()))
-      r.fail("cell #" + std::to_string(c) + " offsets are inconsistent with its type");
-    for (int k = 0; k < 4; ++k) m.T(c, k) = int(conn[std::size_t(start + k)]);
-    start = end;
-  }
-  if (start != std::int64_t(conn.size()))
-    r.fail("connectivity has " + std::to_string(conn.size()) + " entries, the offsets use " +
-           std::to_string(start));
+  g.connectivity = cell_array("connectivity", double(g.num_points - 1));
+  g.offsets = cell_array("offsets", 9e15);
+  g.types = cell_array("types", 255);
+  g.point_data = read_arrays(r, piece->FirstChildElement("PointData"));
+  g.cell_data = read_arrays(r, piece->FirstChildElement("CellData"));
+  const XMLElement* field = grid->FirstChildElement("FieldData");  // other field arrays are not decoded
+  if (const XMLElement* da = find_named(field, "disc_frame")) g.disc_frame = read_array(r, da);
+  if (const XMLElement* da = find_named(field, "source")) g.source = read_array(r, da);
 
-  m.V.resize(np, 3);
-  for (std::int64_t i = 0; i < np; ++i)
-    for (int j = 0; j < 3; ++j) m.V(i, j) = pts.v[std::size_t(3 * i + j)];
-
-  // 4. Point and cell data.
-  m.surface = Eigen::VectorXi::Zero(np);
-  m.region = Eigen::VectorXi::Ones(nc);
-  std::vector<DataArray> pdata, cdata;
-  read_data_section(r, piece->FirstChildElement("PointData"), "PointData", np, "surface", m.surface, pdata);
-  read_data_section(r, piece->FirstChildElement("CellData"), "CellData", nc, "region", m.region, cdata);
-
-  // 5. FieldData: frame and provenance (other field arrays are ignored, not decoded).
-  m.source = path;
-  const XMLElement* field = grid->FirstChildElement("FieldData");
-  if (const XMLElement* da = find_named(field, "disc_frame")) {
-    const RawArray f = read_array(r, da);
-    if (f.v.size() != 12) r.fail("FieldData 'disc_frame' must have 12 values");
-    for (double x : f.v)
-      if (!std::isfinite(x)) r.fail("FieldData 'disc_frame' contains non-finite values");
-    for (int i = 0; i < 3; ++i) m.frame.origin_mm(i) = f.v[std::size_t(i)];
-    for (int c = 0; c < 3; ++c)
-      for (int i = 0; i < 3; ++i) m.frame.axes(i, c) = f.v[std::size_t(3 + 3 * c + i)];
-  }
-  if (const XMLElement* da = find_named(field, "source")) {
-    const RawArray s = read_array(r, da);
-    std::string text;
-    for (double c : s.v) {
-      if (c == 0) break;  // VTK String arrays are NUL-terminated
-      if (c > 0 && c < 256) text += char(int(c));
-    }
-    if (!text.empty()) m.source = text;
-  }
-
-  // 6. Quadratic tets: keep only the vertices used as corners, remap indices and point arrays.
-  if (any_quadratic) {
-    std::vector<int> new_index(std::size_t(np), -1);
-    int used = 0;
-    for (Eigen::Index t = 0; t < m.T.rows(); ++t)
-      for (int k = 0; k < 4; ++k) {
-        int& ni = new_index[std::size_t(m.T(t, k))];
-        if (ni < 0) ni = used++;
-      }
-    Eigen::MatrixX3d V(used, 3);
-    Eigen::VectorXi surf(used);
-    for (std::int64_t i = 0; i < np; ++i) {
-      const int ni = new_index[std::size_t(i)];
-      if (ni < 0) continue;
-      V.row(ni) = m.V.row(i);
-      surf(ni) = m.surface(i);
-    }
-    for (DataArray& a : pdata) {
-      Eigen::MatrixXd vals(used, a.values.cols());
-      for (std::int64_t i = 0; i < np; ++i)
-        if (new_index[std::size_t(i)] >= 0) vals.row(new_index[std::size_t(i)]) = a.values.row(i);
-      a.values = std::move(vals);
-    }
-    for (Eigen::Index t = 0; t < m.T.rows(); ++t)
-      for (int k = 0; k < 4; ++k) m.T(t, k) = new_index[std::size_t(m.T(t, k))];
-    m.V = std::move(V);
-    m.surface = std::move(surf);
-  }
-
-  // 7. Geometric sanity (inverted / zero-volume tets) from the shared validator.
-  try {
-    validate(m);
-  } catch (const std::invalid_argument& e) {
-    r.fail(e.what());
-  }
-  if (point_data) *point_data = std::move(pdata);
-  if (cell_data) *cell_data = std::move(cdata);
-  return m;
+  // 3. The mesh, checked (vtk_grid.cpp).
+  return detail::assemble_tet_mesh(r, std::move(g), point_data, cell_data);
 }
 
 }  // namespace spinesim::mesh

@@ -84,7 +84,7 @@ void mesh_one(const OneArgs& a) {
 }
 
 void fem_one(const OneArgs& a) {
-  const auto m = mesh::read_vtu(a.mesh_in);
+  const auto m = mesh::read_tet_mesh(a.mesh_in);
   const double rss_mesh = peak_rss_mb();
   const auto mat = mesh::load_material("real-disc", data_dir());
   const Timer t0;

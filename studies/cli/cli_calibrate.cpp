@@ -211,12 +211,12 @@ void run_calibrate(const CalibrateArgs& a) {
   // 2. The mesh: read, or the level's parametric disc; and the transfer meshes.
   for (const std::string& path : a.transfer_meshes) {
     status("reading transfer mesh " + path);
-    rq.transfer_meshes.emplace_back(path, mesh::read_vtu(path));
+    rq.transfer_meshes.emplace_back(path, mesh::read_tet_mesh(path));
   }
   mesh::TetMesh m;
   if (!a.mesh_path.empty()) {
     status("reading " + a.mesh_path);
-    m = mesh::read_vtu(a.mesh_path);
+    m = mesh::read_tet_mesh(a.mesh_path);
   } else {
     mesh::MeshOptions opt;
     opt.cell_size_mm = a.cell_size_mm;

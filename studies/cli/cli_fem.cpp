@@ -42,7 +42,7 @@ void run_fem(const FemArgs& a) {
 
   Progress progress(3 + int(!a.out.empty()), a.quiet || a.json);
   progress.begin("reading " + a.mesh_path);
-  const mesh::TetMesh m = mesh::read_vtu(a.mesh_path);
+  const mesh::TetMesh m = mesh::read_tet_mesh(a.mesh_path);
   mesh::require_endplate_labels(m);
   progress.end(std::to_string(m.num_tets()) + " tets");
   const Eigen::Vector3d center = a.center.empty() ? fem::DiscFem::default_plate_center(m)

@@ -264,7 +264,7 @@ void run_mss(const MssArgs& a) {
   // 2. Mesh and model.
   Progress progress(3 + int(!a.out.empty()), a.quiet || a.json);
   progress.begin("reading " + a.mesh_path);
-  const mesh::TetMesh m = mesh::read_vtu(a.mesh_path);
+  const mesh::TetMesh m = mesh::read_tet_mesh(a.mesh_path);
   mesh::require_endplate_labels(m);
   const double read_s = progress.end(std::to_string(m.num_tets()) + " tets");
   load.center = center.size() == 3 ? Eigen::Vector3d(center) : fem::DiscFem::default_plate_center(m);
@@ -352,7 +352,7 @@ void run_compare(const CompareArgs& a) {
   // 2. Mesh, FEM reference and MSS on the same mesh.
   Progress progress(4, a.quiet || a.json);
   progress.begin("reading " + a.mesh_path);
-  const mesh::TetMesh m = mesh::read_vtu(a.mesh_path);
+  const mesh::TetMesh m = mesh::read_tet_mesh(a.mesh_path);
   mesh::require_endplate_labels(m);
   progress.end(std::to_string(m.num_tets()) + " tets");
   progress.begin("building the mass-spring model");  // first: a tuned file that does not apply is refused here

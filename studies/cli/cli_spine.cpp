@@ -23,11 +23,7 @@
 // warning on stderr.
 #include "cli_common.hpp"
 
-#include "spinesim/common/timer.hpp"
-#include "model_flags.hpp"
-#include "spinesim/studies/comparison_report.hpp"
-#include "spinesim/studies/mss_run.hpp"  // write_text_file, require_output_folder
-#include "spinesim/studies/spine_studies.hpp"
+#include "spinesim/studies/spine_solve.hpp"
 
 #include "spinesim/spine/equilibrium.hpp"
 #include "spinesim/spine/model.hpp"
@@ -43,9 +39,6 @@
 
 namespace spinesim::cli {
 namespace {
-
-/// The thesis validated its spine for forces up to 600 N (thesis 3.5: 0 … 600 N in 50 N steps).
-constexpr double kValidatedForceN = 600.0;
 
 struct SpineSolveArgs {
   std::vector<std::string> forces, moments, points;
@@ -73,42 +66,7 @@ std::pair<int, Eigen::Vector3d> parse_vertebra_vector(const std::string& text, c
   return {vertebra, Eigen::Vector3d(v)};
 }
 
-/// Newlines in a solver diagnostic would break the one-line error contract.
-std::string vec3(const Eigen::Vector3d& v, int decimals) {
-  return "(" + fixed(v.x(), decimals) + ", " + fixed(v.y(), decimals) + ", " + fixed(v.z(), decimals) + ")";
-}
-
-nlohmann::json vec_json(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
-
-/// Indices of `v` by decreasing value, at most `n`.
-std::vector<int> top_indices(const Eigen::VectorXd& v, int n) {
-  std::vector<int> idx(std::size_t(v.size()));
-  std::iota(idx.begin(), idx.end(), 0);
-  std::stable_sort(idx.begin(), idx.end(), [&](int a, int b) { return v(a) > v(b); });
-  if (int(idx.size()) > n) idx.resize(std::size_t(n));
-  return idx;
-}
-
-double value_or_zero(const Eigen::VectorXd& v, std::size_t i) { return Eigen::Index(i) < v.size() ? v(Eigen::Index(i)) : 0.0; }
-
-std::string solve_csv(const spine::SpineSolution& s) {
-  std::ostringstream os;
-  os << std::setprecision(10)
-     << "vertebra,tx_mm,ty_mm,tz_mm,rx_deg,ry_deg,rz_deg,joint_below,axial_n,shear_ap_n,shear_lat_n,disc_axial_n,"
-        "disc_shear_n,resultant_n,moment_x_nmm,moment_y_nmm,moment_z_nmm\n";
-  for (std::size_t i = 0; i < s.joints.size(); ++i) {
-    const auto& j = s.joints[i];
-    os << spine::vertebra_names()[i];
-    for (int k = 0; k < 6; ++k) os << "," << s.displacement(Eigen::Index(i), k);
-    os << "," << j.joint << "," << j.axial_n << "," << j.shear_ap_n << "," << j.shear_lat_n << "," << j.disc_axial_n << ","
-       << j.disc_shear_n << "," << j.force_world_n.norm();
-    for (int k = 0; k < 3; ++k) os << "," << j.moment_local_nmm(k);
-    os << "\n";
-  }
-  return os.str();
-}
-
-void run_spine_solve(const SpineSolveArgs& a) {
+void solve(const SpineSolveArgs& a) {
   // 1. Options and loads, checked before any work (nothing is written on bad input).
   spine::SolveOptions options;
   options.warn_above_600n = false;  // warned below, before the solve
@@ -161,193 +119,17 @@ void run_spine_solve(const SpineSolveArgs& a) {
   model_options.gravity = !a.no_gravity;
   if (!a.csv.empty()) require_output_folder(a.csv, "--csv");
 
-  // 2. Model and equilibrium.
+  // 2. Model and equilibrium (studies/spine_solve.hpp).
   for (const auto& w : warnings) std::cerr << "spinesim: warning: " << w << std::endl;
-  const Timer t0;
-  const spine::SpineModel m = spine::load_spine_model(data_dir(), model_options);
-  const double model_s = t0.seconds();
-  spine::SpineSolution s;
-  try {
-    s = spine::solve_spine(m, loads, options);
-  } catch (const spine::SolveError& e) {
-    const std::string what = one_line(e.what());
-    throw std::runtime_error(what.find("equilibrium") != std::string::npos ? what
-                                                                            : "the spine did not reach equilibrium: " + what);
-  }
-  const double total_s = t0.seconds();
-  for (const auto& w : s.warnings) std::cerr << "spinesim: warning: " << one_line(w) << std::endl;
+  const SpineSolveRun run = studies::run_spine_solve(data_dir(), {loads, model_options, options});
+  for (const auto& w : run.solution.warnings) std::cerr << "spinesim: warning: " << one_line(w) << std::endl;
 
   // 3. Output.
-  if (!a.csv.empty()) write_text_file(a.csv, solve_csv(s));
-  const auto& names = spine::vertebra_names();
-  const Eigen::VectorXd& recruited = s.recruitment.force_n;
-  Eigen::VectorXd max_force(Eigen::Index(m.muscles.size()));
-  for (std::size_t i = 0; i < m.muscles.size(); ++i) max_force(Eigen::Index(i)) = m.muscles[i].max_force_n();
-  const double max_reserve_nmm = s.recruitment.reserve_nmm.size() ? s.recruitment.reserve_nmm.cwiseAbs().maxCoeff() : 0.0;
-  std::string fused;
-  for (int j : model_options.fused_joints) fused += (fused.empty() ? "" : ", ") + spine::joint_names()[std::size_t(j)];
-  const std::string criterion = a.criterion == "minmax" ? "min-max" : "polynomial, p = " + fixed(a.power, 1);
-
-  if (a.json) {
-    nlohmann::json load_list = nlohmann::json::array(), vertebrae = nlohmann::json::array(), joints = nlohmann::json::array(),
-                   muscles = nlohmann::json::array(), ligaments = nlohmann::json::array();
-    for (const auto& l : loads)
-      load_list.push_back({{"vertebra", names[std::size_t(l.vertebra)]},
-                           {"force_n", vec_json(l.force_n)},
-                           {"moment_nmm", vec_json(l.moment_nmm)},
-                           {"point_mm", vec_json(l.has_point ? l.point_mm : m.vertebrae[std::size_t(l.vertebra)].centre_mm)}});
-    for (std::size_t i = 0; i < names.size(); ++i) {
-      const auto row = s.displacement.row(Eigen::Index(i));
-      vertebrae.push_back({{"name", names[i]},
-                           {"translation_mm", {row(0), row(1), row(2)}},
-                           {"rotation_deg", {row(3), row(4), row(5)}}});
-    }
-    for (const auto& j : s.joints) joints.push_back(joint_reaction_json(j));
-    for (std::size_t i = 0; i < m.muscles.size(); ++i) {
-      const auto& mu = m.muscles[i];
-      muscles.push_back({{"name", mu.name},
-                         {"group", mu.group},
-                         {"side", mu.side},
-                         {"max_force_n", mu.max_force_n()},
-                         {"recruited_force_n", value_or_zero(recruited, i)},
-                         {"activation", value_or_zero(s.recruitment.activation, i)},
-                         {"tension_n", value_or_zero(s.muscle_force_n, i)}});
-    }
-    for (std::size_t i = 0; i < m.ligaments.size(); ++i) {
-      const auto& li = m.ligaments[i];
-      ligaments.push_back({{"name", li.name},
-                           {"type", li.type},
-                           {"joint", li.joint >= 0 ? spine::joint_names()[std::size_t(li.joint)] : ""},
-                           {"force_n", value_or_zero(s.ligament_force_n, i)}});
-    }
-    const Eigen::Matrix<double, 6, 1>& b = s.bushing_wrench;
-    const nlohmann::json j = {
-        {"loads", load_list},
-        {"options",
-         {{"fusion", model_options.fused_joints.empty() ? nlohmann::json::array() : nlohmann::json(fused)},
-          {"muscles", !a.no_muscles},
-          {"gravity", !a.no_gravity},
-          {"criterion", a.criterion},
-          {"power", a.power},
-          {"tolerance_nmm", options.tolerance},
-          {"max_iterations", options.max_iterations}}},
-        {"converged", s.converged},
-        {"iterations", s.iterations},
-        {"gradient_norm_nmm", s.gradient_norm},
-        {"stability",
-         {{"min_stiffness_nmm_per_rad", s.min_stiffness_nmm_per_rad},
-          {"stable", s.min_stiffness_nmm_per_rad > 0},
-          {"softest_mode", s.softest_mode},
-          {"sagittal_solve", s.sagittal_solve}}},
-        {"vertebrae", vertebrae},
-        {"joints", joints},
-        {"muscles", muscles},
-        {"ligaments", ligaments},
-        {"bushing", {{"enabled", m.has_bushing}, {"force_n", {b(0), b(1), b(2)}}, {"moment_nmm", {b(3), b(4), b(5)}}}},
-        {"recruitment",
-         {{"enabled", options.recruit},
-          {"success", s.recruitment.success},
-          {"status", s.recruitment.status},
-          {"iterations", s.recruitment.iterations},
-          {"objective", s.recruitment.objective},
-          {"max_constraint_violation_nmm", s.recruitment.max_constraint_violation_nmm},
-          {"max_reserve_nmm", max_reserve_nmm},
-          {"reserve_nmm", to_json(s.recruitment.reserve_nmm)},
-          {"seconds", s.recruitment.seconds}}},
-        {"warnings", s.warnings},
-        {"seconds", {{"model", model_s}, {"recruitment", s.seconds_recruitment}, {"equilibrium", s.seconds_equilibrium}, {"total", total_s}}},
-        {"csv", a.csv.empty() ? nlohmann::json(nullptr) : nlohmann::json(a.csv)},
-        {"units",
-         {{"frame", "x lateral (body's right -x), y superior, z anterior"},
-          {"translation_mm", "vertebra F.1 centre, world axes, mm"},
-          {"rotation_deg", "rotation vector, world axes, deg"},
-          {"joints", "force the lower side exerts on everything above: world N, N·mm about the moved joint point; "
-                     "axial/shear in the lower vertebra's axes (compression > 0); disc_* in the disc mid-plane; "
-                     "moment_local x flexion+, y torsion, z lateral bending"}}}};
-    print_json(j);
-    return;
-  }
-
-  std::cout << "Spine equilibrium (thesis 3.3): x lateral (body's right -x), y superior, z anterior\n"
-            << "  model: " << (a.no_gravity ? "no gravity" : "gravity") << ", "
-            << (a.no_muscles ? "no muscles" : "muscles recruited (" + criterion + ")") << ", " << m.ligaments.size()
-            << " ligaments" << (m.has_bushing ? ", IAP bushing" : "") << "; fusion: " << (fused.empty() ? "none" : fused) << "\n";
-  for (std::size_t i = 0; i < loads.size(); ++i) {
-    const auto& l = loads[i];
-    std::cout << "  load " << i + 1 << ": " << names[std::size_t(l.vertebra)];
-    if (l.force_n.squaredNorm() > 0)
-      std::cout << " force " << vec3(l.force_n, 1) << " N at "
-                << vec3(l.has_point ? l.point_mm : m.vertebrae[std::size_t(l.vertebra)].centre_mm, 1) << " mm";
-    if (l.moment_nmm.squaredNorm() > 0) std::cout << " couple " << vec3(l.moment_nmm, 1) << " N·mm";
-    std::cout << "\n";
-  }
-  if (loads.empty()) std::cout << "  no external load (gravity only)\n";
-  std::cout << "  converged in " << s.iterations << " Newton iterations, max |dPi/dtheta| " << std::setprecision(2)
-            << std::scientific << s.gradient_norm << std::defaultfloat << " N·mm\n";
-  std::cout << "  tangent stiffness: smallest eigenvalue " << std::setprecision(4) << s.min_stiffness_nmm_per_rad / 1000
-            << " N·m/rad (" << (s.min_stiffness_nmm_per_rad > 0 ? "stable" : "NOT stable") << "), softest mode "
-            << s.softest_mode << "\n\n";
-
-  TextTable v({"vertebra", "tx (mm)", "ty (mm)", "tz (mm)", "rx (deg)", "ry (deg)", "rz (deg)"});
-  for (std::size_t i = 0; i < names.size(); ++i) {
-    std::vector<std::string> row{names[i]};
-    for (int k = 0; k < 6; ++k) row.push_back(fixed(s.displacement(Eigen::Index(i), k), k < 3 ? 3 : 4));
-    v.add(row);
-  }
-  std::cout << "Vertebra displacement (centre translation, rotation vector; world axes)\n";
-  v.print(std::cout, false);
-
-  TextTable jt({"joint", "axial (N)", "shear AP (N)", "shear lat (N)", "disc axial (N)", "disc shear (N)", "|F| (N)",
-                "Mx flex+ (N·m)", "My torsion (N·m)", "Mz lat (N·m)"});
-  for (const auto& j : s.joints)
-    jt.add({j.joint + (std::find(model_options.fused_joints.begin(), model_options.fused_joints.end(),
-                                 spine::joint_index(j.joint)) != model_options.fused_joints.end() ? " (fused)" : ""),
-            fixed(j.axial_n, 1), fixed(j.shear_ap_n, 1), fixed(j.shear_lat_n, 1), fixed(j.disc_axial_n, 1),
-            fixed(j.disc_shear_n, 1), fixed(j.force_world_n.norm(), 1), fixed(j.moment_local_nmm.x() * 1e-3, 3),
-            fixed(j.moment_local_nmm.y() * 1e-3, 3), fixed(j.moment_local_nmm.z() * 1e-3, 3)});
-  std::cout << "\nJoint reactions (lower side on everything above; joint frame = lower vertebra's axes, compression > 0)\n";
-  jt.print(std::cout, false);
-
-  if (!a.no_muscles && !m.muscles.empty() && recruited.size() == Eigen::Index(m.muscles.size())) {
-    int active = 0;
-    for (Eigen::Index i = 0; i < recruited.size(); ++i) active += recruited(i) > 1e-3 * max_force(i);
-    TextTable mt({"muscle", "group", "side", "recruited F (N)", "F max (N)", "activation", "tension (N)"}, 3);
-    for (int i : top_indices(recruited, a.top)) {
-      const auto& mu = m.muscles[std::size_t(i)];
-      mt.add({mu.name, mu.group, mu.side, fixed(recruited(i), 1), fixed(mu.max_force_n(), 1),
-              fixed(value_or_zero(s.recruitment.activation, std::size_t(i)), 3),
-              fixed(value_or_zero(s.muscle_force_n, std::size_t(i)), 1)});
-    }
-    std::cout << "\nMuscles: " << active << " of " << m.muscles.size() << " active (F > 0.1 % of F max); the "
-              << std::min<std::size_t>(std::size_t(a.top), m.muscles.size()) << " strongest (tension: at the equilibrium posture)\n";
-    mt.print(std::cout, false);
-  }
-  if (!m.ligaments.empty() && s.ligament_force_n.size() == Eigen::Index(m.ligaments.size())) {
-    int taut = 0;
-    for (Eigen::Index i = 0; i < s.ligament_force_n.size(); ++i) taut += s.ligament_force_n(i) > 0;
-    TextTable lt({"ligament", "type", "joint", "force (N)"}, 3);
-    for (int i : top_indices(s.ligament_force_n, a.top)) {
-      if (s.ligament_force_n(i) <= 0) break;
-      const auto& li = m.ligaments[std::size_t(i)];
-      lt.add({li.name, li.type, li.joint >= 0 ? spine::joint_names()[std::size_t(li.joint)] : "-", fixed(s.ligament_force_n(i), 2)});
-    }
-    std::cout << "\nLigaments: " << taut << " of " << m.ligaments.size() << " in tension; the strongest\n";
-    lt.print(std::cout, false);
-  }
-  if (m.has_bushing) {
-    const auto& b = s.bushing_wrench;
-    std::cout << "\nIAP bushing on the rib cage (" << names[std::size_t(m.ribs_body)] << "): force "
-              << vec3(Eigen::Vector3d(b(0), b(1), b(2)), 1) << " N, moment "
-              << vec3(Eigen::Vector3d(b(3), b(4), b(5)) * 1e-3, 3) << " N·m\n";
-  }
-  if (options.recruit)
-    std::cout << "Recruitment: " << (s.recruitment.success ? "success" : "FAILED") << " (" << s.recruitment.status << ", "
-              << s.recruitment.iterations << " Ipopt iterations), objective " << std::setprecision(4)
-              << s.recruitment.objective << ", max equilibrium violation " << fixed(s.recruitment.max_constraint_violation_nmm, 3)
-              << " N·mm, largest reserve moment " << fixed(max_reserve_nmm * 1e-3, 3) << " N·m\n";
-  std::cout << "Time: model " << fixed(model_s * 1e3, 1) << " ms, recruitment " << fixed(s.seconds_recruitment * 1e3, 1)
-            << " ms, equilibrium " << fixed(s.seconds_equilibrium * 1e3, 1) << " ms, total " << fixed(total_s * 1e3, 1) << " ms"
-            << (a.csv.empty() ? "" : "; wrote " + a.csv) << "\n";
+  if (!a.csv.empty()) write_text_file(a.csv, spine_solve_csv(run.solution));
+  if (a.json)
+    print_json(spine_solve_json(run, a.csv));
+  else
+    print_spine_solve(std::cout, run, a.top, a.csv);
 }
 
 }  // namespace
@@ -386,7 +168,7 @@ void register_spine(CLI::App& app) {
       "vertebra's axes (the thesis's Fy axial, Fz AP shear) and in the disc mid-plane; moments in N·m.\n"
       "Forces beyond 600 N (the thesis's validated range) are solved with a warning. A solve that does not\n"
       "converge is an error (exit 1, nothing written).");
-  cmd->callback([a] { run_spine_solve(*a); });
+  cmd->callback([a] { solve(*a); });
 
   // `spinesim spine database` (thesis 3.5) lives in cli_spine_database.cpp.
   register_spine_database(*spine_cmd);

@@ -111,7 +111,7 @@ mss::DynamicsOptions check_common(const StudyCommon& c) {
 mesh::TetMesh study_mesh(const StudyCommon& c, Progress& progress) {
   if (!c.mesh_path.empty()) {
     progress.begin("reading " + c.mesh_path);
-    mesh::TetMesh m = mesh::read_vtu(c.mesh_path);
+    mesh::TetMesh m = mesh::read_tet_mesh(c.mesh_path);
     mesh::require_endplate_labels(m);
     progress.end(std::to_string(m.num_tets()) + " tets");
     return m;

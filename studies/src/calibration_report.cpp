@@ -93,6 +93,228 @@ std::string pct(double e) {
   return s.str();
 }
 
+/// Refuses a request that cannot run (before any work).
+void check_request(const mesh::TetMesh& m, const CalibrationRequest& rq) {
+  if (rq.train.empty()) throw std::invalid_argument("calibration needs at least one training case (--train)");
+  for (const auto& h : rq.holdout)
+    for (const auto& t : rq.train)
+      if (h.name == t.name) throw std::invalid_argument("case '" + h.name + "' is both trained on and held out");
+  calibration::validate(rq.ipopt);
+  if (rq.per_spring) {
+    calibration::validate(rq.per_spring_ipopt);
+    const auto& w = rq.per_spring_weights;
+    if (!std::isfinite(w.smoothness) || w.smoothness < 0 || !std::isfinite(w.prior) || w.prior < 0)
+      throw std::invalid_argument("per-spring weights (--smoothness) must be finite and >= 0");
+  }
+  mesh::require_endplate_labels(m);
+  for (const auto& [label, other] : rq.transfer_meshes) {
+    mesh::require_endplate_labels(other);
+    const std::string a = calibration::disc_level(m), b = calibration::disc_level(other);
+    if (!a.empty() && !b.empty() && a != b)
+      throw std::invalid_argument("transfer mesh " + label + " is a " + b + " disc, the calibration mesh a " + a + " disc");
+  }
+}
+
+/// Ipopt's per-iteration line for the status callback.
+std::function<void(int, double, double)> ipopt_progress(const StatusLine& say, const std::string& stage) {
+  return [say, stage](int it, double J, double inf_du) {
+    std::ostringstream s;
+    s << stage << "Ipopt iteration " << it << ": J = " << std::setprecision(4) << J << ", dual infeasibility "
+      << std::setprecision(2) << inf_du;
+    say(s.str());
+  };
+}
+
+/// The tuned file's identity and scales (and per-spring multipliers when that stage ran);
+/// returns the region-level model options (what transfers to other meshes).
+mss::MssOptions fill_tuned_file(CalibrationOutcome& out, const mesh::TetMesh& m, const mesh::RegionMaterials& materials,
+                                const CalibrationRequest& rq, const mss::MssOptions& options,
+                                const calibration::LinearMss& lin, const mss::MssModel& model) {
+  calibration::TunedDisc& t = out.tuned;
+  t.level = calibration::disc_level(m);
+  t.material_name = materials.name;
+  t.material = calibration::material_signature(materials);
+  t.mesh = calibration::fingerprint(m);
+  t.fem_order = rq.fem_order;
+  t.options = options;
+  for (std::size_t j = 0; j < lin.knobs().size(); ++j)
+    t.scales[calibration::knob_name(lin.knobs()[j])] = std::exp(out.result.log_scales(Eigen::Index(j)));
+  const mss::MssOptions region_options = t.mss_options();  // before the multipliers: what transfers
+  if (out.per_spring_ran) {
+    const Eigen::VectorXd mu = out.per_spring.log_multipliers.array().exp();
+    t.edge_multipliers.assign(mu.data(), mu.data() + mu.size());
+    t.edge_order = calibration::edge_order_hash(model);
+  }
+  return region_options;
+}
+
+/// The nonlinear MSS-vs-FEM protocol on every case for the untuned, the tuned and (after the
+/// per-spring stage) the region-only model, at the check load scale.
+void run_nonlinear_checks(CalibrationOutcome& out, const fem::DiscFem& fem, const mss::MssModel& thesis_model,
+                          const mesh::TetMesh& m, const mesh::RegionMaterials& materials, const CalibrationRequest& rq,
+                          const std::vector<fem::LoadCase>& all, const mss::MssOptions& region_options,
+                          const StatusLine& say) {
+  say("nonlinear check: untuned and tuned MSS vs FEM, " + std::to_string(all.size()) + " cases");
+  const Timer t0;
+  const auto compare = [&](const fem::DiscFem& f, const mss::MssModel& model) {
+    return calibration::compare_mss_fem(f, model, all, materials.name, mss::StaticOptions(), rq.check_load_scale);
+  };
+  out.untuned_check = compare(fem, thesis_model);
+  out.tuned_check = compare(fem, mss::MssModel(m, materials, out.tuned.mss_options()));
+  if (out.per_spring_ran) {
+    say("nonlinear check: the region-only fit, " + std::to_string(all.size()) + " cases");
+    out.region_check = compare(fem, mss::MssModel(m, materials, region_options));
+  }
+  out.check_seconds = t0.seconds();
+}
+
+/// The region scales on other meshes of the disc (they transfer; how well? Per-spring
+/// multipliers belong to this mesh and are not carried over).
+void run_transfer_checks(CalibrationOutcome& out, const mesh::RegionMaterials& materials, const CalibrationRequest& rq,
+                         const std::vector<fem::LoadCase>& all, const mss::MssOptions& region_options,
+                         const StatusLine& say) {
+  for (const auto& [label, other] : rq.transfer_meshes) {
+    say("transfer check on " + label + " (" + std::to_string(other.num_tets()) + " tets): FEM and MSS");
+    const Timer t0;
+    const fem::DiscFem other_fem(other, materials, rq.fem_order, fem::DiscFem::default_plate_center(other));
+    TransferCheck tc;
+    tc.label = label;
+    tc.untuned = calibration::compare_mss_fem(other_fem, mss::MssModel(other, materials, term_set_options(TermSet::thesis)),
+                                              all, materials.name, mss::StaticOptions(), rq.check_load_scale);
+    tc.tuned = calibration::compare_mss_fem(other_fem, mss::MssModel(other, materials, region_options), all,
+                                            materials.name, mss::StaticOptions(), rq.check_load_scale);
+    tc.seconds = t0.seconds();
+    out.transfer.push_back(std::move(tc));
+  }
+}
+
+/// One report row per case: linearised and nonlinear errors, untuned beside tuned (and the
+/// region-only fit beside the per-spring one).
+nlohmann::json case_rows(const CalibrationOutcome& out, const calibration::FemReference& ref,
+                         const std::vector<fem::LoadCase>& cases) {
+  nlohmann::json rows = nlohmann::json::array();
+  const calibration::Evaluation& tuned_linear = out.per_spring_ran ? out.per_spring.final.data : out.result.final;
+  for (const auto& lc : cases) {
+    const auto& u = case_error(out.untuned_linear, lc.name);
+    const auto& f = case_error(tuned_linear, lc.name);
+    nlohmann::json r = {{"name", lc.name},
+                        {"untuned_error_linear", u.displacement_error},
+                        {"tuned_error_linear", f.displacement_error},
+                        {"untuned_reaction_error_linear", u.reaction_error},
+                        {"tuned_reaction_error_linear", f.reaction_error}};
+    for (const auto& ref_case : ref.cases)
+      if (ref_case.name == lc.name)
+        r["fem_plate_rotation_deg"] = ref_case.plate_motion.tail<3>().norm() * 180.0 / 3.14159265358979323846;
+    if (out.per_spring_ran) {  // the region-only fit beside the per-spring one
+      const auto& g = case_error(out.result.final, lc.name);
+      r["region_error_linear"] = g.displacement_error;
+      r["region_reaction_error_linear"] = g.reaction_error;
+      const CaseComparison* rn = case_check(out.region_check, lc.name);
+      r["region_error"] = rn ? rn->displacement_error : g.displacement_error;
+      if (rn) r["region_reaction_error"] = rn->reaction_error;
+    }
+    const CaseComparison* un = case_check(out.untuned_check, lc.name);
+    const CaseComparison* tn = case_check(out.tuned_check, lc.name);
+    if (un && tn) {
+      r["untuned_error"] = un->displacement_error;
+      r["tuned_error"] = tn->displacement_error;
+      r["untuned_reaction_error"] = un->reaction_error;
+      r["tuned_reaction_error"] = tn->reaction_error;
+      r["untuned_inverted_tets"] = un->inverted_tets;
+      r["tuned_inverted_tets"] = tn->inverted_tets;
+      r["converged"] = un->converged && tn->converged;
+    } else {  // no nonlinear check: the linearised errors are all there is
+      r["untuned_error"] = u.displacement_error;
+      r["tuned_error"] = f.displacement_error;
+    }
+    rows.push_back(r);
+  }
+  return rows;
+}
+
+/// The transfer checks in the report (region-level scales only).
+nlohmann::json transfer_json(const CalibrationOutcome& out, const CalibrationRequest& rq) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (const TransferCheck& tc : out.transfer) {  // region-level scales only
+    nlohmann::json cases = nlohmann::json::array();
+    for (std::size_t i = 0; i < tc.tuned.cases.size(); ++i)
+      cases.push_back({{"name", tc.tuned.cases[i].name},
+                       {"untuned_error", tc.untuned.cases[i].displacement_error},
+                       {"tuned_error", tc.tuned.cases[i].displacement_error}});
+    const Eigen::VectorXd f = diag(tc.tuned.k6_fem), u = diag(tc.untuned.k6_mss), k = diag(tc.tuned.k6_mss);
+    rows.push_back({{"mesh", tc.label},
+                    {"scales", "region-level"},
+                    {"load_scale", rq.check_load_scale},
+                    {"note", out.per_spring_ran ? "per-spring multipliers do not transfer to another mesh: the "
+                                                  "region-level scales are checked here"
+                                                : "region-level scales transfer to other meshes of the disc"},
+                    {"nodes", tc.tuned.nodes},
+                    {"tets", tc.tuned.tets},
+                    {"cases", cases},
+                    {"stiffness_ratio_untuned", to_json(Eigen::VectorXd(u.cwiseQuotient(f)))},
+                    {"stiffness_ratio_tuned", to_json(Eigen::VectorXd(k.cwiseQuotient(f)))},
+                    {"seconds", tc.seconds}});
+  }
+  return rows;
+}
+
+/// The report stored in the tuned file (t.report): protocol, cases, K6 diagonals, objective,
+/// weights, transfer, Ipopt and timings.
+nlohmann::json calibration_report(const CalibrationOutcome& out, const CalibrationRequest& rq, const mesh::TetMesh& m,
+                                  const calibration::LinearMss& lin, const calibration::FemReference& ref,
+                                  Eigen::Index edge_springs) {
+  const Eigen::VectorXd kf = diag(out.k6_fem), ku = diag(out.k6_untuned), kt = diag(out.k6_tuned),
+                        kr = diag(out.k6_region);
+  nlohmann::json knobs = nlohmann::json::array();
+  for (const auto& k : lin.knobs()) knobs.push_back(calibration::knob_name(k));
+  nlohmann::json report = {
+      {"method",
+       "Ipopt on the MSS linearised at rest (exact adjoint gradient, Gauss-Newton Hessian); errors "
+       "`untuned_error`/`tuned_error`: nonlinear static MSS vs FEM at the case loads x check_load_scale, as "
+       "`spinesim mss compare --load-scale`; `fem_plate_rotation_deg`: the FEM plate's rotation at the full case load; "
+       "`*_linear`: the linearised MSS the optimiser fitted. With --per-spring, `tuned_*` is the per-spring model "
+       "(region scales x one multiplier per main spring) and `region_*` the region-only fit it started from"},
+      {"untuned", "thesis network (main + radial + torsion springs), Van Gelder constants, scales 1"},
+      {"check_load_scale", rq.nonlinear_check ? nlohmann::json(rq.check_load_scale) : nlohmann::json(nullptr)},
+      {"terms", term_set_name(rq.terms)},
+      {"knobs", knobs},
+      {"fem_order", rq.fem_order},
+      {"tets", m.num_tets()},
+      {"nodes", m.num_vertices()},
+      {"train", case_rows(out, ref, rq.train)},
+      {"holdout", case_rows(out, ref, rq.holdout)},
+      {"stiffness_diagonal",
+       {{"fem", to_json(kf)},
+        {"untuned", to_json(ku)},
+        {"tuned", to_json(kt)},
+        {"ratio_untuned", to_json(Eigen::VectorXd(ku.cwiseQuotient(kf)))},
+        {"ratio_tuned", to_json(Eigen::VectorXd(kt.cwiseQuotient(kf)))},
+        {"region", to_json(kr)},
+        {"ratio_region", to_json(Eigen::VectorXd(kr.cwiseQuotient(kf)))},
+        {"units", "tx,ty,tz [N/mm], rx,ry,rz [N·mm/deg], global frame, linear (rest)"}}},
+      {"objective",
+       {{"untuned", evaluation_json(out.untuned_linear)},
+        {"start", evaluation_json(out.result.start)},
+        {"final", evaluation_json(out.result.final)}}},
+      {"weights",
+       {{"reaction", rq.weights.reaction},
+        {"stiffness", rq.weights.stiffness},
+        {"regularisation", rq.weights.regularisation}}},
+      {"transfer", transfer_json(out, rq)},
+      {"ipopt", ipopt_json(out.result, {{"scale_bounds", {rq.ipopt.lower_scale, rq.ipopt.upper_scale}}})},
+      {"timings",
+       {{"fem_s", out.fem_seconds},
+        {"setup_s", out.setup_seconds},
+        {"ipopt_s", out.result.seconds},
+        {"per_spring_s", out.per_spring_ran ? out.per_spring.seconds : 0.0},
+        {"nonlinear_check_s", out.check_seconds},
+        {"transfer_s", [&] { double x = 0; for (const auto& tc : out.transfer) x += tc.seconds; return x; }()},
+        {"total_s", out.total_seconds}}}};
+  if (out.per_spring_ran) report["per_spring"] = per_spring_json(out.per_spring, rq, edge_springs);
+  return report;
+}
+
+
 }  // namespace
 
 TermSet parse_term_set(const std::string& name) {
@@ -120,29 +342,11 @@ mss::MssOptions term_set_options(TermSet t) {
 
 CalibrationOutcome calibrate_disc(const mesh::TetMesh& m, const mesh::RegionMaterials& materials,
                                   const CalibrationRequest& rq, const StatusLine& status) {
-  Timer t_start;
-  const auto say = [&](const std::string& s) {
+  const Timer t_start;
+  const StatusLine say = [&status](const std::string& s) {
     if (status) status(s);
   };
-  if (rq.train.empty()) throw std::invalid_argument("calibration needs at least one training case (--train)");
-  for (const auto& h : rq.holdout)
-    for (const auto& t : rq.train)
-      if (h.name == t.name) throw std::invalid_argument("case '" + h.name + "' is both trained on and held out");
-  calibration::validate(rq.ipopt);
-  if (rq.per_spring) {
-    calibration::validate(rq.per_spring_ipopt);
-    const auto& w = rq.per_spring_weights;
-    if (!std::isfinite(w.smoothness) || w.smoothness < 0 || !std::isfinite(w.prior) || w.prior < 0)
-      throw std::invalid_argument("per-spring weights (--smoothness) must be finite and >= 0");
-  }
-  mesh::require_endplate_labels(m);
-  for (const auto& [label, other] : rq.transfer_meshes) {
-    mesh::require_endplate_labels(other);
-    const std::string a = calibration::disc_level(m), b = calibration::disc_level(other);
-    if (!a.empty() && !b.empty() && a != b)
-      throw std::invalid_argument("transfer mesh " + label + " is a " + b + " disc, the calibration mesh a " + a + " disc");
-  }
-
+  check_request(m, rq);
   CalibrationOutcome out;
   std::vector<fem::LoadCase> all = rq.train;
   all.insert(all.end(), rq.holdout.begin(), rq.holdout.end());
@@ -164,7 +368,6 @@ CalibrationOutcome calibrate_disc(const mesh::TetMesh& m, const mesh::RegionMate
   calibration::Objective thesis_obj(thesis_lin, ref, names(rq.train), rq.weights);
   out.untuned_linear = thesis_obj.evaluate(Eigen::VectorXd::Zero(Eigen::Index(thesis_lin.knobs().size())), false);
   out.k6_untuned = out.untuned_linear.k6;
-
   const mss::MssOptions options = term_set_options(rq.terms);
   const mss::MssModel model(m, materials, options);
   calibration::LinearMss lin(model, calibration::available_knobs(options), c);
@@ -174,16 +377,8 @@ CalibrationOutcome calibrate_disc(const mesh::TetMesh& m, const mesh::RegionMate
   // 3. Ipopt from Van Gelder (all scales 1).
   say("Ipopt: " + std::to_string(lin.knobs().size()) + " stiffness scales, " + std::to_string(rq.train.size()) +
       " training cases");
-  const auto ipopt_progress = [&](const std::string& stage) {
-    return [&say, stage](int it, double J, double inf_du) {
-      std::ostringstream s;
-      s << stage << "Ipopt iteration " << it << ": J = " << std::setprecision(4) << J << ", dual infeasibility "
-        << std::setprecision(2) << inf_du;
-      say(s.str());
-    };
-  };
   out.result = calibration::calibrate(obj, Eigen::VectorXd::Zero(Eigen::Index(lin.knobs().size())), rq.ipopt,
-                                      ipopt_progress(""));
+                                      ipopt_progress(say, ""));
   out.k6_region = out.k6_tuned = out.result.final.k6;
   out.success = out.result.success;
 
@@ -193,174 +388,20 @@ CalibrationOutcome calibrate_disc(const mesh::TetMesh& m, const mesh::RegionMate
     calibration::PerSpringWeights w = rq.per_spring_weights;
     w.prior = rq.weights.regularisation;
     calibration::PerSpringObjective ps(obj, model, out.result.log_scales, w);
-    out.per_spring = calibration::calibrate_per_spring(ps, rq.per_spring_ipopt, ipopt_progress("per-spring "));
+    out.per_spring = calibration::calibrate_per_spring(ps, rq.per_spring_ipopt, ipopt_progress(say, "per-spring "));
     out.per_spring_ran = true;
     out.k6_tuned = out.per_spring.final.data.k6;
     out.success = out.per_spring.success;
   }
 
-  // 4. The tuned file's contents.
-  calibration::TunedDisc& t = out.tuned;
-  t.level = calibration::disc_level(m);
-  t.material_name = materials.name;
-  t.material = calibration::material_signature(materials);
-  t.mesh = calibration::fingerprint(m);
-  t.fem_order = rq.fem_order;
-  t.options = options;
-  for (std::size_t j = 0; j < lin.knobs().size(); ++j)
-    t.scales[calibration::knob_name(lin.knobs()[j])] = std::exp(out.result.log_scales(Eigen::Index(j)));
-  const mss::MssOptions region_options = t.mss_options();  // before the multipliers: what transfers
-  if (out.per_spring_ran) {
-    const Eigen::VectorXd mu = out.per_spring.log_multipliers.array().exp();
-    t.edge_multipliers.assign(mu.data(), mu.data() + mu.size());
-    t.edge_order = calibration::edge_order_hash(model);
-  }
-
-  // 5. Nonlinear checks at the cases' loads (as `mss compare`).
-  if (rq.nonlinear_check && out.success) {
-    say("nonlinear check: untuned and tuned MSS vs FEM, " + std::to_string(all.size()) + " cases");
-    t0.restart();
-    out.untuned_check = calibration::compare_mss_fem(fem, thesis_model, all, materials.name, mss::StaticOptions(), rq.check_load_scale);
-    mss::MssModel tuned(m, materials, t.mss_options());
-    out.tuned_check = calibration::compare_mss_fem(fem, tuned, all, materials.name, mss::StaticOptions(), rq.check_load_scale);
-    if (out.per_spring_ran) {
-      say("nonlinear check: the region-only fit, " + std::to_string(all.size()) + " cases");
-      out.region_check = calibration::compare_mss_fem(fem, mss::MssModel(m, materials, region_options), all, materials.name,
-                                         mss::StaticOptions(), rq.check_load_scale);
-    }
-    out.check_seconds = t0.seconds();
-  }
-  // 6. The region scales on other meshes of the disc (they transfer; how well? Per-spring
-  //    multipliers belong to this mesh and are not carried over).
-  if (out.success)
-    for (const auto& [label, other] : rq.transfer_meshes) {
-      say("transfer check on " + label + " (" + std::to_string(other.num_tets()) + " tets): FEM and MSS");
-      t0.restart();
-      const fem::DiscFem other_fem(other, materials, rq.fem_order, fem::DiscFem::default_plate_center(other));
-      TransferCheck tc;
-      tc.label = label;
-      tc.untuned = calibration::compare_mss_fem(other_fem, mss::MssModel(other, materials, term_set_options(TermSet::thesis)), all,
-                                   materials.name, mss::StaticOptions(), rq.check_load_scale);
-      tc.tuned = calibration::compare_mss_fem(other_fem, mss::MssModel(other, materials, region_options), all, materials.name,
-                                 mss::StaticOptions(), rq.check_load_scale);
-      tc.seconds = t0.seconds();
-      out.transfer.push_back(std::move(tc));
-    }
+  // 4. The tuned file, the nonlinear checks (as `mss compare`) and the transfer meshes.
+  const mss::MssOptions region_options = fill_tuned_file(out, m, materials, rq, options, lin, model);
+  if (rq.nonlinear_check && out.success) run_nonlinear_checks(out, fem, thesis_model, m, materials, rq, all, region_options, say);
+  if (out.success) run_transfer_checks(out, materials, rq, all, region_options, say);
   out.total_seconds = t_start.seconds();
 
-  // 7. Report.
-  auto case_rows = [&](const std::vector<fem::LoadCase>& cases) {
-    nlohmann::json rows = nlohmann::json::array();
-    const calibration::Evaluation& tuned_linear = out.per_spring_ran ? out.per_spring.final.data : out.result.final;
-    for (const auto& lc : cases) {
-      const auto& u = case_error(out.untuned_linear, lc.name);
-      const auto& f = case_error(tuned_linear, lc.name);
-      nlohmann::json r = {{"name", lc.name},
-                          {"untuned_error_linear", u.displacement_error},
-                          {"tuned_error_linear", f.displacement_error},
-                          {"untuned_reaction_error_linear", u.reaction_error},
-                          {"tuned_reaction_error_linear", f.reaction_error}};
-      for (const auto& ref_case : ref.cases)
-        if (ref_case.name == lc.name)
-          r["fem_plate_rotation_deg"] = ref_case.plate_motion.tail<3>().norm() * 180.0 / 3.14159265358979323846;
-      if (out.per_spring_ran) {  // the region-only fit beside the per-spring one
-        const auto& g = case_error(out.result.final, lc.name);
-        r["region_error_linear"] = g.displacement_error;
-        r["region_reaction_error_linear"] = g.reaction_error;
-        const CaseComparison* rn = case_check(out.region_check, lc.name);
-        r["region_error"] = rn ? rn->displacement_error : g.displacement_error;
-        if (rn) r["region_reaction_error"] = rn->reaction_error;
-      }
-      const CaseComparison* un = case_check(out.untuned_check, lc.name);
-      const CaseComparison* tn = case_check(out.tuned_check, lc.name);
-      if (un && tn) {
-        r["untuned_error"] = un->displacement_error;
-        r["tuned_error"] = tn->displacement_error;
-        r["untuned_reaction_error"] = un->reaction_error;
-        r["tuned_reaction_error"] = tn->reaction_error;
-        r["untuned_inverted_tets"] = un->inverted_tets;
-        r["tuned_inverted_tets"] = tn->inverted_tets;
-        r["converged"] = un->converged && tn->converged;
-      } else {  // no nonlinear check: the linearised errors are all there is
-        r["untuned_error"] = u.displacement_error;
-        r["tuned_error"] = f.displacement_error;
-      }
-      rows.push_back(r);
-    }
-    return rows;
-  };
-  const Eigen::VectorXd kf = diag(out.k6_fem), ku = diag(out.k6_untuned), kt = diag(out.k6_tuned),
-                        kr = diag(out.k6_region);
-  nlohmann::json knobs = nlohmann::json::array();
-  for (const auto& k : lin.knobs()) knobs.push_back(calibration::knob_name(k));
-  t.report = {
-      {"method",
-       "Ipopt on the MSS linearised at rest (exact adjoint gradient, Gauss-Newton Hessian); errors "
-       "`untuned_error`/`tuned_error`: nonlinear static MSS vs FEM at the case loads x check_load_scale, as "
-       "`spinesim mss compare --load-scale`; `fem_plate_rotation_deg`: the FEM plate's rotation at the full case load; "
-       "`*_linear`: the linearised MSS the optimiser fitted. With --per-spring, `tuned_*` is the per-spring model "
-       "(region scales x one multiplier per main spring) and `region_*` the region-only fit it started from"},
-      {"untuned", "thesis network (main + radial + torsion springs), Van Gelder constants, scales 1"},
-      {"check_load_scale", rq.nonlinear_check ? nlohmann::json(rq.check_load_scale) : nlohmann::json(nullptr)},
-      {"terms", term_set_name(rq.terms)},
-      {"knobs", knobs},
-      {"fem_order", rq.fem_order},
-      {"tets", m.num_tets()},
-      {"nodes", m.num_vertices()},
-      {"train", case_rows(rq.train)},
-      {"holdout", case_rows(rq.holdout)},
-      {"stiffness_diagonal",
-       {{"fem", to_json(kf)},
-        {"untuned", to_json(ku)},
-        {"tuned", to_json(kt)},
-        {"ratio_untuned", to_json(Eigen::VectorXd(ku.cwiseQuotient(kf)))},
-        {"ratio_tuned", to_json(Eigen::VectorXd(kt.cwiseQuotient(kf)))},
-        {"region", to_json(kr)},
-        {"ratio_region", to_json(Eigen::VectorXd(kr.cwiseQuotient(kf)))},
-        {"units", "tx,ty,tz [N/mm], rx,ry,rz [N·mm/deg], global frame, linear (rest)"}}},
-      {"objective",
-       {{"untuned", evaluation_json(out.untuned_linear)},
-        {"start", evaluation_json(out.result.start)},
-        {"final", evaluation_json(out.result.final)}}},
-      {"weights",
-       {{"reaction", rq.weights.reaction},
-        {"stiffness", rq.weights.stiffness},
-        {"regularisation", rq.weights.regularisation}}},
-      {"transfer",
-       [&] {
-         nlohmann::json rows = nlohmann::json::array();
-         for (const TransferCheck& tc : out.transfer) {  // region-level scales only
-           nlohmann::json cases = nlohmann::json::array();
-           for (std::size_t i = 0; i < tc.tuned.cases.size(); ++i)
-             cases.push_back({{"name", tc.tuned.cases[i].name},
-                              {"untuned_error", tc.untuned.cases[i].displacement_error},
-                              {"tuned_error", tc.tuned.cases[i].displacement_error}});
-           const Eigen::VectorXd f = diag(tc.tuned.k6_fem), u = diag(tc.untuned.k6_mss), k = diag(tc.tuned.k6_mss);
-           rows.push_back({{"mesh", tc.label},
-                           {"scales", "region-level"},
-                           {"load_scale", rq.check_load_scale},
-                           {"note", out.per_spring_ran ? "per-spring multipliers do not transfer to another mesh: the "
-                                                         "region-level scales are checked here"
-                                                       : "region-level scales transfer to other meshes of the disc"},
-                           {"nodes", tc.tuned.nodes},
-                           {"tets", tc.tuned.tets},
-                           {"cases", cases},
-                           {"stiffness_ratio_untuned", to_json(Eigen::VectorXd(u.cwiseQuotient(f)))},
-                           {"stiffness_ratio_tuned", to_json(Eigen::VectorXd(k.cwiseQuotient(f)))},
-                           {"seconds", tc.seconds}});
-         }
-         return rows;
-       }()},
-      {"ipopt", ipopt_json(out.result, {{"scale_bounds", {rq.ipopt.lower_scale, rq.ipopt.upper_scale}}})},
-      {"timings",
-       {{"fem_s", out.fem_seconds},
-        {"setup_s", out.setup_seconds},
-        {"ipopt_s", out.result.seconds},
-        {"per_spring_s", out.per_spring_ran ? out.per_spring.seconds : 0.0},
-        {"nonlinear_check_s", out.check_seconds},
-        {"transfer_s", [&] { double x = 0; for (const auto& tc : out.transfer) x += tc.seconds; return x; }()},
-        {"total_s", out.total_seconds}}}};
-  if (out.per_spring_ran) t.report["per_spring"] = per_spring_json(out.per_spring, rq, model.num_edge_springs());
+  // 5. Report.
+  out.tuned.report = calibration_report(out, rq, m, lin, ref, model.num_edge_springs());
   return out;
 }
 

@@ -586,156 +586,167 @@ bool one_of(const std::string& s, std::initializer_list<const char*> options) {
   return false;
 }
 
+PairSeries column(const TrendRun& r, bool rotation, int k) {
+  return PairSeries{r.pairs, rotation ? Eigen::VectorXd(r.rotation_deg.col(k)) : Eigen::VectorXd(r.translation_mm.col(k))};
+}
+
+std::string count_of(int n, int of, const std::string& what) {
+  return std::to_string(n) + "/" + std::to_string(of) + " " + what;
+}
+
+void add(std::vector<Finding>& out, const char* id, const char* load, const std::string& thesis, const std::string& ours,
+         bool match) {
+  out.push_back({id, load, thesis, ours, match});
+}
+
+/// Lateral force (−x), translations: x shear, y compression, z negligible.
+void lateral_translation_findings(const TrendRun& r, std::vector<Finding>& out) {
+  const double sx = r.force_n.x() > 0 ? 1 : -1;
+  const PairSeries dx = column(r, false, 0), dy = column(r, false, 1), dz = column(r, false, 2);
+  const PairSeries ax{r.pairs, dx.v.cwiseAbs()}, comp{r.pairs, -dy.v};
+  const int n = int(r.pairs.size());
+  add(out, "lateral-shear-everywhere", "lateral", "upper vertebra moves further than the lower one at every pair (lateral shear)",
+      count_of(dx.count_sign("T1-T2", "L4-L5", sx), n, "pairs with Δx along the force"), dx.count_sign("T1-T2", "L4-L5", sx) == n);
+  add(out, "lateral-shear-peak", "lateral", "shearing peak at T10-T11", "max |Δx| (mm) at " + ax.show(ax.argmax()) + "; " + ax.show("T10-T11"),
+      ax.name(ax.argmax()) == "T10-T11");
+  add(out, "lateral-shear-least", "lateral", "least shearing at L4-L5", "min |Δx| (mm) at " + ax.show(ax.argmin()) + "; " + ax.show("L4-L5"),
+      ax.name(ax.argmin()) == "L4-L5");
+  add(out, "lateral-shear-pattern", "lateral", "shearing falls T1-T2→T5-T6, rises T6-T7→T10-T11, falls to L4-L5",
+      "|Δx| (mm) " + ax.show("T1-T2") + ", " + ax.show("T5-T6") + ", " + ax.show("T6-T7") + ", " + ax.show("T10-T11") + ", " +
+          ax.show("L4-L5"),
+      ax("T5-T6") < ax("T1-T2") && ax("T10-T11") > ax("T6-T7") && ax("L4-L5") < ax("T10-T11"));
+  add(out, "lateral-compression-everywhere", "lateral", "whole spine under compression (Δy < 0 at every pair)",
+      count_of(comp.count_sign("T1-T2", "L4-L5", 1), n, "pairs with Δy < 0"), comp.count_sign("T1-T2", "L4-L5", 1) == n);
+  add(out, "lateral-compression-max", "lateral", "largest compression at T10-T11 and T1-T2",
+      "max −Δy (mm) at " + comp.show(comp.argmax(), 4), one_of(comp.name(comp.argmax()), {"T10-T11", "T1-T2"}));
+  add(out, "lateral-compression-min", "lateral", "smallest compression at L4-L5", "min −Δy (mm) at " + comp.show(comp.argmin(), 4),
+      comp.name(comp.argmin()) == "L4-L5");
+  const double zmax = dz.v.cwiseAbs().maxCoeff(), xmax = ax.v.maxCoeff();
+  add(out, "lateral-z-negligible", "lateral", "z relative translation very small (< 10 % of the largest |Δx|)",
+      "max |Δz| " + fixed(zmax, 4) + " mm vs max |Δx| " + fixed(xmax, 4) + " mm", zmax < 0.1 * xmax);
+
+}
+
+/// Lateral force (−x), rotations: flexion negligible, torsion, lateral bending by region.
+void lateral_rotation_findings(const TrendRun& r, std::vector<Finding>& out) {
+  const PairSeries rx = column(r, true, 0), ry = column(r, true, 1), rz = column(r, true, 2);
+  const PairSeries ary{r.pairs, ry.v.cwiseAbs()};
+  const double rxmax = rx.v.cwiseAbs().maxCoeff(), rzmax = rz.v.cwiseAbs().maxCoeff();
+  add(out, "lateral-flexion-negligible", "lateral", "flexion/extension negligible (max |θx| < 10 % of max |θz|)",
+      "max |θx| " + fixed(rxmax, 4) + "°, max |θz| " + fixed(rzmax, 4) + "°", rxmax < 0.1 * rzmax);
+  add(out, "lateral-torsion-min", "lateral", "smallest torsion at T10-T11", "min |θy| (deg) at " + ary.show(ary.argmin(), 4),
+      ary.name(ary.argmin()) == "T10-T11");
+  add(out, "lateral-torsion-max", "lateral", "largest torsion at T5-T6 and L4-L5", "max |θy| (deg) at " + ary.show(ary.argmax(), 4),
+      one_of(ary.name(ary.argmax()), {"T5-T6", "L4-L5"}));
+  {
+    const double s1 = ry("T1-T2") >= 0 ? 1 : -1;
+    const int up = ry.count_sign("T1-T2", "T10-T11", s1), low = ry.count_sign("T11-T12", "L4-L5", -s1);
+    add(out, "lateral-torsion-switch", "lateral", "torsion one way T1-T2…T10-T11, the other way T11-T12…L4-L5",
+        count_of(up, ry.span("T1-T2", "T10-T11"), "upper pairs one way") + ", " + count_of(low, ry.span("T11-T12", "L4-L5"), "lower pairs the other"),
+        up == ry.span("T1-T2", "T10-T11") && low == ry.span("T11-T12", "L4-L5"));
+  }
+  {
+    const double sl = rz("L4-L5") >= 0 ? 1 : -1;
+    const int n_low = rz.count_sign("T10-T11", "L4-L5", sl);
+    add(out, "lateral-bending-lower", "lateral", "T10-L5 in lateral flexion (one side)",
+        count_of(n_low, rz.span("T10-T11", "L4-L5"), "pairs T10-T11…L4-L5 bend the same way"), n_low == rz.span("T10-T11", "L4-L5"));
+    const double su = rz("T1-T2") >= 0 ? 1 : -1;
+    const int a = rz.count_sign("T1-T2", "T5-T6", su), b = rz.count_sign("T6-T7", "T9-T10", -su);
+    add(out, "lateral-bending-upper-opposite", "lateral", "T1-T6 and T6-T10 bend opposite ways",
+        count_of(a, rz.span("T1-T2", "T5-T6"), "of T1-T2…T5-T6 one way") + ", " + count_of(b, rz.span("T6-T7", "T9-T10"), "of T6-T7…T9-T10 the other"),
+        a == rz.span("T1-T2", "T5-T6") && b == rz.span("T6-T7", "T9-T10"));
+  }
+}
+
+/// Forward force (+z): compression above T9, tension below, AP shear, flexion/extension regions.
+void forward_findings(const TrendRun& r, std::vector<Finding>& out) {
+  const double sz = r.force_n.z() > 0 ? 1 : -1;
+  const PairSeries dy = column(r, false, 1), dz = column(r, false, 2);
+  const PairSeries az{r.pairs, dz.v.cwiseAbs()}, comp{r.pairs, -dy.v};
+  const int n = int(r.pairs.size());
+  const int c_up = dy.count_sign("T1-T2", "T8-T9", -1), t_low = dy.count_sign("T9-T10", "L4-L5", 1);
+  add(out, "forward-compression-T1-T9", "forward", "T1-T9 under compression (Δy < 0, T1-T2…T8-T9)",
+      count_of(c_up, dy.span("T1-T2", "T8-T9"), "pairs"), c_up == dy.span("T1-T2", "T8-T9"));
+  add(out, "forward-tension-T9-L5", "forward", "T9-L5 under tension (Δy > 0, T9-T10…L4-L5)",
+      count_of(t_low, dy.span("T9-T10", "L4-L5"), "pairs"), t_low == dy.span("T9-T10", "L4-L5"));
+  add(out, "forward-compression-max", "forward", "largest compression at T1-T2", "max −Δy (mm) at " + comp.show(comp.argmax(), 4),
+      comp.name(comp.argmax()) == "T1-T2");
+  add(out, "forward-tension-max", "forward", "maximum tension at T11-T12", "max Δy (mm) at " + dy.show(dy.argmax(), 4),
+      dy.name(dy.argmax()) == "T11-T12" && dy.v.maxCoeff() > 0);
+  add(out, "forward-shear-everywhere", "forward", "antero-posterior shear at every pair (Δz along the force)",
+      count_of(dz.count_sign("T1-T2", "L4-L5", sz), n, "pairs"), dz.count_sign("T1-T2", "L4-L5", sz) == n);
+  add(out, "forward-shear-max", "forward", "largest AP shear at T10-T11", "max |Δz| (mm) at " + az.show(az.argmax()),
+      az.name(az.argmax()) == "T10-T11");
+  add(out, "forward-shear-min", "forward", "smallest AP shear at L4-L5", "min |Δz| (mm) at " + az.show(az.argmin()),
+      az.name(az.argmin()) == "L4-L5");
+  add(out, "forward-shear-pattern", "forward", "AP shear rises T1-T2→T3-T4, falls T4-T5→T8-T9, rises to T10-T11, falls to L4-L5",
+      "|Δz| (mm) " + az.show("T1-T2") + ", " + az.show("T3-T4") + ", " + az.show("T4-T5") + ", " + az.show("T8-T9") + ", " +
+          az.show("T10-T11") + ", " + az.show("L4-L5"),
+      az("T3-T4") > az("T1-T2") && az("T8-T9") < az("T4-T5") && az("T10-T11") > az("T8-T9") && az("L4-L5") < az("T10-T11"));
+
+  const PairSeries rx = column(r, true, 0);
+  const int f1 = rx.count_sign("T1-T2", "T6-T7", 1), e = rx.count_sign("T7-T8", "T10-T11", -1),
+            f2 = rx.count_sign("T11-T12", "L4-L5", 1);
+  add(out, "forward-flexion-regions", "forward", "flexion T1-T7 and T11-L5, extension T7-T11",
+      "flexion " + count_of(f1, rx.span("T1-T2", "T6-T7"), "of T1-T2…T6-T7") + ", extension " +
+          count_of(e, rx.span("T7-T8", "T10-T11"), "of T7-T8…T10-T11") + ", flexion " + count_of(f2, rx.span("T11-T12", "L4-L5"), "of T11-T12…L4-L5"),
+      f1 == rx.span("T1-T2", "T6-T7") && e == rx.span("T7-T8", "T10-T11") && f2 == rx.span("T11-T12", "L4-L5"));
+  add(out, "forward-flexion-max", "forward", "maximum flexion at T5-T6", "max θx (deg) at " + rx.show(rx.argmax(), 4),
+      rx.name(rx.argmax()) == "T5-T6");
+  add(out, "forward-extension-max", "forward", "maximum extension at T9-T10", "min θx (deg) at " + rx.show(rx.argmin(), 4),
+      rx.name(rx.argmin()) == "T9-T10" && rx.v.minCoeff() < 0);
+}
+
+/// Backward force (−z): compression, AP shear, extension/flexion regions.
+void backward_findings(const TrendRun& r, std::vector<Finding>& out) {
+  const double sz = r.force_n.z() > 0 ? 1 : -1;
+  const PairSeries dy = column(r, false, 1), dz = column(r, false, 2);
+  const PairSeries az{r.pairs, dz.v.cwiseAbs()}, comp{r.pairs, -dy.v};
+  const int n = int(r.pairs.size());
+  add(out, "backward-compression-everywhere", "backward", "whole spine under compression (Δy < 0 at every pair)",
+      count_of(comp.count_sign("T1-T2", "L4-L5", 1), n, "pairs"), comp.count_sign("T1-T2", "L4-L5", 1) == n);
+  add(out, "backward-compression-max", "backward", "maximum compression at T11-T12", "max −Δy (mm) at " + comp.show(comp.argmax(), 4),
+      comp.name(comp.argmax()) == "T11-T12");
+  add(out, "backward-compression-min", "backward", "minimum compression at T6-T7 and L4-L5",
+      "min −Δy (mm) at " + comp.show(comp.argmin(), 4), one_of(comp.name(comp.argmin()), {"T6-T7", "L4-L5"}));
+  add(out, "backward-compression-pattern", "backward", "compression rises T8-T9→T11-T12, then falls to L4-L5",
+      "−Δy (mm) " + comp.show("T8-T9", 4) + ", " + comp.show("T11-T12", 4) + ", " + comp.show("L4-L5", 4),
+      comp("T11-T12") > comp("T8-T9") && comp("L4-L5") < comp("T11-T12"));
+  add(out, "backward-shear-everywhere", "backward", "AP shear at every pair (Δz along the force)",
+      count_of(dz.count_sign("T1-T2", "L4-L5", sz), n, "pairs"), dz.count_sign("T1-T2", "L4-L5", sz) == n);
+  add(out, "backward-shear-max", "backward", "largest AP shear at T1-T2 and T10-T11", "max |Δz| (mm) at " + az.show(az.argmax()),
+      one_of(az.name(az.argmax()), {"T1-T2", "T10-T11"}));
+  add(out, "backward-shear-min", "backward", "smallest AP shear at L4-L5", "min |Δz| (mm) at " + az.show(az.argmin()),
+      az.name(az.argmin()) == "L4-L5");
+  add(out, "backward-shear-pattern", "backward", "AP shear falls T1-T2→T5-T6, rises T6-T7→T10-T11, falls to L4-L5",
+      "|Δz| (mm) " + az.show("T1-T2") + ", " + az.show("T5-T6") + ", " + az.show("T6-T7") + ", " + az.show("T10-T11") + ", " +
+          az.show("L4-L5"),
+      az("T5-T6") < az("T1-T2") && az("T10-T11") > az("T6-T7") && az("L4-L5") < az("T10-T11"));
+
+  const PairSeries rx = column(r, true, 0);
+  const int e1 = rx.count_sign("T1-T2", "T5-T6", -1), f = rx.count_sign("T6-T7", "T9-T10", 1),
+            e2 = rx.count_sign("T10-T11", "L4-L5", -1);
+  add(out, "backward-extension-regions", "backward", "extension T1-T6 and T10-L5, flexion T6-T10",
+      "extension " + count_of(e1, rx.span("T1-T2", "T5-T6"), "of T1-T2…T5-T6") + ", flexion " +
+          count_of(f, rx.span("T6-T7", "T9-T10"), "of T6-T7…T9-T10") + ", extension " + count_of(e2, rx.span("T10-T11", "L4-L5"), "of T10-T11…L4-L5"),
+      e1 == rx.span("T1-T2", "T5-T6") && f == rx.span("T6-T7", "T9-T10") && e2 == rx.span("T10-T11", "L4-L5"));
+  add(out, "backward-extension-max", "backward", "largest extension at T5-T6 and L1-L2", "min θx (deg) at " + rx.show(rx.argmin(), 4),
+      one_of(rx.name(rx.argmin()), {"T5-T6", "L1-L2"}) && rx.v.minCoeff() < 0);
+  add(out, "backward-flexion-max", "backward", "largest flexion at T6-T7", "max θx (deg) at " + rx.show(rx.argmax(), 4),
+      rx.name(rx.argmax()) == "T6-T7" && rx.v.maxCoeff() > 0);
+}
+
 std::vector<Finding> trend_findings(const TrendsStudy& s) {
-  std::vector<Finding> out;
   auto run = [&](const std::string& load) -> const TrendRun& {
     for (const auto& r : s.runs)
       if (r.load == load) return r;
     throw std::logic_error("trends: no run " + load);
   };
-  auto col = [](const TrendRun& r, bool rotation, int k) {
-    return PairSeries{r.pairs, rotation ? Eigen::VectorXd(r.rotation_deg.col(k)) : Eigen::VectorXd(r.translation_mm.col(k))};
-  };
-  auto add = [&](const char* id, const char* load, const std::string& thesis, const std::string& ours, bool match) {
-    out.push_back({id, load, thesis, ours, match});
-  };
-  auto count = [](int n, int of, const std::string& what) { return std::to_string(n) + "/" + std::to_string(of) + " " + what; };
-
-  // Lateral force (−x): x shear, y compression, z negligible; rotations.
-  {
-    const TrendRun& r = run("lateral");
-    const double sx = r.force_n.x() > 0 ? 1 : -1;
-    const PairSeries dx = col(r, false, 0), dy = col(r, false, 1), dz = col(r, false, 2);
-    const PairSeries ax{r.pairs, dx.v.cwiseAbs()}, comp{r.pairs, -dy.v};
-    const int n = int(r.pairs.size());
-    add("lateral-shear-everywhere", "lateral", "upper vertebra moves further than the lower one at every pair (lateral shear)",
-        count(dx.count_sign("T1-T2", "L4-L5", sx), n, "pairs with Δx along the force"), dx.count_sign("T1-T2", "L4-L5", sx) == n);
-    add("lateral-shear-peak", "lateral", "shearing peak at T10-T11", "max |Δx| (mm) at " + ax.show(ax.argmax()) + "; " + ax.show("T10-T11"),
-        ax.name(ax.argmax()) == "T10-T11");
-    add("lateral-shear-least", "lateral", "least shearing at L4-L5", "min |Δx| (mm) at " + ax.show(ax.argmin()) + "; " + ax.show("L4-L5"),
-        ax.name(ax.argmin()) == "L4-L5");
-    add("lateral-shear-pattern", "lateral", "shearing falls T1-T2→T5-T6, rises T6-T7→T10-T11, falls to L4-L5",
-        "|Δx| (mm) " + ax.show("T1-T2") + ", " + ax.show("T5-T6") + ", " + ax.show("T6-T7") + ", " + ax.show("T10-T11") + ", " +
-            ax.show("L4-L5"),
-        ax("T5-T6") < ax("T1-T2") && ax("T10-T11") > ax("T6-T7") && ax("L4-L5") < ax("T10-T11"));
-    add("lateral-compression-everywhere", "lateral", "whole spine under compression (Δy < 0 at every pair)",
-        count(comp.count_sign("T1-T2", "L4-L5", 1), n, "pairs with Δy < 0"), comp.count_sign("T1-T2", "L4-L5", 1) == n);
-    add("lateral-compression-max", "lateral", "largest compression at T10-T11 and T1-T2",
-        "max −Δy (mm) at " + comp.show(comp.argmax(), 4), one_of(comp.name(comp.argmax()), {"T10-T11", "T1-T2"}));
-    add("lateral-compression-min", "lateral", "smallest compression at L4-L5", "min −Δy (mm) at " + comp.show(comp.argmin(), 4),
-        comp.name(comp.argmin()) == "L4-L5");
-    const double zmax = dz.v.cwiseAbs().maxCoeff(), xmax = ax.v.maxCoeff();
-    add("lateral-z-negligible", "lateral", "z relative translation very small (< 10 % of the largest |Δx|)",
-        "max |Δz| " + fixed(zmax, 4) + " mm vs max |Δx| " + fixed(xmax, 4) + " mm", zmax < 0.1 * xmax);
-
-    const PairSeries rx = col(r, true, 0), ry = col(r, true, 1), rz = col(r, true, 2);
-    const PairSeries ary{r.pairs, ry.v.cwiseAbs()};
-    const double rxmax = rx.v.cwiseAbs().maxCoeff(), rzmax = rz.v.cwiseAbs().maxCoeff();
-    add("lateral-flexion-negligible", "lateral", "flexion/extension negligible (max |θx| < 10 % of max |θz|)",
-        "max |θx| " + fixed(rxmax, 4) + "°, max |θz| " + fixed(rzmax, 4) + "°", rxmax < 0.1 * rzmax);
-    add("lateral-torsion-min", "lateral", "smallest torsion at T10-T11", "min |θy| (deg) at " + ary.show(ary.argmin(), 4),
-        ary.name(ary.argmin()) == "T10-T11");
-    add("lateral-torsion-max", "lateral", "largest torsion at T5-T6 and L4-L5", "max |θy| (deg) at " + ary.show(ary.argmax(), 4),
-        one_of(ary.name(ary.argmax()), {"T5-T6", "L4-L5"}));
-    {
-      const double s1 = ry("T1-T2") >= 0 ? 1 : -1;
-      const int up = ry.count_sign("T1-T2", "T10-T11", s1), low = ry.count_sign("T11-T12", "L4-L5", -s1);
-      add("lateral-torsion-switch", "lateral", "torsion one way T1-T2…T10-T11, the other way T11-T12…L4-L5",
-          count(up, ry.span("T1-T2", "T10-T11"), "upper pairs one way") + ", " + count(low, ry.span("T11-T12", "L4-L5"), "lower pairs the other"),
-          up == ry.span("T1-T2", "T10-T11") && low == ry.span("T11-T12", "L4-L5"));
-    }
-    {
-      const double sl = rz("L4-L5") >= 0 ? 1 : -1;
-      const int n_low = rz.count_sign("T10-T11", "L4-L5", sl);
-      add("lateral-bending-lower", "lateral", "T10-L5 in lateral flexion (one side)",
-          count(n_low, rz.span("T10-T11", "L4-L5"), "pairs T10-T11…L4-L5 bend the same way"), n_low == rz.span("T10-T11", "L4-L5"));
-      const double su = rz("T1-T2") >= 0 ? 1 : -1;
-      const int a = rz.count_sign("T1-T2", "T5-T6", su), b = rz.count_sign("T6-T7", "T9-T10", -su);
-      add("lateral-bending-upper-opposite", "lateral", "T1-T6 and T6-T10 bend opposite ways",
-          count(a, rz.span("T1-T2", "T5-T6"), "of T1-T2…T5-T6 one way") + ", " + count(b, rz.span("T6-T7", "T9-T10"), "of T6-T7…T9-T10 the other"),
-          a == rz.span("T1-T2", "T5-T6") && b == rz.span("T6-T7", "T9-T10"));
-    }
-  }
-
-  // Forward force (+z).
-  {
-    const TrendRun& r = run("forward");
-    const double sz = r.force_n.z() > 0 ? 1 : -1;
-    const PairSeries dy = col(r, false, 1), dz = col(r, false, 2);
-    const PairSeries az{r.pairs, dz.v.cwiseAbs()}, comp{r.pairs, -dy.v};
-    const int n = int(r.pairs.size());
-    const int c_up = dy.count_sign("T1-T2", "T8-T9", -1), t_low = dy.count_sign("T9-T10", "L4-L5", 1);
-    add("forward-compression-T1-T9", "forward", "T1-T9 under compression (Δy < 0, T1-T2…T8-T9)",
-        count(c_up, dy.span("T1-T2", "T8-T9"), "pairs"), c_up == dy.span("T1-T2", "T8-T9"));
-    add("forward-tension-T9-L5", "forward", "T9-L5 under tension (Δy > 0, T9-T10…L4-L5)",
-        count(t_low, dy.span("T9-T10", "L4-L5"), "pairs"), t_low == dy.span("T9-T10", "L4-L5"));
-    add("forward-compression-max", "forward", "largest compression at T1-T2", "max −Δy (mm) at " + comp.show(comp.argmax(), 4),
-        comp.name(comp.argmax()) == "T1-T2");
-    add("forward-tension-max", "forward", "maximum tension at T11-T12", "max Δy (mm) at " + dy.show(dy.argmax(), 4),
-        dy.name(dy.argmax()) == "T11-T12" && dy.v.maxCoeff() > 0);
-    add("forward-shear-everywhere", "forward", "antero-posterior shear at every pair (Δz along the force)",
-        count(dz.count_sign("T1-T2", "L4-L5", sz), n, "pairs"), dz.count_sign("T1-T2", "L4-L5", sz) == n);
-    add("forward-shear-max", "forward", "largest AP shear at T10-T11", "max |Δz| (mm) at " + az.show(az.argmax()),
-        az.name(az.argmax()) == "T10-T11");
-    add("forward-shear-min", "forward", "smallest AP shear at L4-L5", "min |Δz| (mm) at " + az.show(az.argmin()),
-        az.name(az.argmin()) == "L4-L5");
-    add("forward-shear-pattern", "forward", "AP shear rises T1-T2→T3-T4, falls T4-T5→T8-T9, rises to T10-T11, falls to L4-L5",
-        "|Δz| (mm) " + az.show("T1-T2") + ", " + az.show("T3-T4") + ", " + az.show("T4-T5") + ", " + az.show("T8-T9") + ", " +
-            az.show("T10-T11") + ", " + az.show("L4-L5"),
-        az("T3-T4") > az("T1-T2") && az("T8-T9") < az("T4-T5") && az("T10-T11") > az("T8-T9") && az("L4-L5") < az("T10-T11"));
-
-    const PairSeries rx = col(r, true, 0);
-    const int f1 = rx.count_sign("T1-T2", "T6-T7", 1), e = rx.count_sign("T7-T8", "T10-T11", -1),
-              f2 = rx.count_sign("T11-T12", "L4-L5", 1);
-    add("forward-flexion-regions", "forward", "flexion T1-T7 and T11-L5, extension T7-T11",
-        "flexion " + count(f1, rx.span("T1-T2", "T6-T7"), "of T1-T2…T6-T7") + ", extension " +
-            count(e, rx.span("T7-T8", "T10-T11"), "of T7-T8…T10-T11") + ", flexion " + count(f2, rx.span("T11-T12", "L4-L5"), "of T11-T12…L4-L5"),
-        f1 == rx.span("T1-T2", "T6-T7") && e == rx.span("T7-T8", "T10-T11") && f2 == rx.span("T11-T12", "L4-L5"));
-    add("forward-flexion-max", "forward", "maximum flexion at T5-T6", "max θx (deg) at " + rx.show(rx.argmax(), 4),
-        rx.name(rx.argmax()) == "T5-T6");
-    add("forward-extension-max", "forward", "maximum extension at T9-T10", "min θx (deg) at " + rx.show(rx.argmin(), 4),
-        rx.name(rx.argmin()) == "T9-T10" && rx.v.minCoeff() < 0);
-  }
-
-  // Backward force (−z).
-  {
-    const TrendRun& r = run("backward");
-    const double sz = r.force_n.z() > 0 ? 1 : -1;
-    const PairSeries dy = col(r, false, 1), dz = col(r, false, 2);
-    const PairSeries az{r.pairs, dz.v.cwiseAbs()}, comp{r.pairs, -dy.v};
-    const int n = int(r.pairs.size());
-    add("backward-compression-everywhere", "backward", "whole spine under compression (Δy < 0 at every pair)",
-        count(comp.count_sign("T1-T2", "L4-L5", 1), n, "pairs"), comp.count_sign("T1-T2", "L4-L5", 1) == n);
-    add("backward-compression-max", "backward", "maximum compression at T11-T12", "max −Δy (mm) at " + comp.show(comp.argmax(), 4),
-        comp.name(comp.argmax()) == "T11-T12");
-    add("backward-compression-min", "backward", "minimum compression at T6-T7 and L4-L5",
-        "min −Δy (mm) at " + comp.show(comp.argmin(), 4), one_of(comp.name(comp.argmin()), {"T6-T7", "L4-L5"}));
-    add("backward-compression-pattern", "backward", "compression rises T8-T9→T11-T12, then falls to L4-L5",
-        "−Δy (mm) " + comp.show("T8-T9", 4) + ", " + comp.show("T11-T12", 4) + ", " + comp.show("L4-L5", 4),
-        comp("T11-T12") > comp("T8-T9") && comp("L4-L5") < comp("T11-T12"));
-    add("backward-shear-everywhere", "backward", "AP shear at every pair (Δz along the force)",
-        count(dz.count_sign("T1-T2", "L4-L5", sz), n, "pairs"), dz.count_sign("T1-T2", "L4-L5", sz) == n);
-    add("backward-shear-max", "backward", "largest AP shear at T1-T2 and T10-T11", "max |Δz| (mm) at " + az.show(az.argmax()),
-        one_of(az.name(az.argmax()), {"T1-T2", "T10-T11"}));
-    add("backward-shear-min", "backward", "smallest AP shear at L4-L5", "min |Δz| (mm) at " + az.show(az.argmin()),
-        az.name(az.argmin()) == "L4-L5");
-    add("backward-shear-pattern", "backward", "AP shear falls T1-T2→T5-T6, rises T6-T7→T10-T11, falls to L4-L5",
-        "|Δz| (mm) " + az.show("T1-T2") + ", " + az.show("T5-T6") + ", " + az.show("T6-T7") + ", " + az.show("T10-T11") + ", " +
-            az.show("L4-L5"),
-        az("T5-T6") < az("T1-T2") && az("T10-T11") > az("T6-T7") && az("L4-L5") < az("T10-T11"));
-
-    const PairSeries rx = col(r, true, 0);
-    const int e1 = rx.count_sign("T1-T2", "T5-T6", -1), f = rx.count_sign("T6-T7", "T9-T10", 1),
-              e2 = rx.count_sign("T10-T11", "L4-L5", -1);
-    add("backward-extension-regions", "backward", "extension T1-T6 and T10-L5, flexion T6-T10",
-        "extension " + count(e1, rx.span("T1-T2", "T5-T6"), "of T1-T2…T5-T6") + ", flexion " +
-            count(f, rx.span("T6-T7", "T9-T10"), "of T6-T7…T9-T10") + ", extension " + count(e2, rx.span("T10-T11", "L4-L5"), "of T10-T11…L4-L5"),
-        e1 == rx.span("T1-T2", "T5-T6") && f == rx.span("T6-T7", "T9-T10") && e2 == rx.span("T10-T11", "L4-L5"));
-    add("backward-extension-max", "backward", "largest extension at T5-T6 and L1-L2", "min θx (deg) at " + rx.show(rx.argmin(), 4),
-        one_of(rx.name(rx.argmin()), {"T5-T6", "L1-L2"}) && rx.v.minCoeff() < 0);
-    add("backward-flexion-max", "backward", "largest flexion at T6-T7", "max θx (deg) at " + rx.show(rx.argmax(), 4),
-        rx.name(rx.argmax()) == "T6-T7" && rx.v.maxCoeff() > 0);
-  }
+  std::vector<Finding> out;
+  lateral_translation_findings(run("lateral"), out);
+  lateral_rotation_findings(run("lateral"), out);
+  forward_findings(run("forward"), out);
+  backward_findings(run("backward"), out);
   return out;
 }
 

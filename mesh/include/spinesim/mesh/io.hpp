@@ -50,10 +50,12 @@ void write_vtu(const std::string& path, const TetMesh& m,
                const std::vector<DataArray>& point_data = {},
                const std::vector<DataArray>& cell_data = {}, const VtuWriteOptions& options = {});
 
-/// Reads a VTU with a single Piece. Supported: format="ascii" and format="binary" (inline base64,
-/// header_type UInt32 or UInt64, no compressor; header and data encoded together or
-/// separately), any VTK numeric type, either byte order. Refused with a message saying how to
-/// re-save: format="appended" / raw AppendedData and compressed files.
+/// Reads a VTU with a single Piece, in every encoding the VTK XML format allows: DataArrays
+/// format="ascii", "binary" (inline base64) or "appended" (<AppendedData> raw or base64, arrays
+/// located by their offsets); header_type UInt32 or UInt64; uncompressed, or compressed with
+/// vtkZLibDataCompressor or vtkLZMADataCompressor (VTK's block header: #blocks, block size,
+/// last block size, compressed sizes); any VTK numeric type, either byte order. A file whose
+/// header announces more than 4 GiB for one array is refused (corrupt or hostile).
 /// Cells: VTK_TETRA (10); VTK_QUADRATIC_TETRA (24) is read by its 4 corner vertices and
 /// vertices used only as mid-edge nodes are dropped (indices and point arrays are remapped).
 /// Any other cell type is an error naming it. Missing `region` -> all 1; missing `surface` ->
@@ -64,6 +66,19 @@ void write_vtu(const std::string& path, const TetMesh& m,
 /// Throws std::invalid_argument with one line "read_vtu: PATH: problem" for any bad file.
 TetMesh read_vtu(const std::string& path, std::vector<DataArray>* point_data = nullptr,
                  std::vector<DataArray>* cell_data = nullptr);
+
+/// Reads a legacy VTK unstructured grid (.vtk): ASCII or BINARY (big-endian), file versions
+/// up to 4.2 (CELLS as "count ids…" lists) and 5.1 (OFFSETS + CONNECTIVITY); POINT_DATA and
+/// CELL_DATA as SCALARS, VECTORS, NORMALS, TENSORS or FIELD arrays; dataset FIELD data
+/// `disc_frame` and `source` as in a VTU. The same cell rules and checks as read_vtu; messages
+/// "read_vtk: PATH: problem".
+TetMesh read_vtk_legacy(const std::string& path, std::vector<DataArray>* point_data = nullptr,
+                        std::vector<DataArray>* cell_data = nullptr);
+
+/// A tetrahedral mesh file of either kind: legacy VTK when it starts with "# vtk DataFile
+/// Version", else VTU. What the program's --mesh options read.
+TetMesh read_tet_mesh(const std::string& path, std::vector<DataArray>* point_data = nullptr,
+                      std::vector<DataArray>* cell_data = nullptr);
 
 /// Medit .mesh (ASCII, MeshVersionFormatted 2, Dimension 3): Vertices with the surface label as
 /// reference, Tetrahedra (1-based) with the region label, and the boundary Triangles (faces used
