@@ -17,6 +17,8 @@
 #include "spinesim/studies/calibration_report.hpp"
 #include "cli_common.hpp"
 
+#include "spinesim/studies/disc_level.hpp"
+
 #include "spinesim/calibration/tuned_set.hpp"
 #include "spinesim/mesh/disc_geometry.hpp"
 #include "spinesim/mesh/io.hpp"
@@ -72,7 +74,7 @@ std::pair<std::string, mesh::TetMesh> coarser_mesh(const mesh::DiscDimensions& d
   std::ostringstream label;
   label << "parametric " << dims.level << ", cell size " << std::setprecision(3) << opt.cell_size_mm << " mm";
   status("meshing the second resolution: " + label.str());
-  return {label.str(), mesh::mesh_parametric_disc(dims, opt, mesh::disc_frame_in_spine(dims.level, data_dir()))};
+  return {label.str(), mesh_disc_level(dims.level, opt)};
 }
 
 double worst(const nlohmann::json& rows, const char* key) {
@@ -113,7 +115,7 @@ void run_all_levels(const CalibrateArgs& a, const CalibrationRequest& rq, const 
     opt.cell_size_mm = a.cell_size_option->count() ? a.cell_size_mm : std::min(2.0, dims.height_mm / 5.0);
     cell_by_level[level] = opt.cell_size_mm;
     status("== " + level + ": meshing (cell size " + std::to_string(opt.cell_size_mm).substr(0, 4) + " mm)");
-    const mesh::TetMesh m = mesh::mesh_parametric_disc(dims, opt, mesh::disc_frame_in_spine(level, data_dir()));
+    const mesh::TetMesh m = mesh_disc_level(level, opt);
     CalibrationRequest level_rq = rq;
     if (!a.no_transfer) level_rq.transfer_meshes.push_back(coarser_mesh(dims, opt, status));
     const CalibrationOutcome o = calibrate_disc(m, materials, level_rq, status);
@@ -222,7 +224,7 @@ void run_calibrate(const CalibrateArgs& a) {
     opt.cell_size_mm = a.cell_size_mm;
     status("meshing " + a.level + " (cell size " + std::to_string(a.cell_size_mm).substr(0, 4) + " mm)");
     const mesh::DiscDimensions dims = mesh::disc_dimensions(a.level, data_dir());
-    m = mesh::mesh_parametric_disc(dims, opt, mesh::disc_frame_in_spine(a.level, data_dir()));  // as `mesh disc --level`
+    m = mesh_disc_level(a.level, opt);  // as `mesh disc --level`
     if (!a.no_transfer && a.transfer_meshes.empty()) rq.transfer_meshes.push_back(coarser_mesh(dims, opt, status));
   }
 

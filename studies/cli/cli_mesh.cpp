@@ -8,6 +8,8 @@
 // Writes a VTU (cell data `region`, point data `surface`) and optionally Medit .mesh, and
 // prints the quality report (tet count, dihedral angles, radius-edge ratio, volume vs exact).
 #include "cli_common.hpp"
+
+#include "spinesim/studies/disc_level.hpp"
 #include "spinesim/studies/mesh_report.hpp"
 
 #include "spinesim/mesh/disc_geometry.hpp"
@@ -111,16 +113,15 @@ void run_mesh_disc(const MeshArgs& a) {
     const auto dims = mesh::disc_dimensions(a.level, data_dir());
     if (a.placement != "spine" && a.placement != "local")
       throw std::invalid_argument("--placement must be 'spine' or 'local'");
-    const mesh::DiscFrame frame =
-        a.placement == "spine" ? mesh::disc_frame_in_spine(dims.level, data_dir()) : mesh::DiscFrame();
+    const DiscPlacement placement = a.placement == "spine" ? DiscPlacement::spine : DiscPlacement::local;
     if (a.structured) {
       const auto& so = a.structured_opt;
       progress.begin("meshing " + dims.level + " (structured, " + std::to_string(so.sectors) + " sectors, " +
                      std::to_string(so.rings) + " rings, " + std::to_string(so.layers) + " layers)");
-      m = mesh::mesh_structured_disc(dims, so, frame);
+      m = mesh_structured_level(dims.level, so, placement);
     } else {
       progress.begin("meshing " + dims.level + " (cell size " + std::to_string(opt.cell_size_mm).substr(0, 4) + " mm)");
-      m = mesh::mesh_parametric_disc(dims, opt, frame);
+      m = mesh_disc_level(dims.level, opt, placement);
     }
     mesh_s = progress.end(std::to_string(m.num_tets()) + " tets");
     exact_volume = mesh::parametric_disc_volume(dims);

@@ -28,6 +28,8 @@
 // function below, and add one line to register_study() at the end of this file.
 #include "cli_common.hpp"
 
+#include "spinesim/studies/disc_level.hpp"
+
 #include "spinesim/mss/quantities.hpp"
 
 #include "spinesim/common/timer.hpp"
@@ -120,7 +122,7 @@ mesh::TetMesh study_mesh(const StudyCommon& c, Progress& progress) {
   mesh::MeshOptions opt;
   opt.cell_size_mm = c.cell_size_mm;
   progress.begin("meshing the " + dims.level + " disc");
-  mesh::TetMesh m = mesh::mesh_parametric_disc(dims, opt, mesh::disc_frame_in_spine(dims.level, data_dir()));
+  mesh::TetMesh m = mesh_disc_level(dims.level, opt);
   progress.end(std::to_string(m.num_tets()) + " tets");
   return m;
 }
