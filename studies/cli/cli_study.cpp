@@ -29,6 +29,7 @@
 #include "cli_common.hpp"
 
 #include "spinesim/studies/disc_level.hpp"
+#include "spinesim/studies/probe_study.hpp"
 
 #include "spinesim/mss/quantities.hpp"
 
@@ -127,9 +128,7 @@ mesh::TetMesh study_mesh(const StudyCommon& c, Progress& progress) {
   return m;
 }
 
-nlohmann::json mesh_json(const mesh::TetMesh& m) {
-  return {{"source", m.source}, {"nodes", m.num_vertices()}, {"tets", m.num_tets()}, {"volume_mm3", mesh::mesh_volume(m)}};
-}
+nlohmann::json mesh_json(const mesh::TetMesh& m) { return study_mesh_json(m); }
 
 double max_displacement(const mss::MssModel& model, const Eigen::VectorXd& x) {
   return mss::max_displacement_mm(model, x);
@@ -143,237 +142,48 @@ std::string file_stem(const std::string& name) {
   return s.empty() ? "material" : s;
 }
 
-/// Min and max of a signed quantity, and the value of largest magnitude.
-struct Range {
-  double lo = INFINITY, hi = -INFINITY;
-  void add(double v) { lo = std::min(lo, v), hi = std::max(hi, v); }
-  double extreme() const { return std::abs(lo) > std::abs(hi) ? lo : hi; }
-};
-
 // --- study probe -------------------------------------------------------------------------------
-
-/// Outward area-weighted normals (unnormalised) at the boundary vertices; zero inside.
-Eigen::MatrixX3d boundary_normals(const mesh::TetMesh& m) {
-  static const int face[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};  // opposite vertex k
-  struct Seen {
-    int count = 0;
-    Eigen::Index tet = 0;
-    int local = 0;
-  };
-  std::unordered_map<std::uint64_t, Seen> faces;
-  faces.reserve(std::size_t(2 * m.num_tets()));
-  for (Eigen::Index t = 0; t < m.num_tets(); ++t)
-    for (int k = 0; k < 4; ++k) {
-      std::array<std::uint64_t, 3> v{std::uint64_t(m.T(t, face[k][0])), std::uint64_t(m.T(t, face[k][1])),
-                                     std::uint64_t(m.T(t, face[k][2]))};
-      std::sort(v.begin(), v.end());
-      Seen& s = faces[(v[0] << 42) | (v[1] << 21) | v[2]];
-      ++s.count;
-      s.tet = t;
-      s.local = k;
-    }
-  Eigen::MatrixX3d n = Eigen::MatrixX3d::Zero(m.num_vertices(), 3);
-  for (const auto& [key, s] : faces) {
-    if (s.count != 1) continue;
-    const auto a = m.T(s.tet, face[s.local][0]), b = m.T(s.tet, face[s.local][1]), c = m.T(s.tet, face[s.local][2]);
-    Eigen::Vector3d nf = (m.V.row(b) - m.V.row(a)).transpose().cross((m.V.row(c) - m.V.row(a)).transpose());
-    if (nf.dot((m.V.row(m.T(s.tet, s.local)) - m.V.row(a)).transpose()) > 0) nf = -nf;  // point away from the tet
-    for (auto i : {a, b, c}) n.row(i) += nf.transpose();
-  }
-  return n;
-}
-
-struct ProbeSite {
-  std::string name;
-  Eigen::Index node = 0;
-  Eigen::Vector3d point_mm, normal;  ///< surface point and outward unit normal, global
-  double start_s = 0;
-};
-
-/// The outer-wall node where the ray from the disc centre in the disc-frame direction named
-/// `name` (anterior, posterior, left, right) leaves the disc: the wall node closest to the ray.
-ProbeSite pick_site(const mesh::TetMesh& m, const Eigen::MatrixX3d& normals, const std::string& name) {
-  Eigen::Vector3d d_local;
-  if (name == "anterior") d_local << 0, 0, 1;
-  else if (name == "posterior") d_local << 0, 0, -1;
-  else if (name == "left") d_local << 1, 0, 0;  // the body's right is -x
-  else if (name == "right") d_local << -1, 0, 0;
-  else throw std::invalid_argument("unknown probe site '" + name + "' (anterior, posterior, left, right)");
-  ProbeSite site;
-  site.name = name;
-  double best = INFINITY;
-  for (Eigen::Index i = 0; i < m.num_vertices(); ++i) {
-    if (m.surface(i) != int(mesh::Surface::outer_wall)) continue;
-    const Eigen::Vector3d p = m.frame.axes.transpose() * (m.V.row(i).transpose() - m.frame.origin_mm);
-    const double along = p.dot(d_local);
-    const double off = (p - along * d_local).norm();
-    if (along > 0 && off < best) best = off, site.node = i;
-  }
-  if (!std::isfinite(best)) throw std::invalid_argument("probe site " + name + ": the mesh has no outer-wall node there");
-  site.point_mm = m.V.row(site.node).transpose();
-  site.normal = normals.row(site.node).transpose().normalized();
-  return site;
-}
 
 struct ProbeArgs {
   StudyCommon common;
-  // Penalty per node: 0 = the solver's default (mss::default_probe_stiffness, ~540 N/mm on
-  // L4-L5). The implicit step resolves the contacts by an active set inside each step, so the
-  // stiff default withdraws smoothly (L4-L5 2 mm cells: largest step-to-step force change
-  // 0.33 N, peak 19.1 N; a 50 N/mm penalty gives 18.1 N with the probe sinking deeper).
+  // Defaults as ProbeStudyRequest (studies/probe_study.hpp).
   double radius_mm = 3.0, depth_mm = 2.0, speed_mm_s = 20.0, hold_s = 0.1, rest_s = 0.2, stiffness_n_per_mm = 0.0;
   std::string material = "real-disc", sites = "anterior,left";
 };
 
-/// Where the probe is at time t: per site, press at `speed` to `depth`, hold, withdraw, then
-/// rest with the probe away (the dent recovers).
-struct ProbeSchedule {
-  std::vector<ProbeSite> sites;
-  double depth_mm, speed_mm_s, hold_s, rest_s;
-  double press_s() const { return depth_mm / speed_mm_s; }
-  double site_s() const { return 2 * press_s() + hold_s + rest_s; }
-  double total_s() const { return site_s() * double(sites.size()); }
-  struct Command {
-    bool active = false;
-    std::size_t site = 0;
-    double depth_mm = 0;
-  };
-  Command at(double t) const {
-    Command c;
-    c.site = std::min(sites.size() - 1, std::size_t(std::max(0.0, t) / site_s()));
-    const double s = t - double(c.site) * site_s(), p = press_s();
-    if (s <= p) c.active = true, c.depth_mm = speed_mm_s * s;
-    else if (s <= p + hold_s) c.active = true, c.depth_mm = depth_mm;
-    else if (s <= 2 * p + hold_s) c.active = true, c.depth_mm = depth_mm - speed_mm_s * (s - p - hold_s);
-    c.depth_mm = std::clamp(c.depth_mm, 0.0, depth_mm);
-    return c;
-  }
-};
+/// The stepping options of the studies' flags (checked by check_common).
+SteppedStudyOptions stepping(const StudyCommon& c, const mss::DynamicsOptions& dyn) {
+  SteppedStudyOptions o;
+  o.out = c.out;
+  o.dynamics = dyn;
+  o.integrator_name = c.integrator;
+  o.frame_every = c.frame_every;
+  o.model = model_options(c.model);
+  o.model_variant = model_variant(c.model);
+  return o;
+}
 
 void run_probe(ProbeArgs a) {
   // 1. Options, checked before any work.
   StudyCommon& c = a.common;
-  const mss::DynamicsOptions dyn = check_common(c);
-  for (double v : {a.radius_mm, a.depth_mm, a.speed_mm_s})
-    if (!std::isfinite(v) || v <= 0) throw std::invalid_argument("--radius, --depth and --speed must be finite and > 0");
-  for (double v : {a.hold_s, a.rest_s, a.stiffness_n_per_mm})
-    if (!std::isfinite(v) || v < 0) throw std::invalid_argument("--hold, --rest and --probe-stiffness must be finite and >= 0");
-  const auto site_names = split_list(a.sites);
-  if (site_names.empty()) throw std::invalid_argument("--sites: give at least one of anterior, posterior, left, right");
-  for (const auto& name : site_names)
-    if (name != "anterior" && name != "posterior" && name != "left" && name != "right")
-      throw std::invalid_argument("unknown probe site '" + name + "' (anterior, posterior, left, right)");
+  ProbeStudyRequest rq;
+  rq.stepping = stepping(c, check_common(c));
+  rq.radius_mm = a.radius_mm, rq.depth_mm = a.depth_mm, rq.speed_mm_s = a.speed_mm_s;
+  rq.hold_s = a.hold_s, rq.rest_s = a.rest_s, rq.stiffness_n_per_mm = a.stiffness_n_per_mm;
+  rq.sites = split_list(a.sites);
+  check(rq);
   const auto materials = mesh::load_material(a.material, data_dir());
-  fs::create_directories(c.out);
 
-  // 2. Disc, model, probe sites.
+  // 2. Disc, then the study (studies/probe_study.hpp).
   Progress progress(4, c.quiet || c.json);
   const mesh::TetMesh m = study_mesh(c, progress);
-  progress.begin("building the mass-spring model (" + model_variant(c.model) + ")");
-  const mss::MssModel model(m, materials, model_options(c.model));
-  progress.end();
-  const Eigen::MatrixX3d normals = boundary_normals(m);
-  ProbeSchedule plan{{}, a.depth_mm, a.speed_mm_s, a.hold_s, a.rest_s};
-  for (const auto& name : site_names) plan.sites.push_back(pick_site(m, normals, name));
-  for (std::size_t i = 0; i < plan.sites.size(); ++i) plan.sites[i].start_s = double(i) * plan.site_s();
-  const int steps = int(std::ceil(plan.total_s() / c.dt_s - 1e-6));  // round-off must not add a step
-
-  // 3. Step: both endplates fixed (identity poses), the probe moving.
-  mss::Simulator sim(model, dyn);
-  mss::State s = sim.rest_state();
-  VtuSeries frames((fs::path(c.out) / "probe.pvd").string());
-  frames.add(0.0, model, s.x_mm);
-  std::ostringstream csv;
-  csv << std::setprecision(10)
-      << "time_s,site,probe_active,probe_x_mm,probe_y_mm,probe_z_mm,depth_mm,force_x_n,force_y_n,force_z_n,force_n,"
-         "volume_mm3,volume_change,max_displacement_mm\n";
-  StepStats stats;
-  Range dv;
-  double max_force = 0, max_u = 0;
-  progress.begin(std::to_string(steps) + " steps (" + c.integrator + " Euler, dt " + std::to_string(c.dt_s) + " s)");
-  // The default penalty costs a rest-Hessian evaluation: resolve it once, not per step.
-  const double k_probe = a.stiffness_n_per_mm > 0 ? a.stiffness_n_per_mm : mss::default_probe_stiffness(model);
-  for (int k = 1; k <= steps; ++k) {
-    const double t = k * c.dt_s;
-    const auto cmd = plan.at(t);
-    const ProbeSite& site = plan.sites[cmd.site];
-    const Eigen::Vector3d center = site.point_mm + (a.radius_mm - cmd.depth_mm) * site.normal;
-    mss::Boundary bc;
-    if (cmd.active) bc.probes.push_back({center, a.radius_mm, k_probe});
-    if (!stats.step(sim, s, bc)) break;
-    const Eigen::Vector3d f = cmd.active ? mss::probe_forces(model, bc, s.x_mm).front() : Eigen::Vector3d::Zero();
-    const double v = model.volume_mm3(s.x_mm), u = max_displacement(model, s.x_mm);
-    dv.add(mss::volume_change(model, s.x_mm));
-    max_force = std::max(max_force, f.norm());
-    max_u = std::max(max_u, u);
-    csv << s.time_s << "," << site.name << "," << int(cmd.active) << "," << center.x() << "," << center.y() << ","
-        << center.z() << "," << cmd.depth_mm << "," << f.x() << "," << f.y() << "," << f.z() << "," << f.norm() << "," << v
-        << "," << mss::volume_change(model, s.x_mm) << "," << u << "\n";
-    if (k % c.frame_every == 0 || k == steps) frames.add(s.time_s, model, s.x_mm);
-  }
-  progress.end(std::to_string(stats.steps_done) + " steps");
-
-  // 4. Files and summary.
-  progress.begin("writing " + c.out);
-  frames.finish();
-  const std::string csv_path = (fs::path(c.out) / "probe.csv").string();
-  const std::string json_path = (fs::path(c.out) / "probe.json").string();
-  write_text_file(csv_path, csv.str());
-  nlohmann::json sites = nlohmann::json::array();
-  for (const auto& p : plan.sites)
-    sites.push_back({{"name", p.name},
-                     {"node", p.node},
-                     {"point_mm", to_json(Eigen::VectorXd(p.point_mm))},
-                     {"normal", to_json(Eigen::VectorXd(p.normal))},
-                     {"start_s", p.start_s}});
-  nlohmann::json j = {{"study", "probe"},
-                      {"thesis", "5.3 test 1, fig. 5.8"},
-                      {"mesh", mesh_json(m)},
-                      {"material", materials.name},
-                      {"model_variant", model_variant(c.model)},
-                      {"model", mss_model_json(model, materials)},
-                      {"probe",
-                       {{"radius_mm", a.radius_mm},
-                        {"depth_mm", a.depth_mm},
-                        {"speed_mm_s", a.speed_mm_s},
-                        {"hold_s", a.hold_s},
-                        {"rest_s", a.rest_s},
-                        {"stiffness_n_per_mm", k_probe},
-                        {"schedule", "per site: press at speed to depth, hold, withdraw, rest with the probe away"}}},
-                      {"sites", sites},
-                      {"integrator", c.integrator},
-                      {"dt_s", c.dt_s},
-                      {"steps", steps},
-                      {"max_force_n", max_force},
-                      {"max_volume_change", std::isfinite(dv.lo) ? dv.extreme() : 0.0},
-                      {"volume_change_range", {std::isfinite(dv.lo) ? dv.lo : 0.0, std::isfinite(dv.hi) ? dv.hi : 0.0}},
-                      {"max_displacement_mm", max_u},
-                      {"files", {{"pvd", frames.pvd_path()}, {"csv", csv_path}, {"json", json_path}}},
-                      {"frames", frames.num_frames()}};
-  stats.add_to(j);
-  write_text_file(json_path, j.dump(2) + "\n");
-  progress.end();
-
-  if (c.json) {
-    print_json(j);
-  } else {
-    std::cout << std::setprecision(4) << "Probe study (thesis 5.3, test 1) on " << m.source << " (" << m.num_tets()
-              << " tets), material " << materials.name << ", MSS " << model_variant(c.model) << "\n"
-              << "  probe radius " << a.radius_mm << " mm, depth " << a.depth_mm << " mm at " << a.speed_mm_s
-              << " mm/s, hold " << a.hold_s << " s, rest " << a.rest_s << " s; both endplates fixed\n";
-    for (const auto& p : plan.sites)
-      std::cout << "  site " << std::left << std::setw(10) << p.name << std::right << " from t = " << p.start_s
-                << " s at (" << p.point_mm.transpose() << ") mm, normal (" << p.normal.transpose() << ")\n";
-    std::cout << "  " << stats.steps_done << " of " << steps << " steps, mean step " << stats.mean_seconds() * 1e3
-              << " ms\n"
-              << "  max probe force " << max_force << " N, max |u| " << max_u << " mm\n"
-              << "  volume change " << 100 * j["volume_change_range"][0].get<double>() << " % .. "
-              << 100 * j["volume_change_range"][1].get<double>() << " %\n"
-              << "  wrote " << frames.pvd_path() << " (" << frames.num_frames() << " frames), " << csv_path << ", "
-              << json_path << "\n";
-  }
-  if (stats.diverged)
-    throw std::runtime_error("probe study diverged at step " + std::to_string(stats.steps_done + 1) + ": " + stats.message);
+  const ProbeStudyResult r = run_probe_study(m, materials, rq, progress.hooks());
+  if (c.json)
+    print_json(r.summary);
+  else
+    print_probe_study(std::cout, m, materials.name, r);
+  if (r.stats.diverged)
+    throw std::runtime_error("probe study diverged at step " + std::to_string(r.stats.steps_done + 1) + ": " + r.stats.message);
 }
 
 // --- study drive -------------------------------------------------------------------------------
