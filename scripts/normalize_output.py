@@ -4,13 +4,37 @@
 A record is a folder: NAME.json (stdout of one command), NAME.status (its exit status),
 NAME.stderr, and files/ (everything the commands wrote). JSON is compared as data, with the
 keys in TIMING_KEYS dropped wherever they stand; text files are compared line by line after
-TIMING_TEXT masks durations; VTU/PVD/CSV files must be identical. Prints one line per
-difference and a summary; exit 1 when anything differs.
+TIMING_TEXT masks durations. Numbers that are not bit-identical but agree to ROUND_OFF relative to
+the largest magnitude of their array (or line) are counted separately as round-off: floating-point
+sums depend on the order of operations, which a change of compiler flags or of what the linker
+keeps may alter. Prints one line per real difference and a summary; exit 1 when anything differs
+beyond round-off.
 """
 import json
 import os
 import re
 import sys
+
+ROUND_OFF = 1e-9
+round_off = {"count": 0, "worst": 0.0}
+
+
+def close(a, b, scale):
+    """Equal, or equal to round-off relative to `scale`; counts the round-off cases."""
+    if a == b:
+        return True
+    if isinstance(a, bool) or isinstance(b, bool):
+        return False
+    d = abs(a - b) / max(scale, 1e-300)
+    if d <= ROUND_OFF:
+        round_off["count"] += 1
+        round_off["worst"] = max(round_off["worst"], d)
+        return True
+    return False
+
+
+def is_number(x):
+    return isinstance(x, (int, float)) and not isinstance(x, bool)
 
 # Measured durations and rates: they differ from run to run of the same binary.
 TIMING_KEYS = re.compile(
@@ -32,8 +56,12 @@ def strip(value):
     return value
 
 
-def diff(a, b, path, out):
-    if type(a) != type(b) and not (isinstance(a, (int, float)) and isinstance(b, (int, float))):
+def diff(a, b, path, out, scale=None):
+    if is_number(a) and is_number(b):
+        if not close(a, b, scale if scale is not None else max(abs(a), abs(b))):
+            out.append(f"{path}: {a!r} != {b!r}")
+        return
+    if type(a) != type(b):
         out.append(f"{path}: {json.dumps(a)[:80]} != {json.dumps(b)[:80]}")
     elif isinstance(a, dict):
         for k in sorted(set(a) | set(b)):
@@ -44,8 +72,10 @@ def diff(a, b, path, out):
     elif isinstance(a, list):
         if len(a) != len(b):
             out.append(f"{path}: length {len(a)} != {len(b)}")
+        nums = [abs(v) for v in a + b if is_number(v)]
+        s = max(nums) if nums else None
         for i, (x, y) in enumerate(zip(a, b)):
-            diff(x, y, f"{path}[{i}]", out)
+            diff(x, y, f"{path}[{i}]", out, s)
     elif a != b:
         out.append(f"{path}: {a!r} != {b!r}")
 
@@ -73,11 +103,24 @@ def compare_text(pa, pb, name, out):
     if len(a) != len(b):
         out.append(f"{name}: {len(a)} lines != {len(b)} lines")
     for i, (x, y) in enumerate(zip(a, b)):
-        if x != y:
+        if x != y and not same_numbers(x, y):
             col = next((k for k, (c, d) in enumerate(zip(x, y)) if c != d), min(len(x), len(y)))
             lo = max(0, col - 30)
             out.append(f"{name}:{i + 1}: …{x[lo:col + 40]!r} != …{y[lo:col + 40]!r}")
             break
+
+
+NUMBER = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?")
+
+
+def same_numbers(x, y):
+    """Lines equal but for numbers that agree to round-off (relative to the line's largest)."""
+    if NUMBER.sub("#", x) != NUMBER.sub("#", y):
+        return False
+    na = [float(m.group(0)) for m in NUMBER.finditer(x)]
+    nb = [float(m.group(0)) for m in NUMBER.finditer(y)]
+    scale = max([abs(v) for v in na + nb] or [0.0])
+    return all(close(p, q, scale) for p, q in zip(na, nb))
 
 
 def files_of(root):
@@ -116,8 +159,10 @@ def main(a_dir, b_dir):
             compare_text(pa, pb, "files/" + f, problems)
     for p in problems[:200]:
         print(p)
+    rounding = (f"; {round_off['count']} numbers differ at round-off (worst {round_off['worst']:.1e} relative)"
+                if round_off["count"] else "; every number bit-identical")
     print(f"compare-outputs: {len(names)} commands, {len(fa & fb)} files: "
-          + ("identical up to timing fields" if not problems else f"{len(problems)} differences"))
+          + ("identical up to timing fields" if not problems else f"{len(problems)} differences") + rounding)
     return 1 if problems else 0
 
 

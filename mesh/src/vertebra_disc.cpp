@@ -190,6 +190,12 @@ class DiscBetween {
   const Eigen::Matrix3d& axes() const { return axes_; }
 
  private:
+  // The steps of the constructor, in order.
+  void set_frame(const TriSurface& inf, const TriSurface& sup);
+  std::vector<char> height_fields(const TriSurface& inf, const TriSurface& sup, const VertebraDiscOptions& opt);
+  std::vector<char> facing_region(const std::vector<char>& facing, const VertebraDiscOptions& opt, Eigen::Vector2d& c0);
+  void set_outline(const std::vector<char>& mask, const Eigen::Vector2d& c0, const VertebraDiscOptions& opt);
+  void measure();
   // Bilinear interpolation of a grid field; NaN when a corner is missing or q is off the grid.
   double height(const std::vector<double>& f, const Eigen::Vector2d& q) const {
     const double fu = (q.x() - u0_) / step_, fv = (q.y() - v0_) / step_;
@@ -221,7 +227,17 @@ DiscBetween::DiscBetween(const TriSurface& inf, const TriSurface& sup, const Ver
       !(opt.nucleus_area_fraction > 0 && opt.nucleus_area_fraction < 1) || opt.outline_harmonics < 1)
     throw std::invalid_argument("vertebra disc options out of range");
 
-  // 1. Axis and local frame.
+  set_frame(inf, sup);
+  const std::vector<char> facing = height_fields(inf, sup, opt);
+  Eigen::Vector2d c0;
+  const std::vector<char> mask = facing_region(facing, opt, c0);
+  set_outline(mask, c0, opt);
+  measure();
+}
+
+// 1. Axis and local frame: y from the inferior to the superior centroid, x the global lateral
+//    axis made orthogonal to it.
+void DiscBetween::set_frame(const TriSurface& inf, const TriSurface& sup) {
   const Eigen::Vector3d c_inf = surface_centroid(inf), c_sup = surface_centroid(sup);
   const Eigen::Vector3d d = c_sup - c_inf;
   if (d.norm() < 1.0)
@@ -240,7 +256,11 @@ DiscBetween::DiscBetween(const TriSurface& inf, const TriSurface& sup, const Ver
   axes_.col(2) = x.cross(y);
   origin_ = 0.5 * (c_inf + c_sup);
 
-  // 2. Height fields over the overlap of the two projections.
+}
+
+// 2. Height fields over the overlap of the two projections; returns the grid nodes where both
+//    endplates face each other with a gap in (0, max_gap].
+std::vector<char> DiscBetween::height_fields(const TriSurface& inf, const TriSurface& sup, const VertebraDiscOptions& opt) {
   const RayTarget lower(inf, origin_, axes_), upper(sup, origin_, axes_);
   auto extent = [&](const TriSurface& s, int col, double& lo, double& hi) {
     const Eigen::VectorXd t = (s.V.rowwise() - origin_.transpose()) * axes_.col(col);
@@ -284,7 +304,12 @@ DiscBetween::DiscBetween(const TriSurface& inf, const TriSurface& sup, const Ver
   if (gap_positive == 0)
     throw std::invalid_argument("the vertebrae do not face each other: the endplates overlap (gap <= 0 mm everywhere)");
 
-  // 3. Largest 4-connected facing component, holes filled.
+  return facing;
+}
+
+// 3. Largest 4-connected facing component, holes filled; c0 its centroid.
+std::vector<char> DiscBetween::facing_region(const std::vector<char>& facing, const VertebraDiscOptions& opt,
+                                             Eigen::Vector2d& c0) {
   std::vector<int> comp(facing.size(), -1);
   int best = -1;
   std::size_t best_size = 0;
@@ -326,7 +351,7 @@ DiscBetween::DiscBetween(const TriSurface& inf, const TriSurface& sup, const Ver
     stack.push_back({i + 1, j}); stack.push_back({i - 1, j});
     stack.push_back({i, j + 1}); stack.push_back({i, j - 1});
   }
-  Eigen::Vector2d c0 = Eigen::Vector2d::Zero();
+  c0 = Eigen::Vector2d::Zero();
   std::size_t count = 0;
   for (int j = 0; j < nv_; ++j)
     for (int i = 0; i < nu_; ++i)
@@ -339,7 +364,15 @@ DiscBetween::DiscBetween(const TriSurface& inf, const TriSurface& sup, const Ver
   if (!in_mask(c0))
     throw std::invalid_argument("the facing endplate region is not star-shaped about its centre; cannot build a disc");
 
-  // 4. Smoothed polar outline, moved rim_margin inwards.
+  return mask;
+}
+
+// 4. Smoothed polar outline, moved rim_margin inwards; the nucleus scale.
+void DiscBetween::set_outline(const std::vector<char>& mask, const Eigen::Vector2d& c0, const VertebraDiscOptions& opt) {
+  auto in_mask = [&](const Eigen::Vector2d& q) {
+    const int i = int(std::lround((q.x() - u0_) / step_)), j = int(std::lround((q.y() - v0_) / step_));
+    return i >= 0 && j >= 0 && i < nu_ && j < nv_ && mask[idx(i, j)];
+  };
   const std::size_t n_dir = 1024;
   std::vector<double> r_exit(n_dir);
   for (std::size_t k = 0; k < n_dir; ++k) {
@@ -360,7 +393,11 @@ DiscBetween::DiscBetween(const TriSurface& inf, const TriSurface& sup, const Ver
   nucleus_center_ = outline_.centroid();
   nucleus_scale_ = std::sqrt(opt.nucleus_area_fraction);
 
-  // 5. Report: area, heights, volume (midpoint rule on a half-step grid), extents, frame.
+}
+
+// 5. Report: area, heights, volume (midpoint rule on a half-step grid), extents, frame.
+void DiscBetween::measure() {
+  const std::size_t n_dir = outline_.R.size();
   info_.footprint_area_mm2 = outline_.area();
   const double h0 = height(s_sup_, nucleus_center_) - height(s_inf_, nucleus_center_);
   if (!(h0 > 0)) throw std::invalid_argument("the endplate gap at the disc centre is not positive");

@@ -125,6 +125,18 @@ struct MssModel::Impl {
 
   void build(const mesh::RegionMaterials& materials);
   void apply_scales();
+
+  // The steps of build(), in order.
+  struct TetProps;
+  TetProps tet_properties(const mesh::RegionMaterials& materials) const;
+  void build_masses(const TetProps& tp);
+  void build_edges(const TetProps& tp);
+  std::vector<std::pair<std::array<int, 3>, std::vector<int>>> build_cylinder();
+  void build_angle_springs(const TetProps& tp,
+                           const std::vector<std::pair<std::array<int, 3>, std::vector<int>>>& unique_faces);
+  void build_tet_terms(const TetProps& tp);
+  void build_damping(const TetProps& tp);
+  void build_slots();
   /// Disc volume V(x) = sum of signed tet volumes, and dV/dx into *u (3n) when u != nullptr.
   double volume_and_gradient(const Eigen::VectorXd& x, Eigen::VectorXd* u) const;
   /// Energy and (optionally, grad != nullptr, accumulated) gradient of the selected terms: the
@@ -136,14 +148,16 @@ struct MssModel::Impl {
                         Eigen::SparseMatrix<double>& H) const;
 };
 
-void MssModel::Impl::build(const mesh::RegionMaterials& materials) {
-  const Eigen::Index n = mesh.num_vertices();
-  const Eigen::Index nt = mesh.num_tets();
-  X.resize(3 * n);
-  for (Eigen::Index i = 0; i < n; ++i) X.segment<3>(3 * i) = mesh.V.row(i).transpose();
+/// Per-tetrahedron material constants and rest volumes (the inputs of every term).
+struct MssModel::Impl::TetProps {
+  std::vector<double> E, G, K, rho, V0;  ///< MPa, MPa, MPa, t/mm^3, mm^3
+};
 
-  // Materials per tet.
-  std::vector<double> E(nt), G(nt), K(nt), rho(nt), V0(nt);
+MssModel::Impl::TetProps MssModel::Impl::tet_properties(const mesh::RegionMaterials& materials) const {
+  const Eigen::Index nt = mesh.num_tets();
+  TetProps tp;
+  std::vector<double>&E = tp.E, &G = tp.G, &K = tp.K, &rho = tp.rho, &V0 = tp.V0;
+  E.resize(nt), G.resize(nt), K.resize(nt), rho.resize(nt), V0.resize(nt);
   for (Eigen::Index t = 0; t < nt; ++t) {
     const mesh::IsotropicMaterial& m = materials.at(mesh.region(t));
     mesh::validate(m, "material of region " + std::to_string(mesh.region(t)));
@@ -153,17 +167,25 @@ void MssModel::Impl::build(const mesh::RegionMaterials& materials) {
     rho[t] = m.density_t_mm3();
     V0[t] = tet_signed_volume(tet_points(X, mesh.T, static_cast<int>(t)));
   }
-  rest_volume = std::accumulate(V0.begin(), V0.end(), 0.0);
 
-  // 1. Lumped masses (5.1).
+  return tp;
+}
+
+// 1. Lumped masses (5.1).
+void MssModel::Impl::build_masses(const TetProps& tp) {
+  const Eigen::Index n = mesh.num_vertices(), nt = mesh.num_tets();
   mass_t = Eigen::VectorXd::Zero(n);
   for (Eigen::Index t = 0; t < nt; ++t)
-    for (int c = 0; c < 4; ++c) mass_t(mesh.T(t, c)) += 0.25 * rho[t] * V0[t];
+    for (int c = 0; c < 4; ++c) mass_t(mesh.T(t, c)) += 0.25 * tp.rho[t] * tp.V0[t];
   for (Eigen::Index i = 0; i < n; ++i)
     require(mass_t(i) > 0.0, "mss: node " + std::to_string(i) +
                                  " belongs to no tetrahedron (zero mass); remove unused vertices");
 
-  // 2. Main springs on the unique edges, Van Gelder (5.2): k = sum E_t V_t / L0^2.
+}
+
+// 2. Main springs on the unique edges, Van Gelder (5.2): k = sum E_t V_t / L0^2.
+void MssModel::Impl::build_edges(const TetProps& tp) {
+  const Eigen::Index nt = mesh.num_tets();
   static constexpr int kEdge[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
   {
     std::vector<std::pair<std::pair<int, int>, int>> pairs;  // ((lo, hi), tet)
@@ -179,17 +201,20 @@ void MssModel::Impl::build(const mesh::RegionMaterials& materials) {
       sp.rest_mm = (X.segment<3>(3 * sp.j) - X.segment<3>(3 * sp.i)).norm();
       for (; s < pairs.size() && pairs[s].first == std::make_pair(sp.i, sp.j); ++s) {
         int t = pairs[s].second;
-        sp.k_part[region_index(mesh.region(t))] += E[t] * V0[t];
+        sp.k_part[region_index(mesh.region(t))] += tp.E[t] * tp.V0[t];
       }
       for (double& k : sp.k_part) k /= sp.rest_mm * sp.rest_mm;
       edges.push_back(sp);
     }
   }
 
-  validate_edge_multipliers(options.edge_multipliers, edges.size());
+}
 
-  // 3. Equivalent cylinder (5.6)-(5.7): endplate diameters from their areas projected on the
-  //    disc axis (equal-area circles), V the mesh volume.
+// 3. Equivalent cylinder (5.6)-(5.7): endplate diameters from their areas projected on the
+//    disc axis (equal-area circles), V the mesh volume. Returns the unique faces with the
+//    tetrahedra that share each (the torsional springs sit on them).
+std::vector<std::pair<std::array<int, 3>, std::vector<int>>> MssModel::Impl::build_cylinder() {
+  const Eigen::Index nt = mesh.num_tets();
   std::vector<std::array<int, 4>> face_list;  // sorted (v0, v1, v2) + tet
   face_list.reserve(4 * nt);
   static constexpr int kFace[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};
@@ -225,8 +250,13 @@ void MssModel::Impl::build(const mesh::RegionMaterials& materials) {
   cylinder.lower_diameter_mm = 2.0 * std::sqrt(area_label[1] / kPi);
   cylinder.mean_diameter_mm = 0.5 * (cylinder.upper_diameter_mm + cylinder.lower_diameter_mm);
 
-  // 4. Torsional springs (5.8): three per unique face; k_t = G pi D_m^4 / (32 L_m n_t), G the mean
-  //    over the face's tetrahedra. Needs both endplates to define the cylinder.
+  return unique_faces;
+}
+
+// 4. Torsional springs (5.8): three per unique face; k_t = G pi D_m^4 / (32 L_m n_t), G the mean
+//    over the face's tetrahedra. Needs both endplates to define the cylinder.
+void MssModel::Impl::build_angle_springs(const TetProps& tp,
+                                         const std::vector<std::pair<std::array<int, 3>, std::vector<int>>>& unique_faces) {
   if (options.torsion_springs) {
     require(cylinder.upper_diameter_mm > 0.0 && cylinder.lower_diameter_mm > 0.0,
             "mss: torsional springs need both endplates (surface labels 1 and 2) for the "
@@ -241,7 +271,7 @@ void MssModel::Impl::build(const mesh::RegionMaterials& materials) {
     for (const auto& [v, tets] : unique_faces) {
       AngleFace f;
       double g_part[2] = {0.0, 0.0};
-      for (int t : tets) g_part[region_index(mesh.region(t))] += G[t] / static_cast<double>(tets.size());
+      for (int t : tets) g_part[region_index(mesh.region(t))] += tp.G[t] / static_cast<double>(tets.size());
       for (int r = 0; r < 2; ++r) f.k_part[r] = g_part[r] * cylinder.k_t_per_shear_modulus;
       f.k = 0.0;
       for (int corner = 0; corner < 3; ++corner) {
@@ -258,7 +288,11 @@ void MssModel::Impl::build(const mesh::RegionMaterials& materials) {
     cylinder.length_mm = 4.0 * rest_volume / (kPi * Dm * Dm);
   }
 
-  // 5. Radial springs (5.3)-(5.5) and the volume term, per tetrahedron.
+}
+
+// 5. Radial springs (5.3)-(5.5) and the volume terms (per tetrahedron, whole disc).
+void MssModel::Impl::build_tet_terms(const TetProps& tp) {
+  const Eigen::Index nt = mesh.num_tets();
   for (Eigen::Index t = 0; t < nt; ++t) {
     const TetPoints p = tet_points(X, mesh.T, static_cast<int>(t));
     const int r = region_index(mesh.region(t));
@@ -266,33 +300,41 @@ void MssModel::Impl::build(const mesh::RegionMaterials& materials) {
       const Eigen::Vector3d xb = 0.25 * p.rowwise().sum();
       double S0 = 0.0;
       for (int c = 0; c < 4; ++c) S0 += (p.col(c) - xb).norm();
-      radial.push_back({static_cast<int>(t), r, S0, options.radial_factor * E[t] * V0[t] / (S0 * S0), 0.0});
+      radial.push_back({static_cast<int>(t), r, S0, options.radial_factor * tp.E[t] * tp.V0[t] / (S0 * S0), 0.0});
     }
     if (options.volume_term)
-      volume.push_back({static_cast<int>(t), r, V0[t], options.volume_factor * K[t] / V0[t], 0.0});
+      volume.push_back({static_cast<int>(t), r, tp.V0[t], options.volume_factor * tp.K[t] / tp.V0[t], 0.0});
   }
 
   // 5b. Whole-disc volume term: k_g = c_g K_mean / V0.
   if (options.disc_volume_term) {
     double KV = 0.0;
-    for (Eigen::Index t = 0; t < nt; ++t) KV += K[t] * V0[t];
+    for (Eigen::Index t = 0; t < nt; ++t) KV += tp.K[t] * tp.V0[t];
     disc_volume_on = true;
     disc_k_unscaled = options.disc_volume_factor * (KV / rest_volume) / rest_volume;
   }
 
-  // 6. Ambient damping (5.11).
+}
+
+// 6. Ambient damping (5.11).
+void MssModel::Impl::build_damping(const TetProps& tp) {
+  const Eigen::Index nt = mesh.num_tets();
   if (options.damping_n_s_per_mm >= 0.0) {
     damping = options.damping_n_s_per_mm;
   } else {
     double EV = 0.0, rhoV = 0.0;
-    for (Eigen::Index t = 0; t < nt; ++t) EV += E[t] * V0[t], rhoV += rho[t] * V0[t];
+    for (Eigen::Index t = 0; t < nt; ++t) EV += tp.E[t] * tp.V0[t], rhoV += tp.rho[t] * tp.V0[t];
     const double length = cylinder.length_mm > 0.0 ? cylinder.length_mm
                                                    : std::cbrt(rest_volume);
     const double omega1 = kPi / length * std::sqrt(EV / rhoV);
     damping = 2.0 * options.damping_ratio * omega1 * mass_t.mean();
   }
 
-  // 7. Hessian pattern and the value slots of every element block.
+}
+
+// 7. Hessian pattern and the value slots of every element block.
+void MssModel::Impl::build_slots() {
+  const Eigen::Index n = mesh.num_vertices(), nt = mesh.num_tets();
   pattern = HessianPattern(mesh.T, n);
   edge_slots.resize(4 * edges.size());
   for (std::size_t e = 0; e < edges.size(); ++e) {
@@ -310,6 +352,22 @@ void MssModel::Impl::build(const mesh::RegionMaterials& materials) {
       for (int b = 0; b < 4; ++b)
         tet_slots[16 * t + 4 * a + b] = pattern.block(mesh.T(t, a), mesh.T(t, b));
 
+}
+
+void MssModel::Impl::build(const mesh::RegionMaterials& materials) {
+  const Eigen::Index n = mesh.num_vertices();
+  X.resize(3 * n);
+  for (Eigen::Index i = 0; i < n; ++i) X.segment<3>(3 * i) = mesh.V.row(i).transpose();
+  const TetProps tp = tet_properties(materials);
+  rest_volume = std::accumulate(tp.V0.begin(), tp.V0.end(), 0.0);
+  build_masses(tp);
+  build_edges(tp);
+  validate_edge_multipliers(options.edge_multipliers, edges.size());
+  const auto unique_faces = build_cylinder();
+  build_angle_springs(tp, unique_faces);
+  build_tet_terms(tp);
+  build_damping(tp);
+  build_slots();
   apply_scales();
 }
 

@@ -22,12 +22,18 @@ double LumpedReduced::quadratic_form(const Eigen::VectorXd& y) const {
 ReducedSpace::ReducedSpace(const MssModel& model, const Eigen::SparseMatrix<double>& H,
                            PlateMode mode, const Eigen::Vector3d& c)
     : mode_(mode), center_(c), X_(model.rest_positions_mm()) {
-  const mesh::TetMesh& m = model.mesh();
   const int nn = int(model.num_nodes());
   if (H.rows() != 3 * nn || H.cols() != 3 * nn || !H.isCompressed())
     throw std::logic_error("mss: reduced space needs the model's compressed Hessian pattern");
+  classify_nodes(model.mesh(), nn);
+  const std::vector<int> outer = build_pattern(H);
+  build_scatter(H, outer);
+}
 
-  // 1. Node roles and numbering (free nodes in node order, so reduced rows stay sorted).
+// 1. Node roles and numbering (free nodes in node order, so reduced rows stay sorted), the
+//    plate maps and the moment length.
+void ReducedSpace::classify_nodes(const mesh::TetMesh& m, int nn) {
+  const Eigen::Vector3d& c = center_;
   role_.assign(std::size_t(nn), NodeRole::free);
   free_index_.assign(std::size_t(nn), -1);
   plate_index_.assign(std::size_t(nn), -1);
@@ -45,7 +51,7 @@ ReducedSpace::ReducedSpace(const MssModel& model, const Eigen::SparseMatrix<doub
       free_nodes_.push_back(i);
     }
   }
-  if (mode == PlateMode::wrench && superior_nodes_.empty())
+  if (mode_ == PlateMode::wrench && superior_nodes_.empty())
     throw std::invalid_argument("mss: a plate wrench needs superior endplate nodes (surface = 2)");
   double arm2 = 0;
   for (int i : superior_nodes_) {
@@ -58,7 +64,12 @@ ReducedSpace::ReducedSpace(const MssModel& model, const Eigen::SparseMatrix<doub
   const bool plate = has_plate_dofs();
   n_ = nf3 + (plate ? 6 : 0);
 
-  // 2. Pattern of the lower triangle of P^T H P.
+}
+
+// 2. Pattern of the lower triangle of P^T H P; returns its column starts.
+std::vector<int> ReducedSpace::build_pattern(const Eigen::SparseMatrix<double>& H) {
+  const int nf3 = 3 * int(free_nodes_.size());
+  const bool plate = has_plate_dofs();
   const int* Hout = H.outerIndexPtr();
   const int* Hin = H.innerIndexPtr();
   std::vector<int> outer(std::size_t(n_) + 1, 0);
@@ -106,7 +117,14 @@ ReducedSpace::ReducedSpace(const MssModel& model, const Eigen::SparseMatrix<doub
   if (plate)
     for (int q = 0; q < 6; ++q) diag_slot_[std::size_t(nf3 + q)] = plate_slot_[q][q];
 
-  // 3. Scatter operations from the full Hessian's value array.
+  return outer;
+}
+
+// 3. Scatter operations from the full Hessian's value array.
+void ReducedSpace::build_scatter(const Eigen::SparseMatrix<double>& H, const std::vector<int>& outer) {
+  const bool plate = has_plate_dofs();
+  const int* Hout = H.outerIndexPtr();
+  const int* Hin = H.innerIndexPtr();
   for (int k = 0; k < int(free_nodes_.size()); ++k) {
     const int j = free_nodes_[std::size_t(k)];
     for (int d = 0; d < 3; ++d) {

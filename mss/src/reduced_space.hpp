@@ -98,6 +98,9 @@ class ReducedSpace {
   double force_norm(const Eigen::VectorXd& r) const;
 
  private:
+  void classify_nodes(const mesh::TetMesh& m, int num_nodes);
+  std::vector<int> build_pattern(const Eigen::SparseMatrix<double>& H);
+  void build_scatter(const Eigen::SparseMatrix<double>& H, const std::vector<int>& outer);
   void add_plate_block(const Matrix6d& B, double* val) const;
 
   PlateMode mode_ = PlateMode::pose;
