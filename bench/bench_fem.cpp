@@ -17,7 +17,7 @@
 #include "spinesim/fem/disc_fem.hpp"
 #include "spinesim/fem/fe_space.hpp"
 #include "spinesim/mesh/mesher.hpp"
-#include "test_meshes.hpp"
+#include "spinesim/mesh/box_mesh.hpp"
 
 #include <benchmark/benchmark.h>
 
@@ -41,7 +41,7 @@ double peak_rss_mb() {
 mesh::TetMesh disc_box(double h_mm) {
   const double lx = 46, ly = 11, lz = 35;
   const auto cells = [&](double l) { return std::max(1, int(std::lround(l / h_mm))); };
-  return test_meshes::box_mesh(cells(lx), cells(ly), cells(lz), lx, ly, lz,
+  return spinesim::mesh::box_mesh(cells(lx), cells(ly), cells(lz), lx, ly, lz,
                                Eigen::Vector3d(-0.5 * lx, 0, -0.5 * lz));
 }
 

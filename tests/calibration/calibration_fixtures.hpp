@@ -4,13 +4,13 @@
 
 #include "spinesim/calibration/objective.hpp"
 #include "spinesim/mss/boundary.hpp"
-#include "test_meshes.hpp"
+#include "spinesim/mesh/box_mesh.hpp"
 
 namespace spinesim::calibration::fixtures {
 
 /// Box 20 x 8 x 16 mm (y up), 5 x 3 x 4 cells, centred on x = z = 0, the central cells nucleus.
 inline mesh::TetMesh two_region_disc() {
-  mesh::TetMesh m = fem::test_meshes::box_mesh(5, 3, 4, 20.0, 8.0, 16.0, Eigen::Vector3d(-10.0, 0.0, -8.0));
+  mesh::TetMesh m = spinesim::mesh::box_mesh(5, 3, 4, 20.0, 8.0, 16.0, Eigen::Vector3d(-10.0, 0.0, -8.0));
   for (Eigen::Index t = 0; t < m.num_tets(); ++t) {
     Eigen::Vector3d c = Eigen::Vector3d::Zero();
     for (int k = 0; k < 4; ++k) c += 0.25 * m.V.row(m.T(t, k)).transpose();

@@ -199,7 +199,7 @@ TEST(PerSpring, RefusesBadInput) {
   const Eigen::VectorXd region_p = Eigen::VectorXd::Zero(9);
   EXPECT_THROW(PerSpringObjective(region, p.model, region_p, PerSpringWeights{-1.0, 0.0}), std::invalid_argument);
   EXPECT_THROW(PerSpringObjective(region, p.model, Eigen::VectorXd::Zero(8)), std::invalid_argument);
-  const mss::MssModel other(fem::test_meshes::box_mesh(4, 3, 4, 20.0, 8.0, 16.0, Eigen::Vector3d(-10.0, 0.0, -8.0)),
+  const mss::MssModel other(spinesim::mesh::box_mesh(4, 3, 4, 20.0, 8.0, 16.0, Eigen::Vector3d(-10.0, 0.0, -8.0)),
                             two_materials(), all_terms());
   EXPECT_THROW(PerSpringObjective(region, other, region_p), std::invalid_argument);
   PerSpringObjective obj(region, p.model, region_p);

@@ -319,7 +319,7 @@ TEST(CheckApplies, RefusesAnotherLevel) {
 
 TEST(CheckApplies, SameLevelOnAnotherMeshTransfers) {
   const TunedDisc t = sample_tuned(l4l5_mesh());
-  mesh::TetMesh finer = fem::test_meshes::box_mesh(7, 4, 5, 20.0, 8.0, 16.0, Eigen::Vector3d(-10.0, 0.0, -8.0));
+  mesh::TetMesh finer = spinesim::mesh::box_mesh(7, 4, 5, 20.0, 8.0, 16.0, Eigen::Vector3d(-10.0, 0.0, -8.0));
   finer.source = "structured disc L4-L5 (12 sectors, 3 rings, 2 layers)";
   ASSERT_FALSE(fingerprint(finer) == t.mesh);
   EXPECT_EQ(check_applies(t, finer, two_materials()), "");
@@ -328,7 +328,7 @@ TEST(CheckApplies, SameLevelOnAnotherMeshTransfers) {
 
 TEST(CheckApplies, NotesWhatItCouldNotCheck) {
   const TunedDisc t = sample_tuned(l4l5_mesh());
-  mesh::TetMesh unknown = fem::test_meshes::box_mesh(6, 3, 4, 20.0, 8.0, 16.0, Eigen::Vector3d(-10.0, 0.0, -8.0));
+  mesh::TetMesh unknown = spinesim::mesh::box_mesh(6, 3, 4, 20.0, 8.0, 16.0, Eigen::Vector3d(-10.0, 0.0, -8.0));
   unknown.source = "disc between vertebrae";
   const std::string note = check_applies(t, unknown, two_materials());
   EXPECT_NE(note.find("unknown"), std::string::npos) << note;
@@ -460,7 +460,7 @@ TEST(PerSpringFile, AppliesToTheFittedMeshOnly) {
   EXPECT_EQ(model.edge_springs()[5].multiplier, t.edge_multipliers[5]);
 
   // Another mesh of the same disc level: a region-level file transfers, a per-spring one not.
-  mesh::TetMesh finer = fem::test_meshes::box_mesh(7, 4, 5, 20.0, 8.0, 16.0, Eigen::Vector3d(-10.0, 0.0, -8.0));
+  mesh::TetMesh finer = spinesim::mesh::box_mesh(7, 4, 5, 20.0, 8.0, 16.0, Eigen::Vector3d(-10.0, 0.0, -8.0));
   finer.source = "structured disc L4-L5 (12 sectors, 3 rings, 2 layers)";
   EXPECT_EQ(check_applies(sample_tuned(m), finer, two_materials()), "");
   expect_not_applicable(t, finer, two_materials(),

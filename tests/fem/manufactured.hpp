@@ -8,13 +8,13 @@
 #include "spinesim/fem/assembly.hpp"
 #include "spinesim/fem/dirichlet.hpp"
 #include "spinesim/fem/fe_space.hpp"
-#include "test_meshes.hpp"
+#include "spinesim/mesh/box_mesh.hpp"
 
 #include <cmath>
 #include <cstdio>
 #include <vector>
 
-namespace spinesim::fem::test_meshes {
+namespace spinesim::fem::manufactured {
 
 
 struct Manufactured {
@@ -38,7 +38,7 @@ struct Manufactured {
 };
 
 inline double solve_and_measure(int order, int n, const Manufactured& ms, const mesh::RegionMaterials& mat) {
-  const mesh::TetMesh m = unit_cube_mesh(n);
+  const mesh::TetMesh m = mesh::unit_cube_mesh(n);
   const FeSpace space = make_fe_space(m, order);
   const Eigen::SparseMatrix<double> K = assemble_stiffness(space, m.region, mat);
   const Eigen::VectorXd f =
@@ -81,4 +81,4 @@ inline std::vector<double> measured_orders(int order, const std::vector<int>& ns
   return rates;
 }
 
-}  // namespace spinesim::fem::test_meshes
+}  // namespace spinesim::fem::manufactured

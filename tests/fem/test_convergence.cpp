@@ -4,7 +4,7 @@
 
 #include <gtest/gtest.h>
 
-using spinesim::fem::test_meshes::measured_orders;
+using spinesim::fem::manufactured::measured_orders;
 
 TEST(Convergence, P1IsSecondOrderInL2) {
   const std::vector<double> rates = measured_orders(1, {2, 4, 8, 16});

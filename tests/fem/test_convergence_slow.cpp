@@ -3,7 +3,7 @@
 
 #include <gtest/gtest.h>
 
-using spinesim::fem::test_meshes::measured_orders;
+using spinesim::fem::manufactured::measured_orders;
 
 TEST(ConvergenceSlow, P2IsThirdOrderInL2UpTo16CellsPerSide) {
   const std::vector<double> rates = measured_orders(2, {4, 8, 16});

@@ -3,7 +3,7 @@
 #include "spinesim/fem/assembly.hpp"
 #include "spinesim/fem/disc_fem.hpp"
 #include "spinesim/fem/fe_space.hpp"
-#include "test_meshes.hpp"
+#include "spinesim/mesh/box_mesh.hpp"
 
 #include <gtest/gtest.h>
 
@@ -19,7 +19,7 @@ namespace {
 
 mesh::TetMesh small_disc_box() {
   // 30 (x) × 8 (y) × 24 (z) mm, symmetric about x = 0.
-  return test_meshes::mirrored_box_mesh(3, 3, 5, 30.0, 8.0, 24.0, -9.0);
+  return spinesim::mesh::mirrored_box_mesh(3, 3, 5, 30.0, 8.0, 24.0, -9.0);
 }
 
 mesh::RegionMaterials two_regions() {
@@ -167,7 +167,7 @@ TEST_P(DiscFemOrder, MirrorSymmetryForbidsOddEvenCoupling) {
 INSTANTIATE_TEST_SUITE_P(P1AndP2, DiscFemOrder, ::testing::Values(1, 2));
 
 TEST(DiscFem, P2NodeCountIsVerticesPlusEdges) {
-  const mesh::TetMesh m = test_meshes::box_mesh(2, 2, 2, 1, 1, 1);
+  const mesh::TetMesh m = spinesim::mesh::box_mesh(2, 2, 2, 1, 1, 1);
   const DiscFem p1(m, two_regions(), 1, DiscFem::default_plate_center(m));
   const DiscFem p2(m, two_regions(), 2, DiscFem::default_plate_center(m));
   EXPECT_EQ(p1.num_nodes(), 27);
@@ -223,7 +223,7 @@ TEST(DiscFem, RejectsBadInputWithAClearMessage) {
 
 TEST(DiscFem, P2MultigridCgMatchesTheDirectSolver) {
   // A finer box so that the P1 coarse space is a real coarsening.
-  mesh::TetMesh m = with_inner_region(test_meshes::mirrored_box_mesh(4, 4, 6, 30.0, 8.0, 24.0, -9.0));
+  mesh::TetMesh m = with_inner_region(spinesim::mesh::mirrored_box_mesh(4, 4, 6, 30.0, 8.0, 24.0, -9.0));
   const Eigen::Vector3d c = DiscFem::default_plate_center(m);
   SolverOptions direct, cg;
   direct.solver = LinearSolver::direct;

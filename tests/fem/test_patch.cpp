@@ -5,7 +5,7 @@
 #include "spinesim/fem/dirichlet.hpp"
 #include "spinesim/fem/elasticity.hpp"
 #include "spinesim/fem/fe_space.hpp"
-#include "test_meshes.hpp"
+#include "spinesim/mesh/box_mesh.hpp"
 
 #include <gtest/gtest.h>
 
@@ -23,8 +23,8 @@ struct LinearField {
 };
 
 void run_patch_test(int order) {
-  mesh::TetMesh m = test_meshes::unit_cube_mesh(4);
-  test_meshes::perturb_interior(m, 0.25, 0.15);
+  mesh::TetMesh m = spinesim::mesh::unit_cube_mesh(4);
+  spinesim::mesh::perturb_interior(m, 0.25, 0.15);
   mesh::validate(m);
   mesh::RegionMaterials mat;
   mat.fallback = {7.0, 0.35, 1000.0};
@@ -39,7 +39,7 @@ void run_patch_test(int order) {
   // (an edge between two boundary vertices through the interior does not occur on this grid's
   // faces-only boundary, and if it did, prescribing the exact linear value would still be right).
   std::set<int> bverts;
-  for (int v : test_meshes::boundary_vertices(m)) bverts.insert(v);
+  for (int v : spinesim::mesh::boundary_vertices(m)) bverts.insert(v);
   std::vector<Eigen::Index> fixed;
   std::vector<double> values;
   std::vector<char> is_fixed(std::size_t(space.num_nodes()), 0);

@@ -5,7 +5,7 @@
 #include "spinesim/mesh/mesher.hpp"
 #include "spinesim/mss/boundary.hpp"
 #include "spinesim/mss/model.hpp"
-#include "test_meshes.hpp"
+#include "spinesim/mesh/box_mesh.hpp"
 
 #include <Eigen/Core>
 
@@ -32,7 +32,7 @@ inline const mesh::TetMesh& l4_l5(double cell_mm) {
 /// Disc-proportioned structured box, 20 x 8 x 16 mm (x, y up, z), 5 x 3 x 4 cells, centred on
 /// x = z = 0; nodes at y = 0 inferior (1), y = 8 superior (2).
 inline mesh::TetMesh small_box() {
-  return fem::test_meshes::box_mesh(5, 3, 4, 20.0, 8.0, 16.0, Eigen::Vector3d(-10.0, 0.0, -8.0));
+  return spinesim::mesh::box_mesh(5, 3, 4, 20.0, 8.0, 16.0, Eigen::Vector3d(-10.0, 0.0, -8.0));
 }
 
 inline Vector6d vec6(double a, double b, double c, double d, double e, double f) {

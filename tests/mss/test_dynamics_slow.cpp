@@ -2,14 +2,11 @@
 //  1. the largest stable dt of the thesis's explicit Euler and of symplectic Euler, by
 //     bisection, against Simulator::predicted_stable_dt_s;
 //  2. the cost of one implicit step (frozen and refreshed matrix) and of a static solve versus
-//     tetrahedron count, and the per-step triangular solve of the three sparse Cholesky
-//     backends (the measurement behind default_cholesky_backend()).
+//     tetrahedron count (the per-step solve of each Cholesky backend is bench/bench_mss_cholesky).
 // Timings are printed, never asserted (shared 2-core machines); each is the best of 5 batches.
 // Run with OPENBLAS_NUM_THREADS=1 for the one-core numbers.
 #include "spinesim/mss/solver.hpp"
 
-#include "../../mss/src/reduced_space.hpp"
-#include "../../mss/src/sparse_cholesky.hpp"
 #include "solver_fixtures.hpp"
 #include "stability.hpp"
 
@@ -97,11 +94,8 @@ TEST(DynamicsSlow, StepAndSolveCostVersusTetrahedronCount) {
     const Boundary compress = fixtures::motion_boundary(m, vec6(0.0, -1.13, 0.0, 0.0, 0.0, 0.0));
     StaticResult r;
     const double t_static = best_time([&] { r = solve_static(model, compress); }, 1, 3);
-    {
-      Eigen::SparseMatrix<double> Hr;
-      model.hessian(X, HessianMode::exact, Hr);
-      dofs = detail::ReducedSpace(model, Hr, PlateMode::pose, Eigen::Vector3d::Zero()).size();
-    }
+    for (Eigen::Index i = 0; i < m.num_vertices(); ++i)  // unknowns with both endplates held
+      dofs += (m.surface(i) != int(mesh::Surface::inferior_endplate) && m.surface(i) != int(mesh::Surface::superior_endplate)) ? 3 : 0;
     std::printf("%6.2f %6ld %6ld %6ld | %8.3f %8.3f | %8.3f %8.3f %8.3f | %8.1f %5d\n", cell,
                 long(m.num_tets()), long(m.num_vertices()), long(dofs), 1e3 * t_grad, 1e3 * t_hess,
                 1e3 * t_frozen, 1e3 * t_moving, 1e3 * t_every, 1e3 * t_static, r.iterations);
@@ -109,39 +103,6 @@ TEST(DynamicsSlow, StepAndSolveCostVersusTetrahedronCount) {
   }
   std::printf("impl.frz: frozen matrix, held boundary; impl.1it: frozen, boundary moving every step;\n"
               "impl.evr: matrix refactorised every step (1 Newton iteration); static: 10 %% compression\n");
-}
-
-TEST(DynamicsSlow, CholeskyBackendsForThePerStepSolve) {
-  std::printf("per-step solve (one forward/back substitution pair) of M/dt^2 + K_d/dt + K_rest, ms\n");
-  std::printf("%6s %6s %6s %9s | %10s %10s %10s | factorise ms (same order)\n", "cell", "tets", "DOF",
-              "nnz(L)", "chm-simpl", "chm-super", "eigen-LLT");
-  for (double cell : {3.5, 2.5, 2.0, 1.6}) {
-    const mesh::TetMesh& m = fixtures::l4_l5(cell);
-    const MssModel model(m, fixtures::real_disc());
-    Eigen::SparseMatrix<double> H;
-    model.hessian(model.rest_positions_mm(), HessianMode::exact, H);
-    const detail::ReducedSpace space(model, H, PlateMode::pose, Eigen::Vector3d::Zero());
-    Eigen::SparseMatrix<double> A = space.pattern();
-    space.reduce_matrix(H, A);
-    space.add_lumped(space.lumped(model.node_masses_t()), 1e6, A);  // dt = 1 ms
-    double solve[3], factor[3], lnz = 0;
-    int k = 0;
-    for (auto b : {detail::CholeskyBackend::cholmod_simplicial, detail::CholeskyBackend::cholmod_supernodal,
-                   detail::CholeskyBackend::eigen_simplicial}) {
-      detail::SparseCholesky c(b);
-      c.analyze(A);
-      factor[k] = best_time([&] { ASSERT_TRUE(c.factorize(A)); }, 1, 3);
-      lnz = c.factor_nonzeros();
-      Eigen::VectorXd x(A.rows());
-      solve[k++] = best_time([&] {
-        x.setOnes();
-        c.solve_in_place(x);
-      }, 100);
-    }
-    std::printf("%6.2f %6ld %6ld %9.0f | %10.3f %10.3f %10.3f | %.1f %.1f %.1f\n", cell, long(m.num_tets()),
-                long(A.rows()), lnz, 1e3 * solve[0], 1e3 * solve[1], 1e3 * solve[2], 1e3 * factor[0],
-                1e3 * factor[1], 1e3 * factor[2]);
-  }
 }
 
 }  // namespace

@@ -5,7 +5,7 @@
 // multipliers are refused.
 #include "spinesim/mss/model.hpp"
 
-#include "test_meshes.hpp"
+#include "spinesim/mesh/box_mesh.hpp"
 
 #include <gtest/gtest.h>
 
@@ -22,7 +22,7 @@ namespace {
 /// Box 10 x 6 x 8 mm, 3x2x2 cells, the cells with x > 5 mm nucleus (two regions, so edges on
 /// the interface have both parts).
 mesh::TetMesh box_with_nucleus() {
-  mesh::TetMesh m = fem::test_meshes::box_mesh(3, 2, 2, 10.0, 6.0, 8.0);
+  mesh::TetMesh m = spinesim::mesh::box_mesh(3, 2, 2, 10.0, 6.0, 8.0);
   for (Eigen::Index t = 0; t < m.num_tets(); ++t) {
     double cx = 0.0;
     for (int k = 0; k < 4; ++k) cx += 0.25 * m.V(m.T(t, k), 0);

@@ -5,7 +5,7 @@
 #include "spinesim/mss/model.hpp"
 
 #include "spinesim/mesh/tet_mesh.hpp"
-#include "test_meshes.hpp"
+#include "spinesim/mesh/box_mesh.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
@@ -19,7 +19,7 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-using fem::test_meshes::box_mesh;
+using spinesim::mesh::box_mesh;
 
 mesh::RegionMaterials two_regions() {
   mesh::RegionMaterials m;

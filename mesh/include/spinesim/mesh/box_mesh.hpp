@@ -1,4 +1,5 @@
-// Structured tetrahedral meshes for the FEM tests and benchmarks.
+// Structured tetrahedral box meshes (for verification against analytic solutions: tests and
+// benchmarks).
 //
 // box_mesh: an nx×ny×nz grid of hexahedra over [x0, x0+lx]×[0, ly]×[z0, z0+lz] (mm), each hex
 // split into the 6 Kuhn tetrahedra along its main diagonal (conforming across hexes because
@@ -17,7 +18,7 @@
 #include <random>
 #include <vector>
 
-namespace spinesim::fem::test_meshes {
+namespace spinesim::mesh {
 
 inline mesh::TetMesh box_mesh(int nx, int ny, int nz, double lx, double ly, double lz,
                               const Eigen::Vector3d& origin = Eigen::Vector3d::Zero()) {
@@ -88,9 +89,9 @@ inline void perturb_interior(mesh::TetMesh& m, double h, double fraction, unsign
       for (int d = 0; d < 3; ++d) m.V(v, d) += uni(rng);
 }
 
-}  // namespace spinesim::fem::test_meshes
+}  // namespace spinesim::mesh
 
-namespace spinesim::fem::test_meshes {
+namespace spinesim::mesh {
 
 /// A box over [-lx/2, lx/2] × [0, ly] × [z0, z0+lz] that is exactly mirror-symmetric about the
 /// plane x = 0 (the right half is a box_mesh, the left half its reflection with flipped
@@ -138,4 +139,4 @@ inline mesh::TetMesh mirrored_box_mesh(int nx_half, int ny, int nz, double lx, d
   return m;
 }
 
-}  // namespace spinesim::fem::test_meshes
+}  // namespace spinesim::mesh
