@@ -1,5 +1,5 @@
 // CGAL Mesh_3 tetrahedralisation of labelled bodies — the project's only Mesh_3 translation
-// unit (it alone costs ~45 s to compile).
+// unit (it is the slowest file of the build to compile).
 //
 // Domain: CGAL::Labeled_mesh_domain_3 over the body's labelling function (0 outside), wrapped
 // in Mesh_domain_with_polyline_features_3 so that sharp rims can be protected as 1D features.

@@ -8,16 +8,10 @@
 
 namespace spinesim::mss::detail {
 
-// Measured (tests/mss/test_dynamics_slow.cpp, L4-L5 real disc, implicit matrix at dt = 1 ms,
-// OPENBLAS_NUM_THREADS=1, best of 5, machine shared): per-step solve in ms for CHOLMOD
-// simplicial / CHOLMOD supernodal / Eigen SimplicialLLT, and factorisation in ms:
-//     2231 tets,  930 DOF:  0.029 / 0.042 / 0.059 ;   1.2 /  1.2 /   1.1
-//     5062 tets, 2079 DOF:  0.168 / 0.172 / 0.316 ;  12.8 /  5.5 /  11.8
-//     9332 tets, 4020 DOF:  0.752 / 0.648 / 1.205 ;  73.7 / 24.7 /  59.6
-//    17579 tets, 7635 DOF:  2.274 / 2.057 / 3.773 ; 433.8 / 80.1 / 308.8
-// The two CHOLMOD solves are alike (the supernodal one wins from ~4k DOF), Eigen's is ~2x
-// slower; supernodal factorises 2-5x faster, which the refreshed matrix and the frozen
-// refactorisation on a probe-contact change need. Hence supernodal.
+// The backend for the MSS step: the two CHOLMOD solves are alike per step and Eigen's is
+// slower; supernodal CHOLMOD factorises fastest, which the refreshed matrix and the frozen
+// refactorisation on a probe-contact change need. Hence supernodal (measured by
+// bench/bench_mss_cholesky; docs/benchmarks.md, "Cholesky backends").
 CholeskyBackend default_cholesky_backend() { return CholeskyBackend::cholmod_supernodal; }
 
 struct SparseCholesky::Impl {

@@ -119,22 +119,26 @@ struct BenchArgs {
 
 void bench_mesh(const BenchArgs& a) {
   nlohmann::json rows = nlohmann::json::array();
-  if (!a.json)
-    std::cout << "Meshing " << a.level << " (CGAL Mesh_3, default options)\n"
-              << " cell mm     tets    nodes   seconds  min dihedral  volume err %  peak MB\n";
-  for (double h : parse_list(a.cell_sizes, "--cell-sizes")) {
+  TextTable t({"cell mm", "tets", "nodes", "seconds", "min dihedral", "volume err %", "peak MB"}, 0);
+  const auto sizes = parse_list(a.cell_sizes, "--cell-sizes");
+  ProgressBar bar(int(sizes.size()), a.json, "runs");
+  for (double h : sizes) {
+    bar.update(int(rows.size()), "meshing at " + fixed(h, 2) + " mm");
     std::ostringstream args;
     args << "bench-mesh-one --level " << a.level << " --cell-size " << h;
     const auto r = run_child(args.str());
     rows.push_back(r);
-    if (!a.json)
-      std::cout << std::fixed << std::setprecision(2) << std::setw(8) << h << std::setw(9) << r["tets"].get<long>()
-                << std::setw(9) << r["nodes"].get<long>() << std::setw(10) << r["seconds"].get<double>()
-                << std::setw(14) << r["min_dihedral_deg"].get<double>() << std::setw(14) << std::setprecision(3)
-                << 100 * r["volume_error"].get<double>() << std::setw(9) << std::setprecision(0)
-                << r["peak_rss_mb"].get<double>() << std::endl;
+    t.add({fixed(h, 2), std::to_string(r["tets"].get<long>()), std::to_string(r["nodes"].get<long>()),
+           fixed(r["seconds"].get<double>(), 2), fixed(r["min_dihedral_deg"].get<double>(), 2),
+           fixed(100 * r["volume_error"].get<double>(), 3), fixed(r["peak_rss_mb"].get<double>(), 0)});
   }
-  if (a.json) print_json({{"level", a.level}, {"runs", rows}});
+  bar.finish();
+  if (a.json) {
+    print_json({{"level", a.level}, {"runs", rows}});
+    return;
+  }
+  std::cout << "Meshing " << a.level << " (CGAL Mesh_3, default options)\n";
+  t.print(std::cout, false, " ");
 }
 
 void bench_fem(const BenchArgs& a) {
@@ -142,10 +146,12 @@ void bench_fem(const BenchArgs& a) {
   const fs::path dir = fs::temp_directory_path() / ("spinesim-bench-" + std::to_string(getpid()));
   fs::create_directories(dir);
   nlohmann::json rows = nlohmann::json::array();
-  if (!a.json)
-    std::cout << "FEM reference on " << a.level << " meshes (real-disc), one process per run\n"
-              << " order     DOF  assembly  analyse  factorise  6 solves  6x6 total  1 load  peak MB\n";
-  for (double h : parse_list(a.cell_sizes, "--cell-sizes")) {
+  TextTable t({"order", "DOF", "assembly", "analyse", "factorise", "6 solves", "6x6 total", "1 load", "peak MB"}, 0);
+  const auto sizes = parse_list(a.cell_sizes, "--cell-sizes");
+  ProgressBar bar(int(sizes.size()), a.json, "meshes");
+  int done = 0;
+  for (double h : sizes) {
+    bar.update(done++, "cell size " + fixed(h, 2) + " mm");
     const fs::path mesh_path = dir / ("disc-" + std::to_string(h) + ".vtu");
     std::ostringstream margs;
     margs << "bench-mesh-one --level " << a.level << " --cell-size " << h << " --mesh-out '" << mesh_path.string()
@@ -157,17 +163,20 @@ void bench_fem(const BenchArgs& a) {
       auto r = run_child(fargs.str());
       r["cell_size_mm"] = h;
       rows.push_back(r);
-      if (!a.json)
-        std::cout << std::fixed << std::setprecision(3) << std::setw(6) << int(order) << std::setw(8)
-                  << r["dofs"].get<long>() << std::setw(10) << r["assembly_s"].get<double>() << std::setw(9)
-                  << r["analyse_s"].get<double>() << std::setw(11) << r["factorise_s"].get<double>() << std::setw(10)
-                  << r["stiffness_solves_s"].get<double>() << std::setw(11) << r["stiffness_total_s"].get<double>()
-                  << std::setw(8) << r["load_solve_s"].get<double>() << std::setw(9) << std::setprecision(0)
-                  << r["peak_rss_mb"].get<double>() << std::endl;
+      t.add({std::to_string(int(order)), std::to_string(r["dofs"].get<long>()), fixed(r["assembly_s"].get<double>(), 3),
+             fixed(r["analyse_s"].get<double>(), 3), fixed(r["factorise_s"].get<double>(), 3),
+             fixed(r["stiffness_solves_s"].get<double>(), 3), fixed(r["stiffness_total_s"].get<double>(), 3),
+             fixed(r["load_solve_s"].get<double>(), 3), fixed(r["peak_rss_mb"].get<double>(), 0)});
     }
   }
+  bar.finish();
   fs::remove_all(dir);
-  if (a.json) print_json({{"level", a.level}, {"runs", rows}});
+  if (a.json) {
+    print_json({{"level", a.level}, {"runs", rows}});
+    return;
+  }
+  std::cout << "FEM reference on " << a.level << " meshes (real-disc), one process per run; times in s\n";
+  t.print(std::cout, false, " ");
 }
 
 }  // namespace

@@ -85,8 +85,7 @@ double worst(const nlohmann::json& rows, const char* key) {
 
 /// --level all: every level's parametric disc, one tuned set file (tuned_set.hpp), written only
 /// when every level succeeded.
-void run_all_levels(const CalibrateArgs& a, const CalibrationRequest& rq, const mesh::RegionMaterials& materials,
-                    const StatusLine& status) {
+void run_all_levels(const CalibrateArgs& a, const CalibrationRequest& rq, const mesh::RegionMaterials& materials) {
   calibration::TunedSet set;
   set.material_name = materials.name;
   std::ostringstream cmd;
@@ -98,27 +97,27 @@ void run_all_levels(const CalibrateArgs& a, const CalibrationRequest& rq, const 
   set.settings = {{"cell_size_rule", a.cell_size_option->count() ? "as given" : "min(2 mm, disc height / 5)"},
                   {"mesh", "parametric disc (data/disc_morphometry.csv), CGAL, placed in the spine (as `mesh disc --level`)"},
                   {"check_load_scale", rq.nonlinear_check ? nlohmann::json(rq.check_load_scale) : nlohmann::json(nullptr)}};
-  std::ostringstream table;
-  table << std::left << std::setw(9) << "level" << std::right << std::setw(7) << "tets" << std::setw(13)
-        << "train max" << std::setw(13) << "holdout max" << std::setw(15) << "K6 diag ratio" << std::setw(9)
-        << "Ipopt" << std::setw(9) << "time" << "\n"
-        << std::left << std::setw(9) << "" << std::right << std::setw(7) << "" << std::setw(13) << "untuned>tuned"
-        << std::setw(13) << "untuned>tuned" << std::setw(15) << "tuned min-max" << std::setw(9) << "its" << std::setw(9)
-        << "s" << "\n";
+  TextTable table({"level", "tets", "train max (untuned>tuned)", "holdout max (untuned>tuned)",
+                   "K6 diag ratio (tuned, min-max)", "Ipopt its", "time (s)"});
   std::vector<std::string> failed;
   // Thin thoracic discs (4.5-7 mm) get at least five cells through the height: at 2 mm the
-  // fitted MSS stays 12-17 % off the FEM there, at height/5 (~1 mm) 8-9 % (T5-T6 measured).
+  // fitted MSS stays much further off the FEM there (calibration/README.md).
   nlohmann::json cell_by_level = nlohmann::json::object();
+  // One line on a terminal: the level being calibrated, its stage, how many are done, the ETA.
+  ProgressBar bar(int(mesh::disc_levels().size()), a.quiet || a.json, "levels");
+  int done = 0;
   for (const std::string& level : mesh::disc_levels()) {
+    const StatusLine level_status = [&bar, &done, &level](const std::string& s) { bar.update(done, level + ": " + s); };
     const mesh::DiscDimensions dims = mesh::disc_dimensions(level, data_dir());
     mesh::MeshOptions opt;
     opt.cell_size_mm = a.cell_size_option->count() ? a.cell_size_mm : std::min(2.0, dims.height_mm / 5.0);
     cell_by_level[level] = opt.cell_size_mm;
-    status("== " + level + ": meshing (cell size " + std::to_string(opt.cell_size_mm).substr(0, 4) + " mm)");
+    level_status("meshing (cell size " + std::to_string(opt.cell_size_mm).substr(0, 4) + " mm)");
     const mesh::TetMesh m = mesh_disc_level(level, opt);
     CalibrationRequest level_rq = rq;
-    if (!a.no_transfer) level_rq.transfer_meshes.push_back(coarser_mesh(dims, opt, status));
-    const CalibrationOutcome o = calibrate_disc(m, materials, level_rq, status);
+    if (!a.no_transfer) level_rq.transfer_meshes.push_back(coarser_mesh(dims, opt, level_status));
+    const CalibrationOutcome o = calibrate_disc(m, materials, level_rq, level_status);
+    ++done;
     if (!o.result.success) {
       failed.push_back(level + " (" + o.result.status + ")");
       continue;
@@ -127,22 +126,15 @@ void run_all_levels(const CalibrateArgs& a, const CalibrationRequest& rq, const 
     const auto& ratio = rep["stiffness_diagonal"]["ratio_tuned"];
     double lo = 1e300, hi = 0;
     for (const auto& v : ratio) lo = std::min(lo, v.get<double>()), hi = std::max(hi, v.get<double>());
-    const auto pair = [](double u, double t) {
-      std::ostringstream s;
-      s << std::fixed << std::setprecision(0) << 100 * u << ">" << std::setprecision(1) << 100 * t << "%";
-      return s.str();
-    };
-    table << std::left << std::setw(9) << level << std::right << std::setw(7) << m.num_tets() << std::setw(13)
-          << pair(worst(rep["train"], "untuned_error"), worst(rep["train"], "tuned_error")) << std::setw(13)
-          << (rep["holdout"].empty() ? std::string("-")
-                                     : pair(worst(rep["holdout"], "untuned_error"), worst(rep["holdout"], "tuned_error")))
-          << std::setw(15)
-          << [&] { std::ostringstream s; s << std::fixed << std::setprecision(3) << lo << "-" << hi; return s.str(); }()
-          << std::setw(9) << o.result.iterations << std::setw(9) << std::fixed << std::setprecision(1) << o.total_seconds
-          << "\n";
+    const auto pair = [](double u, double t) { return fixed(100 * u, 0) + ">" + fixed(100 * t, 1) + "%"; };
+    table.add({level, std::to_string(m.num_tets()), pair(worst(rep["train"], "untuned_error"), worst(rep["train"], "tuned_error")),
+               rep["holdout"].empty() ? std::string("-")
+                                      : pair(worst(rep["holdout"], "untuned_error"), worst(rep["holdout"], "tuned_error")),
+               fixed(lo, 3) + "-" + fixed(hi, 3), std::to_string(o.result.iterations), fixed(o.total_seconds, 1)});
     set.levels.emplace(level, o.tuned);
   }
   set.settings["cell_size_mm"] = cell_by_level;
+  bar.finish();
   if (!failed.empty()) {
     std::string list;
     for (const auto& f : failed) list += (list.empty() ? "" : ", ") + f;
@@ -157,8 +149,9 @@ void run_all_levels(const CalibrateArgs& a, const CalibrationRequest& rq, const 
   }
   std::cout << "Calibration of all " << set.levels.size() << " levels, material " << materials.name << ", terms "
             << a.terms << " (errors: relative nodal displacement, nonlinear check at loads x " << rq.check_load_scale
-            << ")\n\n"
-            << table.str() << "\nwrote " << a.out << "\n";
+            << ")\n\n";
+  table.print(std::cout, false);
+  std::cout << "\nwrote " << a.out << "\n";
 }
 
 void run_calibrate(const CalibrateArgs& a) {
@@ -208,7 +201,7 @@ void run_calibrate(const CalibrateArgs& a) {
   const auto status = [chatty](const std::string& s) {
     if (chatty) std::cerr << "  " << s << std::endl;
   };
-  if (a.level == "all") return run_all_levels(a, rq, materials, status);
+  if (a.level == "all") return run_all_levels(a, rq, materials);
 
   // 2. The mesh: read, or the level's parametric disc; and the transfer meshes.
   for (const std::string& path : a.transfer_meshes) {
@@ -297,8 +290,7 @@ void register_calibrate(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--no-check", a->no_check, "Skip the nonlinear MSS-vs-FEM check (errors then linearised only)");
   cmd->add_option("--out", a->out, "Tuned parameter file to write (JSON); required");
-  cmd->add_flag("--json", a->json, "Print the tuned file's contents as JSON on stdout");
-  cmd->add_flag("--quiet", a->quiet, "No progress on stderr");
+  add_output_flags(cmd, a->json, a->quiet, "the tuned file\'s contents as JSON");
   cmd->footer(
       "Objective (training cases): mean relative nodal displacement error^2 + w_r reaction error^2 under\n"
       "the FEM's plate motion + w_k mean ln^2(K6_ii MSS/FEM) + w_p mean ln^2(scale), the MSS linearised at\n"

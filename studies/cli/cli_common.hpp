@@ -23,6 +23,13 @@ using namespace spinesim::studies;  // the command line is a thin layer over the
 /// Parses "a,b,c" into exactly n finite numbers; throws std::invalid_argument naming `what`.
 Eigen::VectorXd parse_numbers(const std::string& text, int n, const std::string& what);
 
+/// --json (one JSON object on stdout; `what` says which) and --quiet (no progress on stderr).
+void add_output_flags(CLI::App* cmd, bool& json, bool& quiet, const std::string& what = "a JSON summary");
+
+/// The plate load options of `fem` and `mss`: --motion, --wrench, --case, --center.
+void add_plate_load_options(CLI::App* cmd, std::string& motion, std::string& wrench, std::string& load_case,
+                            std::string& center);
+
 /// "a,b,,c" -> {"a", "b", "c"} (empty items dropped).
 std::vector<std::string> split_list(const std::string& text);
 

@@ -38,8 +38,7 @@ void register_demo(CLI::App& app) {
   cmd->add_option("--level", a->request.level, "Disc level")->capture_default_str();
   cmd->add_option("--cell-size", a->request.cell_size_mm, "Mesh cell size, mm")->capture_default_str();
   cmd->add_option("--order", a->request.fem_order, "FEM element order 1 or 2")->capture_default_str();
-  cmd->add_flag("--json", a->json, "Print a JSON summary on stdout");
-  cmd->add_flag("--quiet", a->quiet, "No progress on stderr");
+  add_output_flags(cmd, a->json, a->quiet);
   cmd->callback([a] { run(*a); });
 }
 

@@ -120,15 +120,9 @@ void register_fem(CLI::App& app) {
   cmd->add_option("--material", a->material, "Preset (real-disc, annulus-nucleus, rubber, polyethylene) or JSON file")
       ->capture_default_str();
   cmd->add_option("--order", a->order, "Element order: 1 (P1) or 2 (P2)")->capture_default_str();
-  cmd->add_option("--motion", a->motion, "Plate motion tx,ty,tz,rx,ry,rz (mm, degrees)");
-  cmd->add_option("--wrench", a->wrench, "Applied wrench Fx,Fy,Fz,Mx,My,Mz (N, N·mm) about the centre");
-  cmd->add_option("--case", a->load_case,
-                  "Named load case in the disc frame: compression, tension, shear-ap, shear-lat, flexion, "
-                  "extension, lateral-bending, torsion");
-  cmd->add_option("--center", a->center, "Plate centre x,y,z (mm); default: mean of the superior endplate nodes");
+  add_plate_load_options(cmd, a->motion, a->wrench, a->load_case, a->center);
   cmd->add_option("--out", a->out, "Write the displacement field to this VTU");
-  cmd->add_flag("--json", a->json, "Print a JSON summary on stdout");
-  cmd->add_flag("--quiet", a->quiet, "No progress on stderr");
+  add_output_flags(cmd, a->json, a->quiet);
   cmd->callback([a] { run_fem(*a); });
 }
 

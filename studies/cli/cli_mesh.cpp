@@ -203,8 +203,7 @@ void register_mesh(CLI::App& app) {
                      "Structured: stretch each section to the outline's exact area (exact volume)")};
   disc->add_option("--out", a->out, "Output VTU file")->capture_default_str();
   disc->add_option("--medit", a->medit, "Also write a Medit .mesh file");
-  disc->add_flag("--json", a->json, "Print a JSON summary on stdout");
-  disc->add_flag("--quiet", a->quiet, "No progress on stderr");
+  add_output_flags(disc, a->json, a->quiet);
   disc->callback([a, cgal, structured] {
     a->cgal_flags_given.clear();
     a->structured_flags_given.clear();

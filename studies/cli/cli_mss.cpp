@@ -413,12 +413,7 @@ void register_mss(CLI::App& app) {
           ->capture_default_str();
   cmd->add_option("--params", a->params, "Tuned disc from `spinesim calibrate` (sets terms, scales and, unless given, the material); or a "
                   "tuned set such as data/tuned_discs.json (the mesh's level is used)");
-  cmd->add_option("--motion", a->motion, "Plate motion tx,ty,tz,rx,ry,rz (mm, degrees)");
-  cmd->add_option("--wrench", a->wrench, "Applied wrench Fx,Fy,Fz,Mx,My,Mz (N, N·mm) about the centre");
-  cmd->add_option("--case", a->load_case,
-                  "Named load case in the disc frame: compression, tension, shear-ap, shear-lat, flexion, "
-                  "extension, lateral-bending, torsion");
-  cmd->add_option("--center", a->center, "Plate centre x,y,z (mm); default: mean of the superior endplate nodes");
+  add_plate_load_options(cmd, a->motion, a->wrench, a->load_case, a->center);
   cmd->add_flag("--static", a->static_run, "Static equilibrium (the default)");
   auto* dt = cmd->add_option("--dt", a->dt_s, "Time step, s (dynamic run)")->capture_default_str();
   auto* steps = cmd->add_option("--steps", a->steps, "Number of time steps (dynamic run)");
@@ -430,8 +425,7 @@ void register_mss(CLI::App& app) {
   cmd->add_option("--frame-every", a->frame_every, "Dynamic .pvd output: a frame every K steps (0: about 100 frames)");
   add_model_flags(cmd, a->model);
   cmd->add_option("--out", a->out, "Write the result: .vtu (final state) or .pvd (time series of a dynamic run)");
-  cmd->add_flag("--json", a->json, "Print a JSON summary on stdout");
-  cmd->add_flag("--quiet", a->quiet, "No progress on stderr");
+  add_output_flags(cmd, a->json, a->quiet);
   cmd->footer(
       "Dynamic runs ramp the load linearly over the first 10 % of the steps, then hold it. A diverging run\n"
       "exits 1 with the reason, \"diverged\": true in its JSON and no output file.");
@@ -447,8 +441,7 @@ void register_mss(CLI::App& app) {
   cmp->add_option("--order", c->order, "FEM element order: 1 (P1) or 2 (P2)")->capture_default_str();
   add_model_flags(cmp, c->model);
   cmp->add_option("--csv", c->csv, "Also write one CSV row per case");
-  cmp->add_flag("--json", c->json, "Print a JSON summary on stdout");
-  cmp->add_flag("--quiet", c->quiet, "No progress on stderr");
+  add_output_flags(cmp, c->json, c->quiet);
   cmp->footer(kCompareProtocol);
   cmp->callback([c] { run_compare(*c); });
 

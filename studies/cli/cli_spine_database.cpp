@@ -52,14 +52,6 @@ std::vector<int> vertebra_list(const std::string& text) {
   return out;
 }
 
-/// "done/total" on one stderr line, redrawn (only on a terminal, like Progress).
-std::function<void(int, int)> counter(const Progress& p) {
-  if (p.quiet()) return {};
-  return [](int done, int total) {
-    if (done == total || done % 10 == 0) std::cerr << "\r  " << done << "/" << total << " solves" << std::flush;
-    if (done == total) std::cerr << "\r" << std::string(24, ' ') << "\r" << std::flush;
-  };
-}
 
 sp::SolveOptions solve_options(bool recruit) {
   sp::SolveOptions o;
@@ -75,16 +67,15 @@ void print_residuals(const sp::DatabaseInfo& info, std::ostream& os) {
   for (int d = 1; d <= sp::kDbMaxDegree; ++d) os << " " << r.degree_count[std::size_t(d)];
   os << "), " << r.fits_above_tolerance << " above tolerance (RMS > max(" << 100 * info.tolerance.relative
      << " % of range, " << info.tolerance.absolute << "))\n";
-  os << std::left << std::setw(10) << " direction" << std::right << std::setw(11) << "max mm" << std::setw(11)
-     << "rms mm" << std::setw(11) << "max deg" << std::setw(11) << "rms deg" << std::setw(11) << "above tol\n";
+  TextTable t({"direction", "max mm", "rms mm", "max deg", "rms deg", "above tol"});
   auto row = [&](const std::string& name, const sp::ResidualSummary& s) {
-    os << std::left << std::setw(10) << (" " + name) << std::right << std::setw(11) << fixed(s.max_translation_mm, 4)
-       << std::setw(11) << fixed(s.rms_translation_mm, 4) << std::setw(11) << fixed(s.max_rotation_deg, 4)
-       << std::setw(11) << fixed(s.rms_rotation_deg, 4) << std::setw(10) << s.fits_above_tolerance << "\n";
+    t.add({name, fixed(s.max_translation_mm, 4), fixed(s.rms_translation_mm, 4), fixed(s.max_rotation_deg, 4),
+           fixed(s.rms_rotation_deg, 4), std::to_string(s.fits_above_tolerance)});
   };
   for (int d = 0; d < sp::kDbDirections; ++d)
     row(sp::direction_names()[std::size_t(d)], info.residuals_per_direction[std::size_t(d)]);
   row("all", r);
+  t.print(os, false, " ");
 }
 
 void print_failed(const std::vector<sp::FailedSolve>& failed, std::ostream& os) {
@@ -112,25 +103,25 @@ void print_out_of_plane(const std::vector<sp::OutOfPlaneSolve>& solves, std::ost
 std::string percent(double error, double scale) { return scale > 0 ? fixed(100 * error / scale, 1) + "%" : "-"; }
 
 void print_superposition(const sp::SuperpositionReport& r, std::ostream& os) {
-  os << "Superposition of axis responses vs a direct solve (max over the 17 vertebrae; % of the max response):\n"
-     << std::left << std::setw(6) << " on" << std::setw(8) << "plane" << std::right << std::setw(7) << "|F| N"
-     << std::setw(10) << "resp mm" << std::setw(10) << "resp deg" << std::setw(16) << "db err mm" << std::setw(16)
-     << "db err deg" << std::setw(16) << "axis-sum mm" << std::setw(16) << "axis-sum deg" << "\n";
+  os << "Superposition of axis responses vs a direct solve (max over the 17 vertebrae; % of the max response):\n";
+  TextTable t({"on", "plane", "|F| N", "resp mm", "resp deg", "db err mm", "db err deg", "axis-sum mm", "axis-sum deg",
+               "note"}, 2);
   for (const auto& c : r.cases) {
-    os << std::left << std::setw(6) << (" " + sp::vertebra_names()[std::size_t(c.vertebra)]) << std::setw(8) << c.plane
-       << std::right << std::setw(7) << fixed(c.force_n.norm(), 0);
+    const std::string vertebra = sp::vertebra_names()[std::size_t(c.vertebra)];
     if (!c.solved) {
-      os << "  " << c.message << "\n";
+      t.add({vertebra, c.plane, fixed(c.force_n.norm(), 0), "-", "-", "-", "-", "-", "-", c.message});
       continue;
     }
     auto pair = [&](double e, double scale) { return fixed(e, 3) + " (" + percent(e, scale) + ")"; };
-    os << std::setw(10) << fixed(c.response_translation_mm, 2) << std::setw(10) << fixed(c.response_rotation_deg, 2)
-       << std::setw(16) << pair(c.db_error_translation_mm, c.response_translation_mm) << std::setw(16)
-       << pair(c.db_error_rotation_deg, c.response_rotation_deg) << std::setw(16)
-       << pair(c.axis_sum_error_translation_mm, c.response_translation_mm) << std::setw(16)
-       << pair(c.axis_sum_error_rotation_deg, c.response_rotation_deg) << (c.extrapolated ? "  extrapolated" : "")
-       << (c.message.empty() ? "" : "  " + c.message) << "\n";
+    std::string note = c.extrapolated ? "extrapolated" : "";
+    if (!c.message.empty()) note += (note.empty() ? "" : "; ") + c.message;
+    t.add({vertebra, c.plane, fixed(c.force_n.norm(), 0), fixed(c.response_translation_mm, 2),
+           fixed(c.response_rotation_deg, 2), pair(c.db_error_translation_mm, c.response_translation_mm),
+           pair(c.db_error_rotation_deg, c.response_rotation_deg),
+           pair(c.axis_sum_error_translation_mm, c.response_translation_mm),
+           pair(c.axis_sum_error_rotation_deg, c.response_rotation_deg), note});
   }
+  t.print(os, false, " ");
   os << "Worst (database: within the solved range): database " << fixed(r.max_db_translation_mm, 3) << " mm (" << fixed(100 * r.max_db_translation_relative, 1)
      << " %), " << fixed(r.max_db_rotation_deg, 3) << " deg (" << fixed(100 * r.max_db_rotation_relative, 1)
      << " %); sum of direct axis solves " << fixed(r.max_axis_sum_translation_mm, 3) << " mm ("
@@ -193,7 +184,8 @@ void run_generate(const DatabaseArgs& a) {
   g.solve = solve_options(!a.no_recruit);
   g.loaded_vertebrae = vertebra_list(a.vertebrae);
   g.workers = a.workers;
-  g.progress = counter(progress);
+  ProgressBar solves(0, progress.quiet(), "solves");
+  g.progress = solves.callback();
   const int nv = g.loaded_vertebrae.empty() ? sp::kDbVertebrae : int(g.loaded_vertebrae.size());
   progress.begin("solving " + std::to_string(nv * sp::kDbDirections * 12 + 1) + " load cases");
   const sp::ResponseSamples samples = sp::sample_responses(model, g);
@@ -206,7 +198,9 @@ void run_generate(const DatabaseArgs& a) {
   db.info.model = mo;
   const auto cases = oblique_cases(a, db);
   progress.begin("superposition check: " + std::to_string(cases.size()) + " oblique forces");
-  db.info.superposition = sp::check_superposition(model, db, cases, g.solve, a.workers, counter(progress));
+  solves.finish();
+  db.info.superposition = sp::check_superposition(model, db, cases, g.solve, a.workers, solves.callback());
+  solves.finish();
   db.info.has_superposition = true;
   progress.end();
 
@@ -273,7 +267,9 @@ void run_check(const DatabaseArgs& a) {
   progress.begin("re-solving " + std::to_string(rows.size()) + " grid forces");
   std::vector<sp::VertebraResponse> disp;
   std::vector<std::string> errors;
-  sp::solve_cases(model, loads, so, a.workers, disp, errors, counter(progress));
+  ProgressBar solves(0, progress.quiet(), "solves");
+  sp::solve_cases(model, loads, so, a.workers, disp, errors, solves.callback());
+  solves.finish();
   if (!errors[0].empty()) throw std::runtime_error("the gravity-only solve failed: " + errors[0]);
   // The solver stops at a gradient tolerance, and the coefficients are rounded: a small margin.
   const double margin = 1e-3;
@@ -300,7 +296,8 @@ void run_check(const DatabaseArgs& a) {
   }
   progress.end();
   progress.begin("superposition check: " + std::to_string(cases.size()) + " oblique forces");
-  const sp::SuperpositionReport sup = sp::check_superposition(model, db, cases, so, a.workers, counter(progress));
+  const sp::SuperpositionReport sup = sp::check_superposition(model, db, cases, so, a.workers, solves.callback());
+  solves.finish();
   progress.end();
 
   if (a.json) {
@@ -323,12 +320,13 @@ void run_check(const DatabaseArgs& a) {
               << "Baseline (gravity only) vs file: " << fixed(base_mm, 5) << " mm, " << fixed(base_deg, 5) << " deg\n"
               << "Grid forces re-solved (error = max over vertebrae; allowed = the file's max fit residual + "
               << margin << "):\n";
+    TextTable t({"vertebra", "direction", "force (N)", "error (mm)", "allowed (mm)", "error (deg)", "allowed (deg)",
+                 "verdict"}, 2);
     for (const auto& r : rows)
-      std::cout << "  " << std::left << std::setw(4) << sp::vertebra_names()[std::size_t(r.vertebra)] << std::setw(3)
-                << sp::direction_names()[std::size_t(r.direction)] << std::right << std::setw(5) << r.force_n << " N "
-                << std::setw(9) << fixed(r.error_mm, 4) << " mm (<= " << fixed(r.allowed_mm, 4) << ") " << std::setw(9)
-                << fixed(r.error_deg, 4) << " deg (<= " << fixed(r.allowed_deg, 4) << ") "
-                << (r.ok() ? "ok" : r.message.empty() ? "MISMATCH" : "FAILED " + r.message) << "\n";
+      t.add({sp::vertebra_names()[std::size_t(r.vertebra)], sp::direction_names()[std::size_t(r.direction)],
+             fixed(r.force_n, 0), fixed(r.error_mm, 4), fixed(r.allowed_mm, 4), fixed(r.error_deg, 4), fixed(r.allowed_deg, 4),
+             r.ok() ? "ok" : r.message.empty() ? "MISMATCH" : "FAILED " + r.message});
+    t.print(std::cout, false);
     print_superposition(sup, std::cout);
   }
   if (!all_ok) throw std::runtime_error(path + " does not match the model: re-solved responses differ beyond the fit residuals");

@@ -90,8 +90,7 @@ void add_common_options(CLI::App* cmd, StudyCommon& c) {
   cmd->add_flag("--frozen", c.frozen, "Implicit: keep the rest-stiffness factorisation (one solve per step)");
   cmd->add_option("--frame-every", c.frame_every, "A VTU frame every K steps")->capture_default_str();
   add_model_flags(cmd, c.model);
-  cmd->add_flag("--json", c.json, "Print the JSON summary on stdout");
-  cmd->add_flag("--quiet", c.quiet, "No progress on stderr");
+  add_output_flags(cmd, c.json, c.quiet, "the JSON summary");
 }
 
 /// Checks the shared options (before any work) and returns the dynamics options.
@@ -311,10 +310,10 @@ void run_drive(DriveArgs a) {
               << " tets): inferior endplate (L3) fixed, superior (L2) driven, disc frame (x lateral, y axial, z "
                  "anterior), "
               << model_variant(c.model) << " MSS, " << c.integrator << " Euler dt " << c.dt_s << " s\n"
-              << "  schedule: time (s)   axial (mm)   flexion (deg), linear in between\n";
-    for (const auto& k : keys)
-      std::cout << "            " << std::setw(8) << k.time_s << std::setw(13) << k.axial_mm << std::setw(15)
-                << k.flexion_deg << "\n";
+              << "  schedule (linear in between):\n";
+    TextTable t({"time (s)", "axial (mm)", "flexion (deg)"}, 0);
+    for (const auto& k : keys) t.add({significant(k.time_s, 6), significant(k.axial_mm, 6), significant(k.flexion_deg, 6)});
+    t.print(std::cout, false, "    ");
   }
 
   // 3. One run per material.
@@ -349,20 +348,18 @@ void run_drive(DriveArgs a) {
   if (c.json) {
     print_json(j);
   } else {
-    std::cout << "\n  " << std::left << std::setw(18) << "material" << std::right << std::setw(12) << "E (MPa)"
-              << std::setw(16) << "peak |F| (N)" << std::setw(16) << "peak Fy (N)" << std::setw(18) << "peak |M| (N·mm)"
-              << std::setw(14) << "max dV/V0" << std::setw(14) << "step (ms)" << "\n";
+    TextTable t({"material", "E (MPa)", "peak |F| (N)", "peak Fy (N)", "peak |M| (N·mm)", "max dV/V0", "step (ms)", ""});
     for (const auto& r : results) {
       std::ostringstream e;  // "4.2/1" when annulus and nucleus differ
       const double ea = r.json["E_mpa_annulus"].get<double>(), en = r.json["E_mpa_nucleus"].get<double>();
       e << ea;
       if (en != ea) e << "/" << en;
-      std::cout << "  " << std::left << std::setw(18) << r.json["material"].get<std::string>() << std::right
-                << std::setw(12) << e.str() << std::setw(16) << std::setprecision(5)
-                << r.peak_force_n << std::setw(16) << r.peak_axial_n << std::setw(18) << r.peak_moment_nmm
-                << std::setw(13) << 100 * r.json["max_volume_change"].get<double>() << "%" << std::setw(14)
-                << r.stats.mean_seconds() * 1e3 << (r.stats.diverged ? "  DIVERGED" : "") << "\n";
+      t.add({r.json["material"].get<std::string>(), e.str(), significant(r.peak_force_n, 5), significant(r.peak_axial_n, 5),
+             significant(r.peak_moment_nmm, 5), significant(100 * r.json["max_volume_change"].get<double>(), 5) + "%",
+             significant(r.stats.mean_seconds() * 1e3, 5), r.stats.diverged ? "DIVERGED" : ""});
     }
+    std::cout << "\n";
+    t.print(std::cout, false);
     std::cout << "  wrote " << json_path << " and drive-<material>.{pvd,csv} in " << c.out << "\n";
   }
   if (!diverged.empty()) throw std::runtime_error("drive study diverged for: " + diverged);
@@ -504,8 +501,7 @@ void register_materials(CLI::App& study) {
   cmd->add_option("--materials", a->materials, "Comma-separated presets or JSON files")->capture_default_str();
   cmd->add_option("--terms", a->terms, "What the calibration tunes: thesis, thesis+volume, all")->capture_default_str();
   cmd->add_option("--csv", a->csv, "Write a CSV, one row per material x model (fem, untuned, tuned)");
-  cmd->add_flag("--json", a->json, "Print the JSON summary on stdout (instead of the tables)");
-  cmd->add_flag("--quiet", a->quiet, "No progress on stderr");
+  add_output_flags(cmd, a->json, a->quiet, "the JSON summary (instead of the tables)");
   cmd->footer(
       "Protocol: one mesh of --level for every material; inferior endplate fixed, superior endplate a rigid\n"
       "plate about the mean of its vertices. Per material:\n"

@@ -14,9 +14,9 @@
 #include <cstdlib>
 #include <iostream>
 
-// OpenBLAS (under supernodal CHOLMOD) busy-waits its worker threads; on these 2-core machines
-// any other load made a P2 factorisation 5-9x slower with 2 threads than with 1 (measured:
-// 35k DOF, 1.0 s vs 4.7-9.2 s). One thread unless the user sets OPENBLAS_NUM_THREADS.
+// OpenBLAS (under supernodal CHOLMOD) busy-waits its worker threads; on 2-core machines any
+// other load made a P2 factorisation several times slower with 2 threads than with 1
+// (docs/benchmarks.md, "OpenBLAS threads"). One thread unless the user sets OPENBLAS_NUM_THREADS.
 extern "C" void openblas_set_num_threads(int) __attribute__((weak));
 
 int main(int argc, char** argv) {

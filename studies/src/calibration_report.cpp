@@ -1,5 +1,8 @@
 #include "spinesim/studies/calibration_report.hpp"
 
+#include "spinesim/studies/format.hpp"
+#include "spinesim/studies/table.hpp"
+
 #include "spinesim/common/timer.hpp"
 #include "spinesim/studies/json.hpp"
 #include "spinesim/studies/fem_report.hpp"
@@ -87,11 +90,7 @@ nlohmann::json per_spring_json(const calibration::PerSpringResult& r, const Cali
           {"transfer", "per-spring multipliers belong to this mesh; other meshes get the region-level scales"}};
 }
 
-std::string pct(double e) {
-  std::ostringstream s;
-  s << std::fixed << std::setprecision(1) << 100.0 * e << " %";
-  return s.str();
-}
+std::string pct(double e) { return percent(e); }
 
 /// Refuses a request that cannot run (before any work).
 void check_request(const mesh::TetMesh& m, const CalibrationRequest& rq) {
@@ -438,45 +437,47 @@ void print_calibration(std::ostream& os, const CalibrationOutcome& o, const Cali
      << (rq.nonlinear_check ? "Relative nodal displacement error vs FEM (nonlinear MSS at the case loads x " +
                                  std::to_string(rq.check_load_scale).substr(0, 4) + "; linearised in brackets):\n\n"
                              : "Relative nodal displacement error vs FEM (linearised MSS only: --no-check):\n\n")
-     << "  " << std::left << std::setw(18) << "case" << std::setw(10) << "set" << std::right << std::setw(24)
-     << "untuned (Van Gelder)";
-  if (ps) os << std::setw(24) << "region scales";
-  os << std::setw(24) << (ps ? "per-spring" : "tuned") << "\n";
+     ;
+  std::vector<std::string> head{"case", "set", "untuned (Van Gelder)"};
+  if (ps) head.push_back("region scales");
+  head.push_back(ps ? "per-spring" : "tuned");
+  TextTable cases(head, 2);
   for (const char* set : {"train", "holdout"})
     for (const auto& r : rep[set]) {
       const auto cell = [&](const char* nl, const char* lin) {
         return pct(r[nl].get<double>()) + " (" + pct(r[lin].get<double>()) + ")";
       };
-      os << "  " << std::left << std::setw(18) << r["name"].get<std::string>() << std::setw(10) << set << std::right
-         << std::setw(24) << cell("untuned_error", "untuned_error_linear");
-      if (ps) os << std::setw(24) << cell("region_error", "region_error_linear");
-      os << std::setw(24) << cell("tuned_error", "tuned_error_linear") << "\n";
+      std::vector<std::string> row{r["name"].get<std::string>(), set, cell("untuned_error", "untuned_error_linear")};
+      if (ps) row.push_back(cell("region_error", "region_error_linear"));
+      row.push_back(cell("tuned_error", "tuned_error_linear"));
+      cases.add(row);
     }
+  cases.print(os, false);
   static const char* dof[] = {"tx [N/mm]", "ty [N/mm]", "tz [N/mm]", "rx [N·mm/deg]", "ry [N·mm/deg]", "rz [N·mm/deg]"};
   const auto& kd = rep["stiffness_diagonal"];
-  os << "\n6x6 plate stiffness diagonal (linear), MSS / FEM:\n\n  " << std::left << std::setw(16) << "DOF" << std::right
-     << std::setw(12) << "FEM" << std::setw(12) << "untuned";
-  if (ps) os << std::setw(12) << "region";
-  os << std::setw(12) << (ps ? "per-spring" : "tuned") << "\n";
-  for (int i = 0; i < 6; ++i) {
-    os << "  " << std::left << std::setw(16) << dof[i] << std::right << std::defaultfloat << std::setprecision(4)
-       << std::setw(12) << kd["fem"][std::size_t(i)].get<double>() << std::fixed << std::setprecision(3)
-       << std::setw(12) << kd["ratio_untuned"][std::size_t(i)].get<double>();
-    if (ps) os << std::setw(12) << kd["ratio_region"][std::size_t(i)].get<double>();
-    os << std::setw(12) << kd["ratio_tuned"][std::size_t(i)].get<double>() << "\n";
+  os << "\n6x6 plate stiffness diagonal (linear), MSS / FEM:\n\n";
+  std::vector<std::string> khead{"DOF", "FEM", "untuned"};
+  if (ps) khead.push_back("region");
+  khead.push_back(ps ? "per-spring" : "tuned");
+  TextTable k6(khead);
+  for (std::size_t i = 0; i < 6; ++i) {
+    std::vector<std::string> row{dof[i], significant(kd["fem"][i].get<double>(), 4), fixed(kd["ratio_untuned"][i].get<double>(), 3)};
+    if (ps) row.push_back(fixed(kd["ratio_region"][i].get<double>(), 3));
+    row.push_back(fixed(kd["ratio_tuned"][i].get<double>(), 3));
+    k6.add(row);
   }
+  k6.print(os, false);
   for (const auto& tr : rep["transfer"]) {
     os << "\n" << (ps ? "Region-level scales" : "Same scales") << " on another mesh: " << tr["mesh"].get<std::string>()
        << " (" << tr["tets"] << " tets), vs the FEM there"
-       << (ps ? " (per-spring multipliers do not transfer to another mesh)" : "") << ":\n\n"
-       << "  " << std::left << std::setw(18) << "case" << std::right << std::setw(24) << "untuned" << std::setw(24)
-       << (ps ? "region scales" : "tuned") << "\n";
+       << (ps ? " (per-spring multipliers do not transfer to another mesh)" : "") << ":\n\n";
+    TextTable t({"case", "untuned", ps ? "region scales" : "tuned"});
     for (const auto& c : tr["cases"])
-      os << "  " << std::left << std::setw(18) << c["name"].get<std::string>() << std::right << std::setw(24)
-         << pct(c["untuned_error"].get<double>()) << std::setw(24) << pct(c["tuned_error"].get<double>()) << "\n";
+      t.add({c["name"].get<std::string>(), pct(c["untuned_error"].get<double>()), pct(c["tuned_error"].get<double>())});
+    t.print(os, false);
     os << "  6x6 diagonal MSS/FEM, tuned:";
-    for (const auto& r : tr["stiffness_ratio_tuned"]) os << " " << std::fixed << std::setprecision(3) << r.get<double>();
-    os << std::defaultfloat << "\n";
+    for (const auto& r : tr["stiffness_ratio_tuned"]) os << " " << fixed(r.get<double>(), 3);
+    os << "\n";
   }
   os << "\nTuned " << (ps ? "region " : "") << "scales (x Van Gelder constants):";
   for (const auto& [name, s] : o.tuned.scales) os << "  " << name << " " << std::setprecision(3) << s;

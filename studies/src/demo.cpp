@@ -235,6 +235,7 @@ std::string Demo::report() const {
          << solver->num_dofs() << " DOF; assembly + factorisation + 6x6 condensation " << std::setprecision(3) << fem_seconds
          << " s.\n\n### 6x6 disc stiffness in the disc frame (x lateral, y axial, z anterior)\n\n```\n";
   print_stiffness(report, k_local);
+  report << std::defaultfloat << std::setprecision(4);  // the prose below: shortest form, 4 digits
   report << "```\n\n### Load cases (wrench on the superior plate, disc frame)\n\n" << case_table
          << "\n## Material comparison (thesis fig. 5.9): FEM, untuned and tuned MSS\n\n"
          << "The same mesh (cell size " << rq.cell_size_mm << " mm) in each material preset, side by side: the FEM P"

@@ -1,7 +1,12 @@
 #include "spinesim/studies/fem_report.hpp"
 
+#include "spinesim/studies/format.hpp"
+#include "spinesim/studies/table.hpp"
+
 #include <cmath>
 #include <iomanip>
+#include <string>
+#include <vector>
 
 namespace spinesim::studies {
 
@@ -29,15 +34,15 @@ fem::Matrix6d stiffness_per_degree(const fem::Matrix6d& k_rad) {
 
 void print_stiffness(std::ostream& os, const fem::Matrix6d& k_rad) {
   const fem::Matrix6d k = stiffness_per_degree(k_rad);
-  static const char* rows[] = {"Fx [N]   ", "Fy [N]   ", "Fz [N]   ", "Mx [N·mm]", "My [N·mm]", "Mz [N·mm]"};
+  static const char* rows[] = {"Fx [N]", "Fy [N]", "Fz [N]", "Mx [N·mm]", "My [N·mm]", "Mz [N·mm]"};
   os << "  6x6 stiffness about the plate centre (columns: tx ty tz per mm, rx ry rz per degree)\n";
-  os << "             " << std::setw(12) << "tx" << std::setw(12) << "ty" << std::setw(12) << "tz" << std::setw(12)
-     << "rx" << std::setw(12) << "ry" << std::setw(12) << "rz" << "\n";
+  TextTable t({"", "tx", "ty", "tz", "rx", "ry", "rz"});
   for (int i = 0; i < 6; ++i) {
-    os << "  " << rows[i] << " ";
-    for (int c = 0; c < 6; ++c) os << std::setw(12) << std::setprecision(4) << std::defaultfloat << k(i, c);
-    os << "\n";
+    std::vector<std::string> row{rows[i]};
+    for (int c = 0; c < 6; ++c) row.push_back(significant(k(i, c), 4));
+    t.add(row);
   }
+  t.print(os, false);
 }
 
 }  // namespace spinesim::studies

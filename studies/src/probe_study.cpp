@@ -4,6 +4,7 @@
 #include "spinesim/mss/boundary.hpp"
 #include "spinesim/mss/quantities.hpp"
 #include "spinesim/studies/files.hpp"
+#include "spinesim/studies/format.hpp"
 #include "spinesim/studies/json.hpp"
 
 #include <algorithm>
@@ -223,7 +224,7 @@ void print_probe_study(std::ostream& os, const mesh::TetMesh& m, const std::stri
             << "  probe radius " << rq.radius_mm << " mm, depth " << rq.depth_mm << " mm at " << rq.speed_mm_s
             << " mm/s, hold " << rq.hold_s << " s, rest " << rq.rest_s << " s; both endplates fixed\n";
   for (const auto& p : r.sites)
-    os << "  site " << std::left << std::setw(10) << p.name << std::right << " from t = " << p.start_s
+    os << "  site " << pad(p.name, 10, true) << " from t = " << p.start_s
               << " s at (" << p.point_mm.transpose() << ") mm, normal (" << p.normal.transpose() << ")\n";
   os << "  " << r.stats.steps_done << " of " << r.steps << " steps, mean step " << r.stats.mean_seconds() * 1e3
             << " ms\n"

@@ -47,8 +47,11 @@ std::string human_duration(double s) {
 ProgressBar::ProgressBar(int total, bool quiet, std::string unit)
     : total_(std::max(total, 0)), quiet_(quiet || !stderr_is_terminal()), unit_(std::move(unit)) {}
 
-ProgressBar::~ProgressBar() {
+ProgressBar::~ProgressBar() { finish(); }
+
+void ProgressBar::finish() {
   if (drawn_) std::cerr << "\r\033[K" << std::flush;
+  drawn_ = false;
 }
 
 std::string ProgressBar::render(int done, int total, double elapsed_s, const std::string& label,

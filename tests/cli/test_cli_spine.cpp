@@ -10,6 +10,8 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <functional>
 #include <map>
 #include <sstream>
 #include <string>
@@ -288,6 +290,30 @@ TEST(SpineDatabaseCli, SmallGenerationWritesAFileThatChecks) {
   const CliRun check = run_spinesim("spine database --check --quiet --vertebrae T7 --superposition-on T7 "
                                     "--magnitudes 300 --out " + in_quotes(out) + " --json");
   EXPECT_EQ(check.status, 0) << check.err;
+}
+
+// --check must also fail: the same file with every fitted coefficient 20 % too large no longer
+// matches the model's direct solves, and is reported as such (exit 1, one line, file named).
+TEST(SpineDatabaseCli, CheckFailsOnAFileThatNoLongerMatchesTheModel) {
+  const std::string out = tmp("db-T7-wrong.json");
+  const std::string args = "--quiet --vertebrae T7 --superposition-on T7 --magnitudes 300 --out " + in_quotes(out);
+  ASSERT_EQ(run_spinesim("spine database " + args).status, 0);
+  json db = json::parse(slurp(out));
+  int changed = 0;
+  const std::function<void(json&)> scale = [&](json& v) {
+    if (v.is_array())
+      for (auto& x : v) scale(x);
+    else if (v.is_number() && v.get<double>() != 0)
+      v = 1.2 * v.get<double>(), ++changed;
+  };
+  for (auto& fit : db["fits"]) scale(fit["c"]);
+  ASSERT_GT(changed, 0);
+  std::ofstream(out) << db.dump(1);
+  const CliRun check = run_spinesim("spine database --check " + args);
+  EXPECT_EQ(check.status, 1);
+  EXPECT_EQ(count_lines(check.err), 1) << check.err;
+  EXPECT_NE(check.err.find("does not match the model"), std::string::npos) << check.err;
+  EXPECT_NE(check.err.find(out), std::string::npos) << check.err;
 }
 
 TEST(SpineDatabaseCli, RefusesBadInput) {

@@ -18,9 +18,8 @@
 //   K6 = K_pp - K_fp^T Z,   motion q: u_f = -Z q,   wrench w: q = K6^-1 w.
 // The reaction is evaluated directly from the assembled blocks, -(K_fp^T u_f + K_pp q), which
 // equals -K6 q (and -w for a wrench solve) up to round-off — the tests check that.
-// Cost (bench/bench_fem.cpp, 2 cores, OpenBLAS): assembly is ~2–5 % of the total; the sparse
-// Cholesky factorisation dominates (3-D fill: ~100 GFlop at 100k DOF). P1 on an L4-L5 disc of
-// 4–13k vertices (9–31k DOF) takes 0.14–0.74 s; P2 on 4.2k vertices (80k DOF) ~3.7 s.
+// Cost: the sparse Cholesky factorisation dominates (3-D fill), assembly is a few per cent;
+// measured per mesh size in docs/benchmarks.md ("FEM reference").
 #pragma once
 
 #include "spinesim/mesh/material.hpp"
@@ -44,9 +43,9 @@ struct Timings {
 /// two-level P2→P1 preconditioner (P2 only; p2_multigrid.hpp) — the P1 block is factorised
 /// instead, and K6 uses the energy form K_pp - 2 sym(K_fp^T Z) + Z^T K_ff Z, whose error is
 /// quadratic in the CG error. `automatic`: CG for P2 above `cg_min_dofs` free DOF, else direct.
-/// Measured (bench_fem, 2 cores): on disc-proportioned boxes CG wins from ~60k DOF (176k: 6.5 s
-/// vs 14.3 s, ~0.4 vs ~1.8 GB), but on the CGAL L4-L5 disc with a nu = 0.49 nucleus it needs
-/// ~60 iterations and loses at 80k DOF (5.0 s vs 3.7 s); hence the threshold.
+/// The threshold is where CG overtook the direct solve on the meshes measured (bench_fem;
+/// docs/benchmarks.md, "CG or direct"): earlier on boxes, later on discs with a nu = 0.49
+/// nucleus, which slows CG.
 enum class LinearSolver { automatic, direct, p_multigrid_cg };
 
 struct SolverOptions {

@@ -34,10 +34,9 @@
 // included), every node of the top layer 2, outer-ring nodes of the intermediate layers 3,
 // the rest 0. With layers = 1 every node is on an endplate (no free node).
 //
-// Measured (tests/mesh/test_structured_disc.cpp), defaults 12 × 3 × 2 on all 17 levels:
-// 360 tets and 111 nodes a disc, 6120 tets in all (≈ 0.86 ms a step at 0.14 µs/tet);
-// min dihedral 18.9° (T4-T5, the thinnest disc at 4.5 mm; 22-24° on lumbar discs), max 142°,
-// max radius-edge ratio 1.71; volume -5.10 % (inscribed polygon; the same on every level).
+// With the defaults 12 × 3 × 2: 360 tets and 111 nodes a disc on every level; its quality and
+// volume error per level are checked by tests/mesh/test_structured_disc.cpp and listed in
+// docs/benchmarks.md ("Structured discs").
 // Other resolutions, worst min dihedral over the 17 levels [tets a disc, volume error]:
 //   12×2×2 14.7° [216, -5.1 %]   14×3×2 20.2° [420, -3.7 %]   16×3×2 20.0° [480, -2.8 %]
 //   16×2×2 14.4° [288, -2.8 %]   12×3×3 13.2° [540, -5.1 %]   20×3×2 16.3° [600, -1.8 %]

@@ -26,9 +26,9 @@
 //                  couples every node, so its Hessian k_g ∇V ∇V^T + k_g (V - V0) H_V is split: the
 //                  sparse part k_g (V - V0) H_V is in hessian() (exact mode), the dense rank-one
 //                  part comes from disc_volume_rank_one() for Sherman–Morrison in the solvers.
-//                  Why both volume terms (measured, tests/mss/test_volume.cpp, L4-L5, 10 %
-//                  compression): per-tet penalties lock — at c_v = 100 the disc is 24x too stiff
-//                  and still loses 1.2 % — while the whole-disc term lets the wall bulge freely.
+//                  Why both volume terms: stiff per-tet penalties lock (the disc gets far too
+//                  stiff and still loses volume) while the whole-disc term lets the wall bulge
+//                  freely (tests/mss/test_volume.cpp; numbers in docs/benchmarks.md).
 //   damping (5.11) K_d = MssOptions::damping_n_s_per_mm, or by default 2 zeta omega_1 m_mean with
 //                  omega_1 = (pi / L_m) sqrt(E_mean / rho_mean) (the first axial mode of the
 //                  equivalent cylinder between fixed plates), zeta = MssOptions::damping_ratio.

@@ -38,10 +38,10 @@ struct CalibrationRequest {
   calibration::IpoptSettings ipopt;
   bool nonlinear_check = true;  ///< also run the nonlinear MSS-vs-FEM protocol (mss_report.hpp)
   /// Load factor of the nonlinear check: the calibration protocol asks for cases "small enough
-  /// for linear theory", and the standard ones are not — 7.5 N·m turns L4-L5 by 9.5 (flexion) to 15 deg
-  /// (torsion) and a thoracic disc by ~20 deg, where any geometrically exact model departs from
-  /// the linear FEM by O(theta/2) in displacement (measured on L4-L5, tuned: extension 11.3 % at x1, 6.1 % at x0.3, 5.6 % at
-  /// x0.1 = the linearised error). 0.1 keeps every level within ~2 deg.
+  /// for linear theory", and the standard 7.5 N·m moments turn a disc by 10-20 deg, where any
+  /// geometrically exact model departs from the linear FEM by O(theta/2) in displacement. 0.1
+  /// keeps every level within a few degrees (the error against the load factor is in
+  /// calibration/README.md).
   double check_load_scale = 0.1;
   /// Other meshes of the same disc on which the tuned region scales are also checked (the
   /// "second mesh resolution" of the protocol): FEM on each, untuned and tuned MSS, same cases

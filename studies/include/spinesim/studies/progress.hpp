@@ -59,8 +59,11 @@ class ProgressBar {
   /// The line as it would be drawn (for tests): label, bar, count, percentage, ETA.
   static std::string render(int done, int total, double elapsed_s, const std::string& label,
                             const std::string& unit, int width = 24);
-  /// A callback (done, total) for drivers that report counts (the database, sweeps).
+  /// A callback (done, total) for drivers that report counts (the database, sweeps); empty
+  /// when quiet. The bar must outlive it.
   std::function<void(int, int)> callback();
+  /// Clears the bar's line (the next output starts on a clean line).
+  void finish();
 
  private:
   int total_;
