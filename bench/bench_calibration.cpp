@@ -56,7 +56,8 @@ void label(benchmark::State& state, const Disc& d) {
 void Setup(benchmark::State& state) {
   Disc& d = disc(int(state.range(0)));
   for (auto _ : state) {
-    calibration::LinearMss lin(*d.model, calibration::available_knobs(d.model->options()), d.reference.plate_center_mm);
+    calibration::LinearMss lin(*d.model, calibration::available_knobs(d.model->options()),
+                               d.reference.plate_center_mm);
     benchmark::DoNotOptimize(lin.num_unknowns());
   }
   label(state, d);
@@ -65,7 +66,8 @@ void Setup(benchmark::State& state) {
 void Evaluate(benchmark::State& state) {
   Disc& d = disc(int(state.range(0)));
   const bool hessian = state.range(1) != 0;
-  calibration::LinearMss lin(*d.model, calibration::available_knobs(d.model->options()), d.reference.plate_center_mm);
+  calibration::LinearMss lin(*d.model, calibration::available_knobs(d.model->options()),
+                             d.reference.plate_center_mm);
   calibration::Objective obj(lin, d.reference, kTrain);
   const Eigen::VectorXd p = Eigen::VectorXd::Constant(Eigen::Index(lin.knobs().size()), -0.3);
   for (auto _ : state) benchmark::DoNotOptimize(obj.evaluate(p, true, hessian).value);
@@ -76,9 +78,11 @@ void Calibrate(benchmark::State& state) {
   Disc& d = disc(int(state.range(0)));
   int iterations = 0;
   for (auto _ : state) {
-    calibration::LinearMss lin(*d.model, calibration::available_knobs(d.model->options()), d.reference.plate_center_mm);
+    calibration::LinearMss lin(*d.model, calibration::available_knobs(d.model->options()),
+                               d.reference.plate_center_mm);
     calibration::Objective obj(lin, d.reference, kTrain);
-    const auto r = calibration::calibrate(obj, Eigen::VectorXd::Zero(Eigen::Index(lin.knobs().size())));
+    const auto r =
+        calibration::calibrate(obj, Eigen::VectorXd::Zero(Eigen::Index(lin.knobs().size())));
     if (!r.success) state.SkipWithError(r.status.c_str());
     iterations = r.iterations;
   }

@@ -16,8 +16,8 @@
 #include "spinesim/fem/cholmod_solver.hpp"
 #include "spinesim/fem/disc_fem.hpp"
 #include "spinesim/fem/fe_space.hpp"
-#include "spinesim/mesh/mesher.hpp"
 #include "spinesim/mesh/box_mesh.hpp"
+#include "spinesim/mesh/mesher.hpp"
 
 #include <benchmark/benchmark.h>
 
@@ -42,7 +42,7 @@ mesh::TetMesh disc_box(double h_mm) {
   const double lx = 46, ly = 11, lz = 35;
   const auto cells = [&](double l) { return std::max(1, int(std::lround(l / h_mm))); };
   return spinesim::mesh::box_mesh(cells(lx), cells(ly), cells(lz), lx, ly, lz,
-                               Eigen::Vector3d(-0.5 * lx, 0, -0.5 * lz));
+                                  Eigen::Vector3d(-0.5 * lx, 0, -0.5 * lz));
 }
 
 mesh::RegionMaterials disc_material() {
@@ -74,9 +74,12 @@ Problem& problem(int order, double h_mm) {
     const Eigen::VectorXi labels = node_surface_labels(p->space, p->mesh);
     p->roles.assign(std::size_t(labels.size()), NodeRole::free);
     for (Eigen::Index i = 0; i < labels.size(); ++i)
-      p->roles[std::size_t(i)] = labels(i) == 1 ? NodeRole::fixed : labels(i) == 2 ? NodeRole::plate : NodeRole::free;
+      p->roles[std::size_t(i)] = labels(i) == 1   ? NodeRole::fixed
+                                 : labels(i) == 2 ? NodeRole::plate
+                                                  : NodeRole::free;
     p->pattern = build_free_block_pattern(p->space, p->roles);
-    p->coupling = assemble_constrained(p->space, p->mesh.region, disc_material(), p->roles, p->center, p->pattern);
+    p->coupling = assemble_constrained(p->space, p->mesh.region, disc_material(), p->roles,
+                                       p->center, p->pattern);
     cache[{order, std::lround(h_mm * 1000)}] = std::move(p);
     return *cache[{order, std::lround(h_mm * 1000)}];
   }
@@ -105,7 +108,8 @@ void BM_Pattern(benchmark::State& st) {
 void BM_Assembly(benchmark::State& st) {
   Problem& p = problem(int(st.range(0)), h_of(st));
   for (auto _ : st) {
-    PlateCoupling c = assemble_constrained(p.space, p.mesh.region, disc_material(), p.roles, p.center, p.pattern);
+    PlateCoupling c =
+        assemble_constrained(p.space, p.mesh.region, disc_material(), p.roles, p.center, p.pattern);
     benchmark::DoNotOptimize(c.K_pp(0, 0));
   }
   set_counters(st, p);
@@ -172,7 +176,10 @@ void BM_L4L5Disc(benchmark::State& st) {
   if (it == meshes.end()) {
     mesh::MeshOptions opt;
     opt.cell_size_mm = double(st.range(1)) * 1e-3;
-    it = meshes.emplace(st.range(1), mesh::mesh_parametric_disc({"L4-L5", 47.3, 35.5, 46.6, 35.0, 11.3}, opt)).first;
+    it = meshes
+             .emplace(st.range(1),
+                      mesh::mesh_parametric_disc({"L4-L5", 47.3, 35.5, 46.6, 35.0, 11.3}, opt))
+             .first;
   }
   const mesh::TetMesh& m = it->second;
   mesh::RegionMaterials mat;

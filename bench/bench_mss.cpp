@@ -46,8 +46,10 @@ const mesh::TetMesh& disc_mesh(const std::string& level, double cell_mm) {
     const mesh::DiscDimensions dims = mesh::disc_dimensions(level, SPINESIM_DATA_DIR);
     mesh::MeshOptions opt;
     opt.cell_size_mm = cell_mm;
-    it = cache.emplace(key, cell_mm > 0 ? mesh::mesh_parametric_disc(dims, opt)
-                                        : mesh::mesh_structured_disc(dims)).first;
+    it = cache
+             .emplace(key, cell_mm > 0 ? mesh::mesh_parametric_disc(dims, opt)
+                                       : mesh::mesh_structured_disc(dims))
+             .first;
   }
   return it->second;
 }
@@ -118,7 +120,9 @@ void step_benchmark(benchmark::State& state, MatrixUpdate update) {
 }
 
 void ImplicitFrozen(benchmark::State& state) { step_benchmark(state, MatrixUpdate::frozen); }
-void ImplicitNewton(benchmark::State& state) { step_benchmark(state, MatrixUpdate::every_iteration); }
+void ImplicitNewton(benchmark::State& state) {
+  step_benchmark(state, MatrixUpdate::every_iteration);
+}
 
 void Static(benchmark::State& state) {
   const MssModel& model = disc_model(state.range(0) / 1000.0);

@@ -28,7 +28,8 @@ const Eigen::SparseMatrix<double>& step_matrix(double cell_mm) {
   if (A.rows() == 0) {
     mesh::MeshOptions opt;
     opt.cell_size_mm = cell_mm;
-    const mesh::TetMesh m = mesh::mesh_parametric_disc(mesh::disc_dimensions("L4-L5", SPINESIM_DATA_DIR), opt);
+    const mesh::TetMesh m =
+        mesh::mesh_parametric_disc(mesh::disc_dimensions("L4-L5", SPINESIM_DATA_DIR), opt);
     const MssModel model(m, mesh::load_material("real-disc", SPINESIM_DATA_DIR));
     Eigen::SparseMatrix<double> H;
     model.hessian(model.rest_positions_mm(), HessianMode::exact, H);

@@ -69,7 +69,8 @@ BENCHMARK(Recruitment)->Unit(benchmark::kMillisecond);
 
 void DatabaseEvaluate(benchmark::State& state) {
   const DisplacementDatabase& db = database();
-  const Eigen::Vector3d force = state.range(0) ? Eigen::Vector3d(-212.1, 150.0, 212.1) : Eigen::Vector3d(0, 0, 300);
+  const Eigen::Vector3d force =
+      state.range(0) ? Eigen::Vector3d(-212.1, 150.0, 212.1) : Eigen::Vector3d(0, 0, 300);
   VertebraResponse out;
   int v = 0;
   for (auto _ : state) {

@@ -13,30 +13,51 @@ namespace spinesim::calibration::detail {
 namespace {
 
 using clock_type = std::chrono::steady_clock;
-double since(clock_type::time_point t0) { return std::chrono::duration<double>(clock_type::now() - t0).count(); }
+double since(clock_type::time_point t0) {
+  return std::chrono::duration<double>(clock_type::now() - t0).count();
+}
 
 const char* status_name(Ipopt::ApplicationReturnStatus s) {
   using namespace Ipopt;
   switch (s) {
-    case Solve_Succeeded: return "Solve_Succeeded";
-    case Solved_To_Acceptable_Level: return "Solved_To_Acceptable_Level";
-    case Infeasible_Problem_Detected: return "Infeasible_Problem_Detected";
-    case Search_Direction_Becomes_Too_Small: return "Search_Direction_Becomes_Too_Small";
-    case Diverging_Iterates: return "Diverging_Iterates";
-    case User_Requested_Stop: return "User_Requested_Stop";
-    case Feasible_Point_Found: return "Feasible_Point_Found";
-    case Maximum_Iterations_Exceeded: return "Maximum_Iterations_Exceeded";
-    case Restoration_Failed: return "Restoration_Failed";
-    case Error_In_Step_Computation: return "Error_In_Step_Computation";
-    case Maximum_CpuTime_Exceeded: return "Maximum_CpuTime_Exceeded";
-    case Not_Enough_Degrees_Of_Freedom: return "Not_Enough_Degrees_Of_Freedom";
-    case Invalid_Problem_Definition: return "Invalid_Problem_Definition";
-    case Invalid_Option: return "Invalid_Option";
-    case Invalid_Number_Detected: return "Invalid_Number_Detected";
-    case Unrecoverable_Exception: return "Unrecoverable_Exception";
-    case NonIpopt_Exception_Thrown: return "NonIpopt_Exception_Thrown";
-    case Insufficient_Memory: return "Insufficient_Memory";
-    case Internal_Error: return "Internal_Error";
+    case Solve_Succeeded:
+      return "Solve_Succeeded";
+    case Solved_To_Acceptable_Level:
+      return "Solved_To_Acceptable_Level";
+    case Infeasible_Problem_Detected:
+      return "Infeasible_Problem_Detected";
+    case Search_Direction_Becomes_Too_Small:
+      return "Search_Direction_Becomes_Too_Small";
+    case Diverging_Iterates:
+      return "Diverging_Iterates";
+    case User_Requested_Stop:
+      return "User_Requested_Stop";
+    case Feasible_Point_Found:
+      return "Feasible_Point_Found";
+    case Maximum_Iterations_Exceeded:
+      return "Maximum_Iterations_Exceeded";
+    case Restoration_Failed:
+      return "Restoration_Failed";
+    case Error_In_Step_Computation:
+      return "Error_In_Step_Computation";
+    case Maximum_CpuTime_Exceeded:
+      return "Maximum_CpuTime_Exceeded";
+    case Not_Enough_Degrees_Of_Freedom:
+      return "Not_Enough_Degrees_Of_Freedom";
+    case Invalid_Problem_Definition:
+      return "Invalid_Problem_Definition";
+    case Invalid_Option:
+      return "Invalid_Option";
+    case Invalid_Number_Detected:
+      return "Invalid_Number_Detected";
+    case Unrecoverable_Exception:
+      return "Unrecoverable_Exception";
+    case NonIpopt_Exception_Thrown:
+      return "NonIpopt_Exception_Thrown";
+    case Insufficient_Memory:
+      return "Insufficient_Memory";
+    case Internal_Error:
+      return "Internal_Error";
   }
   return "Unknown_Status";
 }
@@ -44,28 +65,33 @@ const char* status_name(Ipopt::ApplicationReturnStatus s) {
 /// min f(p), ln lower <= p <= ln upper, for Ipopt.
 class BoundedNlp : public Ipopt::TNLP {
  public:
-  BoundedNlp(const NlpFunction& f, Eigen::VectorXd start, HessianKind hessian, const IpoptSettings& settings,
-             const Progress& progress)
-      : f_(f), start_(std::move(start)), hessian_(hessian), settings_(settings), progress_(progress) {}
+  BoundedNlp(const NlpFunction& f, Eigen::VectorXd start, HessianKind hessian,
+             const IpoptSettings& settings, const Progress& progress)
+      : f_(f),
+        start_(std::move(start)),
+        hessian_(hessian),
+        settings_(settings),
+        progress_(progress) {}
 
-  bool get_nlp_info(Ipopt::Index& n, Ipopt::Index& m, Ipopt::Index& nnz_jac_g, Ipopt::Index& nnz_h_lag,
-                    IndexStyleEnum& index_style) override {
+  bool get_nlp_info(Ipopt::Index& n, Ipopt::Index& m, Ipopt::Index& nnz_jac_g,
+                    Ipopt::Index& nnz_h_lag, IndexStyleEnum& index_style) override {
     n = Ipopt::Index(start_.size());
     m = 0, nnz_jac_g = 0;
     nnz_h_lag = hessian_ == HessianKind::dense ? n * (n + 1) / 2 : 0;  // dense lower triangle
     index_style = C_STYLE;
     return true;
   }
-  bool get_bounds_info(Ipopt::Index n, Ipopt::Number* x_l, Ipopt::Number* x_u, Ipopt::Index, Ipopt::Number*,
-                       Ipopt::Number*) override {
+  bool get_bounds_info(Ipopt::Index n, Ipopt::Number* x_l, Ipopt::Number* x_u, Ipopt::Index,
+                       Ipopt::Number*, Ipopt::Number*) override {
     for (Ipopt::Index i = 0; i < n; ++i) {
       x_l[i] = std::log(settings_.lower_scale);
       x_u[i] = std::log(settings_.upper_scale);
     }
     return true;
   }
-  bool get_starting_point(Ipopt::Index n, bool init_x, Ipopt::Number* x, bool init_z, Ipopt::Number*,
-                          Ipopt::Number*, Ipopt::Index, bool init_lambda, Ipopt::Number*) override {
+  bool get_starting_point(Ipopt::Index n, bool init_x, Ipopt::Number* x, bool init_z,
+                          Ipopt::Number*, Ipopt::Number*, Ipopt::Index, bool init_lambda,
+                          Ipopt::Number*) override {
     if (!init_x || init_z || init_lambda) return false;
     for (Ipopt::Index i = 0; i < n; ++i) x[i] = start_(i);
     return true;
@@ -80,9 +106,11 @@ class BoundedNlp : public Ipopt::TNLP {
     for (Ipopt::Index i = 0; i < n; ++i) g[i] = last_.gradient(i);
     return true;
   }
-  bool eval_g(Ipopt::Index, const Ipopt::Number*, bool, Ipopt::Index, Ipopt::Number*) override { return true; }
-  bool eval_jac_g(Ipopt::Index, const Ipopt::Number*, bool, Ipopt::Index, Ipopt::Index, Ipopt::Index*,
-                  Ipopt::Index*, Ipopt::Number*) override {
+  bool eval_g(Ipopt::Index, const Ipopt::Number*, bool, Ipopt::Index, Ipopt::Number*) override {
+    return true;
+  }
+  bool eval_jac_g(Ipopt::Index, const Ipopt::Number*, bool, Ipopt::Index, Ipopt::Index,
+                  Ipopt::Index*, Ipopt::Index*, Ipopt::Number*) override {
     return true;
   }
   bool eval_h(Ipopt::Index n, const Ipopt::Number* x, bool, Ipopt::Number obj_factor, Ipopt::Index,
@@ -100,17 +128,18 @@ class BoundedNlp : public Ipopt::TNLP {
       for (Ipopt::Index j = 0; j <= i; ++j) values[e++] = obj_factor * last_.hessian(i, j);
     return true;
   }
-  bool intermediate_callback(Ipopt::AlgorithmMode, Ipopt::Index iter, Ipopt::Number obj_value, Ipopt::Number,
-                             Ipopt::Number inf_du, Ipopt::Number, Ipopt::Number, Ipopt::Number, Ipopt::Number,
-                             Ipopt::Number, Ipopt::Index, const Ipopt::IpoptData*,
-                             Ipopt::IpoptCalculatedQuantities*) override {
+  bool intermediate_callback(Ipopt::AlgorithmMode, Ipopt::Index iter, Ipopt::Number obj_value,
+                             Ipopt::Number, Ipopt::Number inf_du, Ipopt::Number, Ipopt::Number,
+                             Ipopt::Number, Ipopt::Number, Ipopt::Number, Ipopt::Index,
+                             const Ipopt::IpoptData*, Ipopt::IpoptCalculatedQuantities*) override {
     iterations_ = int(iter);
     if (progress_) progress_(int(iter), obj_value, inf_du);
     return true;
   }
-  void finalize_solution(Ipopt::SolverReturn, Ipopt::Index n, const Ipopt::Number* x, const Ipopt::Number*,
-                         const Ipopt::Number*, Ipopt::Index, const Ipopt::Number*, const Ipopt::Number*,
-                         Ipopt::Number, const Ipopt::IpoptData*, Ipopt::IpoptCalculatedQuantities*) override {
+  void finalize_solution(Ipopt::SolverReturn, Ipopt::Index n, const Ipopt::Number* x,
+                         const Ipopt::Number*, const Ipopt::Number*, Ipopt::Index,
+                         const Ipopt::Number*, const Ipopt::Number*, Ipopt::Number,
+                         const Ipopt::IpoptData*, Ipopt::IpoptCalculatedQuantities*) override {
     final_ = Eigen::Map<const Eigen::VectorXd>(x, n);
   }
 
@@ -152,11 +181,13 @@ class BoundedNlp : public Ipopt::TNLP {
 }  // namespace
 
 NlpRun run_bounded_nlp(const NlpFunction& f, const Eigen::VectorXd& start, HessianKind hessian,
-                       const IpoptSettings& settings, const Progress& progress, double objective_scaling) {
+                       const IpoptSettings& settings, const Progress& progress,
+                       double objective_scaling) {
   NlpRun out;
   Ipopt::SmartPtr<BoundedNlp> nlp = new BoundedNlp(f, start, hessian, settings, progress);
   Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
-  app->Options()->SetStringValue("hessian_approximation", hessian == HessianKind::dense ? "exact" : "limited-memory");
+  app->Options()->SetStringValue("hessian_approximation",
+                                 hessian == HessianKind::dense ? "exact" : "limited-memory");
   app->Options()->SetIntegerValue("max_iter", settings.max_iterations);
   app->Options()->SetNumericValue("tol", settings.tolerance);
   app->Options()->SetNumericValue("acceptable_tol", settings.acceptable_tolerance);

@@ -37,6 +37,7 @@ struct NlpRun {
 /// ln settings.upper_scale, tolerances, iteration limit and print level from `settings`;
 /// `objective_scaling` multiplies f inside Ipopt only (its tolerances are absolute).
 NlpRun run_bounded_nlp(const NlpFunction& f, const Eigen::VectorXd& start, HessianKind hessian,
-                       const IpoptSettings& settings, const Progress& progress, double objective_scaling = 1.0);
+                       const IpoptSettings& settings, const Progress& progress,
+                       double objective_scaling = 1.0);
 
 }  // namespace spinesim::calibration::detail

@@ -11,7 +11,9 @@ namespace spinesim::calibration {
 namespace {
 
 using clock_type = std::chrono::steady_clock;
-double since(clock_type::time_point t0) { return std::chrono::duration<double>(clock_type::now() - t0).count(); }
+double since(clock_type::time_point t0) {
+  return std::chrono::duration<double>(clock_type::now() - t0).count();
+}
 
 }  // namespace
 
@@ -19,8 +21,9 @@ void validate(const IpoptSettings& s) {
   if (!std::isfinite(s.lower_scale) || !std::isfinite(s.upper_scale) || s.lower_scale <= 0)
     throw std::invalid_argument("calibration: scale bounds must be finite and > 0");
   if (!(s.lower_scale < s.upper_scale))
-    throw std::invalid_argument("calibration: infeasible bounds, lower scale " + std::to_string(s.lower_scale) +
-                                " is not below upper scale " + std::to_string(s.upper_scale));
+    throw std::invalid_argument("calibration: infeasible bounds, lower scale " +
+                                std::to_string(s.lower_scale) + " is not below upper scale " +
+                                std::to_string(s.upper_scale));
   if (s.max_iterations < 1) throw std::invalid_argument("calibration: max iterations must be >= 1");
   if (!(s.tolerance > 0) || !(s.acceptable_tolerance > 0))
     throw std::invalid_argument("calibration: Ipopt tolerances must be > 0");
@@ -31,15 +34,16 @@ CalibrationResult calibrate(Objective& objective, const Eigen::VectorXd& start_l
   validate(settings);
   const auto t0 = clock_type::now();
   CalibrationResult out;
-  out.start_log_scales = start_log_scales.cwiseMax(std::log(settings.lower_scale)).cwiseMin(std::log(settings.upper_scale));
+  out.start_log_scales = start_log_scales.cwiseMax(std::log(settings.lower_scale))
+                             .cwiseMin(std::log(settings.upper_scale));
   out.start = objective.evaluate(out.start_log_scales, false);  // throws if the start is unusable
 
   const detail::NlpFunction f = [&objective](const Eigen::VectorXd& p) {
     Evaluation ev = objective.evaluate(p, true, true);
     return detail::NlpValues{ev.value, std::move(ev.gradient), std::move(ev.gauss_newton)};
   };
-  const detail::NlpRun run =
-      detail::run_bounded_nlp(f, out.start_log_scales, detail::HessianKind::dense, settings, progress);  // Gauss–Newton
+  const detail::NlpRun run = detail::run_bounded_nlp(
+      f, out.start_log_scales, detail::HessianKind::dense, settings, progress);  // Gauss–Newton
   out.status = run.status;
   out.success = run.success;
   out.iterations = run.iterations;

@@ -12,11 +12,14 @@
 namespace spinesim::calibration {
 
 namespace {
-double safe_ratio(double num, double den) { return den > 0 ? num / den : (num > 0 ? INFINITY : 0.0); }
+double safe_ratio(double num, double den) {
+  return den > 0 ? num / den : (num > 0 ? INFINITY : 0.0);
+}
 }  // namespace
 
 MssFemComparison compare_mss_fem(const fem::DiscFem& fem, const mss::MssModel& model,
-                                 const std::vector<fem::LoadCase>& cases, const std::string& material_name,
+                                 const std::vector<fem::LoadCase>& cases,
+                                 const std::string& material_name,
                                  const mss::StaticOptions& options, double load_scale) {
   if (!std::isfinite(load_scale) || load_scale <= 0)
     throw std::invalid_argument("the load scale must be a finite number > 0");
@@ -80,7 +83,8 @@ MssFemComparison compare_mss_fem(const fem::DiscFem& fem, const mss::MssModel& m
     r.converged = sw.converged && sm.converged;
     r.iterations = sw.iterations + sm.iterations;
     if (!sw.converged) r.message = "wrench solve: " + sw.message;
-    if (!sm.converged) r.message += (r.message.empty() ? "" : "; ") + std::string("motion solve: ") + sm.message;
+    if (!sm.converged)
+      r.message += (r.message.empty() ? "" : "; ") + std::string("motion solve: ") + sm.message;
     out.cases.push_back(r);
   }
 

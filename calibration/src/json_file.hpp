@@ -31,7 +31,8 @@ auto naming_file(const std::string& path, F&& f) {
   } catch (const std::invalid_argument& e) {
     throw std::invalid_argument("'" + path + "': " + e.what());
   } catch (const nlohmann::json::exception& e) {
-    throw std::invalid_argument("'" + path + "': missing or malformed field (" + std::string(e.what()) + ")");
+    throw std::invalid_argument("'" + path + "': missing or malformed field (" +
+                                std::string(e.what()) + ")");
   }
 }
 

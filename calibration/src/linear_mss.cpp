@@ -15,11 +15,16 @@ namespace {
 
 const char* term_name(mss::Term t) {
   switch (t) {
-    case mss::Term::main: return "main";
-    case mss::Term::radial: return "radial";
-    case mss::Term::torsion: return "torsion";
-    case mss::Term::volume: return "volume";
-    case mss::Term::disc_volume: return "disc_volume";
+    case mss::Term::main:
+      return "main";
+    case mss::Term::radial:
+      return "radial";
+    case mss::Term::torsion:
+      return "torsion";
+    case mss::Term::volume:
+      return "volume";
+    case mss::Term::disc_volume:
+      return "disc_volume";
   }
   return "?";
 }
@@ -56,12 +61,12 @@ std::vector<Knob> available_knobs(const mss::MssOptions& o) {
 struct LinearMss::Impl {
   std::vector<Knob> knobs;
   Eigen::Index ndof = 0, nz = 0;
-  Eigen::SparseMatrix<double> R;                // ndof × nz
-  std::vector<Eigen::SparseMatrix<double>> K;   // per knob, on one shared pattern
-  int rank_one_knob = -1;                       // knob index of disc_volume, or -1
-  Eigen::VectorXd u_red;                        // R^T dV/dx (nz)
-  double kg_unscaled = 0;                       // k_g at scale 1, N/mm^5
-  Eigen::SparseMatrix<double> assembled;        // K(s) on the shared pattern
+  Eigen::SparseMatrix<double> R;               // ndof × nz
+  std::vector<Eigen::SparseMatrix<double>> K;  // per knob, on one shared pattern
+  int rank_one_knob = -1;                      // knob index of disc_volume, or -1
+  Eigen::VectorXd u_red;                       // R^T dV/dx (nz)
+  double kg_unscaled = 0;                      // k_g at scale 1, N/mm^5
+  Eigen::SparseMatrix<double> assembled;       // K(s) on the shared pattern
   fem::CholmodSolver cholesky;
   bool analysed = false;
   // Sherman–Morrison for the rank-one part: K_total^-1 b = A^-1 b - a_u (k u.A^-1 b)/(1 + k u.a_u).
@@ -85,7 +90,8 @@ struct LinearMss::Impl {
   void check_scales(const Eigen::VectorXd& s) const;
   void require_main_knobs() const {
     if (main_knob[0] < 0 || main_knob[1] < 0)
-      throw std::invalid_argument("calibration: per-spring multipliers need both main-spring knobs");
+      throw std::invalid_argument(
+          "calibration: per-spring multipliers need both main-spring knobs");
   }
   /// assembled = sum_j s_j K_j (values only).
   void assemble(const Eigen::VectorXd& s);
@@ -113,7 +119,8 @@ LinearMss::LinearMss(const mss::MssModel& model, std::vector<Knob> knobs, const 
   if (knobs.empty()) throw std::invalid_argument("calibration: no stiffness knobs to tune");
   for (const Knob& k : knobs)
     if (!mss::term_enabled(model.options(), k.term))
-      throw std::invalid_argument("calibration: knob " + knob_name(k) + " belongs to a term that is switched off");
+      throw std::invalid_argument("calibration: knob " + knob_name(k) +
+                                  " belongs to a term that is switched off");
   m.knobs = std::move(knobs);
   m.ndof = model.num_dofs();
 
@@ -123,13 +130,16 @@ LinearMss::LinearMss(const mss::MssModel& model, std::vector<Knob> knobs, const 
   std::vector<Eigen::Index> plate_nodes;
   for (Eigen::Index i = 0; i < mesh.num_vertices(); ++i) {
     const int s = mesh.surface(i);
-    if (s == int(mesh::Surface::superior_endplate)) plate_nodes.push_back(i), ++n_sup;
-    else if (s == int(mesh::Surface::inferior_endplate)) ++n_inf;
+    if (s == int(mesh::Surface::superior_endplate))
+      plate_nodes.push_back(i), ++n_sup;
+    else if (s == int(mesh::Surface::inferior_endplate))
+      ++n_inf;
     else
       for (int a = 0; a < 3; ++a) r.emplace_back(3 * i + a, nf++, 1.0);
   }
   if (n_sup == 0 || n_inf == 0)
-    throw std::invalid_argument("calibration: the mesh needs superior (2) and inferior (1) endplate labels");
+    throw std::invalid_argument(
+        "calibration: the mesh needs superior (2) and inferior (1) endplate labels");
   m.nz = nf + 6;
   for (Eigen::Index i : plate_nodes) {
     // u = t + theta x (X - c): the entries of mesh::plate_map that are not structurally zero
@@ -189,14 +199,18 @@ void LinearMss::Impl::build_edge_entries() {
     for (int end = 0; end < 2; ++end)
       for (int a = 0; a < 3; ++a) {
         const double b = (end == 0 ? -1.0 : 1.0) * e.n(a);
-        for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(Rr, 3 * (end == 0 ? e.i : e.j) + a); it; ++it)
+        for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(
+                 Rr, 3 * (end == 0 ? e.i : e.j) + a);
+             it; ++it)
           r.emplace_back(it.col(), b * it.value());
       }
     std::sort(r.begin(), r.end());
     std::size_t w = 0;  // merge repeated z indices (both ends on the plate)
     for (std::size_t k = 0; k < r.size(); ++k)
-      if (w > 0 && r[w - 1].first == r[k].first) r[w - 1].second += r[k].second;
-      else r[w++] = r[k];
+      if (w > 0 && r[w - 1].first == r[k].first)
+        r[w - 1].second += r[k].second;
+      else
+        r[w++] = r[k];
     r.resize(w);
     for (const auto& [col, vc] : r)
       for (const auto& [row, vr] : r) {
@@ -205,7 +219,8 @@ void LinearMss::Impl::build_edge_entries() {
         const auto* last = inner + outer[col + 1];
         const auto* hit = std::lower_bound(first, last, row);
         if (hit == last || *hit != row)
-          throw std::logic_error("calibration: an edge spring's entry is missing from the stiffness pattern");
+          throw std::logic_error(
+              "calibration: an edge spring's entry is missing from the stiffness pattern");
         entry_slot.push_back(hit - inner);
         entry_coeff.push_back(vr * vc);
       }
@@ -248,7 +263,8 @@ void LinearMss::Impl::add_edge_multipliers(const Eigen::VectorXd& s, const Eigen
     const Edge& ed = edges[e];
     const double d = (mu(Eigen::Index(e)) - ed.mu_model) * (sa * ed.k_part[0] + sn * ed.k_part[1]);
     if (d == 0.0) continue;
-    for (std::size_t k = entry_begin[e]; k < entry_begin[e + 1]; ++k) v[entry_slot[k]] += d * entry_coeff[k];
+    for (std::size_t k = entry_begin[e]; k < entry_begin[e + 1]; ++k)
+      v[entry_slot[k]] += d * entry_coeff[k];
   }
 }
 
@@ -284,8 +300,9 @@ LinearState LinearMss::solve(const Eigen::VectorXd& s, const Eigen::VectorXd& mu
   m.check_scales(s);
   m.require_main_knobs();
   if (mu.size() != Eigen::Index(m.edges.size()))
-    throw std::invalid_argument("calibration: " + std::to_string(mu.size()) + " edge multipliers for " +
-                                std::to_string(m.edges.size()) + " edge springs");
+    throw std::invalid_argument("calibration: " + std::to_string(mu.size()) +
+                                " edge multipliers for " + std::to_string(m.edges.size()) +
+                                " edge springs");
   if (!mu.allFinite() || (mu.array() <= 0).any())
     throw std::invalid_argument("calibration: edge multipliers must be finite and > 0");
   m.assemble(s);
@@ -312,17 +329,23 @@ Eigen::MatrixXd LinearMss::edge_extensions(const Eigen::MatrixXd& A) const {
   Eigen::MatrixXd out(Eigen::Index(m.edges.size()), A.cols());
   for (std::size_t e = 0; e < m.edges.size(); ++e) {
     const Impl::Edge& ed = m.edges[e];
-    out.row(Eigen::Index(e)) = ed.n.transpose() * (U.middleRows<3>(3 * ed.j) - U.middleRows<3>(3 * ed.i));
+    out.row(Eigen::Index(e)) =
+        ed.n.transpose() * (U.middleRows<3>(3 * ed.j) - U.middleRows<3>(3 * ed.i));
   }
   return out;
 }
 
-Eigen::MatrixXd LinearMss::solve_again(const Eigen::MatrixXd& rhs) const { return impl_->solve(rhs); }
+Eigen::MatrixXd LinearMss::solve_again(const Eigen::MatrixXd& rhs) const {
+  return impl_->solve(rhs);
+}
 
 Eigen::VectorXd LinearMss::displacement(const Eigen::VectorXd& z) const { return impl_->R * z; }
-Eigen::VectorXd LinearMss::restrict(const Eigen::VectorXd& v) const { return impl_->R.transpose() * v; }
+Eigen::VectorXd LinearMss::restrict(const Eigen::VectorXd& v) const {
+  return impl_->R.transpose() * v;
+}
 
-std::vector<Eigen::MatrixXd> LinearMss::knob_gram(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B) const {
+std::vector<Eigen::MatrixXd> LinearMss::knob_gram(const Eigen::MatrixXd& A,
+                                                  const Eigen::MatrixXd& B) const {
   const Impl& m = *impl_;
   std::vector<Eigen::MatrixXd> out(m.knobs.size());
   for (std::size_t j = 0; j < m.knobs.size(); ++j) {

@@ -37,18 +37,20 @@ FemReference make_reference(const fem::DiscFem& fem, const mesh::TetMesh& mesh,
   return ref;
 }
 
-Objective::Objective(LinearMss& model, FemReference reference, const std::vector<std::string>& train,
-                     Weights weights)
+Objective::Objective(LinearMss& model, FemReference reference,
+                     const std::vector<std::string>& train, Weights weights)
     : model_(model), ref_(std::move(reference)), w_(weights) {
-  if (!(w_.reaction >= 0) || !(w_.stiffness >= 0) || !(w_.regularisation >= 0) || !std::isfinite(w_.reaction) ||
-      !std::isfinite(w_.stiffness) || !std::isfinite(w_.regularisation))
+  if (!(w_.reaction >= 0) || !(w_.stiffness >= 0) || !(w_.regularisation >= 0) ||
+      !std::isfinite(w_.reaction) || !std::isfinite(w_.stiffness) ||
+      !std::isfinite(w_.regularisation))
     throw std::invalid_argument("calibration: objective weights must be finite and >= 0");
   if (train.empty()) throw std::invalid_argument("calibration: no training load cases");
   for (const std::string& name : train) {
     int found = -1;
     for (std::size_t c = 0; c < ref_.cases.size(); ++c)
       if (ref_.cases[c].name == name) found = int(c);
-    if (found < 0) throw std::invalid_argument("calibration: training case '" + name + "' has no FEM reference");
+    if (found < 0)
+      throw std::invalid_argument("calibration: training case '" + name + "' has no FEM reference");
     train_.push_back(found);
   }
   for (const CaseReference& c : ref_.cases) {
@@ -95,12 +97,14 @@ Evaluation Objective::measure(const LinearState& st, Adjoint* adjoint) const {
     const double u2 = r.displacement_mm.squaredNorm();
     const Vector6d d = S.cwiseProduct((st.k6 - ref_.k6) * r.plate_motion);
     const double size2 = reaction_size2(ref_, r);
-    ev.cases.push_back({r.name, std::sqrt(diff.squaredNorm() / u2), std::sqrt(d.squaredNorm() / size2)});
+    ev.cases.push_back(
+        {r.name, std::sqrt(diff.squaredNorm() / u2), std::sqrt(d.squaredNorm() / size2)});
     if (is_train[std::size_t(c)]) {
       ev.displacement += diff.squaredNorm() / u2 / n_train;
       ev.reaction += d.squaredNorm() / size2 / n_train;
       g.col(c) = model_.restrict(diff) * (2.0 / (n_train * u2));
-      g6_reaction += (2.0 / (n_train * size2)) * S.cwiseProduct(d) * r.plate_motion.transpose();  // d|d|^2/dK6
+      g6_reaction +=
+          (2.0 / (n_train * size2)) * S.cwiseProduct(d) * r.plate_motion.transpose();  // d|d|^2/dK6
     }
   }
   Vector6d log_ratio;
@@ -130,11 +134,13 @@ Evaluation Objective::evaluate(const Eigen::VectorXd& p, bool with_gradient, boo
   if (!with_gradient && !with_hessian) return ev;
 
   // Every knob's bilinear forms: dJ/ds_j = -sum_c lambda_c^T K_j z_c + <G6, Phi^T K_j Phi>.
-  const std::vector<Eigen::MatrixXd> disp = model_.knob_gram(adj.lambda, adj.z);  // nc × nc per knob
-  const std::vector<Eigen::MatrixXd> dk6 = model_.knob_gram(st.Phi, st.Phi);      // 6 × 6 per knob
+  const std::vector<Eigen::MatrixXd> disp =
+      model_.knob_gram(adj.lambda, adj.z);                                    // nc × nc per knob
+  const std::vector<Eigen::MatrixXd> dk6 = model_.knob_gram(st.Phi, st.Phi);  // 6 × 6 per knob
   ev.gradient.resize(nk);
   for (Eigen::Index j = 0; j < nk; ++j) {
-    const double d_s = -disp[std::size_t(j)].trace() + adj.g6.cwiseProduct(dk6[std::size_t(j)]).sum();
+    const double d_s =
+        -disp[std::size_t(j)].trace() + adj.g6.cwiseProduct(dk6[std::size_t(j)]).sum();
     ev.gradient(j) = s(j) * d_s + w_.regularisation * 2.0 * p(j) / double(nk);
   }
   if (!with_hessian) return ev;
@@ -145,23 +151,27 @@ Evaluation Objective::evaluate(const Eigen::VectorXd& p, bool with_gradient, boo
   const Eigen::Index nt = Eigen::Index(train_.size());
   Eigen::MatrixXd kz(model_.num_unknowns(), nk * nt);
   for (Eigen::Index j = 0; j < nk; ++j)
-    for (Eigen::Index t = 0; t < nt; ++t) kz.col(j * nt + t) = model_.knob_product(int(j), adj.z.col(train_[std::size_t(t)]));
+    for (Eigen::Index t = 0; t < nt; ++t)
+      kz.col(j * nt + t) = model_.knob_product(int(j), adj.z.col(train_[std::size_t(t)]));
   const Eigen::MatrixXd dz = model_.solve_again(kz);  // K^-1 K_j z_c = -dz_c/ds_j
   Eigen::MatrixXd gn = Eigen::MatrixXd::Zero(nk, nk);
   for (Eigen::Index t = 0; t < nt; ++t) {
     const CaseReference& r = ref_.cases[std::size_t(train_[std::size_t(t)])];
     const double scale = 1.0 / std::sqrt(r.displacement_mm.squaredNorm() * n_train);
     Eigen::MatrixXd du(model_.num_dofs(), nk);
-    for (Eigen::Index j = 0; j < nk; ++j) du.col(j) = model_.displacement(dz.col(j * nt + t)) * (-s(j) * scale);
+    for (Eigen::Index j = 0; j < nk; ++j)
+      du.col(j) = model_.displacement(dz.col(j * nt + t)) * (-s(j) * scale);
     gn += 2.0 * du.transpose() * du;
     Eigen::MatrixXd dr(6, nk);
     for (Eigen::Index j = 0; j < nk; ++j)
-      dr.col(j) = S.cwiseProduct(dk6[std::size_t(j)] * r.plate_motion) * (s(j) / std::sqrt(reaction_size2(ref_, r) * n_train));
+      dr.col(j) = S.cwiseProduct(dk6[std::size_t(j)] * r.plate_motion) *
+                  (s(j) / std::sqrt(reaction_size2(ref_, r) * n_train));
     gn += 2.0 * w_.reaction * dr.transpose() * dr;
   }
   Eigen::MatrixXd dk(6, nk);
   for (Eigen::Index j = 0; j < nk; ++j)
-    for (int i = 0; i < 6; ++i) dk(i, j) = s(j) * dk6[std::size_t(j)](i, i) / st.k6(i, i) / std::sqrt(6.0);
+    for (int i = 0; i < 6; ++i)
+      dk(i, j) = s(j) * dk6[std::size_t(j)](i, i) / st.k6(i, i) / std::sqrt(6.0);
   gn += 2.0 * w_.stiffness * dk.transpose() * dk;
   gn.diagonal().array() += 2.0 * w_.regularisation / double(nk);
   ev.gauss_newton = gn;

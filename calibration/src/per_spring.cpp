@@ -13,7 +13,9 @@ namespace spinesim::calibration {
 namespace {
 
 using clock_type = std::chrono::steady_clock;
-double since(clock_type::time_point t0) { return std::chrono::duration<double>(clock_type::now() - t0).count(); }
+double since(clock_type::time_point t0) {
+  return std::chrono::duration<double>(clock_type::now() - t0).count();
+}
 
 bool finite_non_negative(double v) { return std::isfinite(v) && v >= 0.0; }
 
@@ -35,7 +37,8 @@ std::vector<std::pair<int, int>> neighbouring_edge_pairs(const mss::MssModel& mo
   const auto edge_index = [&nodes](int a, int b) {
     const std::pair<int, int> key(std::min(a, b), std::max(a, b));
     const auto it = std::lower_bound(nodes.begin(), nodes.end(), key);
-    if (it == nodes.end() || *it != key) throw std::logic_error("calibration: a tetrahedron edge is not an edge spring");
+    if (it == nodes.end() || *it != key)
+      throw std::logic_error("calibration: a tetrahedron edge is not an edge spring");
     return int(it - nodes.begin());
   };
   const Eigen::MatrixX4i& T = model.mesh().T;
@@ -48,24 +51,27 @@ std::vector<std::pair<int, int>> neighbouring_edge_pairs(const mss::MssModel& mo
       for (int b = a + 1; b < 4; ++b) tet_edges[k++] = edge_index(T(t, a), T(t, b));
     for (int a = 0; a < 6; ++a)
       for (int b = a + 1; b < 6; ++b)
-        pairs.emplace_back(std::min(tet_edges[a], tet_edges[b]), std::max(tet_edges[a], tet_edges[b]));
+        pairs.emplace_back(std::min(tet_edges[a], tet_edges[b]),
+                           std::max(tet_edges[a], tet_edges[b]));
   }
   std::sort(pairs.begin(), pairs.end());
   pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
   return pairs;
 }
 
-PerSpringObjective::PerSpringObjective(Objective& region, const mss::MssModel& model, Eigen::VectorXd p,
-                                       PerSpringWeights weights)
+PerSpringObjective::PerSpringObjective(Objective& region, const mss::MssModel& model,
+                                       Eigen::VectorXd p, PerSpringWeights weights)
     : region_(region), p_(std::move(p)), w_(weights) {
   if (!finite_non_negative(w_.smoothness) || !finite_non_negative(w_.prior))
     throw std::invalid_argument("calibration: per-spring weights must be finite and >= 0");
   LinearMss& lin = region_.model();
   if (p_.size() != Eigen::Index(lin.knobs().size()))
-    throw std::invalid_argument("calibration: " + std::to_string(p_.size()) + " region log-scales for " +
-                                std::to_string(lin.knobs().size()) + " knobs");
+    throw std::invalid_argument("calibration: " + std::to_string(p_.size()) +
+                                " region log-scales for " + std::to_string(lin.knobs().size()) +
+                                " knobs");
   if (model.num_edge_springs() != lin.num_edge_springs() || model.num_dofs() != lin.num_dofs())
-    throw std::invalid_argument("calibration: the MSS model is not the one the linearised model was built from");
+    throw std::invalid_argument(
+        "calibration: the MSS model is not the one the linearised model was built from");
   s_ = p_.array().exp();
   k_edge_ = lin.edge_stiffness(s_);  // also checks that both main-spring knobs are tuned
   pairs_ = neighbouring_edge_pairs(model);
@@ -74,8 +80,8 @@ PerSpringObjective::PerSpringObjective(Objective& region, const mss::MssModel& m
 PerSpringEvaluation PerSpringObjective::evaluate(const Eigen::VectorXd& q, bool with_gradient) {
   const Eigen::Index ne = num_unknowns();
   if (q.size() != ne)
-    throw std::invalid_argument("calibration: " + std::to_string(q.size()) + " log-multipliers for " +
-                                std::to_string(ne) + " edge springs");
+    throw std::invalid_argument("calibration: " + std::to_string(q.size()) +
+                                " log-multipliers for " + std::to_string(ne) + " edge springs");
   LinearMss& lin = region_.model();
   const Eigen::VectorXd mu = q.array().exp();
   const LinearState st = lin.solve(s_, mu);
@@ -112,8 +118,9 @@ PerSpringResult calibrate_per_spring(PerSpringObjective& objective, const IpoptS
                                      const Progress& progress) {
   validate(settings);
   if (!(settings.lower_scale < 1.0 && settings.upper_scale > 1.0))
-    throw std::invalid_argument("calibration: per-spring multiplier bounds must bracket 1 (the region fit), got [" +
-                                std::to_string(settings.lower_scale) + ", " + std::to_string(settings.upper_scale) + "]");
+    throw std::invalid_argument(
+        "calibration: per-spring multiplier bounds must bracket 1 (the region fit), got [" +
+        std::to_string(settings.lower_scale) + ", " + std::to_string(settings.upper_scale) + "]");
   const auto t0 = clock_type::now();
   PerSpringResult out;
   const Eigen::VectorXd start = Eigen::VectorXd::Zero(objective.num_unknowns());
@@ -126,8 +133,8 @@ PerSpringResult calibrate_per_spring(PerSpringObjective& objective, const IpoptS
   // J is O(1e-3) and its gradient per spring far smaller: scale J to 1 at the start so that
   // Ipopt's absolute tolerances mean relative ones.
   const double scaling = out.start.value > 0 ? 1.0 / out.start.value : 1.0;
-  const detail::NlpRun run =
-      detail::run_bounded_nlp(f, start, detail::HessianKind::limited_memory, settings, progress, scaling);
+  const detail::NlpRun run = detail::run_bounded_nlp(f, start, detail::HessianKind::limited_memory,
+                                                     settings, progress, scaling);
   out.status = run.status;
   out.success = run.success;
   out.iterations = run.iterations;

@@ -15,20 +15,18 @@ constexpr int kSetVersion = 1;
 nlohmann::json to_json(const TunedSet& set) {
   nlohmann::json levels = nlohmann::json::object();
   for (const auto& [level, disc] : set.levels) levels[level] = to_json(disc);
-  return {{"format", kSetFormat},
-          {"version", kSetVersion},
-          {"material", set.material_name},
-          {"generated_by", set.generated_by},
-          {"settings", set.settings},
-          {"levels", levels}};
+  return {{"format", kSetFormat},          {"version", kSetVersion},
+          {"material", set.material_name}, {"generated_by", set.generated_by},
+          {"settings", set.settings},      {"levels", levels}};
 }
 
 TunedSet tuned_set_from_json(const nlohmann::json& j) {
   if (!j.is_object() || j.value("format", "") != kSetFormat)
-    throw std::invalid_argument(std::string("not a tuned-disc set (\"format\": \"") + kSetFormat + "\" missing)");
+    throw std::invalid_argument(std::string("not a tuned-disc set (\"format\": \"") + kSetFormat +
+                                "\" missing)");
   if (j.value("version", 0) != kSetVersion)
-    throw std::invalid_argument("tuned-disc set version " + j.value("version", nlohmann::json()).dump() +
-                                " is not supported");
+    throw std::invalid_argument("tuned-disc set version " +
+                                j.value("version", nlohmann::json()).dump() + " is not supported");
   TunedSet set;
   set.material_name = j.value("material", "");
   set.generated_by = j.value("generated_by", "");
@@ -44,11 +42,13 @@ TunedSet tuned_set_from_json(const nlohmann::json& j) {
     }
     if (d.per_spring())
       throw std::invalid_argument("level " + level +
-                                  ": per-spring scales belong to one mesh; a tuned set holds region-level scales that transfer");
-    if (d.level != level) throw std::invalid_argument("level " + level + ": its entry says level '" + d.level + "'");
+                                  ": per-spring scales belong to one mesh; a tuned set holds "
+                                  "region-level scales that transfer");
+    if (d.level != level)
+      throw std::invalid_argument("level " + level + ": its entry says level '" + d.level + "'");
     if (d.material_name != set.material_name)
-      throw std::invalid_argument("level " + level + ": material '" + d.material_name + "' is not the set's '" +
-                                  set.material_name + "'");
+      throw std::invalid_argument("level " + level + ": material '" + d.material_name +
+                                  "' is not the set's '" + set.material_name + "'");
     set.levels.emplace(level, std::move(d));
   }
   return set;
@@ -59,26 +59,32 @@ TunedSet read_tuned_set(const std::string& path) {
   return detail::naming_file(path, [&] { return tuned_set_from_json(j); });
 }
 
-std::string shipped_tuned_set_path(const std::string& data_dir) { return data_dir + "/tuned_discs.json"; }
+std::string shipped_tuned_set_path(const std::string& data_dir) {
+  return data_dir + "/tuned_discs.json";
+}
 
 const TunedDisc& tuned_level(const TunedSet& set, const std::string& level) {
   auto it = set.levels.find(level);
   if (it != set.levels.end()) return it->second;
   std::string known;
   for (const auto& [name, _] : set.levels) known += (known.empty() ? "" : ", ") + name;
-  throw std::invalid_argument("no tuned disc for level '" + level + "' (the set has " + known + ")");
+  throw std::invalid_argument("no tuned disc for level '" + level + "' (the set has " + known +
+                              ")");
 }
 
 TunedDisc read_tuned_for_mesh(const std::string& path, const mesh::TetMesh* mesh) {
-  const nlohmann::json j = detail::read_json_file(path, "tuned-disc file");  // read once, whichever kind
+  const nlohmann::json j =
+      detail::read_json_file(path, "tuned-disc file");  // read once, whichever kind
   if (!j.is_object() || j.value("format", "") != kSetFormat)
     return detail::naming_file(path, [&] { return tuned_disc_from_json(j); });
   const TunedSet set = detail::naming_file(path, [&] { return tuned_set_from_json(j); });
   if (!mesh) return set.levels.begin()->second;
   const std::string level = disc_level(*mesh);
   if (level.empty())
-    throw std::invalid_argument("'" + path + "' holds one tuned disc per level, and this mesh's level is unknown: give "
-                                "that level's tuned.json");
+    throw std::invalid_argument(
+        "'" + path +
+        "' holds one tuned disc per level, and this mesh's level is unknown: give "
+        "that level's tuned.json");
   try {
     return tuned_level(set, level);
   } catch (const std::invalid_argument& e) {

@@ -43,7 +43,8 @@ FreeBlockPattern build_free_block_pattern(const FeSpace& space, const std::vecto
   for (std::size_t i = 0; i < roles.size(); ++i)
     if (roles[i] == NodeRole::free) {
       const Eigen::RowVector3d c = (space.X.row(Eigen::Index(i)) - lo) * scale;
-      keyed.emplace_back(morton_key(std::uint32_t(c.x()), std::uint32_t(c.y()), std::uint32_t(c.z())), int(i));
+      keyed.emplace_back(
+          morton_key(std::uint32_t(c.x()), std::uint32_t(c.y()), std::uint32_t(c.z())), int(i));
     }
   if (order == FreeNodeOrder::spatial) std::sort(keyed.begin(), keyed.end());
   int nf = 0;
@@ -180,7 +181,8 @@ void assemble_constrained_impl(const FeSpace& space, const Eigen::VectorXi& regi
 PlateCoupling assemble_constrained(const FeSpace& space, const Eigen::VectorXi& region,
                                    const mesh::RegionMaterials& materials,
                                    const std::vector<NodeRole>& roles,
-                                   const Eigen::Vector3d& plate_center_mm, FreeBlockPattern& pattern) {
+                                   const Eigen::Vector3d& plate_center_mm,
+                                   FreeBlockPattern& pattern) {
   PlateCoupling out;
   if (space.order == 1)
     assemble_constrained_impl<4>(space, region, materials, roles, plate_center_mm, pattern, out);
@@ -223,23 +225,24 @@ void for_each_quadrature_point(const FeSpace& space, int n, Fn&& fn) {
 Eigen::VectorXd assemble_body_force(const FeSpace& space, const VectorField& body_force, int n) {
   Eigen::VectorXd f = Eigen::VectorXd::Zero(3 * space.num_nodes());
   const int npe = space.nodes_per_element();
-  for_each_quadrature_point(space, n, [&](Eigen::Index t, const Eigen::VectorXd& N, const Eigen::Vector3d& x,
-                                          double w) {
-    const Eigen::Vector3d b = body_force(x) * w;
-    for (int a = 0; a < npe; ++a) f.segment<3>(3 * space.elements(t, a)) += N(a) * b;
-  });
+  for_each_quadrature_point(
+      space, n, [&](Eigen::Index t, const Eigen::VectorXd& N, const Eigen::Vector3d& x, double w) {
+        const Eigen::Vector3d b = body_force(x) * w;
+        for (int a = 0; a < npe; ++a) f.segment<3>(3 * space.elements(t, a)) += N(a) * b;
+      });
   return f;
 }
 
-double l2_error(const FeSpace& space, const Eigen::VectorXd& u_h, const VectorField& u_exact, int n) {
+double l2_error(const FeSpace& space, const Eigen::VectorXd& u_h, const VectorField& u_exact,
+                int n) {
   const int npe = space.nodes_per_element();
   double sum = 0;
-  for_each_quadrature_point(space, n, [&](Eigen::Index t, const Eigen::VectorXd& N, const Eigen::Vector3d& x,
-                                          double w) {
-    Eigen::Vector3d uh = Eigen::Vector3d::Zero();
-    for (int a = 0; a < npe; ++a) uh += N(a) * u_h.segment<3>(3 * space.elements(t, a));
-    sum += w * (uh - u_exact(x)).squaredNorm();
-  });
+  for_each_quadrature_point(
+      space, n, [&](Eigen::Index t, const Eigen::VectorXd& N, const Eigen::Vector3d& x, double w) {
+        Eigen::Vector3d uh = Eigen::Vector3d::Zero();
+        for (int a = 0; a < npe; ++a) uh += N(a) * u_h.segment<3>(3 * space.elements(t, a));
+        sum += w * (uh - u_exact(x)).squaredNorm();
+      });
   return std::sqrt(sum);
 }
 

@@ -44,8 +44,9 @@ void CholmodSolver::factorize(const Eigen::SparseMatrix<double>& lower) {
   factorized_ = false;
   impl_->llt.factorize(lower);
   if (impl_->llt.info() != Eigen::Success)
-    throw std::runtime_error("CHOLMOD: matrix is not positive definite (Cholesky factorisation "
-                             "failed; is the body constrained against rigid motion?)");
+    throw std::runtime_error(
+        "CHOLMOD: matrix is not positive definite (Cholesky factorisation "
+        "failed; is the body constrained against rigid motion?)");
   factorized_ = true;
 }
 
@@ -56,13 +57,20 @@ const char* CholmodSolver::ordering_used() const {
   const cholmod_common& c = impl_->llt.cholmod();
   if (c.selected < 0 || c.selected >= CHOLMOD_MAXMETHODS) return "none";
   switch (c.method[c.selected].ordering) {
-    case CHOLMOD_NATURAL: return "natural";
-    case CHOLMOD_GIVEN: return "given";
-    case CHOLMOD_AMD: return "amd";
-    case CHOLMOD_METIS: return "metis";
-    case CHOLMOD_NESDIS: return "nesdis";
-    case CHOLMOD_COLAMD: return "colamd";
-    default: return "other";
+    case CHOLMOD_NATURAL:
+      return "natural";
+    case CHOLMOD_GIVEN:
+      return "given";
+    case CHOLMOD_AMD:
+      return "amd";
+    case CHOLMOD_METIS:
+      return "metis";
+    case CHOLMOD_NESDIS:
+      return "nesdis";
+    case CHOLMOD_COLAMD:
+      return "colamd";
+    default:
+      return "other";
   }
 }
 
@@ -72,8 +80,9 @@ Eigen::MatrixXd CholmodSolver::solve(const Eigen::MatrixXd& rhs) const {
   if (!rhs.allFinite()) throw std::runtime_error("CHOLMOD: right-hand side is not finite");
   Eigen::MatrixXd x = impl_->llt.solve(rhs);
   if (impl_->llt.info() != Eigen::Success || !x.allFinite())
-    throw std::runtime_error("CHOLMOD: solve failed or gave non-finite values (matrix is not "
-                             "positive definite or is too ill-conditioned)");
+    throw std::runtime_error(
+        "CHOLMOD: solve failed or gave non-finite values (matrix is not "
+        "positive definite or is too ill-conditioned)");
   return x;
 }
 

@@ -27,7 +27,8 @@ Eigen::VectorXd solve_dirichlet(const Eigen::SparseMatrix<double>& K, const Eige
     u(i) = fixed_values(Eigen::Index(k));
   }
   Eigen::Index nf = 0;
-  for (Eigen::Index i = 0; i < n; ++i) free_index[std::size_t(i)] = fixed[std::size_t(i)] ? -1 : nf++;
+  for (Eigen::Index i = 0; i < n; ++i)
+    free_index[std::size_t(i)] = fixed[std::size_t(i)] ? -1 : nf++;
   if (nf == 0) return u;
 
   Eigen::VectorXd rhs(nf);

@@ -73,7 +73,7 @@ struct DiscFem::Impl {
   FreeBlockPattern pattern;
   PlateCoupling coupling;
   CholmodSolver solver;
-  Eigen::MatrixXd Z;          ///< 3nf×6: K_ff^-1 K_fp
+  Eigen::MatrixXd Z;  ///< 3nf×6: K_ff^-1 K_fp
   Matrix6d K6;
   Eigen::LLT<Matrix6d> K6_llt;
   double asymmetry = 0;
@@ -124,10 +124,9 @@ DiscFem::DiscFem(const mesh::TetMesh& mesh, const mesh::RegionMaterials& materia
   // 3. Factorise K_ff and condense onto the plate: K6 = K_pp - K_fp^T K_ff^-1 K_fp.
   d.K6 = d.coupling.K_pp;
   const Eigen::Index nf = 3 * d.pattern.num_free_nodes;
-  const bool use_cg =
-      order == 2 && nf > 0 &&
-      (options.solver == LinearSolver::p_multigrid_cg ||
-       (options.solver == LinearSolver::automatic && nf >= options.cg_min_dofs));
+  const bool use_cg = order == 2 && nf > 0 &&
+                      (options.solver == LinearSolver::p_multigrid_cg ||
+                       (options.solver == LinearSolver::automatic && nf >= options.cg_min_dofs));
   if (use_cg) {
     // P1 block on the same mesh and roles (vertex labels are the same), factorised directly.
     t0 = Clock::now();
@@ -180,7 +179,8 @@ Eigen::Vector3d DiscFem::default_plate_center(const mesh::TetMesh& mesh) {
       ++n;
     }
   if (n == 0)
-    throw std::invalid_argument("mesh has no superior endplate nodes (surface = 2) for the plate centre");
+    throw std::invalid_argument(
+        "mesh has no superior endplate nodes (surface = 2) for the plate centre");
   return sum / double(n);
 }
 

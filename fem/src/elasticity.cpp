@@ -58,7 +58,8 @@ namespace {
 // K_ab = lambda S_ab + mu S_ab^T + mu tr(S_ab) I with S_ab = \int g_a g_b^T dV.
 template <int N>
 void fill_from_gradient_products(const Eigen::Matrix<double, N, 3>* G, const double* w, int nq,
-                                 double lambda, double mu, Eigen::Matrix<double, 3 * N, 3 * N>& Ke) {
+                                 double lambda, double mu,
+                                 Eigen::Matrix<double, 3 * N, 3 * N>& Ke) {
   for (int a = 0; a < N; ++a)
     for (int b = 0; b <= a; ++b) {
       Eigen::Matrix3d S = Eigen::Matrix3d::Zero();
@@ -101,7 +102,8 @@ void element_stiffness_p2(const TetVertices& X, double lambda, double mu,
   fill_from_gradient_products<10>(G, w, 4, lambda, mu, Ke);
 }
 
-Eigen::MatrixXd element_stiffness(int order, const TetVertices& X, const mesh::IsotropicMaterial& m) {
+Eigen::MatrixXd element_stiffness(int order, const TetVertices& X,
+                                  const mesh::IsotropicMaterial& m) {
   const double lambda = m.lame_lambda_mpa(), mu = m.shear_modulus_mpa();
   if (order == 1) {
     Eigen::Matrix<double, 12, 12> K;
@@ -121,8 +123,7 @@ Vector6d element_stress(int order, const TetVertices& X, const mesh::IsotropicMa
   double vol = 0;
   const Eigen::MatrixX3d G = shape_gradients(order, barycentric_gradients(X, vol), L);
   Eigen::Matrix3d grad_u = Eigen::Matrix3d::Zero();  // grad_u(i, j) = d u_i / d x_j
-  for (Eigen::Index a = 0; a < G.rows(); ++a)
-    grad_u += ue.segment<3>(3 * a) * G.row(a);
+  for (Eigen::Index a = 0; a < G.rows(); ++a) grad_u += ue.segment<3>(3 * a) * G.row(a);
   const Eigen::Matrix3d eps = 0.5 * (grad_u + grad_u.transpose());
   Vector6d e;
   e << eps(0, 0), eps(1, 1), eps(2, 2), 2 * eps(1, 2), 2 * eps(0, 2), 2 * eps(0, 1);

@@ -67,7 +67,8 @@ FeSpace make_fe_space(const mesh::TetMesh& mesh, int order) {
   for (Eigen::Index e = 0; e < ne; ++e) {
     s.edge_vertices(e, 0) = edges[std::size_t(e)][0];
     s.edge_vertices(e, 1) = edges[std::size_t(e)][1];
-    s.X.row(nv + e) = 0.5 * (mesh.V.row(edges[std::size_t(e)][0]) + mesh.V.row(edges[std::size_t(e)][1]));
+    s.X.row(nv + e) =
+        0.5 * (mesh.V.row(edges[std::size_t(e)][0]) + mesh.V.row(edges[std::size_t(e)][1]));
   }
   return s;
 }
@@ -76,7 +77,8 @@ Eigen::VectorXi node_surface_labels(const FeSpace& space, const mesh::TetMesh& m
   Eigen::VectorXi label(space.num_nodes());
   label.head(space.num_vertices) = mesh.surface;
   for (Eigen::Index e = 0; e < space.edge_vertices.rows(); ++e) {
-    const int a = mesh.surface(space.edge_vertices(e, 0)), b = mesh.surface(space.edge_vertices(e, 1));
+    const int a = mesh.surface(space.edge_vertices(e, 0)),
+              b = mesh.surface(space.edge_vertices(e, 1));
     const bool endplate = a == b && (a == int(mesh::Surface::inferior_endplate) ||
                                      a == int(mesh::Surface::superior_endplate));
     label(space.num_vertices + e) = endplate ? a : 0;

@@ -18,9 +18,8 @@ LoadCase make(const char* name, int component, double value) {
 
 const std::vector<LoadCase>& standard_load_cases() {
   static const std::vector<LoadCase> cases = {
-      make("compression", 1, -500.0),     make("tension", 1, 200.0),
-      make("shear-ap", 2, 100.0),         make("shear-lat", 0, 100.0),
-      make("flexion", 3, 7500.0),         make("extension", 3, -7500.0),
+      make("compression", 1, -500.0),     make("tension", 1, 200.0),  make("shear-ap", 2, 100.0),
+      make("shear-lat", 0, 100.0),        make("flexion", 3, 7500.0), make("extension", 3, -7500.0),
       make("lateral-bending", 5, 7500.0), make("torsion", 4, 7500.0)};
   return cases;
 }
@@ -39,8 +38,9 @@ std::vector<LoadCase> parse_load_cases(const std::string& list) {
   std::stringstream ss(list);
   std::string item;
   while (std::getline(ss, item, ',')) {
-    item.erase(std::remove_if(item.begin(), item.end(), [](unsigned char ch) { return std::isspace(ch); }),
-               item.end());
+    item.erase(
+        std::remove_if(item.begin(), item.end(), [](unsigned char ch) { return std::isspace(ch); }),
+        item.end());
     if (!item.empty()) out.push_back(load_case(item));
   }
   if (out.empty()) throw std::invalid_argument("no load case given");

@@ -23,8 +23,8 @@ constexpr int kCols = 6;
 #endif
 
 // y = K x
-SPINESIM_KERNEL void sym_multiply(const int* outer, const int* inner, const double* val, Eigen::Index n,
-                                  const double* x, double* y) {
+SPINESIM_KERNEL void sym_multiply(const int* outer, const int* inner, const double* val,
+                                  Eigen::Index n, const double* x, double* y) {
   std::fill_n(y, n * kCols, 0.0);
   for (Eigen::Index j = 0; j < n; ++j) {
     const double* xj = x + j * kCols;
@@ -89,7 +89,9 @@ struct Kernels {
   void forward_gs(const double* b, double* x, double* r) const {
     ::spinesim::fem::forward_gs(outer, inner, val, inv_diag, n, b, x, r);
   }
-  void backward_gs(double* r) const { ::spinesim::fem::backward_gs(outer, inner, val, inv_diag, n, r); }
+  void backward_gs(double* r) const {
+    ::spinesim::fem::backward_gs(outer, inner, val, inv_diag, n, r);
+  }
 };
 
 }  // namespace
@@ -120,7 +122,8 @@ struct P2MultigridCg::Group {
           if (par[i][std::size_t(k)] >= 0)
             for (int d = 0; d < 3; ++d)
               for (int c = 0; c < NC; ++c)
-                rc(3 * par[i][std::size_t(k)] + d, c) += wt[i][std::size_t(k)] * w[(3 * i + d) * NC + c];
+                rc(3 * par[i][std::size_t(k)] + d, c) +=
+                    wt[i][std::size_t(k)] * w[(3 * i + d) * NC + c];
       Eigen::MatrixXd ec;
       {
         std::lock_guard<std::mutex> lock(coarse_mutex);
@@ -131,15 +134,18 @@ struct P2MultigridCg::Group {
           if (par[i][std::size_t(k)] >= 0)
             for (int d = 0; d < 3; ++d)
               for (int c = 0; c < NC; ++c)
-                out[(3 * i + d) * NC + c] += wt[i][std::size_t(k)] * ec(3 * par[i][std::size_t(k)] + d, c);
+                out[(3 * i + d) * NC + c] +=
+                    wt[i][std::size_t(k)] * ec(3 * par[i][std::size_t(k)] + d, c);
       K.multiply(out, t.data());
       for (Eigen::Index i = 0; i < n * NC; ++i) w[std::size_t(i)] = res[i] - t[std::size_t(i)];
       K.backward_gs(w.data());
       for (Eigen::Index i = 0; i < n * NC; ++i) out[i] += w[std::size_t(i)];
     };
-    const auto column_dots = [&](const std::vector<double>& a, const std::vector<double>& b, double* out) {
+    const auto column_dots = [&](const std::vector<double>& a, const std::vector<double>& b,
+                                 double* out) {
       for (int c = 0; c < NC; ++c) out[c] = 0;
-      for (Eigen::Index i = 0; i < n * NC; ++i) out[i % NC] += a[std::size_t(i)] * b[std::size_t(i)];
+      for (Eigen::Index i = 0; i < n * NC; ++i)
+        out[i % NC] += a[std::size_t(i)] * b[std::size_t(i)];
     };
 
     precondition(r.data(), z.data());
@@ -168,16 +174,19 @@ struct P2MultigridCg::Group {
       }
       for (Eigen::Index i = 0; i < n; ++i)
         for (int c = 0; c < NC; ++c)
-          p[std::size_t(i * NC + c)] = z[std::size_t(i * NC + c)] + beta[c] * p[std::size_t(i * NC + c)];
+          p[std::size_t(i * NC + c)] =
+              z[std::size_t(i * NC + c)] + beta[c] * p[std::size_t(i * NC + c)];
     }
     return -1;
   }
 };
 
 P2MultigridCg::P2MultigridCg(const Eigen::SparseMatrix<double>& fine_lower,
-                             const Eigen::SparseMatrix<double>& coarse_lower, P1ToP2Embedding embedding)
+                             const Eigen::SparseMatrix<double>& coarse_lower,
+                             P1ToP2Embedding embedding)
     : K_(fine_lower), Kc_(coarse_lower), embed_(std::move(embedding)) {
-  if (Eigen::Index(3 * embed_.parent.size()) != K_.rows() || 3 * embed_.num_coarse_nodes != Kc_.rows())
+  if (Eigen::Index(3 * embed_.parent.size()) != K_.rows() ||
+      3 * embed_.num_coarse_nodes != Kc_.rows())
     throw std::invalid_argument("P2MultigridCg: embedding does not match the matrices");
   coarse_.compute(Kc_);
   inv_diag_.resize(K_.rows());
@@ -190,16 +199,21 @@ P2MultigridCg::P2MultigridCg(const Eigen::SparseMatrix<double>& fine_lower,
 }
 
 Eigen::MatrixXd P2MultigridCg::solve(const Eigen::MatrixXd& B, double rel_tol, int max_iterations) {
-  if (B.rows() != K_.rows()) throw std::invalid_argument("P2MultigridCg: right-hand side has wrong size");
+  if (B.rows() != K_.rows())
+    throw std::invalid_argument("P2MultigridCg: right-hand side has wrong size");
   if (!B.allFinite()) throw std::runtime_error("P2MultigridCg: right-hand side is not finite");
   constexpr int NC = 6;  // columns per thread (one pass over the matrix serves all six)
   const Eigen::Index n = K_.rows();
-  const Kernels<NC> kernels{K_.outerIndexPtr(), K_.innerIndexPtr(), K_.valuePtr(), inv_diag_.data(), n};
+  const Kernels<NC> kernels{K_.outerIndexPtr(), K_.innerIndexPtr(), K_.valuePtr(), inv_diag_.data(),
+                            n};
   const Eigen::Index groups = (B.cols() + NC - 1) / NC;
-  std::vector<std::vector<double>> b(std::size_t(groups), std::vector<double>(std::size_t(n * NC), 0.0));
-  std::vector<std::vector<double>> x(std::size_t(groups), std::vector<double>(std::size_t(n * NC), 0.0));
+  std::vector<std::vector<double>> b(std::size_t(groups),
+                                     std::vector<double>(std::size_t(n * NC), 0.0));
+  std::vector<std::vector<double>> x(std::size_t(groups),
+                                     std::vector<double>(std::size_t(n * NC), 0.0));
   for (Eigen::Index c = 0; c < B.cols(); ++c)
-    for (Eigen::Index i = 0; i < n; ++i) b[std::size_t(c / NC)][std::size_t(i * NC + c % NC)] = B(i, c);
+    for (Eigen::Index i = 0; i < n; ++i)
+      b[std::size_t(c / NC)][std::size_t(i * NC + c % NC)] = B(i, c);
   std::vector<int> iterations(std::size_t(groups), 0);
   std::mutex coarse_mutex;
   std::vector<std::thread> threads;
@@ -208,14 +222,14 @@ Eigen::MatrixXd P2MultigridCg::solve(const Eigen::MatrixXd& B, double rel_tol, i
   // One group (the usual 6 plate columns) runs on this thread: measured faster than splitting
   // columns over both cores, where the coarse CHOLMOD solve's BLAS threads compete with ours.
   const auto run_group = [&](Eigen::Index g) {
-      try {
-        iterations[std::size_t(g)] = Group::run<NC>(*this, kernels, b[std::size_t(g)].data(),
-                                                    x[std::size_t(g)].data(), rel_tol, max_iterations,
-                                                    coarse_mutex);
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(error_mutex);
-        error = std::current_exception();
-      }
+    try {
+      iterations[std::size_t(g)] =
+          Group::run<NC>(*this, kernels, b[std::size_t(g)].data(), x[std::size_t(g)].data(),
+                         rel_tol, max_iterations, coarse_mutex);
+    } catch (...) {
+      std::lock_guard<std::mutex> lock(error_mutex);
+      error = std::current_exception();
+    }
   };
   if (groups == 1) {
     run_group(0);
@@ -227,13 +241,15 @@ Eigen::MatrixXd P2MultigridCg::solve(const Eigen::MatrixXd& B, double rel_tol, i
   last_iterations_ = 0;
   for (int it : iterations) {
     if (it < 0)
-      throw std::runtime_error("P2 multigrid CG did not converge in " + std::to_string(max_iterations) +
+      throw std::runtime_error("P2 multigrid CG did not converge in " +
+                               std::to_string(max_iterations) +
                                " iterations (matrix not positive definite or badly conditioned)");
     last_iterations_ = std::max(last_iterations_, it);
   }
   Eigen::MatrixXd X(n, B.cols());
   for (Eigen::Index c = 0; c < B.cols(); ++c)
-    for (Eigen::Index i = 0; i < n; ++i) X(i, c) = x[std::size_t(c / NC)][std::size_t(i * NC + c % NC)];
+    for (Eigen::Index i = 0; i < n; ++i)
+      X(i, c) = x[std::size_t(c / NC)][std::size_t(i * NC + c % NC)];
   if (!X.allFinite()) throw std::runtime_error("P2 multigrid CG produced non-finite values");
   return X;
 }

@@ -61,8 +61,8 @@ TetQuadrature tet_rule_collapsed(int n) {
         const double u = x[std::size_t(i)], v = x[std::size_t(j)], s = x[std::size_t(l)];
         const double px = u, py = v * (1 - u), pz = s * (1 - u) * (1 - v);
         q.barycentric.row(k) << 1 - px - py - pz, px, py, pz;
-        q.weights(k) = 6.0 * w[std::size_t(i)] * w[std::size_t(j)] * w[std::size_t(l)] *
-                       (1 - u) * (1 - u) * (1 - v);
+        q.weights(k) = 6.0 * w[std::size_t(i)] * w[std::size_t(j)] * w[std::size_t(l)] * (1 - u) *
+                       (1 - u) * (1 - v);
       }
   return q;
 }

@@ -37,8 +37,19 @@ double golden_max(F f, double a, double b) {
   double c = b - g * (b - a), d = a + g * (b - a);
   double fc = f(c), fd = f(d);
   for (int it = 0; it < 200 && b - a > 1e-15; ++it) {
-    if (fc > fd) { b = d; d = c; fd = fc; c = b - g * (b - a); fc = f(c); }
-    else         { a = c; c = d; fc = fd; d = a + g * (b - a); fd = f(d); }
+    if (fc > fd) {
+      b = d;
+      d = c;
+      fd = fc;
+      c = b - g * (b - a);
+      fc = f(c);
+    } else {
+      a = c;
+      c = d;
+      fc = fd;
+      d = a + g * (b - a);
+      fd = f(d);
+    }
   }
   return f(0.5 * (a + b));
 }
@@ -51,7 +62,10 @@ double circle_max(F f) {
   double fbest = -1e300;
   for (int k = 0; k < n; ++k) {
     const double v = f(2 * kPi * k / n);
-    if (v > fbest) { fbest = v; best = k; }
+    if (v > fbest) {
+      fbest = v;
+      best = k;
+    }
   }
   const double h = 2 * kPi / n;
   return golden_max(f, 2 * kPi * best / n - h, 2 * kPi * best / n + h);
@@ -99,7 +113,8 @@ std::string fmt(double v) {
 
 // ----------------------------------------------------------------------------- KidneyOutline
 
-KidneyOutline::KidneyOutline(double width_mm, double depth_mm) : width_(width_mm), depth_(depth_mm) {
+KidneyOutline::KidneyOutline(double width_mm, double depth_mm)
+    : width_(width_mm), depth_(depth_mm) {
   if (!(width_mm > 0) || !(depth_mm > 0) || !std::isfinite(width_mm) || !std::isfinite(depth_mm))
     throw std::invalid_argument("disc outline: width and depth must be finite and > 0 mm (got " +
                                 fmt(width_mm) + " x " + fmt(depth_mm) + ")");
@@ -154,7 +169,8 @@ std::vector<Eigen::Vector2d> KidneyOutline::sample(int n, double scale) const {
 // ---------------------------------------------------------------------------- ParametricDisc
 
 ParametricDisc::ParametricDisc(const DiscDimensions& d) : dims_(d) {
-  for (double v : {d.lower_width_mm, d.lower_depth_mm, d.upper_width_mm, d.upper_depth_mm, d.height_mm})
+  for (double v :
+       {d.lower_width_mm, d.lower_depth_mm, d.upper_width_mm, d.upper_depth_mm, d.height_mm})
     if (!(v > 0) || !std::isfinite(v))
       throw std::invalid_argument("disc '" + d.level +
                                   "': widths, depths and height must be finite and > 0 mm");
@@ -207,7 +223,8 @@ double ParametricDisc::volume_mm3() const {
   return dims_.height_mm * unit_area * (w0 * d0 + 0.5 * (w0 * dd + d0 * dw) + dw * dd / 3.0);
 }
 
-std::vector<std::vector<Eigen::Vector3d>> ParametricDisc::feature_polylines(double spacing_mm) const {
+std::vector<std::vector<Eigen::Vector3d>> ParametricDisc::feature_polylines(
+    double spacing_mm) const {
   std::vector<std::vector<Eigen::Vector3d>> lines;
   const double half = 0.5 * dims_.height_mm;
   for (double y : {-half, half}) {
@@ -226,6 +243,8 @@ std::vector<std::vector<Eigen::Vector3d>> ParametricDisc::feature_polylines(doub
   return lines;
 }
 
-double parametric_disc_volume(const DiscDimensions& dims) { return ParametricDisc(dims).volume_mm3(); }
+double parametric_disc_volume(const DiscDimensions& dims) {
+  return ParametricDisc(dims).volume_mm3();
+}
 
 }  // namespace spinesim::mesh

@@ -56,7 +56,8 @@ std::vector<std::string> split_cells(const std::string& line) {
   std::size_t start = 0;
   while (true) {
     const auto comma = line.find(',', start);
-    cells.push_back(trim(line.substr(start, comma == std::string::npos ? std::string::npos : comma - start)));
+    cells.push_back(
+        trim(line.substr(start, comma == std::string::npos ? std::string::npos : comma - start)));
     if (comma == std::string::npos) break;
     start = comma + 1;
   }
@@ -81,7 +82,8 @@ CsvTable read_csv(const fs::path& path) {
     }
     if (cells.size() != t.header.size())
       throw std::invalid_argument(t.path + ":" + std::to_string(line_no) + ": expected " +
-                                  std::to_string(t.header.size()) + " cells, got " + std::to_string(cells.size()));
+                                  std::to_string(t.header.size()) + " cells, got " +
+                                  std::to_string(cells.size()));
     t.rows.push_back(std::move(cells));
   }
   if (t.header.empty()) throw std::invalid_argument(t.path + ": no header row");
@@ -112,15 +114,18 @@ std::string canonical_level(const std::string& level) {
 }
 
 /// Row of `table` whose `key_column` equals `key` (exact match).
-const std::vector<std::string>& find_row(const CsvTable& table, const std::string& key_column, const std::string& key) {
+const std::vector<std::string>& find_row(const CsvTable& table, const std::string& key_column,
+                                         const std::string& key) {
   const std::size_t k = table.column(key_column);
   for (const auto& row : table.rows)
     if (row[k] == key) return row;
   throw std::invalid_argument(table.path + ": no row with " + key_column + " = " + key);
 }
 
-Eigen::Vector3d point(const CsvTable& table, const std::vector<std::string>& row, const std::string& what) {
-  return {to_double(row[table.column("x_mm")], what + " x_mm"), to_double(row[table.column("y_mm")], what + " y_mm"),
+Eigen::Vector3d point(const CsvTable& table, const std::vector<std::string>& row,
+                      const std::string& what) {
+  return {to_double(row[table.column("x_mm")], what + " x_mm"),
+          to_double(row[table.column("y_mm")], what + " y_mm"),
           to_double(row[table.column("z_mm")], what + " z_mm")};
 }
 
@@ -128,7 +133,7 @@ Eigen::Vector3d point(const CsvTable& table, const std::vector<std::string>& row
 
 const std::vector<std::string>& disc_levels() {
   static const std::vector<std::string> levels = {
-      "T1-T2", "T2-T3",   "T3-T4",   "T4-T5",   "T5-T6",  "T6-T7", "T7-T8", "T8-T9", "T9-T10",
+      "T1-T2",   "T2-T3",   "T3-T4",  "T4-T5", "T5-T6", "T6-T7", "T7-T8", "T8-T9", "T9-T10",
       "T10-T11", "T11-T12", "T12-L1", "L1-L2", "L2-L3", "L3-L4", "L4-L5", "L5-S1"};
   return levels;
 }
@@ -139,7 +144,8 @@ DiscDimensions disc_dimensions(const std::string& level, const std::string& data
   const auto& row = find_row(table, "level", name);
   auto value = [&](const char* column) {
     const double v = to_double(row[table.column(column)], table.path + " " + name + " " + column);
-    if (!(v > 0)) throw std::invalid_argument(table.path + ": " + name + " " + column + " must be > 0 mm");
+    if (!(v > 0))
+      throw std::invalid_argument(table.path + ": " + name + " " + column + " must be > 0 mm");
     return v;
   };
   DiscDimensions d;
@@ -167,13 +173,16 @@ DiscFrame disc_frame_in_spine(const std::string& level, const std::string& data_
   const Eigen::Vector3d top = point(centres, find_row(centres, "segment", superior), superior);
   // F.1 has no sacrum: below L5 the joint point stands in for the inferior centre.
   const Eigen::Vector3d bottom =
-      inferior == "S1" ? frame.origin_mm : point(centres, find_row(centres, "segment", inferior), inferior);
+      inferior == "S1" ? frame.origin_mm
+                       : point(centres, find_row(centres, "segment", inferior), inferior);
   Eigen::Vector3d y = top - bottom;
-  if (!(y.norm() > 1e-9)) throw std::invalid_argument("disc " + name + ": coincident vertebra centres");
+  if (!(y.norm() > 1e-9))
+    throw std::invalid_argument("disc " + name + ": coincident vertebra centres");
   y.normalize();
 
   Eigen::Vector3d x = Eigen::Vector3d::UnitX() - y.x() * y;  // global x, orthogonal to the axis
-  if (!(x.norm() > 1e-9)) throw std::invalid_argument("disc " + name + ": axis is parallel to global x");
+  if (!(x.norm() > 1e-9))
+    throw std::invalid_argument("disc " + name + ": axis is parallel to global x");
   x.normalize();
   Eigen::Vector3d z = x.cross(y);
   if (z.z() < 0) {  // keep z anterior; flipping x and z together keeps the frame right-handed

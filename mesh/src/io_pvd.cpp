@@ -17,7 +17,6 @@
 namespace spinesim::mesh {
 namespace {
 
-
 std::string shortest(double v) {
   char buf[64];
   const auto res = std::to_chars(buf, buf + sizeof buf, v);  // shortest round-trip form
@@ -33,10 +32,12 @@ void write_pvd(const std::string& path, const std::vector<PvdEntry>& entries) {
   for (std::size_t i = 0; i < entries.size(); ++i) {
     const PvdEntry& e = entries[i];
     const std::string which = "dataset " + std::to_string(i);
-    if (!std::isfinite(e.time_s)) throw std::invalid_argument(who + which + " has a non-finite time");
+    if (!std::isfinite(e.time_s))
+      throw std::invalid_argument(who + which + " has a non-finite time");
     if (i > 0 && !(e.time_s > entries[i - 1].time_s))
       throw std::invalid_argument(who + which + ": times must be strictly increasing (" +
-                                  shortest(entries[i - 1].time_s) + " then " + shortest(e.time_s) + ")");
+                                  shortest(entries[i - 1].time_s) + " then " + shortest(e.time_s) +
+                                  ")");
     if (e.file.empty()) throw std::invalid_argument(who + which + " has an empty file name");
     for (char c : e.file)
       if (static_cast<unsigned char>(c) < 0x20)

@@ -8,8 +8,8 @@
 // skipped by CGAL.
 #include "spinesim/mesh/io.hpp"
 
-#include <CGAL/Simple_cartesian.h>
 #include <CGAL/IO/polygon_soup_io.h>
+#include <CGAL/Simple_cartesian.h>
 
 #include <algorithm>
 #include <array>
@@ -32,12 +32,18 @@ using Point = Kernel::Point_3;
 /// File coordinates (already in mm) -> spinesim frame; the maps are documented in io.hpp.
 Eigen::Vector3d to_spinesim_frame(const Eigen::Vector3d& p, UpAxis up) {
   switch (up) {
-    case UpAxis::y: return {p.x(), p.y(), p.z()};
-    case UpAxis::z: return {p.y(), p.z(), p.x()};
-    case UpAxis::x: return {p.z(), p.x(), p.y()};
-    case UpAxis::minus_y: return {p.x(), -p.y(), -p.z()};
-    case UpAxis::minus_z: return {p.y(), -p.z(), -p.x()};
-    case UpAxis::minus_x: return {p.z(), -p.x(), -p.y()};
+    case UpAxis::y:
+      return {p.x(), p.y(), p.z()};
+    case UpAxis::z:
+      return {p.y(), p.z(), p.x()};
+    case UpAxis::x:
+      return {p.z(), p.x(), p.y()};
+    case UpAxis::minus_y:
+      return {p.x(), -p.y(), -p.z()};
+    case UpAxis::minus_z:
+      return {p.y(), -p.z(), -p.x()};
+    case UpAxis::minus_x:
+      return {p.z(), -p.x(), -p.y()};
   }
   return p;
 }

@@ -29,13 +29,20 @@ struct LegacyType {
 };
 
 bool legacy_type(std::string t, LegacyType& out) {
-  std::transform(t.begin(), t.end(), t.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-  static const struct { const char* name; LegacyType type; } table[] = {
-      {"bit", {1, 'u'}},          {"unsigned_char", {1, 'u'}}, {"char", {1, 'i'}},
-      {"unsigned_short", {2, 'u'}}, {"short", {2, 'i'}},       {"unsigned_int", {4, 'u'}},
-      {"int", {4, 'i'}},          {"unsigned_long", {8, 'u'}}, {"long", {8, 'i'}},
-      {"float", {4, 'f'}},        {"double", {8, 'f'}},        {"vtktypeint64", {8, 'i'}},
-      {"vtktypeuint64", {8, 'u'}}, {"vtktypeint32", {4, 'i'}}, {"vtktypeuint32", {4, 'u'}},
+  std::transform(t.begin(), t.end(), t.begin(),
+                 [](unsigned char c) { return char(std::tolower(c)); });
+  static const struct {
+    const char* name;
+    LegacyType type;
+  } table[] = {
+      {"bit", {1, 'u'}},           {"unsigned_char", {1, 'u'}},
+      {"char", {1, 'i'}},          {"unsigned_short", {2, 'u'}},
+      {"short", {2, 'i'}},         {"unsigned_int", {4, 'u'}},
+      {"int", {4, 'i'}},           {"unsigned_long", {8, 'u'}},
+      {"long", {8, 'i'}},          {"float", {4, 'f'}},
+      {"double", {8, 'f'}},        {"vtktypeint64", {8, 'i'}},
+      {"vtktypeuint64", {8, 'u'}}, {"vtktypeint32", {4, 'i'}},
+      {"vtktypeuint32", {4, 'u'}},
   };
   for (const auto& e : table)
     if (t == e.name) {
@@ -80,20 +87,25 @@ class LegacyReader : public detail::FileError {
   }
   /// `n` values of type `t`.
   std::vector<double> values(std::int64_t n, const LegacyType& t, const std::string& what) {
-    if (n < 0 || std::uint64_t(n) > (std::uint64_t(1) << 32)) fail(what + ": implausible count " + std::to_string(n));
+    if (n < 0 || std::uint64_t(n) > (std::uint64_t(1) << 32))
+      fail(what + ": implausible count " + std::to_string(n));
     std::vector<double> v;
     v.reserve(std::size_t(std::min<std::int64_t>(n, std::int64_t(text_.size()))));
     if (binary) {
       const std::size_t bytes = std::size_t(n) * std::size_t(t.size);
       if (text_.size() - pos_ < bytes) fail(what + ": binary data is truncated");
-      for (std::int64_t i = 0; i < n; ++i) v.push_back(decode(reinterpret_cast<const unsigned char*>(text_.data()) + pos_ + std::size_t(i) * std::size_t(t.size), t));
+      for (std::int64_t i = 0; i < n; ++i)
+        v.push_back(decode(reinterpret_cast<const unsigned char*>(text_.data()) + pos_ +
+                               std::size_t(i) * std::size_t(t.size),
+                           t));
       pos_ += bytes;
       if (pos_ < text_.size() && text_[pos_] == '\n') ++pos_;  // the newline after the data
       return v;
     }
     for (std::int64_t i = 0; i < n; ++i) {
       skip_space();
-      if (pos_ >= text_.size()) fail(what + ": expected " + std::to_string(n) + " values, found " + std::to_string(i));
+      if (pos_ >= text_.size())
+        fail(what + ": expected " + std::to_string(n) + " values, found " + std::to_string(i));
       const char* s = text_.data() + pos_;
       const char* end = text_.data() + text_.size();
       if (*s == '+') ++s;
@@ -146,7 +158,8 @@ std::int64_t count_of(LegacyReader& r, const std::string& word, const std::strin
   return n;
 }
 
-std::vector<std::int64_t> integers(LegacyReader& r, std::int64_t n, const LegacyType& t, const std::string& what) {
+std::vector<std::int64_t> integers(LegacyReader& r, std::int64_t n, const LegacyType& t,
+                                   const std::string& what) {
   RawArray a;
   a.name = what;
   a.v = r.values(n, t, what);
@@ -162,7 +175,8 @@ void read_cells(LegacyReader& r, const std::vector<std::string>& w, detail::RawG
     if (off_words.size() < 2 || off_words[0] != "OFFSETS") r.fail("CELLS: expected OFFSETS");
     auto offsets = integers(r, a, type_of(r, off_words[1], "OFFSETS"), "OFFSETS");
     const auto conn_words = r.words();
-    if (conn_words.size() < 2 || conn_words[0] != "CONNECTIVITY") r.fail("CELLS: expected CONNECTIVITY");
+    if (conn_words.size() < 2 || conn_words[0] != "CONNECTIVITY")
+      r.fail("CELLS: expected CONNECTIVITY");
     g.connectivity = integers(r, b, type_of(r, conn_words[1], "CONNECTIVITY"), "CONNECTIVITY");
     if (offsets.empty() || offsets.front() != 0) r.fail("OFFSETS must start at 0");
     g.num_cells = a - 1;
@@ -176,16 +190,19 @@ void read_cells(LegacyReader& r, const std::vector<std::string>& w, detail::RawG
     if (k >= list.size() || list[k] < 0 || k + 1 + std::size_t(list[k]) > list.size())
       r.fail("CELLS: cell #" + std::to_string(c) + " runs past the list");
     const std::size_t count = std::size_t(list[k]);
-    g.connectivity.insert(g.connectivity.end(), list.begin() + std::ptrdiff_t(k + 1), list.begin() + std::ptrdiff_t(k + 1 + count));
+    g.connectivity.insert(g.connectivity.end(), list.begin() + std::ptrdiff_t(k + 1),
+                          list.begin() + std::ptrdiff_t(k + 1 + count));
     g.offsets.push_back(std::int64_t(g.connectivity.size()));
     k += 1 + count;
   }
-  if (k != list.size()) r.fail("CELLS: size " + std::to_string(b) + " does not match the cells listed");
+  if (k != list.size())
+    r.fail("CELLS: size " + std::to_string(b) + " does not match the cells listed");
 }
 
 /// The attribute arrays of a POINT_DATA or CELL_DATA section of `n` tuples, up to the next
 /// section keyword (returned in `next`, empty at the end of the file).
-std::vector<RawArray> read_attributes(LegacyReader& r, std::int64_t n, std::vector<std::string>& next) {
+std::vector<RawArray> read_attributes(LegacyReader& r, std::int64_t n,
+                                      std::vector<std::string>& next) {
   std::vector<RawArray> out;
   while (!r.at_end()) {
     const auto w = r.words();
@@ -196,8 +213,7 @@ std::vector<RawArray> read_attributes(LegacyReader& r, std::int64_t n, std::vect
       return out;
     }
     if (key == "METADATA") {  // VTK 9: INFORMATION blocks up to an empty line
-      while (!r.at_end() && !r.line().empty()) {
-      }
+      while (!r.at_end() && !r.line().empty()) {}
       continue;
     }
     if (key == "SCALARS") {
@@ -207,7 +223,8 @@ std::vector<RawArray> read_attributes(LegacyReader& r, std::int64_t n, std::vect
       a.ncomp = w.size() > 3 ? int(count_of(r, w[3], "SCALARS")) : 1;
       const LegacyType t = type_of(r, w[2], "SCALARS " + a.name);
       const auto lut = r.words();
-      if (lut.empty() || lut[0] != "LOOKUP_TABLE") r.fail("SCALARS " + a.name + ": expected LOOKUP_TABLE");
+      if (lut.empty() || lut[0] != "LOOKUP_TABLE")
+        r.fail("SCALARS " + a.name + ": expected LOOKUP_TABLE");
       a.v = r.values(n * a.ncomp, t, "SCALARS " + a.name);
       out.push_back(std::move(a));
     } else if (key == "VECTORS" || key == "NORMALS" || key == "TENSORS") {
@@ -221,7 +238,8 @@ std::vector<RawArray> read_attributes(LegacyReader& r, std::int64_t n, std::vect
       const std::int64_t arrays = w.size() > 2 ? count_of(r, w[2], "FIELD") : 0;
       for (std::int64_t i = 0; i < arrays; ++i) {
         const auto h = r.words();
-        if (h.size() < 4) r.fail("FIELD array #" + std::to_string(i) + ": expected 'name components tuples type'");
+        if (h.size() < 4)
+          r.fail("FIELD array #" + std::to_string(i) + ": expected 'name components tuples type'");
         RawArray a;
         a.name = h[0];
         a.ncomp = int(count_of(r, h[1], "FIELD " + a.name));
@@ -231,7 +249,8 @@ std::vector<RawArray> read_attributes(LegacyReader& r, std::int64_t n, std::vect
         out.push_back(std::move(a));
       }
     } else {
-      r.fail("attribute '" + key + "' is not supported (SCALARS, VECTORS, NORMALS, TENSORS, FIELD are)");
+      r.fail("attribute '" + key +
+             "' is not supported (SCALARS, VECTORS, NORMALS, TENSORS, FIELD are)");
     }
   }
   next.clear();
@@ -242,15 +261,19 @@ std::vector<RawArray> read_attributes(LegacyReader& r, std::int64_t n, std::vect
 void read_header(LegacyReader& r) {
   const std::string first = r.line();
   const std::string tag = "# vtk DataFile Version ";
-  if (first.compare(0, tag.size(), tag) != 0) r.fail("not a legacy VTK file (no '# vtk DataFile Version' line)");
+  if (first.compare(0, tag.size(), tag) != 0)
+    r.fail("not a legacy VTK file (no '# vtk DataFile Version' line)");
   r.version_major = std::atoi(first.c_str() + tag.size());
   r.line();  // title
   const std::string mode = r.line();
-  if (mode == "BINARY") r.binary = true;
-  else if (mode != "ASCII") r.fail("third line must be ASCII or BINARY, found '" + mode + "'");
+  if (mode == "BINARY")
+    r.binary = true;
+  else if (mode != "ASCII")
+    r.fail("third line must be ASCII or BINARY, found '" + mode + "'");
   const auto ds = r.words();
   if (ds.size() < 2 || ds[0] != "DATASET") r.fail("expected a DATASET line");
-  if (ds[1] != "UNSTRUCTURED_GRID") r.fail("DATASET " + ds[1] + " is not an unstructured grid of tetrahedra");
+  if (ds[1] != "UNSTRUCTURED_GRID")
+    r.fail("DATASET " + ds[1] + " is not an unstructured grid of tetrahedra");
 }
 
 }  // namespace
@@ -258,9 +281,11 @@ void read_header(LegacyReader& r) {
 TetMesh read_vtk_legacy(const std::string& path, std::vector<DataArray>* point_data,
                         std::vector<DataArray>* cell_data) {
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) detail::FileError{"read_vtk", path}.fail("no such file");
+  if (!std::filesystem::is_regular_file(path, ec))
+    detail::FileError{"read_vtk", path}.fail("no such file");
   std::ifstream in(path, std::ios::binary);
-  LegacyReader r(path, std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()));
+  LegacyReader r(
+      path, std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()));
   read_header(r);
   detail::RawGrid g;
   bool have_points = false, have_types = false;
@@ -289,13 +314,14 @@ TetMesh read_vtk_legacy(const std::string& path, std::vector<DataArray>* point_d
       continue;
     } else if (key == "FIELD") {  // dataset-level field data: frame and provenance if present
       for (RawArray& a : read_attributes(r, 0, next))
-        if (a.name == "disc_frame") g.disc_frame = a;
-        else if (a.name == "source") g.source = a;
+        if (a.name == "disc_frame")
+          g.disc_frame = a;
+        else if (a.name == "source")
+          g.source = a;
       w = next;
       continue;
     } else if (key == "METADATA") {
-      while (!r.at_end() && !r.line().empty()) {
-      }
+      while (!r.at_end() && !r.line().empty()) {}
     } else {
       r.fail("unexpected section '" + key + "'");
     }
@@ -311,7 +337,8 @@ TetMesh read_tet_mesh(const std::string& path, std::vector<DataArray>* point_dat
   std::ifstream in(path, std::ios::binary);
   char head[23] = {};
   in.read(head, sizeof head);
-  if (in.gcount() == std::streamsize(sizeof head) && std::string(head, sizeof head) == "# vtk DataFile Version ")
+  if (in.gcount() == std::streamsize(sizeof head) &&
+      std::string(head, sizeof head) == "# vtk DataFile Version ")
     return read_vtk_legacy(path, point_data, cell_data);
   return read_vtu(path, point_data, cell_data);
 }

@@ -2,9 +2,9 @@
 #include "spinesim/mesh/io.hpp"
 
 #include "spinesim/common/atomic_file.hpp"
-#include "xml_escape.hpp"
 #include "vtk_grid.hpp"
 #include "write_checks.hpp"
+#include "xml_escape.hpp"
 
 #include <lzma.h>
 #include <tinyxml2.h>
@@ -44,7 +44,8 @@ void base64_encode(const std::vector<unsigned char>& in, std::ostream& os) {
   out.reserve((in.size() + 2) / 3 * 4);
   std::size_t i = 0;
   for (; i + 3 <= in.size(); i += 3) {
-    const std::uint32_t w = (std::uint32_t(in[i]) << 16) | (std::uint32_t(in[i + 1]) << 8) | in[i + 2];
+    const std::uint32_t w =
+        (std::uint32_t(in[i]) << 16) | (std::uint32_t(in[i + 1]) << 8) | in[i + 2];
     out += kB64[(w >> 18) & 63];
     out += kB64[(w >> 12) & 63];
     out += kB64[(w >> 6) & 63];
@@ -110,7 +111,6 @@ bool base64_decode(const char* s, std::size_t n, std::vector<unsigned char>& out
 // ------------------------------------------------------------------------------------------
 // Writing
 
-
 template <class T>
 void write_ascii_value(std::ostream& os, T v) {
   char buf[64];
@@ -136,8 +136,10 @@ void write_data_array(std::ostream& os, const char* vtk_type, const std::string&
     const std::size_t per_line = ncomp > 1 && ncomp <= 12 ? std::size_t(ncomp) : 6;
     for (std::size_t i = 0; i < data.size(); ++i) {
       if (i > 0) {
-        if (i % per_line == 0) os << "\n" << indent << "  ";
-        else os << ' ';
+        if (i % per_line == 0)
+          os << "\n" << indent << "  ";
+        else
+          os << ' ';
       }
       write_ascii_value(os, data[i]);
     }
@@ -199,9 +201,12 @@ struct VtkType {
 };
 
 bool vtk_type(const std::string& t, VtkType& out) {
-  static const struct { const char* name; VtkType type; } table[] = {
-      {"Int8", {1, 'i'}},    {"UInt8", {1, 'u'}},   {"Int16", {2, 'i'}},   {"UInt16", {2, 'u'}},
-      {"Int32", {4, 'i'}},   {"UInt32", {4, 'u'}},  {"Int64", {8, 'i'}},   {"UInt64", {8, 'u'}},
+  static const struct {
+    const char* name;
+    VtkType type;
+  } table[] = {
+      {"Int8", {1, 'i'}},    {"UInt8", {1, 'u'}},   {"Int16", {2, 'i'}},  {"UInt16", {2, 'u'}},
+      {"Int32", {4, 'i'}},   {"UInt32", {4, 'u'}},  {"Int64", {8, 'i'}},  {"UInt64", {8, 'u'}},
       {"Float32", {4, 'f'}}, {"Float64", {8, 'f'}}, {"String", {1, 'u'}}, {"Char", {1, 'i'}},
   };
   for (const auto& e : table)
@@ -229,18 +234,50 @@ double decode_value(const unsigned char* p, VtkType t, bool swap) {
       }
     case 'i': {
       std::int64_t v = 0;
-      if (t.size == 1) { std::int8_t x; std::memcpy(&x, b, 1); v = x; }
-      if (t.size == 2) { std::int16_t x; std::memcpy(&x, b, 2); v = x; }
-      if (t.size == 4) { std::int32_t x; std::memcpy(&x, b, 4); v = x; }
-      if (t.size == 8) { std::int64_t x; std::memcpy(&x, b, 8); v = x; }
+      if (t.size == 1) {
+        std::int8_t x;
+        std::memcpy(&x, b, 1);
+        v = x;
+      }
+      if (t.size == 2) {
+        std::int16_t x;
+        std::memcpy(&x, b, 2);
+        v = x;
+      }
+      if (t.size == 4) {
+        std::int32_t x;
+        std::memcpy(&x, b, 4);
+        v = x;
+      }
+      if (t.size == 8) {
+        std::int64_t x;
+        std::memcpy(&x, b, 8);
+        v = x;
+      }
       return double(v);
     }
     default: {
       std::uint64_t v = 0;
-      if (t.size == 1) { std::uint8_t x; std::memcpy(&x, b, 1); v = x; }
-      if (t.size == 2) { std::uint16_t x; std::memcpy(&x, b, 2); v = x; }
-      if (t.size == 4) { std::uint32_t x; std::memcpy(&x, b, 4); v = x; }
-      if (t.size == 8) { std::uint64_t x; std::memcpy(&x, b, 8); v = x; }
+      if (t.size == 1) {
+        std::uint8_t x;
+        std::memcpy(&x, b, 1);
+        v = x;
+      }
+      if (t.size == 2) {
+        std::uint16_t x;
+        std::memcpy(&x, b, 2);
+        v = x;
+      }
+      if (t.size == 4) {
+        std::uint32_t x;
+        std::memcpy(&x, b, 4);
+        v = x;
+      }
+      if (t.size == 8) {
+        std::uint64_t x;
+        std::memcpy(&x, b, 8);
+        v = x;
+      }
       return double(v);
     }
   }
@@ -256,10 +293,12 @@ std::vector<double> parse_ascii(const Reader& r, const std::string& name, const 
     if (*s == '+') ++s;
     double x;
     const auto res = std::from_chars(s, end, x);
-    if (res.ec != std::errc() || (res.ptr < end && !std::isspace(static_cast<unsigned char>(*res.ptr))))
-    {
+    if (res.ec != std::errc() ||
+        (res.ptr < end && !std::isspace(static_cast<unsigned char>(*res.ptr)))) {
       const char* tok_end = s;
-      while (tok_end < end && tok_end - s < 24 && !std::isspace(static_cast<unsigned char>(*tok_end))) ++tok_end;
+      while (tok_end < end && tok_end - s < 24 &&
+             !std::isspace(static_cast<unsigned char>(*tok_end)))
+        ++tok_end;
       r.fail("DataArray '" + name + "' has a value that is not a number: \"" +
              std::string(s, tok_end) + "\"");
     }
@@ -278,8 +317,8 @@ std::uint64_t header_value(const Reader& r, const unsigned char* p) {
 }
 
 /// Decompresses one block of `csize` bytes at `src` into exactly `usize` bytes at `dst`.
-void inflate_block(const Reader& r, const std::string& name, const unsigned char* src, std::uint64_t csize,
-                   unsigned char* dst, std::uint64_t usize) {
+void inflate_block(const Reader& r, const std::string& name, const unsigned char* src,
+                   std::uint64_t csize, unsigned char* dst, std::uint64_t usize) {
   bool ok = false;
   if (r.compressor == Compressor::zlib) {
     uLongf dlen = uLongf(usize);
@@ -294,14 +333,16 @@ void inflate_block(const Reader& r, const std::string& name, const unsigned char
       lzma_end(&z);
     }
   }
-  if (!ok) r.fail("DataArray '" + name + "' has a compressed block that does not decompress to its " +
-                  std::to_string(usize) + " bytes (corrupt data)");
+  if (!ok)
+    r.fail("DataArray '" + name + "' has a compressed block that does not decompress to its " +
+           std::to_string(usize) + " bytes (corrupt data)");
 }
 
 /// The payload of one binary array stored at `p` (`n` bytes available): VTK's header — the byte
 /// count, or with a compressor [#blocks, block size, last block size, compressed sizes…], each
 /// of header_type — then the data, decompressed.
-std::vector<unsigned char> read_block(const Reader& r, const std::string& name, const unsigned char* p, std::size_t n) {
+std::vector<unsigned char> read_block(const Reader& r, const std::string& name,
+                                      const unsigned char* p, std::size_t n) {
   const std::size_t hb = std::size_t(r.header_bytes);
   const auto truncated = [&](const std::string& what) {
     r.fail("DataArray '" + name + "' binary data is truncated (" + what + ")");
@@ -310,15 +351,18 @@ std::vector<unsigned char> read_block(const Reader& r, const std::string& name, 
     if (n < hb) truncated("no block header");
     const std::uint64_t nbytes = header_value(r, p);
     if (n - hb < nbytes)
-      truncated("header says " + std::to_string(nbytes) + " bytes, found " + std::to_string(n - hb));
+      truncated("header says " + std::to_string(nbytes) + " bytes, found " +
+                std::to_string(n - hb));
     return std::vector<unsigned char>(p + hb, p + hb + nbytes);
   }
   if (n < 3 * hb) truncated("no compression header");
-  const std::uint64_t nblocks = header_value(r, p), block = header_value(r, p + hb), last = header_value(r, p + 2 * hb);
-  if (nblocks > n / hb - 3) truncated("the compression header counts " + std::to_string(nblocks) + " blocks");
+  const std::uint64_t nblocks = header_value(r, p), block = header_value(r, p + hb),
+                      last = header_value(r, p + 2 * hb);
+  if (nblocks > n / hb - 3)
+    truncated("the compression header counts " + std::to_string(nblocks) + " blocks");
   if (nblocks > 0 && (block == 0 || last > block))
-    r.fail("DataArray '" + name + "' has an inconsistent compression header (block size " + std::to_string(block) +
-           ", last block " + std::to_string(last) + ")");
+    r.fail("DataArray '" + name + "' has an inconsistent compression header (block size " +
+           std::to_string(block) + ", last block " + std::to_string(last) + ")");
   const std::uint64_t total = nblocks == 0 ? 0 : (nblocks - 1) * block + (last > 0 ? last : block);
   if (block > kMaxArrayBytes || total > kMaxArrayBytes)
     r.fail("DataArray '" + name + "' announces " + std::to_string(total) +
@@ -336,29 +380,34 @@ std::vector<unsigned char> read_block(const Reader& r, const std::string& name, 
   return out;
 }
 
-std::vector<double> to_values(const Reader& r, const std::string& name, const std::vector<unsigned char>& bytes,
-                              VtkType t) {
+std::vector<double> to_values(const Reader& r, const std::string& name,
+                              const std::vector<unsigned char>& bytes, VtkType t) {
   if (bytes.size() % std::size_t(t.size) != 0)
     r.fail("DataArray '" + name + "' byte count " + std::to_string(bytes.size()) +
            " is not a multiple of the value size");
   std::vector<double> v(bytes.size() / std::size_t(t.size));
-  for (std::size_t i = 0; i < v.size(); ++i) v[i] = decode_value(bytes.data() + i * std::size_t(t.size), t, r.swap_bytes);
+  for (std::size_t i = 0; i < v.size(); ++i)
+    v[i] = decode_value(bytes.data() + i * std::size_t(t.size), t, r.swap_bytes);
   return v;
 }
 
-std::vector<unsigned char> decode_base64(const Reader& r, const std::string& name, const char* text, std::size_t n) {
+std::vector<unsigned char> decode_base64(const Reader& r, const std::string& name, const char* text,
+                                         std::size_t n) {
   std::vector<unsigned char> bytes;
-  if (!text || !base64_decode(text, n, bytes)) r.fail("DataArray '" + name + "' has invalid or truncated base64 data");
+  if (!text || !base64_decode(text, n, bytes))
+    r.fail("DataArray '" + name + "' has invalid or truncated base64 data");
   return bytes;
 }
 
 /// An array in <AppendedData> at `offset` (bytes into the raw data, or characters into the
 /// base64 text, after the '_' marker).
-std::vector<unsigned char> appended_block(const Reader& r, const std::string& name, std::int64_t offset) {
-  if (!r.has_appended) r.fail("DataArray '" + name + "' is appended but the file has no <AppendedData>");
+std::vector<unsigned char> appended_block(const Reader& r, const std::string& name,
+                                          std::int64_t offset) {
+  if (!r.has_appended)
+    r.fail("DataArray '" + name + "' is appended but the file has no <AppendedData>");
   if (offset < 0 || std::size_t(offset) >= r.appended.size())
-    r.fail("DataArray '" + name + "' offset " + std::to_string(offset) + " is outside the appended data (" +
-           std::to_string(r.appended.size()) + " bytes)");
+    r.fail("DataArray '" + name + "' offset " + std::to_string(offset) +
+           " is outside the appended data (" + std::to_string(r.appended.size()) + " bytes)");
   if (!r.appended_base64) {
     const auto* p = reinterpret_cast<const unsigned char*>(r.appended.data()) + offset;
     return read_block(r, name, p, r.appended.size() - std::size_t(offset));
@@ -405,14 +454,16 @@ RawArray read_array(const Reader& r, const tinyxml2::XMLElement* da) {
 std::vector<RawArray> read_arrays(const Reader& r, const tinyxml2::XMLElement* parent) {
   std::vector<RawArray> out;
   if (!parent) return out;
-  for (auto* da = parent->FirstChildElement("DataArray"); da; da = da->NextSiblingElement("DataArray"))
+  for (auto* da = parent->FirstChildElement("DataArray"); da;
+       da = da->NextSiblingElement("DataArray"))
     out.push_back(read_array(r, da));
   return out;
 }
 
 const tinyxml2::XMLElement* find_named(const tinyxml2::XMLElement* parent, const char* name) {
   if (!parent) return nullptr;
-  for (auto* da = parent->FirstChildElement("DataArray"); da; da = da->NextSiblingElement("DataArray")) {
+  for (auto* da = parent->FirstChildElement("DataArray"); da;
+       da = da->NextSiblingElement("DataArray")) {
     const char* n = da->Attribute("Name");
     if (n && std::strcmp(n, name) == 0) return da;
   }
@@ -430,11 +481,13 @@ std::string split_appended(Reader& r, std::string text) {
     r.fail("<AppendedData> is not closed (truncated file?)");
   const std::string tag = text.substr(open, tag_end - open);
   const std::size_t enc = tag.find("encoding=\"");
-  const std::string encoding = enc == std::string::npos ? "raw" : tag.substr(enc + 10, tag.find('"', enc + 10) - enc - 10);
+  const std::string encoding =
+      enc == std::string::npos ? "raw" : tag.substr(enc + 10, tag.find('"', enc + 10) - enc - 10);
   if (encoding != "raw" && encoding != "base64")
     r.fail("<AppendedData> has unknown encoding '" + encoding + "' (raw or base64)");
   const std::size_t marker = text.find('_', tag_end);
-  if (marker == std::string::npos || marker > close) r.fail("<AppendedData> has no '_' marker before its data");
+  if (marker == std::string::npos || marker > close)
+    r.fail("<AppendedData> has no '_' marker before its data");
   r.has_appended = true;
   r.appended_base64 = encoding == "base64";
   r.appended = text.substr(marker + 1, close - marker - 1);
@@ -447,8 +500,10 @@ void read_envelope(Reader& r, const tinyxml2::XMLElement* root) {
   if (!ftype || std::strcmp(ftype, "UnstructuredGrid") != 0)
     r.fail(std::string("not an UnstructuredGrid (VTKFile type=\"") + (ftype ? ftype : "") + "\")");
   if (const char* comp = root->Attribute("compressor")) {
-    if (std::strcmp(comp, "vtkZLibDataCompressor") == 0) r.compressor = Compressor::zlib;
-    else if (std::strcmp(comp, "vtkLZMADataCompressor") == 0) r.compressor = Compressor::lzma;
+    if (std::strcmp(comp, "vtkZLibDataCompressor") == 0)
+      r.compressor = Compressor::zlib;
+    else if (std::strcmp(comp, "vtkLZMADataCompressor") == 0)
+      r.compressor = Compressor::lzma;
     else
       r.fail(std::string("data compressed with ") + comp +
              ", which is not supported; re-save it with zlib or LZMA compression, or uncompressed "
@@ -458,9 +513,12 @@ void read_envelope(Reader& r, const tinyxml2::XMLElement* root) {
   const bool file_little = !order || std::strcmp(order, "BigEndian") != 0;
   r.swap_bytes = file_little != host_is_little_endian();
   if (const char* ht = root->Attribute("header_type")) {
-    if (std::strcmp(ht, "UInt32") == 0) r.header_bytes = 4;
-    else if (std::strcmp(ht, "UInt64") == 0) r.header_bytes = 8;
-    else r.fail(std::string("unsupported header_type \"") + ht + "\"");
+    if (std::strcmp(ht, "UInt32") == 0)
+      r.header_bytes = 4;
+    else if (std::strcmp(ht, "UInt64") == 0)
+      r.header_bytes = 8;
+    else
+      r.fail(std::string("unsupported header_type \"") + ht + "\"");
   }
 }
 
@@ -468,7 +526,8 @@ void read_envelope(Reader& r, const tinyxml2::XMLElement* root) {
 void collect_offsets(Reader& r, const tinyxml2::XMLElement* e) {
   for (const auto* c = e->FirstChildElement(); c; c = c->NextSiblingElement()) {
     std::int64_t off = 0;
-    if (std::strcmp(c->Name(), "DataArray") == 0 && c->QueryInt64Attribute("offset", &off) == tinyxml2::XML_SUCCESS)
+    if (std::strcmp(c->Name(), "DataArray") == 0 &&
+        c->QueryInt64Attribute("offset", &off) == tinyxml2::XML_SUCCESS)
       r.appended_offsets.push_back(off);
     collect_offsets(r, c);
   }
@@ -518,7 +577,8 @@ void write_vtu(const std::string& path, const TetMesh& m, const std::vector<Data
     if (!source.empty())
       write_data_array(os, "UInt8", "source", 1, source, VtuEncoding::ascii, "      ");
     os << "    </FieldData>\n"
-       << "    <Piece NumberOfPoints=\"" << m.num_vertices() << "\" NumberOfCells=\"" << nt << "\">\n"
+       << "    <Piece NumberOfPoints=\"" << m.num_vertices() << "\" NumberOfCells=\"" << nt
+       << "\">\n"
        << "      <PointData Scalars=\"surface\">\n";
     const char* in = "        ";
     write_data_array(os, "Int32", "surface", 1, surface, enc, in);
@@ -567,7 +627,8 @@ TetMesh read_vtu(const std::string& path, std::vector<DataArray>* point_data,
     r.fail("not a readable XML file (" + err + ")");
   }
   const XMLElement* root = doc.RootElement();
-  if (!root || std::strcmp(root->Name(), "VTKFile") != 0) r.fail("not a VTK XML file (no <VTKFile>)");
+  if (!root || std::strcmp(root->Name(), "VTKFile") != 0)
+    r.fail("not a VTK XML file (no <VTKFile>)");
   read_envelope(r, root);
   collect_offsets(r, root);
   std::sort(r.appended_offsets.begin(), r.appended_offsets.end());
@@ -575,15 +636,19 @@ TetMesh read_vtu(const std::string& path, std::vector<DataArray>* point_data,
   if (!grid) r.fail("no <UnstructuredGrid> element");
   const XMLElement* piece = grid->FirstChildElement("Piece");
   if (!piece) r.fail("no <Piece> element");
-  if (piece->NextSiblingElement("Piece")) r.fail("has more than one Piece; merge them into one first");
+  if (piece->NextSiblingElement("Piece"))
+    r.fail("has more than one Piece; merge them into one first");
 
   // 2. The grid's arrays, decoded.
   detail::RawGrid g;
-  if (piece->QueryInt64Attribute("NumberOfPoints", &g.num_points) != tinyxml2::XML_SUCCESS || g.num_points < 0)
+  if (piece->QueryInt64Attribute("NumberOfPoints", &g.num_points) != tinyxml2::XML_SUCCESS ||
+      g.num_points < 0)
     r.fail("Piece has no valid NumberOfPoints");
-  if (piece->QueryInt64Attribute("NumberOfCells", &g.num_cells) != tinyxml2::XML_SUCCESS || g.num_cells < 0)
+  if (piece->QueryInt64Attribute("NumberOfCells", &g.num_cells) != tinyxml2::XML_SUCCESS ||
+      g.num_cells < 0)
     r.fail("Piece has no valid NumberOfCells");
-  if (g.num_points == 0 || g.num_cells == 0) r.fail("mesh is empty (NumberOfPoints or NumberOfCells is 0)");
+  if (g.num_points == 0 || g.num_cells == 0)
+    r.fail("mesh is empty (NumberOfPoints or NumberOfCells is 0)");
   const XMLElement* points_el = piece->FirstChildElement("Points");
   const XMLElement* pda = points_el ? points_el->FirstChildElement("DataArray") : nullptr;
   if (!pda) r.fail("no <Points> DataArray");
@@ -602,7 +667,8 @@ TetMesh read_vtu(const std::string& path, std::vector<DataArray>* point_data,
   g.types = cell_array("types", 255);
   g.point_data = read_arrays(r, piece->FirstChildElement("PointData"));
   g.cell_data = read_arrays(r, piece->FirstChildElement("CellData"));
-  const XMLElement* field = grid->FirstChildElement("FieldData");  // other field arrays are not decoded
+  const XMLElement* field =
+      grid->FirstChildElement("FieldData");  // other field arrays are not decoded
   if (const XMLElement* da = find_named(field, "disc_frame")) g.disc_frame = read_array(r, da);
   if (const XMLElement* da = find_named(field, "source")) g.source = read_array(r, da);
 

@@ -30,8 +30,7 @@ IsotropicMaterial parse_one(const nlohmann::json& j, const std::string& what) {
   if (!j.contains("E_mpa")) throw std::invalid_argument(what + ": missing 'E_mpa'");
   m.youngs_modulus_mpa = number("E_mpa");
   const bool has_nu = j.contains("nu"), has_g = j.contains("G_mpa");
-  if (has_nu == has_g)
-    throw std::invalid_argument(what + ": give exactly one of 'nu' and 'G_mpa'");
+  if (has_nu == has_g) throw std::invalid_argument(what + ": give exactly one of 'nu' and 'G_mpa'");
   if (has_nu) {
     m.poisson_ratio = number("nu");
   } else {
@@ -41,8 +40,8 @@ IsotropicMaterial parse_one(const nlohmann::json& j, const std::string& what) {
     // An (E, G) pair is trusted only when it implies an ordinary isotropic solid: thesis
     // table 5.1 gives rubber E 30 / G 0.6 (nu = 24) and polyethylene E 200 / G 117 (nu < 0).
     if (!(nu >= 0.0 && nu < 0.5))
-      throw std::invalid_argument(what + ": E_mpa = " + fmt(m.youngs_modulus_mpa) + " and G_mpa = " +
-                                  fmt(g) + " imply nu = E/(2G) - 1 = " + fmt(nu) +
+      throw std::invalid_argument(what + ": E_mpa = " + fmt(m.youngs_modulus_mpa) +
+                                  " and G_mpa = " + fmt(g) + " imply nu = E/(2G) - 1 = " + fmt(nu) +
                                   ", outside [0, 0.5) of an isotropic solid; give E_mpa and nu");
     m.poisson_ratio = nu;
   }
@@ -57,10 +56,13 @@ void validate(const IsotropicMaterial& m, const std::string& what) {
   const double e = m.youngs_modulus_mpa, nu = m.poisson_ratio, rho = m.density_kg_m3;
   if (!std::isfinite(e) || !std::isfinite(nu) || !std::isfinite(rho))
     throw std::invalid_argument(what + ": non-finite material constant");
-  if (!(e > 0)) throw std::invalid_argument(what + ": Young's modulus must be > 0 MPa (got " + fmt(e) + ")");
+  if (!(e > 0))
+    throw std::invalid_argument(what + ": Young's modulus must be > 0 MPa (got " + fmt(e) + ")");
   if (!(nu > -1.0 && nu < 0.5))
-    throw std::invalid_argument(what + ": Poisson's ratio must lie in (-1, 0.5) (got " + fmt(nu) + ")");
-  if (!(rho > 0)) throw std::invalid_argument(what + ": density must be > 0 kg/m^3 (got " + fmt(rho) + ")");
+    throw std::invalid_argument(what + ": Poisson's ratio must lie in (-1, 0.5) (got " + fmt(nu) +
+                                ")");
+  if (!(rho > 0))
+    throw std::invalid_argument(what + ": density must be > 0 kg/m^3 (got " + fmt(rho) + ")");
 }
 
 RegionMaterials material_from_json(const nlohmann::json& j) {
@@ -71,9 +73,12 @@ RegionMaterials material_from_json(const nlohmann::json& j) {
   try {
     if (per_region) {
       if (!j.contains("annulus") || !j.contains("nucleus"))
-        throw std::invalid_argument("material '" + r.name + "': per-region files need both 'annulus' and 'nucleus'");
-      r.by_region[int(Region::annulus)] = parse_one(j.at("annulus"), "material '" + r.name + "' annulus");
-      r.by_region[int(Region::nucleus)] = parse_one(j.at("nucleus"), "material '" + r.name + "' nucleus");
+        throw std::invalid_argument("material '" + r.name +
+                                    "': per-region files need both 'annulus' and 'nucleus'");
+      r.by_region[int(Region::annulus)] =
+          parse_one(j.at("annulus"), "material '" + r.name + "' annulus");
+      r.by_region[int(Region::nucleus)] =
+          parse_one(j.at("nucleus"), "material '" + r.name + "' nucleus");
       r.fallback = r.by_region[int(Region::annulus)];
     } else {
       r.fallback = parse_one(j, "material '" + r.name + "'");
@@ -93,8 +98,10 @@ RegionMaterials load_material(const std::string& name_or_path, const std::string
       std::string known;
       if (fs::is_directory(fs::path(data_dir) / "materials"))
         for (const auto& e : fs::directory_iterator(fs::path(data_dir) / "materials"))
-          if (e.path().extension() == ".json") known += (known.empty() ? "" : ", ") + e.path().stem().string();
-      throw std::invalid_argument("unknown material '" + name_or_path + "' (no such file; presets: " + known + ")");
+          if (e.path().extension() == ".json")
+            known += (known.empty() ? "" : ", ") + e.path().stem().string();
+      throw std::invalid_argument("unknown material '" + name_or_path +
+                                  "' (no such file; presets: " + known + ")");
     }
     path = preset;
   }

@@ -13,16 +13,16 @@
 #include <CGAL/Mesh_criteria_3.h>
 #include <CGAL/Mesh_domain_with_polyline_features_3.h>
 #include <CGAL/Mesh_triangulation_3.h>
-#include <CGAL/make_mesh_3.h>
 #include <CGAL/Random.h>
+#include <CGAL/make_mesh_3.h>
 
 #include <Eigen/Geometry>
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <functional>
 #include <memory>
-#include <cmath>
 #include <stdexcept>
 #include <unordered_map>
 #include <vector>
@@ -75,7 +75,8 @@ TetMesh to_tet_mesh(const C3t3& c3t3, const LabeledBody& body) {
       Eigen::Vector3d n = (p1 - p0).cross(p2 - p0);
       if (n.dot(centroid - opposite) < 0) n = -n;
       n.normalize();
-      const Surface s = body.classify_facet ? body.classify_facet(centroid, n) : Surface::outer_wall;
+      const Surface s =
+          body.classify_facet ? body.classify_facet(centroid, n) : Surface::outer_wall;
       boundary.push_back({f, s});
     }
   }
@@ -96,10 +97,14 @@ TetMesh to_tet_mesh(const C3t3& c3t3, const LabeledBody& body) {
   // rim nodes carry the endplate label (docs/units-and-frame.md).
   auto priority = [](int s) {
     switch (Surface(s)) {
-      case Surface::superior_endplate: return 3;
-      case Surface::inferior_endplate: return 2;
-      case Surface::outer_wall: return 1;
-      default: return 0;
+      case Surface::superior_endplate:
+        return 3;
+      case Surface::inferior_endplate:
+        return 2;
+      case Surface::outer_wall:
+        return 1;
+      default:
+        return 0;
     }
   };
   m.surface = Eigen::VectorXi::Zero(m.V.rows());
@@ -128,13 +133,15 @@ TetMesh mesh_labeled_body(const LabeledBody& body, const MeshOptions& opt) {
   for (int i = 0; i < 24 && !found; ++i)
     for (int j = 0; j < 24 && !found; ++j)
       for (int k = 0; k < 24 && !found; ++k) {
-        const Eigen::Vector3d q = body.center_mm + body.bounding_radius_mm *
-                                                       (Eigen::Vector3d(i, j, k) / 11.5 - Eigen::Vector3d::Ones());
+        const Eigen::Vector3d q =
+            body.center_mm +
+            body.bounding_radius_mm * (Eigen::Vector3d(i, j, k) / 11.5 - Eigen::Vector3d::Ones());
         found = body.label(q) > 0;
       }
   if (!found)
-    throw std::runtime_error("CGAL Mesh_3 cannot mesh " + body.name +
-                             ": the labelling function is 0 everywhere in its bounding sphere (no tetrahedra)");
+    throw std::runtime_error(
+        "CGAL Mesh_3 cannot mesh " + body.name +
+        ": the labelling function is 0 everywhere in its bounding sphere (no tetrahedra)");
 
   CGAL::Random rng(opt.seed);
   CGAL::get_default_random() = CGAL::Random(opt.seed);  // the perturber draws from it
@@ -159,11 +166,10 @@ TetMesh mesh_labeled_body(const LabeledBody& body, const MeshOptions& opt) {
 
   const double facet_size = opt.facet_size_mm > 0 ? opt.facet_size_mm : opt.cell_size_mm;
   const double edge_size = opt.edge_size_mm > 0 ? opt.edge_size_mm : opt.cell_size_mm;
-  const Criteria criteria(params::edge_size = edge_size, params::facet_angle = opt.facet_angle_deg,
-                          params::facet_size = facet_size,
-                          params::facet_distance = opt.facet_distance_mm,
-                          params::cell_radius_edge_ratio = opt.radius_edge_ratio,
-                          params::cell_size = opt.cell_size_mm);
+  const Criteria criteria(
+      params::edge_size = edge_size, params::facet_angle = opt.facet_angle_deg,
+      params::facet_size = facet_size, params::facet_distance = opt.facet_distance_mm,
+      params::cell_radius_edge_ratio = opt.radius_edge_ratio, params::cell_size = opt.cell_size_mm);
 
   C3t3 c3t3 = polylines.empty()
                   ? CGAL::make_mesh_3<C3t3>(domain, criteria, params::no_features(),
@@ -187,7 +193,8 @@ TetMesh mesh_parametric_disc(const DiscDimensions& dims, const MeshOptions& opt,
   };
   const double half_w = 0.5 * std::max(dims.lower_width_mm, dims.upper_width_mm);
   const double depth = std::max(dims.lower_depth_mm, dims.upper_depth_mm);
-  body.bounding_radius_mm = 1.1 * std::sqrt(half_w * half_w + depth * depth + 0.25 * dims.height_mm * dims.height_mm);
+  body.bounding_radius_mm =
+      1.1 * std::sqrt(half_w * half_w + depth * depth + 0.25 * dims.height_mm * dims.height_mm);
   body.exact_volume_mm3 = disc->volume_mm3();
   // Feature geometry is sampled much finer than the mesh; protection balls follow edge_size.
   const double cell = opt.cell_size_mm > 0 ? opt.cell_size_mm : 1.0;

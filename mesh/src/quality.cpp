@@ -73,8 +73,8 @@ QualityReport quality_report(const TetMesh& m, double exact_volume_mm3) {
   q.min_edge_mm = std::numeric_limits<double>::infinity();
   double ratio_sum = 0.0, edge_sum = 0.0;
   for (Eigen::Index t = 0; t < m.num_tets(); ++t) {
-    const Eigen::Vector3d a = m.V.row(m.T(t, 0)), b = m.V.row(m.T(t, 1)),
-                          c = m.V.row(m.T(t, 2)), d = m.V.row(m.T(t, 3));
+    const Eigen::Vector3d a = m.V.row(m.T(t, 0)), b = m.V.row(m.T(t, 1)), c = m.V.row(m.T(t, 2)),
+                          d = m.V.row(m.T(t, 3));
     for (double ang : dihedral_angles_deg(a, b, c, d)) {
       q.min_dihedral_deg = std::min(q.min_dihedral_deg, ang);
       q.max_dihedral_deg = std::max(q.max_dihedral_deg, ang);

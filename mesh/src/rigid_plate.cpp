@@ -16,10 +16,13 @@ PlateMap plate_map(const Eigen::Vector3d& r) {
 }
 
 namespace {
-bool on_plate(const TetMesh& m, Eigen::Index i) { return m.surface(i) == int(Surface::superior_endplate); }
+bool on_plate(const TetMesh& m, Eigen::Index i) {
+  return m.surface(i) == int(Surface::superior_endplate);
+}
 }  // namespace
 
-double plate_rms_displacement(const TetMesh& m, const Eigen::Vector3d& c, const Eigen::Matrix<double, 6, 1>& q) {
+double plate_rms_displacement(const TetMesh& m, const Eigen::Vector3d& c,
+                              const Eigen::Matrix<double, 6, 1>& q) {
   double sum = 0;
   Eigen::Index n = 0;
   for (Eigen::Index i = 0; i < m.num_vertices(); ++i)

@@ -27,7 +27,9 @@ struct SectionNumbering {
   int ring_node(int k, int i) const { return 1 + (k - 1) * sectors + (i % sectors); }
 };
 
-double cross2(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
+double cross2(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  return a.x() * b.y() - a.y() * b.x();
+}
 
 // `sectors` curve parameters θ_i of `o`, equally spaced in arc length, counter-clockwise from
 // the posterior midpoint θ = -π/2 (the bottom of the notch). Arc length from a 4096-chord
@@ -38,7 +40,8 @@ std::vector<double> equal_arc_angles(const KidneyOutline& o, int sectors) {
   constexpr int kChords = 4096;
   std::vector<double> arc(kChords + 1, 0.0);
   auto theta = [&](double k) { return -0.5 * kPi + 2 * kPi * k / kChords; };
-  for (int k = 0; k < kChords; ++k) arc[k + 1] = arc[k] + (o.point(theta(k + 1)) - o.point(theta(k))).norm();
+  for (int k = 0; k < kChords; ++k)
+    arc[k + 1] = arc[k] + (o.point(theta(k + 1)) - o.point(theta(k))).norm();
   std::vector<double> angles(static_cast<std::size_t>(sectors));
   for (int i = 0; i < sectors; ++i) {
     const double target = arc.back() * i / sectors;
@@ -51,9 +54,10 @@ std::vector<double> equal_arc_angles(const KidneyOutline& o, int sectors) {
 
 // (x, z) of every node of one layer's cross-section at height y, mm: the centroid, then the
 // rings (outline points at `angles`, scaled by s · area_factor about the centroid).
-std::vector<Eigen::Vector2d> section_points(const ParametricDisc& disc, double y_mm, const SectionNumbering& num,
-                                            const std::vector<double>& scales, const std::vector<double>& angles,
-                                            bool match_area) {
+std::vector<Eigen::Vector2d> section_points(const ParametricDisc& disc, double y_mm,
+                                            const SectionNumbering& num,
+                                            const std::vector<double>& scales,
+                                            const std::vector<double>& angles, bool match_area) {
   const KidneyOutline o = disc.outline_at(y_mm);
   const Eigen::Vector2d c = o.centroid_mm();
   std::vector<Eigen::Vector2d> rim;
@@ -61,7 +65,8 @@ std::vector<Eigen::Vector2d> section_points(const ParametricDisc& disc, double y
   double factor = 1.0;
   if (match_area) {  // stretch the rim polygon about the centroid to the outline's exact area
     double twice_area = 0;
-    for (std::size_t i = 0; i < rim.size(); ++i) twice_area += cross2(rim[i], rim[(i + 1) % rim.size()]);
+    for (std::size_t i = 0; i < rim.size(); ++i)
+      twice_area += cross2(rim[i], rim[(i + 1) % rim.size()]);
     factor = std::sqrt(2 * o.area_mm2() / twice_area);
   }
   std::vector<Eigen::Vector2d> p;
@@ -104,9 +109,10 @@ void check_section(const std::vector<SectionTriangle>& tris, const std::vector<E
   for (const auto& t : tris) {
     const double a2 = cross2(p[t.v[1]] - p[t.v[0]], p[t.v[2]] - p[t.v[0]]);
     if (!(a2 > 1e-9 * scale2))
-      throw std::runtime_error("structured disc " + level +
-                               ": degenerate or folded cross-section triangle (outline not star-shaped "
-                               "about its centroid at this resolution)");
+      throw std::runtime_error(
+          "structured disc " + level +
+          ": degenerate or folded cross-section triangle (outline not star-shaped "
+          "about its centroid at this resolution)");
   }
 }
 
@@ -119,18 +125,23 @@ double signed_volume6(const Eigen::MatrixX3d& V, const std::array<int, 4>& t) {
 
 void validate(const StructuredDiscOptions& opt) {
   if (opt.sectors < 6 || opt.rings < 2 || opt.layers < 1)
-    throw std::invalid_argument("structured disc: need sectors >= 6, rings >= 2 (rim and nucleus boundary), "
-                                "layers >= 1 (got " + std::to_string(opt.sectors) + ", " +
-                                std::to_string(opt.rings) + ", " + std::to_string(opt.layers) + ")");
+    throw std::invalid_argument(
+        "structured disc: need sectors >= 6, rings >= 2 (rim and nucleus boundary), "
+        "layers >= 1 (got " +
+        std::to_string(opt.sectors) + ", " + std::to_string(opt.rings) + ", " +
+        std::to_string(opt.layers) + ")");
 }
 
 std::vector<double> structured_ring_scales(int rings) {
-  if (rings < 2) throw std::invalid_argument("structured disc: need rings >= 2 (got " + std::to_string(rings) + ")");
+  if (rings < 2)
+    throw std::invalid_argument("structured disc: need rings >= 2 (got " + std::to_string(rings) +
+                                ")");
   const double sn = std::sqrt(kNucleusAreaFraction);
   const int nn = std::clamp(int(std::lround(rings * sn)), 1, rings - 1);
   const int na = rings - nn;
   std::vector<double> s;
-  for (int k = 1; k <= nn; ++k) s.push_back(k == nn ? sn : sn * std::sqrt(double(k) / nn));  // equal areas
+  for (int k = 1; k <= nn; ++k)
+    s.push_back(k == nn ? sn : sn * std::sqrt(double(k) / nn));  // equal areas
   for (int k = 1; k <= na; ++k) s.push_back(k == na ? 1.0 : sn + (1.0 - sn) * k / na);
   return s;
 }
@@ -140,16 +151,17 @@ TetMesh mesh_structured_disc(const DiscDimensions& dims, const StructuredDiscOpt
   validate(opt);
   const ParametricDisc disc(dims);
   const std::vector<double> scales = structured_ring_scales(opt.rings);
-  const int nucleus_rings = int(std::count_if(scales.begin(), scales.end(), [](double s) {
-    return s <= std::sqrt(kNucleusAreaFraction);
-  }));
+  const int nucleus_rings = int(std::count_if(
+      scales.begin(), scales.end(), [](double s) { return s <= std::sqrt(kNucleusAreaFraction); }));
   const SectionNumbering num{opt.sectors, opt.rings};
   const int n = num.per_layer();
   const double h = dims.height_mm;
   // One set of curve parameters for every layer: each section is then the same polygon
   // stretched in x and z about the centroid, so triangles keep their orientation.
   const std::vector<double> angles = equal_arc_angles(disc.outline_at(0.0), opt.sectors);
-  auto section = [&](double y) { return section_points(disc, y, num, scales, angles, opt.match_area); };
+  auto section = [&](double y) {
+    return section_points(disc, y, num, scales, angles, opt.match_area);
+  };
 
   // 1. Nodes, layer by layer (global index = layer · n + layer-local index).
   TetMesh m;
@@ -187,8 +199,9 @@ TetMesh mesh_structured_disc(const DiscDimensions& dims, const StructuredDiscOpt
       std::sort(s.begin(), s.end());
       const int a = l * n + s[0], b = l * n + s[1], c = l * n + s[2];
       const int a1 = a + n, b1 = b + n, c1 = c + n;
-      for (std::array<int, 4> tet : {std::array<int, 4>{a, b, c, c1}, std::array<int, 4>{a, b, b1, c1},
-                                     std::array<int, 4>{a, a1, b1, c1}}) {
+      for (std::array<int, 4> tet :
+           {std::array<int, 4>{a, b, c, c1}, std::array<int, 4>{a, b, b1, c1},
+            std::array<int, 4>{a, a1, b1, c1}}) {
         if (signed_volume6(m.V, tet) < 0) std::swap(tet[2], tet[3]);
         assert(signed_volume6(m.V, tet) > 0);
         m.T.row(t) << tet[0], tet[1], tet[2], tet[3];
@@ -197,7 +210,8 @@ TetMesh mesh_structured_disc(const DiscDimensions& dims, const StructuredDiscOpt
     }
   }
   m.source = "structured disc " + dims.level + " (" + std::to_string(opt.sectors) + " sectors, " +
-             std::to_string(opt.rings) + " rings, " + std::to_string(opt.layers) + " layers" + (opt.match_area ? ", area-matched)" : ")");
+             std::to_string(opt.rings) + " rings, " + std::to_string(opt.layers) + " layers" +
+             (opt.match_area ? ", area-matched)" : ")");
 
   // 4. Placement: x' = origin + axes x (as mesh_parametric_disc).
   m.V = (m.V * placement.axes.transpose()).rowwise() + placement.origin_mm.transpose();

@@ -9,8 +9,8 @@
 namespace spinesim::mesh {
 
 double tet_volume(const TetMesh& m, Eigen::Index t) {
-  const Eigen::Vector3d a = m.V.row(m.T(t, 0)), b = m.V.row(m.T(t, 1)),
-                        c = m.V.row(m.T(t, 2)), d = m.V.row(m.T(t, 3));
+  const Eigen::Vector3d a = m.V.row(m.T(t, 0)), b = m.V.row(m.T(t, 1)), c = m.V.row(m.T(t, 2)),
+                        d = m.V.row(m.T(t, 3));
   return (b - a).dot((c - a).cross(d - a)) / 6.0;
 }
 

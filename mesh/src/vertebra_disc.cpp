@@ -39,9 +39,11 @@ void check_surface(const TriSurface& s, const char* which) {
   if (s.V.rows() == 0 || s.F.rows() == 0)
     throw std::invalid_argument(std::string(which) + " vertebra surface is empty (no triangles)");
   if (!s.V.allFinite())
-    throw std::invalid_argument(std::string(which) + " vertebra surface has non-finite coordinates");
+    throw std::invalid_argument(std::string(which) +
+                                " vertebra surface has non-finite coordinates");
   if (s.F.minCoeff() < 0 || s.F.maxCoeff() >= s.V.rows())
-    throw std::invalid_argument(std::string(which) + " vertebra surface has a vertex index out of range");
+    throw std::invalid_argument(std::string(which) +
+                                " vertebra surface has a vertex index out of range");
 }
 
 // Area-weighted centroid of the triangles, mm.
@@ -88,9 +90,11 @@ struct RayTarget {
     if (!hit) return {kNaN, 0.0};
     const std::size_t id = std::size_t(hit->second - tris.begin());
     double y = kNaN;
-    if (const K::Point_3* p = boost::get<K::Point_3>(&hit->first)) y = p->y();
+    if (const K::Point_3* p = boost::get<K::Point_3>(&hit->first))
+      y = p->y();
     else if (const K::Segment_3* sg = boost::get<K::Segment_3>(&hit->first))
-      y = dir_y < 0 ? std::max(sg->source().y(), sg->target().y()) : std::min(sg->source().y(), sg->target().y());
+      y = dir_y < 0 ? std::max(sg->source().y(), sg->target().y())
+                    : std::min(sg->source().y(), sg->target().y());
     return {y, abs_cos[id]};
   }
 };
@@ -192,9 +196,12 @@ class DiscBetween {
  private:
   // The steps of the constructor, in order.
   void set_frame(const TriSurface& inf, const TriSurface& sup);
-  std::vector<char> height_fields(const TriSurface& inf, const TriSurface& sup, const VertebraDiscOptions& opt);
-  std::vector<char> facing_region(const std::vector<char>& facing, const VertebraDiscOptions& opt, Eigen::Vector2d& c0);
-  void set_outline(const std::vector<char>& mask, const Eigen::Vector2d& c0, const VertebraDiscOptions& opt);
+  std::vector<char> height_fields(const TriSurface& inf, const TriSurface& sup,
+                                  const VertebraDiscOptions& opt);
+  std::vector<char> facing_region(const std::vector<char>& facing, const VertebraDiscOptions& opt,
+                                  Eigen::Vector2d& c0);
+  void set_outline(const std::vector<char>& mask, const Eigen::Vector2d& c0,
+                   const VertebraDiscOptions& opt);
   void measure();
   // Bilinear interpolation of a grid field; NaN when a corner is missing or q is off the grid.
   double height(const std::vector<double>& f, const Eigen::Vector2d& q) const {
@@ -220,11 +227,14 @@ class DiscBetween {
   VertebraDiscInfo info_;
 };
 
-DiscBetween::DiscBetween(const TriSurface& inf, const TriSurface& sup, const VertebraDiscOptions& opt) {
+DiscBetween::DiscBetween(const TriSurface& inf, const TriSurface& sup,
+                         const VertebraDiscOptions& opt) {
   check_surface(inf, "inferior");
   check_surface(sup, "superior");
-  if (!(opt.grid_step_mm > 0) || !(opt.max_gap_mm > 0) || !(opt.facing_angle_deg > 0 && opt.facing_angle_deg < 90) ||
-      !(opt.nucleus_area_fraction > 0 && opt.nucleus_area_fraction < 1) || opt.outline_harmonics < 1)
+  if (!(opt.grid_step_mm > 0) || !(opt.max_gap_mm > 0) ||
+      !(opt.facing_angle_deg > 0 && opt.facing_angle_deg < 90) ||
+      !(opt.nucleus_area_fraction > 0 && opt.nucleus_area_fraction < 1) ||
+      opt.outline_harmonics < 1)
     throw std::invalid_argument("vertebra disc options out of range");
 
   set_frame(inf, sup);
@@ -242,12 +252,14 @@ void DiscBetween::set_frame(const TriSurface& inf, const TriSurface& sup) {
   const Eigen::Vector3d d = c_sup - c_inf;
   if (d.norm() < 1.0)
     throw std::invalid_argument("the vertebrae do not face each other: their centroids coincide (" +
-                                fmt(d.norm()) + " mm apart; the same vertebra twice, or the wrong --units?)");
+                                fmt(d.norm()) +
+                                " mm apart; the same vertebra twice, or the wrong --units?)");
   const Eigen::Vector3d y = d.normalized();
   if (y.y() < std::cos(60.0 * kPi / 180.0))
     throw std::invalid_argument(
         "the vertebrae do not face each other: the superior vertebra is not above the inferior one "
-        "(centroid direction " + fmt(y.x()) + ", " + fmt(y.y()) + ", " + fmt(y.z()) +
+        "(centroid direction " +
+        fmt(y.x()) + ", " + fmt(y.y()) + ", " + fmt(y.z()) +
         "; swapped order or wrong --up axis?)");
   Eigen::Vector3d x = Eigen::Vector3d::UnitX() - y.x() * y;
   x.normalize();
@@ -255,12 +267,12 @@ void DiscBetween::set_frame(const TriSurface& inf, const TriSurface& sup) {
   axes_.col(1) = y;
   axes_.col(2) = x.cross(y);
   origin_ = 0.5 * (c_inf + c_sup);
-
 }
 
 // 2. Height fields over the overlap of the two projections; returns the grid nodes where both
 //    endplates face each other with a gap in (0, max_gap].
-std::vector<char> DiscBetween::height_fields(const TriSurface& inf, const TriSurface& sup, const VertebraDiscOptions& opt) {
+std::vector<char> DiscBetween::height_fields(const TriSurface& inf, const TriSurface& sup,
+                                             const VertebraDiscOptions& opt) {
   const RayTarget lower(inf, origin_, axes_), upper(sup, origin_, axes_);
   auto extent = [&](const TriSurface& s, int col, double& lo, double& hi) {
     const Eigen::VectorXd t = (s.V.rowwise() - origin_.transpose()) * axes_.col(col);
@@ -275,7 +287,8 @@ std::vector<char> DiscBetween::height_fields(const TriSurface& inf, const TriSur
   const double ulo = std::max(ul1, ul2), uhi = std::min(uh1, uh2);
   const double vlo = std::max(vl1, vl2), vhi = std::min(vh1, vh2);
   if (!(uhi - ulo > 2 * opt.grid_step_mm && vhi - vlo > 2 * opt.grid_step_mm))
-    throw std::invalid_argument("the vertebrae do not face each other: their footprints along the axis do not overlap");
+    throw std::invalid_argument(
+        "the vertebrae do not face each other: their footprints along the axis do not overlap");
   step_ = opt.grid_step_mm;
   u0_ = ulo;
   v0_ = vlo;
@@ -299,17 +312,19 @@ std::vector<char> DiscBetween::height_fields(const TriSurface& inf, const TriSur
       if (hi - lo > 0 && hi - lo <= opt.max_gap_mm) facing[idx(i, j)] = 1;
     }
   if (both_facing == 0)
-    throw std::invalid_argument("the vertebrae do not face each other: no upward-facing part of the inferior "
-                                "surface lies below a downward-facing part of the superior one");
+    throw std::invalid_argument(
+        "the vertebrae do not face each other: no upward-facing part of the inferior "
+        "surface lies below a downward-facing part of the superior one");
   if (gap_positive == 0)
-    throw std::invalid_argument("the vertebrae do not face each other: the endplates overlap (gap <= 0 mm everywhere)");
+    throw std::invalid_argument(
+        "the vertebrae do not face each other: the endplates overlap (gap <= 0 mm everywhere)");
 
   return facing;
 }
 
 // 3. Largest 4-connected facing component, holes filled; c0 its centroid.
-std::vector<char> DiscBetween::facing_region(const std::vector<char>& facing, const VertebraDiscOptions& opt,
-                                             Eigen::Vector2d& c0) {
+std::vector<char> DiscBetween::facing_region(const std::vector<char>& facing,
+                                             const VertebraDiscOptions& opt, Eigen::Vector2d& c0) {
   std::vector<int> comp(facing.size(), -1);
   int best = -1;
   std::size_t best_size = 0;
@@ -333,50 +348,67 @@ std::vector<char> DiscBetween::facing_region(const std::vector<char>& facing, co
             stack.push_back({n[0], n[1]});
           }
       }
-      if (size > best_size) { best_size = size; best = id; }
+      if (size > best_size) {
+        best_size = size;
+        best = id;
+      }
     }
   if (best < 0 || double(best_size) * step_ * step_ < 50.0)
-    throw std::invalid_argument("the vertebrae do not face each other: no facing endplates with a gap in (0, " +
-                                fmt(opt.max_gap_mm) + "] mm (gap absurd or no overlap)");
+    throw std::invalid_argument(
+        "the vertebrae do not face each other: no facing endplates with a gap in (0, " +
+        fmt(opt.max_gap_mm) + "] mm (gap absurd or no overlap)");
   std::vector<char> mask(facing.size(), 0), outside(facing.size(), 0);
   for (std::size_t k = 0; k < mask.size(); ++k) mask[k] = comp[k] == best;
   stack.clear();  // flood the complement from the grid border; what it misses are holes
-  for (int i = 0; i < nu_; ++i) for (int j : {0, nv_ - 1}) stack.push_back({i, j});
-  for (int j = 0; j < nv_; ++j) for (int i : {0, nu_ - 1}) stack.push_back({i, j});
+  for (int i = 0; i < nu_; ++i)
+    for (int j : {0, nv_ - 1}) stack.push_back({i, j});
+  for (int j = 0; j < nv_; ++j)
+    for (int i : {0, nu_ - 1}) stack.push_back({i, j});
   while (!stack.empty()) {
     const auto [i, j] = stack.back();
     stack.pop_back();
     if (i < 0 || j < 0 || i >= nu_ || j >= nv_ || mask[idx(i, j)] || outside[idx(i, j)]) continue;
     outside[idx(i, j)] = 1;
-    stack.push_back({i + 1, j}); stack.push_back({i - 1, j});
-    stack.push_back({i, j + 1}); stack.push_back({i, j - 1});
+    stack.push_back({i + 1, j});
+    stack.push_back({i - 1, j});
+    stack.push_back({i, j + 1});
+    stack.push_back({i, j - 1});
   }
   c0 = Eigen::Vector2d::Zero();
   std::size_t count = 0;
   for (int j = 0; j < nv_; ++j)
     for (int i = 0; i < nu_; ++i)
-      if (!outside[idx(i, j)]) { mask[idx(i, j)] = 1; c0 += Eigen::Vector2d(u0_ + i * step_, v0_ + j * step_); ++count; }
+      if (!outside[idx(i, j)]) {
+        mask[idx(i, j)] = 1;
+        c0 += Eigen::Vector2d(u0_ + i * step_, v0_ + j * step_);
+        ++count;
+      }
   c0 /= double(count);
   auto in_mask = [&](const Eigen::Vector2d& q) {
-    const int i = int(std::lround((q.x() - u0_) / step_)), j = int(std::lround((q.y() - v0_) / step_));
+    const int i = int(std::lround((q.x() - u0_) / step_)),
+              j = int(std::lround((q.y() - v0_) / step_));
     return i >= 0 && j >= 0 && i < nu_ && j < nv_ && mask[idx(i, j)];
   };
   if (!in_mask(c0))
-    throw std::invalid_argument("the facing endplate region is not star-shaped about its centre; cannot build a disc");
+    throw std::invalid_argument(
+        "the facing endplate region is not star-shaped about its centre; cannot build a disc");
 
   return mask;
 }
 
 // 4. Smoothed polar outline, moved rim_margin inwards; the nucleus scale.
-void DiscBetween::set_outline(const std::vector<char>& mask, const Eigen::Vector2d& c0, const VertebraDiscOptions& opt) {
+void DiscBetween::set_outline(const std::vector<char>& mask, const Eigen::Vector2d& c0,
+                              const VertebraDiscOptions& opt) {
   auto in_mask = [&](const Eigen::Vector2d& q) {
-    const int i = int(std::lround((q.x() - u0_) / step_)), j = int(std::lround((q.y() - v0_) / step_));
+    const int i = int(std::lround((q.x() - u0_) / step_)),
+              j = int(std::lround((q.y() - v0_) / step_));
     return i >= 0 && j >= 0 && i < nu_ && j < nv_ && mask[idx(i, j)];
   };
   const std::size_t n_dir = 1024;
   std::vector<double> r_exit(n_dir);
   for (std::size_t k = 0; k < n_dir; ++k) {
-    const Eigen::Vector2d dir(std::cos(2 * kPi * double(k) / n_dir), std::sin(2 * kPi * double(k) / n_dir));
+    const Eigen::Vector2d dir(std::cos(2 * kPi * double(k) / n_dir),
+                              std::sin(2 * kPi * double(k) / n_dir));
     double r = 0;
     while (in_mask(c0 + (r + 0.25 * step_) * dir)) r += 0.25 * step_;
     r_exit[k] = r;
@@ -386,13 +418,14 @@ void DiscBetween::set_outline(const std::vector<char>& mask, const Eigen::Vector
   r_smooth = low_pass(r_smooth, opt.outline_harmonics);
   for (double& r : r_smooth) {
     r -= opt.rim_margin_mm;
-    if (!(r > 2.0)) throw std::invalid_argument("the facing endplate region is too small or too irregular for a disc");
+    if (!(r > 2.0))
+      throw std::invalid_argument(
+          "the facing endplate region is too small or too irregular for a disc");
   }
   outline_.c0 = c0;
   outline_.R = r_smooth;
   nucleus_center_ = outline_.centroid();
   nucleus_scale_ = std::sqrt(opt.nucleus_area_fraction);
-
 }
 
 // 5. Report: area, heights, volume (midpoint rule on a half-step grid), extents, frame.
@@ -421,12 +454,16 @@ void DiscBetween::measure() {
       y_hi = std::max(y_hi, hi);
     }
   if (!(info_.min_height_mm > 0))
-    throw std::invalid_argument("the vertebrae do not face each other: the endplates touch or overlap inside the footprint (gap " +
-                                fmt(info_.min_height_mm) + " mm)");
+    throw std::invalid_argument(
+        "the vertebrae do not face each other: the endplates touch or overlap inside the footprint "
+        "(gap " +
+        fmt(info_.min_height_mm) + " mm)");
   for (std::size_t k = 0; k < n_dir; ++k) {
     const Eigen::Vector2d p = outline_.point(double(k) * outline_.angle_step());
-    x_lo = std::min(x_lo, p.x()); x_hi = std::max(x_hi, p.x());
-    z_lo = std::min(z_lo, p.y()); z_hi = std::max(z_hi, p.y());
+    x_lo = std::min(x_lo, p.x());
+    x_hi = std::max(x_hi, p.x());
+    z_lo = std::min(z_lo, p.y());
+    z_hi = std::max(z_hi, p.y());
   }
   info_.width_mm = x_hi - x_lo;
   info_.depth_mm = z_hi - z_lo;
@@ -442,13 +479,16 @@ std::vector<std::vector<Eigen::Vector3d>> DiscBetween::feature_polylines(double 
   std::vector<std::vector<Eigen::Vector3d>> lines;
   double perimeter = 0;
   for (std::size_t k = 0; k < outline_.R.size(); ++k)
-    perimeter += (outline_.point(double(k + 1) * outline_.angle_step()) - outline_.point(double(k) * outline_.angle_step())).norm();
+    perimeter += (outline_.point(double(k + 1) * outline_.angle_step()) -
+                  outline_.point(double(k) * outline_.angle_step()))
+                     .norm();
   const int n = std::max(64, int(std::ceil(perimeter / std::max(spacing_mm, 1e-3))));
   for (double scale : {1.0, nucleus_scale_})
     for (const std::vector<double>* field : {&s_inf_, &s_sup_}) {
       std::vector<Eigen::Vector3d> line;
       for (int k = 0; k < n; ++k) {
-        const Eigen::Vector2d q = nucleus_center_ + scale * (outline_.point(2 * kPi * k / n) - nucleus_center_);
+        const Eigen::Vector2d q =
+            nucleus_center_ + scale * (outline_.point(2 * kPi * k / n) - nucleus_center_);
         line.emplace_back(q.x(), height(*field, q), q.y());
       }
       line.push_back(line.front());
@@ -459,12 +499,14 @@ std::vector<std::vector<Eigen::Vector3d>> DiscBetween::feature_polylines(double 
 
 }  // namespace
 
-VertebraDiscInfo analyse_vertebra_pair(const TriSurface& inferior_vertebra, const TriSurface& superior_vertebra,
+VertebraDiscInfo analyse_vertebra_pair(const TriSurface& inferior_vertebra,
+                                       const TriSurface& superior_vertebra,
                                        const VertebraDiscOptions& opt) {
   return DiscBetween(inferior_vertebra, superior_vertebra, opt).info();
 }
 
-TetMesh mesh_disc_between_vertebrae(const TriSurface& inferior_vertebra, const TriSurface& superior_vertebra,
+TetMesh mesh_disc_between_vertebrae(const TriSurface& inferior_vertebra,
+                                    const TriSurface& superior_vertebra,
                                     const MeshOptions& mesh_opt, const VertebraDiscOptions& opt,
                                     VertebraDiscInfo* info) {
   const auto disc = std::make_shared<const DiscBetween>(inferior_vertebra, superior_vertebra, opt);

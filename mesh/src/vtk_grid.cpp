@@ -14,16 +14,26 @@ constexpr int kVtkQuadraticTetra = 24;
 
 std::string cell_type_name(std::int64_t type) {
   switch (type) {
-    case 1: return "vertex (1)";
-    case 3: return "line (3)";
-    case 5: return "triangle (5)";
-    case 9: return "quad (9)";
-    case 12: return "hexahedron (12)";
-    case 13: return "wedge (13)";
-    case 14: return "pyramid (14)";
-    case 22: return "quadratic triangle (22)";
-    case 25: return "quadratic hexahedron (25)";
-    default: return "VTK type " + std::to_string(type);
+    case 1:
+      return "vertex (1)";
+    case 3:
+      return "line (3)";
+    case 5:
+      return "triangle (5)";
+    case 9:
+      return "quad (9)";
+    case 12:
+      return "hexahedron (12)";
+    case 13:
+      return "wedge (13)";
+    case 14:
+      return "pyramid (14)";
+    case 22:
+      return "quadratic triangle (22)";
+    case 25:
+      return "quadratic hexahedron (25)";
+    default:
+      return "VTK type " + std::to_string(type);
   }
 }
 
@@ -58,19 +68,22 @@ void split_section(const FileError& e, const std::vector<RawArray>& arrays, cons
 bool read_cells(const FileError& e, const RawGrid& g, TetMesh& m) {
   const std::int64_t nc = g.num_cells;
   if (std::int64_t(g.offsets.size()) != nc || std::int64_t(g.types.size()) != nc)
-    e.fail("Cells offsets/types have " + std::to_string(g.offsets.size()) + "/" + std::to_string(g.types.size()) +
-           " entries, NumberOfCells says " + std::to_string(nc));
+    e.fail("Cells offsets/types have " + std::to_string(g.offsets.size()) + "/" +
+           std::to_string(g.types.size()) + " entries, NumberOfCells says " + std::to_string(nc));
   for (std::int64_t v : g.connectivity)
     if (v < 0 || v >= g.num_points)
-      e.fail("connectivity refers to point " + std::to_string(v) + ", the file has " + std::to_string(g.num_points));
+      e.fail("connectivity refers to point " + std::to_string(v) + ", the file has " +
+             std::to_string(g.num_points));
   bool any_quadratic = false;
   m.T.resize(nc, 4);
   std::int64_t start = 0;
   for (std::int64_t c = 0; c < nc; ++c) {
     const std::int64_t type = g.types[std::size_t(c)];
     std::int64_t want = 0;
-    if (type == kVtkTetra) want = 4;
-    else if (type == kVtkQuadraticTetra) want = 10, any_quadratic = true;
+    if (type == kVtkTetra)
+      want = 4;
+    else if (type == kVtkQuadraticTetra)
+      want = 10, any_quadratic = true;
     else
       e.fail("cell #" + std::to_string(c) + " is a " + cell_type_name(type) +
              "; only tetrahedra (VTK types 10 and 24) are supported");
@@ -81,8 +94,8 @@ bool read_cells(const FileError& e, const RawGrid& g, TetMesh& m) {
     start = end;
   }
   if (start != std::int64_t(g.connectivity.size()))
-    e.fail("connectivity has " + std::to_string(g.connectivity.size()) + " entries, the offsets use " +
-           std::to_string(start));
+    e.fail("connectivity has " + std::to_string(g.connectivity.size()) +
+           " entries, the offsets use " + std::to_string(start));
   return any_quadratic;
 }
 
@@ -143,8 +156,9 @@ std::vector<std::int64_t> as_integers(const FileError& e, const RawArray& a, dou
   for (std::size_t i = 0; i < a.v.size(); ++i) {
     const double x = a.v[i];
     if (!(x >= lo && x <= hi) || x != std::floor(x))
-      e.fail("'" + a.name + "' entry #" + std::to_string(i) + " = " + std::to_string(x) + " is not an integer in [" +
-             std::to_string(std::int64_t(lo)) + ", " + std::to_string(std::int64_t(hi)) + "]");
+      e.fail("'" + a.name + "' entry #" + std::to_string(i) + " = " + std::to_string(x) +
+             " is not an integer in [" + std::to_string(std::int64_t(lo)) + ", " +
+             std::to_string(std::int64_t(hi)) + "]");
     out[i] = std::int64_t(x);
   }
   return out;
@@ -155,7 +169,8 @@ TetMesh assemble_tet_mesh(const FileError& e, RawGrid g, std::vector<DataArray>*
   const std::int64_t np = g.num_points, nc = g.num_cells;
   if (np == 0 || nc == 0) e.fail("mesh is empty (NumberOfPoints or NumberOfCells is 0)");
   // 1. Points.
-  if (g.points.ncomp != 3) e.fail("Points must have 3 components, found " + std::to_string(g.points.ncomp));
+  if (g.points.ncomp != 3)
+    e.fail("Points must have 3 components, found " + std::to_string(g.points.ncomp));
   if (std::int64_t(g.points.v.size()) != 3 * np)
     e.fail("Points has " + std::to_string(g.points.v.size() / 3) + " points, NumberOfPoints says " +
            std::to_string(np));

@@ -30,10 +30,10 @@ struct RawArray {
 /// An unstructured grid as a file stores it.
 struct RawGrid {
   std::int64_t num_points = 0, num_cells = 0;
-  RawArray points;                             ///< 3 components
-  std::vector<std::int64_t> connectivity;      ///< point indices, cell after cell
-  std::vector<std::int64_t> offsets;           ///< #cells: end of each cell in `connectivity`
-  std::vector<std::int64_t> types;             ///< #cells: VTK cell types
+  RawArray points;                         ///< 3 components
+  std::vector<std::int64_t> connectivity;  ///< point indices, cell after cell
+  std::vector<std::int64_t> offsets;       ///< #cells: end of each cell in `connectivity`
+  std::vector<std::int64_t> types;         ///< #cells: VTK cell types
   std::vector<RawArray> point_data, cell_data;
   std::optional<RawArray> disc_frame, source;  ///< FieldData written by write_vtu
 };

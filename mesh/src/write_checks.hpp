@@ -13,7 +13,8 @@ namespace spinesim::mesh::detail {
 inline void check_mesh_for_writing(const TetMesh& m, const std::string& who) {
   if (m.num_vertices() == 0 || m.num_tets() == 0)
     throw std::invalid_argument(who + "mesh is empty (no vertices or no tetrahedra)");
-  if (!m.V.allFinite()) throw std::invalid_argument(who + "vertex coordinates contain non-finite values");
+  if (!m.V.allFinite())
+    throw std::invalid_argument(who + "vertex coordinates contain non-finite values");
   if (m.region.size() != m.num_tets())
     throw std::invalid_argument(who + "region labels: expected one per tetrahedron");
   if (m.surface.size() != m.num_vertices())

@@ -24,7 +24,8 @@ void require(bool ok, const std::string& message) {
 void validate_pose(const RigidPose& p, const std::string& what) {
   require(p.rotation.allFinite() && p.translation_mm.allFinite(),
           "boundary: " + what + " pose has non-finite entries");
-  const double orth = (p.rotation.transpose() * p.rotation - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+  const double orth =
+      (p.rotation.transpose() * p.rotation - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
   require(orth <= 1e-8 && p.rotation.determinant() > 0.0,
           "boundary: " + what + " rotation is not a proper orthonormal matrix (|R^T R - I| = " +
               std::to_string(orth) + ")");
@@ -74,7 +75,8 @@ Eigen::Vector3d default_plate_center(const mesh::TetMesh& m) {
       sum += m.V.row(i).transpose();
       ++n;
     }
-  require(n > 0, "boundary: mesh has no superior endplate nodes (surface = 2) for the plate centre");
+  require(n > 0,
+          "boundary: mesh has no superior endplate nodes (surface = 2) for the plate centre");
   return sum / double(n);
 }
 

@@ -90,8 +90,8 @@ double edge_spring(const Eigen::Vector3d& x0, const Eigen::Vector3d& x1, double 
   return energy;
 }
 
-double radial_springs(const TetPoints& x, double k_s_n_per_mm, double rest_sum_mm,
-                      Vector12d* grad, Matrix12d* hess, HessianMode mode) {
+double radial_springs(const TetPoints& x, double k_s_n_per_mm, double rest_sum_mm, Vector12d* grad,
+                      Matrix12d* hess, HessianMode mode) {
   const Eigen::Vector3d barycentre = 0.25 * x.rowwise().sum();
   TetPoints u;  // unit radial directions u_j, columns
   double r[4];  // radial lengths |x_j - x_B|, mm
@@ -158,7 +158,7 @@ namespace {
 // The angle at the apex and its gradient with respect to the two arms a, b (rad/mm).
 struct ArmAngle {
   double theta;
-  bool degenerate;  // an arm of zero length or collinear arms: direction undefined
+  bool degenerate;                   // an arm of zero length or collinear arms: direction undefined
   double dot, cross_norm, la2, lb2;  // a.b, |a x b|, |a|^2, |b|^2
   Eigen::Vector3d dtheta_da, dtheta_db;
 };
@@ -184,9 +184,9 @@ ArmAngle arm_angle(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
 
 }  // namespace
 
-double angle_spring(const Eigen::Vector3d& x0, const Eigen::Vector3d& x1,
-                    const Eigen::Vector3d& x2, double k_t_nmm_per_rad, double rest_angle_rad,
-                    Vector9d* grad, Matrix9d* hess, HessianMode mode) {
+double angle_spring(const Eigen::Vector3d& x0, const Eigen::Vector3d& x1, const Eigen::Vector3d& x2,
+                    double k_t_nmm_per_rad, double rest_angle_rad, Vector9d* grad, Matrix9d* hess,
+                    HessianMode mode) {
   const Eigen::Vector3d a = x1 - x0;
   const Eigen::Vector3d b = x2 - x0;
   if (!grad && !hess) {

@@ -10,7 +10,8 @@ double default_probe_stiffness(const MssModel& model, const Eigen::SparseMatrix<
   return 100.0 * H.diagonal().sum() / (2.0 * edges);
 }
 
-ExternalLoads::ExternalLoads(const Boundary& bc, double default_probe_k, const Eigen::VectorXi* surface)
+ExternalLoads::ExternalLoads(const Boundary& bc, double default_probe_k,
+                             const Eigen::VectorXi* surface)
     : probes_(bc.probes), surface_(surface) {
   for (Probe& p : probes_)
     if (p.stiffness_n_per_mm == 0.0) p.stiffness_n_per_mm = default_probe_k;
@@ -22,7 +23,8 @@ double ExternalLoads::energy(const Eigen::VectorXd& x) const {
   const Eigen::Index n = x.size() / 3;
   for (const Probe& p : probes_)
     for (Eigen::Index i = 0; i < n; ++i)
-      if (touchable(i)) e += probe_contact(x.segment<3>(3 * i), p.center_mm, p.radius_mm, p.stiffness_n_per_mm);
+      if (touchable(i))
+        e += probe_contact(x.segment<3>(3 * i), p.center_mm, p.radius_mm, p.stiffness_n_per_mm);
   if (forces_) e -= forces_->dot(x);
   return e;
 }
@@ -46,17 +48,19 @@ double ExternalLoads::add_gradient(const Eigen::VectorXd& x, Eigen::VectorXd& g)
   return e;
 }
 
-void ExternalLoads::add_hessian(const Eigen::VectorXd& x, HessianMode mode, const ReducedSpace& space,
-                                Eigen::SparseMatrix<double>& A) const {
+void ExternalLoads::add_hessian(const Eigen::VectorXd& x, HessianMode mode,
+                                const ReducedSpace& space, Eigen::SparseMatrix<double>& A) const {
   const Eigen::Index n = x.size() / 3;
   Eigen::Vector3d gi;
   Eigen::Matrix3d hi;
   for (const Probe& p : probes_) {
     const double r2 = p.radius_mm * p.radius_mm;
     for (Eigen::Index i = 0; i < n; ++i) {
-      if ((x.segment<3>(3 * i) - p.center_mm).squaredNorm() >= r2 || !space.is_unknown(int(i)) || !touchable(i))
+      if ((x.segment<3>(3 * i) - p.center_mm).squaredNorm() >= r2 || !space.is_unknown(int(i)) ||
+          !touchable(i))
         continue;
-      probe_contact(x.segment<3>(3 * i), p.center_mm, p.radius_mm, p.stiffness_n_per_mm, &gi, &hi, mode);
+      probe_contact(x.segment<3>(3 * i), p.center_mm, p.radius_mm, p.stiffness_n_per_mm, &gi, &hi,
+                    mode);
       space.add_node_block(int(i), hi, A);
     }
   }
@@ -68,7 +72,8 @@ void ExternalLoads::contact_nodes(const Eigen::VectorXd& x, std::vector<int>& no
   for (const Probe& p : probes_) {
     const double r2 = p.radius_mm * p.radius_mm;
     for (Eigen::Index i = 0; i < n; ++i)
-      if ((x.segment<3>(3 * i) - p.center_mm).squaredNorm() < r2 && touchable(i)) nodes.push_back(int(i));
+      if ((x.segment<3>(3 * i) - p.center_mm).squaredNorm() < r2 && touchable(i))
+        nodes.push_back(int(i));
   }
   std::sort(nodes.begin(), nodes.end());
   nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());

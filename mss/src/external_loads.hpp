@@ -16,14 +16,16 @@ namespace spinesim::mss::detail {
 
 /// 100 k̄, k̄ = trace(K_rest) / (2 #edge springs) (boundary.hpp, Probe::stiffness_n_per_mm),
 /// from the full rest Hessian of the model.
-double default_probe_stiffness(const MssModel& model, const Eigen::SparseMatrix<double>& rest_hessian);
+double default_probe_stiffness(const MssModel& model,
+                               const Eigen::SparseMatrix<double>& rest_hessian);
 
 class ExternalLoads {
  public:
   /// `default_probe_k`: used for probes whose stiffness is 0. `surface` (#nodes labels, may be
   /// null): probes touch only nodes with a non-zero surface label — contact is a surface effect,
   /// and a probe pressed deep must not grab interior nodes directly.
-  ExternalLoads(const Boundary& bc, double default_probe_k, const Eigen::VectorXi* surface = nullptr);
+  ExternalLoads(const Boundary& bc, double default_probe_k,
+                const Eigen::VectorXi* surface = nullptr);
   ExternalLoads() = default;  ///< no loads
 
   bool empty() const { return probes_.empty() && forces_ == nullptr; }
@@ -44,7 +46,7 @@ class ExternalLoads {
 
  private:
   std::vector<Probe> probes_;
-  const Eigen::VectorXd* forces_ = nullptr;  ///< points into the Boundary, or null
+  const Eigen::VectorXd* forces_ = nullptr;   ///< points into the Boundary, or null
   const Eigen::VectorXi* surface_ = nullptr;  ///< the mesh's surface labels, or null (all nodes)
 };
 

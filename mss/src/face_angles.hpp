@@ -59,9 +59,12 @@ inline double face_angle_springs(const double* x0, const double* x1, const doubl
   const double l01 = e01.squaredNorm(), l12 = e12.squaredNorm(), l20 = e20.squaredNorm();
   // Corner c: a = next edge out of x_c, b = minus the edge into x_c; d = a.b.
   const double d0 = -e01.dot(e20), d1 = -e12.dot(e01), d2 = -e20.dot(e12);
-  const double dt0 = small_angle_atan2(s * rest.cos0[0] - d0 * rest.sin0[0], d0 * rest.cos0[0] + s * rest.sin0[0]);
-  const double dt1 = small_angle_atan2(s * rest.cos0[1] - d1 * rest.sin0[1], d1 * rest.cos0[1] + s * rest.sin0[1]);
-  const double dt2 = small_angle_atan2(s * rest.cos0[2] - d2 * rest.sin0[2], d2 * rest.cos0[2] + s * rest.sin0[2]);
+  const double dt0 =
+      small_angle_atan2(s * rest.cos0[0] - d0 * rest.sin0[0], d0 * rest.cos0[0] + s * rest.sin0[0]);
+  const double dt1 =
+      small_angle_atan2(s * rest.cos0[1] - d1 * rest.sin0[1], d1 * rest.cos0[1] + s * rest.sin0[1]);
+  const double dt2 =
+      small_angle_atan2(s * rest.cos0[2] - d2 * rest.sin0[2], d2 * rest.cos0[2] + s * rest.sin0[2]);
   const double energy = 0.5 * k * (dt0 * dt0 + dt1 * dt1 + dt2 * dt2);
   if constexpr (with_gradient) {
     if (!(s > 0.0)) return energy;  // flat triangle: no direction to turn in (as angle_spring)
@@ -88,7 +91,8 @@ inline double face_angle_springs(const double* x0, const double* x1, const doubl
 /// kernel, and scatter-add the gradients. `Face` has v[3] and rest; k_of(face) its stiffness.
 /// Same energy and gradient as the scalar loop up to round-off (tests/mss/test_model.cpp).
 template <class Face, class KOf>
-double face_angle_springs_all(const std::vector<Face>& faces, KOf k_of, const double* x, double* g) {
+double face_angle_springs_all(const std::vector<Face>& faces, KOf k_of, const double* x,
+                              double* g) {
   constexpr int B = 8;
   double energy = 0.0;
   alignas(64) double P[9][B], C0[3][B], S0[3][B], K[B], E[B], G[9][B];
@@ -139,8 +143,8 @@ double face_angle_springs_all(const std::vector<Face>& faces, KOf k_of, const do
       const Face& face = faces[b + static_cast<std::size_t>(f)];
       if (!ok[f]) {  // outside the series range or a flat triangle: the scalar kernel
         double gs[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
-        E[f] = face_angle_springs<true>(x + 3 * face.v[0], x + 3 * face.v[1], x + 3 * face.v[2], K[f],
-                                        face.rest, gs, gs + 3, gs + 6);
+        E[f] = face_angle_springs<true>(x + 3 * face.v[0], x + 3 * face.v[1], x + 3 * face.v[2],
+                                        K[f], face.rest, gs, gs + 3, gs + 6);
         for (int r = 0; r < 9; ++r) G[r][f] = gs[r];
       }
       energy += E[f];

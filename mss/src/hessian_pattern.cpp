@@ -47,12 +47,11 @@ int HessianPattern::block(int p, int q) const {
 }
 
 void HessianPattern::reset(Eigen::SparseMatrix<double>& H) const {
-  const bool same = H.rows() == pattern_.rows() && H.cols() == pattern_.cols() &&
-                    H.isCompressed() && H.nonZeros() == pattern_.nonZeros() &&
-                    std::equal(H.outerIndexPtr(), H.outerIndexPtr() + H.cols() + 1,
-                               pattern_.outerIndexPtr()) &&
-                    std::equal(H.innerIndexPtr(), H.innerIndexPtr() + H.nonZeros(),
-                               pattern_.innerIndexPtr());
+  const bool same =
+      H.rows() == pattern_.rows() && H.cols() == pattern_.cols() && H.isCompressed() &&
+      H.nonZeros() == pattern_.nonZeros() &&
+      std::equal(H.outerIndexPtr(), H.outerIndexPtr() + H.cols() + 1, pattern_.outerIndexPtr()) &&
+      std::equal(H.innerIndexPtr(), H.innerIndexPtr() + H.nonZeros(), pattern_.innerIndexPtr());
   if (!same) H = pattern_;
   std::fill(H.valuePtr(), H.valuePtr() + H.nonZeros(), 0.0);
 }

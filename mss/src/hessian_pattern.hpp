@@ -37,9 +37,9 @@ class HessianPattern {
 
  private:
   Eigen::SparseMatrix<double> pattern_;
-  std::vector<int> stride_;        ///< nonzeros per column of node q (3 x its neighbour count)
-  std::vector<int> first_;         ///< CSR offsets of the sorted neighbour lists
-  std::vector<int> neighbours_;    ///< sorted neighbours of each node, itself included
+  std::vector<int> stride_;      ///< nonzeros per column of node q (3 x its neighbour count)
+  std::vector<int> first_;       ///< CSR offsets of the sorted neighbour lists
+  std::vector<int> neighbours_;  ///< sorted neighbours of each node, itself included
 };
 
 }  // namespace spinesim::mss

@@ -21,7 +21,9 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 
 /// Region label -> index into the per-region stiffness parts (0 annulus, 1 nucleus).
-int region_index(int region_label) { return region_label == static_cast<int>(mesh::Region::nucleus) ? 1 : 0; }
+int region_index(int region_label) {
+  return region_label == static_cast<int>(mesh::Region::nucleus) ? 1 : 0;
+}
 
 struct EdgeSpring {
   int i, j;
@@ -43,10 +45,10 @@ struct AngleFace {
 /// Per-tetrahedron terms (radial springs and volume penalty share the vertex set).
 struct TetTerm {
   int t;
-  int region;        ///< 0 annulus, 1 nucleus
-  double rest;       ///< S0 (mm) for radial springs, V0 (mm^3) for the volume term
-  double k_unscaled; ///< k_s N/mm or k_v N/mm^5
-  double k;          ///< scaled
+  int region;         ///< 0 annulus, 1 nucleus
+  double rest;        ///< S0 (mm) for radial springs, V0 (mm^3) for the volume term
+  double k_unscaled;  ///< k_s N/mm or k_v N/mm^5
+  double k;           ///< scaled
 };
 
 void require(bool ok, const std::string& message) {
@@ -56,9 +58,11 @@ void require(bool ok, const std::string& message) {
 /// The per-spring multipliers: none, or one finite positive value per edge spring.
 void validate_edge_multipliers(const std::vector<double>& mu, std::size_t num_edges) {
   require(mu.empty() || mu.size() == num_edges,
-          "mss: " + std::to_string(mu.size()) + " edge multipliers for " + std::to_string(num_edges) +
+          "mss: " + std::to_string(mu.size()) + " edge multipliers for " +
+              std::to_string(num_edges) +
               " edge springs (per-spring multipliers belong to the mesh they were made for)");
-  for (double v : mu) require(std::isfinite(v) && v > 0.0, "mss: edge multipliers must be finite and > 0");
+  for (double v : mu)
+    require(std::isfinite(v) && v > 0.0, "mss: edge multipliers must be finite and > 0");
 }
 
 void validate_options(const MssOptions& o) {
@@ -70,7 +74,8 @@ void validate_options(const MssOptions& o) {
           "mss: damping ratio must be finite and >= 0");
   require(std::isfinite(o.damping_n_s_per_mm), "mss: damping K_d must be finite");
   for (const auto& s : o.scales)
-    for (double v : s.by_region) require(positive(v), "mss: stiffness scales must be finite and > 0");
+    for (double v : s.by_region)
+      require(positive(v), "mss: stiffness scales must be finite and > 0");
 }
 
 TetPoints tet_points(const Eigen::VectorXd& x, const Eigen::MatrixX4i& T, int t) {
@@ -78,7 +83,6 @@ TetPoints tet_points(const Eigen::VectorXd& x, const Eigen::MatrixX4i& T, int t)
   for (int c = 0; c < 4; ++c) p.col(c) = x.segment<3>(3 * T(t, c));
   return p;
 }
-
 
 void check_size(const Eigen::VectorXd& x, Eigen::Index n) {
   if (x.size() != 3 * n)
@@ -105,9 +109,9 @@ struct KSelect {
 struct MssModel::Impl {
   mesh::TetMesh mesh;
   MssOptions options;
-  Eigen::VectorXd X;        // rest positions, 3n
-  Eigen::VectorXd mass_t;   // n
-  double damping = 0;       // K_d, N·s/mm
+  Eigen::VectorXd X;       // rest positions, 3n
+  Eigen::VectorXd mass_t;  // n
+  double damping = 0;      // K_d, N·s/mm
   EquivalentCylinder cylinder;
   double rest_volume = 0;
 
@@ -118,10 +122,10 @@ struct MssModel::Impl {
   bool disc_volume_on = false;
   double disc_k_unscaled = 0, disc_k = 0;  // k_g, N/mm^5
 
-  HessianPattern pattern;   // 3x3 node blocks of every node pair sharing a tet
-  std::vector<int> edge_slots;    // 4 per edge: block (a,b) offsets, a,b in {0,1}
-  std::vector<int> face_slots;    // 9 per face
-  std::vector<int> tet_slots;     // 16 per tetrahedron
+  HessianPattern pattern;       // 3x3 node blocks of every node pair sharing a tet
+  std::vector<int> edge_slots;  // 4 per edge: block (a,b) offsets, a,b in {0,1}
+  std::vector<int> face_slots;  // 9 per face
+  std::vector<int> tet_slots;   // 16 per tetrahedron
 
   void build(const mesh::RegionMaterials& materials);
   void apply_scales();
@@ -132,8 +136,9 @@ struct MssModel::Impl {
   void build_masses(const TetProps& tp);
   void build_edges(const TetProps& tp);
   std::vector<std::pair<std::array<int, 3>, std::vector<int>>> build_cylinder();
-  void build_angle_springs(const TetProps& tp,
-                           const std::vector<std::pair<std::array<int, 3>, std::vector<int>>>& unique_faces);
+  void build_angle_springs(
+      const TetProps& tp,
+      const std::vector<std::pair<std::array<int, 3>, std::vector<int>>>& unique_faces);
   void build_tet_terms(const TetProps& tp);
   void build_damping(const TetProps& tp);
   void build_slots();
@@ -153,7 +158,8 @@ struct MssModel::Impl::TetProps {
   std::vector<double> E, G, K, rho, V0;  ///< MPa, MPa, MPa, t/mm^3, mm^3
 };
 
-MssModel::Impl::TetProps MssModel::Impl::tet_properties(const mesh::RegionMaterials& materials) const {
+MssModel::Impl::TetProps MssModel::Impl::tet_properties(
+    const mesh::RegionMaterials& materials) const {
   const Eigen::Index nt = mesh.num_tets();
   TetProps tp;
   std::vector<double>&E = tp.E, &G = tp.G, &K = tp.K, &rho = tp.rho, &V0 = tp.V0;
@@ -180,7 +186,6 @@ void MssModel::Impl::build_masses(const TetProps& tp) {
   for (Eigen::Index i = 0; i < n; ++i)
     require(mass_t(i) > 0.0, "mss: node " + std::to_string(i) +
                                  " belongs to no tetrahedron (zero mass); remove unused vertices");
-
 }
 
 // 2. Main springs on the unique edges, Van Gelder (5.2): k = sum E_t V_t / L0^2.
@@ -207,7 +212,6 @@ void MssModel::Impl::build_edges(const TetProps& tp) {
       edges.push_back(sp);
     }
   }
-
 }
 
 // 3. Equivalent cylinder (5.6)-(5.7): endplate diameters from their areas projected on the
@@ -238,8 +242,7 @@ std::vector<std::pair<std::array<int, 3>, std::vector<int>>> MssModel::Impl::bui
       const int l0 = mesh.surface(v[0]), l1 = mesh.surface(v[1]), l2 = mesh.surface(v[2]);
       if (l0 == l1 && l1 == l2 && (l0 == 1 || l0 == 2)) {
         const Eigen::Vector3d p0 = X.segment<3>(3 * v[0]);
-        const Eigen::Vector3d n2 =
-            (X.segment<3>(3 * v[1]) - p0).cross(X.segment<3>(3 * v[2]) - p0);
+        const Eigen::Vector3d n2 = (X.segment<3>(3 * v[1]) - p0).cross(X.segment<3>(3 * v[2]) - p0);
         area_label[l0] += 0.5 * std::abs(n2.dot(axis));
       }
     }
@@ -255,8 +258,9 @@ std::vector<std::pair<std::array<int, 3>, std::vector<int>>> MssModel::Impl::bui
 
 // 4. Torsional springs (5.8): three per unique face; k_t = G pi D_m^4 / (32 L_m n_t), G the mean
 //    over the face's tetrahedra. Needs both endplates to define the cylinder.
-void MssModel::Impl::build_angle_springs(const TetProps& tp,
-                                         const std::vector<std::pair<std::array<int, 3>, std::vector<int>>>& unique_faces) {
+void MssModel::Impl::build_angle_springs(
+    const TetProps& tp,
+    const std::vector<std::pair<std::array<int, 3>, std::vector<int>>>& unique_faces) {
   if (options.torsion_springs) {
     require(cylinder.upper_diameter_mm > 0.0 && cylinder.lower_diameter_mm > 0.0,
             "mss: torsional springs need both endplates (surface labels 1 and 2) for the "
@@ -264,20 +268,22 @@ void MssModel::Impl::build_angle_springs(const TetProps& tp,
     const double Dm = cylinder.mean_diameter_mm;
     cylinder.length_mm = 4.0 * rest_volume / (kPi * Dm * Dm);
     cylinder.num_angle_springs = static_cast<Eigen::Index>(3 * unique_faces.size());
-    cylinder.k_t_per_shear_modulus = kPi * std::pow(Dm, 4) /
-                                     (32.0 * cylinder.length_mm *
-                                      static_cast<double>(cylinder.num_angle_springs));
+    cylinder.k_t_per_shear_modulus =
+        kPi * std::pow(Dm, 4) /
+        (32.0 * cylinder.length_mm * static_cast<double>(cylinder.num_angle_springs));
     faces.reserve(unique_faces.size());
     for (const auto& [v, tets] : unique_faces) {
       AngleFace f;
       double g_part[2] = {0.0, 0.0};
-      for (int t : tets) g_part[region_index(mesh.region(t))] += tp.G[t] / static_cast<double>(tets.size());
+      for (int t : tets)
+        g_part[region_index(mesh.region(t))] += tp.G[t] / static_cast<double>(tets.size());
       for (int r = 0; r < 2; ++r) f.k_part[r] = g_part[r] * cylinder.k_t_per_shear_modulus;
       f.k = 0.0;
       for (int corner = 0; corner < 3; ++corner) {
         f.v[corner] = v[corner];
-        f.rest_rad[corner] = angle_at(X.segment<3>(3 * v[corner]), X.segment<3>(3 * v[(corner + 1) % 3]),
-                                      X.segment<3>(3 * v[(corner + 2) % 3]));
+        f.rest_rad[corner] =
+            angle_at(X.segment<3>(3 * v[corner]), X.segment<3>(3 * v[(corner + 1) % 3]),
+                     X.segment<3>(3 * v[(corner + 2) % 3]));
         f.rest.cos0[corner] = std::cos(f.rest_rad[corner]);
         f.rest.sin0[corner] = std::sin(f.rest_rad[corner]);
       }
@@ -287,7 +293,6 @@ void MssModel::Impl::build_angle_springs(const TetProps& tp,
     const double Dm = cylinder.mean_diameter_mm;
     cylinder.length_mm = 4.0 * rest_volume / (kPi * Dm * Dm);
   }
-
 }
 
 // 5. Radial springs (5.3)-(5.5) and the volume terms (per tetrahedron, whole disc).
@@ -300,10 +305,12 @@ void MssModel::Impl::build_tet_terms(const TetProps& tp) {
       const Eigen::Vector3d xb = 0.25 * p.rowwise().sum();
       double S0 = 0.0;
       for (int c = 0; c < 4; ++c) S0 += (p.col(c) - xb).norm();
-      radial.push_back({static_cast<int>(t), r, S0, options.radial_factor * tp.E[t] * tp.V0[t] / (S0 * S0), 0.0});
+      radial.push_back({static_cast<int>(t), r, S0,
+                        options.radial_factor * tp.E[t] * tp.V0[t] / (S0 * S0), 0.0});
     }
     if (options.volume_term)
-      volume.push_back({static_cast<int>(t), r, tp.V0[t], options.volume_factor * tp.K[t] / tp.V0[t], 0.0});
+      volume.push_back(
+          {static_cast<int>(t), r, tp.V0[t], options.volume_factor * tp.K[t] / tp.V0[t], 0.0});
   }
 
   // 5b. Whole-disc volume term: k_g = c_g K_mean / V0.
@@ -313,7 +320,6 @@ void MssModel::Impl::build_tet_terms(const TetProps& tp) {
     disc_volume_on = true;
     disc_k_unscaled = options.disc_volume_factor * (KV / rest_volume) / rest_volume;
   }
-
 }
 
 // 6. Ambient damping (5.11).
@@ -324,12 +330,10 @@ void MssModel::Impl::build_damping(const TetProps& tp) {
   } else {
     double EV = 0.0, rhoV = 0.0;
     for (Eigen::Index t = 0; t < nt; ++t) EV += tp.E[t] * tp.V0[t], rhoV += tp.rho[t] * tp.V0[t];
-    const double length = cylinder.length_mm > 0.0 ? cylinder.length_mm
-                                                   : std::cbrt(rest_volume);
+    const double length = cylinder.length_mm > 0.0 ? cylinder.length_mm : std::cbrt(rest_volume);
     const double omega1 = kPi / length * std::sqrt(EV / rhoV);
     damping = 2.0 * options.damping_ratio * omega1 * mass_t.mean();
   }
-
 }
 
 // 7. Hessian pattern and the value slots of every element block.
@@ -345,13 +349,13 @@ void MssModel::Impl::build_slots() {
   face_slots.resize(9 * faces.size());
   for (std::size_t s = 0; s < faces.size(); ++s)
     for (int a = 0; a < 3; ++a)
-      for (int b = 0; b < 3; ++b) face_slots[9 * s + 3 * a + b] = pattern.block(faces[s].v[a], faces[s].v[b]);
+      for (int b = 0; b < 3; ++b)
+        face_slots[9 * s + 3 * a + b] = pattern.block(faces[s].v[a], faces[s].v[b]);
   tet_slots.resize(16 * static_cast<std::size_t>(nt));
   for (Eigen::Index t = 0; t < nt; ++t)
     for (int a = 0; a < 4; ++a)
       for (int b = 0; b < 4; ++b)
         tet_slots[16 * t + 4 * a + b] = pattern.block(mesh.T(t, a), mesh.T(t, b));
-
 }
 
 void MssModel::Impl::build(const mesh::RegionMaterials& materials) {
@@ -414,7 +418,9 @@ const Eigen::VectorXd& MssModel::node_masses_t() const { return impl_->mass_t; }
 double MssModel::total_mass_t() const { return impl_->mass_t.sum(); }
 double MssModel::damping_n_s_per_mm() const { return impl_->damping; }
 const EquivalentCylinder& MssModel::cylinder() const { return impl_->cylinder; }
-Eigen::Index MssModel::num_edge_springs() const { return static_cast<Eigen::Index>(impl_->edges.size()); }
+Eigen::Index MssModel::num_edge_springs() const {
+  return static_cast<Eigen::Index>(impl_->edges.size());
+}
 std::vector<EdgeSpringInfo> MssModel::edge_springs() const {
   const auto& s = impl_->options.scales[static_cast<int>(Term::main)].by_region;
   std::vector<EdgeSpringInfo> out;
@@ -429,9 +435,15 @@ std::vector<EdgeSpringInfo> MssModel::edge_springs() const {
   }
   return out;
 }
-Eigen::Index MssModel::num_radial_tets() const { return static_cast<Eigen::Index>(impl_->radial.size()); }
-Eigen::Index MssModel::num_angle_springs() const { return 3 * static_cast<Eigen::Index>(impl_->faces.size()); }
-Eigen::Index MssModel::num_volume_terms() const { return static_cast<Eigen::Index>(impl_->volume.size()); }
+Eigen::Index MssModel::num_radial_tets() const {
+  return static_cast<Eigen::Index>(impl_->radial.size());
+}
+Eigen::Index MssModel::num_angle_springs() const {
+  return 3 * static_cast<Eigen::Index>(impl_->faces.size());
+}
+Eigen::Index MssModel::num_volume_terms() const {
+  return static_cast<Eigen::Index>(impl_->volume.size());
+}
 double MssModel::rest_volume_mm3() const { return impl_->rest_volume; }
 
 void MssModel::set_scales(const std::array<RegionScales, kNumTerms>& scales) {
@@ -447,7 +459,6 @@ void MssModel::set_edge_multipliers(const std::vector<double>& multipliers) {
   impl_->options.edge_multipliers = multipliers;
   impl_->apply_scales();
 }
-
 
 double MssModel::energy(const Eigen::VectorXd& x) const {
   check_size(x, num_nodes());
@@ -483,7 +494,7 @@ void MssModel::term_gradient(const Eigen::VectorXd& x, Term term, int region_ind
 }
 
 double MssModel::Impl::accumulate(const Eigen::VectorXd& x, const bool* terms, KSelect sel,
-                                 Eigen::VectorXd* grad) const {
+                                  Eigen::VectorXd* grad) const {
   const Impl& m = *this;
   double energy = 0.0;
   const double* xp = x.data();
@@ -500,8 +511,8 @@ double MssModel::Impl::accumulate(const Eigen::VectorXd& x, const bool* terms, K
   }
   if (terms[static_cast<int>(Term::torsion)]) {
     if (grad) {
-      energy += face_angle_springs_all(m.faces, [&sel](const AngleFace& f) { return sel.angle(f); },
-                                       xp, grad->data());
+      energy += face_angle_springs_all(
+          m.faces, [&sel](const AngleFace& f) { return sel.angle(f); }, xp, grad->data());
     } else {
       for (const AngleFace& f : m.faces)
         energy += face_angle_springs<false>(xp + 3 * f.v[0], xp + 3 * f.v[1], xp + 3 * f.v[2],
@@ -562,8 +573,8 @@ void MssModel::Impl::assemble_hessian(const Eigen::VectorXd& x, HessianMode mode
   // Scatter a local (3k x 3k) element Hessian into its node blocks.
   auto scatter = [&](const auto& h, const int* slots, int k, const int* nodes) {
     for (int a = 0; a < k; ++a)
-      for (int b = 0; b < k; ++b) m.pattern.add_block(val, slots[k * a + b], nodes[b],
-                                                      h.template block<3, 3>(3 * a, 3 * b));
+      for (int b = 0; b < k; ++b)
+        m.pattern.add_block(val, slots[k * a + b], nodes[b], h.template block<3, 3>(3 * a, 3 * b));
   };
   Matrix6d h6;
   for (std::size_t e = 0; e < (terms[static_cast<int>(Term::main)] ? m.edges.size() : 0); ++e) {
@@ -577,11 +588,12 @@ void MssModel::Impl::assemble_hessian(const Eigen::VectorXd& x, HessianMode mode
     const AngleFace& f = m.faces[s];
     for (int c = 0; c < 3; ++c) {  // corner c: apex v[c], arms to v[c+1], v[c+2]
       const int nodes[3] = {f.v[c], f.v[(c + 1) % 3], f.v[(c + 2) % 3]};
-      angle_spring(point(nodes[0]), point(nodes[1]), point(nodes[2]), sel.angle(f), f.rest_rad[c], nullptr,
-                   &h9, mode);
+      angle_spring(point(nodes[0]), point(nodes[1]), point(nodes[2]), sel.angle(f), f.rest_rad[c],
+                   nullptr, &h9, mode);
       int slots[9];
       for (int a = 0; a < 3; ++a)
-        for (int b = 0; b < 3; ++b) slots[3 * a + b] = m.face_slots[9 * s + 3 * ((c + a) % 3) + (c + b) % 3];
+        for (int b = 0; b < 3; ++b)
+          slots[3 * a + b] = m.face_slots[9 * s + 3 * ((c + a) % 3) + (c + b) % 3];
       scatter(h9, slots, 3, nodes);
     }
   }
@@ -606,8 +618,10 @@ void MssModel::Impl::assemble_hessian(const Eigen::VectorXd& x, HessianMode mode
   // Whole-disc volume, sparse part k_g (V - V0) H_V (exact mode only; the rank-one part is
   // disc_volume_rank_one's). H_V is trilinear in the arms a, b, c of each tet:
   //   d2V/da db = -[c]x/6,  d2V/da dc = [b]x/6,  d2V/db dc = -[a]x/6, zero diagonal blocks.
-  if (terms[static_cast<int>(Term::disc_volume)] && m.disc_volume_on && mode == HessianMode::exact) {
-    const double w = sel.disc(m.disc_k, m.disc_k_unscaled) * (m.volume_and_gradient(x, nullptr) - m.rest_volume);
+  if (terms[static_cast<int>(Term::disc_volume)] && m.disc_volume_on &&
+      mode == HessianMode::exact) {
+    const double w =
+        sel.disc(m.disc_k, m.disc_k_unscaled) * (m.volume_and_gradient(x, nullptr) - m.rest_volume);
     auto skew = [](const Eigen::Vector3d& v) {
       Eigen::Matrix3d S;
       S << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;

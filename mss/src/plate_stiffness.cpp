@@ -10,8 +10,12 @@
 namespace spinesim::mss {
 
 namespace {
-bool is_superior(const mesh::TetMesh& m, Eigen::Index i) { return m.surface(i) == int(mesh::Surface::superior_endplate); }
-bool is_inferior(const mesh::TetMesh& m, Eigen::Index i) { return m.surface(i) == int(mesh::Surface::inferior_endplate); }
+bool is_superior(const mesh::TetMesh& m, Eigen::Index i) {
+  return m.surface(i) == int(mesh::Surface::superior_endplate);
+}
+bool is_inferior(const mesh::TetMesh& m, Eigen::Index i) {
+  return m.surface(i) == int(mesh::Surface::inferior_endplate);
+}
 }  // namespace
 
 Matrix6d plate_stiffness(const MssModel& model, const Eigen::Vector3d& center_mm) {
@@ -64,8 +68,10 @@ Matrix6d plate_stiffness(const MssModel& model, const Eigen::Vector3d& center_mm
   Vector6d u_p = Vector6d::Zero();
   if (kg != 0.0)
     for (Eigen::Index dof = 0; dof < ndof; ++dof) {
-      if (free_index[std::size_t(dof)] >= 0) u_f(free_index[std::size_t(dof)]) = u(dof);
-      else if (is_superior(m, dof / 3)) u_p += u(dof) * map.row(dof).transpose();
+      if (free_index[std::size_t(dof)] >= 0)
+        u_f(free_index[std::size_t(dof)]) = u(dof);
+      else if (is_superior(m, dof / 3))
+        u_p += u(dof) * map.row(dof).transpose();
     }
   b += kg * u_f * u_p.transpose();
   kpp += kg * u_p * u_p.transpose();

@@ -16,8 +16,12 @@ class ReducedPotential {
  public:
   ReducedPotential(const MssModel& model, const ReducedSpace& space, const ExternalLoads* loads,
                    const Vector6d& wrench)
-      : model_(&model), space_(&space), loads_(loads), wrench_(wrench),
-        x_(model.rest_positions_mm()), g_(Eigen::VectorXd::Zero(model.num_dofs())) {}
+      : model_(&model),
+        space_(&space),
+        loads_(loads),
+        wrench_(wrench),
+        x_(model.rest_positions_mm()),
+        g_(Eigen::VectorXd::Zero(model.num_dofs())) {}
   ReducedPotential() = default;
 
   /// New loads and wrench, same model and space; keeps the workspaces (no allocation).

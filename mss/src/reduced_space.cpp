@@ -59,11 +59,11 @@ void ReducedSpace::classify_nodes(const mesh::TetMesh& m, int nn) {
     plate_maps_.push_back(plate_map(arm));
     arm2 += arm.squaredNorm();
   }
-  if (!superior_nodes_.empty() && arm2 > 0) moment_length_ = std::sqrt(arm2 / double(superior_nodes_.size()));
+  if (!superior_nodes_.empty() && arm2 > 0)
+    moment_length_ = std::sqrt(arm2 / double(superior_nodes_.size()));
   const int nf3 = 3 * int(free_nodes_.size());
   const bool plate = has_plate_dofs();
   n_ = nf3 + (plate ? 6 : 0);
-
 }
 
 // 2. Pattern of the lower triangle of P^T H P; returns its column starts.
@@ -121,7 +121,8 @@ std::vector<int> ReducedSpace::build_pattern(const Eigen::SparseMatrix<double>& 
 }
 
 // 3. Scatter operations from the full Hessian's value array.
-void ReducedSpace::build_scatter(const Eigen::SparseMatrix<double>& H, const std::vector<int>& outer) {
+void ReducedSpace::build_scatter(const Eigen::SparseMatrix<double>& H,
+                                 const std::vector<int>& outer) {
   const bool plate = has_plate_dofs();
   const int* Hout = H.outerIndexPtr();
   const int* Hin = H.innerIndexPtr();
@@ -270,7 +271,8 @@ double ReducedSpace::force_norm(const Eigen::VectorXd& r) const {
   const Eigen::Index nf3 = plate_offset();
   double s = r.head(nf3).squaredNorm();
   if (has_plate_dofs())
-    s += r.segment<3>(nf3).squaredNorm() + r.tail<3>().squaredNorm() / (moment_length_ * moment_length_);
+    s += r.segment<3>(nf3).squaredNorm() +
+         r.tail<3>().squaredNorm() / (moment_length_ * moment_length_);
   return std::sqrt(s);
 }
 

@@ -14,9 +14,9 @@
 // reduce_matrix() refills values through precomputed slots: no search, no allocation.
 #pragma once
 
+#include "spinesim/mesh/rigid_plate.hpp"
 #include "spinesim/mss/boundary.hpp"
 #include "spinesim/mss/model.hpp"
-#include "spinesim/mesh/rigid_plate.hpp"
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
@@ -35,8 +35,8 @@ using mesh::plate_map;
 /// Mass-like reduced matrix P^T diag(w) P for per-node weights w (masses, or ones for the
 /// ambient damping): a diagonal over the free DOF and a dense 6x6 plate block.
 struct LumpedReduced {
-  Eigen::VectorXd diagonal;               ///< size(); zero on the plate DOF
-  Matrix6d plate = Matrix6d::Zero();      ///< zero in pose mode
+  Eigen::VectorXd diagonal;           ///< size(); zero on the plate DOF
+  Matrix6d plate = Matrix6d::Zero();  ///< zero in pose mode
   /// out = this * y (out preallocated, no aliasing with y).
   void apply(const Eigen::VectorXd& y, Eigen::VectorXd& out) const;
   double quadratic_form(const Eigen::VectorXd& y) const;  ///< y^T this y
@@ -107,19 +107,25 @@ class ReducedSpace {
   Eigen::Vector3d center_ = Eigen::Vector3d::Zero();
   Eigen::Index n_ = 0;
   double moment_length_ = 1.0;
-  Eigen::VectorXd X_;                    ///< rest positions, 3#nodes
+  Eigen::VectorXd X_;  ///< rest positions, 3#nodes
   std::vector<NodeRole> role_;
-  std::vector<int> free_index_;          ///< node -> free node index, -1 if not free
+  std::vector<int> free_index_;  ///< node -> free node index, -1 if not free
   std::vector<int> free_nodes_, superior_nodes_, inferior_nodes_;
-  std::vector<int> plate_index_;         ///< node -> index into superior_nodes_, -1 otherwise
-  std::vector<Matrix36d> plate_maps_;    ///< R_i per superior node (wrench mode)
+  std::vector<int> plate_index_;       ///< node -> index into superior_nodes_, -1 otherwise
+  std::vector<Matrix36d> plate_maps_;  ///< R_i per superior node (wrench mode)
 
   Eigen::SparseMatrix<double> pattern_;
-  std::vector<int> diag_slot_;           ///< value index of (k, k) for every reduced DOF k
-  int plate_slot_[6][6] = {};            ///< value index of (3nf+p, 3nf+q), p >= q
-  struct FreeFree { int src, dst; };
-  struct FreePlate { int src, dst, plate, comp; };   ///< dst: first of 6 plate rows
-  struct PlatePlate { int src, plate_row, comp_row, plate_col, comp_col; };
+  std::vector<int> diag_slot_;  ///< value index of (k, k) for every reduced DOF k
+  int plate_slot_[6][6] = {};   ///< value index of (3nf+p, 3nf+q), p >= q
+  struct FreeFree {
+    int src, dst;
+  };
+  struct FreePlate {
+    int src, dst, plate, comp;
+  };  ///< dst: first of 6 plate rows
+  struct PlatePlate {
+    int src, plate_row, comp_row, plate_col, comp_col;
+  };
   std::vector<FreeFree> ff_;
   std::vector<FreePlate> fp_;
   std::vector<PlatePlate> pp_;

@@ -79,7 +79,7 @@ void validate_options(const DynamicsOptions& o) {
 struct Simulator::Impl {
   const MssModel* model = nullptr;
   DynamicsOptions opt;
-  double kd = 0;               ///< K_d, N·s/mm
+  double kd = 0;  ///< K_d, N·s/mm
   double divergence_mm = 0;
   double probe_k_default = 0;  ///< N/mm
   double floor_n = 0;          ///< round-off floor of residual norms, N
@@ -102,8 +102,10 @@ struct Simulator::Impl {
     bool active;
   };
   std::vector<Pair> pairs;
-  Eigen::MatrixXd base_W, base_Z;  ///< low-rank part of the factorised matrix (rank-one volume term)
-  std::unordered_map<int, Eigen::MatrixXd> contact_solves;  ///< cached A^-1 e columns of contact nodes
+  Eigen::MatrixXd base_W,
+      base_Z;  ///< low-rank part of the factorised matrix (rank-one volume term)
+  std::unordered_map<int, Eigen::MatrixXd>
+      contact_solves;  ///< cached A^-1 e columns of contact nodes
 
   // Workspaces (sized once per reduced system): full 3#nodes and reduced vectors.
   Eigen::VectorXd x, v;
@@ -121,14 +123,16 @@ struct Simulator::Impl {
   bool contact_direction(const ExternalLoads& loads, const Eigen::VectorXd& xs);
   /// A^-1 of the reduced unit vectors of a free node (key = node) or of the plate DOF (key -1).
   const Eigen::MatrixXd& contact_solve(int key);
-  StepReport explicit_step(State& s, const Boundary& bc, const ExternalLoads& loads, bool symplectic);
+  StepReport explicit_step(State& s, const Boundary& bc, const ExternalLoads& loads,
+                           bool symplectic);
   StepReport implicit_step(State& s, const Boundary& bc, const ExternalLoads& loads);
   StepReport commit(State& s, const Boundary& bc, int iterations);
 };
 
 void Simulator::Impl::ensure_space(PlateMode mode, const Eigen::Vector3d& c) {
   // The plate centre shapes the reduced space only through the wrench-mode plate map.
-  if (have_space && space.mode() == mode && (mode == PlateMode::pose || space.center() == c)) return;
+  if (have_space && space.mode() == mode && (mode == PlateMode::pose || space.center() == c))
+    return;
   space = ReducedSpace(*model, H_rest, mode, c);
   const double dt = opt.dt_s;
   mass = space.lumped(model->node_masses_t());
@@ -171,8 +175,9 @@ bool Simulator::Impl::factor_frozen() {
   contacts_attached = false;
   if (!frozen_ready) return false;
   // The whole-disc volume term's rank-one part at rest.
-  tangent.set_rank_one(detail::reduced_rank_one(*model, space, model->rest_positions_mm(), u_rank_one, w_rank_one),
-                       w_rank_one);
+  tangent.set_rank_one(
+      detail::reduced_rank_one(*model, space, model->rest_positions_mm(), u_rank_one, w_rank_one),
+      w_rank_one);
   base_W = tangent.low_rank_W();
   base_Z = tangent.low_rank_Z();
   return true;
@@ -209,16 +214,21 @@ bool Simulator::Impl::contact_direction(const ExternalLoads& loads, const Eigen:
       pairs.push_back({int(i), a / dist, p.radius_mm - dist, p.stiffness_n_per_mm, false});
     }
   // Reduced image of a node vector v: P^T (e_i v) (3 free rows, or R_i^T v on the plate DOF).
-  const auto reduced_column = [&](int i, const Eigen::Vector3d& v, Eigen::Ref<Eigen::VectorXd> col) {
+  const auto reduced_column = [&](int i, const Eigen::Vector3d& v,
+                                  Eigen::Ref<Eigen::VectorXd> col) {
     col.setZero();
     if (space.role(i) == detail::NodeRole::free)
       col.segment<3>(3 * space.free_index(i)) = v;
     else
-      col.tail<6>() = detail::plate_map(model->rest_positions_mm().segment<3>(3 * i) - space.center()).transpose() * v;
+      col.tail<6>() =
+          detail::plate_map(model->rest_positions_mm().segment<3>(3 * i) - space.center())
+              .transpose() *
+          v;
   };
   const auto node_step = [&](int i) -> Eigen::Vector3d {
     if (space.role(i) == detail::NodeRole::free) return d.segment<3>(3 * space.free_index(i));
-    return detail::plate_map(model->rest_positions_mm().segment<3>(3 * i) - space.center()) * d.tail<6>();
+    return detail::plate_map(model->rest_positions_mm().segment<3>(3 * i) - space.center()) *
+           d.tail<6>();
   };
   for (Pair& c : pairs) c.active = c.p0 > 0.0;
   // Active-set loop on the quadratic model r.d + d.A d/2 + sum k/2 max(0, p0 - n.d_i)^2: with the
@@ -289,7 +299,8 @@ StepReport Simulator::Impl::explicit_step(State& s, const Boundary& bc, const Ex
   return commit(s, bc, 0);
 }
 
-StepReport Simulator::Impl::implicit_step(State& s, const Boundary& bc, const ExternalLoads& loads) {
+StepReport Simulator::Impl::implicit_step(State& s, const Boundary& bc,
+                                          const ExternalLoads& loads) {
   const double dt = opt.dt_s;
   ReducedPotential& pot = potential;
   pot.set_loads(&loads, space.has_plate_dofs() ? bc.wrench : Vector6d::Zero());
@@ -303,15 +314,17 @@ StepReport Simulator::Impl::implicit_step(State& s, const Boundary& bc, const Ex
   const bool frozen = opt.matrix_update == MatrixUpdate::frozen;
   int it = 0;
   while (it < opt.newton_iterations) {
-    if (!std::isfinite(phi) || !r.allFinite()) return {false, it, "non-finite forces in the implicit step"};
+    if (!std::isfinite(phi) || !r.allFinite())
+      return {false, it, "non-finite forces in the implicit step"};
     const double rn = space.force_norm(r);
     if (rn <= floor_n || (it > 0 && rn <= opt.newton_relative_tolerance * r0)) break;
     // 1. The matrix without probe contacts: the frozen factor, or the current Hessian.
     if (frozen) {
-      if (!factor_frozen()) return {false, it, "the frozen implicit matrix is not positive definite"};
+      if (!factor_frozen())
+        return {false, it, "the frozen implicit matrix is not positive definite"};
     } else {
-      if (detail::factor_tangent(*model, space, ExternalLoads(), pot.x(), &inertia, 1.0, H, A, tangent) ==
-          detail::TangentKind::failed)
+      if (detail::factor_tangent(*model, space, ExternalLoads(), pot.x(), &inertia, 1.0, H, A,
+                                 tangent) == detail::TangentKind::failed)
         return {false, it, "the implicit step matrix could not be factorised"};
       base_W = tangent.low_rank_W();
       base_Z = tangent.low_rank_Z();
@@ -339,9 +352,9 @@ StepReport Simulator::Impl::implicit_step(State& s, const Boundary& bc, const Ex
       y_trial = y + alpha * d;
       const double phi_trial = phi_and_gradient(pot, y_trial, r_trial);
       if (!std::isfinite(phi_trial)) continue;
-      accepted = phi_trial <= phi + 1e-4 * alpha * slope ||
-                 (std::abs(phi_trial - phi) <= 1e-12 * std::abs(phi) &&
-                  space.force_norm(r_trial) < rn);
+      accepted =
+          phi_trial <= phi + 1e-4 * alpha * slope ||
+          (std::abs(phi_trial - phi) <= 1e-12 * std::abs(phi) && space.force_norm(r_trial) < rn);
       if (accepted) phi = phi_trial;
     }
     if (!accepted) {
@@ -349,7 +362,8 @@ StepReport Simulator::Impl::implicit_step(State& s, const Boundary& bc, const Ex
       // few hundred ulps of the force floor (a different summation order of the forces — e.g.
       // the blocked angle-spring kernel — moves the last bits), else a genuine failure.
       if (rn <= 1e3 * floor_n) break;
-      return {false, it, "line search failed in the implicit step (|r| = " + std::to_string(rn) + " N)"};
+      return {false, it,
+              "line search failed in the implicit step (|r| = " + std::to_string(rn) + " N)"};
     }
     y.swap(y_trial);
     r.swap(r_trial);
@@ -380,8 +394,9 @@ StepReport Simulator::Impl::commit(State& s, const Boundary& bc, int iterations)
     return {false, iterations, "step diverged: non-finite positions or velocities (state kept)"};
   if (std::sqrt(worst) > limit)
     return {false, iterations,
-            "step diverged: a node moved " + std::to_string(std::sqrt(worst)) + " mm from rest, more than " +
-                std::to_string(limit) + " mm (divergence distance + largest endplate displacement; state kept)"};
+            "step diverged: a node moved " + std::to_string(std::sqrt(worst)) +
+                " mm from rest, more than " + std::to_string(limit) +
+                " mm (divergence distance + largest endplate displacement; state kept)"};
   Vector6d q;
   if (space.has_plate_dofs()) {
     q = y.tail<6>();
@@ -411,8 +426,9 @@ Simulator::Simulator(const MssModel& model, const DynamicsOptions& options)
   const Eigen::MatrixX3d& V = model.mesh().V;
   const double diag = (V.colwise().maxCoeff() - V.colwise().minCoeff()).norm();
   d.divergence_mm = options.divergence_distance_mm > 0 ? options.divergence_distance_mm : diag;
-  d.floor_n = 100.0 * std::numeric_limits<double>::epsilon() * d.H_rest.diagonal().cwiseAbs().mean() *
-              std::max(1.0, X.cwiseAbs().maxCoeff()) * std::sqrt(double(model.num_dofs()));
+  d.floor_n = 100.0 * std::numeric_limits<double>::epsilon() *
+              d.H_rest.diagonal().cwiseAbs().mean() * std::max(1.0, X.cwiseAbs().maxCoeff()) *
+              std::sqrt(double(model.num_dofs()));
   d.x.resize(model.num_dofs());
   d.v.resize(model.num_dofs());
 }
@@ -436,16 +452,20 @@ StepReport Simulator::step(State& s, const Boundary& bc) {
   validate(bc, model.num_nodes());
   require(s.x_mm.size() == model.num_dofs() && s.v_mm_s.size() == model.num_dofs(),
           "mss: state vectors must have 3 x #nodes entries");
-  if (!s.x_mm.allFinite() || !s.v_mm_s.allFinite() || !s.plate_q.allFinite() || !s.plate_qdot.allFinite())
+  if (!s.x_mm.allFinite() || !s.v_mm_s.allFinite() || !s.plate_q.allFinite() ||
+      !s.plate_qdot.allFinite())
     return {false, 0, "state is not finite"};
   d.ensure_space(bc.plate_mode, bc.plate_center_mm);
   const ExternalLoads loads(bc, d.probe_k_default, &model.mesh().surface);
   d.space.gather(s.x_mm, s.plate_q, d.yn);
   d.space.gather(s.v_mm_s, s.plate_qdot, d.un);
   switch (d.opt.integrator) {
-    case Integrator::explicit_euler: return d.explicit_step(s, bc, loads, false);
-    case Integrator::symplectic_euler: return d.explicit_step(s, bc, loads, true);
-    default: return d.implicit_step(s, bc, loads);
+    case Integrator::explicit_euler:
+      return d.explicit_step(s, bc, loads, false);
+    case Integrator::symplectic_euler:
+      return d.explicit_step(s, bc, loads, true);
+    default:
+      return d.implicit_step(s, bc, loads);
   }
 }
 

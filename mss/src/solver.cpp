@@ -53,7 +53,8 @@ StaticResult solve_static(const MssModel& model, const Boundary& bc, const Stati
   validate(bc, model.num_nodes());
   if (!(options.relative_tolerance > 0.0) || !std::isfinite(options.relative_tolerance))
     throw std::invalid_argument("mss: static relative tolerance must be finite and > 0");
-  if (options.max_iterations < 1) throw std::invalid_argument("mss: static max_iterations must be >= 1");
+  if (options.max_iterations < 1)
+    throw std::invalid_argument("mss: static max_iterations must be >= 1");
   const Eigen::VectorXd& X = model.rest_positions_mm();
   if (x_start.size() != 0) check_positions(x_start, model, "static start vector");
 
@@ -71,8 +72,8 @@ StaticResult solve_static(const MssModel& model, const Boundary& bc, const Stati
   ReducedPotential pot(model, space, &loads, wrench);
   pot.x() = x_start.size() ? x_start : X;
   space.set_dirichlet_positions(bc, pot.x());
-  const Vector6d q0 = space.has_plate_dofs() && x_start.size() ? space.fit_plate_motion(x_start)
-                                                               : Vector6d::Zero();
+  const Vector6d q0 =
+      space.has_plate_dofs() && x_start.size() ? space.fit_plate_motion(x_start) : Vector6d::Zero();
   const Eigen::Index n = space.size();
   Eigen::VectorXd y(n), r(n), d(n), y_trial(n), r_trial(n);
   space.gather(pot.x(), q0, y);
@@ -93,8 +94,8 @@ StaticResult solve_static(const MssModel& model, const Boundary& bc, const Stati
       break;
     }
     if (it == options.max_iterations) {
-      res.message = "no convergence in " + std::to_string(it) + " Newton iterations (|r| = " +
-                    std::to_string(res.residual_n) + " N)";
+      res.message = "no convergence in " + std::to_string(it) +
+                    " Newton iterations (|r| = " + std::to_string(res.residual_n) + " N)";
       break;
     }
     const detail::TangentKind kind =
@@ -121,8 +122,8 @@ StaticResult solve_static(const MssModel& model, const Boundary& bc, const Stati
       }
     }
     if (!accepted) {
-      res.message = "line search failed at Newton iteration " + std::to_string(it) + " (|r| = " +
-                    std::to_string(res.residual_n) + " N)";
+      res.message = "line search failed at Newton iteration " + std::to_string(it) +
+                    " (|r| = " + std::to_string(res.residual_n) + " N)";
       break;
     }
     y.swap(y_trial);

@@ -31,7 +31,8 @@ struct SparseCholesky::Impl {
   explicit Impl(CholeskyBackend b) : backend(b) {
     cholmod_start(&common);
     common.print = 0;  // failures are reported by return values, not on stderr
-    common.supernodal = b == CholeskyBackend::cholmod_supernodal ? CHOLMOD_SUPERNODAL : CHOLMOD_SIMPLICIAL;
+    common.supernodal =
+        b == CholeskyBackend::cholmod_supernodal ? CHOLMOD_SUPERNODAL : CHOLMOD_SIMPLICIAL;
     common.final_ll = 1;
   }
   ~Impl() {
@@ -46,8 +47,8 @@ struct SparseCholesky::Impl {
 
   bool cholmod() const { return backend != CholeskyBackend::eigen_simplicial; }
   cholmod_sparse view(const Eigen::SparseMatrix<double>& A) {
-    cholmod_sparse s = Eigen::viewAsCholmod(Eigen::Ref<Eigen::SparseMatrix<double>>(
-        const_cast<Eigen::SparseMatrix<double>&>(A)));
+    cholmod_sparse s = Eigen::viewAsCholmod(
+        Eigen::Ref<Eigen::SparseMatrix<double>>(const_cast<Eigen::SparseMatrix<double>&>(A)));
     s.stype = -1;  // lower triangle stored
     return s;
   }

@@ -8,8 +8,9 @@
 
 namespace spinesim::mss::detail {
 
-TopEigenpair largest_eigenpair(const std::function<void(const Eigen::VectorXd&, Eigen::VectorXd&)>& apply,
-                               Eigen::Index n, double rel_tol, int max_iterations) {
+TopEigenpair largest_eigenpair(
+    const std::function<void(const Eigen::VectorXd&, Eigen::VectorXd&)>& apply, Eigen::Index n,
+    double rel_tol, int max_iterations) {
   TopEigenpair out;
   if (n == 0) return out;
   const int m = int(std::min<Eigen::Index>(n, std::max(1, max_iterations)));

@@ -17,7 +17,8 @@ struct TopEigenpair {
 /// Top eigenpair of the symmetric n×n operator `apply(v, out)` (out = A v). Stops when the
 /// Ritz residual |A z - theta z| <= rel_tol * theta or after max_iterations (<= n) steps.
 /// Deterministic start vector.
-TopEigenpair largest_eigenpair(const std::function<void(const Eigen::VectorXd&, Eigen::VectorXd&)>& apply,
-                               Eigen::Index n, double rel_tol = 1e-8, int max_iterations = 300);
+TopEigenpair largest_eigenpair(
+    const std::function<void(const Eigen::VectorXd&, Eigen::VectorXd&)>& apply, Eigen::Index n,
+    double rel_tol = 1e-8, int max_iterations = 300);
 
 }  // namespace spinesim::mss::detail

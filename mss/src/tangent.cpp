@@ -46,10 +46,14 @@ double reduced_rank_one(const MssModel& model, const ReducedSpace& space, const 
 
 const char* to_string(TangentKind k) {
   switch (k) {
-    case TangentKind::exact: return "exact";
-    case TangentKind::projected: return "projected";
-    case TangentKind::shifted: return "projected+shift";
-    default: return "failed";
+    case TangentKind::exact:
+      return "exact";
+    case TangentKind::projected:
+      return "projected";
+    case TangentKind::shifted:
+      return "projected+shift";
+    default:
+      return "failed";
   }
 }
 

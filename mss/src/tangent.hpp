@@ -30,7 +30,8 @@ class TangentSolver {
   /// After a successful factorisation: the operator becomes A + k w w^T (k = 0: A alone).
   void set_rank_one(double k, const Eigen::VectorXd& w);
   /// The operator becomes A + W W^T, Z = A^-1 W given (n×r each, r = 0: A alone).
-  void set_low_rank(const Eigen::Ref<const Eigen::MatrixXd>& W, const Eigen::Ref<const Eigen::MatrixXd>& Z);
+  void set_low_rank(const Eigen::Ref<const Eigen::MatrixXd>& W,
+                    const Eigen::Ref<const Eigen::MatrixXd>& Z);
   /// b <- (A + W W^T)^-1 b; allocates nothing when there is no low-rank part.
   void solve_in_place(Eigen::VectorXd& b);
   /// The current low-rank part (for reuse by the caller), n×r.

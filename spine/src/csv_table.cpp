@@ -37,10 +37,9 @@ double CsvTable::number(std::size_t r, const std::string& name) const {
     std::size_t used = 0;
     const double v = std::stod(cell, &used);
     if (used == cell.size() && std::isfinite(v)) return v;
-  } catch (const std::exception&) {
-  }
-  throw std::runtime_error(path + ": row " + std::to_string(r + 1) + " column '" + name + "': '" + cell +
-                           "' is not a finite number");
+  } catch (const std::exception&) {}
+  throw std::runtime_error(path + ": row " + std::to_string(r + 1) + " column '" + name + "': '" +
+                           cell + "' is not a finite number");
 }
 
 std::size_t CsvTable::find(const std::string& key_column, const std::string& key) const {
@@ -64,8 +63,8 @@ CsvTable read_csv(const std::string& path) {
       t.header = std::move(cells);
     } else {
       if (cells.size() != t.header.size())
-        throw std::runtime_error(path + ": a row has " + std::to_string(cells.size()) + " cells, the header " +
-                                 std::to_string(t.header.size()));
+        throw std::runtime_error(path + ": a row has " + std::to_string(cells.size()) +
+                                 " cells, the header " + std::to_string(t.header.size()));
       t.rows.push_back(std::move(cells));
     }
   }

@@ -17,7 +17,9 @@ struct CsvTable {
   std::size_t column(const std::string& name) const;
   /// Number in row r, column `name`; throws naming file, row and column when not finite.
   double number(std::size_t r, const std::string& name) const;
-  const std::string& text(std::size_t r, const std::string& name) const { return rows[r][column(name)]; }
+  const std::string& text(std::size_t r, const std::string& name) const {
+    return rows[r][column(name)];
+  }
   /// Row whose `key_column` equals `key`; throws when absent.
   std::size_t find(const std::string& key_column, const std::string& key) const;
 };

@@ -28,7 +28,8 @@ using nlohmann::json;
 
 constexpr const char* kKind = "spinesim displacement-force database";
 constexpr int kFormatVersion = 1;
-const std::array<const char*, kDbComponents> kComponentNames = {"tx_mm", "ty_mm", "tz_mm", "rx_deg", "ry_deg", "rz_deg"};
+const std::array<const char*, kDbComponents> kComponentNames = {"tx_mm",  "ty_mm",  "tz_mm",
+                                                                "rx_deg", "ry_deg", "rz_deg"};
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -36,8 +37,8 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 
 VertebraResponse as_response(const Eigen::Matrix<double, Eigen::Dynamic, 6>& d) {
   if (d.rows() != kDbVertebrae)
-    throw std::runtime_error("displacement database: the solver returned " + std::to_string(d.rows()) +
-                             " vertebrae, expected 17");
+    throw std::runtime_error("displacement database: the solver returned " +
+                             std::to_string(d.rows()) + " vertebrae, expected 17");
   return d;
 }
 
@@ -54,7 +55,8 @@ int direction_index(const std::string& name) {
   const auto& names = direction_names();
   for (std::size_t i = 0; i < names.size(); ++i)
     if (names[i] == name) return int(i);
-  throw std::invalid_argument("unknown direction '" + name + "' (expected +x, -x, +y, -y, +z or -z)");
+  throw std::invalid_argument("unknown direction '" + name +
+                              "' (expected +x, -x, +y, -y, +z or -z)");
 }
 
 Eigen::Vector3d direction_vector(int d) {
@@ -81,11 +83,13 @@ double evaluate_polynomial(const double* c, int n, double s) {
   return p * s;  // no constant term
 }
 
-Eigen::VectorXd fit_zero_intercept(const Eigen::VectorXd& force_n, const Eigen::VectorXd& y, int degree,
-                                   double scale_n) {
-  if (force_n.size() != y.size()) throw std::invalid_argument("fit: forces and values differ in size");
+Eigen::VectorXd fit_zero_intercept(const Eigen::VectorXd& force_n, const Eigen::VectorXd& y,
+                                   int degree, double scale_n) {
+  if (force_n.size() != y.size())
+    throw std::invalid_argument("fit: forces and values differ in size");
   if (degree < 1 || force_n.size() < degree)
-    throw std::invalid_argument("fit: degree " + std::to_string(degree) + " needs at least that many samples, got " +
+    throw std::invalid_argument("fit: degree " + std::to_string(degree) +
+                                " needs at least that many samples, got " +
                                 std::to_string(force_n.size()));
   if (!force_n.allFinite() || !y.allFinite() || !(scale_n > 0) || !std::isfinite(scale_n))
     throw std::invalid_argument("fit: non-finite sample or scale");
@@ -99,11 +103,13 @@ Eigen::VectorXd fit_zero_intercept(const Eigen::VectorXd& force_n, const Eigen::
   return a.colPivHouseholderQr().solve(y);
 }
 
-PolynomialFit fit_by_residual(const Eigen::VectorXd& force_n, const Eigen::VectorXd& y, double scale_n,
-                              const FitTolerance& tol) {
+PolynomialFit fit_by_residual(const Eigen::VectorXd& force_n, const Eigen::VectorXd& y,
+                              double scale_n, const FitTolerance& tol) {
   if (tol.max_degree < 1 || tol.max_degree > kDbMaxDegree || !(tol.quantum >= 0))
-    throw std::invalid_argument("fit: max degree must be 1.." + std::to_string(kDbMaxDegree) + ", quantum >= 0");
-  const double range = std::max(0.0, y.size() ? y.maxCoeff() : 0.0) - std::min(0.0, y.size() ? y.minCoeff() : 0.0);
+    throw std::invalid_argument("fit: max degree must be 1.." + std::to_string(kDbMaxDegree) +
+                                ", quantum >= 0");
+  const double range =
+      std::max(0.0, y.size() ? y.maxCoeff() : 0.0) - std::min(0.0, y.size() ? y.minCoeff() : 0.0);
   const double allowed = std::max(tol.relative * range, tol.absolute);
   const int top = std::min<int>(tol.max_degree, int(force_n.size()));
   PolynomialFit best;
@@ -111,7 +117,8 @@ PolynomialFit fit_by_residual(const Eigen::VectorXd& force_n, const Eigen::Vecto
   for (int d = 1; d <= top; ++d) {
     PolynomialFit f;
     f.coefficients = fit_zero_intercept(force_n, y, d, scale_n);
-    for (Eigen::Index k = 0; k < d; ++k) f.coefficients[k] = round_to_quantum(f.coefficients[k], tol.quantum);
+    for (Eigen::Index k = 0; k < d; ++k)
+      f.coefficients[k] = round_to_quantum(f.coefficients[k], tol.quantum);
     double sum2 = 0;
     for (Eigen::Index i = 0; i < y.size(); ++i) {
       const double r = evaluate_polynomial(f.coefficients.data(), d, force_n[i] / scale_n) - y[i];
@@ -129,8 +136,9 @@ PolynomialFit fit_by_residual(const Eigen::VectorXd& force_n, const Eigen::Vecto
 // --- solving load cases ----------------------------------------------------------------------
 
 void solve_cases(const SpineModel& m, const std::vector<std::vector<ExternalLoad>>& loads,
-                 const SolveOptions& options, int workers, std::vector<VertebraResponse>& displacement,
-                 std::vector<std::string>& errors, const std::function<void(int, int)>& progress) {
+                 const SolveOptions& options, int workers,
+                 std::vector<VertebraResponse>& displacement, std::vector<std::string>& errors,
+                 const std::function<void(int, int)>& progress) {
   const int n = int(loads.size());
   displacement.assign(std::size_t(n), VertebraResponse::Zero());
   errors.assign(std::size_t(n), std::string());
@@ -196,8 +204,8 @@ ExternalLoad load_at_centre(int vertebra, const Eigen::Vector3d& force_n) {
 
 ResponseSamples sample_responses(const SpineModel& m, const GenerationOptions& o) {
   if (int(m.vertebrae.size()) != kDbVertebrae)
-    throw std::invalid_argument("displacement database: the model has " + std::to_string(m.vertebrae.size()) +
-                                " vertebrae, expected 17");
+    throw std::invalid_argument("displacement database: the model has " +
+                                std::to_string(m.vertebrae.size()) + " vertebrae, expected 17");
   if (!(o.force_step_n > 0) || !(o.force_max_n >= o.force_step_n) || !std::isfinite(o.force_max_n))
     throw std::invalid_argument("displacement database: need 0 < force step <= force max");
   ResponseSamples s;
@@ -206,9 +214,11 @@ ResponseSamples sample_responses(const SpineModel& m, const GenerationOptions& o
   if (s.loaded_vertebrae.empty())
     for (int v = 0; v < kDbVertebrae; ++v) s.loaded_vertebrae.push_back(v);
   for (int v : s.loaded_vertebrae)
-    if (v < 0 || v >= kDbVertebrae) throw std::invalid_argument("displacement database: vertebra index out of range");
+    if (v < 0 || v >= kDbVertebrae)
+      throw std::invalid_argument("displacement database: vertebra index out of range");
   const int steps = int(std::lround(o.force_max_n / o.force_step_n));
-  for (int k = 0; k <= steps; ++k) s.forces_n.push_back(std::min(o.force_max_n, k * o.force_step_n));
+  for (int k = 0; k <= steps; ++k)
+    s.forces_n.push_back(std::min(o.force_max_n, k * o.force_step_n));
 
   // Case 0 is the gravity-only baseline; then (vertebra, direction, force > 0).
   std::vector<std::vector<ExternalLoad>> loads = {{}};
@@ -225,17 +235,21 @@ ResponseSamples sample_responses(const SpineModel& m, const GenerationOptions& o
   solve_cases(m, loads, o.solve, o.workers, disp, errors, o.progress);
   s.seconds = seconds_since(t0);
   s.solves = int(loads.size());
-  s.workers = o.workers > 0 ? std::min(o.workers, s.solves) : int(std::max(1u, std::thread::hardware_concurrency()));
+  s.workers = o.workers > 0 ? std::min(o.workers, s.solves)
+                            : int(std::max(1u, std::thread::hardware_concurrency()));
   if (!errors[0].empty())
-    throw std::runtime_error("displacement database: the gravity-only baseline did not converge: " + errors[0]);
+    throw std::runtime_error("displacement database: the gravity-only baseline did not converge: " +
+                             errors[0]);
   s.baseline = disp[0];
 
   s.responses.resize(kDbVertebrae);
   s.solved.resize(kDbVertebrae);
   for (int v : s.loaded_vertebrae)
     for (int d = 0; d < kDbDirections; ++d) {
-      s.responses[std::size_t(v)][std::size_t(d)].assign(s.forces_n.size(), VertebraResponse::Zero());
-      s.solved[std::size_t(v)][std::size_t(d)].assign(s.forces_n.size(), true);  // 0 N: the baseline
+      s.responses[std::size_t(v)][std::size_t(d)].assign(s.forces_n.size(),
+                                                         VertebraResponse::Zero());
+      s.solved[std::size_t(v)][std::size_t(d)].assign(s.forces_n.size(),
+                                                      true);  // 0 N: the baseline
     }
   for (std::size_t i = 1; i < loads.size(); ++i) {
     const auto [v, d, k] = index[i];
@@ -243,8 +257,10 @@ ResponseSamples sample_responses(const SpineModel& m, const GenerationOptions& o
       const VertebraResponse r = disp[i] - s.baseline;
       s.responses[std::size_t(v)][std::size_t(d)][std::size_t(k)] = r;
       if (d >= 2) {  // ±y, ±z: tx, ry, rz are zero at the symmetric equilibrium
-        const double mm = r.col(0).cwiseAbs().maxCoeff(), deg = r.rightCols<2>().rowwise().norm().maxCoeff();
-        if (mm > 1e-3 || deg > 1e-3) s.out_of_plane.push_back({v, d, s.forces_n[std::size_t(k)], mm, deg});
+        const double mm = r.col(0).cwiseAbs().maxCoeff(),
+                     deg = r.rightCols<2>().rowwise().norm().maxCoeff();
+        if (mm > 1e-3 || deg > 1e-3)
+          s.out_of_plane.push_back({v, d, s.forces_n[std::size_t(k)], mm, deg});
       }
     } else {
       s.solved[std::size_t(v)][std::size_t(d)][std::size_t(k)] = false;
@@ -289,7 +305,8 @@ void DisplacementDatabase::allocate() {
 void DisplacementDatabase::set_fit(int v, int d, int series, const Eigen::VectorXd& c) {
   double* b = block(v, d);
   for (int k = 0; k < kDbMaxDegree; ++k) b[k * kSeries + series] = k < c.size() ? c[k] : 0.0;
-  degree_[std::size_t((v * kDbDirections + d) * kSeries + series)] = static_cast<unsigned char>(c.size());
+  degree_[std::size_t((v * kDbDirections + d) * kSeries + series)] =
+      static_cast<unsigned char>(c.size());
 }
 
 DisplacementDatabase DisplacementDatabase::fit(const ResponseSamples& s, const FitTolerance& tol) {
@@ -316,10 +333,10 @@ DisplacementDatabase DisplacementDatabase::fit(const ResponseSamples& s, const F
       for (std::size_t k = 1; k < s.forces_n.size(); ++k)
         if (ok[k]) used.push_back(k);
       if (used.size() < 3)
-        throw std::runtime_error("displacement database: only " + std::to_string(used.size()) + " of " +
-                                 std::to_string(s.forces_n.size() - 1) + " solves converged for " +
-                                 vertebra_names()[std::size_t(v)] + " " + direction_names()[std::size_t(d)] +
-                                 ": too few to fit");
+        throw std::runtime_error("displacement database: only " + std::to_string(used.size()) +
+                                 " of " + std::to_string(s.forces_n.size() - 1) +
+                                 " solves converged for " + vertebra_names()[std::size_t(v)] + " " +
+                                 direction_names()[std::size_t(d)] + ": too few to fit");
       Eigen::VectorXd f(Eigen::Index(used.size())), y(Eigen::Index(used.size()));
       for (std::size_t i = 0; i < used.size(); ++i) f[Eigen::Index(i)] = s.forces_n[used[i]];
       db.solved_max_[std::size_t(v)][std::size_t(d)] = f.maxCoeff();
@@ -329,15 +346,18 @@ DisplacementDatabase DisplacementDatabase::fit(const ResponseSamples& s, const F
           const PolynomialFit pf = fit_by_residual(f, y, db.force_max_n_, tol);
           db.set_fit(v, d, c * kDbVertebrae + j, pf.coefficients);
           all.add(db.info.residuals, c, pf, int(used.size()));
-          per_direction[std::size_t(d)].add(db.info.residuals_per_direction[std::size_t(d)], c, pf, int(used.size()));
+          per_direction[std::size_t(d)].add(db.info.residuals_per_direction[std::size_t(d)], c, pf,
+                                            int(used.size()));
         }
       // Per (v, d), as max_response_difference() measures: |Δ translation| and |Δ rotation| per vertebra.
       for (std::size_t k : used) {
         VertebraResponse fitted;
         db.evaluate(v, s.forces_n[k] * direction_vector(d), fitted);
         const auto [mm, deg] = max_response_difference(fitted, r[k]);
-        db.residual_t_[std::size_t(v)][std::size_t(d)] = std::max(db.residual_t_[std::size_t(v)][std::size_t(d)], mm);
-        db.residual_r_[std::size_t(v)][std::size_t(d)] = std::max(db.residual_r_[std::size_t(v)][std::size_t(d)], deg);
+        db.residual_t_[std::size_t(v)][std::size_t(d)] =
+            std::max(db.residual_t_[std::size_t(v)][std::size_t(d)], mm);
+        db.residual_r_[std::size_t(v)][std::size_t(d)] =
+            std::max(db.residual_r_[std::size_t(v)][std::size_t(d)], deg);
       }
     }
   }
@@ -347,12 +367,13 @@ DisplacementDatabase DisplacementDatabase::fit(const ResponseSamples& s, const F
   return db;
 }
 
-void DisplacementDatabase::evaluate(int v, const Eigen::Vector3d& force_n, Eigen::Ref<VertebraResponse> out) const {
+void DisplacementDatabase::evaluate(int v, const Eigen::Vector3d& force_n,
+                                    Eigen::Ref<VertebraResponse> out) const {
   if (!has_vertebra(v))
-    throw std::invalid_argument(v < 0 || v >= kDbVertebrae ? "displacement database: vertebra index " +
-                                                                 std::to_string(v) + " out of range 0..16"
-                                                           : "displacement database: no fits for vertebra " +
-                                                                 vertebra_names()[std::size_t(v)]);
+    throw std::invalid_argument(
+        v < 0 || v >= kDbVertebrae
+            ? "displacement database: vertebra index " + std::to_string(v) + " out of range 0..16"
+            : "displacement database: no fits for vertebra " + vertebra_names()[std::size_t(v)]);
   if (!force_n.allFinite()) throw std::invalid_argument("displacement database: non-finite force");
   using Series = Eigen::Matrix<double, kSeries, 1>;
   Series sum = Series::Zero();
@@ -363,7 +384,8 @@ void DisplacementDatabase::evaluate(int v, const Eigen::Vector3d& force_n, Eigen
     const double* c = block(v, 2 * axis + (f < 0 ? 1 : 0));
     // Horner on whole 102-vectors (zero-padded to degree 5): 5 fused multiply-adds per entry.
     Series p = Eigen::Map<const Series>(c + (kDbMaxDegree - 1) * kSeries);
-    for (int k = kDbMaxDegree - 2; k >= 0; --k) p = p * s + Eigen::Map<const Series>(c + k * kSeries);
+    for (int k = kDbMaxDegree - 2; k >= 0; --k)
+      p = p * s + Eigen::Map<const Series>(c + k * kSeries);
     sum += s * p;
   }
   out = Eigen::Map<const VertebraResponse>(sum.data());
@@ -377,22 +399,26 @@ bool DisplacementDatabase::in_range(int v, const Eigen::Vector3d& force_n) const
   if (!has_vertebra(v) || !in_range(force_n)) return false;
   for (int axis = 0; axis < 3; ++axis) {
     const double f = force_n[axis];
-    if (f != 0 && std::abs(f) > solved_max_[std::size_t(v)][std::size_t(2 * axis + (f < 0 ? 1 : 0))]) return false;
+    if (f != 0 &&
+        std::abs(f) > solved_max_[std::size_t(v)][std::size_t(2 * axis + (f < 0 ? 1 : 0))])
+      return false;
   }
   return true;
 }
 
 namespace {
 void check_fit_index(int v, int d, int j, int c) {
-  if (v < 0 || v >= kDbVertebrae || d < 0 || d >= kDbDirections || j < 0 || j >= kDbVertebrae || c < 0 ||
-      c >= kDbComponents)
+  if (v < 0 || v >= kDbVertebrae || d < 0 || d >= kDbDirections || j < 0 || j >= kDbVertebrae ||
+      c < 0 || c >= kDbComponents)
     throw std::invalid_argument("displacement database: fit index out of range");
 }
 }  // namespace
 
 int DisplacementDatabase::degree(int v, int d, int j, int c) const {
   check_fit_index(v, d, j, c);
-  return degree_.empty() ? 0 : degree_[std::size_t((v * kDbDirections + d) * kSeries + c * kDbVertebrae + j)];
+  return degree_.empty()
+             ? 0
+             : degree_[std::size_t((v * kDbDirections + d) * kSeries + c * kDbVertebrae + j)];
 }
 
 Eigen::VectorXd DisplacementDatabase::coefficients(int v, int d, int j, int c) const {
@@ -434,10 +460,14 @@ json number_or_null(double x) { return std::isfinite(x) ? json(x) : json(nullptr
 
 json residuals_json(const ResidualSummary& s) {
   json degrees = json::object();
-  for (int d = 1; d <= kDbMaxDegree; ++d) degrees[std::to_string(d)] = s.degree_count[std::size_t(d)];
-  return {{"max_translation_mm", s.max_translation_mm}, {"rms_translation_mm", s.rms_translation_mm},
-          {"max_rotation_deg", s.max_rotation_deg},     {"rms_rotation_deg", s.rms_rotation_deg},
-          {"fits", s.fits},                             {"fits_above_tolerance", s.fits_above_tolerance},
+  for (int d = 1; d <= kDbMaxDegree; ++d)
+    degrees[std::to_string(d)] = s.degree_count[std::size_t(d)];
+  return {{"max_translation_mm", s.max_translation_mm},
+          {"rms_translation_mm", s.rms_translation_mm},
+          {"max_rotation_deg", s.max_rotation_deg},
+          {"rms_rotation_deg", s.rms_rotation_deg},
+          {"fits", s.fits},
+          {"fits_above_tolerance", s.fits_above_tolerance},
           {"fits_per_degree", degrees}};
 }
 
@@ -449,33 +479,42 @@ ResidualSummary residuals_from_json(const json& j) {
   s.rms_rotation_deg = j.at("rms_rotation_deg").get<double>();
   s.fits = j.at("fits").get<int>();
   s.fits_above_tolerance = j.at("fits_above_tolerance").get<int>();
-  for (int d = 1; d <= kDbMaxDegree; ++d) s.degree_count[std::size_t(d)] = j.at("fits_per_degree").at(std::to_string(d)).get<int>();
+  for (int d = 1; d <= kDbMaxDegree; ++d)
+    s.degree_count[std::size_t(d)] = j.at("fits_per_degree").at(std::to_string(d)).get<int>();
   return s;
 }
 
-std::string vertebra_or_baseline(int v) { return v >= 0 ? vertebra_names()[std::size_t(v)] : "baseline"; }
+std::string vertebra_or_baseline(int v) {
+  return v >= 0 ? vertebra_names()[std::size_t(v)] : "baseline";
+}
 
 json superposition_json(const SuperpositionReport& r) {
   json cases = json::array();
   for (const auto& c : r.cases)
-    cases.push_back({{"vertebra", vertebra_names()[std::size_t(c.vertebra)]},
-                     {"plane", c.plane},
-                     {"force_n", {c.force_n.x(), c.force_n.y(), c.force_n.z()}},
-                     {"solved", c.solved},
-                     {"extrapolated", c.extrapolated},
-                     {"message", c.message},
-                     {"response_translation_mm", c.response_translation_mm},
-                     {"response_rotation_deg", c.response_rotation_deg},
-                     {"db_error_translation_mm", number_or_null(c.db_error_translation_mm)},
-                     {"db_error_rotation_deg", number_or_null(c.db_error_rotation_deg)},
-                     {"axis_sum_error_translation_mm", number_or_null(c.axis_sum_error_translation_mm)},
-                     {"axis_sum_error_rotation_deg", number_or_null(c.axis_sum_error_rotation_deg)}});
+    cases.push_back(
+        {{"vertebra", vertebra_names()[std::size_t(c.vertebra)]},
+         {"plane", c.plane},
+         {"force_n", {c.force_n.x(), c.force_n.y(), c.force_n.z()}},
+         {"solved", c.solved},
+         {"extrapolated", c.extrapolated},
+         {"message", c.message},
+         {"response_translation_mm", c.response_translation_mm},
+         {"response_rotation_deg", c.response_rotation_deg},
+         {"db_error_translation_mm", number_or_null(c.db_error_translation_mm)},
+         {"db_error_rotation_deg", number_or_null(c.db_error_rotation_deg)},
+         {"axis_sum_error_translation_mm", number_or_null(c.axis_sum_error_translation_mm)},
+         {"axis_sum_error_rotation_deg", number_or_null(c.axis_sum_error_rotation_deg)}});
   return {{"what",
-           "oblique force F on a vertebra: the database's superposition of its axis fits (db) and the sum of "
-           "direct solves at each axis component (axis_sum), both against a direct solve of F; errors are the "
-           "max over the 17 vertebrae of |Δ translation| (mm) and |Δ rotation vector| (deg); relative = error / "
-           "the max over the vertebrae of the direct response's |translation| (|rotation|); extrapolated: the force "
-           "needs an axis fit beyond its largest solved force, so its db error is left out of the maxima"},
+           "oblique force F on a vertebra: the database's superposition of its axis fits (db) and "
+           "the sum of "
+           "direct solves at each axis component (axis_sum), both against a direct solve of F; "
+           "errors are the "
+           "max over the 17 vertebrae of |Δ translation| (mm) and |Δ rotation vector| (deg); "
+           "relative = error / "
+           "the max over the vertebrae of the direct response's |translation| (|rotation|); "
+           "extrapolated: the force "
+           "needs an axis fit beyond its largest solved force, so its db error is left out of the "
+           "maxima"},
           {"max_db_translation_mm", r.max_db_translation_mm},
           {"max_db_rotation_deg", r.max_db_rotation_deg},
           {"max_db_translation_relative", r.max_db_translation_relative},
@@ -506,7 +545,8 @@ SuperpositionReport superposition_from_json(const json& j) {
     s.vertebra = vertebra_index(c.at("vertebra").get<std::string>());
     s.plane = c.at("plane").get<std::string>();
     const auto& f = c.at("force_n");
-    s.force_n = Eigen::Vector3d(f.at(0).get<double>(), f.at(1).get<double>(), f.at(2).get<double>());
+    s.force_n =
+        Eigen::Vector3d(f.at(0).get<double>(), f.at(1).get<double>(), f.at(2).get<double>());
     s.solved = c.at("solved").get<bool>();
     s.extrapolated = c.at("extrapolated").get<bool>();
     s.message = c.at("message").get<std::string>();
@@ -524,22 +564,24 @@ SuperpositionReport superposition_from_json(const json& j) {
 json model_json(const DatabaseInfo& i) {
   json fused = json::array();
   for (int j : i.model.fused_joints) fused.push_back(joint_names().at(std::size_t(j)));
-  return {{"fused_joints", fused},
-          {"ligaments", i.model.ligaments},
-          {"muscles", i.model.muscles},
-          {"iap", i.model.iap},
-          {"gravity", i.model.gravity},
-          {"arms_forward", i.model.arms_forward},
-          {"body_mass_kg", i.model.body_mass_kg},
-          {"recruit", i.solve.recruit},
-          {"criterion", i.solve.recruitment.criterion == Criterion::MinMax ? "min-max" : "polynomial"},
-          {"criterion_power", i.solve.recruitment.power},
-          {"solve_tolerance_nmm", i.solve.tolerance}};
+  return {
+      {"fused_joints", fused},
+      {"ligaments", i.model.ligaments},
+      {"muscles", i.model.muscles},
+      {"iap", i.model.iap},
+      {"gravity", i.model.gravity},
+      {"arms_forward", i.model.arms_forward},
+      {"body_mass_kg", i.model.body_mass_kg},
+      {"recruit", i.solve.recruit},
+      {"criterion", i.solve.recruitment.criterion == Criterion::MinMax ? "min-max" : "polynomial"},
+      {"criterion_power", i.solve.recruitment.power},
+      {"solve_tolerance_nmm", i.solve.tolerance}};
 }
 
 void model_from_json(const json& j, DatabaseInfo& i) {
   i.model.fused_joints.clear();
-  for (const auto& n : j.at("fused_joints")) i.model.fused_joints.push_back(joint_index(n.get<std::string>()));
+  for (const auto& n : j.at("fused_joints"))
+    i.model.fused_joints.push_back(joint_index(n.get<std::string>()));
   i.model.ligaments = j.at("ligaments").get<bool>();
   i.model.muscles = j.at("muscles").get<bool>();
   i.model.iap = j.at("iap").get<bool>();
@@ -549,8 +591,10 @@ void model_from_json(const json& j, DatabaseInfo& i) {
   i.solve = SolveOptions();
   i.solve.recruit = j.at("recruit").get<bool>();
   const std::string criterion = j.at("criterion").get<std::string>();
-  if (criterion != "polynomial" && criterion != "min-max") throw std::runtime_error("unknown criterion " + criterion);
-  i.solve.recruitment.criterion = criterion == "min-max" ? Criterion::MinMax : Criterion::Polynomial;
+  if (criterion != "polynomial" && criterion != "min-max")
+    throw std::runtime_error("unknown criterion " + criterion);
+  i.solve.recruitment.criterion =
+      criterion == "min-max" ? Criterion::MinMax : Criterion::Polynomial;
   i.solve.recruitment.power = j.at("criterion_power").get<double>();
   i.solve.tolerance = j.at("solve_tolerance_nmm").get<double>();
 }
@@ -565,57 +609,77 @@ double finite(const json& j) {
 }  // namespace
 
 void DisplacementDatabase::save(const std::string& path) const {
-  if (coef_.empty()) throw std::runtime_error("displacement database: nothing to save (not fitted or loaded)");
+  if (coef_.empty())
+    throw std::runtime_error("displacement database: nothing to save (not fitted or loaded)");
   json head = json::object();  // small metadata first, pretty; then one line per fit
   head["kind"] = kKind;
   head["format_version"] = kFormatVersion;
   head["generated_by"] = info.generated_by;
   head["source"] = info.source;
-  head["units"] = "force N; translation mm (F.1 centre); rotation deg (rotation vector, world axes); "
-                  "frame x lateral (body's right = -x), y superior, z anterior";
-  head["response"] = "displacement(force on the vertebra's F.1 centre, with gravity) - displacement(gravity only), "
-                     "componentwise; the gravity-only displacement is 'baseline'";
-  head["basis"] = "value(f) = sum_{k=1..degree} c[k-1] * s^k, s = f / force_max_n (no constant term)";
-  head["fit_fields"] = "per loaded vertebra and direction: solved_max_n (largest force solved), max_residual_mm / "
-                       "max_residual_deg (worst |fit - sample| of a vertebra's translation / rotation vector over the "
-                       "solved forces and the 17 vertebrae), c[responding vertebra][component] = c_1..c_degree";
+  head["units"] =
+      "force N; translation mm (F.1 centre); rotation deg (rotation vector, world axes); "
+      "frame x lateral (body's right = -x), y superior, z anterior";
+  head["response"] =
+      "displacement(force on the vertebra's F.1 centre, with gravity) - displacement(gravity "
+      "only), "
+      "componentwise; the gravity-only displacement is 'baseline'";
+  head["basis"] =
+      "value(f) = sum_{k=1..degree} c[k-1] * s^k, s = f / force_max_n (no constant term)";
+  head["fit_fields"] =
+      "per loaded vertebra and direction: solved_max_n (largest force solved), max_residual_mm / "
+      "max_residual_deg (worst |fit - sample| of a vertebra's translation / rotation vector over "
+      "the "
+      "solved forces and the 17 vertebrae), c[responding vertebra][component] = c_1..c_degree";
   head["model"] = model_json(info);
   head["force_max_n"] = force_max_n_;
   head["forces_n"] = forces_n_;
   head["vertebrae"] = vertebra_names();
   head["directions"] = direction_names();
   head["components"] = kComponentNames;
-  head["fit_tolerance"] = {{"relative", info.tolerance.relative}, {"absolute", info.tolerance.absolute},
-                           {"max_degree", info.tolerance.max_degree}, {"quantum", info.tolerance.quantum},
-                           {"rule", "lowest degree whose RMS residual <= max(relative * range, absolute)"}};
+  head["fit_tolerance"] = {
+      {"relative", info.tolerance.relative},
+      {"absolute", info.tolerance.absolute},
+      {"max_degree", info.tolerance.max_degree},
+      {"quantum", info.tolerance.quantum},
+      {"rule", "lowest degree whose RMS residual <= max(relative * range, absolute)"}};
   head["residuals"] = residuals_json(info.residuals);
   json per_direction = json::object();
   for (int d = 0; d < kDbDirections; ++d)
-    per_direction[direction_names()[std::size_t(d)]] = residuals_json(info.residuals_per_direction[std::size_t(d)]);
+    per_direction[direction_names()[std::size_t(d)]] =
+        residuals_json(info.residuals_per_direction[std::size_t(d)]);
   head["residuals_per_direction"] = per_direction;
   json failed = json::array();
   for (const auto& f : info.failed)
-    failed.push_back({{"vertebra", vertebra_or_baseline(f.vertebra)},
-                      {"direction", f.direction >= 0 ? direction_names()[std::size_t(f.direction)] : ""},
-                      {"force_n", f.force_n}, {"message", f.message}});
+    failed.push_back(
+        {{"vertebra", vertebra_or_baseline(f.vertebra)},
+         {"direction", f.direction >= 0 ? direction_names()[std::size_t(f.direction)] : ""},
+         {"force_n", f.force_n},
+         {"message", f.message}});
   head["failed_solves"] = failed;
   json out_of_plane = json::array();
   for (const auto& o : info.out_of_plane)
     out_of_plane.push_back({{"vertebra", vertebra_names()[std::size_t(o.vertebra)]},
-                            {"direction", direction_names()[std::size_t(o.direction)]}, {"force_n", o.force_n},
-                            {"lateral_mm", o.lateral_mm}, {"lateral_deg", o.lateral_deg}});
-  head["out_of_plane_solves"] = {
-      {"what", "sagittal-plane forces (+-y, +-z) whose solution left the sagittal plane (max |tx| > 0.001 mm or "
-               "|(ry, rz)| > 0.001 deg over the vertebrae): the model is symmetric about x = 0, so these solves found "
-               "a non-symmetric equilibrium; they are kept in the fits"},
-      {"solves", out_of_plane}};
-  head["superposition_check"] = info.has_superposition ? superposition_json(info.superposition) : json(nullptr);
-  head["generation"] = {{"seconds", info.generation_seconds}, {"solves", info.solves}, {"workers", info.workers}};
+                            {"direction", direction_names()[std::size_t(o.direction)]},
+                            {"force_n", o.force_n},
+                            {"lateral_mm", o.lateral_mm},
+                            {"lateral_deg", o.lateral_deg}});
+  head["out_of_plane_solves"] = {{"what",
+                                  "sagittal-plane forces (+-y, +-z) whose solution left the "
+                                  "sagittal plane (max |tx| > 0.001 mm or "
+                                  "|(ry, rz)| > 0.001 deg over the vertebrae): the model is "
+                                  "symmetric about x = 0, so these solves found "
+                                  "a non-symmetric equilibrium; they are kept in the fits"},
+                                 {"solves", out_of_plane}};
+  head["superposition_check"] =
+      info.has_superposition ? superposition_json(info.superposition) : json(nullptr);
+  head["generation"] = {
+      {"seconds", info.generation_seconds}, {"solves", info.solves}, {"workers", info.workers}};
   head["baseline"] = matrix_json(baseline_);
 
   std::ostringstream text;
   const std::string h = head.dump(1);
-  text << h.substr(0, h.size() - 2) << ",\n \"fits\": [\n";  // reopen the object before its closing "\n}"
+  text << h.substr(0, h.size() - 2)
+       << ",\n \"fits\": [\n";  // reopen the object before its closing "\n}"
   bool first = true;
   for (int v = 0; v < kDbVertebrae; ++v) {
     if (!present_[std::size_t(v)]) continue;
@@ -651,7 +715,8 @@ DisplacementDatabase DisplacementDatabase::load(const std::string& path) {
   try {
     const json j = json::parse(in);
     if (!j.is_object() || j.value("kind", "") != kKind)
-      throw std::runtime_error(std::string("not a displacement database (\"kind\" is not \"") + kKind + "\")");
+      throw std::runtime_error(std::string("not a displacement database (\"kind\" is not \"") +
+                               kKind + "\")");
     if (j.at("format_version").get<int>() != kFormatVersion)
       throw std::runtime_error("format_version " + j.at("format_version").dump() + ", expected " +
                                std::to_string(kFormatVersion));
@@ -663,21 +728,24 @@ DisplacementDatabase DisplacementDatabase::load(const std::string& path) {
     if (!(db.force_max_n_ > 0)) throw std::runtime_error("force_max_n must be > 0");
     for (const auto& f : j.at("forces_n")) db.forces_n_.push_back(finite(f));
     const auto& tol = j.at("fit_tolerance");
-    db.info.tolerance = {finite(tol.at("relative")), finite(tol.at("absolute")), tol.at("max_degree").get<int>(),
-                         finite(tol.at("quantum"))};
+    db.info.tolerance = {finite(tol.at("relative")), finite(tol.at("absolute")),
+                         tol.at("max_degree").get<int>(), finite(tol.at("quantum"))};
     db.info.residuals = residuals_from_json(j.at("residuals"));
     for (int d = 0; d < kDbDirections; ++d)
-      db.info.residuals_per_direction[std::size_t(d)] =
-          residuals_from_json(j.at("residuals_per_direction").at(direction_names()[std::size_t(d)]));
+      db.info.residuals_per_direction[std::size_t(d)] = residuals_from_json(
+          j.at("residuals_per_direction").at(direction_names()[std::size_t(d)]));
     for (const auto& f : j.at("failed_solves")) {
-      const std::string v = f.at("vertebra").get<std::string>(), d = f.at("direction").get<std::string>();
-      db.info.failed.push_back({v == "baseline" ? -1 : vertebra_index(v), d.empty() ? -1 : direction_index(d),
-                                f.at("force_n").get<double>(), f.at("message").get<std::string>()});
+      const std::string v = f.at("vertebra").get<std::string>(),
+                        d = f.at("direction").get<std::string>();
+      db.info.failed.push_back({v == "baseline" ? -1 : vertebra_index(v),
+                                d.empty() ? -1 : direction_index(d), f.at("force_n").get<double>(),
+                                f.at("message").get<std::string>()});
     }
     for (const auto& o : j.at("out_of_plane_solves").at("solves"))
       db.info.out_of_plane.push_back({vertebra_index(o.at("vertebra").get<std::string>()),
-                                      direction_index(o.at("direction").get<std::string>()), finite(o.at("force_n")),
-                                      finite(o.at("lateral_mm")), finite(o.at("lateral_deg"))});
+                                      direction_index(o.at("direction").get<std::string>()),
+                                      finite(o.at("force_n")), finite(o.at("lateral_mm")),
+                                      finite(o.at("lateral_deg"))});
     if (!j.at("superposition_check").is_null()) {
       db.info.has_superposition = true;
       db.info.superposition = superposition_from_json(j.at("superposition_check"));
@@ -689,8 +757,10 @@ DisplacementDatabase DisplacementDatabase::load(const std::string& path) {
     const auto& b = j.at("baseline");
     if (b.size() != kDbVertebrae) throw std::runtime_error("baseline must have 17 rows");
     for (int r = 0; r < kDbVertebrae; ++r) {
-      if (b.at(std::size_t(r)).size() != kDbComponents) throw std::runtime_error("baseline rows must have 6 values");
-      for (int c = 0; c < kDbComponents; ++c) db.baseline_(r, c) = finite(b.at(std::size_t(r)).at(std::size_t(c)));
+      if (b.at(std::size_t(r)).size() != kDbComponents)
+        throw std::runtime_error("baseline rows must have 6 values");
+      for (int c = 0; c < kDbComponents; ++c)
+        db.baseline_(r, c) = finite(b.at(std::size_t(r)).at(std::size_t(c)));
     }
     for (const auto& fit : j.at("fits")) {
       const int v = vertebra_index(fit.at("vertebra").get<std::string>());
@@ -700,13 +770,16 @@ DisplacementDatabase DisplacementDatabase::load(const std::string& path) {
       db.residual_t_[std::size_t(v)][std::size_t(d)] = finite(fit.at("max_residual_mm"));
       db.residual_r_[std::size_t(v)][std::size_t(d)] = finite(fit.at("max_residual_deg"));
       const auto& c = fit.at("c");
-      if (c.size() != kDbVertebrae) throw std::runtime_error("a fit must have 17 responding vertebrae");
+      if (c.size() != kDbVertebrae)
+        throw std::runtime_error("a fit must have 17 responding vertebrae");
       for (int r = 0; r < kDbVertebrae; ++r) {
-        if (c.at(std::size_t(r)).size() != kDbComponents) throw std::runtime_error("a fit row must have 6 components");
+        if (c.at(std::size_t(r)).size() != kDbComponents)
+          throw std::runtime_error("a fit row must have 6 components");
         for (int k = 0; k < kDbComponents; ++k) {
           const auto& cs = c.at(std::size_t(r)).at(std::size_t(k));
           if (!cs.is_array() || cs.empty() || cs.size() > std::size_t(kDbMaxDegree))
-            throw std::runtime_error("a fit needs 1.." + std::to_string(kDbMaxDegree) + " coefficients");
+            throw std::runtime_error("a fit needs 1.." + std::to_string(kDbMaxDegree) +
+                                     " coefficients");
           Eigen::VectorXd coeff(Eigen::Index(cs.size()));
           for (std::size_t i = 0; i < cs.size(); ++i) coeff[Eigen::Index(i)] = finite(cs.at(i));
           db.set_fit(v, d, k * kDbVertebrae + r, coeff);
@@ -716,7 +789,8 @@ DisplacementDatabase DisplacementDatabase::load(const std::string& path) {
     // Every present vertebra needs all six directions, or evaluate() would silently add zeros.
     for (int v = 0; v < kDbVertebrae; ++v)
       for (int d = 0; d < kDbDirections; ++d)
-        if (db.present_[std::size_t(v)] && db.degree_[std::size_t((v * kDbDirections + d) * kSeries)] == 0)
+        if (db.present_[std::size_t(v)] &&
+            db.degree_[std::size_t((v * kDbDirections + d) * kSeries)] == 0)
           throw std::runtime_error("no fit for " + vertebra_names()[std::size_t(v)] + " " +
                                    direction_names()[std::size_t(d)]);
   } catch (const std::exception& e) {
@@ -727,18 +801,25 @@ DisplacementDatabase DisplacementDatabase::load(const std::string& path) {
 
 // --- superposition check ---------------------------------------------------------------------
 
-std::string superposition_json_text(const SuperpositionReport& report) { return superposition_json(report).dump(); }
+std::string superposition_json_text(const SuperpositionReport& report) {
+  return superposition_json(report).dump();
+}
 
-std::pair<double, double> max_response_difference(const VertebraResponse& a, const VertebraResponse& b) {
+std::pair<double, double> max_response_difference(const VertebraResponse& a,
+                                                  const VertebraResponse& b) {
   const VertebraResponse d = a - b;
-  return {d.leftCols<3>().rowwise().norm().maxCoeff(), d.rightCols<3>().rowwise().norm().maxCoeff()};
+  return {d.leftCols<3>().rowwise().norm().maxCoeff(),
+          d.rightCols<3>().rowwise().norm().maxCoeff()};
 }
 
 std::vector<SuperpositionCase> superposition_cases(const std::vector<int>& vertebrae,
                                                    const std::vector<double>& magnitudes_n) {
   const std::vector<std::pair<std::string, Eigen::Vector3d>> directions = {
-      {"xz", Eigen::Vector3d(1, 0, 1)},  {"xy", Eigen::Vector3d(1, 1, 0)},     {"yz", Eigen::Vector3d(0, 1, 1)},
-      {"xyz", Eigen::Vector3d(1, 1, 1)}, {"-x-y-z", Eigen::Vector3d(-1, -1, -1)}};
+      {"xz", Eigen::Vector3d(1, 0, 1)},
+      {"xy", Eigen::Vector3d(1, 1, 0)},
+      {"yz", Eigen::Vector3d(0, 1, 1)},
+      {"xyz", Eigen::Vector3d(1, 1, 1)},
+      {"-x-y-z", Eigen::Vector3d(-1, -1, -1)}};
   std::vector<SuperpositionCase> cases;
   for (int v : vertebrae)
     for (const auto& [plane, dir] : directions)
@@ -753,7 +834,8 @@ std::vector<SuperpositionCase> superposition_cases(const std::vector<int>& verte
 }
 
 SuperpositionReport check_superposition(const SpineModel& m, const DisplacementDatabase& db,
-                                        std::vector<SuperpositionCase> cases, const SolveOptions& options, int workers,
+                                        std::vector<SuperpositionCase> cases,
+                                        const SolveOptions& options, int workers,
                                         const std::function<void(int, int)>& progress) {
   const auto t0 = std::chrono::steady_clock::now();
   // Unique load cases: the baseline, each oblique force, each of its axis components.
@@ -782,7 +864,8 @@ SuperpositionReport check_superposition(const SpineModel& m, const DisplacementD
   std::vector<VertebraResponse> disp;
   std::vector<std::string> errors;
   solve_cases(m, loads, options, workers, disp, errors, progress);
-  if (!errors[0].empty()) throw std::runtime_error("superposition check: the gravity-only solve failed: " + errors[0]);
+  if (!errors[0].empty())
+    throw std::runtime_error("superposition check: the gravity-only solve failed: " + errors[0]);
 
   SuperpositionReport r;
   for (std::size_t i = 0; i < cases.size(); ++i) {
@@ -798,7 +881,8 @@ SuperpositionReport check_superposition(const SpineModel& m, const DisplacementD
     const VertebraResponse reference = disp[direct[i]] - disp[0];
     VertebraResponse from_db;
     db.evaluate(c.vertebra, c.force_n, from_db);
-    std::tie(c.db_error_translation_mm, c.db_error_rotation_deg) = max_response_difference(from_db, reference);
+    std::tie(c.db_error_translation_mm, c.db_error_rotation_deg) =
+        max_response_difference(from_db, reference);
     std::tie(c.response_translation_mm, c.response_rotation_deg) =
         max_response_difference(reference, VertebraResponse::Zero());
     VertebraResponse sum = VertebraResponse::Zero();
@@ -808,7 +892,8 @@ SuperpositionReport check_superposition(const SpineModel& m, const DisplacementD
       sum += disp[a] - disp[0];
     }
     if (c.message.empty())
-      std::tie(c.axis_sum_error_translation_mm, c.axis_sum_error_rotation_deg) = max_response_difference(sum, reference);
+      std::tie(c.axis_sum_error_translation_mm, c.axis_sum_error_rotation_deg) =
+          max_response_difference(sum, reference);
     else
       c.axis_sum_error_translation_mm = c.axis_sum_error_rotation_deg = std::nan("");
     auto worst = [](double& w, double x) {
@@ -818,13 +903,16 @@ SuperpositionReport check_superposition(const SpineModel& m, const DisplacementD
     if (!c.extrapolated) {
       worst(r.max_db_translation_mm, c.db_error_translation_mm);
       worst(r.max_db_rotation_deg, c.db_error_rotation_deg);
-      worst(r.max_db_translation_relative, rel(c.db_error_translation_mm, c.response_translation_mm));
+      worst(r.max_db_translation_relative,
+            rel(c.db_error_translation_mm, c.response_translation_mm));
       worst(r.max_db_rotation_relative, rel(c.db_error_rotation_deg, c.response_rotation_deg));
     }
     worst(r.max_axis_sum_translation_mm, c.axis_sum_error_translation_mm);
     worst(r.max_axis_sum_rotation_deg, c.axis_sum_error_rotation_deg);
-    worst(r.max_axis_sum_translation_relative, rel(c.axis_sum_error_translation_mm, c.response_translation_mm));
-    worst(r.max_axis_sum_rotation_relative, rel(c.axis_sum_error_rotation_deg, c.response_rotation_deg));
+    worst(r.max_axis_sum_translation_relative,
+          rel(c.axis_sum_error_translation_mm, c.response_translation_mm));
+    worst(r.max_axis_sum_rotation_relative,
+          rel(c.axis_sum_error_rotation_deg, c.response_rotation_deg));
   }
   r.cases = std::move(cases);
   r.seconds = seconds_since(t0);

@@ -63,10 +63,11 @@ constexpr double kLigamentToeMm = 0.05;
 double smooth_half_square(double x, double w, double& dx) { return bump_energy(x, w, dx); }
 
 /// Spring with stiffness k_pos for x > 0 and k_neg for x < 0, and a stiff bump beyond the limits.
-double axis_energy(double x, double k_pos, double k_neg, double lim_pos, double lim_neg, double bump, double onset,
-                   double& dE) {
+double axis_energy(double x, double k_pos, double k_neg, double lim_pos, double lim_neg,
+                   double bump, double onset, double& dE) {
   double dq = 0;
-  double E = 0.5 * k_neg * x * x + (k_pos - k_neg) * smooth_half_square(x, kFlexExtBlendRad, dq), ds = 0;
+  double E = 0.5 * k_neg * x * x + (k_pos - k_neg) * smooth_half_square(x, kFlexExtBlendRad, dq),
+         ds = 0;
   dE = k_neg * x + (k_pos - k_neg) * dq;
   if (x > lim_pos) {
     E += bump * k_pos * bump_energy(x - lim_pos, onset, ds);
@@ -81,7 +82,8 @@ double axis_energy(double x, double k_pos, double k_neg, double lim_pos, double 
 /// Joint spring energy and its gradient in θ (x flexion/extension, y torsion, z lateral bending).
 double joint_energy(const SpineModel& m, const Joint& j, const Vector3d& th, Vector3d& dE) {
   const double b = m.rom_bump_factor, w = m.rom_bump_onset;
-  return axis_energy(th.x(), j.k_flexion, j.k_extension, j.rom_flexion, j.rom_extension, b, w, dE.x()) +
+  return axis_energy(th.x(), j.k_flexion, j.k_extension, j.rom_flexion, j.rom_extension, b, w,
+                     dE.x()) +
          axis_energy(th.y(), j.k_torsion, j.k_torsion, j.rom_torsion, j.rom_torsion, b, w, dE.y()) +
          axis_energy(th.z(), j.k_lateral, j.k_lateral, j.rom_lateral, j.rom_lateral, b, w, dE.z());
 }
@@ -100,7 +102,8 @@ struct State {
   explicit State(std::size_t n) : loads(n) {}
 };
 
-State evaluate(const SpineModel& m, const std::vector<ExternalLoad>& ext, const VectorXd& F, const VectorXd& theta) {
+State evaluate(const SpineModel& m, const std::vector<ExternalLoad>& ext, const VectorXd& F,
+               const VectorXd& theta) {
   const std::size_t n = m.joints.size();
   State s(n);
   s.poses = vertebra_poses(m, theta);
@@ -186,7 +189,8 @@ Vector3d joint_point(const SpineModel& m, const std::vector<Pose>& P, std::size_
 }
 
 /// For every joint: the resultant force on, and moment about the joint of, everything above it.
-void resultants_above(const SpineModel& m, const State& s, std::vector<Vector3d>& force, std::vector<Vector3d>& moment) {
+void resultants_above(const SpineModel& m, const State& s, std::vector<Vector3d>& force,
+                      std::vector<Vector3d>& moment) {
   const std::size_t n = m.joints.size();
   force.assign(n, Vector3d::Zero());
   moment.assign(n, Vector3d::Zero());
@@ -218,13 +222,17 @@ VectorXd gradient_of(const SpineModel& m, const State& s, const VectorXd& theta)
   return g;
 }
 
-void check_loads(const SpineModel& m, const std::vector<ExternalLoad>& loads, std::vector<std::string>* warnings) {
+void check_loads(const SpineModel& m, const std::vector<ExternalLoad>& loads,
+                 std::vector<std::string>* warnings) {
   for (const auto& l : loads) {
     if (l.vertebra < 0 || l.vertebra >= int(m.vertebrae.size()))
       throw std::invalid_argument("external load on vertebra index " + std::to_string(l.vertebra) +
-                                  " (valid: 0.." + std::to_string(m.vertebrae.size() - 1) + ", T1..L5)");
-    if (!l.force_n.allFinite() || !l.moment_nmm.allFinite() || (l.has_point && !l.point_mm.allFinite()))
-      throw std::invalid_argument("external load on " + m.vertebrae[std::size_t(l.vertebra)].name + " is not finite");
+                                  " (valid: 0.." + std::to_string(m.vertebrae.size() - 1) +
+                                  ", T1..L5)");
+    if (!l.force_n.allFinite() || !l.moment_nmm.allFinite() ||
+        (l.has_point && !l.point_mm.allFinite()))
+      throw std::invalid_argument("external load on " + m.vertebrae[std::size_t(l.vertebra)].name +
+                                  " is not finite");
     if (warnings && l.force_n.norm() > kThesisForceLimitN) {
       std::ostringstream w;
       w << "force of " << l.force_n.norm() << " N on " << m.vertebrae[std::size_t(l.vertebra)].name
@@ -241,8 +249,8 @@ const char* const kAxisNames[] = {"flexion/extension", "torsion", "lateral bendi
 class Newton {
  public:
   /// `sagittal_only`: flexion/extension coordinates only (a symmetric model under sagittal loads).
-  Newton(const SpineModel& m, const std::vector<ExternalLoad>& loads, const VectorXd& F, const SolveOptions& o,
-         bool sagittal_only)
+  Newton(const SpineModel& m, const std::vector<ExternalLoad>& loads, const VectorXd& F,
+         const SolveOptions& o, bool sagittal_only)
       : m_(m), loads_(loads), F_(F), o_(o) {
     for (std::size_t k = 0; k < m.joints.size(); ++k)
       if (!m.joints[k].fused)
@@ -286,8 +294,9 @@ class Newton {
       Eigen::Index at = 0;
       g.cwiseAbs().maxCoeff(&at);
       std::ostringstream msg;
-      msg << "spine equilibrium did not converge: " << it << " Newton iterations, max |dPi/dtheta| = " << gradient_norm
-          << " N*mm (tolerance " << tolerance << ") at joint " << m_.joints[std::size_t(at / 3)].name << " ("
+      msg << "spine equilibrium did not converge: " << it
+          << " Newton iterations, max |dPi/dtheta| = " << gradient_norm << " N*mm (tolerance "
+          << tolerance << ") at joint " << m_.joints[std::size_t(at / 3)].name << " ("
           << kAxisNames[at % 3] << ")";
       throw SolveError(msg.str());
     }
@@ -352,14 +361,16 @@ class Newton {
 /// Loads in the sagittal plane x = 0: forces without x component at x = 0, moments about x only.
 bool sagittal(const std::vector<ExternalLoad>& loads) {
   for (const auto& l : loads)
-    if (l.force_n.x() != 0 || l.moment_nmm.y() != 0 || l.moment_nmm.z() != 0 || (l.has_point && l.point_mm.x() != 0))
+    if (l.force_n.x() != 0 || l.moment_nmm.y() != 0 || l.moment_nmm.z() != 0 ||
+        (l.has_point && l.point_mm.x() != 0))
       return false;
   return true;
 }
 
 /// A point and its mirror image x → −x are the same to round-off.
 bool mirrored(const Vector3d& a, const Vector3d& b) {
-  return std::abs(a.x() + b.x()) < 1e-9 && std::abs(a.y() - b.y()) < 1e-9 && std::abs(a.z() - b.z()) < 1e-9;
+  return std::abs(a.x() + b.x()) < 1e-9 && std::abs(a.y() - b.y()) < 1e-9 &&
+         std::abs(a.z() - b.z()) < 1e-9;
 }
 
 /// Is the model its own mirror image in x → −x? (Joints, vertebrae and the bushing lie in x = 0
@@ -379,20 +390,30 @@ bool mirror_symmetric(const SpineModel& m) {
     return true;
   };
   auto line_twin = [](const Line& a, const Line& b) {
-    return a.body_a == b.body_a && a.body_b == b.body_b && mirrored(a.a_mm, b.a_mm) && mirrored(a.b_mm, b.b_mm);
+    return a.body_a == b.body_a && a.body_b == b.body_b && mirrored(a.a_mm, b.a_mm) &&
+           mirrored(a.b_mm, b.b_mm);
   };
-  return has_twin(m.muscles, [&](const Muscle& a, const Muscle& b) { return line_twin(a, b) && a.pcsa_mm2 == b.pcsa_mm2 && a.max_stress_mpa == b.max_stress_mpa; }) &&
-         has_twin(m.ligaments, [&](const Ligament& a, const Ligament& b) { return line_twin(a, b) && a.k_n_per_mm == b.k_n_per_mm; }) &&
+  return has_twin(m.muscles,
+                  [&](const Muscle& a, const Muscle& b) {
+                    return line_twin(a, b) && a.pcsa_mm2 == b.pcsa_mm2 &&
+                           a.max_stress_mpa == b.max_stress_mpa;
+                  }) &&
+         has_twin(m.ligaments,
+                  [&](const Ligament& a, const Ligament& b) {
+                    return line_twin(a, b) && a.k_n_per_mm == b.k_n_per_mm;
+                  }) &&
          has_twin(m.weights, [](const PointLoad& a, const PointLoad& b) {
-           return a.body == b.body && mirrored(a.point_mm, b.point_mm) && a.force_n.x() == -b.force_n.x() &&
-                  a.force_n.y() == b.force_n.y() && a.force_n.z() == b.force_n.z();
+           return a.body == b.body && mirrored(a.point_mm, b.point_mm) &&
+                  a.force_n.x() == -b.force_n.x() && a.force_n.y() == b.force_n.y() &&
+                  a.force_n.z() == b.force_n.z();
          });
 }
 
 /// Stability at the solution: the smallest eigenvalue of the tangent stiffness over all free
 /// coordinates and its mode. Not stable: a warning (a sagittal solve there is the symmetric
 /// equilibrium the spine would buckle away from; static-optimisation muscles do not co-contract).
-void assess_stability(const SpineModel& m, const Newton& full, const VectorXd& theta, SpineSolution& out) {
+void assess_stability(const SpineModel& m, const Newton& full, const VectorXd& theta,
+                      SpineSolution& out) {
   if (full.size() == 0) return;
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(full.hessian(theta));
   out.min_stiffness_nmm_per_rad = eig.eigenvalues()[0];
@@ -401,9 +422,10 @@ void assess_stability(const SpineModel& m, const Newton& full, const VectorXd& t
   const Eigen::Index dof = full.coordinate(at);
   out.softest_mode = m.joints[std::size_t(dof / 3)].name + " " + kAxisNames[dof % 3];
   if (!(out.min_stiffness_nmm_per_rad > 0))
-    out.warnings.push_back("the equilibrium is not stable: smallest tangent stiffness " +
-                           std::to_string(out.min_stiffness_nmm_per_rad) + " N*mm/rad, mostly " + out.softest_mode +
-                           (out.sagittal_solve ? " (the spine would buckle out of the sagittal plane)" : ""));
+    out.warnings.push_back(
+        "the equilibrium is not stable: smallest tangent stiffness " +
+        std::to_string(out.min_stiffness_nmm_per_rad) + " N*mm/rad, mostly " + out.softest_mode +
+        (out.sagittal_solve ? " (the spine would buckle out of the sagittal plane)" : ""));
 }
 
 /// Poses, displacements, joint reactions and element forces at the solution.
@@ -414,7 +436,8 @@ void report(const SpineModel& m, const State& s, SpineSolution& out) {
   for (std::size_t i = 0; i < n; ++i) {
     const Vector3d& C = m.vertebrae[i].centre_mm;
     out.displacement.row(Eigen::Index(i)).head<3>() = (s.poses[i].apply(C) - C).transpose();
-    out.displacement.row(Eigen::Index(i)).tail<3>() = (rotation_log(s.poses[i].R) * kRadToDeg).transpose();
+    out.displacement.row(Eigen::Index(i)).tail<3>() =
+        (rotation_log(s.poses[i].R) * kRadToDeg).transpose();
   }
   std::vector<Vector3d> Fa, Ma;
   resultants_above(m, s, Fa, Ma);
@@ -446,16 +469,17 @@ void report(const SpineModel& m, const State& s, SpineSolution& out) {
 
 }  // namespace
 
-double potential(const SpineModel& m, const std::vector<ExternalLoad>& loads, const VectorXd& muscle_force_n,
-                 const VectorXd& theta, VectorXd* gradient) {
+double potential(const SpineModel& m, const std::vector<ExternalLoad>& loads,
+                 const VectorXd& muscle_force_n, const VectorXd& theta, VectorXd* gradient) {
   check_loads(m, loads, nullptr);
   const State s = evaluate(m, loads, muscle_force_n, theta);
   if (gradient) *gradient = gradient_of(m, s, theta);
   return s.energy;
 }
 
-void recruitment_problem(const SpineModel& m, const std::vector<ExternalLoad>& loads, Eigen::MatrixXd& arm,
-                         VectorXd& load_moment_nmm, std::vector<int>& joints) {
+void recruitment_problem(const SpineModel& m, const std::vector<ExternalLoad>& loads,
+                         Eigen::MatrixXd& arm, VectorXd& load_moment_nmm,
+                         std::vector<int>& joints) {
   check_loads(m, loads, nullptr);
   joints.clear();
   for (int j : m.recruited_joints)
@@ -476,7 +500,7 @@ void recruitment_problem(const SpineModel& m, const std::vector<ExternalLoad>& l
     auto above = [j](int body) { return body != kGround && body <= j; };
     for (Eigen::Index i = 0; i < nm; ++i) {
       const Muscle& mu = m.muscles[std::size_t(i)];
-      if (above(mu.body_a) == above(mu.body_b)) continue;  // does not cross joint j
+      if (above(mu.body_a) == above(mu.body_b)) continue;          // does not cross joint j
       const Vector3d u = (mu.a_mm - mu.b_mm) / mu.rest_length_mm;  // unit tension pulls a towards b
       arm.block<3, 1>(3 * Eigen::Index(r), i) =
           above(mu.body_a) ? Vector3d((mu.a_mm - c).cross(-u)) : Vector3d((mu.b_mm - c).cross(u));
@@ -484,11 +508,13 @@ void recruitment_problem(const SpineModel& m, const std::vector<ExternalLoad>& l
   }
 }
 
-SpineSolution solve_spine(const SpineModel& m, const std::vector<ExternalLoad>& loads, const SolveOptions& o) {
+SpineSolution solve_spine(const SpineModel& m, const std::vector<ExternalLoad>& loads,
+                          const SolveOptions& o) {
   SpineSolution out;
   check_loads(m, loads, o.warn_above_600n ? &out.warnings : nullptr);
   if (!(o.tolerance > 0) || o.max_iterations < 1 || !(o.fd_step > 0))
-    throw std::invalid_argument("solve_spine: tolerance and finite-difference step must be > 0, iterations >= 1");
+    throw std::invalid_argument(
+        "solve_spine: tolerance and finite-difference step must be > 0, iterations >= 1");
   const auto t0 = std::chrono::steady_clock::now();
 
   VectorXd F;  // recruited muscle forces (empty: muscles off)
@@ -513,7 +539,8 @@ SpineSolution solve_spine(const SpineModel& m, const std::vector<ExternalLoad>& 
   out.theta = newton.solve(out.iterations, out.gradient_norm);
   out.converged = true;
   assess_stability(m, full, out.theta, out);
-  out.seconds_equilibrium = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+  out.seconds_equilibrium =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
   report(m, evaluate(m, loads, F, out.theta), out);
   return out;
 }

@@ -34,7 +34,8 @@ Eigen::Matrix3d right_jacobian(const Eigen::Vector3d& phi) {
   const double a = phi.norm();
   const Eigen::Matrix3d K = hat(phi);
   if (a < 1e-6) return Eigen::Matrix3d::Identity() - 0.5 * K + K * K / 6.0;
-  return Eigen::Matrix3d::Identity() - (1 - std::cos(a)) / (a * a) * K + (a - std::sin(a)) / (a * a * a) * K * K;
+  return Eigen::Matrix3d::Identity() - (1 - std::cos(a)) / (a * a) * K +
+         (a - std::sin(a)) / (a * a * a) * K * K;
 }
 
 Eigen::Matrix3d left_jacobian_inverse(const Eigen::Vector3d& phi) {
@@ -47,7 +48,8 @@ Eigen::Matrix3d left_jacobian_inverse(const Eigen::Vector3d& phi) {
 
 std::vector<Pose> vertebra_poses(const SpineModel& m, const Eigen::VectorXd& theta) {
   const std::size_t n = m.joints.size();
-  if (theta.size() != dof_count(m)) throw std::invalid_argument("vertebra_poses: theta has the wrong size");
+  if (theta.size() != dof_count(m))
+    throw std::invalid_argument("vertebra_poses: theta has the wrong size");
   std::vector<Pose> poses(n);
   Pose below;  // the sacrum: identity
   for (std::size_t k = n; k-- > 0;) {

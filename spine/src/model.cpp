@@ -25,7 +25,8 @@ using nlohmann::json;
 constexpr double kDeg = M_PI / 180.0;
 
 std::string upper(std::string s) {
-  s.erase(std::remove_if(s.begin(), s.end(), [](unsigned char c) { return std::isspace(c); }), s.end());
+  s.erase(std::remove_if(s.begin(), s.end(), [](unsigned char c) { return std::isspace(c); }),
+          s.end());
   for (char& c : s) c = char(std::toupper(static_cast<unsigned char>(c)));
   return s;
 }
@@ -48,7 +49,8 @@ json read_json(const fs::path& path) {
 
 /// Value at `key` of `j` as a finite number; throws naming the file.
 double number(const json& j, const std::string& key, const std::string& file) {
-  if (!j.contains(key) || !j.at(key).is_number()) throw std::runtime_error(file + ": missing number '" + key + "'");
+  if (!j.contains(key) || !j.at(key).is_number())
+    throw std::runtime_error(file + ": missing number '" + key + "'");
   const double v = j.at(key).get<double>();
   if (!std::isfinite(v)) throw std::runtime_error(file + ": '" + key + "' is not finite");
   return v;
@@ -83,19 +85,22 @@ int segment_body(const std::string& segment, const json& config, const std::stri
   const auto& names = vertebra_names();
   const auto it = std::find(names.begin(), names.end(), name);
   if (it == names.end())
-    throw std::runtime_error(file + ": muscle segment '" + segment +
-                             "' is not a vertebra, a ground segment or an alias (spine_model.json)");
+    throw std::runtime_error(
+        file + ": muscle segment '" + segment +
+        "' is not a vertebra, a ground segment or an alias (spine_model.json)");
   return int(it - names.begin());
 }
 
 void add_line_geometry(Line& line) {
   line.rest_length_mm = (line.a_mm - line.b_mm).norm();
-  if (!(line.rest_length_mm > 1e-6)) throw std::runtime_error("line element " + line.name + " has zero length");
+  if (!(line.rest_length_mm > 1e-6))
+    throw std::runtime_error("line element " + line.name + " has zero length");
 }
 
 /// One muscle table (F.8-F.19 layout): the right side as listed, the left its mirror image.
 /// `group` names the muscle group; empty means the table has a "group" column.
-void load_muscle_table(SpineModel& m, const fs::path& file, const std::string& group, const json& config) {
+void load_muscle_table(SpineModel& m, const fs::path& file, const std::string& group,
+                       const json& config) {
   const CsvTable t = read_csv(file.string());
   for (std::size_t r = 0; r < t.rows.size(); ++r) {
     Muscle right;
@@ -131,9 +136,11 @@ void load_muscles(SpineModel& m, const fs::path& data, const json& config, bool 
       {"F14_F15_quadratus_lumborum.csv", "quadratus lumborum"},
       {"F16_F17_external_oblique.csv", "external oblique"},
       {"F18_F19_internal_oblique.csv", "internal oblique"}};
-  for (const auto& [file, group] : files) load_muscle_table(m, data / "thesis" / file, group, config);
+  for (const auto& [file, group] : files)
+    load_muscle_table(m, data / "thesis" / file, group, config);
   if (trunk_muscles)
-    load_muscle_table(m, data / "spine" / config.at("trunk_muscles").get<std::string>(), "", config);
+    load_muscle_table(m, data / "spine" / config.at("trunk_muscles").get<std::string>(), "",
+                      config);
 }
 
 /// Ligaments across every joint (geometry: spine_model.json "ligaments", an assumption there).
@@ -141,23 +148,29 @@ void load_ligaments(SpineModel& m, const fs::path& data, const json& config) {
   const CsvTable stiff = read_csv((data / "thesis" / "F6_F7_ligament_stiffness.csv").string());
   const CsvTable discs = read_csv((data / "disc_morphometry.csv").string());
   const json& geo = config.at("ligaments");
-  const std::size_t cervical = stiff.find("region", "cervical"), lumbar = stiff.find("region", "lumbar");
+  const std::size_t cervical = stiff.find("region", "cervical"),
+                    lumbar = stiff.find("region", "lumbar");
   static const char* types[] = {"ISL", "LF", "ALL", "PLL", "JC"};
   for (std::size_t j = 0; j < m.joints.size(); ++j) {
     const Joint& joint = m.joints[j];
     const bool thoracic = joint.name[0] == 'T';
     const std::string region = thoracic ? "thoracic" : "lumbar";
     const std::size_t d = discs.find("level", joint.name);
-    const double half_depth = 0.25 * (discs.number(d, "lower_depth_mm") + discs.number(d, "upper_depth_mm"));
+    const double half_depth =
+        0.25 * (discs.number(d, "lower_depth_mm") + discs.number(d, "upper_depth_mm"));
     const double canal = number(geo.at("canal_depth_mm"), region, "spine_model.json ligaments");
-    const double facet = number(geo.at("facet_half_width_mm"), region, "spine_model.json ligaments");
-    const double spinous = number(geo.at("spinous_length_mm"), region, "spine_model.json ligaments");
+    const double facet =
+        number(geo.at("facet_half_width_mm"), region, "spine_model.json ligaments");
+    const double spinous =
+        number(geo.at("spinous_length_mm"), region, "spine_model.json ligaments");
     const Vector3d up = m.vertebrae[j].centre_mm;
     // Below L5-S1 is the sacrum, which F.1 does not list: mirror L5's centre about the joint.
-    const Vector3d low = j + 1 < m.vertebrae.size() ? m.vertebrae[j + 1].centre_mm : Vector3d(2 * joint.point_mm - up);
+    const Vector3d low = j + 1 < m.vertebrae.size() ? m.vertebrae[j + 1].centre_mm
+                                                    : Vector3d(2 * joint.point_mm - up);
     for (const char* type : types) {
       std::string col = std::string(type) + "_n_per_mm";
-      std::transform(col.begin(), col.end(), col.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+      std::transform(col.begin(), col.end(), col.begin(),
+                     [](unsigned char c) { return char(std::tolower(c)); });
       // F.7's note: thoracic ligaments take the mean of the cervical and lumbar values.
       const double k = thoracic ? 0.5 * (stiff.number(cervical, col) + stiff.number(lumbar, col))
                                 : stiff.number(lumbar, col);
@@ -168,7 +181,10 @@ void load_ligaments(SpineModel& m, const fs::path& data, const json& config) {
       if (t == "PLL") dz = -half_depth;
       if (t == "LF") dz = -half_depth - canal;
       if (t == "ISL") dz = -half_depth - canal - 0.5 * spinous;
-      if (t == "JC") { dz = -half_depth - 0.5 * canal; dx = facet; }
+      if (t == "JC") {
+        dz = -half_depth - 0.5 * canal;
+        dx = facet;
+      }
       for (int side : (t == "JC" ? std::vector<int>{-1, 1} : std::vector<int>{0})) {
         Ligament l;
         l.type = t;
@@ -197,7 +213,8 @@ void load_weights(SpineModel& m, const json& config, const std::string& file, bo
   }
   const json& head = config.at("head_neck");
   const double head_kg = number(head, "mass_percent", file) / 100.0 * m.body_mass_kg;
-  m.weights.push_back({"head and neck weight", vertebra_index(head.at("carried_by").get<std::string>()),
+  m.weights.push_back({"head and neck weight",
+                       vertebra_index(head.at("carried_by").get<std::string>()),
                        vec3(head, "point_mm", file), head_kg * g_n_per_kg * down});
   const json& arms = config.at("arms");
   const double arm_kg = number(arms, "mass_percent_each", file) / 100.0 * m.body_mass_kg;
@@ -205,22 +222,24 @@ void load_weights(SpineModel& m, const json& config, const std::string& file, bo
   Vector3d p = vec3(arms, arms_forward ? "forward_point_mm" : "hanging_point_mm", file);
   for (int side : {-1, 1}) {
     const Vector3d q(side * std::abs(p.x()), p.y(), p.z());
-    m.weights.push_back({std::string(side < 0 ? "right" : "left") + " arm weight", carrier, q, arm_kg * g_n_per_kg * down});
+    m.weights.push_back({std::string(side < 0 ? "right" : "left") + " arm weight", carrier, q,
+                         arm_kg * g_n_per_kg * down});
   }
 }
 
 }  // namespace
 
 const std::vector<std::string>& vertebra_names() {
-  static const std::vector<std::string> names = {"T1", "T2", "T3", "T4", "T5", "T6",  "T7", "T8", "T9",
-                                                 "T10", "T11", "T12", "L1", "L2", "L3", "L4", "L5"};
+  static const std::vector<std::string> names = {"T1", "T2", "T3", "T4",  "T5",  "T6",
+                                                 "T7", "T8", "T9", "T10", "T11", "T12",
+                                                 "L1", "L2", "L3", "L4",  "L5"};
   return names;
 }
 
 const std::vector<std::string>& joint_names() {
-  static const std::vector<std::string> names = {"T1-T2",   "T2-T3",   "T3-T4",  "T4-T5", "T5-T6", "T6-T7",
-                                                 "T7-T8",   "T8-T9",   "T9-T10", "T10-T11", "T11-T12", "T12-L1",
-                                                 "L1-L2",   "L2-L3",   "L3-L4",  "L4-L5", "L5-S1"};
+  static const std::vector<std::string> names = {
+      "T1-T2",   "T2-T3",   "T3-T4",  "T4-T5", "T5-T6", "T6-T7", "T7-T8", "T8-T9", "T9-T10",
+      "T10-T11", "T11-T12", "T12-L1", "L1-L2", "L2-L3", "L3-L4", "L4-L5", "L5-S1"};
   return names;
 }
 
@@ -235,7 +254,8 @@ int vertebra_index(const std::string& name) {
 int joint_index(const std::string& name) {
   const auto& names = joint_names();
   const auto it = std::find(names.begin(), names.end(), upper(name));
-  if (it == names.end()) throw std::invalid_argument("unknown joint '" + name + "' (known: " + joined(names) + ")");
+  if (it == names.end())
+    throw std::invalid_argument("unknown joint '" + name + "' (known: " + joined(names) + ")");
   return int(it - names.begin());
 }
 
@@ -251,13 +271,15 @@ std::vector<int> parse_fusion(const std::string& levels) {
     std::stringstream ps(s);
     std::string p;
     while (std::getline(ps, p, '-')) parts.push_back(p);
-    if (parts.size() < 2) throw std::invalid_argument("fusion level '" + item + "' needs two vertebrae, e.g. L3-L4");
+    if (parts.size() < 2)
+      throw std::invalid_argument("fusion level '" + item + "' needs two vertebrae, e.g. L3-L4");
     for (std::size_t k = 0; k + 1 < parts.size(); ++k) {
       const std::string joint = parts[k] + "-" + parts[k + 1];
       const auto& names = joint_names();
       if (std::find(names.begin(), names.end(), joint) == names.end())
-        throw std::invalid_argument("fusion level '" + item + "': " + joint +
-                                    " is not a joint of adjacent vertebrae (known: " + joined(names) + ")");
+        throw std::invalid_argument(
+            "fusion level '" + item + "': " + joint +
+            " is not a joint of adjacent vertebrae (known: " + joined(names) + ")");
       const int j = joint_index(joint);
       if (std::find(joints.begin(), joints.end(), j) == joints.end()) joints.push_back(j);
     }
@@ -272,21 +294,22 @@ IapStiffness iap_from_appendix_c(const std::string& path) {
   IapStiffness s;
   const double volume = number(c, "V_L1L5_mm3", path);
   const auto& areas = c.at("section_areas_mm2");
-  if (!areas.is_array() || areas.empty()) throw std::runtime_error(path + ": section_areas_mm2 must be a non-empty array");
+  if (!areas.is_array() || areas.empty())
+    throw std::runtime_error(path + ": section_areas_mm2 must be a non-empty array");
   for (const auto& a : areas) s.s_mean_mm2 += a.get<double>();
-  s.s_mean_mm2 /= double(areas.size());                       // (3.1)
-  s.h_l1l5_mm = volume / s.s_mean_mm2;                          // (3.2)
+  s.s_mean_mm2 /= double(areas.size());                               // (3.1)
+  s.h_l1l5_mm = volume / s.s_mean_mm2;                                // (3.2)
   s.h_mm = number(c, "abdominal_height_factor", path) * s.h_l1l5_mm;  // (3.3)
-  s.a_mm = std::sqrt(s.s_mean_mm2);                             // (3.4)
+  s.a_mm = std::sqrt(s.s_mean_mm2);                                   // (3.4)
   // P = ρ_Hg g h: mmHg → Pa → MPa.
   s.pressure_mpa = number(c, "mercury_density_kg_m3", path) * number(c, "gravity_m_s2", path) *
                    number(c, "iap_mmhg", path) * 1e-3 * 1e-6;
-  s.k_y = 0.5 * s.pressure_mpa * s.a_mm * s.a_mm;               // (3.9), "N/mm" as the thesis writes it
-  s.k_x = 0.5 * s.pressure_mpa * s.a_mm * s.h_mm;               // (3.10)
-  s.bushing_k_xz = 4 * s.k_x;                                   // (3.15)
-  s.bushing_k_y = 4 * s.k_y;                                    // (3.16), printed "k_y = 4k_y"
-  s.bushing_m_xz_per_deg = s.k_y * kDeg * s.a_mm * s.a_mm;      // (3.17)
-  s.bushing_m_y_per_deg = s.k_x * kDeg * s.a_mm * s.a_mm;       // (3.18)
+  s.k_y = 0.5 * s.pressure_mpa * s.a_mm * s.a_mm;           // (3.9), "N/mm" as the thesis writes it
+  s.k_x = 0.5 * s.pressure_mpa * s.a_mm * s.h_mm;           // (3.10)
+  s.bushing_k_xz = 4 * s.k_x;                               // (3.15)
+  s.bushing_k_y = 4 * s.k_y;                                // (3.16), printed "k_y = 4k_y"
+  s.bushing_m_xz_per_deg = s.k_y * kDeg * s.a_mm * s.a_mm;  // (3.17)
+  s.bushing_m_y_per_deg = s.k_x * kDeg * s.a_mm * s.a_mm;   // (3.18)
   return s;
 }
 
@@ -296,7 +319,8 @@ SpineModel load_spine_model(const std::string& data_dir, const ModelOptions& opt
   const json config = read_json(config_file);
   SpineModel m;
   m.data_dir = data_dir;
-  m.body_mass_kg = options.body_mass_kg > 0 ? options.body_mass_kg : number(config, "body_mass_kg", config_file);
+  m.body_mass_kg =
+      options.body_mass_kg > 0 ? options.body_mass_kg : number(config, "body_mass_kg", config_file);
   m.gravity_mm_s2 = number(config, "gravity_m_s2", config_file) * 1000.0;
   m.muscle_q = number(config, "muscle_short_range_stiffness_q", config_file);
   m.rom_bump_factor = number(config, "joint_rom_bump_factor", config_file);
@@ -304,11 +328,13 @@ SpineModel load_spine_model(const std::string& data_dir, const ModelOptions& opt
   m.chest_front_mm = vec3(config, "chest_front_mm", config_file);
   m.ribs_body = vertebra_index(config.at("ribs").at("fixed_to").get<std::string>());
   if (!(m.muscle_q > 0) || !(m.rom_bump_factor >= 1) || !(m.rom_bump_onset > 0))
-    throw std::runtime_error(config_file + ": need muscle q > 0, a ROM bump factor >= 1 and a bump onset > 0");
+    throw std::runtime_error(config_file +
+                             ": need muscle q > 0, a ROM bump factor >= 1 and a bump onset > 0");
 
   try {
     const CsvTable cm = read_csv((thesis / "F1_vertebra_cm.csv").string());
-    for (const auto& name : vertebra_names()) m.vertebrae.push_back({name, row_point(cm, cm.find("segment", name)), 0});
+    for (const auto& name : vertebra_names())
+      m.vertebrae.push_back({name, row_point(cm, cm.find("segment", name)), 0});
 
     const CsvTable markers = read_csv((thesis / "F2_joint_markers.csv").string());
     const CsvTable k = read_csv((thesis / "F4_joint_torsional_stiffness.csv").string());
@@ -333,10 +359,12 @@ SpineModel load_spine_model(const std::string& data_dir, const ModelOptions& opt
       m.joints.push_back(j);
     }
     for (int f : options.fused_joints) {
-      if (f < 0 || f >= int(m.joints.size())) throw std::invalid_argument("fused joint index out of range");
+      if (f < 0 || f >= int(m.joints.size()))
+        throw std::invalid_argument("fused joint index out of range");
       m.joints[std::size_t(f)].fused = true;
     }
-    for (const auto& name : config.at("recruited_joints")) m.recruited_joints.push_back(joint_index(name.get<std::string>()));
+    for (const auto& name : config.at("recruited_joints"))
+      m.recruited_joints.push_back(joint_index(name.get<std::string>()));
 
     if (options.gravity) load_weights(m, config, config_file, options.arms_forward);
     if (options.ligaments) load_ligaments(m, data, config);
@@ -346,10 +374,14 @@ SpineModel load_spine_model(const std::string& data_dir, const ModelOptions& opt
       const json c = read_json(thesis / "appendix_c_iap.json");
       m.has_bushing = true;
       m.bushing.body = m.ribs_body;
-      m.bushing.point_mm = vec3(c, "bushing_location_mm", (thesis / "appendix_c_iap.json").string());
-      m.bushing.k_translation_n_per_mm = Vector3d(m.iap.bushing_k_xz, m.iap.bushing_k_y, m.iap.bushing_k_xz);
+      m.bushing.point_mm =
+          vec3(c, "bushing_location_mm", (thesis / "appendix_c_iap.json").string());
+      m.bushing.k_translation_n_per_mm =
+          Vector3d(m.iap.bushing_k_xz, m.iap.bushing_k_y, m.iap.bushing_k_xz);
       m.bushing.k_rotation_nmm_per_rad =
-          Vector3d(m.iap.bushing_m_xz_per_deg, m.iap.bushing_m_y_per_deg, m.iap.bushing_m_xz_per_deg) / kDeg;
+          Vector3d(m.iap.bushing_m_xz_per_deg, m.iap.bushing_m_y_per_deg,
+                   m.iap.bushing_m_xz_per_deg) /
+          kDeg;
     }
   } catch (const nlohmann::json::exception& e) {
     throw std::runtime_error(config_file + ": " + e.what());

@@ -29,7 +29,13 @@ class RecruitmentNlp : public Ipopt::TNLP {
  public:
   RecruitmentNlp(const Eigen::MatrixXd& arm, const Eigen::VectorXd& b, const Eigen::VectorXd& fmax,
                  std::vector<JointStrength> strength, const RecruitmentOptions& o)
-      : arm_(arm), b_(b), fmax_(fmax), strength_(std::move(strength)), o_(o), nm_(int(fmax.size())), nr_(int(b.size())),
+      : arm_(arm),
+        b_(b),
+        fmax_(fmax),
+        strength_(std::move(strength)),
+        o_(o),
+        nm_(int(fmax.size())),
+        nr_(int(b.size())),
         minmax_(o.criterion == Criterion::MinMax) {
     for (int c = 0; c < nm_; ++c)
       for (int r = 0; r < nr_; ++r)
@@ -46,18 +52,30 @@ class RecruitmentNlp : public Ipopt::TNLP {
     return true;
   }
 
-  bool get_bounds_info(Ipopt::Index n, Ipopt::Number* xl, Ipopt::Number* xu, Ipopt::Index m, Ipopt::Number* gl,
-                       Ipopt::Number* gu) override {
-    for (int i = 0; i < nm_; ++i) { xl[i] = 0; xu[i] = fmax_[i]; }
-    for (int i = nm_; i < nm_ + nr_; ++i) { xl[i] = -2e19; xu[i] = 2e19; }
-    if (minmax_) { xl[n - 1] = 0; xu[n - 1] = 2e19; }
+  bool get_bounds_info(Ipopt::Index n, Ipopt::Number* xl, Ipopt::Number* xu, Ipopt::Index m,
+                       Ipopt::Number* gl, Ipopt::Number* gu) override {
+    for (int i = 0; i < nm_; ++i) {
+      xl[i] = 0;
+      xu[i] = fmax_[i];
+    }
+    for (int i = nm_; i < nm_ + nr_; ++i) {
+      xl[i] = -2e19;
+      xu[i] = 2e19;
+    }
+    if (minmax_) {
+      xl[n - 1] = 0;
+      xu[n - 1] = 2e19;
+    }
     for (int k = 0; k < nr_; ++k) gl[k] = gu[k] = b_[k];
-    for (int k = nr_; k < m; ++k) { gl[k] = -2e19; gu[k] = 0; }
+    for (int k = nr_; k < m; ++k) {
+      gl[k] = -2e19;
+      gu[k] = 0;
+    }
     return true;
   }
 
-  bool get_starting_point(Ipopt::Index n, bool, Ipopt::Number* x, bool, Ipopt::Number*, Ipopt::Number*,
-                          Ipopt::Index, bool, Ipopt::Number*) override {
+  bool get_starting_point(Ipopt::Index n, bool, Ipopt::Number* x, bool, Ipopt::Number*,
+                          Ipopt::Number*, Ipopt::Index, bool, Ipopt::Number*) override {
     for (int i = 0; i < nm_; ++i) x[i] = 0.05 * fmax_[i];
     for (int i = nm_; i < nm_ + nr_; ++i) x[i] = 0;
     if (minmax_) x[n - 1] = 0.1;
@@ -81,12 +99,15 @@ class RecruitmentNlp : public Ipopt::TNLP {
   bool eval_grad_f(Ipopt::Index, const Ipopt::Number* x, bool, Ipopt::Number* g) override {
     for (int i = 0; i < nm_; ++i) {
       const double a = std::max(x[i] / fmax_[i], 0.0);
-      g[i] = minmax_ ? 2 * kMinMaxRegularisation * a / fmax_[i] : o_.power * std::pow(a, o_.power - 1) / fmax_[i];
+      g[i] = minmax_ ? 2 * kMinMaxRegularisation * a / fmax_[i]
+                     : o_.power * std::pow(a, o_.power - 1) / fmax_[i];
     }
     for (int k = 0; k < nr_; ++k) {
       const JointStrength& s = strength_[std::size_t(k)];
       const double r = x[nm_ + k], a = s.activation(r);
-      g[nm_ + k] = (minmax_ ? 2 * kMinMaxRegularisation * a : o_.power * std::pow(a, o_.power - 1)) * s.slope(r);
+      g[nm_ + k] =
+          (minmax_ ? 2 * kMinMaxRegularisation * a : o_.power * std::pow(a, o_.power - 1)) *
+          s.slope(r);
     }
     if (minmax_) g[nm_ + nr_] = 1;
     return true;
@@ -106,38 +127,60 @@ class RecruitmentNlp : public Ipopt::TNLP {
     return true;
   }
 
-  bool eval_jac_g(Ipopt::Index, const Ipopt::Number*, bool, Ipopt::Index, Ipopt::Index, Ipopt::Index* rows,
-                  Ipopt::Index* cols, Ipopt::Number* values) override {
+  bool eval_jac_g(Ipopt::Index, const Ipopt::Number*, bool, Ipopt::Index, Ipopt::Index,
+                  Ipopt::Index* rows, Ipopt::Index* cols, Ipopt::Number* values) override {
     std::size_t e = 0;
     if (values == nullptr) {
-      for (const auto& [r, c] : nz_) { rows[e] = r; cols[e] = c; ++e; }
-      for (int k = 0; k < nr_; ++k) { rows[e] = k; cols[e] = nm_ + k; ++e; }
+      for (const auto& [r, c] : nz_) {
+        rows[e] = r;
+        cols[e] = c;
+        ++e;
+      }
+      for (int k = 0; k < nr_; ++k) {
+        rows[e] = k;
+        cols[e] = nm_ + k;
+        ++e;
+      }
       if (minmax_) {
         for (int i = 0; i < nm_; ++i) {
-          rows[e] = nr_ + i; cols[e] = i; ++e;
-          rows[e] = nr_ + i; cols[e] = nm_ + nr_; ++e;
+          rows[e] = nr_ + i;
+          cols[e] = i;
+          ++e;
+          rows[e] = nr_ + i;
+          cols[e] = nm_ + nr_;
+          ++e;
         }
         for (int k = 0; k < 2 * nr_; ++k) {
-          rows[e] = nr_ + nm_ + k; cols[e] = nm_ + k / 2; ++e;
-          rows[e] = nr_ + nm_ + k; cols[e] = nm_ + nr_; ++e;
+          rows[e] = nr_ + nm_ + k;
+          cols[e] = nm_ + k / 2;
+          ++e;
+          rows[e] = nr_ + nm_ + k;
+          cols[e] = nm_ + nr_;
+          ++e;
         }
       }
     } else {
       for (const auto& [r, c] : nz_) values[e++] = arm_(r, c);
       for (int k = 0; k < nr_; ++k) values[e++] = 1;
       if (minmax_) {
-        for (int i = 0; i < nm_; ++i) { values[e++] = 1 / fmax_[i]; values[e++] = -1; }
+        for (int i = 0; i < nm_; ++i) {
+          values[e++] = 1 / fmax_[i];
+          values[e++] = -1;
+        }
         for (int k = 0; k < nr_; ++k) {
-          values[e++] = 1 / strength_[std::size_t(k)].pos; values[e++] = -1;
-          values[e++] = -1 / strength_[std::size_t(k)].neg; values[e++] = -1;
+          values[e++] = 1 / strength_[std::size_t(k)].pos;
+          values[e++] = -1;
+          values[e++] = -1 / strength_[std::size_t(k)].neg;
+          values[e++] = -1;
         }
       }
     }
     return true;
   }
 
-  bool eval_h(Ipopt::Index, const Ipopt::Number* x, bool, Ipopt::Number sigma, Ipopt::Index, const Ipopt::Number*,
-              bool, Ipopt::Index, Ipopt::Index* rows, Ipopt::Index* cols, Ipopt::Number* values) override {
+  bool eval_h(Ipopt::Index, const Ipopt::Number* x, bool, Ipopt::Number sigma, Ipopt::Index,
+              const Ipopt::Number*, bool, Ipopt::Index, Ipopt::Index* rows, Ipopt::Index* cols,
+              Ipopt::Number* values) override {
     if (values == nullptr) {
       for (int i = 0; i < nm_ + nr_; ++i) rows[i] = cols[i] = i;
       return true;
@@ -151,22 +194,25 @@ class RecruitmentNlp : public Ipopt::TNLP {
     for (int k = 0; k < nr_; ++k) {
       const JointStrength& s = strength_[std::size_t(k)];
       const double r = x[nm_ + k], a = s.activation(r), d = s.slope(r);
-      const double h = minmax_ ? 2 * kMinMaxRegularisation : o_.power * (o_.power - 1) * std::pow(a, o_.power - 2);
+      const double h = minmax_ ? 2 * kMinMaxRegularisation
+                               : o_.power * (o_.power - 1) * std::pow(a, o_.power - 2);
       values[nm_ + k] = sigma * h * d * d;
     }
     return true;
   }
 
-  bool intermediate_callback(Ipopt::AlgorithmMode, Ipopt::Index iter, Ipopt::Number, Ipopt::Number, Ipopt::Number,
-                             Ipopt::Number, Ipopt::Number, Ipopt::Number, Ipopt::Number, Ipopt::Number,
-                             Ipopt::Index, const Ipopt::IpoptData*, Ipopt::IpoptCalculatedQuantities*) override {
+  bool intermediate_callback(Ipopt::AlgorithmMode, Ipopt::Index iter, Ipopt::Number, Ipopt::Number,
+                             Ipopt::Number, Ipopt::Number, Ipopt::Number, Ipopt::Number,
+                             Ipopt::Number, Ipopt::Number, Ipopt::Index, const Ipopt::IpoptData*,
+                             Ipopt::IpoptCalculatedQuantities*) override {
     iterations = iter;
     return true;
   }
 
-  void finalize_solution(Ipopt::SolverReturn, Ipopt::Index n, const Ipopt::Number* x, const Ipopt::Number*,
-                         const Ipopt::Number*, Ipopt::Index m, const Ipopt::Number* g, const Ipopt::Number*,
-                         Ipopt::Number obj, const Ipopt::IpoptData*, Ipopt::IpoptCalculatedQuantities*) override {
+  void finalize_solution(Ipopt::SolverReturn, Ipopt::Index n, const Ipopt::Number* x,
+                         const Ipopt::Number*, const Ipopt::Number*, Ipopt::Index m,
+                         const Ipopt::Number* g, const Ipopt::Number*, Ipopt::Number obj,
+                         const Ipopt::IpoptData*, Ipopt::IpoptCalculatedQuantities*) override {
     solution = Eigen::Map<const Eigen::VectorXd>(x, n);
     objective = obj;
     violation = 0;
@@ -190,14 +236,22 @@ class RecruitmentNlp : public Ipopt::TNLP {
 
 std::string status_name(Ipopt::ApplicationReturnStatus s) {
   switch (s) {
-    case Ipopt::Solve_Succeeded: return "Solve_Succeeded";
-    case Ipopt::Solved_To_Acceptable_Level: return "Solved_To_Acceptable_Level";
-    case Ipopt::Infeasible_Problem_Detected: return "Infeasible_Problem_Detected";
-    case Ipopt::Maximum_Iterations_Exceeded: return "Maximum_Iterations_Exceeded";
-    case Ipopt::Restoration_Failed: return "Restoration_Failed";
-    case Ipopt::Error_In_Step_Computation: return "Error_In_Step_Computation";
-    case Ipopt::Invalid_Number_Detected: return "Invalid_Number_Detected";
-    default: return "Ipopt_status_" + std::to_string(int(s));
+    case Ipopt::Solve_Succeeded:
+      return "Solve_Succeeded";
+    case Ipopt::Solved_To_Acceptable_Level:
+      return "Solved_To_Acceptable_Level";
+    case Ipopt::Infeasible_Problem_Detected:
+      return "Infeasible_Problem_Detected";
+    case Ipopt::Maximum_Iterations_Exceeded:
+      return "Maximum_Iterations_Exceeded";
+    case Ipopt::Restoration_Failed:
+      return "Restoration_Failed";
+    case Ipopt::Error_In_Step_Computation:
+      return "Error_In_Step_Computation";
+    case Ipopt::Invalid_Number_Detected:
+      return "Invalid_Number_Detected";
+    default:
+      return "Ipopt_status_" + std::to_string(int(s));
   }
 }
 
@@ -210,13 +264,16 @@ std::mutex& ipopt_mutex() {
 
 }  // namespace
 
-Recruitment recruit(const SpineModel& m, const Eigen::MatrixXd& arm, const Eigen::VectorXd& load_moment_nmm,
-                    const RecruitmentOptions& options) {
+Recruitment recruit(const SpineModel& m, const Eigen::MatrixXd& arm,
+                    const Eigen::VectorXd& load_moment_nmm, const RecruitmentOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
   if (!(options.power >= 2 && options.power <= 10))
-    throw std::invalid_argument("recruitment power must be in [2, 10], got " + std::to_string(options.power));
-  if (!(options.passive_strength_scale > 0) || options.max_iterations < 1 || !(options.tolerance > 0))
-    throw std::invalid_argument("recruitment: passive strength scale and tolerance must be > 0, iterations >= 1");
+    throw std::invalid_argument("recruitment power must be in [2, 10], got " +
+                                std::to_string(options.power));
+  if (!(options.passive_strength_scale > 0) || options.max_iterations < 1 ||
+      !(options.tolerance > 0))
+    throw std::invalid_argument(
+        "recruitment: passive strength scale and tolerance must be > 0, iterations >= 1");
   // The rows are the recruited, non-fused joints in order (recruitment_problem); each axis's
   // strength is its spring's moment at the range-of-motion limit.
   std::vector<JointStrength> strength;
@@ -229,11 +286,15 @@ Recruitment recruit(const SpineModel& m, const Eigen::MatrixXd& arm, const Eigen
     strength.push_back({s * jt.k_lateral * jt.rom_lateral, s * jt.k_lateral * jt.rom_lateral});
   }
   for (const auto& st : strength)
-    if (!(st.pos > 0 && st.neg > 0)) throw std::invalid_argument("recruit: a recruited joint has zero range of motion");
+    if (!(st.pos > 0 && st.neg > 0))
+      throw std::invalid_argument("recruit: a recruited joint has zero range of motion");
   const Eigen::Index nm = Eigen::Index(m.muscles.size());
-  if (arm.cols() != nm || arm.rows() != load_moment_nmm.size() || arm.rows() != Eigen::Index(strength.size()))
-    throw std::invalid_argument("recruit: arm must be (3·recruited joints) × muscles, matching the load moments");
-  if (!arm.allFinite() || !load_moment_nmm.allFinite()) throw std::invalid_argument("recruit: non-finite input");
+  if (arm.cols() != nm || arm.rows() != load_moment_nmm.size() ||
+      arm.rows() != Eigen::Index(strength.size()))
+    throw std::invalid_argument(
+        "recruit: arm must be (3·recruited joints) × muscles, matching the load moments");
+  if (!arm.allFinite() || !load_moment_nmm.allFinite())
+    throw std::invalid_argument("recruit: non-finite input");
   Eigen::VectorXd fmax(nm);
   for (Eigen::Index i = 0; i < nm; ++i) fmax[i] = m.muscles[std::size_t(i)].max_force_n();
 
@@ -247,7 +308,8 @@ Recruitment recruit(const SpineModel& m, const Eigen::MatrixXd& arm, const Eigen
     out.status = nm == 0 ? "no muscles" : "no recruited joints";
     return out;
   }
-  Ipopt::SmartPtr<RecruitmentNlp> nlp = new RecruitmentNlp(arm, load_moment_nmm, fmax, strength, options);
+  Ipopt::SmartPtr<RecruitmentNlp> nlp =
+      new RecruitmentNlp(arm, load_moment_nmm, fmax, strength, options);
   {
     std::lock_guard<std::mutex> lock(ipopt_mutex());
     Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();

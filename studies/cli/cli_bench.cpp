@@ -119,7 +119,8 @@ struct BenchArgs {
 
 void bench_mesh(const BenchArgs& a) {
   nlohmann::json rows = nlohmann::json::array();
-  TextTable t({"cell mm", "tets", "nodes", "seconds", "min dihedral", "volume err %", "peak MB"}, 0);
+  TextTable t({"cell mm", "tets", "nodes", "seconds", "min dihedral", "volume err %", "peak MB"},
+              0);
   const auto sizes = parse_list(a.cell_sizes, "--cell-sizes");
   ProgressBar bar(int(sizes.size()), a.json, "runs");
   for (double h : sizes) {
@@ -128,9 +129,11 @@ void bench_mesh(const BenchArgs& a) {
     args << "bench-mesh-one --level " << a.level << " --cell-size " << h;
     const auto r = run_child(args.str());
     rows.push_back(r);
-    t.add({fixed(h, 2), std::to_string(r["tets"].get<long>()), std::to_string(r["nodes"].get<long>()),
-           fixed(r["seconds"].get<double>(), 2), fixed(r["min_dihedral_deg"].get<double>(), 2),
-           fixed(100 * r["volume_error"].get<double>(), 3), fixed(r["peak_rss_mb"].get<double>(), 0)});
+    t.add({fixed(h, 2), std::to_string(r["tets"].get<long>()),
+           std::to_string(r["nodes"].get<long>()), fixed(r["seconds"].get<double>(), 2),
+           fixed(r["min_dihedral_deg"].get<double>(), 2),
+           fixed(100 * r["volume_error"].get<double>(), 3),
+           fixed(r["peak_rss_mb"].get<double>(), 0)});
   }
   bar.finish();
   if (a.json) {
@@ -146,7 +149,9 @@ void bench_fem(const BenchArgs& a) {
   const fs::path dir = fs::temp_directory_path() / ("spinesim-bench-" + std::to_string(getpid()));
   fs::create_directories(dir);
   nlohmann::json rows = nlohmann::json::array();
-  TextTable t({"order", "DOF", "assembly", "analyse", "factorise", "6 solves", "6x6 total", "1 load", "peak MB"}, 0);
+  TextTable t({"order", "DOF", "assembly", "analyse", "factorise", "6 solves", "6x6 total",
+               "1 load", "peak MB"},
+              0);
   const auto sizes = parse_list(a.cell_sizes, "--cell-sizes");
   ProgressBar bar(int(sizes.size()), a.json, "meshes");
   int done = 0;
@@ -154,8 +159,8 @@ void bench_fem(const BenchArgs& a) {
     bar.update(done++, "cell size " + fixed(h, 2) + " mm");
     const fs::path mesh_path = dir / ("disc-" + std::to_string(h) + ".vtu");
     std::ostringstream margs;
-    margs << "bench-mesh-one --level " << a.level << " --cell-size " << h << " --mesh-out '" << mesh_path.string()
-          << "'";
+    margs << "bench-mesh-one --level " << a.level << " --cell-size " << h << " --mesh-out '"
+          << mesh_path.string() << "'";
     run_child(margs.str());
     for (double order : parse_list(a.orders, "--orders")) {
       std::ostringstream fargs;
@@ -163,9 +168,11 @@ void bench_fem(const BenchArgs& a) {
       auto r = run_child(fargs.str());
       r["cell_size_mm"] = h;
       rows.push_back(r);
-      t.add({std::to_string(int(order)), std::to_string(r["dofs"].get<long>()), fixed(r["assembly_s"].get<double>(), 3),
-             fixed(r["analyse_s"].get<double>(), 3), fixed(r["factorise_s"].get<double>(), 3),
-             fixed(r["stiffness_solves_s"].get<double>(), 3), fixed(r["stiffness_total_s"].get<double>(), 3),
+      t.add({std::to_string(int(order)), std::to_string(r["dofs"].get<long>()),
+             fixed(r["assembly_s"].get<double>(), 3), fixed(r["analyse_s"].get<double>(), 3),
+             fixed(r["factorise_s"].get<double>(), 3),
+             fixed(r["stiffness_solves_s"].get<double>(), 3),
+             fixed(r["stiffness_total_s"].get<double>(), 3),
              fixed(r["load_solve_s"].get<double>(), 3), fixed(r["peak_rss_mb"].get<double>(), 0)});
     }
   }
@@ -175,7 +182,8 @@ void bench_fem(const BenchArgs& a) {
     print_json({{"level", a.level}, {"runs", rows}});
     return;
   }
-  std::cout << "FEM reference on " << a.level << " meshes (real-disc), one process per run; times in s\n";
+  std::cout << "FEM reference on " << a.level
+            << " meshes (real-disc), one process per run; times in s\n";
   t.print(std::cout, false, " ");
 }
 
@@ -183,13 +191,16 @@ void bench_fem(const BenchArgs& a) {
 
 void register_bench(CLI::App& app) {
   auto a = std::make_shared<BenchArgs>();
-  auto* cmd = app.add_subcommand("bench", "Measure meshing and FEM speed and memory (each run in its own process)");
+  auto* cmd = app.add_subcommand(
+      "bench", "Measure meshing and FEM speed and memory (each run in its own process)");
   cmd->require_subcommand(1);
   auto* m = cmd->add_subcommand("mesh", "Meshing time, tet count and quality vs cell size");
-  auto* f = cmd->add_subcommand("fem", "FEM assembly / factorisation / solve time and peak memory vs DOF");
+  auto* f = cmd->add_subcommand("fem",
+                                "FEM assembly / factorisation / solve time and peak memory vs DOF");
   for (auto* sub : {m, f}) {
     sub->add_option("--level", a->level, "Disc level")->capture_default_str();
-    sub->add_option("--cell-sizes", a->cell_sizes, "Comma-separated cell sizes, mm")->capture_default_str();
+    sub->add_option("--cell-sizes", a->cell_sizes, "Comma-separated cell sizes, mm")
+        ->capture_default_str();
     sub->add_flag("--json", a->json, "Print a JSON summary on stdout");
   }
   f->add_option("--orders", a->orders, "Comma-separated element orders")->capture_default_str();

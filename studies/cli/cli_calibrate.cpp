@@ -14,8 +14,8 @@
 // multiplier per main spring on top of the fitted region scales (calibration/per_spring.hpp),
 // reported beside the region-only fit; the file (kind "per-spring") then belongs to this mesh, and
 // transfer meshes are checked with the region-level scales.
-#include "spinesim/studies/calibration_report.hpp"
 #include "cli_common.hpp"
+#include "spinesim/studies/calibration_report.hpp"
 
 #include "spinesim/studies/disc_level.hpp"
 
@@ -31,8 +31,8 @@
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
-#include <sstream>
 #include <memory>
+#include <sstream>
 
 namespace spinesim::cli {
 namespace {
@@ -68,11 +68,13 @@ std::vector<fem::LoadCase> other_cases(const std::vector<fem::LoadCase>& train) 
 
 /// The protocol's second mesh resolution for a parametric disc: the same disc at 1.5x the cell
 /// size, labelled with it.
-std::pair<std::string, mesh::TetMesh> coarser_mesh(const mesh::DiscDimensions& dims, mesh::MeshOptions opt,
+std::pair<std::string, mesh::TetMesh> coarser_mesh(const mesh::DiscDimensions& dims,
+                                                   mesh::MeshOptions opt,
                                                    const StatusLine& status) {
   opt.cell_size_mm *= 1.5;
   std::ostringstream label;
-  label << "parametric " << dims.level << ", cell size " << std::setprecision(3) << opt.cell_size_mm << " mm";
+  label << "parametric " << dims.level << ", cell size " << std::setprecision(3) << opt.cell_size_mm
+        << " mm";
   status("meshing the second resolution: " + label.str());
   return {label.str(), mesh_disc_level(dims.level, opt)};
 }
@@ -85,18 +87,25 @@ double worst(const nlohmann::json& rows, const char* key) {
 
 /// --level all: every level's parametric disc, one tuned set file (tuned_set.hpp), written only
 /// when every level succeeded.
-void run_all_levels(const CalibrateArgs& a, const CalibrationRequest& rq, const mesh::RegionMaterials& materials) {
+void run_all_levels(const CalibrateArgs& a, const CalibrationRequest& rq,
+                    const mesh::RegionMaterials& materials) {
   calibration::TunedSet set;
   set.material_name = materials.name;
   std::ostringstream cmd;
   cmd << "spinesim calibrate --level all"
-      << (a.cell_size_option->count() ? " --cell-size " + std::to_string(a.cell_size_mm) : std::string()) << " --material " << a.material
-      << " --terms " << a.terms << " --train " << a.train << (a.holdout.empty() ? "" : " --holdout " + a.holdout)
-      << " --order " << a.order << " --check-load-scale " << rq.check_load_scale << (a.no_check ? " --no-check" : "");
+      << (a.cell_size_option->count() ? " --cell-size " + std::to_string(a.cell_size_mm)
+                                      : std::string())
+      << " --material " << a.material << " --terms " << a.terms << " --train " << a.train
+      << (a.holdout.empty() ? "" : " --holdout " + a.holdout) << " --order " << a.order
+      << " --check-load-scale " << rq.check_load_scale << (a.no_check ? " --no-check" : "");
   set.generated_by = cmd.str();
-  set.settings = {{"cell_size_rule", a.cell_size_option->count() ? "as given" : "min(2 mm, disc height / 5)"},
-                  {"mesh", "parametric disc (data/disc_morphometry.csv), CGAL, placed in the spine (as `mesh disc --level`)"},
-                  {"check_load_scale", rq.nonlinear_check ? nlohmann::json(rq.check_load_scale) : nlohmann::json(nullptr)}};
+  set.settings = {
+      {"cell_size_rule", a.cell_size_option->count() ? "as given" : "min(2 mm, disc height / 5)"},
+      {"mesh",
+       "parametric disc (data/disc_morphometry.csv), CGAL, placed in the spine (as `mesh disc "
+       "--level`)"},
+      {"check_load_scale",
+       rq.nonlinear_check ? nlohmann::json(rq.check_load_scale) : nlohmann::json(nullptr)}};
   TextTable table({"level", "tets", "train max (untuned>tuned)", "holdout max (untuned>tuned)",
                    "K6 diag ratio (tuned, min-max)", "Ipopt its", "time (s)"});
   std::vector<std::string> failed;
@@ -107,10 +116,13 @@ void run_all_levels(const CalibrateArgs& a, const CalibrationRequest& rq, const 
   ProgressBar bar(int(mesh::disc_levels().size()), a.quiet || a.json, "levels");
   int done = 0;
   for (const std::string& level : mesh::disc_levels()) {
-    const StatusLine level_status = [&bar, &done, &level](const std::string& s) { bar.update(done, level + ": " + s); };
+    const StatusLine level_status = [&bar, &done, &level](const std::string& s) {
+      bar.update(done, level + ": " + s);
+    };
     const mesh::DiscDimensions dims = mesh::disc_dimensions(level, data_dir());
     mesh::MeshOptions opt;
-    opt.cell_size_mm = a.cell_size_option->count() ? a.cell_size_mm : std::min(2.0, dims.height_mm / 5.0);
+    opt.cell_size_mm =
+        a.cell_size_option->count() ? a.cell_size_mm : std::min(2.0, dims.height_mm / 5.0);
     cell_by_level[level] = opt.cell_size_mm;
     level_status("meshing (cell size " + std::to_string(opt.cell_size_mm).substr(0, 4) + " mm)");
     const mesh::TetMesh m = mesh_disc_level(level, opt);
@@ -125,12 +137,18 @@ void run_all_levels(const CalibrateArgs& a, const CalibrationRequest& rq, const 
     const auto& rep = o.tuned.report;
     const auto& ratio = rep["stiffness_diagonal"]["ratio_tuned"];
     double lo = 1e300, hi = 0;
-    for (const auto& v : ratio) lo = std::min(lo, v.get<double>()), hi = std::max(hi, v.get<double>());
-    const auto pair = [](double u, double t) { return fixed(100 * u, 0) + ">" + fixed(100 * t, 1) + "%"; };
-    table.add({level, std::to_string(m.num_tets()), pair(worst(rep["train"], "untuned_error"), worst(rep["train"], "tuned_error")),
+    for (const auto& v : ratio)
+      lo = std::min(lo, v.get<double>()), hi = std::max(hi, v.get<double>());
+    const auto pair = [](double u, double t) {
+      return fixed(100 * u, 0) + ">" + fixed(100 * t, 1) + "%";
+    };
+    table.add({level, std::to_string(m.num_tets()),
+               pair(worst(rep["train"], "untuned_error"), worst(rep["train"], "tuned_error")),
                rep["holdout"].empty() ? std::string("-")
-                                      : pair(worst(rep["holdout"], "untuned_error"), worst(rep["holdout"], "tuned_error")),
-               fixed(lo, 3) + "-" + fixed(hi, 3), std::to_string(o.result.iterations), fixed(o.total_seconds, 1)});
+                                      : pair(worst(rep["holdout"], "untuned_error"),
+                                             worst(rep["holdout"], "tuned_error")),
+               fixed(lo, 3) + "-" + fixed(hi, 3), std::to_string(o.result.iterations),
+               fixed(o.total_seconds, 1)});
     set.levels.emplace(level, o.tuned);
   }
   set.settings["cell_size_mm"] = cell_by_level;
@@ -147,9 +165,10 @@ void run_all_levels(const CalibrateArgs& a, const CalibrationRequest& rq, const 
     print_json(j);
     return;
   }
-  std::cout << "Calibration of all " << set.levels.size() << " levels, material " << materials.name << ", terms "
-            << a.terms << " (errors: relative nodal displacement, nonlinear check at loads x " << rq.check_load_scale
-            << ")\n\n";
+  std::cout << "Calibration of all " << set.levels.size() << " levels, material " << materials.name
+            << ", terms " << a.terms
+            << " (errors: relative nodal displacement, nonlinear check at loads x "
+            << rq.check_load_scale << ")\n\n";
   table.print(std::cout, false);
   std::cout << "\nwrote " << a.out << "\n";
 }
@@ -157,32 +176,44 @@ void run_all_levels(const CalibrateArgs& a, const CalibrationRequest& rq, const 
 void run_calibrate(const CalibrateArgs& a) {
   // 1. Everything checked before the work starts.
   if (a.out.empty()) throw std::invalid_argument("--out tuned.json is required");
-  if (a.mesh_path.empty() == a.level.empty()) throw std::invalid_argument("give exactly one of --mesh and --level");
+  if (a.mesh_path.empty() == a.level.empty())
+    throw std::invalid_argument("give exactly one of --mesh and --level");
   if (a.order != 1 && a.order != 2) throw std::invalid_argument("--order must be 1 or 2");
   if (!(a.cell_size_mm > 0)) throw std::invalid_argument("--cell-size must be > 0 mm");
   if (a.level == "all" && !a.transfer_meshes.empty())
-    throw std::invalid_argument("--transfer-mesh is one disc's: with --level all each level is checked at 1.5x its cell size");
+    throw std::invalid_argument(
+        "--transfer-mesh is one disc's: with --level all each level is checked at 1.5x its cell "
+        "size");
   if (a.level == "all" && a.per_spring)
-    throw std::invalid_argument("--per-spring fits one mesh: --level all writes region-level scales, which transfer to other meshes");
-  if (!a.per_spring && (a.smoothness_option->count() || a.per_spring_max_iterations != calibration::per_spring_ipopt_defaults().max_iterations))
-    throw std::invalid_argument("--smoothness and --per-spring-max-iterations go with --per-spring");
+    throw std::invalid_argument(
+        "--per-spring fits one mesh: --level all writes region-level scales, which transfer to "
+        "other meshes");
+  if (!a.per_spring &&
+      (a.smoothness_option->count() ||
+       a.per_spring_max_iterations != calibration::per_spring_ipopt_defaults().max_iterations))
+    throw std::invalid_argument(
+        "--smoothness and --per-spring-max-iterations go with --per-spring");
   require_output_folder(a.out, "--out");
-  if (!a.mesh_path.empty() && std::filesystem::exists(a.out) && std::filesystem::exists(a.mesh_path) &&
-      std::filesystem::equivalent(a.out, a.mesh_path))
+  if (!a.mesh_path.empty() && std::filesystem::exists(a.out) &&
+      std::filesystem::exists(a.mesh_path) && std::filesystem::equivalent(a.out, a.mesh_path))
     throw std::invalid_argument("--out " + a.out + " is the input mesh: give another file");
   CalibrationRequest rq;
   rq.train = fem::parse_load_cases(a.train);
-  rq.holdout = a.holdout.empty() ? other_cases(rq.train)
-               : a.holdout == "none" ? std::vector<fem::LoadCase>() : fem::parse_load_cases(a.holdout);
-  for (const auto& h : rq.holdout)  // calibrate_disc checks it too, but only after meshing (17 times for all)
+  rq.holdout = a.holdout.empty()     ? other_cases(rq.train)
+               : a.holdout == "none" ? std::vector<fem::LoadCase>()
+                                     : fem::parse_load_cases(a.holdout);
+  for (const auto& h :
+       rq.holdout)  // calibrate_disc checks it too, but only after meshing (17 times for all)
     for (const auto& t : rq.train)
-      if (h.name == t.name) throw std::invalid_argument("case '" + h.name + "' is both trained on and held out");
+      if (h.name == t.name)
+        throw std::invalid_argument("case '" + h.name + "' is both trained on and held out");
   rq.fem_order = a.order;
   rq.terms = parse_term_set(a.terms);
   rq.weights = a.weights;
   for (const double w : {a.weights.reaction, a.weights.stiffness, a.weights.regularisation})
     if (!std::isfinite(w) || w < 0)
-      throw std::invalid_argument("--reaction-weight, --stiffness-weight and --regularisation must be finite and >= 0");
+      throw std::invalid_argument(
+          "--reaction-weight, --stiffness-weight and --regularisation must be finite and >= 0");
   rq.ipopt = a.ipopt;
   rq.nonlinear_check = !a.no_check;
   if (!std::isfinite(a.check_load_scale) || a.check_load_scale <= 0)
@@ -215,10 +246,12 @@ void run_calibrate(const CalibrateArgs& a) {
   } else {
     mesh::MeshOptions opt;
     opt.cell_size_mm = a.cell_size_mm;
-    status("meshing " + a.level + " (cell size " + std::to_string(a.cell_size_mm).substr(0, 4) + " mm)");
+    status("meshing " + a.level + " (cell size " + std::to_string(a.cell_size_mm).substr(0, 4) +
+           " mm)");
     const mesh::DiscDimensions dims = mesh::disc_dimensions(a.level, data_dir());
     m = mesh_disc_level(a.level, opt);  // as `mesh disc --level`
-    if (!a.no_transfer && a.transfer_meshes.empty()) rq.transfer_meshes.push_back(coarser_mesh(dims, opt, status));
+    if (!a.no_transfer && a.transfer_meshes.empty())
+      rq.transfer_meshes.push_back(coarser_mesh(dims, opt, status));
   }
 
   // 3. Calibrate, report, write only a successful result.
@@ -235,11 +268,12 @@ void run_calibrate(const CalibrateArgs& a) {
     print_calibration(std::cout, o, rq);
   if (!o.result.success)
     throw std::runtime_error("Ipopt did not converge (" + o.result.status + " after " +
-                             std::to_string(o.result.iterations) + " iterations): no " + a.out + " written");
+                             std::to_string(o.result.iterations) + " iterations): no " + a.out +
+                             " written");
   if (!o.success)
-    throw std::runtime_error("per-spring stage: Ipopt did not converge (" + o.per_spring.status + " after " +
-                             std::to_string(o.per_spring.iterations) + " iterations; the region fit succeeded): no " +
-                             a.out + " written");
+    throw std::runtime_error("per-spring stage: Ipopt did not converge (" + o.per_spring.status +
+                             " after " + std::to_string(o.per_spring.iterations) +
+                             " iterations; the region fit succeeded): no " + a.out + " written");
   if (!a.json) std::cout << "\nwrote " << a.out << "\n";
 }
 
@@ -247,59 +281,86 @@ void run_calibrate(const CalibrateArgs& a) {
 
 void register_calibrate(CLI::App& app) {
   auto a = std::make_shared<CalibrateArgs>();
-  auto* cmd = app.add_subcommand("calibrate", "Tune the mass-spring disc's stiffness to the FEM with Ipopt; writes tuned.json");
+  auto* cmd = app.add_subcommand(
+      "calibrate",
+      "Tune the mass-spring disc's stiffness to the FEM with Ipopt; writes tuned.json");
   cmd->add_option("--mesh", a->mesh_path, "Disc mesh (VTU with endplate labels)");
   cmd->add_option("--level", a->level,
-                  "Or mesh this level's parametric disc (T1-T2 ... L5-S1); `all`: every level into one tuned-set file "
+                  "Or mesh this level's parametric disc (T1-T2 ... L5-S1); `all`: every level into "
+                  "one tuned-set file "
                   "(as data/tuned_discs.json)");
-  a->cell_size_option =
-      cmd->add_option("--cell-size", a->cell_size_mm,
-                      "With --level: CGAL cell size, mm (--level all without it: min(2, disc height / 5) per level)")
-          ->capture_default_str();
-  cmd->add_option("--material", a->material, "Preset (real-disc, annulus-nucleus, rubber, polyethylene) or JSON file")
+  a->cell_size_option = cmd->add_option("--cell-size", a->cell_size_mm,
+                                        "With --level: CGAL cell size, mm (--level all without it: "
+                                        "min(2, disc height / 5) per level)")
+                            ->capture_default_str();
+  cmd->add_option("--material", a->material,
+                  "Preset (real-disc, annulus-nucleus, rubber, polyethylene) or JSON file")
       ->capture_default_str();
-  cmd->add_option("--train", a->train, "Load cases to fit (comma-separated, or all)")->capture_default_str();
-  cmd->add_option("--holdout", a->holdout, "Load cases only reported (default: every other case; none)");
-  cmd->add_option("--terms", a->terms,
-                  "Tuned terms, each per region: thesis (main, radial, torsion springs), thesis+volume "
-                  "(+ per-tet volume term), all (+ whole-disc volume term)")
+  cmd->add_option("--train", a->train, "Load cases to fit (comma-separated, or all)")
+      ->capture_default_str();
+  cmd->add_option("--holdout", a->holdout,
+                  "Load cases only reported (default: every other case; none)");
+  cmd->add_option(
+         "--terms", a->terms,
+         "Tuned terms, each per region: thesis (main, radial, torsion springs), thesis+volume "
+         "(+ per-tet volume term), all (+ whole-disc volume term)")
       ->capture_default_str();
   cmd->add_option("--order", a->order, "FEM reference order, 1 or 2")->capture_default_str();
-  cmd->add_option("--reaction-weight", a->weights.reaction, "w_r: reaction-wrench error weight")->capture_default_str();
-  cmd->add_option("--stiffness-weight", a->weights.stiffness, "w_k: 6x6 diagonal (log ratio) weight")->capture_default_str();
-  cmd->add_option("--regularisation", a->weights.regularisation, "w_p: pull of ln(scale) towards 0 (Van Gelder)")
+  cmd->add_option("--reaction-weight", a->weights.reaction, "w_r: reaction-wrench error weight")
       ->capture_default_str();
-  cmd->add_option("--lower-scale", a->ipopt.lower_scale, "Lower bound of every scale (> 0)")->capture_default_str();
-  cmd->add_option("--upper-scale", a->ipopt.upper_scale, "Upper bound of every scale")->capture_default_str();
-  cmd->add_option("--max-iterations", a->ipopt.max_iterations, "Ipopt iteration limit")->capture_default_str();
+  cmd->add_option("--stiffness-weight", a->weights.stiffness,
+                  "w_k: 6x6 diagonal (log ratio) weight")
+      ->capture_default_str();
+  cmd->add_option("--regularisation", a->weights.regularisation,
+                  "w_p: pull of ln(scale) towards 0 (Van Gelder)")
+      ->capture_default_str();
+  cmd->add_option("--lower-scale", a->ipopt.lower_scale, "Lower bound of every scale (> 0)")
+      ->capture_default_str();
+  cmd->add_option("--upper-scale", a->ipopt.upper_scale, "Upper bound of every scale")
+      ->capture_default_str();
+  cmd->add_option("--max-iterations", a->ipopt.max_iterations, "Ipopt iteration limit")
+      ->capture_default_str();
   cmd->add_option("--check-load-scale", a->check_load_scale,
-                  "Nonlinear check at the case loads x this factor (linear regime; 1 = the standard 7.5 N·m / 500 N loads)")
+                  "Nonlinear check at the case loads x this factor (linear regime; 1 = the "
+                  "standard 7.5 N·m / 500 N loads)")
       ->capture_default_str();
   cmd->add_option("--transfer-mesh", a->transfer_meshes,
-                  "Also check the tuned scales on this mesh of the same disc (repeatable; with --level the default is "
+                  "Also check the tuned scales on this mesh of the same disc (repeatable; with "
+                  "--level the default is "
                   "the same disc at 1.5x the cell size)");
   cmd->add_flag("--no-transfer", a->no_transfer, "With --level: skip the second-resolution check");
   cmd->add_flag("--per-spring", a->per_spring,
-                "After the region fit, one stiffness multiplier per main spring (smoothness-regularised; Ipopt "
+                "After the region fit, one stiffness multiplier per main spring "
+                "(smoothness-regularised; Ipopt "
                 "limited-memory BFGS); the file then applies to this mesh only");
-  a->smoothness_option =
-      cmd->add_option("--smoothness", a->per_spring_weights.smoothness,
-                      "With --per-spring: w_s, weight of mean (ln mu_e - ln mu_f)^2 over springs sharing a tetrahedron")
-          ->capture_default_str();
-  cmd->add_option("--per-spring-max-iterations", a->per_spring_max_iterations, "With --per-spring: its Ipopt iteration limit")
+  a->smoothness_option = cmd->add_option("--smoothness", a->per_spring_weights.smoothness,
+                                         "With --per-spring: w_s, weight of mean (ln mu_e - ln "
+                                         "mu_f)^2 over springs sharing a tetrahedron")
+                             ->capture_default_str();
+  cmd->add_option("--per-spring-max-iterations", a->per_spring_max_iterations,
+                  "With --per-spring: its Ipopt iteration limit")
       ->capture_default_str();
-  cmd->add_flag("--no-check", a->no_check, "Skip the nonlinear MSS-vs-FEM check (errors then linearised only)");
+  cmd->add_flag("--no-check", a->no_check,
+                "Skip the nonlinear MSS-vs-FEM check (errors then linearised only)");
   cmd->add_option("--out", a->out, "Tuned parameter file to write (JSON); required");
   add_output_flags(cmd, a->json, a->quiet, "the tuned file\'s contents as JSON");
   cmd->footer(
-      "Objective (training cases): mean relative nodal displacement error^2 + w_r reaction error^2 under\n"
-      "the FEM's plate motion + w_k mean ln^2(K6_ii MSS/FEM) + w_p mean ln^2(scale), the MSS linearised at\n"
-      "rest; exact adjoint gradient. Reported: untuned (Van Gelder) and tuned errors on training and\n"
-      "held-out cases by the nonlinear MSS at the case loads x --check-load-scale (as `spinesim mss compare\n"
-      "--load-scale`; the FEM is linear, the standard loads turn the plate by up to 15 deg on L4-L5 and ~20 deg\n"
-      "on thoracic discs), beside the linearised errors. A failed Ipopt run exits 1 and writes no file.\n"
-      "--per-spring: then q_e = ln mu_e per main spring, J + w_s smoothness + w_p mean q^2, mu in [0.1, 10]; the\n"
-      "region-only fit is reported beside it, transfer meshes get the region-level scales (per-spring ones do not\n"
+      "Objective (training cases): mean relative nodal displacement error^2 + w_r reaction error^2 "
+      "under\n"
+      "the FEM's plate motion + w_k mean ln^2(K6_ii MSS/FEM) + w_p mean ln^2(scale), the MSS "
+      "linearised at\n"
+      "rest; exact adjoint gradient. Reported: untuned (Van Gelder) and tuned errors on training "
+      "and\n"
+      "held-out cases by the nonlinear MSS at the case loads x --check-load-scale (as `spinesim "
+      "mss compare\n"
+      "--load-scale`; the FEM is linear, the standard loads turn the plate by up to 15 deg on "
+      "L4-L5 and ~20 deg\n"
+      "on thoracic discs), beside the linearised errors. A failed Ipopt run exits 1 and writes no "
+      "file.\n"
+      "--per-spring: then q_e = ln mu_e per main spring, J + w_s smoothness + w_p mean q^2, mu in "
+      "[0.1, 10]; the\n"
+      "region-only fit is reported beside it, transfer meshes get the region-level scales "
+      "(per-spring ones do not\n"
       "transfer), and the file (kind per-spring) is written only when both stages succeed.");
   cmd->callback([a] { run_calibrate(*a); });
 }

@@ -26,8 +26,8 @@ Eigen::VectorXd parse_numbers(const std::string& text, int n, const std::string&
     values.push_back(v);
   }
   if (int(values.size()) != n)
-    throw std::invalid_argument(what + ": expected " + std::to_string(n) + " comma-separated numbers, got " +
-                                std::to_string(values.size()));
+    throw std::invalid_argument(what + ": expected " + std::to_string(n) +
+                                " comma-separated numbers, got " + std::to_string(values.size()));
   return Eigen::Map<Eigen::VectorXd>(values.data(), n);
 }
 
@@ -36,14 +36,17 @@ void add_output_flags(CLI::App* cmd, bool& json, bool& quiet, const std::string&
   cmd->add_flag("--quiet", quiet, "No progress on stderr");
 }
 
-void add_plate_load_options(CLI::App* cmd, std::string& motion, std::string& wrench, std::string& load_case,
-                            std::string& center) {
+void add_plate_load_options(CLI::App* cmd, std::string& motion, std::string& wrench,
+                            std::string& load_case, std::string& center) {
   cmd->add_option("--motion", motion, "Plate motion tx,ty,tz,rx,ry,rz (mm, degrees)");
-  cmd->add_option("--wrench", wrench, "Applied wrench Fx,Fy,Fz,Mx,My,Mz (N, N·mm) about the centre");
-  cmd->add_option("--case", load_case,
-                  "Named load case in the disc frame: compression, tension, shear-ap, shear-lat, flexion, "
-                  "extension, lateral-bending, torsion");
-  cmd->add_option("--center", center, "Plate centre x,y,z (mm); default: mean of the superior endplate nodes");
+  cmd->add_option("--wrench", wrench,
+                  "Applied wrench Fx,Fy,Fz,Mx,My,Mz (N, N·mm) about the centre");
+  cmd->add_option(
+      "--case", load_case,
+      "Named load case in the disc frame: compression, tension, shear-ap, shear-lat, flexion, "
+      "extension, lateral-bending, torsion");
+  cmd->add_option("--center", center,
+                  "Plate centre x,y,z (mm); default: mean of the superior endplate nodes");
 }
 
 std::vector<std::string> split_list(const std::string& text) {

@@ -24,11 +24,12 @@ using namespace spinesim::studies;  // the command line is a thin layer over the
 Eigen::VectorXd parse_numbers(const std::string& text, int n, const std::string& what);
 
 /// --json (one JSON object on stdout; `what` says which) and --quiet (no progress on stderr).
-void add_output_flags(CLI::App* cmd, bool& json, bool& quiet, const std::string& what = "a JSON summary");
+void add_output_flags(CLI::App* cmd, bool& json, bool& quiet,
+                      const std::string& what = "a JSON summary");
 
 /// The plate load options of `fem` and `mss`: --motion, --wrench, --case, --center.
-void add_plate_load_options(CLI::App* cmd, std::string& motion, std::string& wrench, std::string& load_case,
-                            std::string& center);
+void add_plate_load_options(CLI::App* cmd, std::string& motion, std::string& wrench,
+                            std::string& load_case, std::string& center);
 
 /// "a,b,,c" -> {"a", "b", "c"} (empty items dropped).
 std::vector<std::string> split_list(const std::string& text);
@@ -36,12 +37,14 @@ std::vector<std::string> split_list(const std::string& text);
 // Sub-command registration; each lives in its own cli_<verb>.cpp.
 void register_mesh(CLI::App& app);
 void register_fem(CLI::App& app);
-void register_mss(CLI::App& app);    ///< mss, mss compare (cli_mss.cpp)
+void register_mss(CLI::App& app);        ///< mss, mss compare (cli_mss.cpp)
 void register_calibrate(CLI::App& app);  ///< calibrate (cli_calibrate.cpp)
-void register_study(CLI::App& app);  ///< study probe|drive|materials|validation|fusion|trends (cli_study.cpp)
+void register_study(
+    CLI::App& app);  ///< study probe|drive|materials|validation|fusion|trends (cli_study.cpp)
 void register_spine(CLI::App& app);  ///< spine solve (cli_spine.cpp)
 void register_demo(CLI::App& app);
 void register_bench(CLI::App& app);
-void register_spine_database(CLI::App& spine);  ///< spine database, under `spine` (cli_spine_database.cpp)
+void register_spine_database(
+    CLI::App& spine);  ///< spine database, under `spine` (cli_spine_database.cpp)
 
 }  // namespace spinesim::cli

@@ -33,11 +33,14 @@ void run(const DemoArgs& a) {
 
 void register_demo(CLI::App& app) {
   auto a = std::make_shared<DemoArgs>();
-  auto* cmd = app.add_subcommand("demo", "Run the pipeline on the embedded defaults and write a readable report");
+  auto* cmd = app.add_subcommand(
+      "demo", "Run the pipeline on the embedded defaults and write a readable report");
   cmd->add_option("--out", a->request.out, "Output folder")->capture_default_str();
   cmd->add_option("--level", a->request.level, "Disc level")->capture_default_str();
-  cmd->add_option("--cell-size", a->request.cell_size_mm, "Mesh cell size, mm")->capture_default_str();
-  cmd->add_option("--order", a->request.fem_order, "FEM element order 1 or 2")->capture_default_str();
+  cmd->add_option("--cell-size", a->request.cell_size_mm, "Mesh cell size, mm")
+      ->capture_default_str();
+  cmd->add_option("--order", a->request.fem_order, "FEM element order 1 or 2")
+      ->capture_default_str();
   add_output_flags(cmd, a->json, a->quiet);
   cmd->callback([a] { run(*a); });
 }

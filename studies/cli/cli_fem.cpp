@@ -35,8 +35,10 @@ void run_fem(const FemArgs& a) {
   if (loads > 1) throw std::invalid_argument("give at most one of --motion, --wrench and --case");
   // Parse every number before doing any work: bad input fails fast, nothing is written.
   fem::Vector6d motion_deg = fem::Vector6d::Zero(), wrench = fem::Vector6d::Zero();
-  if (!a.motion.empty()) motion_deg = parse_numbers(a.motion, 6, "--motion tx,ty,tz,rx,ry,rz (mm, deg)");
-  if (!a.wrench.empty()) wrench = parse_numbers(a.wrench, 6, "--wrench Fx,Fy,Fz,Mx,My,Mz (N, N·mm)");
+  if (!a.motion.empty())
+    motion_deg = parse_numbers(a.motion, 6, "--motion tx,ty,tz,rx,ry,rz (mm, deg)");
+  if (!a.wrench.empty())
+    wrench = parse_numbers(a.wrench, 6, "--wrench Fx,Fy,Fz,Mx,My,Mz (N, N·mm)");
   const fem::LoadCase* named = a.load_case.empty() ? nullptr : &fem::load_case(a.load_case);
   const auto materials = mesh::load_material(a.material, data_dir());
 
@@ -45,8 +47,9 @@ void run_fem(const FemArgs& a) {
   const mesh::TetMesh m = mesh::read_tet_mesh(a.mesh_path);
   mesh::require_endplate_labels(m);
   progress.end(std::to_string(m.num_tets()) + " tets");
-  const Eigen::Vector3d center = a.center.empty() ? fem::DiscFem::default_plate_center(m)
-                                                  : Eigen::Vector3d(parse_numbers(a.center, 3, "--center x,y,z (mm)"));
+  const Eigen::Vector3d center =
+      a.center.empty() ? fem::DiscFem::default_plate_center(m)
+                       : Eigen::Vector3d(parse_numbers(a.center, 3, "--center x,y,z (mm)"));
 
   progress.begin("assembling and factorising (P" + std::to_string(a.order) + ")");
   fem::DiscFem solver(m, materials, a.order, center);
@@ -88,12 +91,13 @@ void run_fem(const FemArgs& a) {
       {"stiffness_6x6", to_json(Eigen::MatrixXd(stiffness_per_degree(k6)))},
       {"stiffness_6x6_units", kStiffnessUnits},
       {"max_displacement_mm", sol.displacement_mm.rowwise().norm().maxCoeff()},
-      {"timings", {{"setup_s", t.setup_s},
-                   {"assembly_s", t.assembly_s},
-                   {"analyse_s", t.analyse_s},
-                   {"factorise_s", t.factorise_s},
-                   {"stiffness_solve_s", t.solve_s},
-                   {"load_solve_s", solve_s}}}};
+      {"timings",
+       {{"setup_s", t.setup_s},
+        {"assembly_s", t.assembly_s},
+        {"analyse_s", t.analyse_s},
+        {"factorise_s", t.factorise_s},
+        {"stiffness_solve_s", t.solve_s},
+        {"load_solve_s", solve_s}}}};
   if (named) j["case"] = named->name;
   if (!a.out.empty()) j["out"] = a.out;
   if (a.json) {
@@ -101,11 +105,12 @@ void run_fem(const FemArgs& a) {
     return;
   }
   const auto q = motion_rad_to_deg(sol.plate_motion);
-  std::cout << std::setprecision(5) << "FEM P" << a.order << " on " << a.mesh_path << " (" << m.num_tets()
-            << " tets, " << solver.num_dofs() << " DOF), material " << materials.name << "\n"
+  std::cout << std::setprecision(5) << "FEM P" << a.order << " on " << a.mesh_path << " ("
+            << m.num_tets() << " tets, " << solver.num_dofs() << " DOF), material "
+            << materials.name << "\n"
             << "  plate centre  " << center.transpose() << " mm\n"
-            << "  plate motion  t = " << q.head<3>().transpose() << " mm, r = " << q.tail<3>().transpose()
-            << " deg\n"
+            << "  plate motion  t = " << q.head<3>().transpose()
+            << " mm, r = " << q.tail<3>().transpose() << " deg\n"
             << "  reaction      F = " << sol.reaction_wrench.head<3>().transpose()
             << " N, M = " << sol.reaction_wrench.tail<3>().transpose() << " N·mm\n";
   print_stiffness(std::cout, k6);
@@ -115,9 +120,12 @@ void run_fem(const FemArgs& a) {
 
 void register_fem(CLI::App& app) {
   auto a = std::make_shared<FemArgs>();
-  auto* cmd = app.add_subcommand("fem", "Linear FEM reference: rigid superior plate, fixed inferior endplate");
-  cmd->add_option("--mesh", a->mesh_path, "Disc mesh (VTU with `surface` endplate labels)")->required();
-  cmd->add_option("--material", a->material, "Preset (real-disc, annulus-nucleus, rubber, polyethylene) or JSON file")
+  auto* cmd = app.add_subcommand(
+      "fem", "Linear FEM reference: rigid superior plate, fixed inferior endplate");
+  cmd->add_option("--mesh", a->mesh_path, "Disc mesh (VTU with `surface` endplate labels)")
+      ->required();
+  cmd->add_option("--material", a->material,
+                  "Preset (real-disc, annulus-nucleus, rubber, polyethylene) or JSON file")
       ->capture_default_str();
   cmd->add_option("--order", a->order, "Element order: 1 (P1) or 2 (P2)")->capture_default_str();
   add_plate_load_options(cmd, a->motion, a->wrench, a->load_case, a->center);

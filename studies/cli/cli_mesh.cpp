@@ -48,10 +48,12 @@ std::string joined(const std::vector<std::string>& names) {
 void check_mesher_flags(const MeshArgs& a) {
   if (a.structured) {
     if (!a.cgal_flags_given.empty())
-      throw std::invalid_argument("--structured does not take the CGAL options (" + joined(a.cgal_flags_given) +
+      throw std::invalid_argument("--structured does not take the CGAL options (" +
+                                  joined(a.cgal_flags_given) +
                                   "); use --sectors, --rings, --layers");
     if (!a.inferior.empty() || !a.superior.empty())
-      throw std::invalid_argument("--structured meshes a parametric level: give --level, not --inferior/--superior");
+      throw std::invalid_argument(
+          "--structured meshes a parametric level: give --level, not --inferior/--superior");
     mesh::validate(a.structured_opt);
   } else if (!a.structured_flags_given.empty()) {
     throw std::invalid_argument(joined(a.structured_flags_given) + " only apply with --structured");
@@ -61,7 +63,8 @@ void check_mesher_flags(const MeshArgs& a) {
 double units_to_mm(const std::string& u) {
   static const std::map<std::string, double> table = {{"mm", 1.0}, {"cm", 10.0}, {"m", 1000.0}};
   auto it = table.find(u);
-  if (it == table.end()) throw std::invalid_argument("unknown --units '" + u + "' (use mm, cm or m)");
+  if (it == table.end())
+    throw std::invalid_argument("unknown --units '" + u + "' (use mm, cm or m)");
   return it->second;
 }
 
@@ -70,7 +73,8 @@ mesh::UpAxis up_axis(const std::string& u) {
       {"x", mesh::UpAxis::x},        {"y", mesh::UpAxis::y},        {"z", mesh::UpAxis::z},
       {"-x", mesh::UpAxis::minus_x}, {"-y", mesh::UpAxis::minus_y}, {"-z", mesh::UpAxis::minus_z}};
   auto it = table.find(u);
-  if (it == table.end()) throw std::invalid_argument("unknown --up '" + u + "' (use x, y, z, -x, -y or -z)");
+  if (it == table.end())
+    throw std::invalid_argument("unknown --up '" + u + "' (use x, y, z, -x, -y or -z)");
   return it->second;
 }
 
@@ -80,7 +84,8 @@ void run_mesh_disc(const MeshArgs& a) {
   opt.perturb = !a.no_perturb;
   opt.exude = !a.no_exude;
   if (!(opt.cell_size_mm > 0) || !(opt.facet_distance_mm > 0) || !(opt.radius_edge_ratio >= 1.0))
-    throw std::invalid_argument("--cell-size and --facet-distance must be > 0 mm, --radius-edge >= 1");
+    throw std::invalid_argument(
+        "--cell-size and --facet-distance must be > 0 mm, --radius-edge >= 1");
   const bool from_vertebrae = !a.inferior.empty() || !a.superior.empty();
   if (from_vertebrae == !a.level.empty())
     throw std::invalid_argument("give either --level or both --inferior and --superior");
@@ -98,29 +103,37 @@ void run_mesh_disc(const MeshArgs& a) {
     const auto axis = up_axis(a.up);
     const auto inferior = mesh::read_surface(a.inferior, scale, axis);
     const auto superior = mesh::read_surface(a.superior, scale, axis);
-    progress.end(std::to_string(inferior.F.rows()) + " + " + std::to_string(superior.F.rows()) + " triangles");
+    progress.end(std::to_string(inferior.F.rows()) + " + " + std::to_string(superior.F.rows()) +
+                 " triangles");
     progress.begin("meshing the disc between the facing endplates");
     mesh::VertebraDiscInfo info;
-    m = mesh::mesh_disc_between_vertebrae(inferior, superior, opt, mesh::VertebraDiscOptions(), &info);
+    m = mesh::mesh_disc_between_vertebrae(inferior, superior, opt, mesh::VertebraDiscOptions(),
+                                          &info);
     mesh_s = progress.end(std::to_string(m.num_tets()) + " tets");
     exact_volume = info.volume_mm3;  // quadrature of the endplate gap over the footprint
     j["inferior"] = a.inferior;
     j["superior"] = a.superior;
-    j["disc"] = {{"footprint_area_mm2", info.footprint_area_mm2}, {"center_height_mm", info.center_height_mm},
-                 {"min_height_mm", info.min_height_mm},           {"max_height_mm", info.max_height_mm},
-                 {"width_mm", info.width_mm},                     {"depth_mm", info.depth_mm}};
+    j["disc"] = {{"footprint_area_mm2", info.footprint_area_mm2},
+                 {"center_height_mm", info.center_height_mm},
+                 {"min_height_mm", info.min_height_mm},
+                 {"max_height_mm", info.max_height_mm},
+                 {"width_mm", info.width_mm},
+                 {"depth_mm", info.depth_mm}};
   } else {
     const auto dims = mesh::disc_dimensions(a.level, data_dir());
     if (a.placement != "spine" && a.placement != "local")
       throw std::invalid_argument("--placement must be 'spine' or 'local'");
-    const DiscPlacement placement = a.placement == "spine" ? DiscPlacement::spine : DiscPlacement::local;
+    const DiscPlacement placement =
+        a.placement == "spine" ? DiscPlacement::spine : DiscPlacement::local;
     if (a.structured) {
       const auto& so = a.structured_opt;
-      progress.begin("meshing " + dims.level + " (structured, " + std::to_string(so.sectors) + " sectors, " +
-                     std::to_string(so.rings) + " rings, " + std::to_string(so.layers) + " layers)");
+      progress.begin("meshing " + dims.level + " (structured, " + std::to_string(so.sectors) +
+                     " sectors, " + std::to_string(so.rings) + " rings, " +
+                     std::to_string(so.layers) + " layers)");
       m = mesh_structured_level(dims.level, so, placement);
     } else {
-      progress.begin("meshing " + dims.level + " (cell size " + std::to_string(opt.cell_size_mm).substr(0, 4) + " mm)");
+      progress.begin("meshing " + dims.level + " (cell size " +
+                     std::to_string(opt.cell_size_mm).substr(0, 4) + " mm)");
       m = mesh_disc_level(dims.level, opt, placement);
     }
     mesh_s = progress.end(std::to_string(m.num_tets()) + " tets");
@@ -147,10 +160,14 @@ void run_mesh_disc(const MeshArgs& a) {
                     {"match_area", a.structured_opt.match_area}};
   else
     j["options"] = {{"mesher", "cgal"},
-                    {"cell_size_mm", opt.cell_size_mm},     {"facet_distance_mm", opt.facet_distance_mm},
-                    {"facet_size_mm", opt.facet_size_mm},   {"radius_edge_ratio", opt.radius_edge_ratio},
-                    {"odt", opt.odt},                       {"lloyd", opt.lloyd},
-                    {"perturb", opt.perturb},               {"exude", opt.exude},
+                    {"cell_size_mm", opt.cell_size_mm},
+                    {"facet_distance_mm", opt.facet_distance_mm},
+                    {"facet_size_mm", opt.facet_size_mm},
+                    {"radius_edge_ratio", opt.radius_edge_ratio},
+                    {"odt", opt.odt},
+                    {"lloyd", opt.lloyd},
+                    {"perturb", opt.perturb},
+                    {"exude", opt.exude},
                     {"seed", opt.seed}};
   if (a.json)
     print_json(j);
@@ -161,46 +178,64 @@ void run_mesh_disc(const MeshArgs& a) {
 }  // namespace
 
 void register_mesh(CLI::App& app) {
-  auto* mesh_cmd = app.add_subcommand("mesh", "Make tetrahedral disc meshes (CGAL Mesh_3 or structured sweep)");
+  auto* mesh_cmd =
+      app.add_subcommand("mesh", "Make tetrahedral disc meshes (CGAL Mesh_3 or structured sweep)");
   mesh_cmd->require_subcommand(1);
   auto a = std::make_shared<MeshArgs>();
   auto* disc = mesh_cmd->add_subcommand(
-      "disc", "Mesh a disc: a parametric level (--level) or the disc between two vertebra surfaces");
-  disc->add_option("--level", a->level, "Disc level T1-T2 ... L5-S1 (parametric kidney-shaped disc)");
-  disc->add_option("--inferior", a->inferior, "Inferior vertebra or endplate surface (STL/OBJ/PLY/OFF)");
-  disc->add_option("--superior", a->superior, "Superior vertebra or endplate surface (STL/OBJ/PLY/OFF)");
-  disc->add_option("--units", a->units, "Length unit of the surface files: mm, cm or m")->capture_default_str();
-  disc->add_option("--up", a->up, "Superior axis of the surface files: x, y, z, -x, -y, -z")->capture_default_str();
-  disc->add_option("--placement", a->placement,
-                   "Parametric disc placement: 'spine' (between the vertebrae of thesis tables F.1/F.2) "
-                   "or 'local' (upright at the origin)")
+      "disc",
+      "Mesh a disc: a parametric level (--level) or the disc between two vertebra surfaces");
+  disc->add_option("--level", a->level,
+                   "Disc level T1-T2 ... L5-S1 (parametric kidney-shaped disc)");
+  disc->add_option("--inferior", a->inferior,
+                   "Inferior vertebra or endplate surface (STL/OBJ/PLY/OFF)");
+  disc->add_option("--superior", a->superior,
+                   "Superior vertebra or endplate surface (STL/OBJ/PLY/OFF)");
+  disc->add_option("--units", a->units, "Length unit of the surface files: mm, cm or m")
+      ->capture_default_str();
+  disc->add_option("--up", a->up, "Superior axis of the surface files: x, y, z, -x, -y, -z")
+      ->capture_default_str();
+  disc->add_option(
+          "--placement", a->placement,
+          "Parametric disc placement: 'spine' (between the vertebrae of thesis tables F.1/F.2) "
+          "or 'local' (upright at the origin)")
       ->capture_default_str();
   const std::vector<CLI::Option*> cgal = {
-      disc->add_option("--cell-size", a->opt.cell_size_mm, "Upper bound on tet circumradius, mm")->capture_default_str(),
-      disc->add_option("--facet-distance", a->opt.facet_distance_mm, "Boundary approximation bound, mm")
+      disc->add_option("--cell-size", a->opt.cell_size_mm, "Upper bound on tet circumradius, mm")
           ->capture_default_str(),
-      disc->add_option("--facet-size", a->opt.facet_size_mm, "Boundary facet size, mm (0: = cell size)")
+      disc->add_option("--facet-distance", a->opt.facet_distance_mm,
+                       "Boundary approximation bound, mm")
           ->capture_default_str(),
-      disc->add_option("--facet-angle", a->opt.facet_angle_deg, "Minimum boundary facet angle, degrees")
+      disc->add_option("--facet-size", a->opt.facet_size_mm,
+                       "Boundary facet size, mm (0: = cell size)")
           ->capture_default_str(),
-      disc->add_option("--radius-edge", a->opt.radius_edge_ratio, "Cell radius-edge ratio bound")->capture_default_str(),
+      disc->add_option("--facet-angle", a->opt.facet_angle_deg,
+                       "Minimum boundary facet angle, degrees")
+          ->capture_default_str(),
+      disc->add_option("--radius-edge", a->opt.radius_edge_ratio, "Cell radius-edge ratio bound")
+          ->capture_default_str(),
       disc->add_flag("--odt", a->opt.odt, "Run the ODT smoother"),
       disc->add_flag("--lloyd", a->opt.lloyd, "Run the Lloyd smoother"),
       disc->add_flag("--no-perturb", a->no_perturb, "Skip the sliver perturber"),
       disc->add_flag("--no-exude", a->no_exude, "Skip the sliver exuder"),
-      disc->add_option("--seed", a->opt.seed, "Random seed (same seed, same mesh)")->capture_default_str()};
-  disc->add_flag("--structured", a->structured,
-                 "Structured sweep mesh of a parametric level (a few hundred tets; no CGAL criteria)");
+      disc->add_option("--seed", a->opt.seed, "Random seed (same seed, same mesh)")
+          ->capture_default_str()};
+  disc->add_flag(
+      "--structured", a->structured,
+      "Structured sweep mesh of a parametric level (a few hundred tets; no CGAL criteria)");
   const std::vector<CLI::Option*> structured = {
-      disc->add_option("--sectors", a->structured_opt.sectors, "Structured: samples around the outline (>= 6)")
+      disc->add_option("--sectors", a->structured_opt.sectors,
+                       "Structured: samples around the outline (>= 6)")
           ->capture_default_str(),
       disc->add_option("--rings", a->structured_opt.rings,
                        "Structured: point rings, rim and nucleus boundary included (>= 2)")
           ->capture_default_str(),
-      disc->add_option("--layers", a->structured_opt.layers, "Structured: tet layers through the height (>= 1)")
+      disc->add_option("--layers", a->structured_opt.layers,
+                       "Structured: tet layers through the height (>= 1)")
           ->capture_default_str(),
-      disc->add_flag("--match-area", a->structured_opt.match_area,
-                     "Structured: stretch each section to the outline's exact area (exact volume)")};
+      disc->add_flag(
+          "--match-area", a->structured_opt.match_area,
+          "Structured: stretch each section to the outline's exact area (exact volume)")};
   disc->add_option("--out", a->out, "Output VTU file")->capture_default_str();
   disc->add_option("--medit", a->medit, "Also write a Medit .mesh file");
   add_output_flags(disc, a->json, a->quiet);

@@ -19,13 +19,13 @@
 // never jumps (a jump of the prescribed pose in one step would give the endplate nodes a
 // velocity of Δx/dt); K_d ambient damping (5.11). A step that diverges is rejected: the run stops,
 // prints why, says `"diverged": true` in its JSON, writes no file and exits non-zero.
-#include "spinesim/studies/calibration_report.hpp"
 #include "cli_common.hpp"
+#include "spinesim/studies/calibration_report.hpp"
 
-#include "spinesim/mss/quantities.hpp"
-#include "spinesim/studies/fem_report.hpp"
 #include "model_flags.hpp"
+#include "spinesim/mss/quantities.hpp"
 #include "spinesim/studies/comparison_report.hpp"
+#include "spinesim/studies/fem_report.hpp"
 #include "spinesim/studies/mss_run.hpp"
 
 #include "spinesim/calibration/tuned_set.hpp"
@@ -69,8 +69,8 @@ struct ModelChoice {
   std::string variant;
 };
 
-ModelChoice choose_model(const ModelFlags& flags, const std::string& params, const std::string& material,
-                         bool material_given) {
+ModelChoice choose_model(const ModelFlags& flags, const std::string& params,
+                         const std::string& material, bool material_given) {
   ModelChoice c;
   if (params.empty()) {
     c.options = model_options(flags);
@@ -80,9 +80,11 @@ ModelChoice choose_model(const ModelFlags& flags, const std::string& params, con
   }
   const mss::MssOptions defaults;
   if (flags.no_radial || flags.no_torsion || flags.volume_term || flags.disc_volume_term ||
-      flags.volume_factor != defaults.volume_factor || flags.disc_volume_factor != defaults.disc_volume_factor)
+      flags.volume_factor != defaults.volume_factor ||
+      flags.disc_volume_factor != defaults.disc_volume_factor)
     throw std::invalid_argument(
-        "--params fixes the model's terms: drop --no-radial/--no-torsion/--volume-term/--disc-volume-term and their factors");
+        "--params fixes the model's terms: drop "
+        "--no-radial/--no-torsion/--volume-term/--disc-volume-term and their factors");
   const calibration::TunedDisc tuned = calibration::read_tuned_for_mesh(params, nullptr);
   c.options = tuned.mss_options();
   const mss::MssOptions damping = model_options(flags);  // --damping still applies
@@ -91,13 +93,15 @@ ModelChoice choose_model(const ModelFlags& flags, const std::string& params, con
   c.materials = material_given ? mesh::load_material(material, data_dir()) : tuned.materials();
   c.constants = "tuned (" + params + ")";
   c.variant = "tuned " + std::string(c.options.volume_term ? "thesis+volume" : "thesis") +
-              (c.options.disc_volume_term ? "+disc-volume" : "") + (tuned.per_spring() ? ", per-spring" : "");
+              (c.options.disc_volume_term ? "+disc-volume" : "") +
+              (tuned.per_spring() ? ", per-spring" : "");
   return c;
 }
 
 /// The MSS for `m`: with a tuned file, only after it was checked against the mesh and material
 /// (a per-spring file: the very mesh it was fitted on).
-mss::MssModel build_model(const mesh::TetMesh& m, const ModelChoice& c, const std::string& params, bool quiet) {
+mss::MssModel build_model(const mesh::TetMesh& m, const ModelChoice& c, const std::string& params,
+                          bool quiet) {
   if (params.empty()) return mss::MssModel(m, c.materials, c.options);
   const calibration::TunedDisc tuned = calibration::read_tuned_for_mesh(params, &m);
   mss::MssModel model = tuned_model(tuned, m, c.materials, quiet);
@@ -138,7 +142,8 @@ struct Outcome {
 };
 
 /// Static equilibrium under the full load; fills the static JSON fields.
-Outcome solve_static_load(const mss::MssModel& model, const PlateLoad& load, Progress& progress, nlohmann::json& j) {
+Outcome solve_static_load(const mss::MssModel& model, const PlateLoad& load, Progress& progress,
+                          nlohmann::json& j) {
   progress.begin("static equilibrium (Newton)");
   const mss::StaticResult r = mss::solve_static(model, load.boundary(1.0));
   progress.end(std::to_string(r.iterations) + " iterations");
@@ -150,14 +155,16 @@ Outcome solve_static_load(const mss::MssModel& model, const PlateLoad& load, Pro
   Outcome o{r.x_mm, r.plate_motion};
   o.failed = !r.converged || !r.x_mm.allFinite();
   if (o.failed)
-    o.failure = "static solve did not converge after " + std::to_string(r.iterations) + " iterations: " + one_line(r.message);
+    o.failure = "static solve did not converge after " + std::to_string(r.iterations) +
+                " iterations: " + one_line(r.message);
   return o;
 }
 
 /// Steps in time: the load ramped over the first 10 % of the steps, then held; frames into
 /// `frames` (may be null) every `every` steps. Fills the dynamic JSON fields.
-Outcome step_in_time(const mss::MssModel& model, const PlateLoad& load, const MssArgs& a, mss::Integrator integrator,
-                     VtuSeries* frames, Progress& progress, nlohmann::json& j) {
+Outcome step_in_time(const mss::MssModel& model, const PlateLoad& load, const MssArgs& a,
+                     mss::Integrator integrator, VtuSeries* frames, Progress& progress,
+                     nlohmann::json& j) {
   mss::DynamicsOptions dopt;
   dopt.integrator = integrator;
   dopt.dt_s = a.dt_s;
@@ -169,7 +176,8 @@ Outcome step_in_time(const mss::MssModel& model, const PlateLoad& load, const Ms
   const int every = a.frame_every > 0 ? a.frame_every : std::max(1, a.steps / 100);
   if (frames) frames->add(0.0, model, s.x_mm);
 
-  progress.begin(std::to_string(a.steps) + " steps of " + a.integrator + " Euler, dt " + std::to_string(a.dt_s) + " s");
+  progress.begin(std::to_string(a.steps) + " steps of " + a.integrator + " Euler, dt " +
+                 std::to_string(a.dt_s) + " s");
   StepStats stats;
   for (int k = 1; k <= a.steps; ++k) {
     if (!stats.step(sim, s, load.boundary(std::min(1.0, double(k) / ramp)))) break;
@@ -179,13 +187,14 @@ Outcome step_in_time(const mss::MssModel& model, const PlateLoad& load, const Ms
 
   Outcome o;
   o.x_mm = s.x_mm;
-  const double applied = std::min(1.0, double(stats.steps_done) / ramp);  // load factor of the last good step
+  const double applied =
+      std::min(1.0, double(stats.steps_done) / ramp);  // load factor of the last good step
   o.plate_motion = load.is_wrench ? fem::Vector6d(s.plate_q) : fem::Vector6d(applied * load.value);
   if (stats.diverged) {
     const int k = stats.steps_done + 1;
     std::ostringstream os;
-    os << "diverged at step " << k << " of " << a.steps << " (t = " << k * a.dt_s << " s, " << a.integrator
-       << " Euler, dt = " << a.dt_s << " s): " << stats.message;
+    os << "diverged at step " << k << " of " << a.steps << " (t = " << k * a.dt_s << " s, "
+       << a.integrator << " Euler, dt = " << a.dt_s << " s): " << stats.message;
     if (integrator != mss::Integrator::implicit_euler) {
       const double stable = sim.predicted_stable_dt_s(integrator);
       if (std::isfinite(stable)) os << "; predicted stable dt < " << stable << " s";
@@ -201,28 +210,31 @@ Outcome step_in_time(const mss::MssModel& model, const PlateLoad& load, const Ms
   j["matrix_update"] = a.frozen ? "frozen" : "every_iteration";
   stats.add_to(j);
   // About the moved plate centre, like StaticResult::reaction_wrench.
-  j["reaction_wrench"] =
-      to_json(Eigen::VectorXd(mss::plate_reaction(model, o.x_mm, load.center + o.plate_motion.head<3>())));
+  j["reaction_wrench"] = to_json(
+      Eigen::VectorXd(mss::plate_reaction(model, o.x_mm, load.center + o.plate_motion.head<3>())));
   return o;
 }
 
-void print_summary(std::ostream& os, const MssArgs& a, const mss::MssModel& model, const std::string& material,
-                   const PlateLoad& load, const Outcome& o, const nlohmann::json& j) {
+void print_summary(std::ostream& os, const MssArgs& a, const mss::MssModel& model,
+                   const std::string& material, const PlateLoad& load, const Outcome& o,
+                   const nlohmann::json& j) {
   const mesh::TetMesh& m = model.mesh();
-  os << std::setprecision(5) << "MSS on " << a.mesh_path << " (" << m.num_vertices() << " nodes, " << m.num_tets()
-     << " tets), material " << material << ", " << (a.params.empty() ? model_variant(a.model) : "tuned (" + a.params + ")")
-     << "\n"
-     << "  springs       " << model.num_edge_springs() << " edge, " << model.num_radial_tets() << " radial tets, "
-     << model.num_angle_springs() << " angle, " << model.num_volume_terms() << " volume\n"
+  os << std::setprecision(5) << "MSS on " << a.mesh_path << " (" << m.num_vertices() << " nodes, "
+     << m.num_tets() << " tets), material " << material << ", "
+     << (a.params.empty() ? model_variant(a.model) : "tuned (" + a.params + ")") << "\n"
+     << "  springs       " << model.num_edge_springs() << " edge, " << model.num_radial_tets()
+     << " radial tets, " << model.num_angle_springs() << " angle, " << model.num_volume_terms()
+     << " volume\n"
      << "  plate centre  " << load.center.transpose() << " mm\n";
   if (a.dynamic)
-    os << "  dynamic       " << j["steps_done"] << " of " << a.steps << " steps, dt " << a.dt_s << " s, mean step "
-       << j["step_seconds_mean"].get<double>() * 1e3 << " ms\n";
+    os << "  dynamic       " << j["steps_done"] << " of " << a.steps << " steps, dt " << a.dt_s
+       << " s, mean step " << j["step_seconds_mean"].get<double>() * 1e3 << " ms\n";
   else
-    os << "  static        " << (j["converged"].get<bool>() ? "converged" : "NOT converged") << " in "
-       << j["iterations"] << " Newton iterations\n";
+    os << "  static        " << (j["converged"].get<bool>() ? "converged" : "NOT converged")
+       << " in " << j["iterations"] << " Newton iterations\n";
   const auto qd = motion_rad_to_deg(o.plate_motion);
-  os << "  plate motion  t = " << qd.head<3>().transpose() << " mm, r = " << qd.tail<3>().transpose() << " deg\n"
+  os << "  plate motion  t = " << qd.head<3>().transpose()
+     << " mm, r = " << qd.tail<3>().transpose() << " deg\n"
      << "  reaction      " << j["reaction_wrench"].dump() << " (N, N·mm)\n"
      << "  volume        " << j["volume_mm3"].get<double>() << " mm^3, change "
      << 100.0 * j["volume_change"].get<double>() << " %\n";
@@ -233,30 +245,38 @@ void run_mss(const MssArgs& a) {
   if (a.mesh_path.empty()) throw std::invalid_argument("--mesh is required");
   const int loads = int(!a.motion.empty()) + int(!a.wrench.empty()) + int(!a.load_case.empty());
   if (loads > 1) throw std::invalid_argument("give at most one of --motion, --wrench and --case");
-  if (a.static_run && a.dynamic) throw std::invalid_argument("give --static or --dt/--steps/--integrator, not both");
+  if (a.static_run && a.dynamic)
+    throw std::invalid_argument("give --static or --dt/--steps/--integrator, not both");
   PlateLoad load;
   if (!a.motion.empty())
-    load.value = motion_deg_to_rad(parse_numbers(a.motion, 6, "--motion tx,ty,tz,rx,ry,rz (mm, deg)"));
+    load.value =
+        motion_deg_to_rad(parse_numbers(a.motion, 6, "--motion tx,ty,tz,rx,ry,rz (mm, deg)"));
   if (!a.wrench.empty()) {
     load.is_wrench = true;
     load.value = parse_numbers(a.wrench, 6, "--wrench Fx,Fy,Fz,Mx,My,Mz (N, N·mm)");
   }
   const fem::LoadCase* named = a.load_case.empty() ? nullptr : &fem::load_case(a.load_case);
-  const Eigen::VectorXd center = a.center.empty() ? Eigen::VectorXd() : parse_numbers(a.center, 3, "--center x,y,z (mm)");
+  const Eigen::VectorXd center =
+      a.center.empty() ? Eigen::VectorXd() : parse_numbers(a.center, 3, "--center x,y,z (mm)");
   mss::Integrator integrator = mss::Integrator::implicit_euler;
   if (a.dynamic) {
     integrator = parse_integrator(a.integrator);
-    if (!std::isfinite(a.dt_s) || a.dt_s <= 0) throw std::invalid_argument("--dt must be a finite number > 0 s");
+    if (!std::isfinite(a.dt_s) || a.dt_s <= 0)
+      throw std::invalid_argument("--dt must be a finite number > 0 s");
     if (a.steps < 1) throw std::invalid_argument("a dynamic run needs --steps N with N >= 1");
     if (a.frame_every < 0) throw std::invalid_argument("--frame-every must be >= 0");
     if (a.newton_iterations < 1) throw std::invalid_argument("--newton must be >= 1");
   }
-  const ModelChoice choice = choose_model(a.model, a.params, a.material, a.material_option->count() > 0);
+  const ModelChoice choice =
+      choose_model(a.model, a.params, a.material, a.material_option->count() > 0);
   const bool series = !a.out.empty() && fs::path(a.out).extension() == ".pvd";
   if (!a.out.empty()) {
     if (fs::path(a.out).extension() != ".vtu" && !series)
-      throw std::invalid_argument("--out " + a.out + ": give a .vtu file (or a .pvd time series for a dynamic run)");
-    if (series && !a.dynamic) throw std::invalid_argument("--out " + a.out + ": a .pvd time series needs a dynamic run (--dt/--steps)");
+      throw std::invalid_argument("--out " + a.out +
+                                  ": give a .vtu file (or a .pvd time series for a dynamic run)");
+    if (series && !a.dynamic)
+      throw std::invalid_argument("--out " + a.out +
+                                  ": a .pvd time series needs a dynamic run (--dt/--steps)");
     require_output_folder(a.out, "--out");
   }
   const auto& materials = choice.materials;
@@ -267,7 +287,8 @@ void run_mss(const MssArgs& a) {
   const mesh::TetMesh m = mesh::read_tet_mesh(a.mesh_path);
   mesh::require_endplate_labels(m);
   const double read_s = progress.end(std::to_string(m.num_tets()) + " tets");
-  load.center = center.size() == 3 ? Eigen::Vector3d(center) : fem::DiscFem::default_plate_center(m);
+  load.center =
+      center.size() == 3 ? Eigen::Vector3d(center) : fem::DiscFem::default_plate_center(m);
   if (named) {
     load.is_wrench = true;
     load.value = fem::global_wrench(*named, m.frame);
@@ -293,7 +314,8 @@ void run_mss(const MssArgs& a) {
   const Outcome o = a.dynamic ? step_in_time(model, load, a, integrator, frames.get(), progress, j)
                               : solve_static_load(model, load, progress, j);
   j["reaction_wrench_units"] =
-      "Fx,Fy,Fz [N], Mx,My,Mz [N·mm] exerted by the disc on the plate, about the moved plate centre";
+      "Fx,Fy,Fz [N], Mx,My,Mz [N·mm] exerted by the disc on the plate, about the moved plate "
+      "centre";
   j["plate_motion"] = to_json(Eigen::VectorXd(motion_rad_to_deg(o.plate_motion)));
   j["plate_motion_units"] = "tx,ty,tz [mm], rx,ry,rz [deg]";
   j["volume_mm3"] = model.volume_mm3(o.x_mm);
@@ -343,8 +365,10 @@ struct CompareArgs {
 void run_compare(const CompareArgs& a) {
   // 1. Options.
   const auto cases = fem::parse_load_cases(a.cases);
-  const ModelChoice choice = choose_model(a.model, a.params, a.material, a.material_option->count() > 0);
-  if (!std::isfinite(a.load_scale) || a.load_scale <= 0) throw std::invalid_argument("--load-scale must be a finite number > 0");
+  const ModelChoice choice =
+      choose_model(a.model, a.params, a.material, a.material_option->count() > 0);
+  if (!std::isfinite(a.load_scale) || a.load_scale <= 0)
+    throw std::invalid_argument("--load-scale must be a finite number > 0");
   if (a.order != 1 && a.order != 2) throw std::invalid_argument("--order must be 1 or 2");
   if (!a.csv.empty()) require_output_folder(a.csv, "--csv");
   const auto& materials = choice.materials;
@@ -355,7 +379,8 @@ void run_compare(const CompareArgs& a) {
   const mesh::TetMesh m = mesh::read_tet_mesh(a.mesh_path);
   mesh::require_endplate_labels(m);
   progress.end(std::to_string(m.num_tets()) + " tets");
-  progress.begin("building the mass-spring model");  // first: a tuned file that does not apply is refused here
+  progress.begin(
+      "building the mass-spring model");  // first: a tuned file that does not apply is refused here
   const mss::MssModel model = build_model(m, choice, a.params, a.quiet || a.json);
   progress.end();
   progress.begin("FEM P" + std::to_string(a.order) + " assembly and factorisation");
@@ -364,7 +389,8 @@ void run_compare(const CompareArgs& a) {
 
   // 3. The protocol (mss_report.hpp).
   progress.begin("comparing " + std::to_string(cases.size()) + " load cases");
-  MssFemComparison cmp = calibration::compare_mss_fem(solver, model, cases, materials.name, mss::StaticOptions(), a.load_scale);
+  MssFemComparison cmp = calibration::compare_mss_fem(solver, model, cases, materials.name,
+                                                      mss::StaticOptions(), a.load_scale);
   cmp.constants = choice.constants;
   progress.end();
 
@@ -378,13 +404,16 @@ void run_compare(const CompareArgs& a) {
     print_json(j);
     return;
   }
-  std::cout << "MSS (" << choice.constants << ", " << choice.variant << ") vs FEM P" << a.order << " on " << a.mesh_path
-            << " (" << m.num_vertices() << " nodes, " << m.num_tets() << " tets), material " << materials.name
-            << (a.load_scale != 1.0 ? ", loads x " + std::to_string(a.load_scale) : std::string()) << "\n\n";
+  std::cout << "MSS (" << choice.constants << ", " << choice.variant << ") vs FEM P" << a.order
+            << " on " << a.mesh_path << " (" << m.num_vertices() << " nodes, " << m.num_tets()
+            << " tets), material " << materials.name
+            << (a.load_scale != 1.0 ? ", loads x " + std::to_string(a.load_scale) : std::string())
+            << "\n\n";
   print_comparison(std::cout, cmp, false);
 }
 
-constexpr const char* kCompareProtocol = R"(Protocol (same mesh, each named case's wrench w on the superior plate, inferior fixed):
+constexpr const char* kCompareProtocol =
+    R"(Protocol (same mesh, each named case's wrench w on the superior plate, inferior fixed):
   (a) wrench-loaded, FEM (vertex displacements) vs MSS static:
       displacement_error = ||u_mss - u_fem|| / ||u_fem|| over all vertices;
       plate_motion_error = RMS over plate nodes of |rigid displacement(q_mss - q_fem)|
@@ -405,40 +434,59 @@ geometric nonlinearity.)";
 
 void register_mss(CLI::App& app) {
   auto a = std::make_shared<MssArgs>();
-  auto* cmd = app.add_subcommand("mss", "Tetrahedral mass-spring disc (thesis ch. 5): static or dynamic, rigid-plate load");
+  auto* cmd = app.add_subcommand(
+      "mss", "Tetrahedral mass-spring disc (thesis ch. 5): static or dynamic, rigid-plate load");
   cmd->require_subcommand(0, 1);
-  cmd->add_option("--mesh", a->mesh_path, "Disc mesh (VTU with `surface` endplate labels); required");
+  cmd->add_option("--mesh", a->mesh_path,
+                  "Disc mesh (VTU with `surface` endplate labels); required");
   a->material_option =
-      cmd->add_option("--material", a->material, "Preset (real-disc, annulus-nucleus, rubber, polyethylene) or JSON file")
+      cmd->add_option("--material", a->material,
+                      "Preset (real-disc, annulus-nucleus, rubber, polyethylene) or JSON file")
           ->capture_default_str();
-  cmd->add_option("--params", a->params, "Tuned disc from `spinesim calibrate` (sets terms, scales and, unless given, the material); or a "
+  cmd->add_option("--params", a->params,
+                  "Tuned disc from `spinesim calibrate` (sets terms, scales and, unless given, the "
+                  "material); or a "
                   "tuned set such as data/tuned_discs.json (the mesh's level is used)");
   add_plate_load_options(cmd, a->motion, a->wrench, a->load_case, a->center);
   cmd->add_flag("--static", a->static_run, "Static equilibrium (the default)");
   auto* dt = cmd->add_option("--dt", a->dt_s, "Time step, s (dynamic run)")->capture_default_str();
   auto* steps = cmd->add_option("--steps", a->steps, "Number of time steps (dynamic run)");
-  auto* integ = cmd->add_option("--integrator", a->integrator, "implicit, symplectic or explicit (thesis 5.20-5.21)")
+  auto* integ = cmd->add_option("--integrator", a->integrator,
+                                "implicit, symplectic or explicit (thesis 5.20-5.21)")
                     ->capture_default_str();
-  cmd->add_option("--newton", a->newton_iterations, "Implicit: max Newton iterations per step (1 = Baraff-Witkin)")
+  cmd->add_option("--newton", a->newton_iterations,
+                  "Implicit: max Newton iterations per step (1 = Baraff-Witkin)")
       ->capture_default_str();
-  cmd->add_flag("--frozen", a->frozen, "Implicit: keep the rest-stiffness factorisation (one solve per step)");
-  cmd->add_option("--frame-every", a->frame_every, "Dynamic .pvd output: a frame every K steps (0: about 100 frames)");
+  cmd->add_flag("--frozen", a->frozen,
+                "Implicit: keep the rest-stiffness factorisation (one solve per step)");
+  cmd->add_option("--frame-every", a->frame_every,
+                  "Dynamic .pvd output: a frame every K steps (0: about 100 frames)");
   add_model_flags(cmd, a->model);
-  cmd->add_option("--out", a->out, "Write the result: .vtu (final state) or .pvd (time series of a dynamic run)");
+  cmd->add_option("--out", a->out,
+                  "Write the result: .vtu (final state) or .pvd (time series of a dynamic run)");
   add_output_flags(cmd, a->json, a->quiet);
   cmd->footer(
-      "Dynamic runs ramp the load linearly over the first 10 % of the steps, then hold it. A diverging run\n"
+      "Dynamic runs ramp the load linearly over the first 10 % of the steps, then hold it. A "
+      "diverging run\n"
       "exits 1 with the reason, \"diverged\": true in its JSON and no output file.");
 
   auto c = std::make_shared<CompareArgs>();
-  auto* cmp = cmd->add_subcommand("compare", "MSS (untuned, or tuned with --params) vs FEM on the same mesh for the named load cases");
-  cmp->add_option("--mesh", c->mesh_path, "Disc mesh (VTU with `surface` endplate labels)")->required();
-  c->material_option = cmp->add_option("--material", c->material, "Preset or JSON file")->capture_default_str();
-  cmp->add_option("--params", c->params, "Tuned disc from `spinesim calibrate` instead of the untuned constants (or a tuned set: the "
-                  "mesh's level)");
-  cmp->add_option("--load-scale", c->load_scale, "Multiply every case's wrench by this factor")->capture_default_str();
+  auto* cmp = cmd->add_subcommand(
+      "compare",
+      "MSS (untuned, or tuned with --params) vs FEM on the same mesh for the named load cases");
+  cmp->add_option("--mesh", c->mesh_path, "Disc mesh (VTU with `surface` endplate labels)")
+      ->required();
+  c->material_option =
+      cmp->add_option("--material", c->material, "Preset or JSON file")->capture_default_str();
+  cmp->add_option(
+      "--params", c->params,
+      "Tuned disc from `spinesim calibrate` instead of the untuned constants (or a tuned set: the "
+      "mesh's level)");
+  cmp->add_option("--load-scale", c->load_scale, "Multiply every case's wrench by this factor")
+      ->capture_default_str();
   cmp->add_option("--cases", c->cases, "Comma-separated load cases, or all")->capture_default_str();
-  cmp->add_option("--order", c->order, "FEM element order: 1 (P1) or 2 (P2)")->capture_default_str();
+  cmp->add_option("--order", c->order, "FEM element order: 1 (P1) or 2 (P2)")
+      ->capture_default_str();
   add_model_flags(cmp, c->model);
   cmp->add_option("--csv", c->csv, "Also write one CSV row per case");
   add_output_flags(cmp, c->json, c->quiet);

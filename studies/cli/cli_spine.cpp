@@ -51,18 +51,21 @@ struct SpineSolveArgs {
 };
 
 /// "T7:0,0,300" → vertebra index and three finite numbers; errors name the option.
-std::pair<int, Eigen::Vector3d> parse_vertebra_vector(const std::string& text, const std::string& option,
+std::pair<int, Eigen::Vector3d> parse_vertebra_vector(const std::string& text,
+                                                      const std::string& option,
                                                       const std::string& what) {
   const auto colon = text.find(':');
   if (colon == std::string::npos)
-    throw std::invalid_argument(option + " '" + text + "': expected VERTEBRA:" + what + " (e.g. T7:0,0,300)");
+    throw std::invalid_argument(option + " '" + text + "': expected VERTEBRA:" + what +
+                                " (e.g. T7:0,0,300)");
   int vertebra = 0;
   try {
     vertebra = spine::vertebra_index(text.substr(0, colon));
   } catch (const std::invalid_argument& e) {
     throw std::invalid_argument(option + " '" + text + "': " + e.what());
   }
-  const Eigen::VectorXd v = parse_numbers(text.substr(colon + 1), 3, option + " " + text.substr(0, colon));
+  const Eigen::VectorXd v =
+      parse_numbers(text.substr(colon + 1), 3, option + " " + text.substr(0, colon));
   return {vertebra, Eigen::Vector3d(v)};
 }
 
@@ -71,18 +74,24 @@ void solve(const SpineSolveArgs& a) {
   spine::SolveOptions options;
   options.warn_above_600n = false;  // warned below, before the solve
   options.recruit = !a.no_muscles;
-  if (a.criterion == "polynomial") options.recruitment.criterion = spine::Criterion::Polynomial;
-  else if (a.criterion == "minmax") options.recruitment.criterion = spine::Criterion::MinMax;
-  else throw std::invalid_argument("--criterion '" + a.criterion + "': use polynomial or minmax");
-  if (!std::isfinite(a.power) || a.power < 1) throw std::invalid_argument("--power must be a finite number >= 1");
+  if (a.criterion == "polynomial")
+    options.recruitment.criterion = spine::Criterion::Polynomial;
+  else if (a.criterion == "minmax")
+    options.recruitment.criterion = spine::Criterion::MinMax;
+  else
+    throw std::invalid_argument("--criterion '" + a.criterion + "': use polynomial or minmax");
+  if (!std::isfinite(a.power) || a.power < 1)
+    throw std::invalid_argument("--power must be a finite number >= 1");
   options.recruitment.power = a.power;
-  if (!std::isfinite(a.tolerance_nmm) || a.tolerance_nmm <= 0) throw std::invalid_argument("--tolerance must be a finite number > 0 N·mm");
+  if (!std::isfinite(a.tolerance_nmm) || a.tolerance_nmm <= 0)
+    throw std::invalid_argument("--tolerance must be a finite number > 0 N·mm");
   if (a.max_iterations < 1) throw std::invalid_argument("--max-iterations must be >= 1");
   if (a.top < 0) throw std::invalid_argument("--top must be >= 0");
   options.tolerance = a.tolerance_nmm;
   options.max_iterations = a.max_iterations;
   if (!a.points.empty() && a.points.size() != a.forces.size())
-    throw std::invalid_argument("--at: give one point per --force (" + std::to_string(a.forces.size()) + " forces, " +
+    throw std::invalid_argument("--at: give one point per --force (" +
+                                std::to_string(a.forces.size()) + " forces, " +
                                 std::to_string(a.points.size()) + " points)");
 
   std::vector<spine::ExternalLoad> loads;
@@ -97,8 +106,9 @@ void solve(const SpineSolveArgs& a) {
       l.point_mm = Eigen::Vector3d(parse_numbers(a.points[i], 3, "--at"));
     }
     if (force.norm() > kValidatedForceN)
-      warnings.push_back("--force " + a.forces[i] + ": |F| = " + fixed(force.norm(), 1) + " N is beyond the " +
-                         fixed(kValidatedForceN, 0) + " N the thesis validated; solving anyway");
+      warnings.push_back("--force " + a.forces[i] + ": |F| = " + fixed(force.norm(), 1) +
+                         " N is beyond the " + fixed(kValidatedForceN, 0) +
+                         " N the thesis validated; solving anyway");
     loads.push_back(l);
   }
   for (const auto& text : a.moments) {
@@ -122,7 +132,8 @@ void solve(const SpineSolveArgs& a) {
   // 2. Model and equilibrium (studies/spine_solve.hpp).
   for (const auto& w : warnings) std::cerr << "spinesim: warning: " << w << std::endl;
   const SpineSolveRun run = studies::run_spine_solve(data_dir(), {loads, model_options, options});
-  for (const auto& w : run.solution.warnings) std::cerr << "spinesim: warning: " << one_line(w) << std::endl;
+  for (const auto& w : run.solution.warnings)
+    std::cerr << "spinesim: warning: " << one_line(w) << std::endl;
 
   // 3. Output.
   if (!a.csv.empty()) write_text_file(a.csv, spine_solve_csv(run.solution));
@@ -135,38 +146,58 @@ void solve(const SpineSolveArgs& a) {
 }  // namespace
 
 void register_spine(CLI::App& app) {
-  auto* spine_cmd = app.add_subcommand("spine", "The vertebra-driven thoracolumbar spine: equilibrium, muscles, joint forces");
+  auto* spine_cmd = app.add_subcommand(
+      "spine", "The vertebra-driven thoracolumbar spine: equilibrium, muscles, joint forces");
   spine_cmd->require_subcommand(1);
 
   auto a = std::make_shared<SpineSolveArgs>();
-  auto* cmd = spine_cmd->add_subcommand("solve", "Quasi-static equilibrium under gravity and loads on any vertebra");
-  cmd->add_option("--force", a->forces, "VERTEBRA:Fx,Fy,Fz in N at the vertebra's centre (repeatable), e.g. T7:0,0,300")
+  auto* cmd = spine_cmd->add_subcommand(
+      "solve", "Quasi-static equilibrium under gravity and loads on any vertebra");
+  cmd->add_option("--force", a->forces,
+                  "VERTEBRA:Fx,Fy,Fz in N at the vertebra's centre (repeatable), e.g. T7:0,0,300")
       ->allow_extra_args(false);
-  cmd->add_option("--moment", a->moments, "VERTEBRA:Mx,My,Mz couple in N·mm (repeatable)")->allow_extra_args(false);
-  cmd->add_option("--at", a->points, "x,y,z point of the --force with the same position, mm, reference posture (repeatable)")
+  cmd->add_option("--moment", a->moments, "VERTEBRA:Mx,My,Mz couple in N·mm (repeatable)")
+      ->allow_extra_args(false);
+  cmd->add_option(
+         "--at", a->points,
+         "x,y,z point of the --force with the same position, mm, reference posture (repeatable)")
       ->allow_extra_args(false);
   cmd->add_option("--fusion", a->fusion, "Fused levels, e.g. L3-L4 or L3-L4-L5 or L3-L4,T12-L1");
-  cmd->add_option("--criterion", a->criterion, "Muscle recruitment: polynomial or minmax")->capture_default_str();
-  cmd->add_option("--power", a->power, "Power p of the polynomial criterion sum (F/Fmax)^p")->capture_default_str();
+  cmd->add_option("--criterion", a->criterion, "Muscle recruitment: polynomial or minmax")
+      ->capture_default_str();
+  cmd->add_option("--power", a->power, "Power p of the polynomial criterion sum (F/Fmax)^p")
+      ->capture_default_str();
   cmd->add_flag("--no-muscles", a->no_muscles, "Passive spine: no muscles");
   cmd->add_flag("--no-trunk-muscles", a->no_trunk_muscles,
-                "Lumbar muscles F.8-F.19 only: leave out the restored thoracic erector spinae and rectus abdominis");
+                "Lumbar muscles F.8-F.19 only: leave out the restored thoracic erector spinae and "
+                "rectus abdominis");
   cmd->add_flag("--no-gravity", a->no_gravity, "No weights (vertebrae, head, arms)");
-  cmd->add_option("--tolerance", a->tolerance_nmm, "Newton tolerance on max |dPi/dtheta|, N·mm")->capture_default_str();
-  cmd->add_option("--max-iterations", a->max_iterations, "Newton iterations before giving up")->capture_default_str();
-  cmd->add_option("--top", a->top, "Muscles and ligaments listed in the table")->capture_default_str();
+  cmd->add_option("--tolerance", a->tolerance_nmm, "Newton tolerance on max |dPi/dtheta|, N·mm")
+      ->capture_default_str();
+  cmd->add_option("--max-iterations", a->max_iterations, "Newton iterations before giving up")
+      ->capture_default_str();
+  cmd->add_option("--top", a->top, "Muscles and ligaments listed in the table")
+      ->capture_default_str();
   cmd->add_option("--csv", a->csv, "Write one row per vertebra and the joint below it");
-  cmd->add_flag("--json", a->json, "Print everything as one JSON object on stdout (instead of the tables)");
+  cmd->add_flag("--json", a->json,
+                "Print everything as one JSON object on stdout (instead of the tables)");
   cmd->footer(
-      "Loads are dead loads (constant direction and size) given in the reference posture. Gravity acts on the\n"
-      "vertebrae (Bruno et al. 2015 masses), the head and neck (on T1) and the arms (on the rib cage, T6).\n"
-      "Muscles: the thesis's lumbar set (tables F.8-F.19) and the LifeMOD trunk muscles it names without data\n"
-      "(thoracic erector spinae, rectus abdominis; data/spine/trunk_muscles.csv). They are recruited for the\n"
+      "Loads are dead loads (constant direction and size) given in the reference posture. Gravity "
+      "acts on the\n"
+      "vertebrae (Bruno et al. 2015 masses), the head and neck (on T1) and the arms (on the rib "
+      "cage, T6).\n"
+      "Muscles: the thesis's lumbar set (tables F.8-F.19) and the LifeMOD trunk muscles it names "
+      "without data\n"
+      "(thoracic erector spinae, rectus abdominis; data/spine/trunk_muscles.csv). They are "
+      "recruited for the\n"
       "lumbar joints T12-L1 ... L5-S1 in the reference posture, then act as\n"
       "springs with short-range stiffness while Newton finds the equilibrium (spine/README.md).\n"
-      "Joint reaction: the force the lower side exerts on everything above (compression > 0), in the lower\n"
-      "vertebra's axes (the thesis's Fy axial, Fz AP shear) and in the disc mid-plane; moments in N·m.\n"
-      "Forces beyond 600 N (the thesis's validated range) are solved with a warning. A solve that does not\n"
+      "Joint reaction: the force the lower side exerts on everything above (compression > 0), in "
+      "the lower\n"
+      "vertebra's axes (the thesis's Fy axial, Fz AP shear) and in the disc mid-plane; moments in "
+      "N·m.\n"
+      "Forces beyond 600 N (the thesis's validated range) are solved with a warning. A solve that "
+      "does not\n"
       "converge is an error (exit 1, nothing written).");
   cmd->callback([a] { solve(*a); });
 

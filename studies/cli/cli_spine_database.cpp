@@ -33,9 +33,12 @@ using nlohmann::json;
 namespace sp = spinesim::spine;
 
 constexpr const char* kSource =
-    "spinesim's spine model (data/thesis tables F.1-F.19, appendix C, data/spine/spine_model.json) solved by "
-    "spine::solve_spine (quasi-static equilibrium under gravity, Ipopt muscle recruitment) with the force on the "
-    "loaded vertebra's F.1 centre along +-x, +-y, +-z, 0-600 N in 50 N steps (thesis 3.5); least-squares polynomial "
+    "spinesim's spine model (data/thesis tables F.1-F.19, appendix C, data/spine/spine_model.json) "
+    "solved by "
+    "spine::solve_spine (quasi-static equilibrium under gravity, Ipopt muscle recruitment) with "
+    "the force on the "
+    "loaded vertebra's F.1 centre along +-x, +-y, +-z, 0-600 N in 50 N steps (thesis 3.5); "
+    "least-squares polynomial "
     "fits, degree chosen by residual";
 
 struct DatabaseArgs {
@@ -52,7 +55,6 @@ std::vector<int> vertebra_list(const std::string& text) {
   return out;
 }
 
-
 sp::SolveOptions solve_options(bool recruit) {
   sp::SolveOptions o;
   o.recruit = recruit;
@@ -65,12 +67,13 @@ void print_residuals(const sp::DatabaseInfo& info, std::ostream& os) {
   const auto& r = info.residuals;
   os << "Fits: " << r.fits << " (per degree 1-5:";
   for (int d = 1; d <= sp::kDbMaxDegree; ++d) os << " " << r.degree_count[std::size_t(d)];
-  os << "), " << r.fits_above_tolerance << " above tolerance (RMS > max(" << 100 * info.tolerance.relative
-     << " % of range, " << info.tolerance.absolute << "))\n";
+  os << "), " << r.fits_above_tolerance << " above tolerance (RMS > max("
+     << 100 * info.tolerance.relative << " % of range, " << info.tolerance.absolute << "))\n";
   TextTable t({"direction", "max mm", "rms mm", "max deg", "rms deg", "above tol"});
   auto row = [&](const std::string& name, const sp::ResidualSummary& s) {
-    t.add({name, fixed(s.max_translation_mm, 4), fixed(s.rms_translation_mm, 4), fixed(s.max_rotation_deg, 4),
-           fixed(s.rms_rotation_deg, 4), std::to_string(s.fits_above_tolerance)});
+    t.add({name, fixed(s.max_translation_mm, 4), fixed(s.rms_translation_mm, 4),
+           fixed(s.max_rotation_deg, 4), fixed(s.rms_rotation_deg, 4),
+           std::to_string(s.fits_above_tolerance)});
   };
   for (int d = 0; d < sp::kDbDirections; ++d)
     row(sp::direction_names()[std::size_t(d)], info.residuals_per_direction[std::size_t(d)]);
@@ -79,14 +82,17 @@ void print_residuals(const sp::DatabaseInfo& info, std::ostream& os) {
 }
 
 void print_failed(const std::vector<sp::FailedSolve>& failed, std::ostream& os) {
-  os << "Failed solves (left out of the fits): " << (failed.empty() ? "none" : std::to_string(failed.size())) << "\n";
+  os << "Failed solves (left out of the fits): "
+     << (failed.empty() ? "none" : std::to_string(failed.size())) << "\n";
   for (const auto& f : failed)
-    os << "  " << sp::vertebra_names()[std::size_t(f.vertebra)] << " " << sp::direction_names()[std::size_t(f.direction)]
-       << " " << f.force_n << " N: " << f.message << "\n";
+    os << "  " << sp::vertebra_names()[std::size_t(f.vertebra)] << " "
+       << sp::direction_names()[std::size_t(f.direction)] << " " << f.force_n << " N: " << f.message
+       << "\n";
 }
 
 void print_out_of_plane(const std::vector<sp::OutOfPlaneSolve>& solves, std::ostream& os) {
-  os << "Sagittal forces (+-y, +-z) whose solution left the sagittal plane (the model is symmetric, so a symmetric "
+  os << "Sagittal forces (+-y, +-z) whose solution left the sagittal plane (the model is "
+        "symmetric, so a symmetric "
         "equilibrium exists): "
      << (solves.empty() ? "none" : std::to_string(solves.size())) << "\n";
   double mm = 0, deg = 0;
@@ -97,49 +103,64 @@ void print_out_of_plane(const std::vector<sp::OutOfPlaneSolve>& solves, std::ost
             sp::direction_names()[std::size_t(o.direction)] + "@" + fixed(o.force_n, 0);
   }
   if (!solves.empty())
-    os << "  worst |tx| " << fixed(mm, 3) << " mm, |(ry, rz)| " << fixed(deg, 3) << " deg: " << list << "\n";
+    os << "  worst |tx| " << fixed(mm, 3) << " mm, |(ry, rz)| " << fixed(deg, 3) << " deg: " << list
+       << "\n";
 }
 
-std::string percent(double error, double scale) { return scale > 0 ? fixed(100 * error / scale, 1) + "%" : "-"; }
+std::string percent(double error, double scale) {
+  return scale > 0 ? fixed(100 * error / scale, 1) + "%" : "-";
+}
 
 void print_superposition(const sp::SuperpositionReport& r, std::ostream& os) {
-  os << "Superposition of axis responses vs a direct solve (max over the 17 vertebrae; % of the max response):\n";
-  TextTable t({"on", "plane", "|F| N", "resp mm", "resp deg", "db err mm", "db err deg", "axis-sum mm", "axis-sum deg",
-               "note"}, 2);
+  os << "Superposition of axis responses vs a direct solve (max over the 17 vertebrae; % of the "
+        "max response):\n";
+  TextTable t({"on", "plane", "|F| N", "resp mm", "resp deg", "db err mm", "db err deg",
+               "axis-sum mm", "axis-sum deg", "note"},
+              2);
   for (const auto& c : r.cases) {
     const std::string vertebra = sp::vertebra_names()[std::size_t(c.vertebra)];
     if (!c.solved) {
-      t.add({vertebra, c.plane, fixed(c.force_n.norm(), 0), "-", "-", "-", "-", "-", "-", c.message});
+      t.add(
+          {vertebra, c.plane, fixed(c.force_n.norm(), 0), "-", "-", "-", "-", "-", "-", c.message});
       continue;
     }
-    auto pair = [&](double e, double scale) { return fixed(e, 3) + " (" + percent(e, scale) + ")"; };
+    auto pair = [&](double e, double scale) {
+      return fixed(e, 3) + " (" + percent(e, scale) + ")";
+    };
     std::string note = c.extrapolated ? "extrapolated" : "";
     if (!c.message.empty()) note += (note.empty() ? "" : "; ") + c.message;
     t.add({vertebra, c.plane, fixed(c.force_n.norm(), 0), fixed(c.response_translation_mm, 2),
-           fixed(c.response_rotation_deg, 2), pair(c.db_error_translation_mm, c.response_translation_mm),
+           fixed(c.response_rotation_deg, 2),
+           pair(c.db_error_translation_mm, c.response_translation_mm),
            pair(c.db_error_rotation_deg, c.response_rotation_deg),
            pair(c.axis_sum_error_translation_mm, c.response_translation_mm),
            pair(c.axis_sum_error_rotation_deg, c.response_rotation_deg), note});
   }
   t.print(os, false, " ");
-  os << "Worst (database: within the solved range): database " << fixed(r.max_db_translation_mm, 3) << " mm (" << fixed(100 * r.max_db_translation_relative, 1)
-     << " %), " << fixed(r.max_db_rotation_deg, 3) << " deg (" << fixed(100 * r.max_db_rotation_relative, 1)
+  os << "Worst (database: within the solved range): database " << fixed(r.max_db_translation_mm, 3)
+     << " mm (" << fixed(100 * r.max_db_translation_relative, 1) << " %), "
+     << fixed(r.max_db_rotation_deg, 3) << " deg (" << fixed(100 * r.max_db_rotation_relative, 1)
      << " %); sum of direct axis solves " << fixed(r.max_axis_sum_translation_mm, 3) << " mm ("
-     << fixed(100 * r.max_axis_sum_translation_relative, 1) << " %), " << fixed(r.max_axis_sum_rotation_deg, 3)
-     << " deg (" << fixed(100 * r.max_axis_sum_rotation_relative, 1) << " %)\n";
+     << fixed(100 * r.max_axis_sum_translation_relative, 1) << " %), "
+     << fixed(r.max_axis_sum_rotation_deg, 3) << " deg ("
+     << fixed(100 * r.max_axis_sum_rotation_relative, 1) << " %)\n";
 }
 
 std::vector<double> magnitudes(const DatabaseArgs& a) {
-  const Eigen::VectorXd m = parse_numbers(a.magnitudes, int(split_list(a.magnitudes).size()), "--magnitudes");
-  if (m.size() == 0 || m.minCoeff() <= 0) throw std::invalid_argument("--magnitudes: give forces > 0 N");
+  const Eigen::VectorXd m =
+      parse_numbers(a.magnitudes, int(split_list(a.magnitudes).size()), "--magnitudes");
+  if (m.size() == 0 || m.minCoeff() <= 0)
+    throw std::invalid_argument("--magnitudes: give forces > 0 N");
   return std::vector<double>(m.data(), m.data() + m.size());
 }
 
-std::vector<sp::SuperpositionCase> oblique_cases(const DatabaseArgs& a, const sp::DisplacementDatabase& db) {
+std::vector<sp::SuperpositionCase> oblique_cases(const DatabaseArgs& a,
+                                                 const sp::DisplacementDatabase& db) {
   std::vector<int> on;
   for (int v : vertebra_list(a.superposition_on))
     if (db.has_vertebra(v)) on.push_back(v);
-  for (int v = 0; on.empty() && v < sp::kDbVertebrae; ++v)  // a subset without T1/T7/L3: its first vertebra
+  for (int v = 0; on.empty() && v < sp::kDbVertebrae;
+       ++v)  // a subset without T1/T7/L3: its first vertebra
     if (db.has_vertebra(v)) on.push_back(v);
   return sp::superposition_cases(on, magnitudes(a));
 }
@@ -148,12 +169,14 @@ std::vector<sp::SuperpositionCase> oblique_cases(const DatabaseArgs& a, const sp
 void validate(const DatabaseArgs& a) {
   if (a.workers < 0) throw std::invalid_argument("--workers must be >= 0");
   vertebra_list(a.vertebrae);
-  if (vertebra_list(a.superposition_on).empty()) throw std::invalid_argument("--superposition-on: no vertebra given");
+  if (vertebra_list(a.superposition_on).empty())
+    throw std::invalid_argument("--superposition-on: no vertebra given");
   magnitudes(a);
   if (!a.fusion.empty()) sp::parse_fusion(a.fusion);
   if (!a.check) {
     const auto dir = std::filesystem::absolute(a.out).parent_path();
-    if (!std::filesystem::is_directory(dir)) throw std::invalid_argument("--out: no folder " + dir.string());
+    if (!std::filesystem::is_directory(dir))
+      throw std::invalid_argument("--out: no folder " + dir.string());
   }
 }
 
@@ -164,7 +187,8 @@ std::string command_line(const DatabaseArgs& a) {
   if (!a.vertebrae.empty()) c += " --vertebrae " + a.vertebrae;
   if (!a.fusion.empty()) c += " --fusion " + a.fusion;
   if (a.no_recruit) c += " --no-recruit";
-  if (a.superposition_on != DatabaseArgs().superposition_on) c += " --superposition-on " + a.superposition_on;
+  if (a.superposition_on != DatabaseArgs().superposition_on)
+    c += " --superposition-on " + a.superposition_on;
   if (a.magnitudes != DatabaseArgs().magnitudes) c += " --magnitudes " + a.magnitudes;
   return c;
 }
@@ -199,7 +223,8 @@ void run_generate(const DatabaseArgs& a) {
   const auto cases = oblique_cases(a, db);
   progress.begin("superposition check: " + std::to_string(cases.size()) + " oblique forces");
   solves.finish();
-  db.info.superposition = sp::check_superposition(model, db, cases, g.solve, a.workers, solves.callback());
+  db.info.superposition =
+      sp::check_superposition(model, db, cases, g.solve, a.workers, solves.callback());
   solves.finish();
   db.info.has_superposition = true;
   progress.end();
@@ -219,14 +244,16 @@ void run_generate(const DatabaseArgs& a) {
     print_json(file);
     return;
   }
-  std::cout << "Displacement-force database: " << nv << " loaded vertebrae x 6 directions x 12 forces + baseline = "
-            << samples.solves << " solves, " << samples.workers << " workers, " << fixed(samples.seconds, 1) << " s\n";
+  std::cout << "Displacement-force database: " << nv
+            << " loaded vertebrae x 6 directions x 12 forces + baseline = " << samples.solves
+            << " solves, " << samples.workers << " workers, " << fixed(samples.seconds, 1)
+            << " s\n";
   print_residuals(db.info, std::cout);
   print_failed(samples.failed, std::cout);
   print_out_of_plane(samples.out_of_plane, std::cout);
   print_superposition(db.info.superposition, std::cout);
-  std::cout << "Wrote " << a.out << " (" << std::filesystem::file_size(a.out) / 1024 << " KiB), total "
-            << fixed(t0.seconds(), 1) << " s\n";
+  std::cout << "Wrote " << a.out << " (" << std::filesystem::file_size(a.out) / 1024
+            << " KiB), total " << fixed(t0.seconds(), 1) << " s\n";
 }
 
 // --- check -----------------------------------------------------------------------------------
@@ -240,7 +267,8 @@ struct GridRow {
 };
 
 void run_check(const DatabaseArgs& a) {
-  const std::string path = a.out_option->count() ? a.out : data_dir() + "/spine/displacement_db.json";
+  const std::string path =
+      a.out_option->count() ? a.out : data_dir() + "/spine/displacement_db.json";
   Progress progress(3, a.quiet);
   progress.begin("loading " + path + " and its model");
   const sp::DisplacementDatabase db = sp::DisplacementDatabase::load(path);
@@ -284,7 +312,8 @@ void run_check(const DatabaseArgs& a) {
       // A force the file also failed at is consistent, not a mismatch.
       bool known = false;
       for (const auto& f : db.info.failed)
-        known = known || (f.vertebra == r.vertebra && f.direction == r.direction && f.force_n == r.force_n);
+        known = known ||
+                (f.vertebra == r.vertebra && f.direction == r.direction && f.force_n == r.force_n);
       if (known) r.message = "";
       all_ok = all_ok && known;
       continue;
@@ -296,7 +325,8 @@ void run_check(const DatabaseArgs& a) {
   }
   progress.end();
   progress.begin("superposition check: " + std::to_string(cases.size()) + " oblique forces");
-  const sp::SuperpositionReport sup = sp::check_superposition(model, db, cases, so, a.workers, solves.callback());
+  const sp::SuperpositionReport sup =
+      sp::check_superposition(model, db, cases, so, a.workers, solves.callback());
   solves.finish();
   progress.end();
 
@@ -305,8 +335,12 @@ void run_check(const DatabaseArgs& a) {
     for (const auto& r : rows)
       grid.push_back({{"vertebra", sp::vertebra_names()[std::size_t(r.vertebra)]},
                       {"direction", sp::direction_names()[std::size_t(r.direction)]},
-                      {"force_n", r.force_n}, {"error_mm", r.error_mm}, {"error_deg", r.error_deg},
-                      {"allowed_mm", r.allowed_mm}, {"allowed_deg", r.allowed_deg}, {"ok", r.ok()},
+                      {"force_n", r.force_n},
+                      {"error_mm", r.error_mm},
+                      {"error_deg", r.error_deg},
+                      {"allowed_mm", r.allowed_mm},
+                      {"allowed_deg", r.allowed_deg},
+                      {"ok", r.ok()},
                       {"message", r.message}});
     print_json({{"file", path},
                 {"generated_by", db.info.generated_by},
@@ -317,38 +351,53 @@ void run_check(const DatabaseArgs& a) {
                 {"ok", all_ok}});
   } else {
     std::cout << "Checking " << path << " (" << db.info.generated_by << ")\n"
-              << "Baseline (gravity only) vs file: " << fixed(base_mm, 5) << " mm, " << fixed(base_deg, 5) << " deg\n"
-              << "Grid forces re-solved (error = max over vertebrae; allowed = the file's max fit residual + "
+              << "Baseline (gravity only) vs file: " << fixed(base_mm, 5) << " mm, "
+              << fixed(base_deg, 5) << " deg\n"
+              << "Grid forces re-solved (error = max over vertebrae; allowed = the file's max fit "
+                 "residual + "
               << margin << "):\n";
-    TextTable t({"vertebra", "direction", "force (N)", "error (mm)", "allowed (mm)", "error (deg)", "allowed (deg)",
-                 "verdict"}, 2);
+    TextTable t({"vertebra", "direction", "force (N)", "error (mm)", "allowed (mm)", "error (deg)",
+                 "allowed (deg)", "verdict"},
+                2);
     for (const auto& r : rows)
-      t.add({sp::vertebra_names()[std::size_t(r.vertebra)], sp::direction_names()[std::size_t(r.direction)],
-             fixed(r.force_n, 0), fixed(r.error_mm, 4), fixed(r.allowed_mm, 4), fixed(r.error_deg, 4), fixed(r.allowed_deg, 4),
-             r.ok() ? "ok" : r.message.empty() ? "MISMATCH" : "FAILED " + r.message});
+      t.add({sp::vertebra_names()[std::size_t(r.vertebra)],
+             sp::direction_names()[std::size_t(r.direction)], fixed(r.force_n, 0),
+             fixed(r.error_mm, 4), fixed(r.allowed_mm, 4), fixed(r.error_deg, 4),
+             fixed(r.allowed_deg, 4),
+             r.ok()              ? "ok"
+             : r.message.empty() ? "MISMATCH"
+                                 : "FAILED " + r.message});
     t.print(std::cout, false);
     print_superposition(sup, std::cout);
   }
-  if (!all_ok) throw std::runtime_error(path + " does not match the model: re-solved responses differ beyond the fit residuals");
+  if (!all_ok)
+    throw std::runtime_error(
+        path + " does not match the model: re-solved responses differ beyond the fit residuals");
 }
 
 }  // namespace
 
 void register_spine_database(CLI::App& spine) {
   auto a = std::make_shared<DatabaseArgs>();
-  auto* cmd = spine.add_subcommand(
-      "database", "Thesis 3.5 displacement-force database: solve, fit, write; measure the superposition assumption");
-  a->out_option = cmd->add_option("--out", a->out, "Database file (JSON); with --check the file checked "
-                                                   "(default there: data/spine/displacement_db.json)")
+  auto* cmd = spine.add_subcommand("database",
+                                   "Thesis 3.5 displacement-force database: solve, fit, write; "
+                                   "measure the superposition assumption");
+  a->out_option = cmd->add_option("--out", a->out,
+                                  "Database file (JSON); with --check the file checked "
+                                  "(default there: data/spine/displacement_db.json)")
                       ->capture_default_str();
-  cmd->add_flag("--check", a->check, "Verify an existing file against direct solves instead of generating one");
+  cmd->add_flag("--check", a->check,
+                "Verify an existing file against direct solves instead of generating one");
   cmd->add_option("--vertebrae", a->vertebrae, "Loaded vertebrae, e.g. T1,L3 (default: T1…L5)");
   cmd->add_option("--fusion", a->fusion, "Fused levels of the model, e.g. L3-L4,L4-L5");
   cmd->add_flag("--no-recruit", a->no_recruit, "Muscles off (passive spine)");
-  cmd->add_option("--superposition-on", a->superposition_on, "Vertebrae loaded by the oblique forces")
+  cmd->add_option("--superposition-on", a->superposition_on,
+                  "Vertebrae loaded by the oblique forces")
       ->capture_default_str();
-  cmd->add_option("--magnitudes", a->magnitudes, "Oblique force magnitudes, N")->capture_default_str();
-  cmd->add_option("--workers", a->workers, "Solver threads (0: one per core)")->capture_default_str();
+  cmd->add_option("--magnitudes", a->magnitudes, "Oblique force magnitudes, N")
+      ->capture_default_str();
+  cmd->add_option("--workers", a->workers, "Solver threads (0: one per core)")
+      ->capture_default_str();
   cmd->add_flag("--json", a->json, "One JSON object on stdout (the file's metadata, or the check)");
   cmd->add_flag("--quiet", a->quiet, "No progress on stderr");
   cmd->callback([a] {

@@ -33,11 +33,11 @@
 
 #include "spinesim/mss/quantities.hpp"
 
+#include "model_flags.hpp"
 #include "spinesim/common/timer.hpp"
+#include "spinesim/studies/comparison_report.hpp"
 #include "spinesim/studies/fem_report.hpp"
 #include "spinesim/studies/materials_study.hpp"
-#include "model_flags.hpp"
-#include "spinesim/studies/comparison_report.hpp"
 #include "spinesim/studies/mss_run.hpp"
 #include "spinesim/studies/spine_studies.hpp"
 
@@ -82,20 +82,26 @@ struct StudyCommon {
 void add_common_options(CLI::App* cmd, StudyCommon& c) {
   cmd->add_option("--out", c.out, "Output folder (created)")->capture_default_str();
   cmd->add_option("--mesh", c.mesh_path, "Disc mesh VTU (default: mesh --level in-process)");
-  cmd->add_option("--level", c.level, "Disc level meshed when no --mesh is given")->capture_default_str();
+  cmd->add_option("--level", c.level, "Disc level meshed when no --mesh is given")
+      ->capture_default_str();
   cmd->add_option("--cell-size", c.cell_size_mm, "Mesh cell size, mm")->capture_default_str();
   cmd->add_option("--dt", c.dt_s, "Time step, s")->capture_default_str();
-  cmd->add_option("--integrator", c.integrator, "implicit, symplectic or explicit")->capture_default_str();
-  cmd->add_option("--newton", c.newton_iterations, "Implicit: max Newton iterations per step")->capture_default_str();
-  cmd->add_flag("--frozen", c.frozen, "Implicit: keep the rest-stiffness factorisation (one solve per step)");
-  cmd->add_option("--frame-every", c.frame_every, "A VTU frame every K steps")->capture_default_str();
+  cmd->add_option("--integrator", c.integrator, "implicit, symplectic or explicit")
+      ->capture_default_str();
+  cmd->add_option("--newton", c.newton_iterations, "Implicit: max Newton iterations per step")
+      ->capture_default_str();
+  cmd->add_flag("--frozen", c.frozen,
+                "Implicit: keep the rest-stiffness factorisation (one solve per step)");
+  cmd->add_option("--frame-every", c.frame_every, "A VTU frame every K steps")
+      ->capture_default_str();
   add_model_flags(cmd, c.model);
   add_output_flags(cmd, c.json, c.quiet, "the JSON summary");
 }
 
 /// Checks the shared options (before any work) and returns the dynamics options.
 mss::DynamicsOptions check_common(const StudyCommon& c) {
-  if (!std::isfinite(c.dt_s) || c.dt_s <= 0) throw std::invalid_argument("--dt must be a finite number > 0 s");
+  if (!std::isfinite(c.dt_s) || c.dt_s <= 0)
+    throw std::invalid_argument("--dt must be a finite number > 0 s");
   if (c.frame_every < 1) throw std::invalid_argument("--frame-every must be >= 1");
   if (c.newton_iterations < 1) throw std::invalid_argument("--newton must be >= 1");
   if (c.mesh_path.empty() && (!std::isfinite(c.cell_size_mm) || c.cell_size_mm <= 0))
@@ -146,7 +152,8 @@ std::string file_stem(const std::string& name) {
 struct ProbeArgs {
   StudyCommon common;
   // Defaults as ProbeStudyRequest (studies/probe_study.hpp).
-  double radius_mm = 3.0, depth_mm = 2.0, speed_mm_s = 20.0, hold_s = 0.1, rest_s = 0.2, stiffness_n_per_mm = 0.0;
+  double radius_mm = 3.0, depth_mm = 2.0, speed_mm_s = 20.0, hold_s = 0.1, rest_s = 0.2,
+         stiffness_n_per_mm = 0.0;
   std::string material = "real-disc", sites = "anterior,left";
 };
 
@@ -182,7 +189,8 @@ void run_probe(ProbeArgs a) {
   else
     print_probe_study(std::cout, m, materials.name, r);
   if (r.stats.diverged)
-    throw std::runtime_error("probe study diverged at step " + std::to_string(r.stats.steps_done + 1) + ": " + r.stats.message);
+    throw std::runtime_error("probe study diverged at step " +
+                             std::to_string(r.stats.steps_done + 1) + ": " + r.stats.message);
 }
 
 // --- study drive -------------------------------------------------------------------------------
@@ -234,8 +242,9 @@ struct DriveResult {
 };
 
 /// One material through the schedule; writes drive-<name>.pvd, its frames and drive-<name>.csv.
-DriveResult drive_one(const mesh::TetMesh& m, const mesh::RegionMaterials& materials, const StudyCommon& c,
-                      const mss::DynamicsOptions& dyn, const std::vector<Keyframe>& keys) {
+DriveResult drive_one(const mesh::TetMesh& m, const mesh::RegionMaterials& materials,
+                      const StudyCommon& c, const mss::DynamicsOptions& dyn,
+                      const std::vector<Keyframe>& keys) {
   const mss::MssModel model(m, materials, model_options(c.model));
   const Eigen::Vector3d center = fem::DiscFem::default_plate_center(m);
   const Eigen::Matrix3d& axes = m.frame.axes;
@@ -248,7 +257,8 @@ DriveResult drive_one(const mesh::TetMesh& m, const mesh::RegionMaterials& mater
   frames.add(0.0, model, s.x_mm);
   std::ostringstream csv;
   csv << std::setprecision(10)
-      << "time_s,tx_mm,ty_mm,tz_mm,rx_deg,ry_deg,rz_deg,Fx_n,Fy_n,Fz_n,Mx_nmm,My_nmm,Mz_nmm,volume_mm3,volume_change,"
+      << "time_s,tx_mm,ty_mm,tz_mm,rx_deg,ry_deg,rz_deg,Fx_n,Fy_n,Fz_n,Mx_nmm,My_nmm,Mz_nmm,volume_"
+         "mm3,volume_change,"
          "max_displacement_mm\n";
   DriveResult r;
   for (int k = 1; k <= steps; ++k) {
@@ -258,7 +268,8 @@ DriveResult drive_one(const mesh::TetMesh& m, const mesh::RegionMaterials& mater
     bc.superior = mss::plate_pose(q, center);
     bc.plate_center_mm = center;
     if (!r.stats.step(sim, s, bc)) break;
-    const fem::Vector6d w = rotate6(axes.transpose(), mss::plate_reaction(model, s.x_mm, center + q.head<3>()));
+    const fem::Vector6d w =
+        rotate6(axes.transpose(), mss::plate_reaction(model, s.x_mm, center + q.head<3>()));
     const double dv = mss::volume_change(model, s.x_mm);
     r.peak_force_n = std::max(r.peak_force_n, w.head<3>().norm());
     r.peak_axial_n = std::max(r.peak_axial_n, w(1));
@@ -268,7 +279,8 @@ DriveResult drive_one(const mesh::TetMesh& m, const mesh::RegionMaterials& mater
     csv << s.time_s;
     for (int i = 0; i < 6; ++i) csv << "," << qd(i);
     for (int i = 0; i < 6; ++i) csv << "," << w(i);
-    csv << "," << model.volume_mm3(s.x_mm) << "," << dv << "," << max_displacement(model, s.x_mm) << "\n";
+    csv << "," << model.volume_mm3(s.x_mm) << "," << dv << "," << max_displacement(model, s.x_mm)
+        << "\n";
     if (k % c.frame_every == 0 || k == steps) frames.add(s.time_s, model, s.x_mm);
   }
   frames.finish();
@@ -295,9 +307,11 @@ void run_drive(DriveArgs a) {
   const mss::DynamicsOptions dyn = check_common(c);
   if (!std::isfinite(a.compression_mm) || !std::isfinite(a.flexion_deg))
     throw std::invalid_argument("--compression and --flexion must be finite numbers");
-  if (!std::isfinite(a.time_scale) || a.time_scale <= 0) throw std::invalid_argument("--time-scale must be finite and > 0");
+  if (!std::isfinite(a.time_scale) || a.time_scale <= 0)
+    throw std::invalid_argument("--time-scale must be finite and > 0");
   std::vector<mesh::RegionMaterials> materials;
-  for (const auto& name : split_list(a.materials)) materials.push_back(mesh::load_material(name, data_dir()));
+  for (const auto& name : split_list(a.materials))
+    materials.push_back(mesh::load_material(name, data_dir()));
   if (materials.empty()) throw std::invalid_argument("--materials: give at least one material");
   const auto keys = drive_schedule(a.compression_mm, a.flexion_deg, a.time_scale);
   fs::create_directories(c.out);
@@ -307,12 +321,15 @@ void run_drive(DriveArgs a) {
   const mesh::TetMesh m = study_mesh(c, progress);
   if (!c.json) {
     std::cout << "Drive study (thesis 5.3, test 2) on " << m.source << " (" << m.num_tets()
-              << " tets): inferior endplate (L3) fixed, superior (L2) driven, disc frame (x lateral, y axial, z "
+              << " tets): inferior endplate (L3) fixed, superior (L2) driven, disc frame (x "
+                 "lateral, y axial, z "
                  "anterior), "
-              << model_variant(c.model) << " MSS, " << c.integrator << " Euler dt " << c.dt_s << " s\n"
+              << model_variant(c.model) << " MSS, " << c.integrator << " Euler dt " << c.dt_s
+              << " s\n"
               << "  schedule (linear in between):\n";
     TextTable t({"time (s)", "axial (mm)", "flexion (deg)"}, 0);
-    for (const auto& k : keys) t.add({significant(k.time_s, 6), significant(k.axial_mm, 6), significant(k.flexion_deg, 6)});
+    for (const auto& k : keys)
+      t.add({significant(k.time_s, 6), significant(k.axial_mm, 6), significant(k.flexion_deg, 6)});
     t.print(std::cout, false, "    ");
   }
 
@@ -328,34 +345,41 @@ void run_drive(DriveArgs a) {
 
   // 4. Summary.
   nlohmann::json schedule = nlohmann::json::array();
-  for (const auto& k : keys) schedule.push_back({{"time_s", k.time_s}, {"axial_mm", k.axial_mm}, {"flexion_deg", k.flexion_deg}});
+  for (const auto& k : keys)
+    schedule.push_back(
+        {{"time_s", k.time_s}, {"axial_mm", k.axial_mm}, {"flexion_deg", k.flexion_deg}});
   std::string diverged;
   for (const auto& r : results)
-    if (r.stats.diverged) diverged += (diverged.empty() ? "" : ", ") + r.json["material"].get<std::string>();
+    if (r.stats.diverged)
+      diverged += (diverged.empty() ? "" : ", ") + r.json["material"].get<std::string>();
   const std::string json_path = (fs::path(c.out) / "drive.json").string();
-  nlohmann::json j = {{"study", "drive"},
-                      {"thesis", "5.3 test 2, fig. 5.9"},
-                      {"mesh", mesh_json(m)},
-                      {"model_variant", model_variant(c.model)},
-                      {"integrator", c.integrator},
-                      {"dt_s", c.dt_s},
-                      {"frame", "disc (x lateral, y axial, z anterior); reaction about the moved plate centre"},
-                      {"schedule", schedule},
-                      {"materials", runs},
-                      {"diverged", !diverged.empty()},
-                      {"json", json_path}};
+  nlohmann::json j = {
+      {"study", "drive"},
+      {"thesis", "5.3 test 2, fig. 5.9"},
+      {"mesh", mesh_json(m)},
+      {"model_variant", model_variant(c.model)},
+      {"integrator", c.integrator},
+      {"dt_s", c.dt_s},
+      {"frame", "disc (x lateral, y axial, z anterior); reaction about the moved plate centre"},
+      {"schedule", schedule},
+      {"materials", runs},
+      {"diverged", !diverged.empty()},
+      {"json", json_path}};
   write_text_file(json_path, j.dump(2) + "\n");
   if (c.json) {
     print_json(j);
   } else {
-    TextTable t({"material", "E (MPa)", "peak |F| (N)", "peak Fy (N)", "peak |M| (N·mm)", "max dV/V0", "step (ms)", ""});
+    TextTable t({"material", "E (MPa)", "peak |F| (N)", "peak Fy (N)", "peak |M| (N·mm)",
+                 "max dV/V0", "step (ms)", ""});
     for (const auto& r : results) {
       std::ostringstream e;  // "4.2/1" when annulus and nucleus differ
-      const double ea = r.json["E_mpa_annulus"].get<double>(), en = r.json["E_mpa_nucleus"].get<double>();
+      const double ea = r.json["E_mpa_annulus"].get<double>(),
+                   en = r.json["E_mpa_nucleus"].get<double>();
       e << ea;
       if (en != ea) e << "/" << en;
-      t.add({r.json["material"].get<std::string>(), e.str(), significant(r.peak_force_n, 5), significant(r.peak_axial_n, 5),
-             significant(r.peak_moment_nmm, 5), significant(100 * r.json["max_volume_change"].get<double>(), 5) + "%",
+      t.add({r.json["material"].get<std::string>(), e.str(), significant(r.peak_force_n, 5),
+             significant(r.peak_axial_n, 5), significant(r.peak_moment_nmm, 5),
+             significant(100 * r.json["max_volume_change"].get<double>(), 5) + "%",
              significant(r.stats.mean_seconds() * 1e3, 5), r.stats.diverged ? "DIVERGED" : ""});
     }
     std::cout << "\n";
@@ -377,9 +401,11 @@ struct MaterialsArgs {
 /// Throws std::invalid_argument unless `path` can be created (its folder exists and is writable).
 void require_writable(const std::string& path, const std::string& option) {
   require_output_folder(path, option);
-  const fs::path dir = fs::path(path).parent_path().empty() ? fs::path(".") : fs::path(path).parent_path();
+  const fs::path dir =
+      fs::path(path).parent_path().empty() ? fs::path(".") : fs::path(path).parent_path();
   if (::access(dir.c_str(), W_OK) != 0)
-    throw std::invalid_argument(option + " " + path + ": folder " + dir.string() + " is not writable");
+    throw std::invalid_argument(option + " " + path + ": folder " + dir.string() +
+                                " is not writable");
 }
 
 void run_materials(const MaterialsArgs& a) {
@@ -390,7 +416,8 @@ void run_materials(const MaterialsArgs& a) {
   MaterialsStudyOptions options;
   options.terms = parse_term_set(a.terms);
   std::vector<mesh::RegionMaterials> materials;
-  for (const auto& name : split_list(a.materials)) materials.push_back(mesh::load_material(name, data_dir()));
+  for (const auto& name : split_list(a.materials))
+    materials.push_back(mesh::load_material(name, data_dir()));
   if (materials.empty()) throw std::invalid_argument("--materials: give at least one material");
   if (!a.csv.empty()) require_writable(a.csv, "--csv");
   const Timer t_start;
@@ -402,13 +429,16 @@ void run_materials(const MaterialsArgs& a) {
   c.cell_size_mm = a.cell_size_mm;
   const mesh::TetMesh m = study_mesh(c, progress);
   if (!a.json) {
-    std::cout << "Material study (thesis fig. 5.9) on " << m.source << ": " << m.num_vertices() << " nodes, "
-              << m.num_tets() << " tets, cell size " << a.cell_size_mm << " mm\n"
-              << "  load: compression, F_y = -500 N on the superior plate (disc frame), inferior endplate fixed\n"
-              << "  FEM P" << options.fem_order << ", linear | untuned MSS: thesis network, Van Gelder constants"
+    std::cout << "Material study (thesis fig. 5.9) on " << m.source << ": " << m.num_vertices()
+              << " nodes, " << m.num_tets() << " tets, cell size " << a.cell_size_mm << " mm\n"
+              << "  load: compression, F_y = -500 N on the superior plate (disc frame), inferior "
+                 "endplate fixed\n"
+              << "  FEM P" << options.fem_order
+              << ", linear | untuned MSS: thesis network, Van Gelder constants"
               << " | tuned MSS: " << term_set_name(options.terms)
               << " scales calibrated to the FEM | MSS: nonlinear static\n";
-    for (const auto& mat : materials) std::cout << "  " << mat.name << ": " << describe_material(mat) << "\n";
+    for (const auto& mat : materials)
+      std::cout << "  " << mat.name << ": " << describe_material(mat) << "\n";
     std::cout << "\n";
   }
 
@@ -432,16 +462,19 @@ void run_materials(const MaterialsArgs& a) {
       {"cell_size_mm", a.cell_size_mm},
       {"mesh", mesh_json(m)},
       {"fem_order", options.fem_order},
-      {"untuned", "thesis network (main + radial + torsion springs), Van Gelder constants, scales 1"},
+      {"untuned",
+       "thesis network (main + radial + torsion springs), Van Gelder constants, scales 1"},
       {"tuned_terms", term_set_name(options.terms)},
       {"load", {{"case", "compression"}, {"wrench_local", to_json(Eigen::VectorXd(w))}}},
       {"units",
        {{"frame", "disc (x lateral, y axial, z anterior)"},
         {"wrench_local", "Fx,Fy,Fz [N], Mx,My,Mz [N·mm]"},
         {"stiffness_diagonal", "tx,ty,tz [N/mm], rx,ry,rz [N·mm/deg], linear at rest"},
-        {"plate_axial_displacement_mm", "superior plate u_y under the load, mm, negative towards the inferior endplate"},
+        {"plate_axial_displacement_mm",
+         "superior plate u_y under the load, mm, negative towards the inferior endplate"},
         {"max_displacement_mm", "largest vertex displacement under the load, mm"},
-        {"volume_change", "(V - V0)/V0 under the load; FEM: P1 volume of the mesh with displaced vertices"},
+        {"volume_change",
+         "(V - V0)/V0 under the load; FEM: P1 volume of the mesh with displaced vertices"},
         {"displacement_error", "|u_MSS - u_FEM|_F / |u_FEM|_F over the vertices, under the load"}}},
       {"materials", materials_json(results)},
       {"csv", a.csv.empty() ? nlohmann::json(nullptr) : nlohmann::json(a.csv)},
@@ -461,17 +494,24 @@ void run_materials(const MaterialsArgs& a) {
 void register_probe(CLI::App& study) {
   auto a = std::make_shared<ProbeArgs>();
   a->common.level = "L4-L5";
-  auto* cmd = study.add_subcommand("probe", "Thesis 5.3 test 1: a rigid sphere pressed into the disc wall, volume tracked");
+  auto* cmd = study.add_subcommand(
+      "probe", "Thesis 5.3 test 1: a rigid sphere pressed into the disc wall, volume tracked");
   add_common_options(cmd, a->common);
   cmd->add_option("--material", a->material, "Preset or JSON file")->capture_default_str();
   cmd->add_option("--radius", a->radius_mm, "Probe radius, mm")->capture_default_str();
-  cmd->add_option("--depth", a->depth_mm, "Indentation depth into the undeformed surface, mm")->capture_default_str();
-  cmd->add_option("--speed", a->speed_mm_s, "Press and withdraw speed, mm/s")->capture_default_str();
-  cmd->add_option("--hold", a->hold_s, "Hold at full depth, s")->capture_default_str();
-  cmd->add_option("--rest", a->rest_s, "Probe away after each site (recovery), s")->capture_default_str();
-  cmd->add_option("--probe-stiffness", a->stiffness_n_per_mm, "Penalty per node, N/mm (0: the solver's default, 100 x the mean edge stiffness from the rest Hessian)")
+  cmd->add_option("--depth", a->depth_mm, "Indentation depth into the undeformed surface, mm")
       ->capture_default_str();
-  cmd->add_option("--sites", a->sites, "Sites in order: anterior, posterior, left, right")->capture_default_str();
+  cmd->add_option("--speed", a->speed_mm_s, "Press and withdraw speed, mm/s")
+      ->capture_default_str();
+  cmd->add_option("--hold", a->hold_s, "Hold at full depth, s")->capture_default_str();
+  cmd->add_option("--rest", a->rest_s, "Probe away after each site (recovery), s")
+      ->capture_default_str();
+  cmd->add_option("--probe-stiffness", a->stiffness_n_per_mm,
+                  "Penalty per node, N/mm (0: the solver's default, 100 x the mean edge stiffness "
+                  "from the rest Hessian)")
+      ->capture_default_str();
+  cmd->add_option("--sites", a->sites, "Sites in order: anterior, posterior, left, right")
+      ->capture_default_str();
   cmd->footer("Writes OUT/probe.pvd (+ OUT/probe/ frames), OUT/probe.csv and OUT/probe.json.");
   cmd->callback([a] { run_probe(*a); });
 }
@@ -479,43 +519,63 @@ void register_probe(CLI::App& study) {
 void register_drive(CLI::App& study) {
   auto a = std::make_shared<DriveArgs>();
   a->common.level = "L2-L3";
-  auto* cmd = study.add_subcommand("drive", "Thesis 5.3 test 2: L2-L3 disc, L3 fixed, L2 driven, per material");
+  auto* cmd = study.add_subcommand(
+      "drive", "Thesis 5.3 test 2: L2-L3 disc, L3 fixed, L2 driven, per material");
   add_common_options(cmd, a->common);
-  cmd->add_option("--materials", a->materials, "Comma-separated presets or JSON files")->capture_default_str();
-  cmd->add_option("--compression", a->compression_mm, "Axial compression of the schedule, mm")->capture_default_str();
-  cmd->add_option("--flexion", a->flexion_deg, "Flexion of the schedule, degrees")->capture_default_str();
-  cmd->add_option("--time-scale", a->time_scale, "Multiply the schedule's times (1.2 s at 1)")->capture_default_str();
+  cmd->add_option("--materials", a->materials, "Comma-separated presets or JSON files")
+      ->capture_default_str();
+  cmd->add_option("--compression", a->compression_mm, "Axial compression of the schedule, mm")
+      ->capture_default_str();
+  cmd->add_option("--flexion", a->flexion_deg, "Flexion of the schedule, degrees")
+      ->capture_default_str();
+  cmd->add_option("--time-scale", a->time_scale, "Multiply the schedule's times (1.2 s at 1)")
+      ->capture_default_str();
   cmd->footer(
-      "Schedule (disc frame, linear in between): 0-0.2 s compress; 0.3-0.5 s flex; 0.6-0.8 s unflex;\n"
-      "0.9-1.1 s release; hold 0.1 s between. Writes OUT/drive-<material>.pvd (+ frames), OUT/drive-<material>.csv\n"
-      "(time, plate motion mm/deg, reaction N and N·mm in the disc frame, volume) and OUT/drive.json.");
+      "Schedule (disc frame, linear in between): 0-0.2 s compress; 0.3-0.5 s flex; 0.6-0.8 s "
+      "unflex;\n"
+      "0.9-1.1 s release; hold 0.1 s between. Writes OUT/drive-<material>.pvd (+ frames), "
+      "OUT/drive-<material>.csv\n"
+      "(time, plate motion mm/deg, reaction N and N·mm in the disc frame, volume) and "
+      "OUT/drive.json.");
   cmd->callback([a] { run_drive(*a); });
 }
 
 void register_materials(CLI::App& study) {
   auto a = std::make_shared<MaterialsArgs>();
-  auto* cmd = study.add_subcommand(
-      "materials", "Thesis fig. 5.9 with a reference: per material, FEM vs untuned vs tuned MSS under the same load");
+  auto* cmd = study.add_subcommand("materials",
+                                   "Thesis fig. 5.9 with a reference: per material, FEM vs untuned "
+                                   "vs tuned MSS under the same load");
   cmd->add_option("--level", a->level, "Disc level, meshed in-process")->capture_default_str();
   cmd->add_option("--cell-size", a->cell_size_mm, "Mesh cell size, mm")->capture_default_str();
-  cmd->add_option("--materials", a->materials, "Comma-separated presets or JSON files")->capture_default_str();
-  cmd->add_option("--terms", a->terms, "What the calibration tunes: thesis, thesis+volume, all")->capture_default_str();
-  cmd->add_option("--csv", a->csv, "Write a CSV, one row per material x model (fem, untuned, tuned)");
+  cmd->add_option("--materials", a->materials, "Comma-separated presets or JSON files")
+      ->capture_default_str();
+  cmd->add_option("--terms", a->terms, "What the calibration tunes: thesis, thesis+volume, all")
+      ->capture_default_str();
+  cmd->add_option("--csv", a->csv,
+                  "Write a CSV, one row per material x model (fem, untuned, tuned)");
   add_output_flags(cmd, a->json, a->quiet, "the JSON summary (instead of the tables)");
   cmd->footer(
-      "Protocol: one mesh of --level for every material; inferior endplate fixed, superior endplate a rigid\n"
+      "Protocol: one mesh of --level for every material; inferior endplate fixed, superior "
+      "endplate a rigid\n"
       "plate about the mean of its vertices. Per material:\n"
-      "  1. FEM P2, linear: the 6x6 plate stiffness and the compression case (F_y = -500 N in the disc\n"
+      "  1. FEM P2, linear: the 6x6 plate stiffness and the compression case (F_y = -500 N in the "
+      "disc\n"
       "     frame, the thesis's fig. 5.9 load);\n"
-      "  2. Ipopt calibrates the MSS stiffness scales (--terms, per region) to that FEM on compression,\n"
+      "  2. Ipopt calibrates the MSS stiffness scales (--terms, per region) to that FEM on "
+      "compression,\n"
       "     shear-ap, flexion and torsion, linearised (as `spinesim calibrate --no-check`);\n"
-      "  3. the untuned MSS (thesis network: main + radial + torsion springs, Van Gelder constants) and\n"
+      "  3. the untuned MSS (thesis network: main + radial + torsion springs, Van Gelder "
+      "constants) and\n"
       "     the tuned MSS, nonlinear static under the same wrench.\n"
-      "Reported per model, disc frame (x lateral, y axial, z anterior): axial stiffness K6_yy (N/mm) and\n"
-      "the 6x6 diagonal (N/mm, N·mm/deg), linear at rest; under the compression: the superior plate's u_y\n"
-      "(mm), max |u| (mm), the volume change (MSS: signed tet volumes; FEM: the P1 volume of the mesh with\n"
+      "Reported per model, disc frame (x lateral, y axial, z anterior): axial stiffness K6_yy "
+      "(N/mm) and\n"
+      "the 6x6 diagonal (N/mm, N·mm/deg), linear at rest; under the compression: the superior "
+      "plate's u_y\n"
+      "(mm), max |u| (mm), the volume change (MSS: signed tet volumes; FEM: the P1 volume of the "
+      "mesh with\n"
       "its vertices moved by the FEM displacement) and the nodal displacement error vs the FEM.\n"
-      "Output: tables on stdout (or --json), --csv FILE. Exit 1 if a calibration fails (tables still shown).");
+      "Output: tables on stdout (or --json), --csv FILE. Exit 1 if a calibration fails (tables "
+      "still shown).");
   cmd->callback([a] { run_materials(*a); });
 }
 
@@ -535,24 +595,28 @@ struct SpineStudyArgs {
 /// A line under the title when the study runs on the lumbar muscles only.
 void print_muscle_set(const SpineStudyArgs& a) {
   if (a.no_trunk_muscles)
-    std::cout << "Muscles: F.8-F.19 only (--no-trunk-muscles: no thoracic erector spinae, no rectus abdominis)\n\n";
+    std::cout << "Muscles: F.8-F.19 only (--no-trunk-muscles: no thoracic erector spinae, no "
+                 "rectus abdominis)\n\n";
 }
 
 void add_spine_study_options(CLI::App* cmd, SpineStudyArgs& a, bool with_force) {
-  if (with_force) cmd->add_option("--force", a.force_n, "Force on the T1 centre, N")->capture_default_str();
+  if (with_force)
+    cmd->add_option("--force", a.force_n, "Force on the T1 centre, N")->capture_default_str();
   cmd->add_option("--csv", a.csv, "Write the study's CSV");
   cmd->add_flag("--json", a.json, "Print the JSON summary on stdout (instead of the tables)");
   cmd->add_flag("--no-trunk-muscles", a.no_trunk_muscles,
-                "Lumbar muscles F.8-F.19 only: leave out the restored thoracic erector spinae and rectus abdominis");
+                "Lumbar muscles F.8-F.19 only: leave out the restored thoracic erector spinae and "
+                "rectus abdominis");
   cmd->add_flag("--quiet", a.quiet, "No progress on stderr");
 }
 
 /// Checks shared by the spine studies before any work; returns the progress hooks.
 StageHooks spine_study_hooks(const SpineStudyArgs& a, Progress& progress) {
-  if (!std::isfinite(a.force_n) || a.force_n <= 0) throw std::invalid_argument("--force must be a finite number > 0 N");
+  if (!std::isfinite(a.force_n) || a.force_n <= 0)
+    throw std::invalid_argument("--force must be a finite number > 0 N");
   if (a.force_n > 600)
-    std::cerr << "spinesim: warning: --force " << a.force_n << " N is beyond the 600 N the thesis validated; solving anyway"
-              << std::endl;
+    std::cerr << "spinesim: warning: --force " << a.force_n
+              << " N is beyond the 600 N the thesis validated; solving anyway" << std::endl;
   if (!a.csv.empty()) require_writable(a.csv, "--csv");
   StageHooks hooks;
   hooks.begin = [&progress](const std::string& what) { progress.begin(what); };
@@ -562,8 +626,9 @@ StageHooks spine_study_hooks(const SpineStudyArgs& a, Progress& progress) {
 
 /// Writes the CSV (--csv), then prints the JSON summary (--json) or the title, the muscle set and the table.
 template <class Study>
-void emit_spine_study(const SpineStudyArgs& a, const Study& s, const char* title, std::string (*to_csv)(const Study&),
-                      nlohmann::json (*to_json)(const Study&), void (*print)(std::ostream&, const Study&, bool)) {
+void emit_spine_study(const SpineStudyArgs& a, const Study& s, const char* title,
+                      std::string (*to_csv)(const Study&), nlohmann::json (*to_json)(const Study&),
+                      void (*print)(std::ostream&, const Study&, bool)) {
   if (!a.csv.empty()) write_text_file(a.csv, to_csv(s));
   if (a.json) {
     nlohmann::json j = to_json(s);
@@ -574,70 +639,95 @@ void emit_spine_study(const SpineStudyArgs& a, const Study& s, const char* title
   std::cout << title << "\n\n";
   print_muscle_set(a);
   print(std::cout, s, false);
-  std::cout << "Total " << fixed(s.seconds, 2) << " s" << (a.csv.empty() ? "" : "; wrote " + a.csv) << "\n";
+  std::cout << "Total " << fixed(s.seconds, 2) << " s" << (a.csv.empty() ? "" : "; wrote " + a.csv)
+            << "\n";
 }
 
 void run_validation(const SpineStudyArgs& a) {
   Progress progress(kValidationStages, a.quiet || a.json);
-  const ValidationStudy s = run_validation_study(data_dir(), a.model(), spine_study_hooks(a, progress));
-  emit_spine_study(a, s, "Spine validation (thesis 3.4): McGill & Norman 1987 at L5-S1, Wilke et al. 2001 at L4-L5",
-                   validation_csv, validation_json, print_validation);
+  const ValidationStudy s =
+      run_validation_study(data_dir(), a.model(), spine_study_hooks(a, progress));
+  emit_spine_study(
+      a, s,
+      "Spine validation (thesis 3.4): McGill & Norman 1987 at L5-S1, Wilke et al. 2001 at L4-L5",
+      validation_csv, validation_json, print_validation);
 }
 
 void run_fusion(const SpineStudyArgs& a) {
   Progress progress(kFusionStages, a.quiet || a.json);
-  const FusionStudy s = run_fusion_study(data_dir(), a.force_n, a.model(), spine_study_hooks(a, progress));
-  emit_spine_study(a, s, "Spinal fusion vs the normal spine (thesis 6.1)", fusion_csv, fusion_json, print_fusion);
+  const FusionStudy s =
+      run_fusion_study(data_dir(), a.force_n, a.model(), spine_study_hooks(a, progress));
+  emit_spine_study(a, s, "Spinal fusion vs the normal spine (thesis 6.1)", fusion_csv, fusion_json,
+                   print_fusion);
 }
 
 void run_trends(const SpineStudyArgs& a) {
   Progress progress(kTrendsStages, a.quiet || a.json);
-  const TrendsStudy s = run_trends_study(data_dir(), a.force_n, a.model(), spine_study_hooks(a, progress));
-  emit_spine_study(a, s, "Relative motion of adjacent vertebrae under a force on T1 (thesis 6.3-6.4)", trends_csv,
-                   trends_json, print_trends);
+  const TrendsStudy s =
+      run_trends_study(data_dir(), a.force_n, a.model(), spine_study_hooks(a, progress));
+  emit_spine_study(a, s,
+                   "Relative motion of adjacent vertebrae under a force on T1 (thesis 6.3-6.4)",
+                   trends_csv, trends_json, print_trends);
 }
 
 void register_validation(CLI::App& study) {
   auto a = std::make_shared<SpineStudyArgs>();
-  auto* cmd = study.add_subcommand("validation", "Thesis 3.4: L5-S1 forces at a 238 N·m extension moment, L4-L5 force holding a crate");
+  auto* cmd = study.add_subcommand(
+      "validation",
+      "Thesis 3.4: L5-S1 forces at a 238 N·m extension moment, L4-L5 force holding a crate");
   add_spine_study_options(cmd, *a, false);
   cmd->footer(
-      "(a) McGill & Norman 1987: a +z force on the T7 centre raised until the net external moment about the\n"
-      "    L5-S1 joint point (T7 force and every weight above, in the equilibrium posture) is 238 N·m; L5-S1\n"
+      "(a) McGill & Norman 1987: a +z force on the T7 centre raised until the net external moment "
+      "about the\n"
+      "    L5-S1 joint point (T7 force and every weight above, in the equilibrium posture) is 238 "
+      "N·m; L5-S1\n"
       "    axial and shear force (joint and disc frames) against 3929-4688 N and <= 650 N.\n"
-      "(b) Wilke et al. 2001: 19.8 kg crate 600 mm in front of the chest, arms forward; L4-L5 axial force\n"
-      "    against 3240 N +- 15 %. Targets: data/spine/spine_model.json \"validation\". Nothing is tuned.\n"
-      "Output: table (or --json with each case's forces beside its targets), --csv FILE. A missed target is\n"
+      "(b) Wilke et al. 2001: 19.8 kg crate 600 mm in front of the chest, arms forward; L4-L5 "
+      "axial force\n"
+      "    against 3240 N +- 15 %. Targets: data/spine/spine_model.json \"validation\". Nothing is "
+      "tuned.\n"
+      "Output: table (or --json with each case's forces beside its targets), --csv FILE. A missed "
+      "target is\n"
       "reported (exit 0); a failed solve is an error (exit 1).");
   cmd->callback([a] { run_validation(*a); });
 }
 
 void register_fusion(CLI::App& study) {
   auto a = std::make_shared<SpineStudyArgs>();
-  auto* cmd = study.add_subcommand("fusion", "Thesis 6.1: normal spine vs fusion at L3-L4, L4-L5, L3-L4-L5 under forces on T1");
+  auto* cmd = study.add_subcommand(
+      "fusion", "Thesis 6.1: normal spine vs fusion at L3-L4, L4-L5, L3-L4-L5 under forces on T1");
   add_spine_study_options(cmd, *a, true);
   cmd->footer(
-      "The same forward (+z), backward (-z) and lateral (-x) force on the T1 centre, per model: T1 motion (the\n"
-      "force's effect, minus the model's gravity-only equilibrium; mm, deg) and the L2-L3 and L5-S1 joint\n"
-      "forces (totals, joint frame; N). The thesis's findings are checked: MATCH or DIFFERS, not forced.");
+      "The same forward (+z), backward (-z) and lateral (-x) force on the T1 centre, per model: T1 "
+      "motion (the\n"
+      "force's effect, minus the model's gravity-only equilibrium; mm, deg) and the L2-L3 and "
+      "L5-S1 joint\n"
+      "forces (totals, joint frame; N). The thesis's findings are checked: MATCH or DIFFERS, not "
+      "forced.");
   cmd->callback([a] { run_fusion(*a); });
 }
 
 void register_trends(CLI::App& study) {
   auto a = std::make_shared<SpineStudyArgs>();
-  auto* cmd = study.add_subcommand("trends", "Thesis 6.3-6.4: relative motion of adjacent vertebrae under forces on T1, vs the thesis's trends");
+  auto* cmd = study.add_subcommand("trends",
+                                   "Thesis 6.3-6.4: relative motion of adjacent vertebrae under "
+                                   "forces on T1, vs the thesis's trends");
   add_spine_study_options(cmd, *a, true);
   cmd->footer(
-      "Lateral (-x), forward (+z) and backward (-z) force on the T1 centre. Per pair T1-T2 ... L4-L5: relative\n"
-      "translation of the centres (upper minus lower, world axes, mm) and the joint rotation (deg), each minus its\n"
-      "gravity-only value. Each trend the thesis states is printed as MATCH or DIFFERS with our numbers.");
+      "Lateral (-x), forward (+z) and backward (-z) force on the T1 centre. Per pair T1-T2 ... "
+      "L4-L5: relative\n"
+      "translation of the centres (upper minus lower, world axes, mm) and the joint rotation "
+      "(deg), each minus its\n"
+      "gravity-only value. Each trend the thesis states is printed as MATCH or DIFFERS with our "
+      "numbers.");
   cmd->callback([a] { run_trends(*a); });
 }
 }  // namespace
 
 void register_study(CLI::App& app) {
-
-  auto* study = app.add_subcommand("study", "The thesis's studies (5.3 functional tests, material comparison), as VTU series, CSV, JSON");
+  auto* study = app.add_subcommand(
+      "study",
+      "The thesis's studies (5.3 functional tests, material comparison), as VTU series, CSV, JSON");
   study->require_subcommand(1);
   register_probe(*study);
   register_drive(*study);

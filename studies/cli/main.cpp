@@ -21,8 +21,9 @@ extern "C" void openblas_set_num_threads(int) __attribute__((weak));
 
 int main(int argc, char** argv) {
   if (openblas_set_num_threads && !std::getenv("OPENBLAS_NUM_THREADS")) openblas_set_num_threads(1);
-  CLI::App app{"spinesim: finite-element-validated intervertebral-disc deformation\n"
-               "(CGAL disc meshes, linear FEM reference, mass-spring discs, spine model)"};
+  CLI::App app{
+      "spinesim: finite-element-validated intervertebral-disc deformation\n"
+      "(CGAL disc meshes, linear FEM reference, mass-spring discs, spine model)"};
   app.set_version_flag("--version", std::string("spinesim ") + SPINESIM_VERSION);
   app.require_subcommand(1);
   spinesim::cli::register_mesh(app);

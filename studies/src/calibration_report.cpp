@@ -4,8 +4,8 @@
 #include "spinesim/studies/table.hpp"
 
 #include "spinesim/common/timer.hpp"
-#include "spinesim/studies/json.hpp"
 #include "spinesim/studies/fem_report.hpp"
+#include "spinesim/studies/json.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -18,7 +18,6 @@
 namespace spinesim::studies {
 
 namespace {
-
 
 std::vector<std::string> names(const std::vector<fem::LoadCase>& cases) {
   std::vector<std::string> out;
@@ -34,7 +33,8 @@ nlohmann::json evaluation_json(const calibration::Evaluation& e) {
           {"regularisation", e.regularisation}};
 }
 
-const calibration::CaseError& case_error(const calibration::Evaluation& e, const std::string& name) {
+const calibration::CaseError& case_error(const calibration::Evaluation& e,
+                                         const std::string& name) {
   for (const auto& c : e.cases)
     if (c.name == name) return c;
   throw std::logic_error("calibration report: case " + name + " missing");
@@ -51,20 +51,24 @@ Eigen::VectorXd diag(const fem::Matrix6d& k) { return stiffness_per_degree(k).di
 /// An Ipopt run in the report (either stage's result), plus `extra` fields.
 template <class Result>
 nlohmann::json ipopt_json(const Result& r, nlohmann::json extra) {
-  extra.update({{"status", r.status},
-                {"success", r.success},
-                {"iterations", r.iterations},
-                {"evaluations", r.evaluations},
-                {"seconds", r.seconds},
-                {"seconds_per_evaluation", r.evaluations ? r.evaluation_seconds / r.evaluations : 0.0}});
+  extra.update(
+      {{"status", r.status},
+       {"success", r.success},
+       {"iterations", r.iterations},
+       {"evaluations", r.evaluations},
+       {"seconds", r.seconds},
+       {"seconds_per_evaluation", r.evaluations ? r.evaluation_seconds / r.evaluations : 0.0}});
   return extra;
 }
 
 /// The per-spring stage in the report: weights, Ipopt, J at both ends, where the multipliers went.
-nlohmann::json per_spring_json(const calibration::PerSpringResult& r, const CalibrationRequest& rq, Eigen::Index edges) {
-  std::vector<double> q(r.log_multipliers.data(), r.log_multipliers.data() + r.log_multipliers.size());
+nlohmann::json per_spring_json(const calibration::PerSpringResult& r, const CalibrationRequest& rq,
+                               Eigen::Index edges) {
+  std::vector<double> q(r.log_multipliers.data(),
+                        r.log_multipliers.data() + r.log_multipliers.size());
   std::sort(q.begin(), q.end());
-  const double lo = std::log(rq.per_spring_ipopt.lower_scale), hi = std::log(rq.per_spring_ipopt.upper_scale);
+  const double lo = std::log(rq.per_spring_ipopt.lower_scale),
+               hi = std::log(rq.per_spring_ipopt.upper_scale);
   const auto count = [&q](auto pred) { return std::count_if(q.begin(), q.end(), pred); };
   const auto objective = [](const calibration::PerSpringEvaluation& e) {
     nlohmann::json j = evaluation_json(e.data);
@@ -75,29 +79,34 @@ nlohmann::json per_spring_json(const calibration::PerSpringResult& r, const Cali
     j.erase("regularisation");
     return j;
   };
-  return {{"edge_springs", edges},
-          {"weights", {{"smoothness", rq.per_spring_weights.smoothness}, {"prior", rq.weights.regularisation}}},
-          {"multiplier_bounds", {rq.per_spring_ipopt.lower_scale, rq.per_spring_ipopt.upper_scale}},
-          {"multipliers",
-           {{"min", std::exp(q.front())},
-            {"median", std::exp(q[q.size() / 2])},
-            {"max", std::exp(q.back())},
-            {"at_lower_bound", count([lo](double v) { return v <= lo + 1e-6; })},
-            {"at_upper_bound", count([hi](double v) { return v >= hi - 1e-6; })}}},
-          {"kept_region_fit", r.kept_start},
-          {"objective", {{"start", objective(r.start)}, {"final", objective(r.final)}}},
-          {"ipopt", ipopt_json(r, {{"hessian", "limited-memory BFGS"}})},
-          {"transfer", "per-spring multipliers belong to this mesh; other meshes get the region-level scales"}};
+  return {
+      {"edge_springs", edges},
+      {"weights",
+       {{"smoothness", rq.per_spring_weights.smoothness}, {"prior", rq.weights.regularisation}}},
+      {"multiplier_bounds", {rq.per_spring_ipopt.lower_scale, rq.per_spring_ipopt.upper_scale}},
+      {"multipliers",
+       {{"min", std::exp(q.front())},
+        {"median", std::exp(q[q.size() / 2])},
+        {"max", std::exp(q.back())},
+        {"at_lower_bound", count([lo](double v) { return v <= lo + 1e-6; })},
+        {"at_upper_bound", count([hi](double v) { return v >= hi - 1e-6; })}}},
+      {"kept_region_fit", r.kept_start},
+      {"objective", {{"start", objective(r.start)}, {"final", objective(r.final)}}},
+      {"ipopt", ipopt_json(r, {{"hessian", "limited-memory BFGS"}})},
+      {"transfer",
+       "per-spring multipliers belong to this mesh; other meshes get the region-level scales"}};
 }
 
 std::string pct(double e) { return percent(e); }
 
 /// Refuses a request that cannot run (before any work).
 void check_request(const mesh::TetMesh& m, const CalibrationRequest& rq) {
-  if (rq.train.empty()) throw std::invalid_argument("calibration needs at least one training case (--train)");
+  if (rq.train.empty())
+    throw std::invalid_argument("calibration needs at least one training case (--train)");
   for (const auto& h : rq.holdout)
     for (const auto& t : rq.train)
-      if (h.name == t.name) throw std::invalid_argument("case '" + h.name + "' is both trained on and held out");
+      if (h.name == t.name)
+        throw std::invalid_argument("case '" + h.name + "' is both trained on and held out");
   calibration::validate(rq.ipopt);
   if (rq.per_spring) {
     calibration::validate(rq.per_spring_ipopt);
@@ -110,23 +119,26 @@ void check_request(const mesh::TetMesh& m, const CalibrationRequest& rq) {
     mesh::require_endplate_labels(other);
     const std::string a = calibration::disc_level(m), b = calibration::disc_level(other);
     if (!a.empty() && !b.empty() && a != b)
-      throw std::invalid_argument("transfer mesh " + label + " is a " + b + " disc, the calibration mesh a " + a + " disc");
+      throw std::invalid_argument("transfer mesh " + label + " is a " + b +
+                                  " disc, the calibration mesh a " + a + " disc");
   }
 }
 
 /// Ipopt's per-iteration line for the status callback.
-std::function<void(int, double, double)> ipopt_progress(const StatusLine& say, const std::string& stage) {
+std::function<void(int, double, double)> ipopt_progress(const StatusLine& say,
+                                                        const std::string& stage) {
   return [say, stage](int it, double J, double inf_du) {
     std::ostringstream s;
-    s << stage << "Ipopt iteration " << it << ": J = " << std::setprecision(4) << J << ", dual infeasibility "
-      << std::setprecision(2) << inf_du;
+    s << stage << "Ipopt iteration " << it << ": J = " << std::setprecision(4) << J
+      << ", dual infeasibility " << std::setprecision(2) << inf_du;
     say(s.str());
   };
 }
 
 /// The tuned file's identity and scales (and per-spring multipliers when that stage ran);
 /// returns the region-level model options (what transfers to other meshes).
-mss::MssOptions fill_tuned_file(CalibrationOutcome& out, const mesh::TetMesh& m, const mesh::RegionMaterials& materials,
+mss::MssOptions fill_tuned_file(CalibrationOutcome& out, const mesh::TetMesh& m,
+                                const mesh::RegionMaterials& materials,
                                 const CalibrationRequest& rq, const mss::MssOptions& options,
                                 const calibration::LinearMss& lin, const mss::MssModel& model) {
   calibration::TunedDisc& t = out.tuned;
@@ -137,7 +149,8 @@ mss::MssOptions fill_tuned_file(CalibrationOutcome& out, const mesh::TetMesh& m,
   t.fem_order = rq.fem_order;
   t.options = options;
   for (std::size_t j = 0; j < lin.knobs().size(); ++j)
-    t.scales[calibration::knob_name(lin.knobs()[j])] = std::exp(out.result.log_scales(Eigen::Index(j)));
+    t.scales[calibration::knob_name(lin.knobs()[j])] =
+        std::exp(out.result.log_scales(Eigen::Index(j)));
   const mss::MssOptions region_options = t.mss_options();  // before the multipliers: what transfers
   if (out.per_spring_ran) {
     const Eigen::VectorXd mu = out.per_spring.log_multipliers.array().exp();
@@ -149,14 +162,16 @@ mss::MssOptions fill_tuned_file(CalibrationOutcome& out, const mesh::TetMesh& m,
 
 /// The nonlinear MSS-vs-FEM protocol on every case for the untuned, the tuned and (after the
 /// per-spring stage) the region-only model, at the check load scale.
-void run_nonlinear_checks(CalibrationOutcome& out, const fem::DiscFem& fem, const mss::MssModel& thesis_model,
-                          const mesh::TetMesh& m, const mesh::RegionMaterials& materials, const CalibrationRequest& rq,
-                          const std::vector<fem::LoadCase>& all, const mss::MssOptions& region_options,
-                          const StatusLine& say) {
+void run_nonlinear_checks(CalibrationOutcome& out, const fem::DiscFem& fem,
+                          const mss::MssModel& thesis_model, const mesh::TetMesh& m,
+                          const mesh::RegionMaterials& materials, const CalibrationRequest& rq,
+                          const std::vector<fem::LoadCase>& all,
+                          const mss::MssOptions& region_options, const StatusLine& say) {
   say("nonlinear check: untuned and tuned MSS vs FEM, " + std::to_string(all.size()) + " cases");
   const Timer t0;
   const auto compare = [&](const fem::DiscFem& f, const mss::MssModel& model) {
-    return calibration::compare_mss_fem(f, model, all, materials.name, mss::StaticOptions(), rq.check_load_scale);
+    return calibration::compare_mss_fem(f, model, all, materials.name, mss::StaticOptions(),
+                                        rq.check_load_scale);
   };
   out.untuned_check = compare(fem, thesis_model);
   out.tuned_check = compare(fem, mss::MssModel(m, materials, out.tuned.mss_options()));
@@ -169,19 +184,23 @@ void run_nonlinear_checks(CalibrationOutcome& out, const fem::DiscFem& fem, cons
 
 /// The region scales on other meshes of the disc (they transfer; how well? Per-spring
 /// multipliers belong to this mesh and are not carried over).
-void run_transfer_checks(CalibrationOutcome& out, const mesh::RegionMaterials& materials, const CalibrationRequest& rq,
-                         const std::vector<fem::LoadCase>& all, const mss::MssOptions& region_options,
-                         const StatusLine& say) {
+void run_transfer_checks(CalibrationOutcome& out, const mesh::RegionMaterials& materials,
+                         const CalibrationRequest& rq, const std::vector<fem::LoadCase>& all,
+                         const mss::MssOptions& region_options, const StatusLine& say) {
   for (const auto& [label, other] : rq.transfer_meshes) {
-    say("transfer check on " + label + " (" + std::to_string(other.num_tets()) + " tets): FEM and MSS");
+    say("transfer check on " + label + " (" + std::to_string(other.num_tets()) +
+        " tets): FEM and MSS");
     const Timer t0;
-    const fem::DiscFem other_fem(other, materials, rq.fem_order, fem::DiscFem::default_plate_center(other));
+    const fem::DiscFem other_fem(other, materials, rq.fem_order,
+                                 fem::DiscFem::default_plate_center(other));
     TransferCheck tc;
     tc.label = label;
-    tc.untuned = calibration::compare_mss_fem(other_fem, mss::MssModel(other, materials, term_set_options(TermSet::thesis)),
-                                              all, materials.name, mss::StaticOptions(), rq.check_load_scale);
-    tc.tuned = calibration::compare_mss_fem(other_fem, mss::MssModel(other, materials, region_options), all,
-                                            materials.name, mss::StaticOptions(), rq.check_load_scale);
+    tc.untuned = calibration::compare_mss_fem(
+        other_fem, mss::MssModel(other, materials, term_set_options(TermSet::thesis)), all,
+        materials.name, mss::StaticOptions(), rq.check_load_scale);
+    tc.tuned = calibration::compare_mss_fem(
+        other_fem, mss::MssModel(other, materials, region_options), all, materials.name,
+        mss::StaticOptions(), rq.check_load_scale);
     tc.seconds = t0.seconds();
     out.transfer.push_back(std::move(tc));
   }
@@ -192,7 +211,8 @@ void run_transfer_checks(CalibrationOutcome& out, const mesh::RegionMaterials& m
 nlohmann::json case_rows(const CalibrationOutcome& out, const calibration::FemReference& ref,
                          const std::vector<fem::LoadCase>& cases) {
   nlohmann::json rows = nlohmann::json::array();
-  const calibration::Evaluation& tuned_linear = out.per_spring_ran ? out.per_spring.final.data : out.result.final;
+  const calibration::Evaluation& tuned_linear =
+      out.per_spring_ran ? out.per_spring.final.data : out.result.final;
   for (const auto& lc : cases) {
     const auto& u = case_error(out.untuned_linear, lc.name);
     const auto& f = case_error(tuned_linear, lc.name);
@@ -203,7 +223,8 @@ nlohmann::json case_rows(const CalibrationOutcome& out, const calibration::FemRe
                         {"tuned_reaction_error_linear", f.reaction_error}};
     for (const auto& ref_case : ref.cases)
       if (ref_case.name == lc.name)
-        r["fem_plate_rotation_deg"] = ref_case.plate_motion.tail<3>().norm() * 180.0 / 3.14159265358979323846;
+        r["fem_plate_rotation_deg"] =
+            ref_case.plate_motion.tail<3>().norm() * 180.0 / 3.14159265358979323846;
     if (out.per_spring_ran) {  // the region-only fit beside the per-spring one
       const auto& g = case_error(out.result.final, lc.name);
       r["region_error_linear"] = g.displacement_error;
@@ -240,13 +261,15 @@ nlohmann::json transfer_json(const CalibrationOutcome& out, const CalibrationReq
       cases.push_back({{"name", tc.tuned.cases[i].name},
                        {"untuned_error", tc.untuned.cases[i].displacement_error},
                        {"tuned_error", tc.tuned.cases[i].displacement_error}});
-    const Eigen::VectorXd f = diag(tc.tuned.k6_fem), u = diag(tc.untuned.k6_mss), k = diag(tc.tuned.k6_mss);
+    const Eigen::VectorXd f = diag(tc.tuned.k6_fem), u = diag(tc.untuned.k6_mss),
+                          k = diag(tc.tuned.k6_mss);
     rows.push_back({{"mesh", tc.label},
                     {"scales", "region-level"},
                     {"load_scale", rq.check_load_scale},
-                    {"note", out.per_spring_ran ? "per-spring multipliers do not transfer to another mesh: the "
-                                                  "region-level scales are checked here"
-                                                : "region-level scales transfer to other meshes of the disc"},
+                    {"note", out.per_spring_ran
+                                 ? "per-spring multipliers do not transfer to another mesh: the "
+                                   "region-level scales are checked here"
+                                 : "region-level scales transfer to other meshes of the disc"},
                     {"nodes", tc.tuned.nodes},
                     {"tets", tc.tuned.tets},
                     {"cases", cases},
@@ -259,9 +282,9 @@ nlohmann::json transfer_json(const CalibrationOutcome& out, const CalibrationReq
 
 /// The report stored in the tuned file (t.report): protocol, cases, K6 diagonals, objective,
 /// weights, transfer, Ipopt and timings.
-nlohmann::json calibration_report(const CalibrationOutcome& out, const CalibrationRequest& rq, const mesh::TetMesh& m,
-                                  const calibration::LinearMss& lin, const calibration::FemReference& ref,
-                                  Eigen::Index edge_springs) {
+nlohmann::json calibration_report(const CalibrationOutcome& out, const CalibrationRequest& rq,
+                                  const mesh::TetMesh& m, const calibration::LinearMss& lin,
+                                  const calibration::FemReference& ref, Eigen::Index edge_springs) {
   const Eigen::VectorXd kf = diag(out.k6_fem), ku = diag(out.k6_untuned), kt = diag(out.k6_tuned),
                         kr = diag(out.k6_region);
   nlohmann::json knobs = nlohmann::json::array();
@@ -313,7 +336,6 @@ nlohmann::json calibration_report(const CalibrationOutcome& out, const Calibrati
   return report;
 }
 
-
 }  // namespace
 
 TermSet parse_term_set(const std::string& name) {
@@ -325,9 +347,12 @@ TermSet parse_term_set(const std::string& name) {
 
 std::string term_set_name(TermSet t) {
   switch (t) {
-    case TermSet::thesis: return "thesis";
-    case TermSet::thesis_volume: return "thesis+volume";
-    case TermSet::all: return "all";
+    case TermSet::thesis:
+      return "thesis";
+    case TermSet::thesis_volume:
+      return "thesis+volume";
+    case TermSet::all:
+      return "all";
   }
   return "?";
 }
@@ -351,7 +376,8 @@ CalibrationOutcome calibrate_disc(const mesh::TetMesh& m, const mesh::RegionMate
   all.insert(all.end(), rq.holdout.begin(), rq.holdout.end());
 
   // 1. FEM reference on the same mesh.
-  say("FEM P" + std::to_string(rq.fem_order) + " reference (" + std::to_string(m.num_tets()) + " tets)");
+  say("FEM P" + std::to_string(rq.fem_order) + " reference (" + std::to_string(m.num_tets()) +
+      " tets)");
   Timer t0;
   const Eigen::Vector3d c = fem::DiscFem::default_plate_center(m);
   const fem::DiscFem fem(m, materials, rq.fem_order, c);
@@ -363,9 +389,11 @@ CalibrationOutcome calibrate_disc(const mesh::TetMesh& m, const mesh::RegionMate
   say("linearising the mass-spring model at rest");
   t0.restart();
   const mss::MssModel thesis_model(m, materials, term_set_options(TermSet::thesis));
-  calibration::LinearMss thesis_lin(thesis_model, calibration::available_knobs(thesis_model.options()), c);
+  calibration::LinearMss thesis_lin(thesis_model,
+                                    calibration::available_knobs(thesis_model.options()), c);
   calibration::Objective thesis_obj(thesis_lin, ref, names(rq.train), rq.weights);
-  out.untuned_linear = thesis_obj.evaluate(Eigen::VectorXd::Zero(Eigen::Index(thesis_lin.knobs().size())), false);
+  out.untuned_linear =
+      thesis_obj.evaluate(Eigen::VectorXd::Zero(Eigen::Index(thesis_lin.knobs().size())), false);
   out.k6_untuned = out.untuned_linear.k6;
   const mss::MssOptions options = term_set_options(rq.terms);
   const mss::MssModel model(m, materials, options);
@@ -374,28 +402,32 @@ CalibrationOutcome calibrate_disc(const mesh::TetMesh& m, const mesh::RegionMate
   out.setup_seconds = t0.seconds();
 
   // 3. Ipopt from Van Gelder (all scales 1).
-  say("Ipopt: " + std::to_string(lin.knobs().size()) + " stiffness scales, " + std::to_string(rq.train.size()) +
-      " training cases");
-  out.result = calibration::calibrate(obj, Eigen::VectorXd::Zero(Eigen::Index(lin.knobs().size())), rq.ipopt,
-                                      ipopt_progress(say, ""));
+  say("Ipopt: " + std::to_string(lin.knobs().size()) + " stiffness scales, " +
+      std::to_string(rq.train.size()) + " training cases");
+  out.result = calibration::calibrate(obj, Eigen::VectorXd::Zero(Eigen::Index(lin.knobs().size())),
+                                      rq.ipopt, ipopt_progress(say, ""));
   out.k6_region = out.k6_tuned = out.result.final.k6;
   out.success = out.result.success;
 
   // 3b. Per-spring multipliers on top of the fitted region scales.
   if (rq.per_spring && out.result.success) {
-    say("per-spring stage: " + std::to_string(model.num_edge_springs()) + " edge springs, Ipopt limited-memory BFGS");
+    say("per-spring stage: " + std::to_string(model.num_edge_springs()) +
+        " edge springs, Ipopt limited-memory BFGS");
     calibration::PerSpringWeights w = rq.per_spring_weights;
     w.prior = rq.weights.regularisation;
     calibration::PerSpringObjective ps(obj, model, out.result.log_scales, w);
-    out.per_spring = calibration::calibrate_per_spring(ps, rq.per_spring_ipopt, ipopt_progress(say, "per-spring "));
+    out.per_spring = calibration::calibrate_per_spring(ps, rq.per_spring_ipopt,
+                                                       ipopt_progress(say, "per-spring "));
     out.per_spring_ran = true;
     out.k6_tuned = out.per_spring.final.data.k6;
     out.success = out.per_spring.success;
   }
 
   // 4. The tuned file, the nonlinear checks (as `mss compare`) and the transfer meshes.
-  const mss::MssOptions region_options = fill_tuned_file(out, m, materials, rq, options, lin, model);
-  if (rq.nonlinear_check && out.success) run_nonlinear_checks(out, fem, thesis_model, m, materials, rq, all, region_options, say);
+  const mss::MssOptions region_options =
+      fill_tuned_file(out, m, materials, rq, options, lin, model);
+  if (rq.nonlinear_check && out.success)
+    run_nonlinear_checks(out, fem, thesis_model, m, materials, rq, all, region_options, say);
   if (out.success) run_transfer_checks(out, materials, rq, all, region_options, say);
   out.total_seconds = t_start.seconds();
 
@@ -411,33 +443,40 @@ mss::MssModel tuned_model(const calibration::TunedDisc& tuned, const mesh::TetMe
   return calibration::build_tuned_model(tuned, mesh, materials);
 }
 
-void print_calibration(std::ostream& os, const CalibrationOutcome& o, const CalibrationRequest& rq) {
+void print_calibration(std::ostream& os, const CalibrationOutcome& o,
+                       const CalibrationRequest& rq) {
   const auto& rep = o.tuned.report;
   const bool ps = o.per_spring_ran;
-  os << "Calibration of " << (o.tuned.level.empty() ? "disc" : o.tuned.level) << " (" << rep["nodes"] << " nodes, "
-     << rep["tets"] << " tets), material " << o.tuned.material_name << ", terms " << term_set_name(rq.terms)
-     << ", FEM P" << rq.fem_order << (ps ? ", region scales then per-spring multipliers" : "") << "\n"
-     << "Ipopt" << (ps ? " (region scales)" : "") << ": " << o.result.status << " after " << o.result.iterations
-     << " iterations, " << o.result.evaluations << " evaluations, " << std::fixed << std::setprecision(2)
-     << o.result.seconds << " s (" << std::setprecision(1) << 1e3 * rep["ipopt"]["seconds_per_evaluation"].get<double>()
+  os << "Calibration of " << (o.tuned.level.empty() ? "disc" : o.tuned.level) << " ("
+     << rep["nodes"] << " nodes, " << rep["tets"] << " tets), material " << o.tuned.material_name
+     << ", terms " << term_set_name(rq.terms) << ", FEM P" << rq.fem_order
+     << (ps ? ", region scales then per-spring multipliers" : "") << "\n"
+     << "Ipopt" << (ps ? " (region scales)" : "") << ": " << o.result.status << " after "
+     << o.result.iterations << " iterations, " << o.result.evaluations << " evaluations, "
+     << std::fixed << std::setprecision(2) << o.result.seconds << " s (" << std::setprecision(1)
+     << 1e3 * rep["ipopt"]["seconds_per_evaluation"].get<double>()
      << " ms per objective + gradient + Hessian)\n";
   if (ps) {
     const auto& p = rep["per_spring"];
-    os << "Ipopt (per-spring, " << p["edge_springs"] << " multipliers in [" << std::defaultfloat << std::setprecision(6)
-       << rq.per_spring_ipopt.lower_scale << ", " << rq.per_spring_ipopt.upper_scale << "], smoothness weight "
-       << rq.per_spring_weights.smoothness << ", limited-memory BFGS): " << o.per_spring.status << " after "
-       << o.per_spring.iterations << " iterations, " << o.per_spring.evaluations << " evaluations, " << std::fixed
-       << std::setprecision(2) << o.per_spring.seconds << " s; J " << std::setprecision(3) << std::scientific
-       << o.per_spring.start.value << " -> " << o.per_spring.final.value << std::fixed
-       << (o.per_spring.kept_start ? " (Ipopt ended higher: the region fit is kept)" : "") << "; multipliers "
-       << std::setprecision(2) << p["multipliers"]["min"].get<double>() << " .. " << p["multipliers"]["max"].get<double>()
-       << ", median " << p["multipliers"]["median"].get<double>() << "\n";
+    os << "Ipopt (per-spring, " << p["edge_springs"] << " multipliers in [" << std::defaultfloat
+       << std::setprecision(6) << rq.per_spring_ipopt.lower_scale << ", "
+       << rq.per_spring_ipopt.upper_scale << "], smoothness weight "
+       << rq.per_spring_weights.smoothness << ", limited-memory BFGS): " << o.per_spring.status
+       << " after " << o.per_spring.iterations << " iterations, " << o.per_spring.evaluations
+       << " evaluations, " << std::fixed << std::setprecision(2) << o.per_spring.seconds << " s; J "
+       << std::setprecision(3) << std::scientific << o.per_spring.start.value << " -> "
+       << o.per_spring.final.value << std::fixed
+       << (o.per_spring.kept_start ? " (Ipopt ended higher: the region fit is kept)" : "")
+       << "; multipliers " << std::setprecision(2) << p["multipliers"]["min"].get<double>()
+       << " .. " << p["multipliers"]["max"].get<double>() << ", median "
+       << p["multipliers"]["median"].get<double>() << "\n";
   }
   os << "\n"
-     << (rq.nonlinear_check ? "Relative nodal displacement error vs FEM (nonlinear MSS at the case loads x " +
-                                 std::to_string(rq.check_load_scale).substr(0, 4) + "; linearised in brackets):\n\n"
-                             : "Relative nodal displacement error vs FEM (linearised MSS only: --no-check):\n\n")
-     ;
+     << (rq.nonlinear_check
+             ? "Relative nodal displacement error vs FEM (nonlinear MSS at the case loads x " +
+                   std::to_string(rq.check_load_scale).substr(0, 4) +
+                   "; linearised in brackets):\n\n"
+             : "Relative nodal displacement error vs FEM (linearised MSS only: --no-check):\n\n");
   std::vector<std::string> head{"case", "set", "untuned (Van Gelder)"};
   if (ps) head.push_back("region scales");
   head.push_back(ps ? "per-spring" : "tuned");
@@ -447,13 +486,15 @@ void print_calibration(std::ostream& os, const CalibrationOutcome& o, const Cali
       const auto cell = [&](const char* nl, const char* lin) {
         return pct(r[nl].get<double>()) + " (" + pct(r[lin].get<double>()) + ")";
       };
-      std::vector<std::string> row{r["name"].get<std::string>(), set, cell("untuned_error", "untuned_error_linear")};
+      std::vector<std::string> row{r["name"].get<std::string>(), set,
+                                   cell("untuned_error", "untuned_error_linear")};
       if (ps) row.push_back(cell("region_error", "region_error_linear"));
       row.push_back(cell("tuned_error", "tuned_error_linear"));
       cases.add(row);
     }
   cases.print(os, false);
-  static const char* dof[] = {"tx [N/mm]", "ty [N/mm]", "tz [N/mm]", "rx [N·mm/deg]", "ry [N·mm/deg]", "rz [N·mm/deg]"};
+  static const char* dof[] = {"tx [N/mm]",     "ty [N/mm]",     "tz [N/mm]",
+                              "rx [N·mm/deg]", "ry [N·mm/deg]", "rz [N·mm/deg]"};
   const auto& kd = rep["stiffness_diagonal"];
   os << "\n6x6 plate stiffness diagonal (linear), MSS / FEM:\n\n";
   std::vector<std::string> khead{"DOF", "FEM", "untuned"};
@@ -461,26 +502,31 @@ void print_calibration(std::ostream& os, const CalibrationOutcome& o, const Cali
   khead.push_back(ps ? "per-spring" : "tuned");
   TextTable k6(khead);
   for (std::size_t i = 0; i < 6; ++i) {
-    std::vector<std::string> row{dof[i], significant(kd["fem"][i].get<double>(), 4), fixed(kd["ratio_untuned"][i].get<double>(), 3)};
+    std::vector<std::string> row{dof[i], significant(kd["fem"][i].get<double>(), 4),
+                                 fixed(kd["ratio_untuned"][i].get<double>(), 3)};
     if (ps) row.push_back(fixed(kd["ratio_region"][i].get<double>(), 3));
     row.push_back(fixed(kd["ratio_tuned"][i].get<double>(), 3));
     k6.add(row);
   }
   k6.print(os, false);
   for (const auto& tr : rep["transfer"]) {
-    os << "\n" << (ps ? "Region-level scales" : "Same scales") << " on another mesh: " << tr["mesh"].get<std::string>()
-       << " (" << tr["tets"] << " tets), vs the FEM there"
+    os << "\n"
+       << (ps ? "Region-level scales" : "Same scales")
+       << " on another mesh: " << tr["mesh"].get<std::string>() << " (" << tr["tets"]
+       << " tets), vs the FEM there"
        << (ps ? " (per-spring multipliers do not transfer to another mesh)" : "") << ":\n\n";
     TextTable t({"case", "untuned", ps ? "region scales" : "tuned"});
     for (const auto& c : tr["cases"])
-      t.add({c["name"].get<std::string>(), pct(c["untuned_error"].get<double>()), pct(c["tuned_error"].get<double>())});
+      t.add({c["name"].get<std::string>(), pct(c["untuned_error"].get<double>()),
+             pct(c["tuned_error"].get<double>())});
     t.print(os, false);
     os << "  6x6 diagonal MSS/FEM, tuned:";
     for (const auto& r : tr["stiffness_ratio_tuned"]) os << " " << fixed(r.get<double>(), 3);
     os << "\n";
   }
   os << "\nTuned " << (ps ? "region " : "") << "scales (x Van Gelder constants):";
-  for (const auto& [name, s] : o.tuned.scales) os << "  " << name << " " << std::setprecision(3) << s;
+  for (const auto& [name, s] : o.tuned.scales)
+    os << "  " << name << " " << std::setprecision(3) << s;
   os << std::defaultfloat << "\n";
   if (ps)
     os << "Per-spring multipliers: " << o.tuned.edge_multipliers.size()

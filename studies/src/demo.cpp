@@ -50,8 +50,10 @@ fem::Matrix6d to_disc_frame(const fem::Matrix6d& k, const mesh::DiscFrame& f) {
 /// The four training and four held-out cases of the demo's calibration.
 CalibrationRequest demo_calibration_request() {
   CalibrationRequest rq;
-  for (const char* c : {"compression", "shear-ap", "flexion", "torsion"}) rq.train.push_back(fem::load_case(c));
-  for (const char* c : {"tension", "shear-lat", "extension", "lateral-bending"}) rq.holdout.push_back(fem::load_case(c));
+  for (const char* c : {"compression", "shear-ap", "flexion", "torsion"})
+    rq.train.push_back(fem::load_case(c));
+  for (const char* c : {"tension", "shear-lat", "extension", "lateral-bending"})
+    rq.holdout.push_back(fem::load_case(c));
   return rq;
 }
 
@@ -119,7 +121,8 @@ void Demo::fem_reference() {
   real_disc = mesh::load_material("real-disc", data_dir());
   hooks.begin_stage("FEM P" + std::to_string(rq.fem_order) + " stiffness (real-disc)");
   const Timer t;
-  solver = std::make_unique<fem::DiscFem>(m, real_disc, rq.fem_order, fem::DiscFem::default_plate_center(m));
+  solver = std::make_unique<fem::DiscFem>(m, real_disc, rq.fem_order,
+                                          fem::DiscFem::default_plate_center(m));
   k6 = solver->stiffness_6x6();
   fem_seconds = t.seconds();
   hooks.end_stage(std::to_string(solver->num_dofs()) + " DOF");
@@ -129,14 +132,15 @@ void Demo::fem_reference() {
 void Demo::fem_load_cases() {
   hooks.begin_stage("FEM load cases");
   std::vector<mesh::DataArray> fields;
-  TextTable table({"case", "load (disc frame)", "plate translation (mm, disc frame)", "plate rotation (deg, disc frame)",
-                   "max |u| (mm)"});
+  TextTable table({"case", "load (disc frame)", "plate translation (mm, disc frame)",
+                   "plate rotation (deg, disc frame)", "max |u| (mm)"});
   table.set_plain_markdown(true);
   for (const auto& c : fem::standard_load_cases()) {
     const auto sol = solver->solve_wrench(fem::global_wrench(c, m.frame));
     fields.push_back({"displacement_" + c.name, sol.displacement_mm});
     const Eigen::Vector3d t_local = m.frame.axes.transpose() * sol.plate_motion.head<3>();
-    const Eigen::Vector3d r_local = m.frame.axes.transpose() * sol.plate_motion.tail<3>() * 180.0 / M_PI;
+    const Eigen::Vector3d r_local =
+        m.frame.axes.transpose() * sol.plate_motion.tail<3>() * 180.0 / M_PI;
     const double umax = sol.displacement_mm.rowwise().norm().maxCoeff();
     cases.push_back({{"name", c.name},
                      {"wrench_local", to_json(c.wrench_local)},
@@ -154,7 +158,8 @@ void Demo::fem_load_cases() {
     };
     std::ostringstream load;  // default precision, as the case is defined
     load << component[k] << " = " << c.wrench_local(k) << (k < 3 ? " N" : " N·mm");
-    table.add({c.name, load.str(), cell(t_local.transpose()), cell(r_local.transpose()), cell(umax)});
+    table.add(
+        {c.name, load.str(), cell(t_local.transpose()), cell(r_local.transpose()), cell(umax)});
   }
   std::ostringstream os;
   table.print(os, true);
@@ -172,7 +177,8 @@ void Demo::material_study() {
   constants.set_plain_markdown(true);
   for (const char* name : kPresets) {
     const auto mat = mesh::load_material(name, data_dir());
-    constants.add({mat.name, describe_material(mat), significant(mat.at(int(mesh::Region::annulus)).density_kg_m3, 6)});
+    constants.add({mat.name, describe_material(mat),
+                   significant(mat.at(int(mesh::Region::annulus)).density_kg_m3, 6)});
     materials.push_back(study_material(m, mat, materials_options, hooks));
   }
   materials_seconds = t.seconds();
@@ -185,10 +191,12 @@ void Demo::material_study() {
 
 // 4. Mass-spring disc (untuned Van Gelder constants) vs the FEM above: the baseline.
 void Demo::mss_baseline() {
-  hooks.begin_stage("MSS vs FEM, " + std::to_string(fem::standard_load_cases().size()) + " load cases");
+  hooks.begin_stage("MSS vs FEM, " + std::to_string(fem::standard_load_cases().size()) +
+                    " load cases");
   const Timer t;
   const mss::MssModel mss_model(m, real_disc);
-  mss_vs_fem = calibration::compare_mss_fem(*solver, mss_model, fem::standard_load_cases(), real_disc.name);
+  mss_vs_fem =
+      calibration::compare_mss_fem(*solver, mss_model, fem::standard_load_cases(), real_disc.name);
   mss_seconds = t.seconds();
   hooks.end_stage();
   std::ostringstream os;
@@ -228,51 +236,71 @@ std::string Demo::report() const {
   report << "# spinesim demo — " << dims.level << " disc\n\n"
          << "## Mesh (CGAL Mesh_3, cell size " << rq.cell_size_mm << " mm)\n\n```\n";
   print_quality(report, quality, m.source);
-  report << "```\n\nMeshing took " << std::setprecision(3) << mesh_seconds << " s. Files: `" << fs::path(mesh_path).filename().string()
-         << "`, `" << fs::path(result_path).filename().string() << "` (open in ParaView).\n\n"
-         << "## FEM reference (P" << rq.fem_order << ", real-disc E = " << real_disc.fallback.youngs_modulus_mpa
+  report << "```\n\nMeshing took " << std::setprecision(3) << mesh_seconds << " s. Files: `"
+         << fs::path(mesh_path).filename().string() << "`, `"
+         << fs::path(result_path).filename().string() << "` (open in ParaView).\n\n"
+         << "## FEM reference (P" << rq.fem_order
+         << ", real-disc E = " << real_disc.fallback.youngs_modulus_mpa
          << " MPa, nu = " << std::setprecision(3) << real_disc.fallback.poisson_ratio << ")\n\n"
-         << solver->num_dofs() << " DOF; assembly + factorisation + 6x6 condensation " << std::setprecision(3) << fem_seconds
-         << " s.\n\n### 6x6 disc stiffness in the disc frame (x lateral, y axial, z anterior)\n\n```\n";
+         << solver->num_dofs() << " DOF; assembly + factorisation + 6x6 condensation "
+         << std::setprecision(3) << fem_seconds
+         << " s.\n\n### 6x6 disc stiffness in the disc frame (x lateral, y axial, z "
+            "anterior)\n\n```\n";
   print_stiffness(report, k_local);
   report << std::defaultfloat << std::setprecision(4);  // the prose below: shortest form, 4 digits
-  report << "```\n\n### Load cases (wrench on the superior plate, disc frame)\n\n" << case_table
+  report << "```\n\n### Load cases (wrench on the superior plate, disc frame)\n\n"
+         << case_table
          << "\n## Material comparison (thesis fig. 5.9): FEM, untuned and tuned MSS\n\n"
-         << "The same mesh (cell size " << rq.cell_size_mm << " mm) in each material preset, side by side: the FEM P"
-         << rq.fem_order << "\n(linear); the thesis's mass-spring disc with untuned Van Gelder constants; and the mass-spring\n"
+         << "The same mesh (cell size " << rq.cell_size_mm
+         << " mm) in each material preset, side by side: the FEM P" << rq.fem_order
+         << "\n(linear); the thesis's mass-spring disc with untuned Van Gelder constants; and the "
+            "mass-spring\n"
          << "disc calibrated to that material's FEM (" << term_set_name(materials_options.terms)
          << " stiffness scales per region; Ipopt on compression,\nshear-ap, flexion and torsion). "
-         << "The thesis's fig. 5.9 load, 500 N compression on the superior plate, is\nsolved statically "
+         << "The thesis's fig. 5.9 load, 500 N compression on the superior plate, is\nsolved "
+            "statically "
          << "(the MSS nonlinear); stiffnesses are linear at rest. Disc frame: x lateral, y axial,\n"
-         << "z anterior. `spinesim study materials --help` gives the protocol. " << std::setprecision(3) << materials_seconds
-         << " s.\n\n"
-         << constants_table << "\n" << material_table
-         << "\n## MSS vs FEM (untuned Van Gelder baseline)\n\n"
-         << "The thesis's mass-spring disc (main, radial and torsional springs, real-disc constants) on the same\n"
-         << "mesh, static, against the FEM above (`spinesim mss compare --help` gives the protocol): displacement\n"
-         << "error under each case's wrench, reaction error under the FEM's plate motion. This is what the\n"
+         << "z anterior. `spinesim study materials --help` gives the protocol. "
+         << std::setprecision(3) << materials_seconds << " s.\n\n"
+         << constants_table << "\n"
+         << material_table << "\n## MSS vs FEM (untuned Van Gelder baseline)\n\n"
+         << "The thesis's mass-spring disc (main, radial and torsional springs, real-disc "
+            "constants) on the same\n"
+         << "mesh, static, against the FEM above (`spinesim mss compare --help` gives the "
+            "protocol): displacement\n"
+         << "error under each case's wrench, reaction error under the FEM's plate motion. This is "
+            "what the\n"
          << "calibration must beat. " << std::setprecision(3) << mss_seconds << " s.\n\n"
-         << mss_table
-         << "\n## Calibration: the mass-spring disc tuned to the FEM (real disc)\n\n"
-         << "Ipopt fits the per-region scales of the MSS terms (" << term_set_name(calibration_request.terms)
-         << ") to the FEM on four training cases; the other four are held out.\nErrors: relative nodal "
-         << "displacement, nonlinear MSS at the case loads x " << calibration_request.check_load_scale
-         << " (the linear regime the FEM describes),\nthe linearised errors in brackets. `spinesim calibrate --help` "
-         << "and calibration/README.md give the protocol. " << std::setprecision(3) << calibration_seconds << " s.\n\n```\n"
+         << mss_table << "\n## Calibration: the mass-spring disc tuned to the FEM (real disc)\n\n"
+         << "Ipopt fits the per-region scales of the MSS terms ("
+         << term_set_name(calibration_request.terms)
+         << ") to the FEM on four training cases; the other four are held out.\nErrors: relative "
+            "nodal "
+         << "displacement, nonlinear MSS at the case loads x "
+         << calibration_request.check_load_scale
+         << " (the linear regime the FEM describes),\nthe linearised errors in brackets. `spinesim "
+            "calibrate --help` "
+         << "and calibration/README.md give the protocol. " << std::setprecision(3)
+         << calibration_seconds << " s.\n\n```\n"
          << calibration_text << "```\n"
          << "\n## Spine: validation (thesis 3.4)\n\n"
-         << "The open thoracolumbar spine (spine/: 17 vertebrae, F.4 joint springs with F.5 limits, ligaments, the\n"
-         << "F.8-F.19 lumbar muscles and the LifeMOD trunk muscles the thesis names without data (restored in\n"
-         << "data/spine/trunk_muscles.csv by stated rules), recruited by Ipopt, the IAP bushing, gravity), nothing tuned\n"
+         << "The open thoracolumbar spine (spine/: 17 vertebrae, F.4 joint springs with F.5 "
+            "limits, ligaments, the\n"
+         << "F.8-F.19 lumbar muscles and the LifeMOD trunk muscles the thesis names without data "
+            "(restored in\n"
+         << "data/spine/trunk_muscles.csv by stated rules), recruited by Ipopt, the IAP bushing, "
+            "gravity), nothing tuned\n"
          << "to these targets. "
-         << "`spinesim study validation --help` gives the protocol. " << std::setprecision(3) << spine_validation.seconds
-         << " s.\n\n"
-         << validation_text
-         << "\n## Spine: fusion vs the normal spine (thesis 6.1)\n\n"
-         << "`spinesim study fusion --help` gives the protocol. " << std::setprecision(3) << spine_fusion.seconds << " s.\n\n"
+         << "`spinesim study validation --help` gives the protocol. " << std::setprecision(3)
+         << spine_validation.seconds << " s.\n\n"
+         << validation_text << "\n## Spine: fusion vs the normal spine (thesis 6.1)\n\n"
+         << "`spinesim study fusion --help` gives the protocol. " << std::setprecision(3)
+         << spine_fusion.seconds << " s.\n\n"
          << fusion_text
-         << "\n## Spine: relative vertebra motion under a force on T1 vs the thesis's trends (6.3-6.4)\n\n"
-         << "`spinesim study trends --help` gives the protocol. " << std::setprecision(3) << spine_trends.seconds << " s.\n\n"
+         << "\n## Spine: relative vertebra motion under a force on T1 vs the thesis's trends "
+            "(6.3-6.4)\n\n"
+         << "`spinesim study trends --help` gives the protocol. " << std::setprecision(3)
+         << spine_trends.seconds << " s.\n\n"
          << trends_text;
   return report.str();
 }
@@ -280,34 +308,36 @@ std::string Demo::report() const {
 nlohmann::json Demo::summary(const std::string& report_path) const {
   const fem::Matrix6d k_local = to_disc_frame(k6, m.frame);
   return {{"level", dims.level},
-                      {"mesh", quality_json(quality)},
-                      {"mesh_seconds", mesh_seconds},
-                      {"fem_order", rq.fem_order},
-                      {"fem_dofs", solver->num_dofs()},
-                      {"fem_stiffness_seconds", fem_seconds},
-                      {"stiffness_6x6_disc_frame", matrix_to_json(stiffness_per_degree(k_local))},
-                      {"stiffness_6x6_units", kStiffnessUnits},
-                      {"cases", cases},
-                      {"materials", materials_json(materials)},
-                      {"materials_seconds", materials_seconds},
-                      {"mss_vs_fem", comparison_json(mss_vs_fem)},
-                      {"calibration", calibrated.tuned.report},
-                      {"calibration_scales", calibrated.tuned.scales},
-                      {"spine_validation", validation_json(spine_validation)},
-                      {"spine_fusion", fusion_json(spine_fusion)},
-                      {"spine_trends", trends_json(spine_trends)},
-                      {"report", report_path},
-                      {"files", {mesh_path, result_path}}};
+          {"mesh", quality_json(quality)},
+          {"mesh_seconds", mesh_seconds},
+          {"fem_order", rq.fem_order},
+          {"fem_dofs", solver->num_dofs()},
+          {"fem_stiffness_seconds", fem_seconds},
+          {"stiffness_6x6_disc_frame", matrix_to_json(stiffness_per_degree(k_local))},
+          {"stiffness_6x6_units", kStiffnessUnits},
+          {"cases", cases},
+          {"materials", materials_json(materials)},
+          {"materials_seconds", materials_seconds},
+          {"mss_vs_fem", comparison_json(mss_vs_fem)},
+          {"calibration", calibrated.tuned.report},
+          {"calibration_scales", calibrated.tuned.scales},
+          {"spine_validation", validation_json(spine_validation)},
+          {"spine_fusion", fusion_json(spine_fusion)},
+          {"spine_trends", trends_json(spine_trends)},
+          {"report", report_path},
+          {"files", {mesh_path, result_path}}};
 }
 
 }  // namespace
 
 int demo_stages() {
-  return 5 + kStagesPerMaterial * int(std::size(kPresets)) + kValidationStages + kFusionStages + kTrendsStages;
+  return 5 + kStagesPerMaterial * int(std::size(kPresets)) + kValidationStages + kFusionStages +
+         kTrendsStages;
 }
 
 DemoResult run_demo(const DemoRequest& rq, const StageHooks& hooks) {
-  if (rq.fem_order != 1 && rq.fem_order != 2) throw std::invalid_argument("the FEM order must be 1 or 2");
+  if (rq.fem_order != 1 && rq.fem_order != 2)
+    throw std::invalid_argument("the FEM order must be 1 or 2");
   fs::create_directories(rq.out);
   Demo demo(rq, hooks);
   demo.mesh_disc();

@@ -10,18 +10,22 @@
 namespace spinesim::studies {
 namespace fs = std::filesystem;
 
-void write_text_file(const std::string& path, const std::string& text) { write_text_atomically(path, text); }
+void write_text_file(const std::string& path, const std::string& text) {
+  write_text_atomically(path, text);
+}
 
 void require_output_folder(const std::string& path, const std::string& option) {
   fs::path dir = fs::path(path).parent_path();
   if (dir.empty()) dir = ".";
   if (!fs::is_directory(dir))
-    throw std::invalid_argument(option + " " + path + ": folder " + dir.string() + " does not exist");
+    throw std::invalid_argument(option + " " + path + ": folder " + dir.string() +
+                                " does not exist");
 }
 
 VtuSeries::VtuSeries(const std::string& pvd_path) : pvd_path_(pvd_path) {
   const fs::path p(pvd_path);
-  if (p.extension() != ".pvd") throw std::invalid_argument("time series " + pvd_path + ": the name must end in .pvd");
+  if (p.extension() != ".pvd")
+    throw std::invalid_argument("time series " + pvd_path + ": the name must end in .pvd");
   require_output_folder(pvd_path, "time series");
   stem_ = p.stem().string();
   folder_ = (p.parent_path() / stem_).string();

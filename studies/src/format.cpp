@@ -34,8 +34,8 @@ std::string one_line(std::string s) {
 }
 
 std::size_t display_width(const std::string& s) {
-  return std::size_t(
-      std::count_if(s.begin(), s.end(), [](char c) { return (static_cast<unsigned char>(c) & 0xC0) != 0x80; }));
+  return std::size_t(std::count_if(
+      s.begin(), s.end(), [](char c) { return (static_cast<unsigned char>(c) & 0xC0) != 0x80; }));
 }
 
 std::string pad(const std::string& s, std::size_t width, bool left) {

@@ -1,14 +1,14 @@
 #include "spinesim/studies/materials_study.hpp"
 
 #include "spinesim/common/timer.hpp"
-#include "spinesim/studies/json.hpp"
-#include "spinesim/studies/fem_report.hpp"
 #include "spinesim/studies/comparison_report.hpp"
+#include "spinesim/studies/fem_report.hpp"
+#include "spinesim/studies/json.hpp"
 #include "spinesim/studies/mss_run.hpp"
 
 #include "spinesim/fem/load_cases.hpp"
-#include "spinesim/mss/quantities.hpp"
 #include "spinesim/mss/model.hpp"
+#include "spinesim/mss/quantities.hpp"
 #include "spinesim/mss/solver.hpp"
 
 #include <algorithm>
@@ -19,7 +19,6 @@
 
 namespace spinesim::studies {
 namespace {
-
 
 /// The training cases of the calibration (those of `spinesim calibrate`); every other case is
 /// held out (reported in the tuned file, not fitted).
@@ -48,8 +47,9 @@ double p1_volume_change(const mesh::TetMesh& m, const Eigen::MatrixX3d& u) {
 }
 
 /// The MSS under the compression wrench (nonlinear static), compared with the FEM's solution.
-ModelResponse mss_response(const mss::MssModel& model, const fem::Vector6d& wrench, const Eigen::Vector3d& center,
-                           const fem::Matrix6d& k6, const fem::PlateSolution& f) {
+ModelResponse mss_response(const mss::MssModel& model, const fem::Vector6d& wrench,
+                           const Eigen::Vector3d& center, const fem::Matrix6d& k6,
+                           const fem::PlateSolution& f) {
   const mesh::TetMesh& m = model.mesh();
   mss::Boundary bc;
   bc.plate_mode = mss::PlateMode::wrench;
@@ -128,36 +128,45 @@ std::string flags(const ModelResponse& r) {
 }
 
 std::vector<Block> blocks() {
-  static const char* dof[] = {"lateral shear tx, N/mm", "axial ty, N/mm", "anterior-posterior shear tz, N/mm",
-                              "flexion-extension rx, N·mm/deg", "axial torsion ry, N·mm/deg",
+  static const char* dof[] = {"lateral shear tx, N/mm",
+                              "axial ty, N/mm",
+                              "anterior-posterior shear tz, N/mm",
+                              "flexion-extension rx, N·mm/deg",
+                              "axial torsion ry, N·mm/deg",
                               "lateral bending rz, N·mm/deg"};
   std::vector<Block> out = {
       {"Axial stiffness K6_yy, N/mm (linear, at rest; MSS/FEM in brackets)",
        [](const ModelResponse& r, const ModelResponse& f, bool is_fem) {
          return with_ratio(r.axial_stiffness_n_per_mm(), f.axial_stiffness_n_per_mm(), is_fem);
        }},
-      {"Superior-plate axial displacement u_y under 500 N compression, mm (negative: towards the inferior "
+      {"Superior-plate axial displacement u_y under 500 N compression, mm (negative: towards the "
+       "inferior "
        "endplate; MSS/FEM in brackets)",
        [](const ModelResponse& r, const ModelResponse& f, bool is_fem) {
-         return with_ratio(r.plate_axial_displacement_mm, f.plate_axial_displacement_mm, is_fem) + flags(r);
+         return with_ratio(r.plate_axial_displacement_mm, f.plate_axial_displacement_mm, is_fem) +
+                flags(r);
        }},
       {"Largest vertex displacement max |u| under 500 N compression, mm",
-       [](const ModelResponse& r, const ModelResponse&, bool) { return number(r.max_displacement_mm) + flags(r); }},
+       [](const ModelResponse& r, const ModelResponse&, bool) {
+         return number(r.max_displacement_mm) + flags(r);
+       }},
       {"Volume change dV/V0 under 500 N compression, % (FEM: P1 volume of the displaced vertices)",
        [](const ModelResponse& r, const ModelResponse&, bool) {
          std::ostringstream s;
          s << std::setprecision(3) << 100.0 * r.volume_change << " %" << flags(r);
          return s.str();
        }},
-      {"Nodal displacement error vs FEM under 500 N compression, % (|u_MSS - u_FEM| / |u_FEM|, all vertices)",
+      {"Nodal displacement error vs FEM under 500 N compression, % (|u_MSS - u_FEM| / |u_FEM|, all "
+       "vertices)",
        [](const ModelResponse& r, const ModelResponse&, bool is_fem) {
          return is_fem ? std::string("—") : percent(r.displacement_error, 1) + flags(r);
        }}};
   for (int i : {0, 2, 3, 4, 5})
-    out.push_back({std::string("6x6 diagonal, ") + dof[i] + " (linear, at rest; MSS/FEM in brackets)",
-                   [i](const ModelResponse& r, const ModelResponse& f, bool is_fem) {
-                     return with_ratio(r.stiffness_diagonal(i), f.stiffness_diagonal(i), is_fem);
-                   }});
+    out.push_back(
+        {std::string("6x6 diagonal, ") + dof[i] + " (linear, at rest; MSS/FEM in brackets)",
+         [i](const ModelResponse& r, const ModelResponse& f, bool is_fem) {
+           return with_ratio(r.stiffness_diagonal(i), f.stiffness_diagonal(i), is_fem);
+         }});
   return out;
 }
 
@@ -212,7 +221,8 @@ MaterialResult study_material(const mesh::TetMesh& m, const mesh::RegionMaterial
   CalibrationRequest rq;
   rq.train = fem::parse_load_cases(kTrainCases);
   for (const auto& lc : fem::standard_load_cases())
-    if (std::none_of(rq.train.begin(), rq.train.end(), [&](const fem::LoadCase& t) { return t.name == lc.name; }))
+    if (std::none_of(rq.train.begin(), rq.train.end(),
+                     [&](const fem::LoadCase& t) { return t.name == lc.name; }))
       rq.holdout.push_back(lc);
   rq.fem_order = options.fem_order;
   rq.terms = options.terms;
@@ -256,56 +266,65 @@ std::string describe_material(const mesh::RegionMaterials& materials) {
   return s.str();
 }
 
-void print_materials(std::ostream& os, const std::vector<MaterialResult>& results, int fem_order, bool markdown) {
+void print_materials(std::ostream& os, const std::vector<MaterialResult>& results, int fem_order,
+                     bool markdown) {
   const std::string fem_head = "FEM P" + std::to_string(fem_order);
   const char* heads[] = {"untuned MSS", "tuned MSS"};
   bool any_unconverged = false, any_inverted = false, any_failed = false;
   for (const Block& b : blocks()) {
     if (markdown)
-      os << "**" << b.title << "**\n\n| material | " << fem_head << " | " << heads[0] << " | " << heads[1]
-         << " |\n|---|---:|---:|---:|\n";
+      os << "**" << b.title << "**\n\n| material | " << fem_head << " | " << heads[0] << " | "
+         << heads[1] << " |\n|---|---:|---:|---:|\n";
     else
       os << b.title << "\n  " << pad("material", 18, true) << pad(fem_head, 14) << pad(heads[0], 20)
          << pad(heads[1], 20) << "\n";
     for (const MaterialResult& r : results) {
-      const std::string cells[] = {b.cell(r.fem, r.fem, true), b.cell(r.untuned, r.fem, false),
-                                   r.tuned.available ? b.cell(r.tuned, r.fem, false) : "calibration failed"};
+      const std::string cells[] = {
+          b.cell(r.fem, r.fem, true), b.cell(r.untuned, r.fem, false),
+          r.tuned.available ? b.cell(r.tuned, r.fem, false) : "calibration failed"};
       if (markdown)
-        os << "| " << r.material << " | " << cells[0] << " | " << cells[1] << " | " << cells[2] << " |\n";
+        os << "| " << r.material << " | " << cells[0] << " | " << cells[1] << " | " << cells[2]
+           << " |\n";
       else
-        os << "  " << pad(r.material, 18, true) << pad(cells[0], 14) << pad(cells[1], 20) << pad(cells[2], 20) << "\n";
+        os << "  " << pad(r.material, 18, true) << pad(cells[0], 14) << pad(cells[1], 20)
+           << pad(cells[2], 20) << "\n";
       for (const ModelResponse* m : {&r.untuned, &r.tuned})
         if (m->available) any_unconverged |= !m->converged, any_inverted |= m->inverted_tets > 0;
       any_failed |= !r.tuned.available;
     }
     os << "\n";
   }
-  if (any_unconverged) os << "† the static MSS solve did not converge (the last iterate is shown).\n";
+  if (any_unconverged)
+    os << "† the static MSS solve did not converge (the last iterate is shown).\n";
   if (any_inverted) os << "‡ tetrahedra inside out at the MSS equilibrium.\n";
-  if (any_failed) os << "calibration failed: Ipopt did not converge for that material (status in the JSON).\n";
+  if (any_failed)
+    os << "calibration failed: Ipopt did not converge for that material (status in the JSON).\n";
 }
 
 std::string materials_csv(const std::vector<MaterialResult>& results) {
   std::ostringstream os;
   os << std::setprecision(10)
      << "material,model,E_annulus_MPa,E_nucleus_MPa,nu_annulus,nu_nucleus,axial_stiffness_N_per_mm,"
-        "K_tx_N_per_mm,K_ty_N_per_mm,K_tz_N_per_mm,K_rx_Nmm_per_deg,K_ry_Nmm_per_deg,K_rz_Nmm_per_deg,"
-        "plate_uy_500N_mm,max_displacement_500N_mm,volume_change_500N,displacement_error_500N,converged,"
+        "K_tx_N_per_mm,K_ty_N_per_mm,K_tz_N_per_mm,K_rx_Nmm_per_deg,K_ry_Nmm_per_deg,K_rz_Nmm_per_"
+        "deg,"
+        "plate_uy_500N_mm,max_displacement_500N_mm,volume_change_500N,displacement_error_500N,"
+        "converged,"
         "inverted_tets\n";
   for (const MaterialResult& r : results) {
     const std::pair<const char*, const ModelResponse*> models[] = {
         {"fem", &r.fem}, {"untuned", &r.untuned}, {"tuned", &r.tuned}};
     for (const auto& [name, m] : models) {
-      os << r.material << "," << name << "," << r.e_annulus_mpa << "," << r.e_nucleus_mpa << "," << r.nu_annulus << ","
-         << r.nu_nucleus;
+      os << r.material << "," << name << "," << r.e_annulus_mpa << "," << r.e_nucleus_mpa << ","
+         << r.nu_annulus << "," << r.nu_nucleus;
       if (!m->available) {  // a failed calibration: the row is there, its numbers are not
         os << std::string(11, ',') << ",0,\n";
         continue;
       }
       os << "," << m->axial_stiffness_n_per_mm();
       for (int i = 0; i < 6; ++i) os << "," << m->stiffness_diagonal(i);
-      os << "," << m->plate_axial_displacement_mm << "," << m->max_displacement_mm << "," << m->volume_change << ","
-         << m->displacement_error << "," << (m->converged ? 1 : 0) << "," << m->inverted_tets << "\n";
+      os << "," << m->plate_axial_displacement_mm << "," << m->max_displacement_mm << ","
+         << m->volume_change << "," << m->displacement_error << "," << (m->converged ? 1 : 0) << ","
+         << m->inverted_tets << "\n";
     }
   }
   return os.str();
@@ -326,7 +345,9 @@ nlohmann::json materials_json(const std::vector<MaterialResult>& results) {
                      {"iterations", r.ipopt_iterations},
                      {"scales", r.scales}}},
                    {"timings",
-                    {{"fem_s", r.fem_seconds}, {"calibration_s", r.calibration_seconds}, {"mss_static_s", r.mss_seconds}}}});
+                    {{"fem_s", r.fem_seconds},
+                     {"calibration_s", r.calibration_seconds},
+                     {"mss_static_s", r.mss_seconds}}}});
   return out;
 }
 

@@ -31,12 +31,14 @@ nlohmann::json quality_json(const mesh::QualityReport& q) {
 void print_quality(std::ostream& os, const mesh::QualityReport& q, const std::string& title) {
   os << std::fixed << std::setprecision(2);
   os << "Mesh " << title << "\n"
-     << "  nodes " << q.vertices << ", tets " << q.tets << " (annulus " << q.annulus_tets << ", nucleus "
-     << q.nucleus_tets << ")\n"
-     << "  endplate nodes: inferior " << q.inferior_nodes << ", superior " << q.superior_nodes << "; wall "
-     << q.wall_nodes << "\n"
-     << "  dihedral angle  min " << q.min_dihedral_deg << " deg, max " << q.max_dihedral_deg << " deg\n"
-     << "  radius-edge     max " << q.max_radius_edge_ratio << ", mean " << q.mean_radius_edge_ratio << "\n"
+     << "  nodes " << q.vertices << ", tets " << q.tets << " (annulus " << q.annulus_tets
+     << ", nucleus " << q.nucleus_tets << ")\n"
+     << "  endplate nodes: inferior " << q.inferior_nodes << ", superior " << q.superior_nodes
+     << "; wall " << q.wall_nodes << "\n"
+     << "  dihedral angle  min " << q.min_dihedral_deg << " deg, max " << q.max_dihedral_deg
+     << " deg\n"
+     << "  radius-edge     max " << q.max_radius_edge_ratio << ", mean " << q.mean_radius_edge_ratio
+     << "\n"
      << "  edge length     min " << q.min_edge_mm << " mm, mean " << q.mean_edge_mm << " mm, max "
      << q.max_edge_mm << " mm\n"
      << "  volume          " << q.volume_mm3 << " mm^3";

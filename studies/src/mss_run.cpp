@@ -54,7 +54,8 @@ nlohmann::json mss_model_json(const mss::MssModel& model, const mesh::RegionMate
             {"num_angle_springs", cyl.num_angle_springs},
             {"k_t_per_shear_modulus_mm3", cyl.k_t_per_shear_modulus},
             {"k_t_nmm_per_rad",
-             {{"annulus", g_annulus * cyl.k_t_per_shear_modulus}, {"nucleus", g_nucleus * cyl.k_t_per_shear_modulus}}}}},
+             {{"annulus", g_annulus * cyl.k_t_per_shear_modulus},
+              {"nucleus", g_nucleus * cyl.k_t_per_shear_modulus}}}}},
           {"options", [&o] {
              nlohmann::json j = calibration::terms_json(o);
              j["damping_ratio"] = o.damping_ratio;

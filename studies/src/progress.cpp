@@ -13,17 +13,21 @@ namespace spinesim::studies {
 
 bool stderr_is_terminal() { return isatty(STDERR_FILENO) != 0; }
 
-Progress::Progress(int stages, bool quiet) : stages_(stages), quiet_(quiet || !stderr_is_terminal()) {}
+Progress::Progress(int stages, bool quiet)
+    : stages_(stages), quiet_(quiet || !stderr_is_terminal()) {}
 
 void Progress::begin(const std::string& what) {
   ++current_;
   timer_.restart();
-  if (!quiet_) std::cerr << "[" << current_ << "/" << stages_ << "] " << what << " ..." << std::flush;
+  if (!quiet_)
+    std::cerr << "[" << current_ << "/" << stages_ << "] " << what << " ..." << std::flush;
 }
 
 double Progress::end(const std::string& detail) {
   const double s = timer_.seconds();
-  if (!quiet_) std::cerr << " done, " << fixed(s, 2) << " s" << (detail.empty() ? "" : " (" + detail + ")") << std::endl;
+  if (!quiet_)
+    std::cerr << " done, " << fixed(s, 2) << " s" << (detail.empty() ? "" : " (" + detail + ")")
+              << std::endl;
   return s;
 }
 
@@ -41,7 +45,8 @@ std::string human_duration(double s) {
   if (total < 60) return std::to_string(total) + " s";
   if (total < 3600) return std::to_string(total / 60) + " min " + std::to_string(total % 60) + " s";
   const long min = (total % 3600) / 60;
-  return std::to_string(total / 3600) + " h " + (min < 10 ? "0" : "") + std::to_string(min) + " min";
+  return std::to_string(total / 3600) + " h " + (min < 10 ? "0" : "") + std::to_string(min) +
+         " min";
 }
 
 ProgressBar::ProgressBar(int total, bool quiet, std::string unit)
@@ -61,8 +66,9 @@ std::string ProgressBar::render(int done, int total, double elapsed_s, const std
   const int filled = int(std::floor(fraction * width));
   std::ostringstream os;
   if (!label.empty()) os << label << "  ";
-  os << "[" << std::string(std::size_t(filled), '#') << std::string(std::size_t(width - filled), '.') << "]  " << done
-     << "/" << total << (unit.empty() ? "" : " " + unit) << "  " << std::lround(100 * fraction) << " %";
+  os << "[" << std::string(std::size_t(filled), '#')
+     << std::string(std::size_t(width - filled), '.') << "]  " << done << "/" << total
+     << (unit.empty() ? "" : " " + unit) << "  " << std::lround(100 * fraction) << " %";
   if (done > 0 && done < total) os << "  ETA " << human_duration(elapsed_s / done * (total - done));
   return os.str();
 }

@@ -18,7 +18,8 @@ namespace {
 
 /// "(x, y, z)" with `decimals` digits.
 std::string vec3(const Eigen::Vector3d& v, int decimals) {
-  return "(" + fixed(v.x(), decimals) + ", " + fixed(v.y(), decimals) + ", " + fixed(v.z(), decimals) + ")";
+  return "(" + fixed(v.x(), decimals) + ", " + fixed(v.y(), decimals) + ", " +
+         fixed(v.z(), decimals) + ")";
 }
 
 /// Indices of `v` by decreasing value, at most `n`.
@@ -30,21 +31,24 @@ std::vector<int> top_indices(const Eigen::VectorXd& v, int n) {
   return idx;
 }
 
-double value_or_zero(const Eigen::VectorXd& v, std::size_t i) { return Eigen::Index(i) < v.size() ? v(Eigen::Index(i)) : 0.0; }
+double value_or_zero(const Eigen::VectorXd& v, std::size_t i) {
+  return Eigen::Index(i) < v.size() ? v(Eigen::Index(i)) : 0.0;
+}
 
 }  // namespace
 
 std::string spine_solve_csv(const spine::SpineSolution& s) {
   std::ostringstream os;
   os << std::setprecision(10)
-     << "vertebra,tx_mm,ty_mm,tz_mm,rx_deg,ry_deg,rz_deg,joint_below,axial_n,shear_ap_n,shear_lat_n,disc_axial_n,"
+     << "vertebra,tx_mm,ty_mm,tz_mm,rx_deg,ry_deg,rz_deg,joint_below,axial_n,shear_ap_n,shear_lat_"
+        "n,disc_axial_n,"
         "disc_shear_n,resultant_n,moment_x_nmm,moment_y_nmm,moment_z_nmm\n";
   for (std::size_t i = 0; i < s.joints.size(); ++i) {
     const auto& j = s.joints[i];
     os << spine::vertebra_names()[i];
     for (int k = 0; k < 6; ++k) os << "," << s.displacement(Eigen::Index(i), k);
-    os << "," << j.joint << "," << j.axial_n << "," << j.shear_ap_n << "," << j.shear_lat_n << "," << j.disc_axial_n << ","
-       << j.disc_shear_n << "," << j.force_world_n.norm();
+    os << "," << j.joint << "," << j.axial_n << "," << j.shear_ap_n << "," << j.shear_lat_n << ","
+       << j.disc_axial_n << "," << j.disc_shear_n << "," << j.force_world_n.norm();
     for (int k = 0; k < 3; ++k) os << "," << j.moment_local_nmm(k);
     os << "\n";
   }
@@ -55,11 +59,14 @@ namespace {
 
 std::string fused_list(const spine::ModelOptions& o) {
   std::string fused;
-  for (int j : o.fused_joints) fused += (fused.empty() ? "" : ", ") + spine::joint_names()[std::size_t(j)];
+  for (int j : o.fused_joints)
+    fused += (fused.empty() ? "" : ", ") + spine::joint_names()[std::size_t(j)];
   return fused;
 }
 
-bool polynomial(const SpineSolveRun& r) { return r.request.solve.recruitment.criterion == spine::Criterion::Polynomial; }
+bool polynomial(const SpineSolveRun& r) {
+  return r.request.solve.recruitment.criterion == spine::Criterion::Polynomial;
+}
 
 double max_reserve_nmm(const spine::SpineSolution& s) {
   return s.recruitment.reserve_nmm.size() ? s.recruitment.reserve_nmm.cwiseAbs().maxCoeff() : 0.0;
@@ -71,7 +78,9 @@ nlohmann::json loads_json(const SpineSolveRun& r) {
     out.push_back({{"vertebra", spine::vertebra_names()[std::size_t(l.vertebra)]},
                    {"force_n", to_json(l.force_n)},
                    {"moment_nmm", to_json(l.moment_nmm)},
-                   {"point_mm", to_json(l.has_point ? l.point_mm : r.model.vertebrae[std::size_t(l.vertebra)].centre_mm)}});
+                   {"point_mm",
+                    to_json(l.has_point ? l.point_mm
+                                        : r.model.vertebrae[std::size_t(l.vertebra)].centre_mm)}});
   return out;
 }
 
@@ -80,7 +89,9 @@ nlohmann::json vertebrae_json(const spine::SpineSolution& s) {
   const auto& names = spine::vertebra_names();
   for (std::size_t i = 0; i < names.size(); ++i) {
     const auto row = s.displacement.row(Eigen::Index(i));
-    out.push_back({{"name", names[i]}, {"translation_mm", {row(0), row(1), row(2)}}, {"rotation_deg", {row(3), row(4), row(5)}}});
+    out.push_back({{"name", names[i]},
+                   {"translation_mm", {row(0), row(1), row(2)}},
+                   {"rotation_deg", {row(3), row(4), row(5)}}});
   }
   return out;
 }
@@ -137,8 +148,9 @@ SpineSolveRun run_spine_solve(const std::string& data_dir, const SpineSolveReque
     r.solution = spine::solve_spine(r.model, request.loads, request.solve);
   } catch (const spine::SolveError& e) {
     const std::string what = one_line(e.what());
-    throw std::runtime_error(what.find("equilibrium") != std::string::npos ? what
-                                                                            : "the spine did not reach equilibrium: " + what);
+    throw std::runtime_error(what.find("equilibrium") != std::string::npos
+                                 ? what
+                                 : "the spine did not reach equilibrium: " + what);
   }
   r.total_seconds = t0.seconds();
   return r;
@@ -154,7 +166,8 @@ nlohmann::json spine_solve_json(const SpineSolveRun& r, const std::string& csv) 
   return {
       {"loads", loads_json(r)},
       {"options",
-       {{"fusion", model_options.fused_joints.empty() ? nlohmann::json::array() : nlohmann::json(fused_list(model_options))},
+       {{"fusion", model_options.fused_joints.empty() ? nlohmann::json::array()
+                                                      : nlohmann::json(fused_list(model_options))},
         {"muscles", options.recruit},
         {"gravity", model_options.gravity},
         {"criterion", polynomial(r) ? "polynomial" : "minmax"},
@@ -173,20 +186,28 @@ nlohmann::json spine_solve_json(const SpineSolveRun& r, const std::string& csv) 
       {"joints", joints},
       {"muscles", muscles_json(r.model, s)},
       {"ligaments", ligaments_json(r.model, s)},
-      {"bushing", {{"enabled", r.model.has_bushing}, {"force_n", {b(0), b(1), b(2)}}, {"moment_nmm", {b(3), b(4), b(5)}}}},
+      {"bushing",
+       {{"enabled", r.model.has_bushing},
+        {"force_n", {b(0), b(1), b(2)}},
+        {"moment_nmm", {b(3), b(4), b(5)}}}},
       {"recruitment", recruitment_json(r)},
       {"warnings", s.warnings},
       {"seconds",
-       {{"model", r.model_seconds}, {"recruitment", s.seconds_recruitment}, {"equilibrium", s.seconds_equilibrium},
+       {{"model", r.model_seconds},
+        {"recruitment", s.seconds_recruitment},
+        {"equilibrium", s.seconds_equilibrium},
         {"total", r.total_seconds}}},
       {"csv", path_or_null(csv)},
       {"units",
        {{"frame", "x lateral (body's right -x), y superior, z anterior"},
         {"translation_mm", "vertebra F.1 centre, world axes, mm"},
         {"rotation_deg", "rotation vector, world axes, deg"},
-        {"joints", "force the lower side exerts on everything above: world N, N·mm about the moved joint point; "
-                   "axial/shear in the lower vertebra's axes (compression > 0); disc_* in the disc mid-plane; "
-                   "moment_local x flexion+, y torsion, z lateral bending"}}}};
+        {"joints",
+         "force the lower side exerts on everything above: world N, N·mm about the moved joint "
+         "point; "
+         "axial/shear in the lower vertebra's axes (compression > 0); disc_* in the disc "
+         "mid-plane; "
+         "moment_local x flexion+, y torsion, z lateral bending"}}}};
 }
 
 namespace {
@@ -196,26 +217,31 @@ void print_header(std::ostream& os, const SpineSolveRun& r) {
   const spine::SpineSolution& s = r.solution;
   const auto& names = spine::vertebra_names();
   const std::string fused = fused_list(r.request.model);
-  const std::string criterion = polynomial(r) ? "polynomial, p = " + fixed(r.request.solve.recruitment.power, 1) : "min-max";
+  const std::string criterion =
+      polynomial(r) ? "polynomial, p = " + fixed(r.request.solve.recruitment.power, 1) : "min-max";
   os << "Spine equilibrium (thesis 3.3): x lateral (body's right -x), y superior, z anterior\n"
      << "  model: " << (r.request.model.gravity ? "gravity" : "no gravity") << ", "
-     << (r.request.solve.recruit ? "muscles recruited (" + criterion + ")" : "no muscles") << ", " << m.ligaments.size()
-     << " ligaments" << (m.has_bushing ? ", IAP bushing" : "") << "; fusion: " << (fused.empty() ? "none" : fused) << "\n";
+     << (r.request.solve.recruit ? "muscles recruited (" + criterion + ")" : "no muscles") << ", "
+     << m.ligaments.size() << " ligaments" << (m.has_bushing ? ", IAP bushing" : "")
+     << "; fusion: " << (fused.empty() ? "none" : fused) << "\n";
   for (std::size_t i = 0; i < r.request.loads.size(); ++i) {
     const auto& l = r.request.loads[i];
     os << "  load " << i + 1 << ": " << names[std::size_t(l.vertebra)];
     if (l.force_n.squaredNorm() > 0)
       os << " force " << vec3(l.force_n, 1) << " N at "
-         << vec3(l.has_point ? l.point_mm : m.vertebrae[std::size_t(l.vertebra)].centre_mm, 1) << " mm";
+         << vec3(l.has_point ? l.point_mm : m.vertebrae[std::size_t(l.vertebra)].centre_mm, 1)
+         << " mm";
     if (l.moment_nmm.squaredNorm() > 0) os << " couple " << vec3(l.moment_nmm, 1) << " N·mm";
     os << "\n";
   }
   if (r.request.loads.empty()) os << "  no external load (gravity only)\n";
-  os << "  converged in " << s.iterations << " Newton iterations, max |dPi/dtheta| " << std::setprecision(2)
-     << std::scientific << s.gradient_norm << std::defaultfloat << " N·mm\n";
-  os << "  tangent stiffness: smallest eigenvalue " << std::setprecision(4) << s.min_stiffness_nmm_per_rad / 1000
-     << " N·m/rad (" << (s.min_stiffness_nmm_per_rad > 0 ? "stable" : "NOT stable") << "), softest mode " << s.softest_mode
-     << "\n\n";
+  os << "  converged in " << s.iterations << " Newton iterations, max |dPi/dtheta| "
+     << std::setprecision(2) << std::scientific << s.gradient_norm << std::defaultfloat
+     << " N·mm\n";
+  os << "  tangent stiffness: smallest eigenvalue " << std::setprecision(4)
+     << s.min_stiffness_nmm_per_rad / 1000 << " N·m/rad ("
+     << (s.min_stiffness_nmm_per_rad > 0 ? "stable" : "NOT stable") << "), softest mode "
+     << s.softest_mode << "\n\n";
 }
 
 void print_vertebrae(std::ostream& os, const spine::SpineSolution& s) {
@@ -223,7 +249,8 @@ void print_vertebrae(std::ostream& os, const spine::SpineSolution& s) {
   TextTable v({"vertebra", "tx (mm)", "ty (mm)", "tz (mm)", "rx (deg)", "ry (deg)", "rz (deg)"});
   for (std::size_t i = 0; i < names.size(); ++i) {
     std::vector<std::string> row{names[i]};
-    for (int k = 0; k < 6; ++k) row.push_back(fixed(s.displacement(Eigen::Index(i), k), k < 3 ? 3 : 4));
+    for (int k = 0; k < 6; ++k)
+      row.push_back(fixed(s.displacement(Eigen::Index(i), k), k < 3 ? 3 : 4));
     v.add(row);
   }
   os << "Vertebra displacement (centre translation, rotation vector; world axes)\n";
@@ -232,35 +259,46 @@ void print_vertebrae(std::ostream& os, const spine::SpineSolution& s) {
 
 void print_joints(std::ostream& os, const SpineSolveRun& r) {
   const auto& fused = r.request.model.fused_joints;
-  TextTable jt({"joint", "axial (N)", "shear AP (N)", "shear lat (N)", "disc axial (N)", "disc shear (N)", "|F| (N)",
-                "Mx flex+ (N·m)", "My torsion (N·m)", "Mz lat (N·m)"});
+  TextTable jt({"joint", "axial (N)", "shear AP (N)", "shear lat (N)", "disc axial (N)",
+                "disc shear (N)", "|F| (N)", "Mx flex+ (N·m)", "My torsion (N·m)", "Mz lat (N·m)"});
   for (const auto& j : r.solution.joints)
-    jt.add({j.joint + (std::find(fused.begin(), fused.end(), spine::joint_index(j.joint)) != fused.end() ? " (fused)" : ""),
-            fixed(j.axial_n, 1), fixed(j.shear_ap_n, 1), fixed(j.shear_lat_n, 1), fixed(j.disc_axial_n, 1),
-            fixed(j.disc_shear_n, 1), fixed(j.force_world_n.norm(), 1), fixed(j.moment_local_nmm.x() * 1e-3, 3),
-            fixed(j.moment_local_nmm.y() * 1e-3, 3), fixed(j.moment_local_nmm.z() * 1e-3, 3)});
-  os << "\nJoint reactions (lower side on everything above; joint frame = lower vertebra's axes, compression > 0)\n";
+    jt.add({j.joint +
+                (std::find(fused.begin(), fused.end(), spine::joint_index(j.joint)) != fused.end()
+                     ? " (fused)"
+                     : ""),
+            fixed(j.axial_n, 1), fixed(j.shear_ap_n, 1), fixed(j.shear_lat_n, 1),
+            fixed(j.disc_axial_n, 1), fixed(j.disc_shear_n, 1), fixed(j.force_world_n.norm(), 1),
+            fixed(j.moment_local_nmm.x() * 1e-3, 3), fixed(j.moment_local_nmm.y() * 1e-3, 3),
+            fixed(j.moment_local_nmm.z() * 1e-3, 3)});
+  os << "\nJoint reactions (lower side on everything above; joint frame = lower vertebra's axes, "
+        "compression > 0)\n";
   jt.print(os, false);
 }
 
-void print_muscles(std::ostream& os, const spine::SpineModel& m, const spine::SpineSolution& s, int top) {
+void print_muscles(std::ostream& os, const spine::SpineModel& m, const spine::SpineSolution& s,
+                   int top) {
   const Eigen::VectorXd& recruited = s.recruitment.force_n;
   if (m.muscles.empty() || recruited.size() != Eigen::Index(m.muscles.size())) return;
   int active = 0;
-  for (Eigen::Index i = 0; i < recruited.size(); ++i) active += recruited(i) > 1e-3 * m.muscles[std::size_t(i)].max_force_n();
-  TextTable mt({"muscle", "group", "side", "recruited F (N)", "F max (N)", "activation", "tension (N)"}, 3);
+  for (Eigen::Index i = 0; i < recruited.size(); ++i)
+    active += recruited(i) > 1e-3 * m.muscles[std::size_t(i)].max_force_n();
+  TextTable mt(
+      {"muscle", "group", "side", "recruited F (N)", "F max (N)", "activation", "tension (N)"}, 3);
   for (int i : top_indices(recruited, top)) {
     const auto& mu = m.muscles[std::size_t(i)];
     mt.add({mu.name, mu.group, mu.side, fixed(recruited(i), 1), fixed(mu.max_force_n(), 1),
             fixed(value_or_zero(s.recruitment.activation, std::size_t(i)), 3),
             fixed(value_or_zero(s.muscle_force_n, std::size_t(i)), 1)});
   }
-  os << "\nMuscles: " << active << " of " << m.muscles.size() << " active (F > 0.1 % of F max); the "
-     << std::min<std::size_t>(std::size_t(top), m.muscles.size()) << " strongest (tension: at the equilibrium posture)\n";
+  os << "\nMuscles: " << active << " of " << m.muscles.size()
+     << " active (F > 0.1 % of F max); the "
+     << std::min<std::size_t>(std::size_t(top), m.muscles.size())
+     << " strongest (tension: at the equilibrium posture)\n";
   mt.print(os, false);
 }
 
-void print_ligaments(std::ostream& os, const spine::SpineModel& m, const spine::SpineSolution& s, int top) {
+void print_ligaments(std::ostream& os, const spine::SpineModel& m, const spine::SpineSolution& s,
+                     int top) {
   if (m.ligaments.empty() || s.ligament_force_n.size() != Eigen::Index(m.ligaments.size())) return;
   int taut = 0;
   for (Eigen::Index i = 0; i < s.ligament_force_n.size(); ++i) taut += s.ligament_force_n(i) > 0;
@@ -268,7 +306,8 @@ void print_ligaments(std::ostream& os, const spine::SpineModel& m, const spine::
   for (int i : top_indices(s.ligament_force_n, top)) {
     if (s.ligament_force_n(i) <= 0) break;
     const auto& li = m.ligaments[std::size_t(i)];
-    lt.add({li.name, li.type, li.joint >= 0 ? spine::joint_names()[std::size_t(li.joint)] : "-", fixed(s.ligament_force_n(i), 2)});
+    lt.add({li.name, li.type, li.joint >= 0 ? spine::joint_names()[std::size_t(li.joint)] : "-",
+            fixed(s.ligament_force_n(i), 2)});
   }
   os << "\nLigaments: " << taut << " of " << m.ligaments.size() << " in tension; the strongest\n";
   lt.print(os, false);
@@ -279,17 +318,19 @@ void print_footer(std::ostream& os, const SpineSolveRun& r, const std::string& c
   const spine::SpineSolution& s = r.solution;
   if (m.has_bushing) {
     const auto& b = s.bushing_wrench;
-    os << "\nIAP bushing on the rib cage (" << spine::vertebra_names()[std::size_t(m.ribs_body)] << "): force "
-       << vec3(Eigen::Vector3d(b(0), b(1), b(2)), 1) << " N, moment " << vec3(Eigen::Vector3d(b(3), b(4), b(5)) * 1e-3, 3)
-       << " N·m\n";
+    os << "\nIAP bushing on the rib cage (" << spine::vertebra_names()[std::size_t(m.ribs_body)]
+       << "): force " << vec3(Eigen::Vector3d(b(0), b(1), b(2)), 1) << " N, moment "
+       << vec3(Eigen::Vector3d(b(3), b(4), b(5)) * 1e-3, 3) << " N·m\n";
   }
   if (r.request.solve.recruit)
-    os << "Recruitment: " << (s.recruitment.success ? "success" : "FAILED") << " (" << s.recruitment.status << ", "
-       << s.recruitment.iterations << " Ipopt iterations), objective " << std::setprecision(4) << s.recruitment.objective
+    os << "Recruitment: " << (s.recruitment.success ? "success" : "FAILED") << " ("
+       << s.recruitment.status << ", " << s.recruitment.iterations
+       << " Ipopt iterations), objective " << std::setprecision(4) << s.recruitment.objective
        << ", max equilibrium violation " << fixed(s.recruitment.max_constraint_violation_nmm, 3)
        << " N·mm, largest reserve moment " << fixed(max_reserve_nmm(s) * 1e-3, 3) << " N·m\n";
-  os << "Time: model " << fixed(r.model_seconds * 1e3, 1) << " ms, recruitment " << fixed(s.seconds_recruitment * 1e3, 1)
-     << " ms, equilibrium " << fixed(s.seconds_equilibrium * 1e3, 1) << " ms, total " << fixed(r.total_seconds * 1e3, 1)
+  os << "Time: model " << fixed(r.model_seconds * 1e3, 1) << " ms, recruitment "
+     << fixed(s.seconds_recruitment * 1e3, 1) << " ms, equilibrium "
+     << fixed(s.seconds_equilibrium * 1e3, 1) << " ms, total " << fixed(r.total_seconds * 1e3, 1)
      << " ms" << (csv.empty() ? "" : "; wrote " + csv) << "\n";
 }
 

@@ -32,14 +32,12 @@ namespace {
 constexpr double kDeg = 180.0 / M_PI;
 const double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-
 void begin(const StageHooks& h, const std::string& what) {
   if (h.begin) h.begin(what);
 }
 void end(const StageHooks& h, const std::string& detail) {
   if (h.end) h.end(detail);
 }
-
 
 /// data/spine/spine_model.json (the model reads it too; the studies need its "validation" and
 /// "crate" blocks).
@@ -56,7 +54,8 @@ nlohmann::json read_spine_json(const std::string& data_dir) {
 
 double required(const nlohmann::json& j, const std::string& block, const std::string& key) {
   if (!j.contains(key) || !j.at(key).is_number())
-    throw std::runtime_error("spine_model.json: " + block + "." + key + " is missing or not a number");
+    throw std::runtime_error("spine_model.json: " + block + "." + key +
+                             " is missing or not a number");
   return j.at(key).get<double>();
 }
 
@@ -92,7 +91,11 @@ std::string at(const std::vector<std::string>& pairs, int i, double v, int decim
 nlohmann::json findings_json(const std::vector<Finding>& findings) {
   nlohmann::json a = nlohmann::json::array();
   for (const auto& f : findings)
-    a.push_back({{"id", f.id}, {"load", f.load}, {"thesis", f.thesis}, {"ours", f.ours}, {"match", f.match}});
+    a.push_back({{"id", f.id},
+                 {"load", f.load},
+                 {"thesis", f.thesis},
+                 {"ours", f.ours},
+                 {"match", f.match}});
   return a;
 }
 
@@ -127,7 +130,9 @@ const std::vector<LoadDirection>& t1_load_directions() {
 
 // --- validation --------------------------------------------------------------------------------
 
-bool McGillCase::axial_ok() const { return l5s1.axial_n >= axial_lo_n && l5s1.axial_n <= axial_hi_n; }
+bool McGillCase::axial_ok() const {
+  return l5s1.axial_n >= axial_lo_n && l5s1.axial_n <= axial_hi_n;
+}
 bool McGillCase::shear_ok() const { return joint_shear_n(l5s1) <= shear_max_n; }
 bool WilkeCase::ok() const { return std::abs(l4l5.axial_n - target_n) <= tolerance * target_n; }
 
@@ -136,22 +141,27 @@ namespace {
 /// M_ext of spine_studies.hpp: e_x · Σ (x_k − p) × f_k over the weights on vertebrae and the
 /// external loads, at their points in `poses`, plus the external couples; N·mm.
 double external_moment_x(const SpineModel& m, const std::vector<ExternalLoad>& loads,
-                         const std::vector<spine::Pose>& poses, const Eigen::Vector3d& joint_point) {
+                         const std::vector<spine::Pose>& poses,
+                         const Eigen::Vector3d& joint_point) {
   Eigen::Vector3d moment = Eigen::Vector3d::Zero();
   for (const auto& w : m.weights)
-    if (w.body != spine::kGround) moment += (spine::place(poses, w.body, w.point_mm) - joint_point).cross(w.force_n);
+    if (w.body != spine::kGround)
+      moment += (spine::place(poses, w.body, w.point_mm) - joint_point).cross(w.force_n);
   for (const auto& l : loads) {
-    const Eigen::Vector3d X = l.has_point ? l.point_mm : m.vertebrae[std::size_t(l.vertebra)].centre_mm;
+    const Eigen::Vector3d X =
+        l.has_point ? l.point_mm : m.vertebrae[std::size_t(l.vertebra)].centre_mm;
     moment += (spine::place(poses, l.vertebra, X) - joint_point).cross(l.force_n) + l.moment_nmm;
   }
   return moment.x();
 }
 
-McGillCase mcgill_case(const std::string& data_dir, const spine::ModelOptions& model, const nlohmann::json& v) {
+McGillCase mcgill_case(const std::string& data_dir, const spine::ModelOptions& model,
+                       const nlohmann::json& v) {
   McGillCase c;
   c.target_moment_nmm = required(v, "validation", "mcgill_extension_moment_nmm");
   const auto& range = v.at("mcgill_axial_range_n");
-  if (!range.is_array() || range.size() != 2) throw std::runtime_error("spine_model.json: validation.mcgill_axial_range_n must be [lo, hi]");
+  if (!range.is_array() || range.size() != 2)
+    throw std::runtime_error("spine_model.json: validation.mcgill_axial_range_n must be [lo, hi]");
   c.axial_lo_n = range[0].get<double>();
   c.axial_hi_n = range[1].get<double>();
   c.shear_max_n = required(v, "validation", "mcgill_shear_max_n");
@@ -167,7 +177,9 @@ McGillCase mcgill_case(const std::string& data_dir, const spine::ModelOptions& m
   const int l5s1 = spine::joint_index("L5-S1");
   const Eigen::Vector3d p = m.joints[std::size_t(l5s1)].point_mm;
   const spine::SolveOptions options = study_solve_options();
-  auto loads_for = [&](double f) { return std::vector<ExternalLoad>{force_on(t7, Eigen::Vector3d(0, 0, f))}; };
+  auto loads_for = [&](double f) {
+    return std::vector<ExternalLoad>{force_on(t7, Eigen::Vector3d(0, 0, f))};
+  };
   auto moment_at = [&](double f, SpineSolution* keep) {
     const auto loads = loads_for(f);
     SpineSolution s = spine::solve_spine(m, loads, options);
@@ -185,9 +197,10 @@ McGillCase mcgill_case(const std::string& data_dir, const spine::ModelOptions& m
   double f1 = -g0 / lever_mm, g1 = moment_at(f1, &s) - c.target_moment_nmm;
   const double tolerance_nmm = 1e-6 * std::abs(c.target_moment_nmm);
   for (int k = 0; std::abs(g1) > tolerance_nmm; ++k) {
-    if (k == 30 || g1 == g0) throw std::runtime_error("McGill case: no T7 force found giving the L5-S1 moment " +
-                                                      fixed(c.target_moment_nmm * 1e-3, 1) + " N·m after " +
-                                                      std::to_string(c.solves) + " solves");
+    if (k == 30 || g1 == g0)
+      throw std::runtime_error("McGill case: no T7 force found giving the L5-S1 moment " +
+                               fixed(c.target_moment_nmm * 1e-3, 1) + " N·m after " +
+                               std::to_string(c.solves) + " solves");
     const double f2 = f1 - g1 * (f1 - f0) / (g1 - g0);
     f0 = f1, g0 = g1;
     f1 = f2;
@@ -204,9 +217,11 @@ McGillCase mcgill_case(const std::string& data_dir, const spine::ModelOptions& m
   return c;
 }
 
-WilkeCase wilke_case(const std::string& data_dir, const spine::ModelOptions& model, const nlohmann::json& j) {
+WilkeCase wilke_case(const std::string& data_dir, const spine::ModelOptions& model,
+                     const nlohmann::json& j) {
   const nlohmann::json& v = j.at("validation");
-  if (!j.contains("crate")) throw std::runtime_error("spine_model.json: the crate block is missing");
+  if (!j.contains("crate"))
+    throw std::runtime_error("spine_model.json: the crate block is missing");
   const nlohmann::json& crate = j.at("crate");
   WilkeCase c;
   c.target_n = required(v, "validation", "wilke_axial_n");
@@ -221,8 +236,9 @@ WilkeCase wilke_case(const std::string& data_dir, const spine::ModelOptions& mod
   mo.arms_forward = true;
   const SpineModel m = spine::load_spine_model(data_dir, mo);
   c.crate_point_mm = m.chest_front_mm + Eigen::Vector3d(0, 0, c.distance_from_chest_mm);
-  ExternalLoad crate_load = force_on(spine::vertebra_index(c.carried_by),
-                                     Eigen::Vector3d(0, -c.crate_mass_kg * m.gravity_mm_s2 * 1e-3, 0));  // N = kg·m/s²
+  ExternalLoad crate_load =
+      force_on(spine::vertebra_index(c.carried_by),
+               Eigen::Vector3d(0, -c.crate_mass_kg * m.gravity_mm_s2 * 1e-3, 0));  // N = kg·m/s²
   crate_load.has_point = true;
   crate_load.point_mm = c.crate_point_mm;
   const SpineSolution s = spine::solve_spine(m, {crate_load}, study_solve_options());
@@ -237,7 +253,8 @@ ValidationStudy run_validation_study(const std::string& data_dir, const spine::M
                                      const StageHooks& hooks) {
   Timer t0;
   const nlohmann::json j = read_spine_json(data_dir);
-  if (!j.contains("validation")) throw std::runtime_error("spine_model.json: the validation block is missing");
+  if (!j.contains("validation"))
+    throw std::runtime_error("spine_model.json: the validation block is missing");
   ValidationStudy s;
   begin(hooks, "McGill & Norman: force on T7 for the L5-S1 moment");
   s.mcgill = mcgill_case(data_dir, model, j.at("validation"));
@@ -255,33 +272,47 @@ void print_validation(std::ostream& os, const ValidationStudy& s, bool markdown)
   const WilkeCase& b = s.wilke;
   auto verdict = [](bool ok) { return std::string(ok ? "pass" : "FAIL"); };
   TextTable t({"case", "quantity", "ours", "target", "thesis", "de Zee 2007", "verdict"}, 2);
-  t.add({"McGill", "T7 force (N)", fixed(a.t7_force_n, 1), "-", fixed(a.thesis_force_n, 0), "-", ""});
+  t.add(
+      {"McGill", "T7 force (N)", fixed(a.t7_force_n, 1), "-", fixed(a.thesis_force_n, 0), "-", ""});
   t.add({"McGill", "L5-S1 external moment M_ext (N·m)", fixed(a.external_moment_nmm * 1e-3, 2),
-         fixed(a.target_moment_nmm * 1e-3, 1), fixed(a.target_moment_nmm * 1e-3, 1), fixed(a.target_moment_nmm * 1e-3, 1), ""});
-  t.add({"McGill", "of which the L5-S1 joint spring carries (N·m)", fixed(a.joint_moment_nmm * 1e-3, 2), "-", "-", "-", ""});
-  t.add({"McGill", "of which muscles, ligaments, IAP carry (N·m)", fixed(a.other_moment_nmm * 1e-3, 2), "-", "-", "-", ""});
+         fixed(a.target_moment_nmm * 1e-3, 1), fixed(a.target_moment_nmm * 1e-3, 1),
+         fixed(a.target_moment_nmm * 1e-3, 1), ""});
+  t.add({"McGill", "of which the L5-S1 joint spring carries (N·m)",
+         fixed(a.joint_moment_nmm * 1e-3, 2), "-", "-", "-", ""});
+  t.add({"McGill", "of which muscles, ligaments, IAP carry (N·m)",
+         fixed(a.other_moment_nmm * 1e-3, 2), "-", "-", "-", ""});
   t.add({"McGill", "L5-S1 axial, joint frame (N)", fixed(a.l5s1.axial_n, 1),
-         fixed(a.axial_lo_n, 0) + "–" + fixed(a.axial_hi_n, 0), fixed(a.thesis_axial_n, 0), fixed(a.dezee_axial_n, 0),
-         verdict(a.axial_ok())});
-  t.add({"McGill", "L5-S1 shear, joint frame (N)", fixed(joint_shear_n(a.l5s1), 1), "≤ " + fixed(a.shear_max_n, 0),
-         fixed(a.thesis_shear_n, 0), fixed(a.dezee_shear_n, 0), verdict(a.shear_ok())});
-  t.add({"McGill", "L5-S1 AP shear +z, joint frame (N)", fixed(a.l5s1.shear_ap_n, 1), "-", "-", "-", ""});
-  t.add({"McGill", "L5-S1 axial, disc frame (N)", fixed(a.l5s1.disc_axial_n, 1), fixed(a.axial_lo_n, 0) + "–" + fixed(a.axial_hi_n, 0),
-         "-", "-", "(info)"});
-  t.add({"McGill", "L5-S1 shear, disc frame (N)", fixed(a.l5s1.disc_shear_n, 1), "≤ " + fixed(a.shear_max_n, 0), "-", "-", "(info)"});
+         fixed(a.axial_lo_n, 0) + "–" + fixed(a.axial_hi_n, 0), fixed(a.thesis_axial_n, 0),
+         fixed(a.dezee_axial_n, 0), verdict(a.axial_ok())});
+  t.add({"McGill", "L5-S1 shear, joint frame (N)", fixed(joint_shear_n(a.l5s1), 1),
+         "≤ " + fixed(a.shear_max_n, 0), fixed(a.thesis_shear_n, 0), fixed(a.dezee_shear_n, 0),
+         verdict(a.shear_ok())});
+  t.add({"McGill", "L5-S1 AP shear +z, joint frame (N)", fixed(a.l5s1.shear_ap_n, 1), "-", "-", "-",
+         ""});
+  t.add({"McGill", "L5-S1 axial, disc frame (N)", fixed(a.l5s1.disc_axial_n, 1),
+         fixed(a.axial_lo_n, 0) + "–" + fixed(a.axial_hi_n, 0), "-", "-", "(info)"});
+  t.add({"McGill", "L5-S1 shear, disc frame (N)", fixed(a.l5s1.disc_shear_n, 1),
+         "≤ " + fixed(a.shear_max_n, 0), "-", "-", "(info)"});
   t.add({"Wilke", "L4-L5 axial, joint frame (N)", fixed(b.l4l5.axial_n, 1),
-         fixed(b.target_n, 0) + " ± " + fixed(100 * b.tolerance, 0) + " %", fixed(b.thesis_n, 1), "-", verdict(b.ok())});
-  t.add({"Wilke", "L4-L5 axial, disc frame (N)", fixed(b.l4l5.disc_axial_n, 1), "-", "-", "-", "(info)"});
-  t.add({"Wilke", "L4-L5 shear, joint frame (N)", fixed(joint_shear_n(b.l4l5), 1), "-", "-", "-", ""});
+         fixed(b.target_n, 0) + " ± " + fixed(100 * b.tolerance, 0) + " %", fixed(b.thesis_n, 1),
+         "-", verdict(b.ok())});
+  t.add({"Wilke", "L4-L5 axial, disc frame (N)", fixed(b.l4l5.disc_axial_n, 1), "-", "-", "-",
+         "(info)"});
+  t.add({"Wilke", "L4-L5 shear, joint frame (N)", fixed(joint_shear_n(b.l4l5), 1), "-", "-", "-",
+         ""});
   t.print(os, markdown);
   os << (markdown ? "\n" : "") << "  McGill: +z force at the T7 centre, raised until M_ext = "
-     << fixed(a.target_moment_nmm * 1e-3, 1) << " N·m (" << a.solves << " solves); M_ext = e_x·Σ(x−p_L5S1)×f over the T7\n"
-     << "  force and the weights above L5-S1 in the equilibrium posture (" << fixed(a.external_moment_reference_nmm * 1e-3, 2)
+     << fixed(a.target_moment_nmm * 1e-3, 1) << " N·m (" << a.solves
+     << " solves); M_ext = e_x·Σ(x−p_L5S1)×f over the T7\n"
+     << "  force and the weights above L5-S1 in the equilibrium posture ("
+     << fixed(a.external_moment_reference_nmm * 1e-3, 2)
      << " N·m in the reference posture); > 0 flexes the trunk.\n"
-     << "  Wilke: " << fixed(b.crate_mass_kg, 1) << " kg crate at (" << fixed(b.crate_point_mm.x(), 0) << ", "
-     << fixed(b.crate_point_mm.y(), 0) << ", " << fixed(b.crate_point_mm.z(), 0) << ") mm, " << fixed(b.distance_from_chest_mm, 0)
+     << "  Wilke: " << fixed(b.crate_mass_kg, 1) << " kg crate at ("
+     << fixed(b.crate_point_mm.x(), 0) << ", " << fixed(b.crate_point_mm.y(), 0) << ", "
+     << fixed(b.crate_point_mm.z(), 0) << ") mm, " << fixed(b.distance_from_chest_mm, 0)
      << " mm in front of the chest, carried by " << b.carried_by << ", arms forward.\n"
-     << "  Joint frame: the lower vertebra's axes (axial +y, compression > 0); disc frame: the disc mid-plane.\n";
+     << "  Joint frame: the lower vertebra's axes (axial +y, compression > 0); disc frame: the "
+        "disc mid-plane.\n";
 }
 
 nlohmann::json validation_json(const ValidationStudy& s) {
@@ -294,7 +325,8 @@ nlohmann::json validation_json(const ValidationStudy& s) {
       {"external_moment_nmm", a.external_moment_nmm},
       {"external_moment_reference_posture_nmm", a.external_moment_reference_nmm},
       {"moment_definition",
-       "M_ext = e_x . sum_k (x_k - p_L5S1) x f_k over the T7 force and the weights above L5-S1 at their equilibrium "
+       "M_ext = e_x . sum_k (x_k - p_L5S1) x f_k over the T7 force and the weights above L5-S1 at "
+       "their equilibrium "
        "positions; > 0 flexes the trunk (the extension moment the trunk must supply)"},
       {"joint_moment_nmm", a.joint_moment_nmm},
       {"muscles_ligaments_iap_moment_nmm", a.other_moment_nmm},
@@ -305,7 +337,10 @@ nlohmann::json validation_json(const ValidationStudy& s) {
       {"disc_shear_n", a.l5s1.disc_shear_n},
       {"l5s1", joint_reaction_json(a.l5s1)},
       {"target", {{"axial_range_n", {a.axial_lo_n, a.axial_hi_n}}, {"shear_max_n", a.shear_max_n}}},
-      {"thesis", {{"t7_force_n", a.thesis_force_n}, {"axial_n", a.thesis_axial_n}, {"shear_n", a.thesis_shear_n}}},
+      {"thesis",
+       {{"t7_force_n", a.thesis_force_n},
+        {"axial_n", a.thesis_axial_n},
+        {"shear_n", a.thesis_shear_n}}},
       {"de_zee", {{"axial_n", a.dezee_axial_n}, {"shear_n", a.dezee_shear_n}}},
       {"axial_ok", a.axial_ok()},
       {"shear_ok", a.shear_ok()},
@@ -314,15 +349,19 @@ nlohmann::json validation_json(const ValidationStudy& s) {
       {"newton_iterations", a.iterations}};
   nlohmann::json wilke = {
       {"source", b.source},
-      {"crate", {{"mass_kg", b.crate_mass_kg}, {"distance_from_chest_mm", b.distance_from_chest_mm},
-                 {"carried_by", b.carried_by}, {"point_mm", to_json(b.crate_point_mm)}}},
+      {"crate",
+       {{"mass_kg", b.crate_mass_kg},
+        {"distance_from_chest_mm", b.distance_from_chest_mm},
+        {"carried_by", b.carried_by},
+        {"point_mm", to_json(b.crate_point_mm)}}},
       {"axial_n", b.l4l5.axial_n},
       {"disc_axial_n", b.l4l5.disc_axial_n},
       {"shear_n", joint_shear_n(b.l4l5)},
       {"l4l5", joint_reaction_json(b.l4l5)},
-      {"target", {{"axial_n", b.target_n},
-                  {"tolerance", b.tolerance},
-                  {"axial_range_n", {b.target_n * (1 - b.tolerance), b.target_n * (1 + b.tolerance)}}}},
+      {"target",
+       {{"axial_n", b.target_n},
+        {"tolerance", b.tolerance},
+        {"axial_range_n", {b.target_n * (1 - b.tolerance), b.target_n * (1 + b.tolerance)}}}},
       {"thesis", {{"axial_n", b.thesis_n}}},
       {"relative_error", (b.l4l5.axial_n - b.target_n) / b.target_n},
       {"pass", b.ok()},
@@ -330,9 +369,13 @@ nlohmann::json validation_json(const ValidationStudy& s) {
   return {{"study", "validation"},
           {"thesis", "3.4"},
           {"trunk_muscles", s.trunk_muscles},
-          {"units", {{"force", "N"}, {"moment", "N·mm"}, {"frame", "x lateral (body's right -x), y superior, z anterior"},
-                     {"joint_frame", "the lower vertebra's axes: axial +y (compression > 0), shear_ap +z, shear_lat +x"},
-                     {"disc_frame", "disc mid-plane: axis from the lower to the upper vertebra centre"}}},
+          {"units",
+           {{"force", "N"},
+            {"moment", "N·mm"},
+            {"frame", "x lateral (body's right -x), y superior, z anterior"},
+            {"joint_frame",
+             "the lower vertebra's axes: axial +y (compression > 0), shear_ap +z, shear_lat +x"},
+            {"disc_frame", "disc mid-plane: axis from the lower to the upper vertebra centre"}}},
           {"mcgill", mcgill},
           {"wilke", wilke},
           {"pass", a.axial_ok() && a.shear_ok() && b.ok()},
@@ -344,22 +387,26 @@ std::string validation_csv(const ValidationStudy& s) {
   const WilkeCase& b = s.wilke;
   std::ostringstream os;
   os << std::setprecision(10) << "case,quantity,unit,value,target_low,target_high,thesis,pass\n";
-  auto row = [&](const char* c, const char* q, const char* unit, double v, double lo, double hi, double thesis,
-                 const char* pass) {
+  auto row = [&](const char* c, const char* q, const char* unit, double v, double lo, double hi,
+                 double thesis, const char* pass) {
     auto num = [](double x) { return std::isnan(x) ? std::string() : fixed(x, 4); };
-    os << c << "," << q << "," << unit << "," << num(v) << "," << num(lo) << "," << num(hi) << "," << num(thesis) << ","
-       << pass << "\n";
+    os << c << "," << q << "," << unit << "," << num(v) << "," << num(lo) << "," << num(hi) << ","
+       << num(thesis) << "," << pass << "\n";
   };
   const char* yes_no[] = {"no", "yes"};
   row("mcgill", "t7_force", "N", a.t7_force_n, kNaN, kNaN, a.thesis_force_n, "");
-  row("mcgill", "external_moment", "N*mm", a.external_moment_nmm, a.target_moment_nmm, a.target_moment_nmm, kNaN, "");
+  row("mcgill", "external_moment", "N*mm", a.external_moment_nmm, a.target_moment_nmm,
+      a.target_moment_nmm, kNaN, "");
   row("mcgill", "joint_moment_x", "N*mm", a.joint_moment_nmm, kNaN, kNaN, kNaN, "");
-  row("mcgill", "l5s1_axial_joint_frame", "N", a.l5s1.axial_n, a.axial_lo_n, a.axial_hi_n, a.thesis_axial_n, yes_no[a.axial_ok()]);
-  row("mcgill", "l5s1_shear_joint_frame", "N", joint_shear_n(a.l5s1), kNaN, a.shear_max_n, a.thesis_shear_n, yes_no[a.shear_ok()]);
-  row("mcgill", "l5s1_axial_disc_frame", "N", a.l5s1.disc_axial_n, a.axial_lo_n, a.axial_hi_n, kNaN, "");
+  row("mcgill", "l5s1_axial_joint_frame", "N", a.l5s1.axial_n, a.axial_lo_n, a.axial_hi_n,
+      a.thesis_axial_n, yes_no[a.axial_ok()]);
+  row("mcgill", "l5s1_shear_joint_frame", "N", joint_shear_n(a.l5s1), kNaN, a.shear_max_n,
+      a.thesis_shear_n, yes_no[a.shear_ok()]);
+  row("mcgill", "l5s1_axial_disc_frame", "N", a.l5s1.disc_axial_n, a.axial_lo_n, a.axial_hi_n, kNaN,
+      "");
   row("mcgill", "l5s1_shear_disc_frame", "N", a.l5s1.disc_shear_n, kNaN, a.shear_max_n, kNaN, "");
-  row("wilke", "l4l5_axial_joint_frame", "N", b.l4l5.axial_n, b.target_n * (1 - b.tolerance), b.target_n * (1 + b.tolerance),
-      b.thesis_n, yes_no[b.ok()]);
+  row("wilke", "l4l5_axial_joint_frame", "N", b.l4l5.axial_n, b.target_n * (1 - b.tolerance),
+      b.target_n * (1 + b.tolerance), b.thesis_n, yes_no[b.ok()]);
   row("wilke", "l4l5_axial_disc_frame", "N", b.l4l5.disc_axial_n, kNaN, kNaN, kNaN, "");
   return os.str();
 }
@@ -376,9 +423,15 @@ namespace {
 
 std::vector<Finding> fusion_findings(const FusionStudy& s) {
   std::vector<Finding> out;
-  auto motion = [&](const std::string& f, const std::string& l) { return s.run(f, l).t1_translation_mm.norm(); };
-  auto l2l3 = [&](const std::string& f, const std::string& l) { return resultant(s.run(f, l).l2l3); };
-  auto l5s1 = [&](const std::string& f, const std::string& l) { return resultant(s.run(f, l).l5s1); };
+  auto motion = [&](const std::string& f, const std::string& l) {
+    return s.run(f, l).t1_translation_mm.norm();
+  };
+  auto l2l3 = [&](const std::string& f, const std::string& l) {
+    return resultant(s.run(f, l).l2l3);
+  };
+  auto l5s1 = [&](const std::string& f, const std::string& l) {
+    return resultant(s.run(f, l).l5s1);
+  };
   const std::vector<std::string> fused = {"L3-L4", "L4-L5", "L3-L4-L5"};
   for (const auto& l : s.loads) {
     {  // 1. Every fusion reduces T1's motion.
@@ -389,41 +442,53 @@ std::vector<Finding> fusion_findings(const FusionStudy& s) {
         ours << ", " << f << " " << fixed(motion(f, l), 3);
         all = all && motion(f, l) < motion("normal", l);
       }
-      out.push_back({"fusion-reduces-motion", l, "every fusion moves T1 less than the normal spine", ours.str(), all});
+      out.push_back({"fusion-reduces-motion", l, "every fusion moves T1 less than the normal spine",
+                     ours.str(), all});
     }
     {  // 2. L3-L4 restricts more than L4-L5; L3-L4-L5 the most.
       const double a = motion("L3-L4", l), b = motion("L4-L5", l), c = motion("L3-L4-L5", l);
-      out.push_back({"l3l4-restricts-more-than-l4l5", l, "fusion at L3-L4 moves T1 less than fusion at L4-L5",
+      out.push_back({"l3l4-restricts-more-than-l4l5", l,
+                     "fusion at L3-L4 moves T1 less than fusion at L4-L5",
                      "L3-L4 " + fixed(a, 3) + " mm, L4-L5 " + fixed(b, 3) + " mm", a < b});
       out.push_back({"l3l4l5-restricts-most", l, "fusion at L3-L4-L5 moves T1 least",
-                     "L3-L4-L5 " + fixed(c, 3) + " mm vs " + fixed(std::min(a, b), 3) + " mm", c < std::min(a, b)});
+                     "L3-L4-L5 " + fixed(c, 3) + " mm vs " + fixed(std::min(a, b), 3) + " mm",
+                     c < std::min(a, b)});
     }
     {  // 3. Adjacent-level forces rise with every fusion.
       std::ostringstream ours;
       bool all = true;
-      ours << "resultant (N) L2-L3 / L5-S1: normal " << fixed(l2l3("normal", l), 1) << " / " << fixed(l5s1("normal", l), 1);
+      ours << "resultant (N) L2-L3 / L5-S1: normal " << fixed(l2l3("normal", l), 1) << " / "
+           << fixed(l5s1("normal", l), 1);
       for (const auto& f : fused) {
         ours << ", " << f << " " << fixed(l2l3(f, l), 1) << " / " << fixed(l5s1(f, l), 1);
         all = all && l2l3(f, l) > l2l3("normal", l) && l5s1(f, l) > l5s1("normal", l);
       }
-      out.push_back({"adjacent-forces-rise", l, "every fusion raises the L2-L3 and L5-S1 forces above the normal spine's",
+      out.push_back({"adjacent-forces-rise", l,
+                     "every fusion raises the L2-L3 and L5-S1 forces above the normal spine's",
                      ours.str(), all});
     }
     {  // 4. L3-L4-L5 raises them most.
-      const double a2 = std::max(l2l3("L3-L4", l), l2l3("L4-L5", l)), a5 = std::max(l5s1("L3-L4", l), l5s1("L4-L5", l));
+      const double a2 = std::max(l2l3("L3-L4", l), l2l3("L4-L5", l)),
+                   a5 = std::max(l5s1("L3-L4", l), l5s1("L4-L5", l));
       const double c2 = l2l3("L3-L4-L5", l), c5 = l5s1("L3-L4-L5", l);
-      out.push_back({"l3l4l5-raises-most", l, "fusion at L3-L4-L5 gives the largest L2-L3 and L5-S1 forces",
-                     "L3-L4-L5 " + fixed(c2, 1) + " / " + fixed(c5, 1) + " N vs single-level max " + fixed(a2, 1) + " / " +
-                         fixed(a5, 1) + " N",
+      out.push_back({"l3l4l5-raises-most", l,
+                     "fusion at L3-L4-L5 gives the largest L2-L3 and L5-S1 forces",
+                     "L3-L4-L5 " + fixed(c2, 1) + " / " + fixed(c5, 1) + " N vs single-level max " +
+                         fixed(a2, 1) + " / " + fixed(a5, 1) + " N",
                      c2 > a2 && c5 > a5});
     }
     {  // 5. L4-L5 fusion loads L2-L3 less than L3-L4 fusion; L5-S1 about equal.
       const double a = l2l3("L3-L4", l), b = l2l3("L4-L5", l);
-      out.push_back({"l4l5-loads-l2l3-less", l, "fusion at L4-L5 loads L2-L3 less than fusion at L3-L4",
-                     "L2-L3: L4-L5 fusion " + fixed(b, 1) + " N, L3-L4 fusion " + fixed(a, 1) + " N", b < a});
-      const double c = l5s1("L3-L4", l), d = l5s1("L4-L5", l), rel = std::abs(c - d) / (0.5 * (c + d));
-      out.push_back({"l5s1-about-equal", l, "L5-S1 force about equal for L3-L4 and L4-L5 fusion (within 5 %)",
-                     "L3-L4 " + fixed(c, 1) + " N, L4-L5 " + fixed(d, 1) + " N (" + fixed(100 * rel, 1) + " %)", rel <= 0.05});
+      out.push_back(
+          {"l4l5-loads-l2l3-less", l, "fusion at L4-L5 loads L2-L3 less than fusion at L3-L4",
+           "L2-L3: L4-L5 fusion " + fixed(b, 1) + " N, L3-L4 fusion " + fixed(a, 1) + " N", b < a});
+      const double c = l5s1("L3-L4", l), d = l5s1("L4-L5", l),
+                   rel = std::abs(c - d) / (0.5 * (c + d));
+      out.push_back({"l5s1-about-equal", l,
+                     "L5-S1 force about equal for L3-L4 and L4-L5 fusion (within 5 %)",
+                     "L3-L4 " + fixed(c, 1) + " N, L4-L5 " + fixed(d, 1) + " N (" +
+                         fixed(100 * rel, 1) + " %)",
+                     rel <= 0.05});
     }
   }
   return out;
@@ -431,9 +496,10 @@ std::vector<Finding> fusion_findings(const FusionStudy& s) {
 
 }  // namespace
 
-FusionStudy run_fusion_study(const std::string& data_dir, double force_n, const spine::ModelOptions& model,
-                             const StageHooks& hooks) {
-  if (!std::isfinite(force_n) || force_n <= 0) throw std::invalid_argument("fusion study: the force must be finite and > 0 N");
+FusionStudy run_fusion_study(const std::string& data_dir, double force_n,
+                             const spine::ModelOptions& model, const StageHooks& hooks) {
+  if (!std::isfinite(force_n) || force_n <= 0)
+    throw std::invalid_argument("fusion study: the force must be finite and > 0 N");
   Timer t0;
   FusionStudy s;
   s.trunk_muscles = model.trunk_muscles;
@@ -442,9 +508,11 @@ FusionStudy run_fusion_study(const std::string& data_dir, double force_n, const 
   for (const auto& d : t1_load_directions()) s.loads.push_back(d.name);
   const spine::SolveOptions options = study_solve_options();
   const int t1 = spine::vertebra_index("T1");
-  const std::size_t l2l3 = std::size_t(spine::joint_index("L2-L3")), l5s1 = std::size_t(spine::joint_index("L5-S1"));
+  const std::size_t l2l3 = std::size_t(spine::joint_index("L2-L3")),
+                    l5s1 = std::size_t(spine::joint_index("L5-S1"));
   for (const auto& fusion : s.fusions) {
-    begin(hooks, "fusion " + fusion + ": gravity only and " + std::to_string(s.loads.size()) + " loads on T1");
+    begin(hooks, "fusion " + fusion + ": gravity only and " + std::to_string(s.loads.size()) +
+                     " loads on T1");
     spine::ModelOptions mo = model;
     mo.fused_joints = fusion == "normal" ? std::vector<int>{} : spine::parse_fusion(fusion);
     const SpineModel m = spine::load_spine_model(data_dir, mo);
@@ -457,10 +525,11 @@ FusionStudy run_fusion_study(const std::string& data_dir, double force_n, const 
       r.load = d.name;
       r.force_n = force_n * d.direction;
       const SpineSolution sol = spine::solve_spine(m, {force_on(t1, r.force_n)}, options);
-      r.t1_translation_mm = sol.poses[std::size_t(t1)].apply(c) - base.poses[std::size_t(t1)].apply(c);
+      r.t1_translation_mm =
+          sol.poses[std::size_t(t1)].apply(c) - base.poses[std::size_t(t1)].apply(c);
       r.t1_total_translation_mm = sol.poses[std::size_t(t1)].apply(c) - c;
-      r.t1_rotation_deg =
-          kDeg * spine::rotation_log(sol.poses[std::size_t(t1)].R * base.poses[std::size_t(t1)].R.transpose());
+      r.t1_rotation_deg = kDeg * spine::rotation_log(sol.poses[std::size_t(t1)].R *
+                                                     base.poses[std::size_t(t1)].R.transpose());
       r.l2l3 = sol.joints[l2l3];
       r.l5s1 = sol.joints[l5s1];
       r.iterations = sol.iterations;
@@ -475,19 +544,24 @@ FusionStudy run_fusion_study(const std::string& data_dir, double force_n, const 
 }
 
 void print_fusion(std::ostream& os, const FusionStudy& s, bool markdown) {
-  TextTable t({"fusion", "load", "T1 |t| (mm)", "T1 t x,y,z (mm)", "T1 |rot| (deg)", "L2-L3 axial (N)", "L2-L3 shear (N)",
-               "L2-L3 |F| (N)", "L5-S1 axial (N)", "L5-S1 shear (N)", "L5-S1 |F| (N)"},
-              2);
+  TextTable t(
+      {"fusion", "load", "T1 |t| (mm)", "T1 t x,y,z (mm)", "T1 |rot| (deg)", "L2-L3 axial (N)",
+       "L2-L3 shear (N)", "L2-L3 |F| (N)", "L5-S1 axial (N)", "L5-S1 shear (N)", "L5-S1 |F| (N)"},
+      2);
   for (const auto& r : s.runs) {
     const Eigen::Vector3d& v = r.t1_translation_mm;
-    t.add({r.fusion, r.load, fixed(v.norm(), 3), fixed(v.x(), 2) + ", " + fixed(v.y(), 2) + ", " + fixed(v.z(), 2),
-           fixed(r.t1_rotation_deg.norm(), 3), fixed(r.l2l3.axial_n, 1), fixed(joint_shear_n(r.l2l3), 1),
-           fixed(resultant(r.l2l3), 1), fixed(r.l5s1.axial_n, 1), fixed(joint_shear_n(r.l5s1), 1), fixed(resultant(r.l5s1), 1)});
+    t.add({r.fusion, r.load, fixed(v.norm(), 3),
+           fixed(v.x(), 2) + ", " + fixed(v.y(), 2) + ", " + fixed(v.z(), 2),
+           fixed(r.t1_rotation_deg.norm(), 3), fixed(r.l2l3.axial_n, 1),
+           fixed(joint_shear_n(r.l2l3), 1), fixed(resultant(r.l2l3), 1), fixed(r.l5s1.axial_n, 1),
+           fixed(joint_shear_n(r.l5s1), 1), fixed(resultant(r.l5s1), 1)});
   }
   t.print(os, markdown);
   os << (markdown ? "\n" : "") << "  " << fixed(s.force_n, 0)
-     << " N on the T1 centre: forward +z, backward -z, lateral -x. T1 motion: the force's effect (minus the same\n"
-     << "  model's gravity-only equilibrium); joint forces: totals (gravity, muscles, force), joint frame.\n\n";
+     << " N on the T1 centre: forward +z, backward -z, lateral -x. T1 motion: the force's effect "
+        "(minus the same\n"
+     << "  model's gravity-only equilibrium); joint forces: totals (gravity, muscles, force), "
+        "joint frame.\n\n";
   print_findings(os, s.findings, markdown);
 }
 
@@ -509,26 +583,31 @@ nlohmann::json fusion_json(const FusionStudy& s) {
                     {"newton_iterations", r.iterations},
                     {"seconds", r.seconds}});
   }
-  return {{"study", "fusion"},
-          {"thesis", "6.1, fig. 6.1-6.6"},
-          {"trunk_muscles", s.trunk_muscles},
-          {"force_n", s.force_n},
-          {"fusions", s.fusions},
-          {"loads", s.loads},
-          {"units", {{"t1_translation_mm", "T1 centre, the force's effect (minus the gravity-only equilibrium), mm"},
-                     {"t1_rotation_deg", "rotation vector of T1 relative to the gravity-only equilibrium, deg"},
-                     {"t1_total_translation_mm", "T1 centre from the reference posture (gravity and force), mm"},
-                     {"joints", "totals in the joint frame (lower vertebra's axes), N and N·mm"}}},
-          {"runs", runs},
-          {"findings", findings_json(s.findings)},
-          {"seconds", s.seconds}};
+  return {
+      {"study", "fusion"},
+      {"thesis", "6.1, fig. 6.1-6.6"},
+      {"trunk_muscles", s.trunk_muscles},
+      {"force_n", s.force_n},
+      {"fusions", s.fusions},
+      {"loads", s.loads},
+      {"units",
+       {{"t1_translation_mm",
+         "T1 centre, the force's effect (minus the gravity-only equilibrium), mm"},
+        {"t1_rotation_deg", "rotation vector of T1 relative to the gravity-only equilibrium, deg"},
+        {"t1_total_translation_mm", "T1 centre from the reference posture (gravity and force), mm"},
+        {"joints", "totals in the joint frame (lower vertebra's axes), N and N·mm"}}},
+      {"runs", runs},
+      {"findings", findings_json(s.findings)},
+      {"seconds", s.seconds}};
 }
 
 std::string fusion_csv(const FusionStudy& s) {
   std::ostringstream os;
   os << std::setprecision(10)
-     << "fusion,load,force_x_n,force_y_n,force_z_n,t1_tx_mm,t1_ty_mm,t1_tz_mm,t1_translation_mm,t1_rx_deg,t1_ry_deg,"
-        "t1_rz_deg,t1_rotation_deg,t1_total_translation_mm,l2l3_axial_n,l2l3_shear_ap_n,l2l3_shear_lat_n,l2l3_resultant_n,l5s1_axial_n,"
+     << "fusion,load,force_x_n,force_y_n,force_z_n,t1_tx_mm,t1_ty_mm,t1_tz_mm,t1_translation_mm,t1_"
+        "rx_deg,t1_ry_deg,"
+        "t1_rz_deg,t1_rotation_deg,t1_total_translation_mm,l2l3_axial_n,l2l3_shear_ap_n,l2l3_shear_"
+        "lat_n,l2l3_resultant_n,l5s1_axial_n,"
         "l5s1_shear_ap_n,l5s1_shear_lat_n,l5s1_resultant_n\n";
   for (const auto& r : s.runs) {
     os << r.fusion << "," << r.load;
@@ -538,7 +617,8 @@ std::string fusion_csv(const FusionStudy& s) {
     for (int k = 0; k < 3; ++k) os << "," << r.t1_rotation_deg(k);
     os << "," << r.t1_rotation_deg.norm() << "," << r.t1_total_translation_mm.norm();
     for (const JointReaction* j : {&r.l2l3, &r.l5s1})
-      os << "," << j->axial_n << "," << j->shear_ap_n << "," << j->shear_lat_n << "," << resultant(*j);
+      os << "," << j->axial_n << "," << j->shear_ap_n << "," << j->shear_lat_n << ","
+         << resultant(*j);
     os << "\n";
   }
   return os.str();
@@ -564,7 +644,9 @@ struct PairSeries {
     for (int i = index(first); i <= index(last); ++i) n += v(i) * sign > 0;
     return n;
   }
-  int span(const std::string& first, const std::string& last) const { return index(last) - index(first) + 1; }
+  int span(const std::string& first, const std::string& last) const {
+    return index(last) - index(first) + 1;
+  }
   int argmax() const {
     Eigen::Index i = 0;
     v.maxCoeff(&i);
@@ -576,7 +658,9 @@ struct PairSeries {
     return int(i);
   }
   std::string name(int i) const { return pairs[std::size_t(i)]; }
-  std::string show(const std::string& pair, int decimals = 3) const { return pair + " " + fixed((*this)(pair), decimals); }
+  std::string show(const std::string& pair, int decimals = 3) const {
+    return pair + " " + fixed((*this)(pair), decimals);
+  }
   std::string show(int i, int decimals = 3) const { return at(pairs, i, v(i), decimals); }
 };
 
@@ -587,15 +671,16 @@ bool one_of(const std::string& s, std::initializer_list<const char*> options) {
 }
 
 PairSeries column(const TrendRun& r, bool rotation, int k) {
-  return PairSeries{r.pairs, rotation ? Eigen::VectorXd(r.rotation_deg.col(k)) : Eigen::VectorXd(r.translation_mm.col(k))};
+  return PairSeries{r.pairs, rotation ? Eigen::VectorXd(r.rotation_deg.col(k))
+                                      : Eigen::VectorXd(r.translation_mm.col(k))};
 }
 
 std::string count_of(int n, int of, const std::string& what) {
   return std::to_string(n) + "/" + std::to_string(of) + " " + what;
 }
 
-void add(std::vector<Finding>& out, const char* id, const char* load, const std::string& thesis, const std::string& ours,
-         bool match) {
+void add(std::vector<Finding>& out, const char* id, const char* load, const std::string& thesis,
+         const std::string& ours, bool match) {
   out.push_back({id, load, thesis, ours, match});
 }
 
@@ -605,26 +690,35 @@ void lateral_translation_findings(const TrendRun& r, std::vector<Finding>& out) 
   const PairSeries dx = column(r, false, 0), dy = column(r, false, 1), dz = column(r, false, 2);
   const PairSeries ax{r.pairs, dx.v.cwiseAbs()}, comp{r.pairs, -dy.v};
   const int n = int(r.pairs.size());
-  add(out, "lateral-shear-everywhere", "lateral", "upper vertebra moves further than the lower one at every pair (lateral shear)",
-      count_of(dx.count_sign("T1-T2", "L4-L5", sx), n, "pairs with Δx along the force"), dx.count_sign("T1-T2", "L4-L5", sx) == n);
-  add(out, "lateral-shear-peak", "lateral", "shearing peak at T10-T11", "max |Δx| (mm) at " + ax.show(ax.argmax()) + "; " + ax.show("T10-T11"),
+  add(out, "lateral-shear-everywhere", "lateral",
+      "upper vertebra moves further than the lower one at every pair (lateral shear)",
+      count_of(dx.count_sign("T1-T2", "L4-L5", sx), n, "pairs with Δx along the force"),
+      dx.count_sign("T1-T2", "L4-L5", sx) == n);
+  add(out, "lateral-shear-peak", "lateral", "shearing peak at T10-T11",
+      "max |Δx| (mm) at " + ax.show(ax.argmax()) + "; " + ax.show("T10-T11"),
       ax.name(ax.argmax()) == "T10-T11");
-  add(out, "lateral-shear-least", "lateral", "least shearing at L4-L5", "min |Δx| (mm) at " + ax.show(ax.argmin()) + "; " + ax.show("L4-L5"),
+  add(out, "lateral-shear-least", "lateral", "least shearing at L4-L5",
+      "min |Δx| (mm) at " + ax.show(ax.argmin()) + "; " + ax.show("L4-L5"),
       ax.name(ax.argmin()) == "L4-L5");
-  add(out, "lateral-shear-pattern", "lateral", "shearing falls T1-T2→T5-T6, rises T6-T7→T10-T11, falls to L4-L5",
-      "|Δx| (mm) " + ax.show("T1-T2") + ", " + ax.show("T5-T6") + ", " + ax.show("T6-T7") + ", " + ax.show("T10-T11") + ", " +
-          ax.show("L4-L5"),
+  add(out, "lateral-shear-pattern", "lateral",
+      "shearing falls T1-T2→T5-T6, rises T6-T7→T10-T11, falls to L4-L5",
+      "|Δx| (mm) " + ax.show("T1-T2") + ", " + ax.show("T5-T6") + ", " + ax.show("T6-T7") + ", " +
+          ax.show("T10-T11") + ", " + ax.show("L4-L5"),
       ax("T5-T6") < ax("T1-T2") && ax("T10-T11") > ax("T6-T7") && ax("L4-L5") < ax("T10-T11"));
-  add(out, "lateral-compression-everywhere", "lateral", "whole spine under compression (Δy < 0 at every pair)",
-      count_of(comp.count_sign("T1-T2", "L4-L5", 1), n, "pairs with Δy < 0"), comp.count_sign("T1-T2", "L4-L5", 1) == n);
+  add(out, "lateral-compression-everywhere", "lateral",
+      "whole spine under compression (Δy < 0 at every pair)",
+      count_of(comp.count_sign("T1-T2", "L4-L5", 1), n, "pairs with Δy < 0"),
+      comp.count_sign("T1-T2", "L4-L5", 1) == n);
   add(out, "lateral-compression-max", "lateral", "largest compression at T10-T11 and T1-T2",
-      "max −Δy (mm) at " + comp.show(comp.argmax(), 4), one_of(comp.name(comp.argmax()), {"T10-T11", "T1-T2"}));
-  add(out, "lateral-compression-min", "lateral", "smallest compression at L4-L5", "min −Δy (mm) at " + comp.show(comp.argmin(), 4),
-      comp.name(comp.argmin()) == "L4-L5");
+      "max −Δy (mm) at " + comp.show(comp.argmax(), 4),
+      one_of(comp.name(comp.argmax()), {"T10-T11", "T1-T2"}));
+  add(out, "lateral-compression-min", "lateral", "smallest compression at L4-L5",
+      "min −Δy (mm) at " + comp.show(comp.argmin(), 4), comp.name(comp.argmin()) == "L4-L5");
   const double zmax = dz.v.cwiseAbs().maxCoeff(), xmax = ax.v.maxCoeff();
-  add(out, "lateral-z-negligible", "lateral", "z relative translation very small (< 10 % of the largest |Δx|)",
-      "max |Δz| " + fixed(zmax, 4) + " mm vs max |Δx| " + fixed(xmax, 4) + " mm", zmax < 0.1 * xmax);
-
+  add(out, "lateral-z-negligible", "lateral",
+      "z relative translation very small (< 10 % of the largest |Δx|)",
+      "max |Δz| " + fixed(zmax, 4) + " mm vs max |Δx| " + fixed(xmax, 4) + " mm",
+      zmax < 0.1 * xmax);
 }
 
 /// Lateral force (−x), rotations: flexion negligible, torsion, lateral bending by region.
@@ -632,28 +726,35 @@ void lateral_rotation_findings(const TrendRun& r, std::vector<Finding>& out) {
   const PairSeries rx = column(r, true, 0), ry = column(r, true, 1), rz = column(r, true, 2);
   const PairSeries ary{r.pairs, ry.v.cwiseAbs()};
   const double rxmax = rx.v.cwiseAbs().maxCoeff(), rzmax = rz.v.cwiseAbs().maxCoeff();
-  add(out, "lateral-flexion-negligible", "lateral", "flexion/extension negligible (max |θx| < 10 % of max |θz|)",
+  add(out, "lateral-flexion-negligible", "lateral",
+      "flexion/extension negligible (max |θx| < 10 % of max |θz|)",
       "max |θx| " + fixed(rxmax, 4) + "°, max |θz| " + fixed(rzmax, 4) + "°", rxmax < 0.1 * rzmax);
-  add(out, "lateral-torsion-min", "lateral", "smallest torsion at T10-T11", "min |θy| (deg) at " + ary.show(ary.argmin(), 4),
-      ary.name(ary.argmin()) == "T10-T11");
-  add(out, "lateral-torsion-max", "lateral", "largest torsion at T5-T6 and L4-L5", "max |θy| (deg) at " + ary.show(ary.argmax(), 4),
+  add(out, "lateral-torsion-min", "lateral", "smallest torsion at T10-T11",
+      "min |θy| (deg) at " + ary.show(ary.argmin(), 4), ary.name(ary.argmin()) == "T10-T11");
+  add(out, "lateral-torsion-max", "lateral", "largest torsion at T5-T6 and L4-L5",
+      "max |θy| (deg) at " + ary.show(ary.argmax(), 4),
       one_of(ary.name(ary.argmax()), {"T5-T6", "L4-L5"}));
   {
     const double s1 = ry("T1-T2") >= 0 ? 1 : -1;
-    const int up = ry.count_sign("T1-T2", "T10-T11", s1), low = ry.count_sign("T11-T12", "L4-L5", -s1);
-    add(out, "lateral-torsion-switch", "lateral", "torsion one way T1-T2…T10-T11, the other way T11-T12…L4-L5",
-        count_of(up, ry.span("T1-T2", "T10-T11"), "upper pairs one way") + ", " + count_of(low, ry.span("T11-T12", "L4-L5"), "lower pairs the other"),
+    const int up = ry.count_sign("T1-T2", "T10-T11", s1),
+              low = ry.count_sign("T11-T12", "L4-L5", -s1);
+    add(out, "lateral-torsion-switch", "lateral",
+        "torsion one way T1-T2…T10-T11, the other way T11-T12…L4-L5",
+        count_of(up, ry.span("T1-T2", "T10-T11"), "upper pairs one way") + ", " +
+            count_of(low, ry.span("T11-T12", "L4-L5"), "lower pairs the other"),
         up == ry.span("T1-T2", "T10-T11") && low == ry.span("T11-T12", "L4-L5"));
   }
   {
     const double sl = rz("L4-L5") >= 0 ? 1 : -1;
     const int n_low = rz.count_sign("T10-T11", "L4-L5", sl);
     add(out, "lateral-bending-lower", "lateral", "T10-L5 in lateral flexion (one side)",
-        count_of(n_low, rz.span("T10-T11", "L4-L5"), "pairs T10-T11…L4-L5 bend the same way"), n_low == rz.span("T10-T11", "L4-L5"));
+        count_of(n_low, rz.span("T10-T11", "L4-L5"), "pairs T10-T11…L4-L5 bend the same way"),
+        n_low == rz.span("T10-T11", "L4-L5"));
     const double su = rz("T1-T2") >= 0 ? 1 : -1;
     const int a = rz.count_sign("T1-T2", "T5-T6", su), b = rz.count_sign("T6-T7", "T9-T10", -su);
     add(out, "lateral-bending-upper-opposite", "lateral", "T1-T6 and T6-T10 bend opposite ways",
-        count_of(a, rz.span("T1-T2", "T5-T6"), "of T1-T2…T5-T6 one way") + ", " + count_of(b, rz.span("T6-T7", "T9-T10"), "of T6-T7…T9-T10 the other"),
+        count_of(a, rz.span("T1-T2", "T5-T6"), "of T1-T2…T5-T6 one way") + ", " +
+            count_of(b, rz.span("T6-T7", "T9-T10"), "of T6-T7…T9-T10 the other"),
         a == rz.span("T1-T2", "T5-T6") && b == rz.span("T6-T7", "T9-T10"));
   }
 }
@@ -669,31 +770,39 @@ void forward_findings(const TrendRun& r, std::vector<Finding>& out) {
       count_of(c_up, dy.span("T1-T2", "T8-T9"), "pairs"), c_up == dy.span("T1-T2", "T8-T9"));
   add(out, "forward-tension-T9-L5", "forward", "T9-L5 under tension (Δy > 0, T9-T10…L4-L5)",
       count_of(t_low, dy.span("T9-T10", "L4-L5"), "pairs"), t_low == dy.span("T9-T10", "L4-L5"));
-  add(out, "forward-compression-max", "forward", "largest compression at T1-T2", "max −Δy (mm) at " + comp.show(comp.argmax(), 4),
-      comp.name(comp.argmax()) == "T1-T2");
-  add(out, "forward-tension-max", "forward", "maximum tension at T11-T12", "max Δy (mm) at " + dy.show(dy.argmax(), 4),
+  add(out, "forward-compression-max", "forward", "largest compression at T1-T2",
+      "max −Δy (mm) at " + comp.show(comp.argmax(), 4), comp.name(comp.argmax()) == "T1-T2");
+  add(out, "forward-tension-max", "forward", "maximum tension at T11-T12",
+      "max Δy (mm) at " + dy.show(dy.argmax(), 4),
       dy.name(dy.argmax()) == "T11-T12" && dy.v.maxCoeff() > 0);
-  add(out, "forward-shear-everywhere", "forward", "antero-posterior shear at every pair (Δz along the force)",
-      count_of(dz.count_sign("T1-T2", "L4-L5", sz), n, "pairs"), dz.count_sign("T1-T2", "L4-L5", sz) == n);
-  add(out, "forward-shear-max", "forward", "largest AP shear at T10-T11", "max |Δz| (mm) at " + az.show(az.argmax()),
-      az.name(az.argmax()) == "T10-T11");
-  add(out, "forward-shear-min", "forward", "smallest AP shear at L4-L5", "min |Δz| (mm) at " + az.show(az.argmin()),
-      az.name(az.argmin()) == "L4-L5");
-  add(out, "forward-shear-pattern", "forward", "AP shear rises T1-T2→T3-T4, falls T4-T5→T8-T9, rises to T10-T11, falls to L4-L5",
-      "|Δz| (mm) " + az.show("T1-T2") + ", " + az.show("T3-T4") + ", " + az.show("T4-T5") + ", " + az.show("T8-T9") + ", " +
-          az.show("T10-T11") + ", " + az.show("L4-L5"),
-      az("T3-T4") > az("T1-T2") && az("T8-T9") < az("T4-T5") && az("T10-T11") > az("T8-T9") && az("L4-L5") < az("T10-T11"));
+  add(out, "forward-shear-everywhere", "forward",
+      "antero-posterior shear at every pair (Δz along the force)",
+      count_of(dz.count_sign("T1-T2", "L4-L5", sz), n, "pairs"),
+      dz.count_sign("T1-T2", "L4-L5", sz) == n);
+  add(out, "forward-shear-max", "forward", "largest AP shear at T10-T11",
+      "max |Δz| (mm) at " + az.show(az.argmax()), az.name(az.argmax()) == "T10-T11");
+  add(out, "forward-shear-min", "forward", "smallest AP shear at L4-L5",
+      "min |Δz| (mm) at " + az.show(az.argmin()), az.name(az.argmin()) == "L4-L5");
+  add(out, "forward-shear-pattern", "forward",
+      "AP shear rises T1-T2→T3-T4, falls T4-T5→T8-T9, rises to T10-T11, falls to L4-L5",
+      "|Δz| (mm) " + az.show("T1-T2") + ", " + az.show("T3-T4") + ", " + az.show("T4-T5") + ", " +
+          az.show("T8-T9") + ", " + az.show("T10-T11") + ", " + az.show("L4-L5"),
+      az("T3-T4") > az("T1-T2") && az("T8-T9") < az("T4-T5") && az("T10-T11") > az("T8-T9") &&
+          az("L4-L5") < az("T10-T11"));
 
   const PairSeries rx = column(r, true, 0);
   const int f1 = rx.count_sign("T1-T2", "T6-T7", 1), e = rx.count_sign("T7-T8", "T10-T11", -1),
             f2 = rx.count_sign("T11-T12", "L4-L5", 1);
   add(out, "forward-flexion-regions", "forward", "flexion T1-T7 and T11-L5, extension T7-T11",
       "flexion " + count_of(f1, rx.span("T1-T2", "T6-T7"), "of T1-T2…T6-T7") + ", extension " +
-          count_of(e, rx.span("T7-T8", "T10-T11"), "of T7-T8…T10-T11") + ", flexion " + count_of(f2, rx.span("T11-T12", "L4-L5"), "of T11-T12…L4-L5"),
-      f1 == rx.span("T1-T2", "T6-T7") && e == rx.span("T7-T8", "T10-T11") && f2 == rx.span("T11-T12", "L4-L5"));
-  add(out, "forward-flexion-max", "forward", "maximum flexion at T5-T6", "max θx (deg) at " + rx.show(rx.argmax(), 4),
-      rx.name(rx.argmax()) == "T5-T6");
-  add(out, "forward-extension-max", "forward", "maximum extension at T9-T10", "min θx (deg) at " + rx.show(rx.argmin(), 4),
+          count_of(e, rx.span("T7-T8", "T10-T11"), "of T7-T8…T10-T11") + ", flexion " +
+          count_of(f2, rx.span("T11-T12", "L4-L5"), "of T11-T12…L4-L5"),
+      f1 == rx.span("T1-T2", "T6-T7") && e == rx.span("T7-T8", "T10-T11") &&
+          f2 == rx.span("T11-T12", "L4-L5"));
+  add(out, "forward-flexion-max", "forward", "maximum flexion at T5-T6",
+      "max θx (deg) at " + rx.show(rx.argmax(), 4), rx.name(rx.argmax()) == "T5-T6");
+  add(out, "forward-extension-max", "forward", "maximum extension at T9-T10",
+      "min θx (deg) at " + rx.show(rx.argmin(), 4),
       rx.name(rx.argmin()) == "T9-T10" && rx.v.minCoeff() < 0);
 }
 
@@ -703,24 +812,32 @@ void backward_findings(const TrendRun& r, std::vector<Finding>& out) {
   const PairSeries dy = column(r, false, 1), dz = column(r, false, 2);
   const PairSeries az{r.pairs, dz.v.cwiseAbs()}, comp{r.pairs, -dy.v};
   const int n = int(r.pairs.size());
-  add(out, "backward-compression-everywhere", "backward", "whole spine under compression (Δy < 0 at every pair)",
-      count_of(comp.count_sign("T1-T2", "L4-L5", 1), n, "pairs"), comp.count_sign("T1-T2", "L4-L5", 1) == n);
-  add(out, "backward-compression-max", "backward", "maximum compression at T11-T12", "max −Δy (mm) at " + comp.show(comp.argmax(), 4),
-      comp.name(comp.argmax()) == "T11-T12");
+  add(out, "backward-compression-everywhere", "backward",
+      "whole spine under compression (Δy < 0 at every pair)",
+      count_of(comp.count_sign("T1-T2", "L4-L5", 1), n, "pairs"),
+      comp.count_sign("T1-T2", "L4-L5", 1) == n);
+  add(out, "backward-compression-max", "backward", "maximum compression at T11-T12",
+      "max −Δy (mm) at " + comp.show(comp.argmax(), 4), comp.name(comp.argmax()) == "T11-T12");
   add(out, "backward-compression-min", "backward", "minimum compression at T6-T7 and L4-L5",
-      "min −Δy (mm) at " + comp.show(comp.argmin(), 4), one_of(comp.name(comp.argmin()), {"T6-T7", "L4-L5"}));
-  add(out, "backward-compression-pattern", "backward", "compression rises T8-T9→T11-T12, then falls to L4-L5",
-      "−Δy (mm) " + comp.show("T8-T9", 4) + ", " + comp.show("T11-T12", 4) + ", " + comp.show("L4-L5", 4),
+      "min −Δy (mm) at " + comp.show(comp.argmin(), 4),
+      one_of(comp.name(comp.argmin()), {"T6-T7", "L4-L5"}));
+  add(out, "backward-compression-pattern", "backward",
+      "compression rises T8-T9→T11-T12, then falls to L4-L5",
+      "−Δy (mm) " + comp.show("T8-T9", 4) + ", " + comp.show("T11-T12", 4) + ", " +
+          comp.show("L4-L5", 4),
       comp("T11-T12") > comp("T8-T9") && comp("L4-L5") < comp("T11-T12"));
   add(out, "backward-shear-everywhere", "backward", "AP shear at every pair (Δz along the force)",
-      count_of(dz.count_sign("T1-T2", "L4-L5", sz), n, "pairs"), dz.count_sign("T1-T2", "L4-L5", sz) == n);
-  add(out, "backward-shear-max", "backward", "largest AP shear at T1-T2 and T10-T11", "max |Δz| (mm) at " + az.show(az.argmax()),
+      count_of(dz.count_sign("T1-T2", "L4-L5", sz), n, "pairs"),
+      dz.count_sign("T1-T2", "L4-L5", sz) == n);
+  add(out, "backward-shear-max", "backward", "largest AP shear at T1-T2 and T10-T11",
+      "max |Δz| (mm) at " + az.show(az.argmax()),
       one_of(az.name(az.argmax()), {"T1-T2", "T10-T11"}));
-  add(out, "backward-shear-min", "backward", "smallest AP shear at L4-L5", "min |Δz| (mm) at " + az.show(az.argmin()),
-      az.name(az.argmin()) == "L4-L5");
-  add(out, "backward-shear-pattern", "backward", "AP shear falls T1-T2→T5-T6, rises T6-T7→T10-T11, falls to L4-L5",
-      "|Δz| (mm) " + az.show("T1-T2") + ", " + az.show("T5-T6") + ", " + az.show("T6-T7") + ", " + az.show("T10-T11") + ", " +
-          az.show("L4-L5"),
+  add(out, "backward-shear-min", "backward", "smallest AP shear at L4-L5",
+      "min |Δz| (mm) at " + az.show(az.argmin()), az.name(az.argmin()) == "L4-L5");
+  add(out, "backward-shear-pattern", "backward",
+      "AP shear falls T1-T2→T5-T6, rises T6-T7→T10-T11, falls to L4-L5",
+      "|Δz| (mm) " + az.show("T1-T2") + ", " + az.show("T5-T6") + ", " + az.show("T6-T7") + ", " +
+          az.show("T10-T11") + ", " + az.show("L4-L5"),
       az("T5-T6") < az("T1-T2") && az("T10-T11") > az("T6-T7") && az("L4-L5") < az("T10-T11"));
 
   const PairSeries rx = column(r, true, 0);
@@ -728,11 +845,15 @@ void backward_findings(const TrendRun& r, std::vector<Finding>& out) {
             e2 = rx.count_sign("T10-T11", "L4-L5", -1);
   add(out, "backward-extension-regions", "backward", "extension T1-T6 and T10-L5, flexion T6-T10",
       "extension " + count_of(e1, rx.span("T1-T2", "T5-T6"), "of T1-T2…T5-T6") + ", flexion " +
-          count_of(f, rx.span("T6-T7", "T9-T10"), "of T6-T7…T9-T10") + ", extension " + count_of(e2, rx.span("T10-T11", "L4-L5"), "of T10-T11…L4-L5"),
-      e1 == rx.span("T1-T2", "T5-T6") && f == rx.span("T6-T7", "T9-T10") && e2 == rx.span("T10-T11", "L4-L5"));
-  add(out, "backward-extension-max", "backward", "largest extension at T5-T6 and L1-L2", "min θx (deg) at " + rx.show(rx.argmin(), 4),
+          count_of(f, rx.span("T6-T7", "T9-T10"), "of T6-T7…T9-T10") + ", extension " +
+          count_of(e2, rx.span("T10-T11", "L4-L5"), "of T10-T11…L4-L5"),
+      e1 == rx.span("T1-T2", "T5-T6") && f == rx.span("T6-T7", "T9-T10") &&
+          e2 == rx.span("T10-T11", "L4-L5"));
+  add(out, "backward-extension-max", "backward", "largest extension at T5-T6 and L1-L2",
+      "min θx (deg) at " + rx.show(rx.argmin(), 4),
       one_of(rx.name(rx.argmin()), {"T5-T6", "L1-L2"}) && rx.v.minCoeff() < 0);
-  add(out, "backward-flexion-max", "backward", "largest flexion at T6-T7", "max θx (deg) at " + rx.show(rx.argmax(), 4),
+  add(out, "backward-flexion-max", "backward", "largest flexion at T6-T7",
+      "max θx (deg) at " + rx.show(rx.argmax(), 4),
       rx.name(rx.argmax()) == "T6-T7" && rx.v.maxCoeff() > 0);
 }
 
@@ -752,9 +873,10 @@ std::vector<Finding> trend_findings(const TrendsStudy& s) {
 
 }  // namespace
 
-TrendsStudy run_trends_study(const std::string& data_dir, double force_n, const spine::ModelOptions& model,
-                             const StageHooks& hooks) {
-  if (!std::isfinite(force_n) || force_n <= 0) throw std::invalid_argument("trends study: the force must be finite and > 0 N");
+TrendsStudy run_trends_study(const std::string& data_dir, double force_n,
+                             const spine::ModelOptions& model, const StageHooks& hooks) {
+  if (!std::isfinite(force_n) || force_n <= 0)
+    throw std::invalid_argument("trends study: the force must be finite and > 0 N");
   Timer t0;
   TrendsStudy s;
   s.force_n = force_n;
@@ -764,7 +886,8 @@ TrendsStudy run_trends_study(const std::string& data_dir, double force_n, const 
   const spine::SolveOptions options = study_solve_options();
   const int t1 = spine::vertebra_index("T1");
   const int n_pairs = int(m.vertebrae.size()) - 1;  // T1-T2 … L4-L5: joints 0 … 15
-  std::vector<std::string> pairs(spine::joint_names().begin(), spine::joint_names().begin() + n_pairs);
+  std::vector<std::string> pairs(spine::joint_names().begin(),
+                                 spine::joint_names().begin() + n_pairs);
   // Relative translation (upper minus lower centre displacement) and θ per pair, one solution.
   auto relative = [&](const SpineSolution& sol, Eigen::MatrixX3d& t, Eigen::MatrixX3d& r) {
     t.resize(n_pairs, 3);
@@ -778,7 +901,8 @@ TrendsStudy run_trends_study(const std::string& data_dir, double force_n, const 
   relative(spine::solve_spine(m, {}, options), base_t, base_r);
   for (const char* name : {"lateral", "forward", "backward"}) {
     const auto& dirs = t1_load_directions();
-    const auto d = std::find_if(dirs.begin(), dirs.end(), [&](const LoadDirection& x) { return x.name == name; });
+    const auto d = std::find_if(dirs.begin(), dirs.end(),
+                                [&](const LoadDirection& x) { return x.name == name; });
     TrendRun r;
     r.load = name;
     r.force_n = force_n * d->direction;
@@ -798,23 +922,29 @@ TrendsStudy run_trends_study(const std::string& data_dir, double force_n, const 
 
 void print_trends(std::ostream& os, const TrendsStudy& s, bool markdown) {
   for (const auto& r : s.runs) {
-    os << (markdown ? "**" : "  ") << r.load << " force (" << fixed(r.force_n.x(), 0) << ", " << fixed(r.force_n.y(), 0) << ", "
-       << fixed(r.force_n.z(), 0) << ") N on T1" << (markdown ? "**\n\n" : "\n");
-    TextTable t({"pair", "Δx (mm)", "Δy (mm)", "Δz (mm)", "θx flex+ (deg)", "θy torsion (deg)", "θz lat. bend (deg)"});
+    os << (markdown ? "**" : "  ") << r.load << " force (" << fixed(r.force_n.x(), 0) << ", "
+       << fixed(r.force_n.y(), 0) << ", " << fixed(r.force_n.z(), 0) << ") N on T1"
+       << (markdown ? "**\n\n" : "\n");
+    TextTable t({"pair", "Δx (mm)", "Δy (mm)", "Δz (mm)", "θx flex+ (deg)", "θy torsion (deg)",
+                 "θz lat. bend (deg)"});
     for (std::size_t i = 0; i < r.pairs.size(); ++i) {
       const auto k = Eigen::Index(i);
-      t.add({r.pairs[i], fixed(r.translation_mm(k, 0), 4), fixed(r.translation_mm(k, 1), 4), fixed(r.translation_mm(k, 2), 4),
-             fixed(r.rotation_deg(k, 0), 4), fixed(r.rotation_deg(k, 1), 4), fixed(r.rotation_deg(k, 2), 4)});
+      t.add({r.pairs[i], fixed(r.translation_mm(k, 0), 4), fixed(r.translation_mm(k, 1), 4),
+             fixed(r.translation_mm(k, 2), 4), fixed(r.rotation_deg(k, 0), 4),
+             fixed(r.rotation_deg(k, 1), 4), fixed(r.rotation_deg(k, 2), 4)});
     }
     t.print(os, markdown);
     os << "\n";
   }
-  os << "  Δ = upper minus lower vertebra centre (world axes), θ = joint rotation (lower vertebra's axes), each minus its\n"
-     << "  gravity-only value. Thesis reading: Δy < 0 compression, Δy > 0 tension, |Δx|, |Δz| shearing.\n\n";
+  os << "  Δ = upper minus lower vertebra centre (world axes), θ = joint rotation (lower "
+        "vertebra's axes), each minus its\n"
+     << "  gravity-only value. Thesis reading: Δy < 0 compression, Δy > 0 tension, |Δx|, |Δz| "
+        "shearing.\n\n";
   print_findings(os, s.findings, markdown);
   int matches = 0;
   for (const auto& f : s.findings) matches += f.match;
-  os << (markdown ? "\n" : "") << "  " << matches << " of " << s.findings.size() << " thesis statements match.\n";
+  os << (markdown ? "\n" : "") << "  " << matches << " of " << s.findings.size()
+     << " thesis statements match.\n";
 }
 
 nlohmann::json trends_json(const TrendsStudy& s) {
@@ -827,7 +957,10 @@ nlohmann::json trends_json(const TrendsStudy& s) {
                        {"translation_mm", to_json(r.translation_mm.row(k).transpose())},
                        {"rotation_deg", to_json(r.rotation_deg.row(k).transpose())}});
     }
-    runs.push_back({{"load", r.load}, {"force_n", to_json(r.force_n)}, {"pairs", pairs}, {"newton_iterations", r.iterations}});
+    runs.push_back({{"load", r.load},
+                    {"force_n", to_json(r.force_n)},
+                    {"pairs", pairs},
+                    {"newton_iterations", r.iterations}});
   }
   int matches = 0;
   for (const auto& f : s.findings) matches += f.match;
@@ -835,9 +968,12 @@ nlohmann::json trends_json(const TrendsStudy& s) {
           {"thesis", "6.3 (relative translations), 6.4 (relative rotations)"},
           {"trunk_muscles", s.trunk_muscles},
           {"force_n", s.force_n},
-          {"units", {{"translation_mm", "upper minus lower F.1 centre, world axes, minus the gravity-only value, mm"},
-                     {"rotation_deg", "joint rotation vector (lower vertebra's axes: x flexion +, y torsion, z lateral "
-                                      "bending) minus the gravity-only value, deg"}}},
+          {"units",
+           {{"translation_mm",
+             "upper minus lower F.1 centre, world axes, minus the gravity-only value, mm"},
+            {"rotation_deg",
+             "joint rotation vector (lower vertebra's axes: x flexion +, y torsion, z lateral "
+             "bending) minus the gravity-only value, deg"}}},
           {"runs", runs},
           {"findings", findings_json(s.findings)},
           {"matches", matches},
@@ -847,7 +983,8 @@ nlohmann::json trends_json(const TrendsStudy& s) {
 
 std::string trends_csv(const TrendsStudy& s) {
   std::ostringstream os;
-  os << std::setprecision(10) << "load,pair,dx_mm,dy_mm,dz_mm,theta_x_deg,theta_y_deg,theta_z_deg\n";
+  os << std::setprecision(10)
+     << "load,pair,dx_mm,dy_mm,dz_mm,theta_x_deg,theta_y_deg,theta_z_deg\n";
   for (const auto& r : s.runs)
     for (std::size_t i = 0; i < r.pairs.size(); ++i) {
       const auto k = Eigen::Index(i);

@@ -3,14 +3,15 @@
 #pragma once
 
 #include "spinesim/calibration/objective.hpp"
-#include "spinesim/mss/boundary.hpp"
 #include "spinesim/mesh/box_mesh.hpp"
+#include "spinesim/mss/boundary.hpp"
 
 namespace spinesim::calibration::fixtures {
 
 /// Box 20 x 8 x 16 mm (y up), 5 x 3 x 4 cells, centred on x = z = 0, the central cells nucleus.
 inline mesh::TetMesh two_region_disc() {
-  mesh::TetMesh m = spinesim::mesh::box_mesh(5, 3, 4, 20.0, 8.0, 16.0, Eigen::Vector3d(-10.0, 0.0, -8.0));
+  mesh::TetMesh m =
+      spinesim::mesh::box_mesh(5, 3, 4, 20.0, 8.0, 16.0, Eigen::Vector3d(-10.0, 0.0, -8.0));
   for (Eigen::Index t = 0; t < m.num_tets(); ++t) {
     Eigen::Vector3d c = Eigen::Vector3d::Zero();
     for (int k = 0; k < 4; ++k) c += 0.25 * m.V.row(m.T(t, k)).transpose();
@@ -36,8 +37,9 @@ inline mss::MssOptions all_terms() {
 
 /// A reference computed by the linearised MSS itself at scales `s` (and per-spring multipliers
 /// `mu` when given): a calibration with the same freedom must find a zero objective.
-inline FemReference synthetic_reference(LinearMss& lin, const mesh::TetMesh& m, const Eigen::VectorXd& s,
-                                        const Eigen::Vector3d& center, const Eigen::VectorXd& mu = Eigen::VectorXd()) {
+inline FemReference synthetic_reference(LinearMss& lin, const mesh::TetMesh& m,
+                                        const Eigen::VectorXd& s, const Eigen::Vector3d& center,
+                                        const Eigen::VectorXd& mu = Eigen::VectorXd()) {
   const LinearState st = mu.size() ? lin.solve(s, mu) : lin.solve(s);
   FemReference ref;
   ref.plate_center_mm = center;

@@ -15,7 +15,8 @@ namespace {
 /// Tuned linear compression error on the structured L4-L5 disc (360 tets) for a homogeneous
 /// material of Poisson ratio nu, with or without the per-tet volume term.
 double tuned_compression_error(double nu, bool volume_term) {
-  static const mesh::TetMesh m = mesh::mesh_structured_disc(mesh::disc_dimensions("L4-L5", SPINESIM_DATA_DIR));
+  static const mesh::TetMesh m =
+      mesh::mesh_structured_disc(mesh::disc_dimensions("L4-L5", SPINESIM_DATA_DIR));
   mesh::RegionMaterials mat;
   mat.name = "homogeneous";
   mat.fallback = {3.22, nu, 1038.0};
@@ -27,7 +28,8 @@ double tuned_compression_error(double nu, bool volume_term) {
   LinearMss lin(model, available_knobs(o), c);
   Objective obj(lin, make_reference(fem, m, fem::standard_load_cases()),
                 {"compression", "shear-ap", "flexion", "torsion"});
-  const CalibrationResult r = calibrate(obj, Eigen::VectorXd::Zero(Eigen::Index(lin.knobs().size())));
+  const CalibrationResult r =
+      calibrate(obj, Eigen::VectorXd::Zero(Eigen::Index(lin.knobs().size())));
   EXPECT_TRUE(r.success) << r.status;
   for (const CaseError& e : r.final.cases)
     if (e.name == "compression") return e.displacement_error;
@@ -36,14 +38,20 @@ double tuned_compression_error(double nu, bool volume_term) {
 }
 
 TEST(CauchyGap, TheVolumeTermBuysMoreTheMoreIncompressibleTheDisc) {
-  const double thesis_25 = tuned_compression_error(0.25, false), volume_25 = tuned_compression_error(0.25, true);
-  const double thesis_45 = tuned_compression_error(0.45, false), volume_45 = tuned_compression_error(0.45, true);
-  std::printf("compression error, tuned: nu 0.25 springs %.1f %% -> +volume %.1f %%; nu 0.45 springs %.1f %% -> "
-              "+volume %.1f %%\n", 100 * thesis_25, 100 * volume_25, 100 * thesis_45, 100 * volume_45);
-  EXPECT_LT(volume_25, thesis_25);  // more knobs never fit worse
+  const double thesis_25 = tuned_compression_error(0.25, false),
+               volume_25 = tuned_compression_error(0.25, true);
+  const double thesis_45 = tuned_compression_error(0.45, false),
+               volume_45 = tuned_compression_error(0.45, true);
+  std::printf(
+      "compression error, tuned: nu 0.25 springs %.1f %% -> +volume %.1f %%; nu 0.45 springs %.1f "
+      "%% -> "
+      "+volume %.1f %%\n",
+      100 * thesis_25, 100 * volume_25, 100 * thesis_45, 100 * volume_45);
+  EXPECT_LT(volume_25, thesis_25);        // more knobs never fit worse
   EXPECT_LT(volume_45, 0.5 * thesis_45);  // at nu = 0.45 the volume term at least halves the error
   EXPECT_GT(thesis_45, 1.5 * thesis_25);  // the springs alone fail as nu leaves 1/4 ...
-  EXPECT_GT(thesis_45 - volume_45, 2.0 * (thesis_25 - volume_25));  // ... and the volume term is what helps
+  EXPECT_GT(thesis_45 - volume_45,
+            2.0 * (thesis_25 - volume_25));  // ... and the volume term is what helps
 }
 
 }  // namespace

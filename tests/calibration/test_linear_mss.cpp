@@ -5,8 +5,8 @@
 
 #include "calibration_fixtures.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
+#include <Eigen/Eigenvalues>
 
 namespace spinesim::calibration {
 namespace {
@@ -24,7 +24,8 @@ Eigen::VectorXd some_scales(Eigen::Index n) {
 TEST(LinearMss, KnobNamesRoundTrip) {
   for (const Knob& k : available_knobs(all_terms())) EXPECT_EQ(knob_from_name(knob_name(k)), k);
   EXPECT_EQ(available_knobs(all_terms()).size(), 9u);
-  EXPECT_EQ(available_knobs(mss::MssOptions()).size(), 6u);  // thesis springs: main, radial, torsion
+  EXPECT_EQ(available_knobs(mss::MssOptions()).size(),
+            6u);  // thesis springs: main, radial, torsion
   EXPECT_THROW(knob_from_name("torsion.cortex"), std::invalid_argument);
 }
 
@@ -90,7 +91,8 @@ TEST(LinearMss, PlateStiffnessDerivativeMatchesFiniteDifferences) {
     Eigen::VectorXd sp = s, sm = s;
     sp(j) += h, sm(j) -= h;
     const Matrix6d fd = (lin.solve(sp).k6 - lin.solve(sm).k6) / (2 * h);
-    EXPECT_LT((fd - grams[std::size_t(j)]).norm(), 1e-6 * st.k6.norm() / s(j)) << knob_name(lin.knobs()[std::size_t(j)]);
+    EXPECT_LT((fd - grams[std::size_t(j)]).norm(), 1e-6 * st.k6.norm() / s(j))
+        << knob_name(lin.knobs()[std::size_t(j)]);
   }
 }
 
@@ -107,7 +109,8 @@ TEST(LinearMss, BadInputIsRefused) {
   EXPECT_THROW(lin.solve(bad), std::invalid_argument);
   mesh::TetMesh no_plate = m;
   no_plate.surface.setZero();
-  EXPECT_THROW(LinearMss(mss::MssModel(no_plate, two_materials()), {{mss::Term::main, 0}}, c), std::invalid_argument);
+  EXPECT_THROW(LinearMss(mss::MssModel(no_plate, two_materials()), {{mss::Term::main, 0}}, c),
+               std::invalid_argument);
 }
 
 }  // namespace

@@ -33,7 +33,8 @@ const std::vector<std::string> kTrain = {"compression", "shear-ap", "flexion", "
 
 TEST(Objective, AdjointGradientMatchesFiniteDifferences) {
   Problem p;
-  Objective obj(p.lin, fixtures::synthetic_reference(p.lin, p.mesh, true_scales(), p.center), kTrain);
+  Objective obj(p.lin, fixtures::synthetic_reference(p.lin, p.mesh, true_scales(), p.center),
+                kTrain);
   Eigen::VectorXd x(9);
   x << 0.1, -0.2, 0.3, 0.05, -0.4, 0.25, -0.1, 0.2, 0.15;
   const Evaluation ev = obj.evaluate(x, true);
@@ -67,7 +68,8 @@ TEST(Objective, EveryPartOfTheGradientIsExact) {
       Eigen::VectorXd xp = x, xm = x;
       xp(j) += 1e-5, xm(j) -= 1e-5;
       const double fd = (obj.evaluate(xp, false).value - obj.evaluate(xm, false).value) / 2e-5;
-      EXPECT_NEAR(ev.gradient(j), fd, 1e-6 * ev.gradient.cwiseAbs().maxCoeff() + 1e-12) << "part " << part;
+      EXPECT_NEAR(ev.gradient(j), fd, 1e-6 * ev.gradient.cwiseAbs().maxCoeff() + 1e-12)
+          << "part " << part;
     }
   }
 }
@@ -76,7 +78,8 @@ TEST(Objective, ZeroAtTheTrueScalesAndPositiveElsewhere) {
   Problem p;
   Weights w;
   w.regularisation = 0.0;
-  Objective obj(p.lin, fixtures::synthetic_reference(p.lin, p.mesh, true_scales(), p.center), kTrain, w);
+  Objective obj(p.lin, fixtures::synthetic_reference(p.lin, p.mesh, true_scales(), p.center),
+                kTrain, w);
   const Evaluation at_truth = obj.evaluate(true_scales().array().log(), true);
   EXPECT_LT(at_truth.value, 1e-20);
   EXPECT_LT(at_truth.gradient.norm(), 1e-9);
@@ -89,7 +92,8 @@ TEST(Objective, ZeroAtTheTrueScalesAndPositiveElsewhere) {
 // central differences of the adjoint gradient there.
 TEST(Objective, GaussNewtonIsTheHessianAtZeroResidual) {
   Problem p;
-  Objective obj(p.lin, fixtures::synthetic_reference(p.lin, p.mesh, true_scales(), p.center), kTrain);
+  Objective obj(p.lin, fixtures::synthetic_reference(p.lin, p.mesh, true_scales(), p.center),
+                kTrain);
   const Eigen::VectorXd x = true_scales().array().log();
   const Evaluation ev = obj.evaluate(x, true, true);
   ASSERT_EQ(ev.gauss_newton.rows(), 9);
@@ -97,8 +101,10 @@ TEST(Objective, GaussNewtonIsTheHessianAtZeroResidual) {
   for (Eigen::Index j = 0; j < x.size(); ++j) {
     Eigen::VectorXd xp = x, xm = x;
     xp(j) += 1e-5, xm(j) -= 1e-5;
-    const Eigen::VectorXd fd = (obj.evaluate(xp, true).gradient - obj.evaluate(xm, true).gradient) / 2e-5;
-    EXPECT_LT((fd - ev.gauss_newton.col(j)).norm(), 1e-6 * ev.gauss_newton.norm()) << knob_name(p.lin.knobs()[std::size_t(j)]);
+    const Eigen::VectorXd fd =
+        (obj.evaluate(xp, true).gradient - obj.evaluate(xm, true).gradient) / 2e-5;
+    EXPECT_LT((fd - ev.gauss_newton.col(j)).norm(), 1e-6 * ev.gauss_newton.norm())
+        << knob_name(p.lin.knobs()[std::size_t(j)]);
   }
 }
 
@@ -107,25 +113,29 @@ TEST(Calibrate, IpoptRecoversTheScalesOfASyntheticReference) {
   Problem p;
   Weights w;
   w.regularisation = 0.0;
-  Objective obj(p.lin, fixtures::synthetic_reference(p.lin, p.mesh, true_scales(), p.center), kTrain, w);
+  Objective obj(p.lin, fixtures::synthetic_reference(p.lin, p.mesh, true_scales(), p.center),
+                kTrain, w);
   int calls = 0;
-  const CalibrationResult r =
-      calibrate(obj, Eigen::VectorXd::Zero(9), IpoptSettings(), [&](int, double, double) { ++calls; });
+  const CalibrationResult r = calibrate(obj, Eigen::VectorXd::Zero(9), IpoptSettings(),
+                                        [&](int, double, double) { ++calls; });
   EXPECT_TRUE(r.success) << r.status;
-  std::printf("Ipopt: %s after %d iterations, %d evaluations, J %.3g -> %.3g\n", r.status.c_str(), r.iterations,
-              r.evaluations, r.start.value, r.final.value);
+  std::printf("Ipopt: %s after %d iterations, %d evaluations, J %.3g -> %.3g\n", r.status.c_str(),
+              r.iterations, r.evaluations, r.start.value, r.final.value);
   EXPECT_GT(calls, 1);
   EXPECT_GT(r.start.value, 1e-2);
   EXPECT_LT(r.final.value, 1e-12);
-  for (const CaseError& c : r.final.cases) EXPECT_LT(c.displacement_error, 1e-5) << c.name;  // held-out ones too
+  for (const CaseError& c : r.final.cases)
+    EXPECT_LT(c.displacement_error, 1e-5) << c.name;  // held-out ones too
   const Eigen::VectorXd s = r.log_scales.array().exp();
   for (Eigen::Index j = 0; j < s.size(); ++j)
-    EXPECT_NEAR(s(j), true_scales()(j), 1e-3 * true_scales()(j)) << knob_name(p.lin.knobs()[std::size_t(j)]);
+    EXPECT_NEAR(s(j), true_scales()(j), 1e-3 * true_scales()(j))
+        << knob_name(p.lin.knobs()[std::size_t(j)]);
 }
 
 TEST(Calibrate, FailuresAreReportedNotHidden) {
   Problem p;
-  Objective obj(p.lin, fixtures::synthetic_reference(p.lin, p.mesh, true_scales(), p.center), kTrain);
+  Objective obj(p.lin, fixtures::synthetic_reference(p.lin, p.mesh, true_scales(), p.center),
+                kTrain);
   IpoptSettings bad;
   bad.lower_scale = 2.0, bad.upper_scale = 0.5;
   try {

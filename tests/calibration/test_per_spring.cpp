@@ -68,7 +68,8 @@ TEST(PerSpringLinearModel, MultipliersMatchTheMssModelBuiltWithThem) {
   const LinearState plain = p.lin.solve(s);
   EXPECT_LT((back.k6 - plain.k6).norm(), 1e-10 * plain.k6.norm());
   // All ones is the region model itself.
-  EXPECT_LT((p.lin.solve(s, Eigen::VectorXd::Ones(p.num_edges())).k6 - plain.k6).norm(), 1e-12 * plain.k6.norm());
+  EXPECT_LT((p.lin.solve(s, Eigen::VectorXd::Ones(p.num_edges())).k6 - plain.k6).norm(),
+            1e-12 * plain.k6.norm());
 }
 
 TEST(PerSpringLinearModel, EdgeStiffnessAndExtensionsAreTheSprings) {
@@ -78,7 +79,8 @@ TEST(PerSpringLinearModel, EdgeStiffnessAndExtensionsAreTheSprings) {
   const std::vector<mss::EdgeSpringInfo> edges = p.model.edge_springs();
   ASSERT_EQ(k.size(), Eigen::Index(edges.size()));
   for (std::size_t e = 0; e < edges.size(); ++e)
-    EXPECT_NEAR(k(Eigen::Index(e)), s(0) * edges[e].k_part[0] + s(1) * edges[e].k_part[1], 1e-12 * k(Eigen::Index(e)));
+    EXPECT_NEAR(k(Eigen::Index(e)), s(0) * edges[e].k_part[0] + s(1) * edges[e].k_part[1],
+                1e-12 * k(Eigen::Index(e)));
   // Extensions of a response: n·(u_j - u_i) with u = R z.
   const LinearState st = p.lin.solve(s);
   const Eigen::VectorXd z = st.Z.col(1);
@@ -86,8 +88,10 @@ TEST(PerSpringLinearModel, EdgeStiffnessAndExtensionsAreTheSprings) {
   const Eigen::MatrixXd ext = p.lin.edge_extensions(z);
   const Eigen::VectorXd& X = p.model.rest_positions_mm();
   for (std::size_t e = 0; e < edges.size(); e += 11) {
-    const Eigen::Vector3d n = (X.segment<3>(3 * edges[e].j) - X.segment<3>(3 * edges[e].i)).normalized();
-    EXPECT_NEAR(ext(Eigen::Index(e), 0), n.dot(u.segment<3>(3 * edges[e].j) - u.segment<3>(3 * edges[e].i)),
+    const Eigen::Vector3d n =
+        (X.segment<3>(3 * edges[e].j) - X.segment<3>(3 * edges[e].i)).normalized();
+    EXPECT_NEAR(ext(Eigen::Index(e), 0),
+                n.dot(u.segment<3>(3 * edges[e].j) - u.segment<3>(3 * edges[e].i)),
                 1e-12 * u.cwiseAbs().maxCoeff());
   }
   EXPECT_THROW(p.lin.solve(s, Eigen::VectorXd::Ones(p.num_edges() - 1)), std::invalid_argument);
@@ -105,17 +109,20 @@ TEST(PerSpring, NeighbourPairsAreTheEdgesSharingATetrahedron) {
     std::vector<int> tet_edges;
     for (int a = 0; a < 4; ++a)
       for (int b = a + 1; b < 4; ++b)
-        tet_edges.push_back(index.at({std::min(p.mesh.T(t, a), p.mesh.T(t, b)), std::max(p.mesh.T(t, a), p.mesh.T(t, b))}));
+        tet_edges.push_back(index.at(
+            {std::min(p.mesh.T(t, a), p.mesh.T(t, b)), std::max(p.mesh.T(t, a), p.mesh.T(t, b))}));
     for (int a = 0; a < 6; ++a)
       for (int b = a + 1; b < 6; ++b)
-        expected.insert({std::min(tet_edges[a], tet_edges[b]), std::max(tet_edges[a], tet_edges[b])});
+        expected.insert(
+            {std::min(tet_edges[a], tet_edges[b]), std::max(tet_edges[a], tet_edges[b])});
   }
   const std::vector<std::pair<int, int>> sorted(expected.begin(), expected.end());
   EXPECT_EQ(sorted, pairs);  // sorted, unique, e < f
 }
 
 /// Central differences of J along a sample of edges against the adjoint gradient.
-void expect_gradient_matches(PerSpringObjective& obj, const Eigen::VectorXd& q, const std::string& what) {
+void expect_gradient_matches(PerSpringObjective& obj, const Eigen::VectorXd& q,
+                             const std::string& what) {
   const PerSpringEvaluation ev = obj.evaluate(q, true);
   ASSERT_EQ(ev.gradient.size(), q.size());
   const double scale = ev.gradient.cwiseAbs().maxCoeff();
@@ -132,7 +139,8 @@ void expect_gradient_matches(PerSpringObjective& obj, const Eigen::VectorXd& q, 
 TEST(PerSpring, GradientMatchesFiniteDifferences) {
   Problem p;
   const FemReference ref = fixtures::synthetic_reference(p.lin, p.mesh, true_scales(), p.center);
-  const Eigen::VectorXd region_p = 0.8 * true_scales().array().log();  // off the truth: every residual non-zero
+  const Eigen::VectorXd region_p =
+      0.8 * true_scales().array().log();  // off the truth: every residual non-zero
   const Eigen::VectorXd q = random_log_multipliers(p.num_edges(), 0.4, 2);
   {
     Objective region(p.lin, ref, kTrain);
@@ -168,7 +176,8 @@ TEST(PerSpring, GradientMatchesFiniteDifferences) {
           const PerSpringEvaluation v = obj.evaluate(x, false);
           return part == 3 ? v.smoothness : v.prior;
         };
-        EXPECT_NEAR(reg(e), (part_value(qp) - part_value(qm)) / (2 * h), 1e-8 * reg.cwiseAbs().maxCoeff() + 1e-12)
+        EXPECT_NEAR(reg(e), (part_value(qp) - part_value(qm)) / (2 * h),
+                    1e-8 * reg.cwiseAbs().maxCoeff() + 1e-12)
             << names[part] << ", edge " << e;
       }
     } else {
@@ -179,31 +188,39 @@ TEST(PerSpring, GradientMatchesFiniteDifferences) {
 
 TEST(PerSpring, StartIsTheRegionFit) {
   Problem p;
-  Objective region(p.lin, fixtures::synthetic_reference(p.lin, p.mesh, true_scales(), p.center), kTrain);
+  Objective region(p.lin, fixtures::synthetic_reference(p.lin, p.mesh, true_scales(), p.center),
+                   kTrain);
   const Eigen::VectorXd region_p = 0.7 * true_scales().array().log();
   const Evaluation at_region = region.evaluate(region_p, false);
   PerSpringObjective obj(region, p.model, region_p);
   const PerSpringEvaluation start = obj.evaluate(Eigen::VectorXd::Zero(p.num_edges()), false);
-  EXPECT_NEAR(start.value, at_region.value - region.weights().regularisation * at_region.regularisation,
+  EXPECT_NEAR(start.value,
+              at_region.value - region.weights().regularisation * at_region.regularisation,
               1e-12 * start.value);
   EXPECT_EQ(start.smoothness, 0.0);
   EXPECT_EQ(start.prior, 0.0);
   ASSERT_EQ(start.data.cases.size(), at_region.cases.size());
   for (std::size_t c = 0; c < start.data.cases.size(); ++c)
-    EXPECT_NEAR(start.data.cases[c].displacement_error, at_region.cases[c].displacement_error, 1e-12);
+    EXPECT_NEAR(start.data.cases[c].displacement_error, at_region.cases[c].displacement_error,
+                1e-12);
 }
 
 TEST(PerSpring, RefusesBadInput) {
   Problem p;
-  Objective region(p.lin, fixtures::synthetic_reference(p.lin, p.mesh, true_scales(), p.center), kTrain);
+  Objective region(p.lin, fixtures::synthetic_reference(p.lin, p.mesh, true_scales(), p.center),
+                   kTrain);
   const Eigen::VectorXd region_p = Eigen::VectorXd::Zero(9);
-  EXPECT_THROW(PerSpringObjective(region, p.model, region_p, PerSpringWeights{-1.0, 0.0}), std::invalid_argument);
-  EXPECT_THROW(PerSpringObjective(region, p.model, Eigen::VectorXd::Zero(8)), std::invalid_argument);
-  const mss::MssModel other(spinesim::mesh::box_mesh(4, 3, 4, 20.0, 8.0, 16.0, Eigen::Vector3d(-10.0, 0.0, -8.0)),
-                            two_materials(), all_terms());
+  EXPECT_THROW(PerSpringObjective(region, p.model, region_p, PerSpringWeights{-1.0, 0.0}),
+               std::invalid_argument);
+  EXPECT_THROW(PerSpringObjective(region, p.model, Eigen::VectorXd::Zero(8)),
+               std::invalid_argument);
+  const mss::MssModel other(
+      spinesim::mesh::box_mesh(4, 3, 4, 20.0, 8.0, 16.0, Eigen::Vector3d(-10.0, 0.0, -8.0)),
+      two_materials(), all_terms());
   EXPECT_THROW(PerSpringObjective(region, other, region_p), std::invalid_argument);
   PerSpringObjective obj(region, p.model, region_p);
-  EXPECT_THROW(obj.evaluate(Eigen::VectorXd::Zero(p.num_edges() + 1), false), std::invalid_argument);
+  EXPECT_THROW(obj.evaluate(Eigen::VectorXd::Zero(p.num_edges() + 1), false),
+               std::invalid_argument);
   IpoptSettings above_one = per_spring_ipopt_defaults();
   above_one.lower_scale = 1.5;
   EXPECT_THROW(calibrate_per_spring(obj, above_one), std::invalid_argument);
@@ -219,7 +236,8 @@ TEST(PerSpring, FitsKnownMultipliersBetterThanRegionScales) {
   Objective region(p.lin, ref, kTrain);
   const CalibrationResult fit = calibrate(region, Eigen::VectorXd::Zero(9));
   ASSERT_TRUE(fit.success) << fit.status;
-  const double region_data = fit.final.value - region.weights().regularisation * fit.final.regularisation;
+  const double region_data =
+      fit.final.value - region.weights().regularisation * fit.final.regularisation;
   ASSERT_GT(region_data, 1e-4) << "the region scales should not reach a per-spring reference";
 
   PerSpringObjective obj(region, p.model, fit.log_scales, PerSpringWeights{1e-3, 1e-6});
@@ -228,7 +246,8 @@ TEST(PerSpring, FitsKnownMultipliersBetterThanRegionScales) {
   EXPECT_FALSE(r.kept_start);
   EXPECT_NEAR(r.start.data.value, region_data, 1e-10 * region_data);
   EXPECT_LT(r.final.value, r.start.value);
-  EXPECT_LT(r.final.data.value, 0.2 * region_data) << "per-spring " << r.final.data.value << ", region " << region_data;
+  EXPECT_LT(r.final.data.value, 0.2 * region_data)
+      << "per-spring " << r.final.data.value << ", region " << region_data;
   // Trained and held-out cases both improve: the multipliers are the reference's, not noise.
   for (std::size_t c = 0; c < r.final.data.cases.size(); ++c)
     EXPECT_LT(r.final.data.cases[c].displacement_error, r.start.data.cases[c].displacement_error)
@@ -241,8 +260,9 @@ TEST(PerSpring, FitsKnownMultipliersBetterThanRegionScales) {
 
 TEST(PerSpring, NeverEndsAboveTheRegionFit) {
   Problem p;
-  const FemReference ref = fixtures::synthetic_reference(p.lin, p.mesh, true_scales(), p.center,
-                                                         random_log_multipliers(p.num_edges(), 0.5, 4).array().exp());
+  const FemReference ref =
+      fixtures::synthetic_reference(p.lin, p.mesh, true_scales(), p.center,
+                                    random_log_multipliers(p.num_edges(), 0.5, 4).array().exp());
   Objective region(p.lin, ref, kTrain);
   const CalibrationResult fit = calibrate(region, Eigen::VectorXd::Zero(9));
   ASSERT_TRUE(fit.success) << fit.status;

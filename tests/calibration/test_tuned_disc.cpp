@@ -69,7 +69,8 @@ void expect_same(const TunedDisc& a, const TunedDisc& b) {
 }
 
 std::string temp_path(const std::string& name) {
-  const auto dir = std::filesystem::path(SPINESIM_TEST_TMP) / ("tuned-disc-" + std::to_string(::getpid()));
+  const auto dir =
+      std::filesystem::path(SPINESIM_TEST_TMP) / ("tuned-disc-" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   return (dir / name).string();
 }
@@ -159,7 +160,8 @@ TEST(DiscLevel, ReadFromTheBuildersProvenance) {
   EXPECT_EQ(level_of("parametric disc L4-L5"), "L4-L5");
   EXPECT_EQ(level_of("parametric disc L5-S1"), "L5-S1");
   EXPECT_EQ(level_of("structured disc T12-L1 (12 sectors, 3 rings, 2 layers)"), "T12-L1");
-  EXPECT_EQ(level_of("structured disc T7-T8 (12 sectors, 3 rings, 2 layers, area-matched)"), "T7-T8");
+  EXPECT_EQ(level_of("structured disc T7-T8 (12 sectors, 3 rings, 2 layers, area-matched)"),
+            "T7-T8");
   EXPECT_EQ(level_of("disc between vertebrae"), "");
   EXPECT_EQ(level_of(""), "");
   // A foreign VTU's source is its path: a folder name is not a checked level.
@@ -203,10 +205,12 @@ TEST(TunedDiscRefuses, UnknownKnob) {
 }
 
 TEST(TunedDiscRefuses, ScaleNotPositiveAndFinite) {
-  for (const double bad : {0.0, -0.5, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()})
+  for (const double bad : {0.0, -0.5, std::numeric_limits<double>::quiet_NaN(),
+                           std::numeric_limits<double>::infinity()})
     expect_refused([bad](json& j) { j["scales"]["radial.nucleus"] = bad; }, "radial.nucleus");
   expect_refused([](json& j) { j["scales"]["radial.nucleus"] = "2"; }, "malformed");
-  expect_refused([](json& j) { j["scales"]["radial.nucleus"] = nullptr; }, "malformed");  // a NaN written to text
+  expect_refused([](json& j) { j["scales"]["radial.nucleus"] = nullptr; },
+                 "malformed");  // a NaN written to text
   expect_refused([](json& j) { j["scales"] = json::object(); }, "no scales");
 }
 
@@ -278,13 +282,15 @@ TEST(TunedDiscRefuses, UnreadableOrCorruptFileNamesIt) {
 // --- does a file apply to this mesh and material? -------------------------------------------------
 
 /// check_applies throws std::invalid_argument mentioning every one of `needles`.
-void expect_not_applicable(const TunedDisc& t, const mesh::TetMesh& m, const mesh::RegionMaterials& mat,
+void expect_not_applicable(const TunedDisc& t, const mesh::TetMesh& m,
+                           const mesh::RegionMaterials& mat,
                            std::initializer_list<std::string> needles) {
   try {
     check_applies(t, m, mat);
     ADD_FAILURE() << "applied";
   } catch (const std::invalid_argument& e) {
-    for (const auto& n : needles) EXPECT_NE(std::string(e.what()).find(n), std::string::npos) << e.what();
+    for (const auto& n : needles)
+      EXPECT_NE(std::string(e.what()).find(n), std::string::npos) << e.what();
   }
 }
 
@@ -319,7 +325,8 @@ TEST(CheckApplies, RefusesAnotherLevel) {
 
 TEST(CheckApplies, SameLevelOnAnotherMeshTransfers) {
   const TunedDisc t = sample_tuned(l4l5_mesh());
-  mesh::TetMesh finer = spinesim::mesh::box_mesh(7, 4, 5, 20.0, 8.0, 16.0, Eigen::Vector3d(-10.0, 0.0, -8.0));
+  mesh::TetMesh finer =
+      spinesim::mesh::box_mesh(7, 4, 5, 20.0, 8.0, 16.0, Eigen::Vector3d(-10.0, 0.0, -8.0));
   finer.source = "structured disc L4-L5 (12 sectors, 3 rings, 2 layers)";
   ASSERT_FALSE(fingerprint(finer) == t.mesh);
   EXPECT_EQ(check_applies(t, finer, two_materials()), "");
@@ -328,7 +335,8 @@ TEST(CheckApplies, SameLevelOnAnotherMeshTransfers) {
 
 TEST(CheckApplies, NotesWhatItCouldNotCheck) {
   const TunedDisc t = sample_tuned(l4l5_mesh());
-  mesh::TetMesh unknown = spinesim::mesh::box_mesh(6, 3, 4, 20.0, 8.0, 16.0, Eigen::Vector3d(-10.0, 0.0, -8.0));
+  mesh::TetMesh unknown =
+      spinesim::mesh::box_mesh(6, 3, 4, 20.0, 8.0, 16.0, Eigen::Vector3d(-10.0, 0.0, -8.0));
   unknown.source = "disc between vertebrae";
   const std::string note = check_applies(t, unknown, two_materials());
   EXPECT_NE(note.find("unknown"), std::string::npos) << note;
@@ -356,7 +364,8 @@ TEST(TunedDisc, MssOptionsPutEachScaleInItsSlot) {
   const TunedDisc t = sample_tuned(l4l5_mesh());
   const mss::MssOptions o = t.mss_options();
   for (const Knob& k : available_knobs(t.options))
-    EXPECT_EQ(o.scales[std::size_t(k.term)].by_region[std::size_t(k.region)], t.scales.at(knob_name(k)))
+    EXPECT_EQ(o.scales[std::size_t(k.term)].by_region[std::size_t(k.region)],
+              t.scales.at(knob_name(k)))
         << knob_name(k);
   EXPECT_EQ(o.scales[std::size_t(mss::Term::disc_volume)].by_region[1], 1.0);  // no such knob
   // Every slot holds a different value: no two knobs share one.
@@ -372,13 +381,15 @@ TEST(TunedDisc, MssOptionsPutEachScaleInItsSlot) {
 
 TEST(TunedDisc, MssOptionsLeaveUnlistedKnobsAtOne) {
   TunedDisc t = sample_tuned(l4l5_mesh());
-  t.options.scales[int(mss::Term::main)].by_region = {7.0, 7.0};  // stale values in `options` do not leak
+  t.options.scales[int(mss::Term::main)].by_region = {
+      7.0, 7.0};  // stale values in `options` do not leak
   t.scales = {{"torsion.nucleus", 0.25}};
   const mss::MssOptions o = t.mss_options();
   for (int term = 0; term < mss::kNumTerms; ++term)
     for (int r = 0; r < 2; ++r) {
       const bool listed = term == int(mss::Term::torsion) && r == 1;
-      EXPECT_EQ(o.scales[std::size_t(term)].by_region[std::size_t(r)], listed ? 0.25 : 1.0) << term << "," << r;
+      EXPECT_EQ(o.scales[std::size_t(term)].by_region[std::size_t(r)], listed ? 0.25 : 1.0)
+          << term << "," << r;
     }
 }
 
@@ -407,7 +418,8 @@ TEST(TunedDisc, MssOptionsScaleTheNamedTermAndRegion) {
 TunedDisc sample_per_spring(const mesh::TetMesh& m) {
   TunedDisc t = sample_tuned(m);
   const mss::MssModel model(m, two_materials(), t.mss_options());
-  for (Eigen::Index e = 0; e < model.num_edge_springs(); ++e) t.edge_multipliers.push_back(0.5 + 1.0 / double(e + 3));
+  for (Eigen::Index e = 0; e < model.num_edge_springs(); ++e)
+    t.edge_multipliers.push_back(0.5 + 1.0 / double(e + 3));
   t.edge_order = edge_order_hash(model);
   return t;
 }
@@ -439,12 +451,15 @@ void expect_per_spring_refused(const std::function<void(json&)>& edit, const std
 
 TEST(PerSpringFile, RefusesBadMultipliers) {
   expect_per_spring_refused([](json& j) { j.erase("edge_multipliers"); }, "edge_multipliers");
-  expect_per_spring_refused([](json& j) { j["edge_multipliers"] = json::array(); }, "no edge_multipliers");
+  expect_per_spring_refused([](json& j) { j["edge_multipliers"] = json::array(); },
+                            "no edge_multipliers");
   for (const double bad : {0.0, -1.0, std::numeric_limits<double>::infinity()})
     expect_per_spring_refused([bad](json& j) { j["edge_multipliers"][3] = bad; }, "finite and > 0");
-  expect_per_spring_refused([](json& j) { j["edge_multipliers"][3] = nullptr; }, "malformed");  // a NaN written to text
+  expect_per_spring_refused([](json& j) { j["edge_multipliers"][3] = nullptr; },
+                            "malformed");  // a NaN written to text
   expect_per_spring_refused([](json& j) { j["edge_multipliers"][3] = "1"; }, "malformed");
-  expect_per_spring_refused([](json& j) { j["edge_springs"] = j["edge_springs"].get<int>() + 1; }, "edge_springs");
+  expect_per_spring_refused([](json& j) { j["edge_springs"] = j["edge_springs"].get<int>() + 1; },
+                            "edge_springs");
   expect_per_spring_refused([](json& j) { j.erase("edge_springs"); }, "edge_springs");
   // The kind decides: multipliers in a region-level file are an error, not silently ignored.
   expect_per_spring_refused([](json& j) { j["kind"] = "region"; }, "per-spring");
@@ -460,12 +475,13 @@ TEST(PerSpringFile, AppliesToTheFittedMeshOnly) {
   EXPECT_EQ(model.edge_springs()[5].multiplier, t.edge_multipliers[5]);
 
   // Another mesh of the same disc level: a region-level file transfers, a per-spring one not.
-  mesh::TetMesh finer = spinesim::mesh::box_mesh(7, 4, 5, 20.0, 8.0, 16.0, Eigen::Vector3d(-10.0, 0.0, -8.0));
+  mesh::TetMesh finer =
+      spinesim::mesh::box_mesh(7, 4, 5, 20.0, 8.0, 16.0, Eigen::Vector3d(-10.0, 0.0, -8.0));
   finer.source = "structured disc L4-L5 (12 sectors, 3 rings, 2 layers)";
   EXPECT_EQ(check_applies(sample_tuned(m), finer, two_materials()), "");
   expect_not_applicable(t, finer, two_materials(),
-                        {"per-spring", "region-level tuned files transfer", "fingerprint " + t.mesh.hash,
-                         "fingerprint " + fingerprint(finer).hash});
+                        {"per-spring", "region-level tuned files transfer",
+                         "fingerprint " + t.mesh.hash, "fingerprint " + fingerprint(finer).hash});
   // Same counts, one vertex moved by a micrometre: another mesh all the same.
   mesh::TetMesh moved = m;
   moved.V(moved.num_vertices() / 2, 1) += 1e-3;
@@ -498,7 +514,8 @@ TEST(PerSpringFile, AnotherEdgeOrderIsRefusedWhenTheModelIsBuilt) {
     build_tuned_model(t, m, two_materials());
     FAIL() << "a per-spring file with another edge order was applied";
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("ordering of the edge springs"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("ordering of the edge springs"), std::string::npos)
+        << e.what();
   }
   expect_per_spring_refused([](json& j) { j.erase("edge_order"); }, "edge_order");
 }

@@ -47,8 +47,8 @@ struct CliRun {
 /// Runs spinesim with `args` (shell words), capturing stdout and stderr.
 inline CliRun run_spinesim(const std::string& args) {
   const fs::path out = tmp_dir() / "cli.stdout", err = tmp_dir() / "cli.stderr";
-  const std::string cmd = std::string("'") + SPINESIM_EXE + "' " + args + " >'" + out.string() + "' 2>'" +
-                          err.string() + "' </dev/null";
+  const std::string cmd = std::string("'") + SPINESIM_EXE + "' " + args + " >'" + out.string() +
+                          "' 2>'" + err.string() + "' </dev/null";
   const int raw = std::system(cmd.c_str());
   CliRun r;
   r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;

@@ -30,7 +30,8 @@ inline const nlohmann::json& study(const std::string& name) {
   if (it != made.end()) return it->second;
   const CliRun r = run_spinesim("study " + name + " --json");
   EXPECT_EQ(r.status, 0) << r.err;
-  return made.emplace(name, r.status == 0 ? nlohmann::json::parse(r.out) : nlohmann::json::object()).first->second;
+  return made.emplace(name, r.status == 0 ? nlohmann::json::parse(r.out) : nlohmann::json::object())
+      .first->second;
 }
 
 /// One run of `study fusion --json` by fusion ("normal", "L3-L4", …) and load ("forward", …).

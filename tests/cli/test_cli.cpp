@@ -1,8 +1,8 @@
 // The `spinesim` command-line contract (docs/cli.md): JSON fields, units,
 // sign conventions, and bad input -> one line on stderr, non-zero exit, no output file.
+#include "cli_runner.hpp"
 #include "spinesim/mesh/io.hpp"
 #include "spinesim/mesh/tet_mesh.hpp"
-#include "cli_runner.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -25,13 +25,13 @@ namespace {
 
 using namespace spinesim::test_cli;
 
-
 /// A coarse L4-L5 disc made once for the whole suite.
 class CliTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     disc_ = tmp("cli-disc.vtu");
-    const CliRun r = run_spinesim("mesh disc --level L4-L5 --cell-size 3 --json --out '" + disc_ + "'");
+    const CliRun r =
+        run_spinesim("mesh disc --level L4-L5 --cell-size 3 --json --out '" + disc_ + "'");
     ASSERT_EQ(r.status, 0) << r.err;
     mesh_json_ = nlohmann::json::parse(r.out);
   }
@@ -44,7 +44,8 @@ nlohmann::json CliTest::mesh_json_;
 }  // namespace
 
 TEST(Cli, HelpOnEveryVerb) {
-  for (const char* verb : {"", "mesh", "mesh disc", "fem", "demo", "bench", "bench mesh", "bench fem"}) {
+  for (const char* verb :
+       {"", "mesh", "mesh disc", "fem", "demo", "bench", "bench mesh", "bench fem"}) {
     const CliRun r = run_spinesim(std::string(verb) + " --help");
     EXPECT_EQ(r.status, 0) << verb;
     EXPECT_NE(r.out.find("--"), std::string::npos) << verb;
@@ -52,8 +53,9 @@ TEST(Cli, HelpOnEveryVerb) {
 }
 
 TEST_F(CliTest, MeshJsonHasQualityFields) {
-  for (const char* key : {"nodes", "tets", "min_dihedral_deg", "max_dihedral_deg", "max_radius_edge_ratio",
-                          "volume_mm3", "exact_volume_mm3", "volume_error", "level"})
+  for (const char* key :
+       {"nodes", "tets", "min_dihedral_deg", "max_dihedral_deg", "max_radius_edge_ratio",
+        "volume_mm3", "exact_volume_mm3", "volume_error", "level"})
     EXPECT_TRUE(mesh_json_.contains(key)) << key;
   EXPECT_GT(mesh_json_["tets"].get<int>(), 100);
   EXPECT_LT(std::abs(mesh_json_["volume_error"].get<double>()), 0.05);
@@ -62,10 +64,12 @@ TEST_F(CliTest, MeshJsonHasQualityFields) {
 
 TEST_F(CliTest, FemCompressionGivesPositiveFyAndSymmetricStiffness) {
   const std::string out = tmp("cli-fem.vtu");
-  const CliRun r = run_spinesim("fem --mesh '" + disc_ + "' --order 1 --motion 0,-0.1,0,0,0,0 --json --out '" + out + "'");
+  const CliRun r = run_spinesim("fem --mesh '" + disc_ +
+                                "' --order 1 --motion 0,-0.1,0,0,0,0 --json --out '" + out + "'");
   ASSERT_EQ(r.status, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
-  for (const char* key : {"nodes", "tets", "plate_center", "plate_motion", "reaction_wrench", "stiffness_6x6"})
+  for (const char* key :
+       {"nodes", "tets", "plate_center", "plate_motion", "reaction_wrench", "stiffness_6x6"})
     EXPECT_TRUE(j.contains(key)) << key;
   EXPECT_EQ(j["plate_motion"].size(), 6u);
   EXPECT_EQ(j["reaction_wrench"].size(), 6u);
@@ -76,7 +80,8 @@ TEST_F(CliTest, FemCompressionGivesPositiveFyAndSymmetricStiffness) {
   // Translational block is symmetric in any units.
   for (int a = 0; a < 3; ++a)
     for (int b = 0; b < 3; ++b)
-      EXPECT_NEAR(k[a][b].get<double>(), k[b][a].get<double>(), 1e-6 * std::abs(k[1][1].get<double>()));
+      EXPECT_NEAR(k[a][b].get<double>(), k[b][a].get<double>(),
+                  1e-6 * std::abs(k[1][1].get<double>()));
   // Reaction = -K q for the prescribed motion.
   EXPECT_NEAR(j["reaction_wrench"][1].get<double>(), 0.1 * k[1][1].get<double>(),
               1e-6 * std::abs(k[1][1].get<double>()));
@@ -90,20 +95,27 @@ TEST_F(CliTest, FemCompressionGivesPositiveFyAndSymmetricStiffness) {
 }
 
 TEST_F(CliTest, FemWrenchIsBalancedByReaction) {
-  const CliRun r = run_spinesim("fem --mesh '" + disc_ + "' --order 1 --wrench 10,-500,20,300,-200,100 --json");
+  const CliRun r =
+      run_spinesim("fem --mesh '" + disc_ + "' --order 1 --wrench 10,-500,20,300,-200,100 --json");
   ASSERT_EQ(r.status, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   const double w[6] = {10, -500, 20, 300, -200, 100};
-  for (int i = 0; i < 6; ++i) EXPECT_NEAR(j["reaction_wrench"][i].get<double>(), -w[i], 1e-6 * 500) << i;
+  for (int i = 0; i < 6; ++i)
+    EXPECT_NEAR(j["reaction_wrench"][i].get<double>(), -w[i], 1e-6 * 500) << i;
 }
 
 TEST_F(CliTest, BadLoadsAreRefusedWithoutOutput) {
   const std::string out = tmp("cli-bad.vtu");
-  expect_refused(run_spinesim("fem --mesh '" + disc_ + "' --wrench 0,nan,0,0,0,0 --out '" + out + "'"), "non-finite");
-  expect_refused(run_spinesim("fem --mesh '" + disc_ + "' --motion 0,-0.1,0 --out '" + out + "'"), "expected 6");
-  expect_refused(run_spinesim("fem --mesh '" + disc_ + "' --order 3 --motion 0,-0.1,0,0,0,0 --out '" + out + "'"),
+  expect_refused(
+      run_spinesim("fem --mesh '" + disc_ + "' --wrench 0,nan,0,0,0,0 --out '" + out + "'"),
+      "non-finite");
+  expect_refused(run_spinesim("fem --mesh '" + disc_ + "' --motion 0,-0.1,0 --out '" + out + "'"),
+                 "expected 6");
+  expect_refused(run_spinesim("fem --mesh '" + disc_ +
+                              "' --order 3 --motion 0,-0.1,0,0,0,0 --out '" + out + "'"),
                  "order");
-  expect_refused(run_spinesim("fem --mesh '" + disc_ + "' --case squat --out '" + out + "'"), "unknown load case");
+  expect_refused(run_spinesim("fem --mesh '" + disc_ + "' --case squat --out '" + out + "'"),
+                 "unknown load case");
   EXPECT_FALSE(fs::exists(out));
 }
 
@@ -118,12 +130,13 @@ TEST_F(CliTest, BadMaterialsAreRefused) {
   for (const auto& [text, needle] : cases) {
     const std::string path = tmp("material.json");
     std::ofstream(path) << text;
-    expect_refused(run_spinesim("fem --mesh '" + disc_ + "' --material '" + path + "' --motion 0,-0.1,0,0,0,0 --out '" +
-                            out + "'"),
+    expect_refused(run_spinesim("fem --mesh '" + disc_ + "' --material '" + path +
+                                "' --motion 0,-0.1,0,0,0,0 --out '" + out + "'"),
                    needle);
   }
-  expect_refused(run_spinesim("fem --mesh '" + disc_ + "' --material unobtainium --motion 0,-0.1,0,0,0,0"),
-                 "unknown material");
+  expect_refused(
+      run_spinesim("fem --mesh '" + disc_ + "' --material unobtainium --motion 0,-0.1,0,0,0,0"),
+      "unknown material");
   EXPECT_FALSE(fs::exists(out));
 }
 
@@ -133,7 +146,8 @@ TEST_F(CliTest, BadMeshesAreRefused) {
   expect_refused(run_spinesim("fem --mesh /nonexistent/disc.vtu" + motion), "disc.vtu");
 
   const std::string corrupt = tmp("corrupt.vtu");
-  std::ofstream(corrupt) << "<VTKFile type=\"UnstructuredGrid\"><UnstructuredGrid><Piece NumberOfPoints=";
+  std::ofstream(corrupt)
+      << "<VTKFile type=\"UnstructuredGrid\"><UnstructuredGrid><Piece NumberOfPoints=";
   expect_refused(run_spinesim("fem --mesh '" + corrupt + "'" + motion), "corrupt.vtu");
 
   TetMesh m = spinesim::mesh::read_vtu(disc_);
@@ -160,13 +174,16 @@ TEST_F(CliTest, BadMeshesAreRefused) {
 TEST(Cli, BadMeshRequestsAreRefused) {
   const std::string out = tmp("cli-no-mesh.vtu");
   expect_refused(run_spinesim("mesh disc --level L9-L10 --out '" + out + "'"), "L9-L10");
-  expect_refused(run_spinesim("mesh disc --level L4-L5 --cell-size -1 --out '" + out + "'"), "cell-size");
+  expect_refused(run_spinesim("mesh disc --level L4-L5 --cell-size -1 --out '" + out + "'"),
+                 "cell-size");
   const std::string empty = tmp("empty.obj");
   std::ofstream(empty) << "# nothing here\n";
-  expect_refused(run_spinesim("mesh disc --inferior '" + empty + "' --superior '" + empty + "' --out '" + out + "'"),
+  expect_refused(run_spinesim("mesh disc --inferior '" + empty + "' --superior '" + empty +
+                              "' --out '" + out + "'"),
                  "empty.obj");
-  expect_refused(run_spinesim("mesh disc --level L4-L5 --inferior a.obj --superior b.obj --out '" + out + "'"),
-                 "either");
+  expect_refused(
+      run_spinesim("mesh disc --level L4-L5 --inferior a.obj --superior b.obj --out '" + out + "'"),
+      "either");
   EXPECT_FALSE(fs::exists(out));
 }
 
@@ -175,8 +192,9 @@ TEST(Cli, VertebraeThatDoNotFaceEachOtherAreRefused) {
   if (!fs::exists(dir / "L4_body.obj")) GTEST_SKIP() << "testdata absent: " << dir;
   const std::string out = tmp("cli-swapped.vtu");
   // Inferior and superior swapped: L4 lies above L5, so they face away from each other.
-  expect_refused(run_spinesim("mesh disc --inferior '" + (dir / "L4_body.obj").string() + "' --superior '" +
-                          (dir / "L5_body.obj").string() + "' --units m --up z --out '" + out + "'"),
-                 "face");
+  expect_refused(
+      run_spinesim("mesh disc --inferior '" + (dir / "L4_body.obj").string() + "' --superior '" +
+                   (dir / "L5_body.obj").string() + "' --units m --up z --out '" + out + "'"),
+      "face");
   EXPECT_FALSE(fs::exists(out));
 }

@@ -53,19 +53,23 @@ const json& material(const json& j, const std::string& name) {
   return none;
 }
 
-double axial(const json& m, const char* model) { return m[model]["axial_stiffness_n_per_mm"].get<double>(); }
+double axial(const json& m, const char* model) {
+  return m[model]["axial_stiffness_n_per_mm"].get<double>();
+}
 
 }  // namespace
 
 // One run, three presets: the orderings and ratios the physics dictates.
 TEST(MaterialsStudy, StifferMaterialsStifferDiscAndTheTunedMssMatchesTheFem) {
   const std::string csv = tmp("materials.csv");
-  const CliRun r = run_spinesim(std::string(kCoarse) + " --materials real-disc,rubber,polyethylene --json --csv '" +
-                                csv + "'");
+  const CliRun r =
+      run_spinesim(std::string(kCoarse) +
+                   " --materials real-disc,rubber,polyethylene --json --csv '" + csv + "'");
   ASSERT_EQ(r.status, 0) << r.err;
   const json j = json::parse(r.out);
   ASSERT_EQ(j["materials"].size(), 3u);
-  const json &real = material(j, "real-disc"), &rubber = material(j, "rubber"), &pe = material(j, "polyethylene");
+  const json &real = material(j, "real-disc"), &rubber = material(j, "rubber"),
+             &pe = material(j, "polyethylene");
 
   // FEM axial stiffness follows E (3.22 < 30 < 200 MPa) ...
   EXPECT_GT(axial(pe, "fem"), axial(rubber, "fem"));
@@ -81,17 +85,22 @@ TEST(MaterialsStudy, StifferMaterialsStifferDiscAndTheTunedMssMatchesTheFem) {
     // The calibration's job: tuned within 10 % of the FEM, and closer than Van Gelder's constants.
     EXPECT_NEAR(tuned / fem, 1.0, 0.10) << name;
     EXPECT_LT(std::abs(tuned / fem - 1), std::abs(untuned / fem - 1)) << name;
-    EXPECT_LT((*m)["tuned"]["displacement_error"].get<double>(), (*m)["untuned"]["displacement_error"].get<double>())
+    EXPECT_LT((*m)["tuned"]["displacement_error"].get<double>(),
+              (*m)["untuned"]["displacement_error"].get<double>())
         << name;
     // 500 N compression moves the plate down and loses volume; the untuned spring network
     // (Cauchy solid, nu = 1/4) loses more than the FEM's nu >= 0.45 material.
     for (const char* model : {"fem", "untuned", "tuned"}) {
-      EXPECT_LT((*m)[model]["plate_axial_displacement_mm"].get<double>(), 0.0) << name << " " << model;
+      EXPECT_LT((*m)[model]["plate_axial_displacement_mm"].get<double>(), 0.0)
+          << name << " " << model;
       EXPECT_LT((*m)[model]["volume_change"].get<double>(), 0.0) << name << " " << model;
       EXPECT_EQ((*m)[model]["stiffness_diagonal"].size(), 6u);
     }
-    EXPECT_LT((*m)["untuned"]["volume_change"].get<double>(), (*m)["fem"]["volume_change"].get<double>()) << name;
-    EXPECT_TRUE((*m)["untuned"]["converged"].get<bool>() && (*m)["tuned"]["converged"].get<bool>()) << name;
+    EXPECT_LT((*m)["untuned"]["volume_change"].get<double>(),
+              (*m)["fem"]["volume_change"].get<double>())
+        << name;
+    EXPECT_TRUE((*m)["untuned"]["converged"].get<bool>() && (*m)["tuned"]["converged"].get<bool>())
+        << name;
   }
   // The thesis's fig. 5.9 claim: the real disc compresses most, polyethylene least (FEM).
   EXPECT_LT(real["fem"]["plate_axial_displacement_mm"].get<double>(),
@@ -112,15 +121,16 @@ TEST(MaterialsStudy, StifferMaterialsStifferDiscAndTheTunedMssMatchesTheFem) {
   }
   EXPECT_EQ(seen.size(), 9u);
   for (const char* mat : {"real-disc", "rubber", "polyethylene"})
-    for (const char* model : {"fem", "untuned", "tuned"}) EXPECT_EQ(seen.count(std::string(mat) + "/" + model), 1u);
+    for (const char* model : {"fem", "untuned", "tuned"})
+      EXPECT_EQ(seen.count(std::string(mat) + "/" + model), 1u);
 }
 
 TEST(MaterialsStudy, ReadableTableHasABlockPerQuantityWithUnits) {
   const CliRun r = run_spinesim(std::string(kCoarse) + " --materials real-disc");
   ASSERT_EQ(r.status, 0) << r.err;
-  for (const char* text : {"Axial stiffness K6_yy, N/mm", "u_y under 500 N compression, mm", "max |u|",
-                           "Volume change dV/V0", "displacement error", "N·mm/deg", "FEM P2", "untuned MSS",
-                           "tuned MSS", "real-disc"})
+  for (const char* text : {"Axial stiffness K6_yy, N/mm", "u_y under 500 N compression, mm",
+                           "max |u|", "Volume change dV/V0", "displacement error", "N·mm/deg",
+                           "FEM P2", "untuned MSS", "tuned MSS", "real-disc"})
     EXPECT_NE(r.out.find(text), std::string::npos) << text << "\n" << r.out;
 }
 
@@ -133,7 +143,9 @@ TEST(MaterialsStudy, HelpStatesTheProtocol) {
 
 TEST(MaterialsStudy, BadInputIsRefusedWithoutAFile) {
   const std::string csv = tmp("refused.csv");
-  expect_refused(run_spinesim(std::string(kCoarse) + " --materials real-disc,granite --csv '" + csv + "'"), "granite");
+  expect_refused(
+      run_spinesim(std::string(kCoarse) + " --materials real-disc,granite --csv '" + csv + "'"),
+      "granite");
   expect_refused(run_spinesim("study materials --level L9-L10 --csv '" + csv + "'"), "L9-L10");
   expect_refused(run_spinesim("study materials --cell-size -1 --csv '" + csv + "'"), "--cell-size");
   expect_refused(run_spinesim("study materials --terms springs --csv '" + csv + "'"), "springs");

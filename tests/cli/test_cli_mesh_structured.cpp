@@ -1,11 +1,11 @@
 // `spinesim mesh disc --structured`: the JSON and the VTU agree with the sweep's counts and
 // labels, the resolution options take effect, bad or mixed options are refused with one line
 // and no file, and the linear FEM reference runs on a structured disc (6×6 stiffness SPD).
+#include "cli_runner.hpp"
 #include "spinesim/fem/disc_fem.hpp"
 #include "spinesim/mesh/io.hpp"
 #include "spinesim/mesh/material.hpp"
 #include "spinesim/mesh/tet_mesh.hpp"
-#include "cli_runner.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -44,7 +44,8 @@ class StructuredCli : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     disc_ = tmp("t7-t8-structured.vtu");
-    const CliRun r = run_spinesim("mesh disc --level T7-T8 --structured --json --out '" + disc_ + "'");
+    const CliRun r =
+        run_spinesim("mesh disc --level T7-T8 --structured --json --out '" + disc_ + "'");
     ASSERT_EQ(r.status, 0) << r.err;
     json_ = json::parse(r.out);
   }
@@ -64,7 +65,7 @@ TEST_F(StructuredCli, JsonReportsTheSweepCountsAndQuality) {
   EXPECT_EQ(json_["superior_nodes"].get<int>(), 37);
   EXPECT_EQ(json_["wall_nodes"].get<int>(), 12);
   EXPECT_EQ(json_["annulus_tets"].get<int>() + json_["nucleus_tets"].get<int>(), 360);
-  EXPECT_GT(json_["min_dihedral_deg"].get<double>(), 18.5);  // worst level T4-T5: 18.9°
+  EXPECT_GT(json_["min_dihedral_deg"].get<double>(), 18.5);         // worst level T4-T5: 18.9°
   EXPECT_NEAR(json_["volume_error"].get<double>(), -0.051, 0.001);  // inscribed 12-gon
   EXPECT_EQ(json_["level"], "T7-T8");
   EXPECT_EQ(json_["placement"], "spine");
@@ -83,13 +84,16 @@ TEST_F(StructuredCli, VtuHoldsTheSameMesh) {
   EXPECT_EQ((m.surface.array() == 1).count(), 37);
   EXPECT_EQ((m.surface.array() == 2).count(), 37);
   EXPECT_EQ((m.region.array() == 2).count(), json_["nucleus_tets"].get<int>());
-  EXPECT_NEAR(mesh::mesh_volume(m), json_["volume_mm3"].get<double>(), 1e-6 * json_["volume_mm3"].get<double>());
+  EXPECT_NEAR(mesh::mesh_volume(m), json_["volume_mm3"].get<double>(),
+              1e-6 * json_["volume_mm3"].get<double>());
 }
 
 TEST(StructuredCliOptions, ResolutionAndPlacementTakeEffect) {
   const std::string out = tmp("l4-l5-16x4x3.vtu");
-  const CliRun r = run_spinesim("mesh disc --level L4-L5 --structured --sectors 16 --rings 4 --layers 3 "
-                                "--placement local --match-area --json --out '" + out + "'");
+  const CliRun r = run_spinesim(
+      "mesh disc --level L4-L5 --structured --sectors 16 --rings 4 --layers 3 "
+      "--placement local --match-area --json --out '" +
+      out + "'");
   ASSERT_EQ(r.status, 0) << r.err;
   const json j = json::parse(r.out);
   EXPECT_EQ(j["nodes"].get<int>(), 4 * (1 + 4 * 16));
@@ -104,9 +108,11 @@ TEST(StructuredCliOptions, ResolutionAndPlacementTakeEffect) {
 }
 
 TEST(StructuredCliOptions, TextReportNamesTheMesher) {
-  const CliRun r = run_spinesim("mesh disc --level T1-T2 --structured --quiet --out '" + tmp("t1-t2.vtu") + "'");
+  const CliRun r =
+      run_spinesim("mesh disc --level T1-T2 --structured --quiet --out '" + tmp("t1-t2.vtu") + "'");
   ASSERT_EQ(r.status, 0) << r.err;
-  EXPECT_NE(r.out.find("structured disc T1-T2 (12 sectors, 3 rings, 2 layers)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("structured disc T1-T2 (12 sectors, 3 rings, 2 layers)"), std::string::npos)
+      << r.out;
   EXPECT_NE(run_spinesim("mesh disc --help").out.find("--structured"), std::string::npos);
 }
 
@@ -116,7 +122,8 @@ TEST(StructuredCliOptions, BadOrMixedOptionsAreRefused) {
   expect_refused(base + "--structured --cell-size 2", out, "--cell-size");
   expect_refused(base + "--structured --odt --seed 3", out, "--odt, --seed");
   expect_refused(base + "--structured --no-exude", out, "CGAL options");
-  expect_refused(base + "--sectors 16 --layers 3", out, "--sectors, --layers only apply with --structured");
+  expect_refused(base + "--sectors 16 --layers 3", out,
+                 "--sectors, --layers only apply with --structured");
   expect_refused(base + "--structured --sectors 5", out, "sectors >= 6");
   expect_refused(base + "--structured --rings 1", out, "rings >= 2");
   expect_refused(base + "--structured --layers 0", out, "layers >= 1");
@@ -135,7 +142,8 @@ TEST_F(StructuredCli, FemRunsOnTheStructuredDisc) {
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eig(0.5 * (k6 + k6.transpose()));
   EXPECT_GT(eig.eigenvalues().minCoeff(), 0.0) << eig.eigenvalues().transpose();
 
-  const CliRun r = run_spinesim("fem --mesh '" + disc_ + "' --order 1 --motion 0,-0.1,0,0,0,0 --json");
+  const CliRun r =
+      run_spinesim("fem --mesh '" + disc_ + "' --order 1 --motion 0,-0.1,0,0,0,0 --json");
   ASSERT_EQ(r.status, 0) << r.err;
   const json j = json::parse(r.out);
   EXPECT_GT(j["reaction_wrench"][1].get<double>(), 0.0);

@@ -1,9 +1,9 @@
 // The mass-spring verbs of the `spinesim` program: `mss` (static and dynamic), `mss compare`,
 // `study probe` and `study drive` — JSON fields, signs, files written (and not written), and bad
 // input -> exit 1 with one line on stderr. One coarse L4-L5 disc (cell size 4 mm) for all.
+#include "cli_runner.hpp"
 #include "spinesim/mesh/io.hpp"
 #include "spinesim/mesh/tet_mesh.hpp"
-#include "cli_runner.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -33,7 +33,8 @@ std::vector<fs::path> pvd_files(const std::string& pvd) {
   const std::string text = slurp(pvd);
   std::vector<fs::path> files;
   const std::regex re("file=\"([^\"]+)\"");
-  for (auto it = std::sregex_iterator(text.begin(), text.end(), re); it != std::sregex_iterator(); ++it)
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), re); it != std::sregex_iterator();
+       ++it)
     files.push_back(fs::path(pvd).parent_path() / (*it)[1].str());
   return files;
 }
@@ -69,12 +70,13 @@ TEST(MssCliHelp, EveryVerbHasHelp) {
 
 TEST_F(MssCli, StaticCompressionPushesThePlateUpAndLosesVolume) {
   const std::string out = tmp("static.vtu");
-  const CliRun r = run_spinesim("mss --mesh '" + disc_ + "' --motion 0,-0.2,0,0,0,0 --json --out '" + out + "'");
+  const CliRun r =
+      run_spinesim("mss --mesh '" + disc_ + "' --motion 0,-0.2,0,0,0,0 --json --out '" + out + "'");
   ASSERT_EQ(r.status, 0) << r.err;
   const json j = json::parse(r.out);
-  for (const char* key : {"nodes", "tets", "plate_center", "plate_motion", "reaction_wrench", "volume_mm3",
-                          "volume_change", "timings", "converged", "iterations", "springs", "K_d_n_s_per_mm",
-                          "equivalent_cylinder"})
+  for (const char* key : {"nodes", "tets", "plate_center", "plate_motion", "reaction_wrench",
+                          "volume_mm3", "volume_change", "timings", "converged", "iterations",
+                          "springs", "K_d_n_s_per_mm", "equivalent_cylinder"})
     EXPECT_TRUE(j.contains(key)) << key;
   expect_finite_vector(j["plate_center"], 3, "plate_center");
   expect_finite_vector(j["plate_motion"], 6, "plate_motion");
@@ -97,14 +99,17 @@ TEST_F(MssCli, StaticCompressionPushesThePlateUpAndLosesVolume) {
   std::vector<spinesim::mesh::DataArray> points, cells;
   const auto m = spinesim::mesh::read_vtu(out, &points, &cells);
   EXPECT_EQ(m.num_tets(), j["tets"].get<long>());
-  const auto disp = std::find_if(points.begin(), points.end(), [](const auto& a) { return a.name == "displacement"; });
+  const auto disp = std::find_if(points.begin(), points.end(),
+                                 [](const auto& a) { return a.name == "displacement"; });
   ASSERT_NE(disp, points.end());
   ASSERT_EQ(disp->values.cols(), 3);
   for (Eigen::Index i = 0; i < m.num_vertices(); ++i) {
-    if (m.surface(i) == 2) EXPECT_NEAR(disp->values(i, 1), -0.2, 1e-9);  // plate nodes follow the plate
+    if (m.surface(i) == 2)
+      EXPECT_NEAR(disp->values(i, 1), -0.2, 1e-9);  // plate nodes follow the plate
     if (m.surface(i) == 1) EXPECT_EQ(disp->values.row(i).norm(), 0.0);
   }
-  const auto dv = std::find_if(cells.begin(), cells.end(), [](const auto& a) { return a.name == "volume_change"; });
+  const auto dv = std::find_if(cells.begin(), cells.end(),
+                               [](const auto& a) { return a.name == "volume_change"; });
   ASSERT_NE(dv, cells.end());
   EXPECT_EQ(dv->values.rows(), m.num_tets());
 }
@@ -127,7 +132,8 @@ TEST_F(MssCli, VolumeTermsKeepTheVolumeBetter) {
   double dv[4];
   const char* flags[] = {"--no-radial", "", "--volume-term", "--disc-volume-term"};
   for (int i = 0; i < 4; ++i) {
-    const CliRun r = run_spinesim("mss --mesh '" + disc_ + "' --motion 0,-1,0,0,0,0 --json " + flags[i]);
+    const CliRun r =
+        run_spinesim("mss --mesh '" + disc_ + "' --motion 0,-1,0,0,0,0 --json " + flags[i]);
     ASSERT_EQ(r.status, 0) << flags[i] << r.err;
     dv[i] = json::parse(r.out)["volume_change"].get<double>();
     EXPECT_LT(dv[i], 0.0) << flags[i];
@@ -140,7 +146,9 @@ TEST_F(MssCli, VolumeTermsKeepTheVolumeBetter) {
 TEST_F(MssCli, ImplicitRunWritesATimeSeries) {
   const std::string pvd = tmp("run.pvd");
   tmp("run");
-  const CliRun r = run_spinesim("mss --mesh '" + disc_ + "' --case compression --dt 1e-3 --steps 20 --frame-every 5 --json --out '" + pvd + "'");
+  const CliRun r = run_spinesim(
+      "mss --mesh '" + disc_ +
+      "' --case compression --dt 1e-3 --steps 20 --frame-every 5 --json --out '" + pvd + "'");
   ASSERT_EQ(r.status, 0) << r.err;
   const json j = json::parse(r.out);
   EXPECT_FALSE(j["diverged"].get<bool>());
@@ -161,7 +169,9 @@ TEST_F(MssCli, ImplicitRunWritesATimeSeries) {
 TEST_F(MssCli, ExplicitEulerAtOneMillisecondDivergesAndWritesNothing) {
   const std::string pvd = tmp("explicit.pvd");
   tmp("explicit");
-  const CliRun r = run_spinesim("mss --mesh '" + disc_ + "' --case compression --dt 1e-3 --steps 50 --integrator explicit --json --out '" + pvd + "'");
+  const CliRun r = run_spinesim(
+      "mss --mesh '" + disc_ +
+      "' --case compression --dt 1e-3 --steps 50 --integrator explicit --json --out '" + pvd + "'");
   EXPECT_EQ(r.status, 1);
   EXPECT_EQ(count_lines(r.err), 1) << r.err;
   EXPECT_NE(r.err.find("diverged"), std::string::npos) << r.err;
@@ -177,16 +187,18 @@ TEST_F(MssCli, ExplicitEulerAtOneMillisecondDivergesAndWritesNothing) {
 
 TEST_F(MssCli, CompareGivesEightFiniteCases) {
   const std::string csv = tmp("compare.csv");
-  const CliRun r = run_spinesim("mss compare --mesh '" + disc_ + "' --order 1 --json --csv '" + csv + "'");
+  const CliRun r =
+      run_spinesim("mss compare --mesh '" + disc_ + "' --order 1 --json --csv '" + csv + "'");
   ASSERT_EQ(r.status, 0) << r.err;
   const json j = json::parse(r.out);
   ASSERT_EQ(j["cases"].size(), 8u);
-  const char* names[] = {"compression", "tension", "shear-ap", "shear-lat", "flexion", "extension", "lateral-bending", "torsion"};
+  const char* names[] = {"compression", "tension",   "shear-ap",        "shear-lat",
+                         "flexion",     "extension", "lateral-bending", "torsion"};
   for (std::size_t i = 0; i < 8; ++i) {
     const auto& c = j["cases"][i];
     EXPECT_EQ(c["name"], names[i]);
-    for (const char* key : {"displacement_error", "plate_motion_error", "reaction_error", "reaction_force_error",
-                            "reaction_moment_error"}) {
+    for (const char* key : {"displacement_error", "plate_motion_error", "reaction_error",
+                            "reaction_force_error", "reaction_moment_error"}) {
       const double e = c[key].get<double>();
       EXPECT_TRUE(std::isfinite(e) && e >= 0.0 && e < 10.0) << names[i] << " " << key << " " << e;
     }
@@ -196,13 +208,15 @@ TEST_F(MssCli, CompareGivesEightFiniteCases) {
     EXPECT_TRUE(c["converged"].get<bool>()) << names[i];
   }
   // Wrench-loaded FEM: its reaction is minus the applied wrench.
-  EXPECT_NEAR(j["cases"][0]["reaction_wrench_fem"][1].get<double>(), -j["cases"][0]["wrench"][1].get<double>(), 1e-6);
+  EXPECT_NEAR(j["cases"][0]["reaction_wrench_fem"][1].get<double>(),
+              -j["cases"][0]["wrench"][1].get<double>(), 1e-6);
   const auto& ratio = j["stiffness_diagonal"]["ratio_mss_over_fem"];
   expect_finite_vector(ratio, 6, "stiffness ratio");
   for (const auto& v : ratio) EXPECT_GT(v.get<double>(), 0.0);
   EXPECT_EQ(count_lines(slurp(csv)), 9);
 
-  const CliRun two = run_spinesim("mss compare --mesh '" + disc_ + "' --order 1 --cases compression,torsion");
+  const CliRun two =
+      run_spinesim("mss compare --mesh '" + disc_ + "' --order 1 --cases compression,torsion");
   ASSERT_EQ(two.status, 0) << two.err;
   EXPECT_NE(two.out.find("torsion"), std::string::npos);
   EXPECT_EQ(two.out.find("flexion"), std::string::npos);
@@ -214,27 +228,33 @@ TEST_F(MssCli, BadInputIsRefusedInOneLineWithoutOutput) {
   const std::string o = " --out '" + out + "'";
   const std::string material = tmp("zero-modulus.json");
   std::ofstream(material) << R"({"name":"zero","E_mpa":0,"nu":0.3})";
-  expect_refused(run_spinesim(mss + "--material '" + material + "' --case compression" + o), "Young's modulus");
+  expect_refused(run_spinesim(mss + "--material '" + material + "' --case compression" + o),
+                 "Young's modulus");
   expect_refused(run_spinesim(mss + "--case compression --dt 0 --steps 5" + o), "--dt");
   expect_refused(run_spinesim(mss + "--case compression --dt -1e-3 --steps 5" + o), "--dt");
   expect_refused(run_spinesim(mss + "--case compression --dt nan --steps 5" + o), "--dt");
   expect_refused(run_spinesim(mss + "--motion 0,nan,0,0,0,0" + o), "non-finite");
   expect_refused(run_spinesim(mss + "--wrench 0,-500,0" + o), "expected 6");
   expect_refused(run_spinesim(mss + "--case compression --steps 0" + o), "--steps");
-  expect_refused(run_spinesim(mss + "--case compression --dt abc --steps 5" + o), "abc");  // malformed number
+  expect_refused(run_spinesim(mss + "--case compression --dt abc --steps 5" + o),
+                 "abc");  // malformed number
   expect_refused(run_spinesim(mss + "--case compression --dt 1e-3 --steps 2.5" + o), "2.5");
   expect_refused(run_spinesim(mss + "--case compression --dt 1e-3" + o), "--steps");
   expect_refused(run_spinesim(mss + "--case squat" + o), "unknown load case");
-  expect_refused(run_spinesim(mss + "--case compression --integrator rk4 --steps 5" + o), "--integrator");
+  expect_refused(run_spinesim(mss + "--case compression --integrator rk4 --steps 5" + o),
+                 "--integrator");
   expect_refused(run_spinesim(mss + "--case compression --damping -1" + o), "--damping");
   expect_refused(run_spinesim(mss + "--case compression --damping nan" + o), "--damping");
   expect_refused(run_spinesim(mss + "--case compression --static --steps 5" + o), "not both");
-  expect_refused(run_spinesim(mss + "--case compression --motion 0,-0.1,0,0,0,0" + o), "at most one");
+  expect_refused(run_spinesim(mss + "--case compression --motion 0,-0.1,0,0,0,0" + o),
+                 "at most one");
   expect_refused(run_spinesim(mss + "--case compression --out '" + pvd + "'"), "dynamic");
   expect_refused(run_spinesim(mss + "--case compression --out '" + tmp("bad.txt") + "'"), ".vtu");
-  expect_refused(run_spinesim(mss + "--case compression --out /nonexistent/folder/r.vtu"), "does not exist");
+  expect_refused(run_spinesim(mss + "--case compression --out /nonexistent/folder/r.vtu"),
+                 "does not exist");
   expect_refused(run_spinesim("mss --case compression" + o), "--mesh");
-  expect_refused(run_spinesim("mss compare --mesh '" + disc_ + "' --cases compression,squat"), "unknown load case");
+  expect_refused(run_spinesim("mss compare --mesh '" + disc_ + "' --cases compression,squat"),
+                 "unknown load case");
   EXPECT_FALSE(fs::exists(out));
   EXPECT_FALSE(fs::exists(pvd));
 
@@ -246,17 +266,21 @@ TEST_F(MssCli, BadInputIsRefusedInOneLineWithoutOutput) {
   expect_refused(run_spinesim(probe + "--sites inside"), "inside");
   expect_refused(run_spinesim(probe + "--integrator leapfrog"), "--integrator");
   expect_refused(run_spinesim(probe + "--material '" + material + "'"), "Young's modulus");
-  expect_refused(run_spinesim("study drive --mesh '" + disc_ + "' --out '" + dir + "' --materials real-disc,unobtainium"),
+  expect_refused(run_spinesim("study drive --mesh '" + disc_ + "' --out '" + dir +
+                              "' --materials real-disc,unobtainium"),
                  "unknown material");
-  expect_refused(run_spinesim("study drive --mesh '" + disc_ + "' --out '" + dir + "' --time-scale 0"), "--time-scale");
+  expect_refused(
+      run_spinesim("study drive --mesh '" + disc_ + "' --out '" + dir + "' --time-scale 0"),
+      "--time-scale");
   EXPECT_FALSE(fs::exists(dir));
 }
 
 TEST_F(MssCli, ProbeStudyWritesSeriesCsvAndSummary) {
   const std::string dir = tmp("probe");
-  const CliRun r = run_spinesim("study probe --mesh '" + disc_ + "' --out '" + dir +
-                                "' --sites anterior,left --radius 4 --depth 0.5 --speed 10 --hold 0.01 --rest 0.01 "
-                                "--frame-every 20 --json");
+  const CliRun r = run_spinesim(
+      "study probe --mesh '" + disc_ + "' --out '" + dir +
+      "' --sites anterior,left --radius 4 --depth 0.5 --speed 10 --hold 0.01 --rest 0.01 "
+      "--frame-every 20 --json");
   ASSERT_EQ(r.status, 0) << r.err;
   const json j = json::parse(r.out);
   EXPECT_FALSE(j["diverged"].get<bool>());
@@ -280,8 +304,9 @@ TEST_F(MssCli, ProbeStudyWritesSeriesCsvAndSummary) {
 
 TEST_F(MssCli, DriveStudyPolyethyleneIsStifferThanTheRealDisc) {
   const std::string dir = tmp("drive");
-  const CliRun r = run_spinesim("study drive --mesh '" + disc_ + "' --out '" + dir +
-                                "' --materials real-disc,polyethylene --time-scale 0.1 --frame-every 40 --json");
+  const CliRun r =
+      run_spinesim("study drive --mesh '" + disc_ + "' --out '" + dir +
+                   "' --materials real-disc,polyethylene --time-scale 0.1 --frame-every 40 --json");
   ASSERT_EQ(r.status, 0) << r.err;
   const json j = json::parse(r.out);
   EXPECT_FALSE(j["diverged"].get<bool>());
@@ -290,7 +315,8 @@ TEST_F(MssCli, DriveStudyPolyethyleneIsStifferThanTheRealDisc) {
   const auto& poly = j["materials"][1];
   EXPECT_EQ(real["steps_done"].get<int>(), 120);
   EXPECT_GT(real["peak_axial_force_n"].get<double>(), 0.0);  // compression pushes the plate up
-  EXPECT_GT(poly["peak_force_n"].get<double>(), 10.0 * real["peak_force_n"].get<double>());  // E 200 vs 3.22 MPa
+  EXPECT_GT(poly["peak_force_n"].get<double>(),
+            10.0 * real["peak_force_n"].get<double>());  // E 200 vs 3.22 MPa
   for (const auto& run : j["materials"]) {
     const auto files = pvd_files(run["files"]["pvd"].get<std::string>());
     EXPECT_EQ(files.size(), run["frames"].get<std::size_t>());

@@ -24,8 +24,11 @@ namespace {
 
 using namespace spinesim::test_cli;
 
-
-double vec_norm(const json& v) { return std::sqrt(v[0].get<double>() * v[0].get<double>() + v[1].get<double>() * v[1].get<double>() + v[2].get<double>() * v[2].get<double>()); }
+double vec_norm(const json& v) {
+  return std::sqrt(v[0].get<double>() * v[0].get<double>() +
+                   v[1].get<double>() * v[1].get<double>() +
+                   v[2].get<double>() * v[2].get<double>());
+}
 
 const json& joint(const json& j, const std::string& name) {
   for (const auto& x : j["joints"])
@@ -40,7 +43,8 @@ const json& joint(const json& j, const std::string& name) {
 // --- spine solve -------------------------------------------------------------------------------
 
 TEST(SpineSolveCli, HelpOnEveryVerb) {
-  for (const char* verb : {"spine", "spine solve", "study validation", "study fusion", "study trends"}) {
+  for (const char* verb :
+       {"spine", "spine solve", "study validation", "study fusion", "study trends"}) {
     const CliRun r = run_spinesim(std::string(verb) + " --help");
     EXPECT_EQ(r.status, 0) << verb;
     EXPECT_NE(r.out.find("--"), std::string::npos) << verb;
@@ -62,8 +66,9 @@ TEST(SpineSolveCli, JsonGivesEveryVertebraJointMuscleAndLigament) {
     EXPECT_EQ(v["translation_mm"].size(), 3u);
     EXPECT_EQ(v["rotation_deg"].size(), 3u);
   }
-  for (const char* key : {"force_world_n", "moment_world_nmm", "axial_n", "shear_ap_n", "shear_lat_n", "disc_axial_n",
-                          "disc_shear_n", "moment_local_nmm", "resultant_n"})
+  for (const char* key :
+       {"force_world_n", "moment_world_nmm", "axial_n", "shear_ap_n", "shear_lat_n", "disc_axial_n",
+        "disc_shear_n", "moment_local_nmm", "resultant_n"})
     EXPECT_TRUE(j["joints"][0].contains(key)) << key;
   ASSERT_FALSE(j["muscles"].empty());
   for (const auto& m : j["muscles"]) {
@@ -73,7 +78,8 @@ TEST(SpineSolveCli, JsonGivesEveryVertebraJointMuscleAndLigament) {
     EXPECT_GE(m["tension_n"].get<double>(), 0.0) << m["name"];
   }
   ASSERT_FALSE(j["ligaments"].empty());
-  for (const auto& l : j["ligaments"]) EXPECT_GE(l["force_n"].get<double>(), 0.0) << l["name"];  // tension only
+  for (const auto& l : j["ligaments"])
+    EXPECT_GE(l["force_n"].get<double>(), 0.0) << l["name"];  // tension only
   EXPECT_TRUE(j["recruitment"]["success"].get<bool>());
   EXPECT_EQ(j["bushing"]["force_n"].size(), 3u);
   EXPECT_GT(j["seconds"]["total"].get<double>(), 0.0);
@@ -106,8 +112,11 @@ TEST(SpineSolveCli, FusedJointDoesNotMove) {
   const json& l4 = j["vertebrae"][15];
   ASSERT_EQ(l3["name"], "L3");
   for (int k = 0; k < 3; ++k)
-    EXPECT_NEAR(l3["rotation_deg"][k].get<double>(), l4["rotation_deg"][k].get<double>(), 1e-9) << k;
-  EXPECT_GT(std::abs(j["vertebrae"][13]["rotation_deg"][0].get<double>() - l3["rotation_deg"][0].get<double>()), 1e-3)
+    EXPECT_NEAR(l3["rotation_deg"][k].get<double>(), l4["rotation_deg"][k].get<double>(), 1e-9)
+        << k;
+  EXPECT_GT(std::abs(j["vertebrae"][13]["rotation_deg"][0].get<double>() -
+                     l3["rotation_deg"][0].get<double>()),
+            1e-3)
       << "L2-L3 (not fused) should bend";
 }
 
@@ -155,7 +164,8 @@ TEST(SpineSolveCliRefuses, BadOptions) {
 
 TEST(SpineSolveCliRefuses, NonConvergedSolveWritesNothing) {
   const std::string csv = tmp("not-converged.csv");
-  const CliRun r = run_spinesim("spine solve --force T7:0,0,300 --max-iterations 1 --csv " + in_quotes(csv));
+  const CliRun r =
+      run_spinesim("spine solve --force T7:0,0,300 --max-iterations 1 --csv " + in_quotes(csv));
   expect_refused(r, "equilibrium");
   EXPECT_FALSE(fs::exists(csv));
 }
@@ -173,8 +183,10 @@ TEST(ValidationStudy, TargetsAreTheLiteraturesAndTheMomentIsReached) {
   EXPECT_GT(a["t7_force_n"].get<double>(), 0.0);
   // The trunk's free body above L5-S1: the external moment is carried by the joint's spring and
   // by the muscles, ligaments and IAP.
-  EXPECT_NEAR(a["external_moment_nmm"].get<double>(),
-              a["joint_moment_nmm"].get<double>() + a["muscles_ligaments_iap_moment_nmm"].get<double>(), 1e-6);
+  EXPECT_NEAR(
+      a["external_moment_nmm"].get<double>(),
+      a["joint_moment_nmm"].get<double>() + a["muscles_ligaments_iap_moment_nmm"].get<double>(),
+      1e-6);
   const json& b = j["wilke"];
   EXPECT_DOUBLE_EQ(b["target"]["axial_n"].get<double>(), 3240.0);
   EXPECT_DOUBLE_EQ(b["target"]["tolerance"].get<double>(), 0.15);
@@ -194,7 +206,8 @@ TEST(ValidationStudy, McGillAndNormanL5S1Window) {
 TEST(ValidationStudy, WilkeCrateL4L5Window) {
   const json& b = study("validation")["wilke"];
   ASSERT_FALSE(b.is_null());
-  EXPECT_NEAR(b["axial_n"].get<double>(), 3240.0, 0.15 * 3240.0) << "L4-L5 axial (joint frame), crate held";
+  EXPECT_NEAR(b["axial_n"].get<double>(), 3240.0, 0.15 * 3240.0)
+      << "L4-L5 axial (joint frame), crate held";
 }
 
 // The lumbar-only model (--no-trunk-muscles) is the thesis's F.8-F.19 set: the flag reaches the model
@@ -211,13 +224,16 @@ TEST(ValidationStudy, NoTrunkMusclesRunsTheLumbarSetAndSaysSo) {
   EXPECT_GT(lumbar["wilke"]["axial_n"].get<double>(), full["wilke"]["axial_n"].get<double>());
   const CliRun t = run_spinesim("study validation --no-trunk-muscles");
   ASSERT_EQ(t.status, 0) << t.err;
-  EXPECT_NE(t.out.find("--no-trunk-muscles"), std::string::npos) << "the table names the muscle set";
+  EXPECT_NE(t.out.find("--no-trunk-muscles"), std::string::npos)
+      << "the table names the muscle set";
 }
 
 // --- study fusion (thesis 6.1) ----------------------------------------------------------------
 
 namespace {
-double force(const std::string& f, const std::string& l, const char* joint) { return fusion_run(f, l)[joint]["resultant_n"]; }
+double force(const std::string& f, const std::string& l, const char* joint) {
+  return fusion_run(f, l)[joint]["resultant_n"];
+}
 }  // namespace
 
 TEST(FusionStudy, TablesAndCsvCoverEveryFusionAndLoad) {
@@ -236,7 +252,8 @@ TEST(FusionStudy, TablesAndCsvCoverEveryFusionAndLoad) {
 TEST(FusionStudy, AdjacentLevelForcesRiseMostWithL3L4L5) {
   const std::string load = "forward";
   for (const char* joint : {"l2l3", "l5s1"}) {
-    for (const auto& f : fused_levels()) EXPECT_GT(force(f, load, joint), force("normal", load, joint)) << f << " " << joint;
+    for (const auto& f : fused_levels())
+      EXPECT_GT(force(f, load, joint), force("normal", load, joint)) << f << " " << joint;
     EXPECT_GT(force("L3-L4-L5", load, joint), force("L3-L4", load, joint)) << joint;
     EXPECT_GT(force("L3-L4-L5", load, joint), force("L4-L5", load, joint)) << joint;
   }
@@ -246,7 +263,8 @@ TEST(FusionStudy, AdjacentLevelForcesRiseMostWithL3L4L5) {
 // every fusion moves T1 less, L3-L4-L5 least. The forward case does not hold (targets file).
 TEST(FusionStudy, FusionReducesT1MotionUnderBackwardAndLateralForces) {
   for (const char* load : {"backward", "lateral"}) {
-    for (const auto& f : fused_levels()) EXPECT_LT(t1_motion(f, load), t1_motion("normal", load)) << f << ", " << load;
+    for (const auto& f : fused_levels())
+      EXPECT_LT(t1_motion(f, load), t1_motion("normal", load)) << f << ", " << load;
     EXPECT_LT(t1_motion("L3-L4-L5", load), t1_motion("L3-L4", load)) << load;
     EXPECT_LT(t1_motion("L3-L4-L5", load), t1_motion("L4-L5", load)) << load;
   }
@@ -281,14 +299,18 @@ TEST(SpineStudiesRefuse, BadForce) {
 // direct solves (tests/spine/test_database.cpp checks the shipped file against the model).
 TEST(SpineDatabaseCli, SmallGenerationWritesAFileThatChecks) {
   const std::string out = tmp("db-T7.json");
-  const CliRun gen = run_spinesim("spine database --quiet --vertebrae T7 --superposition-on T7 --magnitudes 300 --out " +
-                                  in_quotes(out) + " --json");
+  const CliRun gen = run_spinesim(
+      "spine database --quiet --vertebrae T7 --superposition-on T7 --magnitudes 300 --out " +
+      in_quotes(out) + " --json");
   ASSERT_EQ(gen.status, 0) << gen.err;
   const json meta = json::parse(gen.out);
-  EXPECT_EQ(meta["generation"]["solves"].get<int>(), 1 + 6 * 12);  // baseline + 6 directions × 12 forces
+  EXPECT_EQ(meta["generation"]["solves"].get<int>(),
+            1 + 6 * 12);  // baseline + 6 directions × 12 forces
   ASSERT_TRUE(fs::exists(out));
-  const CliRun check = run_spinesim("spine database --check --quiet --vertebrae T7 --superposition-on T7 "
-                                    "--magnitudes 300 --out " + in_quotes(out) + " --json");
+  const CliRun check = run_spinesim(
+      "spine database --check --quiet --vertebrae T7 --superposition-on T7 "
+      "--magnitudes 300 --out " +
+      in_quotes(out) + " --json");
   EXPECT_EQ(check.status, 0) << check.err;
 }
 
@@ -296,7 +318,8 @@ TEST(SpineDatabaseCli, SmallGenerationWritesAFileThatChecks) {
 // matches the model's direct solves, and is reported as such (exit 1, one line, file named).
 TEST(SpineDatabaseCli, CheckFailsOnAFileThatNoLongerMatchesTheModel) {
   const std::string out = tmp("db-T7-wrong.json");
-  const std::string args = "--quiet --vertebrae T7 --superposition-on T7 --magnitudes 300 --out " + in_quotes(out);
+  const std::string args =
+      "--quiet --vertebrae T7 --superposition-on T7 --magnitudes 300 --out " + in_quotes(out);
   ASSERT_EQ(run_spinesim("spine database " + args).status, 0);
   json db = json::parse(slurp(out));
   int changed = 0;
@@ -318,8 +341,13 @@ TEST(SpineDatabaseCli, CheckFailsOnAFileThatNoLongerMatchesTheModel) {
 
 TEST(SpineDatabaseCli, RefusesBadInput) {
   expect_refused(run_spinesim("spine database --quiet --out /nonexistent-folder/db.json"), "--out");
-  expect_refused(run_spinesim("spine database --quiet --vertebrae C3 --out " + in_quotes(tmp("db.json"))), "C3");
-  expect_refused(run_spinesim("spine database --quiet --magnitudes -5 --out " + in_quotes(tmp("db.json"))),
-                 "--magnitudes");
-  expect_refused(run_spinesim("spine database --check --quiet --out " + in_quotes(tmp("missing.json"))), "missing.json");
+  expect_refused(
+      run_spinesim("spine database --quiet --vertebrae C3 --out " + in_quotes(tmp("db.json"))),
+      "C3");
+  expect_refused(
+      run_spinesim("spine database --quiet --magnitudes -5 --out " + in_quotes(tmp("db.json"))),
+      "--magnitudes");
+  expect_refused(
+      run_spinesim("spine database --check --quiet --out " + in_quotes(tmp("missing.json"))),
+      "missing.json");
 }

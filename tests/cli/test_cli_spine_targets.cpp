@@ -18,7 +18,8 @@ using namespace spinesim::test_cli;
 TEST(SpineTargets, BackwardForceOnT1GivesAStableEquilibrium) {
   const json j = solve_json("--force T1:0,0,-300");
   ASSERT_FALSE(j.empty());
-  EXPECT_GT(j["stability"]["min_stiffness_nmm_per_rad"].get<double>(), 0.0) << j["stability"]["softest_mode"];
+  EXPECT_GT(j["stability"]["min_stiffness_nmm_per_rad"].get<double>(), 0.0)
+      << j["stability"]["softest_mode"];
 }
 
 // "spinal fusion at L3-L4-L5 will restrict the range of motion of the whole spine the most ...
@@ -28,6 +29,6 @@ TEST(SpineTargets, BackwardForceOnT1GivesAStableEquilibrium) {
 // cannot give that extension back.
 TEST(SpineTargets, FusionReducesT1MotionUnderTheForwardForce) {
   for (const char* load : {"forward"})
-    for (const auto& f : fused_levels()) EXPECT_LT(t1_motion(f, load), t1_motion("normal", load)) << f << ", " << load;
+    for (const auto& f : fused_levels())
+      EXPECT_LT(t1_motion(f, load), t1_motion("normal", load)) << f << ", " << load;
 }
-

@@ -37,7 +37,9 @@ struct Csv {
     static const std::vector<std::string> empty(32);
     return empty;
   }
-  double num(const std::string& key, const std::string& column) const { return std::stod(row(key).at(col(column))); }
+  double num(const std::string& key, const std::string& column) const {
+    return std::stod(row(key).at(col(column)));
+  }
 };
 
 Csv read_csv(const fs::path& path) {
@@ -130,9 +132,9 @@ TEST(ThesisTables, MuscleAttachmentsAndProperties) {
   const Csv ps = read_csv(kThesis / "F12_F13_psoas_major.csv");
   EXPECT_DOUBLE_EQ(ps.num("NStiss_149", "proximal_y_mm"), 223.13);
   // Every lumbar muscle has the thesis's 0.7 MPa maximum stress and lies on the right (x <= 0).
-  for (const char* f : {"F8_F9_multifidus.csv", "F10_F11_erector_spinae.csv", "F12_F13_psoas_major.csv",
-                        "F14_F15_quadratus_lumborum.csv", "F16_F17_external_oblique.csv",
-                        "F18_F19_internal_oblique.csv"}) {
+  for (const char* f : {"F8_F9_multifidus.csv", "F10_F11_erector_spinae.csv",
+                        "F12_F13_psoas_major.csv", "F14_F15_quadratus_lumborum.csv",
+                        "F16_F17_external_oblique.csv", "F18_F19_internal_oblique.csv"}) {
     const Csv m = read_csv(kThesis / f);
     for (const auto& r : m.rows) {
       EXPECT_DOUBLE_EQ(std::stod(r[m.col("max_stress_mpa")]), 0.7) << f << " " << r[0];
@@ -169,7 +171,8 @@ TEST(ThesisTables, AppendixCRecomputesTheBushing) {
   EXPECT_NEAR(h_mm, 177.433, 1e-3);
   EXPECT_NEAR(a_mm, 129.837, 1e-3);
   // P = rho g h: kg/m^3 * 1e-9 = kg/mm^3; times mm of mercury and m/s^2 gives N/mm^2.
-  const double p_n_mm2 = j.at("iap_mmhg").get<double>() * j.at("mercury_density_kg_m3").get<double>() * 1e-9 *
+  const double p_n_mm2 = j.at("iap_mmhg").get<double>() *
+                         j.at("mercury_density_kg_m3").get<double>() * 1e-9 *
                          j.at("gravity_m_s2").get<double>();
   const double k_y = 0.5 * p_n_mm2 * a_mm * a_mm;
   const double k_x = 0.5 * p_n_mm2 * a_mm * h_mm;
@@ -197,7 +200,8 @@ TEST(DataFiles, EveryCsvIsWellFormed) {
     const Csv c = read_csv(path);
     const std::string name = path.string();
     ASSERT_FALSE(c.comments.empty()) << name;
-    EXPECT_EQ(c.comments.front().rfind("# source:", 0), 0u) << name << ": first line must be '# source: ...'";
+    EXPECT_EQ(c.comments.front().rfind("# source:", 0), 0u)
+        << name << ": first line must be '# source: ...'";
     bool has_units = false;
     for (const auto& line : c.comments) has_units = has_units || line.rfind("# units:", 0) == 0;
     EXPECT_TRUE(has_units) << name;
@@ -213,16 +217,17 @@ TEST(DataFiles, EveryCsvIsWellFormed) {
 
 TEST(DataFiles, MuscleTablesHaveTheirRowCounts) {
   const std::map<std::string, std::size_t> rows = {
-      {"F8_F9_multifidus.csv", 19},           {"F10_F11_erector_spinae.csv", 9},
-      {"F12_F13_psoas_major.csv", 11},        {"F14_F15_quadratus_lumborum.csv", 5},
-      {"F16_F17_external_oblique.csv", 6},    {"F18_F19_internal_oblique.csv", 6}};
+      {"F8_F9_multifidus.csv", 19},        {"F10_F11_erector_spinae.csv", 9},
+      {"F12_F13_psoas_major.csv", 11},     {"F14_F15_quadratus_lumborum.csv", 5},
+      {"F16_F17_external_oblique.csv", 6}, {"F18_F19_internal_oblique.csv", 6}};
   for (const auto& [file, n] : rows) {
     const Csv c = read_csv(kThesis / file);
     EXPECT_EQ(c.rows.size(), n) << file;
     for (const auto& r : c.rows) {
       EXPECT_EQ(r.at(0).rfind("NStiss_", 0), 0u) << file;
       for (std::size_t k = 2; k < r.size(); ++k)
-        if (k != c.col("distal_segment")) EXPECT_NO_THROW((void)std::stod(r[k])) << file << " " << r[0];
+        if (k != c.col("distal_segment"))
+          EXPECT_NO_THROW((void)std::stod(r[k])) << file << " " << r[0];
     }
   }
 }

@@ -32,8 +32,10 @@ TEST(ShippedTunedDiscs, EveryLevelIsThereAndBeatsVanGelder) {
     // or held out, and its 6x6 diagonal is within 10 % of the FEM's.
     for (const char* set_name : {"train", "holdout"})
       for (const auto& c : d.report[set_name])
-        EXPECT_LT(c["tuned_error_linear"].get<double>(), c["untuned_error_linear"].get<double>()) << c["name"];
-    for (const auto& r : d.report["stiffness_diagonal"]["ratio_tuned"]) EXPECT_NEAR(r.get<double>(), 1.0, 0.10);
+        EXPECT_LT(c["tuned_error_linear"].get<double>(), c["untuned_error_linear"].get<double>())
+            << c["name"];
+    for (const auto& r : d.report["stiffness_diagonal"]["ratio_tuned"])
+      EXPECT_NEAR(r.get<double>(), 1.0, 0.10);
   }
 }
 
@@ -53,9 +55,11 @@ TEST(ShippedTunedDiscs, RegeneratingOneLevelReproducesItsScales) {
   const TunedDisc& shipped_disc = tuned_level(shipped(), level);
   mesh::MeshOptions opt;
   opt.cell_size_mm = shipped().settings["cell_size_mm"][level].get<double>();
-  const mesh::TetMesh m = mesh::mesh_parametric_disc(mesh::disc_dimensions(level, SPINESIM_DATA_DIR), opt,
-                                                    mesh::disc_frame_in_spine(level, SPINESIM_DATA_DIR));
-  const mesh::RegionMaterials materials = mesh::load_material(shipped().material_name, SPINESIM_DATA_DIR);
+  const mesh::TetMesh m =
+      mesh::mesh_parametric_disc(mesh::disc_dimensions(level, SPINESIM_DATA_DIR), opt,
+                                 mesh::disc_frame_in_spine(level, SPINESIM_DATA_DIR));
+  const mesh::RegionMaterials materials =
+      mesh::load_material(shipped().material_name, SPINESIM_DATA_DIR);
   EXPECT_EQ(check_applies(shipped_disc, m, materials), "");
 
   const Eigen::Vector3d c = fem::DiscFem::default_plate_center(m);
@@ -74,7 +78,8 @@ TEST(ShippedTunedDiscs, RegeneratingOneLevelReproducesItsScales) {
   w.stiffness = shipped_disc.report["weights"]["stiffness"];
   w.regularisation = shipped_disc.report["weights"]["regularisation"];
   Objective obj(lin, make_reference(fem, m, cases), train, w);
-  const CalibrationResult r = calibrate(obj, Eigen::VectorXd::Zero(Eigen::Index(lin.knobs().size())));
+  const CalibrationResult r =
+      calibrate(obj, Eigen::VectorXd::Zero(Eigen::Index(lin.knobs().size())));
   ASSERT_TRUE(r.success) << r.status;
   ASSERT_EQ(lin.knobs().size(), shipped_disc.scales.size());
   Eigen::VectorXd shipped_p(Eigen::Index(lin.knobs().size()));
@@ -84,7 +89,8 @@ TEST(ShippedTunedDiscs, RegeneratingOneLevelReproducesItsScales) {
 
   if (fingerprint(m) == shipped_disc.mesh) {
     for (std::size_t j = 0; j < lin.knobs().size(); ++j)
-      EXPECT_NEAR(r.log_scales(Eigen::Index(j)), shipped_p(Eigen::Index(j)), 1e-4) << knob_name(lin.knobs()[j]);
+      EXPECT_NEAR(r.log_scales(Eigen::Index(j)), shipped_p(Eigen::Index(j)), 1e-4)
+          << knob_name(lin.knobs()[j]);
     EXPECT_NEAR(r.final.value, shipped_J, 1e-4 * shipped_J);
     return;
   }
@@ -95,7 +101,8 @@ TEST(ShippedTunedDiscs, RegeneratingOneLevelReproducesItsScales) {
   for (std::size_t k = 0; k < with_shipped.cases.size(); ++k)
     EXPECT_NEAR(with_shipped.cases[k].displacement_error, r.final.cases[k].displacement_error, 0.01)
         << with_shipped.cases[k].name;
-  for (int i = 0; i < 6; ++i) EXPECT_NEAR(with_shipped.k6(i, i) / r.final.k6(i, i), 1.0, 0.02) << "K6 " << i;
+  for (int i = 0; i < 6; ++i)
+    EXPECT_NEAR(with_shipped.k6(i, i) / r.final.k6(i, i), 1.0, 0.02) << "K6 " << i;
 }
 
 }  // namespace

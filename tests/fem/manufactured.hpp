@@ -16,7 +16,6 @@
 
 namespace spinesim::fem::manufactured {
 
-
 struct Manufactured {
   Eigen::Matrix3d k;  ///< row m: wave vector of component m
   Eigen::Vector3d phase;
@@ -37,12 +36,13 @@ struct Manufactured {
   }
 };
 
-inline double solve_and_measure(int order, int n, const Manufactured& ms, const mesh::RegionMaterials& mat) {
+inline double solve_and_measure(int order, int n, const Manufactured& ms,
+                                const mesh::RegionMaterials& mat) {
   const mesh::TetMesh m = mesh::unit_cube_mesh(n);
   const FeSpace space = make_fe_space(m, order);
   const Eigen::SparseMatrix<double> K = assemble_stiffness(space, m.region, mat);
-  const Eigen::VectorXd f =
-      assemble_body_force(space, [&](const Eigen::Vector3d& x) { return ms.body_force(x); }, 5);
+  const Eigen::VectorXd f = assemble_body_force(
+      space, [&](const Eigen::Vector3d& x) { return ms.body_force(x); }, 5);
   std::vector<Eigen::Index> fixed;
   std::vector<double> values;
   for (Eigen::Index i = 0; i < space.num_nodes(); ++i) {
@@ -54,7 +54,8 @@ inline double solve_and_measure(int order, int n, const Manufactured& ms, const 
   }
   const Eigen::VectorXd u = solve_dirichlet(
       K, f, fixed, Eigen::Map<const Eigen::VectorXd>(values.data(), Eigen::Index(values.size())));
-  return l2_error(space, u, [&](const Eigen::Vector3d& x) { return ms.u(x); }, 6);
+  return l2_error(
+      space, u, [&](const Eigen::Vector3d& x) { return ms.u(x); }, 6);
 }
 
 /// Prints and returns the measured orders between successive n.

@@ -3,8 +3,8 @@
 // in the elasticity matrix, which displacement-only checks such as the patch test cannot see).
 #include "spinesim/fem/elasticity.hpp"
 
-#include <Eigen/Geometry>
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 
 #include <cmath>
 
@@ -18,7 +18,8 @@ TEST(AbsoluteScales, OneTetrahedronStoresTheStrainEnergyOfItsUniformStrain) {
       2.9, 0.4, 0.1,    //
       0.2, 3.3, 0.5,    //
       0.6, 0.2, 4.1;    // rows: vertices, mm
-  const double V = std::abs((X.row(1) - X.row(0)).dot((X.row(2) - X.row(0)).cross(X.row(3) - X.row(0)))) / 6.0;
+  const double V =
+      std::abs((X.row(1) - X.row(0)).dot((X.row(2) - X.row(0)).cross(X.row(3) - X.row(0)))) / 6.0;
   mesh::IsotropicMaterial mat;
   mat.youngs_modulus_mpa = 3.22;
   mat.poisson_ratio = 0.4557;

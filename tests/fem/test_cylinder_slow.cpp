@@ -100,7 +100,7 @@ TEST(Cylinder, TorsionTorqueIsGJThetaOverLWithP2) {
 
 TEST(Cylinder, AxialCompressionWithNuZeroIsEADeltaOverL) {
   const mesh::TetMesh& m = cylinder();
-  const double E = 10.0, delta = 0.05;  // MPa, mm
+  const double E = 10.0, delta = 0.05;                     // MPa, mm
   const double expected = E * kPi * kR * kR * delta / kL;  // N
   for (int order : {1, 2}) {
     const DiscFem fem(m, homogeneous(E, 0.0), order, top_center());

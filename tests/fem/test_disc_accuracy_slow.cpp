@@ -53,7 +53,12 @@ TEST(DiscAccuracySlow, P1AndP2ConvergeToTheSameStiffness) {
   cg.solver = LinearSolver::p_multigrid_cg;
   const Vector6d ref = DiscFem(fine, annulus_nucleus(), 2, c, cg).stiffness_6x6().diagonal();
   std::printf("reference P2 @ 1.0 mm: diag K6 = %s (N/mm x3, N·mm/rad x3)\n",
-              [&] { std::ostringstream os; os << ref.transpose(); return os.str(); }().c_str());
+              [&] {
+                std::ostringstream os;
+                os << ref.transpose();
+                return os.str();
+              }()
+                  .c_str());
   std::printf("order cell_mm     DOF   time_s   rel. error of diag(K6): tx ty tz rx ry rz\n");
   const auto report = [&](int order, double cell, const Timed& r) {
     const Vector6d e = (r.diag - ref).cwiseQuotient(ref);

@@ -61,7 +61,12 @@ TEST_P(DiscFemOrder, StiffnessIsSymmetricPositiveDefinite) {
   Eigen::SelfAdjointEigenSolver<Matrix6d> eig(K);
   EXPECT_GT(eig.eigenvalues().minCoeff(), 0.0);
   std::printf("P%d: %ld free DOF, K6 diag (N/mm, N·mm/rad): %s\n", GetParam(), long(fem.num_dofs()),
-              [&] { std::ostringstream os; os << K.diagonal().transpose(); return os.str(); }().c_str());
+              [&] {
+                std::ostringstream os;
+                os << K.diagonal().transpose();
+                return os.str();
+              }()
+                  .c_str());
 }
 
 TEST_P(DiscFemOrder, WrenchAndMotionSolvesAreConsistentWithK6) {
@@ -101,7 +106,8 @@ TEST_P(DiscFemOrder, ReactionMatchesDirectSumOverFullStiffness) {
   const Eigen::SparseMatrix<double> K = assemble_stiffness(space, m.region, mat);
   ASSERT_EQ(s.node_displacement_mm.rows(), space.num_nodes());
   Eigen::VectorXd u(3 * space.num_nodes());
-  for (Eigen::Index i = 0; i < space.num_nodes(); ++i) u.segment<3>(3 * i) = s.node_displacement_mm.row(i).transpose();
+  for (Eigen::Index i = 0; i < space.num_nodes(); ++i)
+    u.segment<3>(3 * i) = s.node_displacement_mm.row(i).transpose();
   const Eigen::VectorXd f = K * u;
   Vector6d reaction = Vector6d::Zero();
   double free_residual = 0, scale = 0;
@@ -159,7 +165,8 @@ TEST_P(DiscFemOrder, MirrorSymmetryForbidsOddEvenCoupling) {
   const int odd[3] = {0, 4, 5}, even[3] = {1, 2, 3};
   for (int i : odd)
     for (int j : even)
-      EXPECT_LT(std::abs(K(i, j)), 1e-9 * std::sqrt(K(i, i) * K(j, j))) << "K(" << i << "," << j << ")";
+      EXPECT_LT(std::abs(K(i, j)), 1e-9 * std::sqrt(K(i, i) * K(j, j)))
+          << "K(" << i << "," << j << ")";
   // ... while allowed couplings (e.g. tz with rx: shear with bending) are not zero.
   EXPECT_GT(std::abs(K(2, 3)), 1e-3 * std::sqrt(K(2, 2) * K(3, 3)));
 }
@@ -205,14 +212,16 @@ TEST(DiscFem, RejectsBadInputWithAClearMessage) {
 
   mesh::TetMesh unlabeled = m;
   unlabeled.surface.setZero();
-  EXPECT_NE(invalid_argument_message([&] { DiscFem(unlabeled, two_regions(), 1, c); }).find("endplate"),
-            std::string::npos);
+  EXPECT_NE(
+      invalid_argument_message([&] { DiscFem(unlabeled, two_regions(), 1, c); }).find("endplate"),
+      std::string::npos);
 
   const double nan = std::numeric_limits<double>::quiet_NaN();
   EXPECT_THROW(DiscFem(m, two_regions(), 1, Eigen::Vector3d(0, nan, 0)), std::invalid_argument);
   const DiscFem fem(m, two_regions(), 1, c);
-  EXPECT_NE(invalid_argument_message([&] { fem.solve_wrench(vec6(0, nan, 0, 0, 0, 0)); }).find("wrench"),
-            std::string::npos);
+  EXPECT_NE(
+      invalid_argument_message([&] { fem.solve_wrench(vec6(0, nan, 0, 0, 0, 0)); }).find("wrench"),
+      std::string::npos);
   EXPECT_THROW(fem.solve_motion(vec6(0, 0, 0, 0, std::numeric_limits<double>::infinity(), 0)),
                std::invalid_argument);
 
@@ -223,7 +232,8 @@ TEST(DiscFem, RejectsBadInputWithAClearMessage) {
 
 TEST(DiscFem, P2MultigridCgMatchesTheDirectSolver) {
   // A finer box so that the P1 coarse space is a real coarsening.
-  mesh::TetMesh m = with_inner_region(spinesim::mesh::mirrored_box_mesh(4, 4, 6, 30.0, 8.0, 24.0, -9.0));
+  mesh::TetMesh m =
+      with_inner_region(spinesim::mesh::mirrored_box_mesh(4, 4, 6, 30.0, 8.0, 24.0, -9.0));
   const Eigen::Vector3d c = DiscFem::default_plate_center(m);
   SolverOptions direct, cg;
   direct.solver = LinearSolver::direct;
@@ -232,7 +242,8 @@ TEST(DiscFem, P2MultigridCgMatchesTheDirectSolver) {
   const DiscFem b(m, two_regions(), 2, c, cg);
   EXPECT_EQ(a.timings().cg_iterations, 0);
   EXPECT_GT(b.timings().cg_iterations, 0);
-  std::printf("p-multigrid CG: %d iterations for %ld DOF\n", b.timings().cg_iterations, long(b.num_dofs()));
+  std::printf("p-multigrid CG: %d iterations for %ld DOF\n", b.timings().cg_iterations,
+              long(b.num_dofs()));
   EXPECT_LT(rel(b.stiffness_6x6(), a.stiffness_6x6()), 1e-10);
   EXPECT_LT(b.stiffness_asymmetry(), 1e-8);
   const Vector6d q = vec6(0.05, -0.2, 0.1, 0.01, -0.02, 0.005);

@@ -62,7 +62,8 @@ TEST(Quadrature, CollapsedRuleIsExactForMonomials) {
           for (Eigen::Index k = 0; k < q.weights.size(); ++k)
             s += q.weights(k) / 6.0 * std::pow(q.barycentric(k, 1), a) *
                  std::pow(q.barycentric(k, 2), b) * std::pow(q.barycentric(k, 3), c);
-          const double exact = factorial(a) * factorial(b) * factorial(c) / factorial(a + b + c + 3);
+          const double exact =
+              factorial(a) * factorial(b) * factorial(c) / factorial(a + b + c + 3);
           EXPECT_NEAR(s, exact, 1e-14) << "n=" << n << " a,b,c=" << a << b << c;
         }
   }
@@ -106,9 +107,11 @@ TEST(ElementStiffness, EnergyMatchesHighOrderIntegralOfStressTimesStrain) {
     Eigen::VectorXd ue(3 * N.rows());
     for (Eigen::Index a = 0; a < N.rows(); ++a) {  // linear (P1) or quadratic (P2) field
       const Eigen::Vector3d x = N.row(a).transpose();
-      ue.segment<3>(3 * a) << 0.1 * x.y() + 0.02 * x.z(), -0.05 * x.x() + 0.03 * x.y(), 0.04 * x.z();
+      ue.segment<3>(3 * a) << 0.1 * x.y() + 0.02 * x.z(), -0.05 * x.x() + 0.03 * x.y(),
+          0.04 * x.z();
       if (order == 2)
-        ue.segment<3>(3 * a) += Eigen::Vector3d(0.07 * x.x() * x.y(), -0.02 * x.z() * x.z(), 0.05 * x.x() * x.x());
+        ue.segment<3>(3 * a) +=
+            Eigen::Vector3d(0.07 * x.x() * x.y(), -0.02 * x.z() * x.z(), 0.05 * x.x() * x.x());
     }
     double energy = 0;
     const Matrix6d D = isotropic_elasticity(m);

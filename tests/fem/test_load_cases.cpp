@@ -21,8 +21,9 @@ using namespace spinesim;
 namespace {
 
 struct PlateResponse {
-  Eigen::Vector3d t, theta;         ///< plate translation (mm) and rotation (rad), disc frame
-  double anterior_uy = 0, posterior_uy = 0, left_uy = 0, right_uy = 0;  ///< axial motion of plate edges, mm
+  Eigen::Vector3d t, theta;  ///< plate translation (mm) and rotation (rad), disc frame
+  double anterior_uy = 0, posterior_uy = 0, left_uy = 0,
+         right_uy = 0;  ///< axial motion of plate edges, mm
 };
 
 /// The plate's response to `name` in the disc's own frame, and the axial displacement of the
@@ -49,13 +50,16 @@ PlateResponse respond(const mesh::TetMesh& m, const fem::DiscFem& fem, const std
 void check_anatomy(const mesh::TetMesh& m) {
   const auto materials = mesh::load_material("real-disc", SPINESIM_DATA_DIR);
   const fem::DiscFem fem(m, materials, 1, fem::DiscFem::default_plate_center(m));
-  const PlateResponse compression = respond(m, fem, "compression"), tension = respond(m, fem, "tension");
+  const PlateResponse compression = respond(m, fem, "compression"),
+                      tension = respond(m, fem, "tension");
   EXPECT_LT(compression.t.y(), 0) << "compression moves the superior plate down";
   EXPECT_GT(tension.t.y(), 0);
   EXPECT_GT(respond(m, fem, "shear-ap").t.z(), 0) << "shear-ap pushes the plate anteriorly";
-  EXPECT_GT(respond(m, fem, "shear-lat").t.x(), 0) << "shear-lat pushes the plate towards +x (the body's left)";
+  EXPECT_GT(respond(m, fem, "shear-lat").t.x(), 0)
+      << "shear-lat pushes the plate towards +x (the body's left)";
 
-  const PlateResponse flexion = respond(m, fem, "flexion"), extension = respond(m, fem, "extension");
+  const PlateResponse flexion = respond(m, fem, "flexion"),
+                      extension = respond(m, fem, "extension");
   EXPECT_GT(flexion.theta.x(), 0);
   EXPECT_LT(flexion.anterior_uy, 0) << "flexion closes the anterior annulus";
   EXPECT_GT(flexion.posterior_uy, 0) << "flexion opens the posterior annulus";
@@ -72,13 +76,14 @@ void check_anatomy(const mesh::TetMesh& m) {
   // Each moment case turns the plate mostly about its own axis.
   EXPECT_GT(std::abs(flexion.theta.x()), 3 * flexion.theta.tail<2>().norm());
   EXPECT_GT(std::abs(bending.theta.z()), 3 * bending.theta.head<2>().norm());
-  EXPECT_GT(std::abs(torsion.theta.y()), 3 * Eigen::Vector2d(torsion.theta.x(), torsion.theta.z()).norm());
+  EXPECT_GT(std::abs(torsion.theta.y()),
+            3 * Eigen::Vector2d(torsion.theta.x(), torsion.theta.z()).norm());
 }
 
 mesh::TetMesh structured(const std::string& level, bool in_spine) {
   const auto dims = mesh::disc_dimensions(level, SPINESIM_DATA_DIR);
-  return mesh::mesh_structured_disc(dims, {}, in_spine ? mesh::disc_frame_in_spine(level, SPINESIM_DATA_DIR)
-                                                       : mesh::DiscFrame());
+  return mesh::mesh_structured_disc(
+      dims, {}, in_spine ? mesh::disc_frame_in_spine(level, SPINESIM_DATA_DIR) : mesh::DiscFrame());
 }
 
 }  // namespace
@@ -87,7 +92,8 @@ TEST(LoadCases, AnatomicalSignsInTheDiscFrame) { check_anatomy(structured("L4-L5
 
 TEST(LoadCases, AnatomicalSignsAfterTheRotationIntoTheSpine) {
   const mesh::TetMesh m = structured("L4-L5", true);
-  ASSERT_GT((m.frame.axes - Eigen::Matrix3d::Identity()).norm(), 0.05) << "L4-L5 should be tilted in the spine";
+  ASSERT_GT((m.frame.axes - Eigen::Matrix3d::Identity()).norm(), 0.05)
+      << "L4-L5 should be tilted in the spine";
   check_anatomy(m);
 }
 
@@ -97,7 +103,11 @@ TEST(LoadCases, GlobalWrenchIsTheLocalOneRotated) {
   const mesh::TetMesh m = structured("L1-L2", true);
   for (const auto& c : fem::standard_load_cases()) {
     const fem::Vector6d w = fem::global_wrench(c, m.frame);
-    EXPECT_LE((w.head<3>() - m.frame.axes * c.wrench_local.head<3>()).norm(), 1e-12 * c.wrench_local.norm()) << c.name;
-    EXPECT_LE((w.tail<3>() - m.frame.axes * c.wrench_local.tail<3>()).norm(), 1e-12 * c.wrench_local.norm()) << c.name;
+    EXPECT_LE((w.head<3>() - m.frame.axes * c.wrench_local.head<3>()).norm(),
+              1e-12 * c.wrench_local.norm())
+        << c.name;
+    EXPECT_LE((w.tail<3>() - m.frame.axes * c.wrench_local.tail<3>()).norm(),
+              1e-12 * c.wrench_local.norm())
+        << c.name;
   }
 }

@@ -51,11 +51,13 @@ void run_patch_test(int order) {
   for (int v : bverts) add(v);
   for (Eigen::Index e = 0; e < space.edge_vertices.rows(); ++e) {
     const Eigen::Vector3d mid = space.X.row(space.num_vertices + e).transpose();
-    const bool on_face = (mid.array().abs() < 1e-12).any() || ((mid.array() - 1).abs() < 1e-12).any();
+    const bool on_face =
+        (mid.array().abs() < 1e-12).any() || ((mid.array() - 1).abs() < 1e-12).any();
     if (on_face) add(space.num_vertices + e);
   }
-  const Eigen::VectorXd u = solve_dirichlet(K, Eigen::VectorXd::Zero(K.rows()), fixed,
-                                            Eigen::Map<const Eigen::VectorXd>(values.data(), Eigen::Index(values.size())));
+  const Eigen::VectorXd u = solve_dirichlet(
+      K, Eigen::VectorXd::Zero(K.rows()), fixed,
+      Eigen::Map<const Eigen::VectorXd>(values.data(), Eigen::Index(values.size())));
   double max_err = 0, max_u = 0;
   Eigen::Index interior = 0;
   for (Eigen::Index i = 0; i < space.num_nodes(); ++i) {
@@ -80,10 +82,11 @@ void run_patch_test(int order) {
     for (int a = 0; a < 4; ++a) X.row(a) = space.X.row(space.elements(t, a));
     Eigen::VectorXd ue(3 * npe);
     for (int a = 0; a < npe; ++a) ue.segment<3>(3 * a) = u.segment<3>(3 * space.elements(t, a));
-    for (const Eigen::Vector4d& L : {Eigen::Vector4d(0.25, 0.25, 0.25, 0.25), Eigen::Vector4d(1, 0, 0, 0),
-                                     Eigen::Vector4d(0.1, 0.2, 0.3, 0.4)})
-      max_stress_err = std::max(max_stress_err,
-                                (element_stress(order, X, mat.fallback, ue, L) - sigma).norm());
+    for (const Eigen::Vector4d& L :
+         {Eigen::Vector4d(0.25, 0.25, 0.25, 0.25), Eigen::Vector4d(1, 0, 0, 0),
+          Eigen::Vector4d(0.1, 0.2, 0.3, 0.4)})
+      max_stress_err =
+          std::max(max_stress_err, (element_stress(order, X, mat.fallback, ue, L) - sigma).norm());
   }
   EXPECT_LT(max_stress_err, 1e-10 * sigma.norm()) << "P" << order << " stress not constant";
 }
@@ -96,6 +99,8 @@ TEST(PatchTest, P2ReproducesLinearFieldAndConstantStress) { run_patch_test(2); }
 TEST(Dirichlet, RejectsBadInput) {
   Eigen::SparseMatrix<double> K(3, 3);
   K.setIdentity();
-  EXPECT_THROW(solve_dirichlet(K, Eigen::VectorXd::Zero(2), {}, Eigen::VectorXd()), std::invalid_argument);
-  EXPECT_THROW(solve_dirichlet(K, Eigen::VectorXd::Zero(3), {5}, Eigen::VectorXd::Zero(1)), std::invalid_argument);
+  EXPECT_THROW(solve_dirichlet(K, Eigen::VectorXd::Zero(2), {}, Eigen::VectorXd()),
+               std::invalid_argument);
+  EXPECT_THROW(solve_dirichlet(K, Eigen::VectorXd::Zero(3), {5}, Eigen::VectorXd::Zero(1)),
+               std::invalid_argument);
 }

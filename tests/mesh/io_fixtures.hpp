@@ -20,8 +20,10 @@ inline TetMesh kuhn_cube_mesh() {
   TetMesh m;
   const double h = 12.345678901234567, o = 1.0 / 3.0;
   m.V.resize(8, 3);
-  for (int i = 0; i < 8; ++i) m.V.row(i) << o + h * (i & 1), o + h * ((i >> 1) & 1), o + h * ((i >> 2) & 1);
-  const int kuhn[6][4] = {{0, 1, 3, 7}, {0, 1, 5, 7}, {0, 2, 3, 7}, {0, 2, 6, 7}, {0, 4, 5, 7}, {0, 4, 6, 7}};
+  for (int i = 0; i < 8; ++i)
+    m.V.row(i) << o + h * (i & 1), o + h * ((i >> 1) & 1), o + h * ((i >> 2) & 1);
+  const int kuhn[6][4] = {{0, 1, 3, 7}, {0, 1, 5, 7}, {0, 2, 3, 7},
+                          {0, 2, 6, 7}, {0, 4, 5, 7}, {0, 4, 6, 7}};
   m.T.resize(6, 4);
   for (int t = 0; t < 6; ++t) {
     m.T.row(t) << kuhn[t][0], kuhn[t][1], kuhn[t][2], kuhn[t][3];

@@ -14,7 +14,8 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 
 // Shoelace area and centroid of a closed polygon in (x, z).
-void polygon_area_centroid(const std::vector<Eigen::Vector2d>& p, double& area, Eigen::Vector2d& c) {
+void polygon_area_centroid(const std::vector<Eigen::Vector2d>& p, double& area,
+                           Eigen::Vector2d& c) {
   area = 0;
   c.setZero();
   for (std::size_t i = 0; i < p.size(); ++i) {
@@ -33,8 +34,10 @@ TEST(KidneyOutline, ExtentsAreExactlyWidthAndDepth) {
     const KidneyOutline o(w, d);
     double xmin = 1e9, xmax = -1e9, zmin = 1e9, zmax = -1e9;
     for (const auto& p : o.sample(200000)) {
-      xmin = std::min(xmin, p.x()); xmax = std::max(xmax, p.x());
-      zmin = std::min(zmin, p.y()); zmax = std::max(zmax, p.y());
+      xmin = std::min(xmin, p.x());
+      xmax = std::max(xmax, p.x());
+      zmin = std::min(zmin, p.y());
+      zmax = std::max(zmax, p.y());
     }
     EXPECT_NEAR(xmax - xmin, w, 1e-7 * w);
     EXPECT_NEAR(zmax - zmin, d, 1e-7 * d);

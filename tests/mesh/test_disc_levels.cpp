@@ -112,8 +112,8 @@ TEST(DiscFrame, OrthonormalRightHandedAndAnterior) {
     const Eigen::Matrix3d& r = f.axes;
     EXPECT_TRUE((r.transpose() * r).isApprox(Eigen::Matrix3d::Identity(), 1e-12));
     EXPECT_NEAR(r.determinant(), 1.0, 1e-12);
-    EXPECT_GT(r(1, 1), 0.8);  // axial axis points up (within ~37 degrees of global y)
-    EXPECT_GT(r(2, 2), 0.0);  // anterior axis has a positive global-z component
+    EXPECT_GT(r(1, 1), 0.8);           // axial axis points up (within ~37 degrees of global y)
+    EXPECT_GT(r(2, 2), 0.0);           // anterior axis has a positive global-z component
     EXPECT_NEAR(r(0, 0), 1.0, 1e-12);  // the thesis spine is symmetric: lateral = global x
   }
 }

@@ -38,9 +38,12 @@ MeditFile parse_medit(const std::string& path) {
   std::string word;
   const std::map<std::string, int> width = {{"Vertices", 4}, {"Tetrahedra", 5}, {"Triangles", 4}};
   while (is >> word) {
-    if (word == "MeshVersionFormatted") is >> f.version;
-    else if (word == "Dimension") is >> f.dimension;
-    else if (word == "End") f.ended = true;
+    if (word == "MeshVersionFormatted")
+      is >> f.version;
+    else if (word == "Dimension")
+      is >> f.dimension;
+    else if (word == "End")
+      f.ended = true;
     else if (width.count(word)) {
       std::size_t n;
       is >> n;
@@ -130,7 +133,8 @@ TEST(IoMedit, MeshioReadsIt) {
       "/usr/bin/python3 -c \"import sys, meshio; m = meshio.read(sys.argv[1]); "
       "d = {c.type: len(c.data) for c in m.cells}; "
       "print(len(m.points), d.get('tetra', 0), d.get('triangle', 0), "
-      "int(sum(sum(r) for r in m.cell_data['medit:ref'][:1])))\" " + path + " > " + out + " 2>&1";
+      "int(sum(sum(r) for r in m.cell_data['medit:ref'][:1])))\" " +
+      path + " > " + out + " 2>&1";
   ASSERT_EQ(std::system(cmd.c_str()), 0) << std::ifstream(out).rdbuf();
   std::ifstream is(out);
   long np = -1, nt = -1, nf = -1, ref_sum = -1;

@@ -46,7 +46,8 @@ std::vector<PvdEntry> sample_entries() {
 }
 
 bool has_python3() {
-  return fs::exists("/usr/bin/python3") && std::system("/usr/bin/python3 -c 'import xml.etree.ElementTree' >/dev/null 2>&1") == 0;
+  return fs::exists("/usr/bin/python3") &&
+         std::system("/usr/bin/python3 -c 'import xml.etree.ElementTree' >/dev/null 2>&1") == 0;
 }
 
 }  // namespace
@@ -95,7 +96,9 @@ TEST(IoPvd, ShortestTimesAndOneLinePerDataset) {
   EXPECT_NE(text.find("timestep=\"0.001\""), std::string::npos) << text;
   EXPECT_NE(text.find("type=\"Collection\""), std::string::npos);
   std::size_t n = 0;
-  for (std::size_t at = text.find("<DataSet"); at != std::string::npos; at = text.find("<DataSet", at + 1)) ++n;
+  for (std::size_t at = text.find("<DataSet"); at != std::string::npos;
+       at = text.find("<DataSet", at + 1))
+    ++n;
   EXPECT_EQ(n, 3u);
   EXPECT_EQ(count_files(dir), 1);  // no temporary left behind
 }

@@ -32,7 +32,8 @@ std::string spit(const std::string& path, const std::string& text) {
 }
 
 /// Binary STL with the given triangles (each 9 floats).
-std::string write_binary_stl(const std::string& path, const std::vector<std::array<float, 9>>& tris) {
+std::string write_binary_stl(const std::string& path,
+                             const std::vector<std::array<float, 9>>& tris) {
   std::ofstream os(path, std::ios::binary);
   char header[80] = "binary stl written by test_io_surface";
   os.write(header, 80);
@@ -134,7 +135,10 @@ TEST(IoSurface, EveryUpAxisMapIsARotationSendingUpToPlusY) {
   const std::string path = spit(dir + "/axes.off",
                                 "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n"
                                 "3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n");
-  const struct { UpAxis up; Eigen::Vector3d up_file; } cases[] = {
+  const struct {
+    UpAxis up;
+    Eigen::Vector3d up_file;
+  } cases[] = {
       {UpAxis::x, {1, 0, 0}},        {UpAxis::y, {0, 1, 0}},        {UpAxis::z, {0, 0, 1}},
       {UpAxis::minus_x, {-1, 0, 0}}, {UpAxis::minus_y, {0, -1, 0}}, {UpAxis::minus_z, {0, 0, -1}},
   };
@@ -160,10 +164,12 @@ TEST(IoSurface, BadInputGivesOneLineErrors) {
   expect_error(spit(dir + "/garbage.ply", "not a ply\n"), 1, "cannot be read");
   // CGAL's own check lets index == vertex count through; ours does not.
   expect_error(spit(dir + "/range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n"), 1, "out of range");
-  expect_error(spit(dir + "/range.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n"), 1, "cannot be read");
+  expect_error(spit(dir + "/range.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n"), 1,
+               "cannot be read");
   expect_error(spit(dir + "/edge.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n"), 1, "fewer than 3");
   const float nan = std::numeric_limits<float>::quiet_NaN();
-  expect_error(write_binary_stl(dir + "/nan.stl", {{0, 0, 0, 1, 0, 0, 0, nan, 0}}), 1, "non-finite");
+  expect_error(write_binary_stl(dir + "/nan.stl", {{0, 0, 0, 1, 0, 0, 0, nan, 0}}), 1,
+               "non-finite");
   const std::string ok = spit(dir + "/ok.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
   EXPECT_NO_THROW(read_surface(ok, 1, UpAxis::y));
   expect_error(ok, 0, "unit scale");
@@ -178,7 +184,8 @@ TEST(IoSurface, RealL4BodyBoundingBoxAndAnteriorDirection) {
   if (!fs::exists(root / "L4_body.obj") || !fs::exists(root / "L4_Schrumpfverpacken.obj"))
     GTEST_SKIP() << "external test data not found under " << root;
   const TriSurface body = read_surface((root / "L4_body.obj").string(), 1000.0, UpAxis::z);
-  const TriSurface whole = read_surface((root / "L4_Schrumpfverpacken.obj").string(), 1000.0, UpAxis::z);
+  const TriSurface whole =
+      read_surface((root / "L4_Schrumpfverpacken.obj").string(), 1000.0, UpAxis::z);
   EXPECT_EQ(body.V.rows(), 2356);
   EXPECT_EQ(body.F.rows(), 4078);
   const Eigen::RowVector3d lo = body.V.colwise().minCoeff(), hi = body.V.colwise().maxCoeff();

@@ -166,7 +166,7 @@ TEST(IoVtu, ReadsVtkStyleSeparatelyEncodedBinaryHeaders) {
   const TetMesh m = read_vtu(data_file("tet_vtk_style_binary.vtu"));
   ASSERT_EQ(m.num_vertices(), 4);
   ASSERT_EQ(m.num_tets(), 1);
-  EXPECT_EQ(m.region(0), 1);                   // missing region -> 1
+  EXPECT_EQ(m.region(0), 1);                       // missing region -> 1
   EXPECT_EQ(m.surface, Eigen::VectorXi::Zero(4));  // missing surface -> 0
   EXPECT_EQ(m.V(1, 0), 2.0);
   EXPECT_EQ(m.V(3, 2), 2.0);
@@ -307,18 +307,22 @@ TEST(IoVtu, ReadsEveryEncodingMeshioWritesAndAppendedData) {
     EXPECT_EQ(r.surface, m.surface);
     ASSERT_EQ(pd2.size(), pd.size());
     for (const DataArray& want : pd) {
-      const auto got = std::find_if(pd2.begin(), pd2.end(), [&](const DataArray& a) { return a.name == want.name; });
+      const auto got = std::find_if(pd2.begin(), pd2.end(),
+                                    [&](const DataArray& a) { return a.name == want.name; });
       ASSERT_NE(got, pd2.end()) << want.name;
       ASSERT_EQ(got->values.rows(), want.values.rows()) << want.name;
       ASSERT_EQ(got->values.cols(), want.values.cols()) << want.name;
-      EXPECT_LE((got->values - want.values).cwiseAbs().maxCoeff(), tol * want.values.cwiseAbs().maxCoeff() + (ascii ? 1e-300 : 0))
+      EXPECT_LE((got->values - want.values).cwiseAbs().maxCoeff(),
+                tol * want.values.cwiseAbs().maxCoeff() + (ascii ? 1e-300 : 0))
           << want.name;
     }
     ASSERT_EQ(cd2.size(), 1u);
     EXPECT_EQ(cd2[0].name, "volume");
     EXPECT_LE((cd2[0].values - volume).cwiseAbs().maxCoeff(), tol * volume.cwiseAbs().maxCoeff());
   }
-  EXPECT_EQ(files, 1 + 6 + 4 + 8);  // VTU ascii, binary x 3 compressions x 2 headers, legacy x 4, appended x 8
+  EXPECT_EQ(
+      files,
+      1 + 6 + 4 + 8);  // VTU ascii, binary x 3 compressions x 2 headers, legacy x 4, appended x 8
 }
 
 TEST(IoVtu, ReadsQuadraticTetsFromMeshio) {
@@ -375,75 +379,119 @@ TEST(IoVtu, MissingFile) {
 }
 
 TEST(IoVtu, BadFilesGiveOneLineErrors) {
-  expect_read_error("not_xml", [](std::string& s) { s = "solid cube\nthis is not xml"; }, "XML");
-  expect_read_error("polydata", [](std::string& s) {
-    replace_once(s, "type=\"UnstructuredGrid\"", "type=\"PolyData\"");
-  }, "not an UnstructuredGrid");
-  expect_read_error("npoints", [](std::string& s) {
-    replace_once(s, "NumberOfPoints=\"8\"", "NumberOfPoints=\"9\"");
-  }, "NumberOfPoints");
-  expect_read_error("index_range", [](std::string& s) {
-    const auto [a, b] = array_body(s, "connectivity");
-    s.replace(a, b - a, "0 1 3 7 0 1 5 7 0 2 3 7 0 2 6 7 0 4 5 7 0 4 6 8");
-  }, "connectivity");
-  expect_read_error("nan_point", [](std::string& s) {
-    const auto [a, b] = array_body(s, "Points");
-    const auto first = s.find_first_not_of(" \n", a);
-    s.replace(first, s.find(' ', first) - first, "nan");
-  }, "non-finite");
-  expect_read_error("garbage_number", [](std::string& s) {
-    const auto [a, b] = array_body(s, "Points");
-    s.insert(a, " 1.0abc ");
-  }, "not a number");
-  expect_read_error("truncated_base64", [](std::string& s) {
-    const auto [a, b] = array_body(s, "Points");
-    s.erase(a + (b - a) / 2, b - a - (b - a) / 2);
-  }, "truncated", VtuEncoding::binary);
-  expect_read_error("bad_base64_char", [](std::string& s) {
-    const auto [a, b] = array_body(s, "Points");
-    s[a + 20] = '*';
-  }, "base64", VtuEncoding::binary);
-  expect_read_error("appended", [](std::string& s) {
-    replace_once(s, "format=\"ascii\">", "format=\"appended\" offset=\"0\">");
-  }, "appended");
-  expect_read_error("lz4", [](std::string& s) {
-    replace_once(s, "header_type=", "compressor=\"vtkLZ4DataCompressor\" header_type=");
-  }, "vtkLZ4DataCompressor");
-  expect_read_error("corrupt_zlib", [](std::string& s) {
-    // A compressed file whose block does not inflate: a 1-block header, then garbage.
-    replace_once(s, "header_type=\"UInt64\"", "header_type=\"UInt32\" compressor=\"vtkZLibDataCompressor\"");
-    const auto [a, b] = array_body(s, "Points");
-    s.replace(a, b - a, "AQAAAGAAAABgAAAACAAAAA==AAECAwQFBgc=");
-  }, "does not decompress", VtuEncoding::binary);
-  expect_read_error("huge_block", [](std::string& s) {
-    // 2^32-1 blocks announced in 12 bytes of data.
-    replace_once(s, "header_type=\"UInt64\"", "header_type=\"UInt32\" compressor=\"vtkZLibDataCompressor\"");
-    const auto [a, b] = array_body(s, "Points");
-    s.replace(a, b - a, "/////wAAAAAAAAAA");
-  }, "truncated", VtuEncoding::binary);
-  expect_read_error("hexahedron", [](std::string& s) {
-    const auto [a, b] = array_body(s, "types");
-    s.replace(a, b - a, "10 10 10 10 10 12");
-  }, "hexahedron");
-  expect_read_error("offsets", [](std::string& s) {
-    const auto [a, b] = array_body(s, "offsets");
-    s.replace(a, b - a, "4 8 12 16 20 23");
-  }, "offsets");
-  expect_read_error("region_size", [](std::string& s) {
-    const auto [a, b] = array_body(s, "region");
-    s.replace(a, b - a, "1 2 1");
-  }, "region");
-  expect_read_error("inverted", [](std::string& s) {
-    const auto [a, b] = array_body(s, "connectivity");
-    const std::string body = s.substr(a, b - a);
-    // swap the last two indices of the first tet
-    std::istringstream is(body);
-    std::vector<std::string> v{std::istream_iterator<std::string>(is), {}};
-    std::swap(v[2], v[3]);
-    std::string out;
-    for (const auto& x : v) out += x + " ";
-    s.replace(a, b - a, out);
-  }, "inverted");
+  expect_read_error(
+      "not_xml", [](std::string& s) { s = "solid cube\nthis is not xml"; }, "XML");
+  expect_read_error(
+      "polydata",
+      [](std::string& s) { replace_once(s, "type=\"UnstructuredGrid\"", "type=\"PolyData\""); },
+      "not an UnstructuredGrid");
+  expect_read_error(
+      "npoints",
+      [](std::string& s) { replace_once(s, "NumberOfPoints=\"8\"", "NumberOfPoints=\"9\""); },
+      "NumberOfPoints");
+  expect_read_error(
+      "index_range",
+      [](std::string& s) {
+        const auto [a, b] = array_body(s, "connectivity");
+        s.replace(a, b - a, "0 1 3 7 0 1 5 7 0 2 3 7 0 2 6 7 0 4 5 7 0 4 6 8");
+      },
+      "connectivity");
+  expect_read_error(
+      "nan_point",
+      [](std::string& s) {
+        const auto [a, b] = array_body(s, "Points");
+        const auto first = s.find_first_not_of(" \n", a);
+        s.replace(first, s.find(' ', first) - first, "nan");
+      },
+      "non-finite");
+  expect_read_error(
+      "garbage_number",
+      [](std::string& s) {
+        const auto [a, b] = array_body(s, "Points");
+        s.insert(a, " 1.0abc ");
+      },
+      "not a number");
+  expect_read_error(
+      "truncated_base64",
+      [](std::string& s) {
+        const auto [a, b] = array_body(s, "Points");
+        s.erase(a + (b - a) / 2, b - a - (b - a) / 2);
+      },
+      "truncated", VtuEncoding::binary);
+  expect_read_error(
+      "bad_base64_char",
+      [](std::string& s) {
+        const auto [a, b] = array_body(s, "Points");
+        s[a + 20] = '*';
+      },
+      "base64", VtuEncoding::binary);
+  expect_read_error(
+      "appended",
+      [](std::string& s) {
+        replace_once(s, "format=\"ascii\">", "format=\"appended\" offset=\"0\">");
+      },
+      "appended");
+  expect_read_error(
+      "lz4",
+      [](std::string& s) {
+        replace_once(s, "header_type=", "compressor=\"vtkLZ4DataCompressor\" header_type=");
+      },
+      "vtkLZ4DataCompressor");
+  expect_read_error(
+      "corrupt_zlib",
+      [](std::string& s) {
+        // A compressed file whose block does not inflate: a 1-block header, then garbage.
+        replace_once(s, "header_type=\"UInt64\"",
+                     "header_type=\"UInt32\" compressor=\"vtkZLibDataCompressor\"");
+        const auto [a, b] = array_body(s, "Points");
+        s.replace(a, b - a, "AQAAAGAAAABgAAAACAAAAA==AAECAwQFBgc=");
+      },
+      "does not decompress", VtuEncoding::binary);
+  expect_read_error(
+      "huge_block",
+      [](std::string& s) {
+        // 2^32-1 blocks announced in 12 bytes of data.
+        replace_once(s, "header_type=\"UInt64\"",
+                     "header_type=\"UInt32\" compressor=\"vtkZLibDataCompressor\"");
+        const auto [a, b] = array_body(s, "Points");
+        s.replace(a, b - a, "/////wAAAAAAAAAA");
+      },
+      "truncated", VtuEncoding::binary);
+  expect_read_error(
+      "hexahedron",
+      [](std::string& s) {
+        const auto [a, b] = array_body(s, "types");
+        s.replace(a, b - a, "10 10 10 10 10 12");
+      },
+      "hexahedron");
+  expect_read_error(
+      "offsets",
+      [](std::string& s) {
+        const auto [a, b] = array_body(s, "offsets");
+        s.replace(a, b - a, "4 8 12 16 20 23");
+      },
+      "offsets");
+  expect_read_error(
+      "region_size",
+      [](std::string& s) {
+        const auto [a, b] = array_body(s, "region");
+        s.replace(a, b - a, "1 2 1");
+      },
+      "region");
+  expect_read_error(
+      "inverted",
+      [](std::string& s) {
+        const auto [a, b] = array_body(s, "connectivity");
+        const std::string body = s.substr(a, b - a);
+        // swap the last two indices of the first tet
+        std::istringstream is(body);
+        std::vector<std::string> v{std::istream_iterator<std::string>(is), {}};
+        std::swap(v[2], v[3]);
+        std::string out;
+        for (const auto& x : v) out += x + " ";
+        s.replace(a, b - a, out);
+      },
+      "inverted");
 }
 
 TEST(IoVtu, RefusesNonFiniteDataAndLeavesNoFile) {
@@ -457,7 +505,8 @@ TEST(IoVtu, RefusesNonFiniteDataAndLeavesNoFile) {
       write_vtu(path, m, pd, {}, {enc});
       FAIL() << "NaN accepted";
     } catch (const std::invalid_argument& e) {
-      EXPECT_NE(std::string(e.what()).find("contains non-finite values"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("contains non-finite values"), std::string::npos)
+          << e.what();
     }
   }
   m.V(2, 2) = std::numeric_limits<double>::infinity();
@@ -472,8 +521,10 @@ TEST(IoVtu, RefusesBadArraysAndLabels) {
   const std::string path = dir + "/out.vtu";
   const TetMesh m = cube_mesh();
   EXPECT_THROW(write_vtu(path, m, {{"short", Eigen::MatrixXd::Zero(3, 1)}}), std::invalid_argument);
-  EXPECT_THROW(write_vtu(path, m, {{"surface", Eigen::MatrixXd::Zero(8, 1)}}), std::invalid_argument);
-  EXPECT_THROW(write_vtu(path, m, {}, {{"region", Eigen::MatrixXd::Zero(6, 1)}}), std::invalid_argument);
+  EXPECT_THROW(write_vtu(path, m, {{"surface", Eigen::MatrixXd::Zero(8, 1)}}),
+               std::invalid_argument);
+  EXPECT_THROW(write_vtu(path, m, {}, {{"region", Eigen::MatrixXd::Zero(6, 1)}}),
+               std::invalid_argument);
   EXPECT_THROW(write_vtu(path, m, {{"", Eigen::MatrixXd::Zero(8, 1)}}), std::invalid_argument);
   TetMesh bad = m;
   bad.region.resize(2);

@@ -33,7 +33,9 @@ std::string refusal(F&& f) {
   return "";
 }
 
-bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+bool contains(const std::string& s, const std::string& part) {
+  return s.find(part) != std::string::npos;
+}
 
 TEST(MaterialPresets, AllLoadAndValidate) {
   for (const char* name : {"real-disc", "annulus-nucleus", "rubber", "polyethylene"}) {
@@ -83,8 +85,8 @@ TEST(MaterialPresets, Table51RawEGPairsAreRefusedWithTheImpliedNu) {
       refusal([] { load_material(kData + "/materials/invalid/table5.1-rubber-EG.json", kData); });
   EXPECT_TRUE(contains(rubber, "nu")) << rubber;
   EXPECT_TRUE(contains(rubber, "24")) << rubber;  // E/(2G) - 1 = 30/1.2 - 1
-  const std::string pe =
-      refusal([] { load_material(kData + "/materials/invalid/table5.1-polyethylene-EG.json", kData); });
+  const std::string pe = refusal(
+      [] { load_material(kData + "/materials/invalid/table5.1-polyethylene-EG.json", kData); });
   EXPECT_TRUE(contains(pe, "nu")) << pe;
   EXPECT_TRUE(contains(pe, "-0.145")) << pe;  // 200/234 - 1
 }
@@ -99,7 +101,7 @@ TEST(MaterialJson, BadConstantsAreRefusedWithTheReason) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   auto msg = [](const json& j) { return refusal([&] { material_from_json(j); }); };
 
-  EXPECT_TRUE(contains(msg({{"E_mpa", 0.0}, {"nu", 0.3}}), "Young's modulus")) ;
+  EXPECT_TRUE(contains(msg({{"E_mpa", 0.0}, {"nu", 0.3}}), "Young's modulus"));
   EXPECT_TRUE(contains(msg({{"E_mpa", -1.0}, {"nu", 0.3}}), "Young's modulus"));
   EXPECT_TRUE(contains(msg({{"E_mpa", 1.0}, {"nu", 0.5}}), "Poisson"));
   EXPECT_TRUE(contains(msg({{"E_mpa", 1.0}, {"nu", 0.7}}), "Poisson"));
@@ -113,7 +115,8 @@ TEST(MaterialJson, BadConstantsAreRefusedWithTheReason) {
   EXPECT_TRUE(contains(msg({{"E_mpa", "soft"}, {"nu", 0.3}}), "number"));
   EXPECT_TRUE(contains(msg({{"E_mpa", 1.0}, {"nu", 0.3}, {"G_mpa", 0.4}}), "exactly one"));
   EXPECT_TRUE(contains(msg({{"annulus", {{"E_mpa", 4.2}, {"nu", 0.45}}}}), "both"));
-  EXPECT_TRUE(contains(msg({{"annulus", {{"E_mpa", 4.2}, {"nu", 0.45}}}, {"nucleus", {{"E_mpa", 1.0}}}}), "nu"));
+  EXPECT_TRUE(contains(
+      msg({{"annulus", {{"E_mpa", 4.2}, {"nu", 0.45}}}, {"nucleus", {{"E_mpa", 1.0}}}}), "nu"));
 }
 
 TEST(MaterialFiles, UnknownPresetListsTheKnownOnes) {

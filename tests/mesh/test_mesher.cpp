@@ -56,10 +56,21 @@ TEST(Mesher, SurfaceLabelsSitOnTheirSurfaces) {
   int wall = 0, sup = 0, inf = 0;
   for (Eigen::Index v = 0; v < m.num_vertices(); ++v) {
     switch (Surface(m.surface(v))) {
-      case Surface::superior_endplate: ++sup; EXPECT_NEAR(m.V(v, 1), half, 1e-3); break;
-      case Surface::inferior_endplate: ++inf; EXPECT_NEAR(m.V(v, 1), -half, 1e-3); break;
-      case Surface::outer_wall: ++wall; EXPECT_LT(std::abs(m.V(v, 1)), half); break;
-      default: EXPECT_LT(std::abs(m.V(v, 1)), half); break;
+      case Surface::superior_endplate:
+        ++sup;
+        EXPECT_NEAR(m.V(v, 1), half, 1e-3);
+        break;
+      case Surface::inferior_endplate:
+        ++inf;
+        EXPECT_NEAR(m.V(v, 1), -half, 1e-3);
+        break;
+      case Surface::outer_wall:
+        ++wall;
+        EXPECT_LT(std::abs(m.V(v, 1)), half);
+        break;
+      default:
+        EXPECT_LT(std::abs(m.V(v, 1)), half);
+        break;
     }
   }
   EXPECT_GT(sup, 20);
@@ -118,10 +129,12 @@ TEST(Mesher, L4L5AtOnePointFiveMillimetres) {
   o.cell_size_mm = 1.5;
   const auto t0 = std::chrono::steady_clock::now();
   const TetMesh m = mesh_parametric_disc(l4_l5(), o);
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const auto q = quality_report(m, parametric_disc_volume(l4_l5()));
   std::printf("L4-L5 @ 1.5 mm: %lld tets, %.2f s, dihedral %.1f..%.1f deg, volume error %.3f %%\n",
-              (long long)q.tets, seconds, q.min_dihedral_deg, q.max_dihedral_deg, 100 * q.volume_error());
+              (long long)q.tets, seconds, q.min_dihedral_deg, q.max_dihedral_deg,
+              100 * q.volume_error());
   EXPECT_GE(q.min_dihedral_deg, 10.0);
   EXPECT_LT(std::abs(q.volume_error()), 0.02);
   EXPECT_NEAR(double(q.annulus_tets + q.nucleus_tets), double(q.tets), 0.0);

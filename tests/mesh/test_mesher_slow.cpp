@@ -21,8 +21,9 @@ TEST(MesherSlow, L4L5SizeSweep) {
     const TetMesh m = mesh_parametric_disc(d, o);
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const auto q = quality_report(m, parametric_disc_volume(d));
-    std::printf("%5.1f %7lld %7.2f %8.2f %8.2f %8.2f %9.3f\n", h, (long long)q.tets, s, q.min_dihedral_deg,
-                q.max_dihedral_deg, q.max_radius_edge_ratio, 100 * q.volume_error());
+    std::printf("%5.1f %7lld %7.2f %8.2f %8.2f %8.2f %9.3f\n", h, (long long)q.tets, s,
+                q.min_dihedral_deg, q.max_dihedral_deg, q.max_radius_edge_ratio,
+                100 * q.volume_error());
     EXPECT_NO_THROW(validate(m));
     EXPECT_LT(std::abs(q.volume_error()), 0.02);
     // At 3 mm the cells are a quarter of the disc height and slivers pinned to the protected
@@ -39,4 +40,3 @@ TEST(MesherSlow, CoarseDiscWithOdtHasNoSlivers) {
   const auto q = quality_report(mesh_parametric_disc(d, o), parametric_disc_volume(d));
   EXPECT_GE(q.min_dihedral_deg, 10.0);
 }
-

@@ -50,7 +50,7 @@ TEST(Quality, RightCornerTet) {
   EXPECT_NEAR(q.mean_edge_mm, (3 + 3 * std::sqrt(2.0)) / 6, 1e-12);
   EXPECT_NEAR(q.volume_mm3, 1.0 / 6.0, 1e-15);
   const auto a = dihedral_angles_deg(P.row(0), P.row(1), P.row(2), P.row(3));
-  EXPECT_NEAR(a[0], 90.0, 1e-9);  // edge (0,1)
+  EXPECT_NEAR(a[0], 90.0, 1e-9);                                            // edge (0,1)
   EXPECT_NEAR(a[5], std::acos(1.0 / std::sqrt(3.0)) * 180.0 / M_PI, 1e-9);  // edge (2,3)
 }
 

@@ -1,9 +1,9 @@
 // Structured (sweep) disc mesh: conformity (every interior face shared by two tets, closed
 // boundary), counts and labels, volume convergence to the exact disc, nucleus share, quality
 // on all 17 levels, placement, and bad options.
-#include "spinesim/mesh/structured_disc.hpp"
 #include "spinesim/mesh/mesher.hpp"
 #include "spinesim/mesh/quality.hpp"
+#include "spinesim/mesh/structured_disc.hpp"
 
 #include <gtest/gtest.h>
 
@@ -53,8 +53,8 @@ double volume_error(const DiscDimensions& d, const StructuredDiscOptions& o) {
 }  // namespace
 
 TEST(StructuredDisc, CountsMatchTheSweep) {
-  for (const StructuredDiscOptions o : {StructuredDiscOptions{}, StructuredDiscOptions{6, 2, 1},
-                                        StructuredDiscOptions{24, 5, 3}}) {
+  for (const StructuredDiscOptions o :
+       {StructuredDiscOptions{}, StructuredDiscOptions{6, 2, 1}, StructuredDiscOptions{24, 5, 3}}) {
     const TetMesh m = mesh_structured_disc(l4_l5(), o);
     EXPECT_NO_THROW(validate(m));
     EXPECT_EQ(m.num_vertices(), (o.layers + 1) * (1 + o.rings * o.sectors));
@@ -64,8 +64,8 @@ TEST(StructuredDisc, CountsMatchTheSweep) {
 }
 
 TEST(StructuredDisc, ConformingWithAClosedBoundary) {
-  for (const StructuredDiscOptions o : {StructuredDiscOptions{}, StructuredDiscOptions{7, 2, 1},
-                                        StructuredDiscOptions{13, 4, 3}}) {
+  for (const StructuredDiscOptions o :
+       {StructuredDiscOptions{}, StructuredDiscOptions{7, 2, 1}, StructuredDiscOptions{13, 4, 3}}) {
     const TetMesh m = mesh_structured_disc(l4_l5(), o);
     const auto count = face_counts(m);
     std::set<std::array<int, 2>> edges;
@@ -163,11 +163,12 @@ TEST(StructuredDisc, MatchedAreaGivesTheExactVolume) {
 // exactly 0.4 of the rim polygon's area at every height, and the sweep integrates both exactly:
 // the share is 0.4 to round-off (measured |error| <= 2e-15 on all 17 levels).
 TEST(StructuredDisc, NucleusHoldsFortyPercent) {
-  for (const StructuredDiscOptions o : {StructuredDiscOptions{}, StructuredDiscOptions{8, 2, 1},
-                                        StructuredDiscOptions{32, 6, 4}}) {
+  for (const StructuredDiscOptions o :
+       {StructuredDiscOptions{}, StructuredDiscOptions{8, 2, 1}, StructuredDiscOptions{32, 6, 4}}) {
     const TetMesh m = mesh_structured_disc(l4_l5(), o);
     const double share = region_volume(m, Region::nucleus) / mesh_volume(m);
-    EXPECT_NEAR(share, kNucleusAreaFraction, 1e-12) << o.sectors << "x" << o.rings << "x" << o.layers;
+    EXPECT_NEAR(share, kNucleusAreaFraction, 1e-12)
+        << o.sectors << "x" << o.rings << "x" << o.layers;
     EXPECT_GT(region_volume(m, Region::annulus), 0.0);
   }
 }
@@ -196,17 +197,17 @@ TEST(StructuredDisc, AllSeventeenLevelsWithDefaults) {
     const TetMesh m = mesh_structured_disc(d, o, disc_frame_in_spine(level, kData));
     ASSERT_NO_THROW(validate(m)) << level;
     const auto q = quality_report(m, parametric_disc_volume(d));
-    std::printf("%-7s %5lld %5lld  %6.2f / %6.2f        %5.2f   %+.3f %%\n", level.c_str(), (long long)q.tets,
-                (long long)q.vertices, q.min_dihedral_deg, q.max_dihedral_deg, q.max_radius_edge_ratio,
-                100 * q.volume_error());
+    std::printf("%-7s %5lld %5lld  %6.2f / %6.2f        %5.2f   %+.3f %%\n", level.c_str(),
+                (long long)q.tets, (long long)q.vertices, q.min_dihedral_deg, q.max_dihedral_deg,
+                q.max_radius_edge_ratio, 100 * q.volume_error());
     total += q.tets;
     worst_dihedral = std::min(worst_dihedral, q.min_dihedral_deg);
     worst_volume = std::max(worst_volume, std::abs(q.volume_error()));
     EXPECT_GT(q.min_dihedral_deg, 18.5) << level;
     EXPECT_NEAR(q.volume_error(), -0.051, 0.001) << level;
   }
-  std::printf("total %ld tets, min dihedral %.2f deg, worst volume error %.3f %%\n", total, worst_dihedral,
-              100 * worst_volume);
+  std::printf("total %ld tets, min dihedral %.2f deg, worst volume error %.3f %%\n", total,
+              worst_dihedral, 100 * worst_volume);
   EXPECT_EQ(total, 17L * 3 * o.layers * o.sectors * (2 * o.rings - 1));
 }
 
@@ -216,7 +217,8 @@ TEST(StructuredDisc, PlacementMovesTheDiscRigidly) {
   f.origin_mm = Eigen::Vector3d(3.0, 420.0, -12.0);
   f.axes = Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitX()).toRotationMatrix();
   const TetMesh placed = mesh_structured_disc(l4_l5(), {}, f);
-  const Eigen::MatrixX3d expect = (local.V * f.axes.transpose()).rowwise() + f.origin_mm.transpose();
+  const Eigen::MatrixX3d expect =
+      (local.V * f.axes.transpose()).rowwise() + f.origin_mm.transpose();
   EXPECT_LT((placed.V - expect).cwiseAbs().maxCoeff(), 1e-9);
   EXPECT_TRUE(placed.frame.origin_mm.isApprox(f.origin_mm));
   EXPECT_TRUE(placed.frame.axes.isApprox(f.axes));
@@ -232,9 +234,10 @@ TEST(StructuredDisc, PlacementMovesTheDiscRigidly) {
 }
 
 TEST(StructuredDisc, BadOptionsAreRefused) {
-  for (const StructuredDiscOptions o : {StructuredDiscOptions{5, 3, 2}, StructuredDiscOptions{16, 1, 2},
-                                        StructuredDiscOptions{16, 0, 2}, StructuredDiscOptions{16, 3, 0},
-                                        StructuredDiscOptions{-16, 3, 2}}) {
+  for (const StructuredDiscOptions o :
+       {StructuredDiscOptions{5, 3, 2}, StructuredDiscOptions{16, 1, 2},
+        StructuredDiscOptions{16, 0, 2}, StructuredDiscOptions{16, 3, 0},
+        StructuredDiscOptions{-16, 3, 2}}) {
     try {
       mesh_structured_disc(l4_l5(), o);
       ADD_FAILURE() << "accepted " << o.sectors << "x" << o.rings << "x" << o.layers;

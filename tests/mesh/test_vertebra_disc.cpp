@@ -14,9 +14,11 @@ using namespace spinesim::mesh;
 namespace {
 const std::string kDir = std::string(SPINESIM_TESTDATA_DIR) + "/artisynth-lss";
 
-TriSurface load(const std::string& name) { return read_surface(kDir + "/" + name, 1000.0, UpAxis::z); }
+TriSurface load(const std::string& name) {
+  return read_surface(kDir + "/" + name, 1000.0, UpAxis::z);
+}
 
-#define SKIP_WITHOUT_DATA()                                                               \
+#define SKIP_WITHOUT_DATA() \
   if (!std::filesystem::exists(kDir + "/L4_body.obj")) GTEST_SKIP() << "no test data in " << kDir
 
 MeshOptions coarse() {
@@ -31,11 +33,12 @@ void check_disc(const TriSurface& l5, const TriSurface& l4, const char* what) {
   const TetMesh m = mesh_disc_between_vertebrae(l5, l4, coarse(), {}, &info);
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const auto q = quality_report(m, info.volume_mm3);
-  std::printf("%s: height %.2f mm (%.2f..%.2f), area %.0f mm^2, %.1f x %.1f mm, %lld tets, %.2f s, "
-              "dihedral %.1f..%.1f, volume %.0f vs %.0f mm^3 (%.2f %%)\n",
-              what, info.center_height_mm, info.min_height_mm, info.max_height_mm, info.footprint_area_mm2,
-              info.width_mm, info.depth_mm, (long long)q.tets, s, q.min_dihedral_deg, q.max_dihedral_deg,
-              q.volume_mm3, info.volume_mm3, 100 * q.volume_error());
+  std::printf(
+      "%s: height %.2f mm (%.2f..%.2f), area %.0f mm^2, %.1f x %.1f mm, %lld tets, %.2f s, "
+      "dihedral %.1f..%.1f, volume %.0f vs %.0f mm^3 (%.2f %%)\n",
+      what, info.center_height_mm, info.min_height_mm, info.max_height_mm, info.footprint_area_mm2,
+      info.width_mm, info.depth_mm, (long long)q.tets, s, q.min_dihedral_deg, q.max_dihedral_deg,
+      q.volume_mm3, info.volume_mm3, 100 * q.volume_error());
   EXPECT_NO_THROW(validate(m));
   EXPECT_NO_THROW(require_endplate_labels(m));
   EXPECT_GT(q.wall_nodes, 0);

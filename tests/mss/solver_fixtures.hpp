@@ -1,11 +1,11 @@
 // Meshes, materials and boundaries shared by the MSS solver and dynamics tests.
 #pragma once
 
+#include "spinesim/mesh/box_mesh.hpp"
 #include "spinesim/mesh/material.hpp"
 #include "spinesim/mesh/mesher.hpp"
 #include "spinesim/mss/boundary.hpp"
 #include "spinesim/mss/model.hpp"
-#include "spinesim/mesh/box_mesh.hpp"
 
 #include <Eigen/Core>
 
@@ -14,7 +14,9 @@
 namespace spinesim::mss::fixtures {
 
 /// Thesis table 5.1 "real disc": E 3.22 MPa, nu 0.4557, rho 1038 kg/m^3.
-inline mesh::RegionMaterials real_disc() { return mesh::load_material("real-disc", SPINESIM_DATA_DIR); }
+inline mesh::RegionMaterials real_disc() {
+  return mesh::load_material("real-disc", SPINESIM_DATA_DIR);
+}
 
 /// Parametric L4-L5 disc (47.3 x 35.5 / 46.6 x 35.0 mm, 11.3 mm high), CGAL-meshed once per
 /// cell size and test process.
@@ -24,7 +26,10 @@ inline const mesh::TetMesh& l4_l5(double cell_mm) {
   if (it == cache.end()) {
     mesh::MeshOptions opt;
     opt.cell_size_mm = cell_mm;
-    it = cache.emplace(cell_mm, mesh::mesh_parametric_disc({"L4-L5", 47.3, 35.5, 46.6, 35.0, 11.3}, opt)).first;
+    it = cache
+             .emplace(cell_mm,
+                      mesh::mesh_parametric_disc({"L4-L5", 47.3, 35.5, 46.6, 35.0, 11.3}, opt))
+             .first;
   }
   return it->second;
 }

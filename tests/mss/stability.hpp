@@ -42,8 +42,9 @@ inline bool stays_stable(const MssModel& model, Integrator integrator, double dt
 
 /// Largest stable dt by bisection in log dt between a stable and an unstable bracket.
 inline double measured_stable_dt(const MssModel& model, Integrator integrator, double lo, double hi,
-                          int steps, int bisections) {
-  EXPECT_TRUE(stays_stable(model, integrator, lo, steps)) << "lower bracket " << lo << " s unstable";
+                                 int steps, int bisections) {
+  EXPECT_TRUE(stays_stable(model, integrator, lo, steps))
+      << "lower bracket " << lo << " s unstable";
   EXPECT_FALSE(stays_stable(model, integrator, hi, steps)) << "upper bracket " << hi << " s stable";
   for (int k = 0; k < bisections; ++k) {
     const double mid = std::sqrt(lo * hi);

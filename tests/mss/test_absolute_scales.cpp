@@ -29,7 +29,8 @@ double angle(const Eigen::Vector3d& apex, const Eigen::Vector3d& a, const Eigen:
 TEST(AbsoluteScales, TorsionSpringConstantAndEnergyFollowTheEquivalentCylinder) {
   const auto dims = mesh::disc_dimensions("L4-L5", SPINESIM_DATA_DIR);
   const mesh::TetMesh m = mesh::mesh_structured_disc(dims);
-  const auto materials = mesh::load_material("real-disc", SPINESIM_DATA_DIR);  // one material everywhere
+  const auto materials =
+      mesh::load_material("real-disc", SPINESIM_DATA_DIR);  // one material everywhere
   const mss::MssModel model(m, materials);
   const mss::EquivalentCylinder& cyl = model.cylinder();
 
@@ -61,12 +62,14 @@ TEST(AbsoluteScales, TorsionSpringConstantAndEnergyFollowTheEquivalentCylinder) 
   double sum = 0;
   for (const auto& f : faces)
     for (int c = 0; c < 3; ++c) {
-      const int p = f[std::size_t(c)], a = f[std::size_t((c + 1) % 3)], b = f[std::size_t((c + 2) % 3)];
+      const int p = f[std::size_t(c)], a = f[std::size_t((c + 1) % 3)],
+                b = f[std::size_t((c + 2) % 3)];
       const double dtheta = angle(x.segment<3>(3 * p), x.segment<3>(3 * a), x.segment<3>(3 * b)) -
                             angle(X.segment<3>(3 * p), X.segment<3>(3 * a), X.segment<3>(3 * b));
       sum += dtheta * dtheta;
     }
   const double expected = 0.5 * k_t * sum;
-  const double energy = model.term_energy(x, mss::Term::torsion, 0) + model.term_energy(x, mss::Term::torsion, 1);
+  const double energy =
+      model.term_energy(x, mss::Term::torsion, 0) + model.term_energy(x, mss::Term::torsion, 1);
   EXPECT_NEAR(energy, expected, 1e-6 * expected);
 }

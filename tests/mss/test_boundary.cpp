@@ -4,8 +4,8 @@
 
 #include "solver_fixtures.hpp"
 
-#include <Eigen/Geometry>
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 
 #include <cmath>
 #include <limits>
@@ -37,7 +37,8 @@ TEST(Boundary, SmallRotationIsTheCrossProductToFirstOrder) {
   double previous = 0;
   for (double eps : {1e-2, 1e-3}) {
     const Eigen::Vector3d theta = eps * dir;
-    const double err = (rotation_from_vector(theta) - Eigen::Matrix3d::Identity() - cross(theta)).norm();
+    const double err =
+        (rotation_from_vector(theta) - Eigen::Matrix3d::Identity() - cross(theta)).norm();
     // The remainder is [theta]x^2 / 2 + O(eps^3): quadratic in eps.
     EXPECT_NEAR(err, (0.5 * cross(theta) * cross(theta)).norm(), 0.1 * err);
     if (previous > 0) EXPECT_NEAR(previous / err, 100.0, 2.0);
@@ -56,7 +57,8 @@ TEST(Boundary, PlatePoseMovesTheCentreByTAndInvertsToTheMotion) {
   for (double eps : {1e-3, 1e-4}) {
     const Vector6d qe = eps * q;
     const Eigen::Vector3d lin = X + qe.head<3>() + qe.tail<3>().cross(X - c);
-    EXPECT_LT((plate_pose(qe, c).apply(X) - lin).norm(), 0.6 * qe.tail<3>().squaredNorm() * (X - c).norm());
+    EXPECT_LT((plate_pose(qe, c).apply(X) - lin).norm(),
+              0.6 * qe.tail<3>().squaredNorm() * (X - c).norm());
   }
 }
 
@@ -78,7 +80,7 @@ TEST(Boundary, ValidateRefusesBadInput) {
     EXPECT_THROW(validate(bc, n), std::invalid_argument);
   };
   refused([](Boundary& b) { b.superior.translation_mm.x() = kNaN; });
-  refused([](Boundary& b) { b.inferior.rotation(0, 1) = 0.1; });                   // not orthonormal
+  refused([](Boundary& b) { b.inferior.rotation(0, 1) = 0.1; });  // not orthonormal
   refused([](Boundary& b) { b.superior.rotation = -Eigen::Matrix3d::Identity(); });  // reflection
   refused([](Boundary& b) { b.wrench(4) = kNaN; });
   refused([](Boundary& b) { b.plate_center_mm.z() = std::numeric_limits<double>::infinity(); });

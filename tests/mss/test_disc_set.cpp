@@ -12,8 +12,8 @@ namespace {
 std::vector<Boundary> boundaries(const DiscSet& set, double squeeze_mm) {
   std::vector<Boundary> bcs;
   for (int i = 0; i < set.size(); ++i)
-    bcs.push_back(fixtures::motion_boundary(set.model(i).mesh(),
-                                            fixtures::vec6(0, -squeeze_mm * (i + 1), 0, 0.01 * i, 0, 0)));
+    bcs.push_back(fixtures::motion_boundary(
+        set.model(i).mesh(), fixtures::vec6(0, -squeeze_mm * (i + 1), 0, 0.01 * i, 0, 0)));
   return bcs;
 }
 
@@ -28,10 +28,12 @@ TEST(DiscSet, ParallelStepsEqualSeparateSteps) {
   State s = alone.rest_state();
   for (int step = 0; step < 5; ++step) {
     for (DiscSet* set : {&serial, &parallel})
-      for (const StepReport& r : set->step(boundaries(*set, 0.02 * (step + 1)))) ASSERT_TRUE(r.ok) << r.message;
+      for (const StepReport& r : set->step(boundaries(*set, 0.02 * (step + 1))))
+        ASSERT_TRUE(r.ok) << r.message;
     ASSERT_TRUE(alone.step(s, boundaries(serial, 0.02 * (step + 1))[2]).ok);
   }
-  for (int i = 0; i < 3; ++i) EXPECT_EQ((serial.state(i).x_mm - parallel.state(i).x_mm).norm(), 0.0);
+  for (int i = 0; i < 3; ++i)
+    EXPECT_EQ((serial.state(i).x_mm - parallel.state(i).x_mm).norm(), 0.0);
   EXPECT_EQ((serial.state(2).x_mm - s.x_mm).norm(), 0.0);
   EXPECT_GT((serial.state(2).x_mm - serial.model(2).rest_positions_mm()).norm(), 0.0);
   EXPECT_EQ(serial.total_tets(), 3.0 * double(box.num_tets()));

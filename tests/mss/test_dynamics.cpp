@@ -12,8 +12,8 @@
 
 #include <cmath>
 #include <cstdio>
-#include <limits>
 #include <cstdlib>
+#include <limits>
 #include <random>
 
 namespace spinesim::mss {
@@ -31,7 +31,8 @@ State run(Simulator& sim, State s, const Boundary& bc, int steps) {
   return s;
 }
 
-double rel_displacement_error(const MssModel& model, const Eigen::VectorXd& x, const Eigen::VectorXd& ref) {
+double rel_displacement_error(const MssModel& model, const Eigen::VectorXd& x,
+                              const Eigen::VectorXd& ref) {
   return (x - ref).norm() / (ref - model.rest_positions_mm()).norm();
 }
 
@@ -53,7 +54,9 @@ TEST_F(DynamicsBox, OptionsAreValidated) {
   refused([](DynamicsOptions& o) { o.dt_s = std::numeric_limits<double>::quiet_NaN(); });
   refused([](DynamicsOptions& o) { o.newton_iterations = 0; });
   refused([](DynamicsOptions& o) { o.divergence_distance_mm = -1.0; });
-  refused([](DynamicsOptions& o) { o.newton_relative_tolerance = std::numeric_limits<double>::infinity(); });
+  refused([](DynamicsOptions& o) {
+    o.newton_relative_tolerance = std::numeric_limits<double>::infinity();
+  });
   Simulator sim(model_, DynamicsOptions());
   State s = sim.rest_state();
   s.v_mm_s.resize(3);
@@ -69,7 +72,8 @@ TEST_F(DynamicsBox, OptionsAreValidated) {
 }
 
 TEST_F(DynamicsBox, RestIsAFixedPointOfEveryIntegrator) {
-  for (Integrator integ : {Integrator::explicit_euler, Integrator::symplectic_euler, Integrator::implicit_euler}) {
+  for (Integrator integ :
+       {Integrator::explicit_euler, Integrator::symplectic_euler, Integrator::implicit_euler}) {
     DynamicsOptions o;
     o.integrator = integ;
     o.dt_s = integ == Integrator::implicit_euler ? 1e-3 : 1e-7;
@@ -86,7 +90,8 @@ TEST_F(DynamicsBox, EndplateVelocityIsItsDisplacementOverDt) {
   const Boundary bc = fixtures::motion_boundary(mesh_, vec6(0.01, -0.02, 0.0, 0.0, 0.0, 0.0));
   ASSERT_TRUE(sim.step(s, bc).ok);
   for (Eigen::Index i = 0; i < model_.num_nodes(); ++i) {
-    if (mesh_.surface(i) == 2) EXPECT_LT((s.v_mm_s.segment<3>(3 * i) - Eigen::Vector3d(10.0, -20.0, 0.0)).norm(), 1e-9);
+    if (mesh_.surface(i) == 2)
+      EXPECT_LT((s.v_mm_s.segment<3>(3 * i) - Eigen::Vector3d(10.0, -20.0, 0.0)).norm(), 1e-9);
     if (mesh_.surface(i) == 1) EXPECT_EQ(s.v_mm_s.segment<3>(3 * i).norm(), 0.0);
   }
   EXPECT_LT((s.plate_q - vec6(0.01, -0.02, 0, 0, 0, 0)).norm(), 1e-15);
@@ -103,15 +108,19 @@ TEST_F(DynamicsBox, ExplicitLimitsMatchThePrediction) {
   for (Integrator integ : {Integrator::explicit_euler, Integrator::symplectic_euler}) {
     const double predicted = sim.predicted_stable_dt_s(integ);
     ASSERT_GT(predicted, 0.0);
-    const double measured = measured_stable_dt(model_, integ, 0.5 * predicted, 2.0 * predicted, 400, 8);
-    std::printf("%s Euler, real disc, box (%ld tets): largest stable dt measured %.3g s, predicted "
-                "%.3g s (ratio %.3f)\n", integ == Integrator::explicit_euler ? "explicit" : "symplectic",
-                long(mesh_.num_tets()), measured, predicted, measured / predicted);
+    const double measured =
+        measured_stable_dt(model_, integ, 0.5 * predicted, 2.0 * predicted, 400, 8);
+    std::printf(
+        "%s Euler, real disc, box (%ld tets): largest stable dt measured %.3g s, predicted "
+        "%.3g s (ratio %.3f)\n",
+        integ == Integrator::explicit_euler ? "explicit" : "symplectic", long(mesh_.num_tets()),
+        measured, predicted, measured / predicted);
     EXPECT_GE(measured / predicted, 0.98);  // 0.5 % bisection resolution + criterion
     EXPECT_LE(measured / predicted, 1.25);
     EXPECT_LT(measured, 1e-4);  // orders of magnitude below the thesis's 1 ms
   }
-  EXPECT_EQ(sim.predicted_stable_dt_s(Integrator::implicit_euler), std::numeric_limits<double>::infinity());
+  EXPECT_EQ(sim.predicted_stable_dt_s(Integrator::implicit_euler),
+            std::numeric_limits<double>::infinity());
 }
 
 TEST_F(DynamicsBox, SymplecticRunConvergesToTheStaticSolution) {
@@ -123,10 +132,12 @@ TEST_F(DynamicsBox, SymplecticRunConvergesToTheStaticSolution) {
   Simulator probe_sim(model_, o);
   o.dt_s = 0.5 * probe_sim.predicted_stable_dt_s(Integrator::symplectic_euler);
   Simulator sim(model_, o);
-  const int steps = int(std::ceil(10e-3 / o.dt_s));  // 10 ms: overdamped slow modes decay as exp(-omega^2 t / c)
+  const int steps =
+      int(std::ceil(10e-3 / o.dt_s));  // 10 ms: overdamped slow modes decay as exp(-omega^2 t / c)
   const State s = run(sim, sim.rest_state(), bc, steps);
   const double err = rel_displacement_error(model_, s.x_mm, ref.x_mm);
-  std::printf("symplectic, dt %.3g s, %d steps: relative error to the static solution %.2e\n", o.dt_s, steps, err);
+  std::printf("symplectic, dt %.3g s, %d steps: relative error to the static solution %.2e\n",
+              o.dt_s, steps, err);
   EXPECT_LT(err, 1e-6);
 }
 
@@ -144,9 +155,12 @@ TEST_F(DynamicsBox, ImplicitRunsConvergeToTheStaticSolutionForMotionWrenchAndPro
       Simulator sim(model_, o);
       const State s = run(sim, sim.rest_state(), *bc, 100);
       const double err = rel_displacement_error(model_, s.x_mm, ref.x_mm);
-      EXPECT_LT(err, 1e-6) << (bc == &motion ? "motion" : bc == &wrench ? "wrench" : "probe")
+      EXPECT_LT(err, 1e-6) << (bc == &motion   ? "motion"
+                               : bc == &wrench ? "wrench"
+                                               : "probe")
                            << (mu == MatrixUpdate::frozen ? ", frozen" : ", every iteration");
-      if (bc == &wrench) EXPECT_LT((s.plate_q - ref.plate_motion).norm(), 1e-6 * ref.plate_motion.norm());
+      if (bc == &wrench)
+        EXPECT_LT((s.plate_q - ref.plate_motion).norm(), 1e-6 * ref.plate_motion.norm());
     }
   }
 }
@@ -182,10 +196,12 @@ TEST_F(DynamicsBox, FrozenAndRefreshedMatricesAgreeForSmallMotions) {
   double worst = 0;
   for (int k = 1; k <= 40; ++k) {  // a 10 µm ramp over 20 ms, then held
     const double ramp = std::min(1.0, k / 20.0);
-    const Boundary bc = fixtures::motion_boundary(mesh_, ramp * vec6(0.002, -0.01, 0.0, 0.0005, 0.0, 0.0));
+    const Boundary bc =
+        fixtures::motion_boundary(mesh_, ramp * vec6(0.002, -0.01, 0.0, 0.0005, 0.0, 0.0));
     ASSERT_TRUE(a.step(sa, bc).ok);
     ASSERT_TRUE(b.step(sb, bc).ok);
-    worst = std::max(worst, (sa.x_mm - sb.x_mm).norm() / (sb.x_mm - model_.rest_positions_mm()).norm());
+    worst =
+        std::max(worst, (sa.x_mm - sb.x_mm).norm() / (sb.x_mm - model_.rest_positions_mm()).norm());
   }
   std::printf("frozen vs every-iteration, 10 µm ramp: largest relative difference %.2e\n", worst);
   EXPECT_LT(worst, 1e-3);
@@ -210,9 +226,11 @@ TEST_F(DynamicsBox, BothEndplatesMovedRigidlyEndStressFree) {
   }
   double worst = 0;
   for (Eigen::Index i = 0; i < model_.num_nodes(); ++i)
-    worst = std::max(worst, (s.x_mm.segment<3>(3 * i) - bc.inferior.apply(model_.rest_positions_mm().segment<3>(3 * i))).norm());
-  std::printf("rigid endplate motion: max |x - P(X)| = %.2e mm after holding, E = %.2e N·mm\n", worst,
-              model_.energy(s.x_mm));
+    worst = std::max(worst, (s.x_mm.segment<3>(3 * i) -
+                             bc.inferior.apply(model_.rest_positions_mm().segment<3>(3 * i)))
+                                .norm());
+  std::printf("rigid endplate motion: max |x - P(X)| = %.2e mm after holding, E = %.2e N·mm\n",
+              worst, model_.energy(s.x_mm));
   EXPECT_LT(worst, 1e-8);
   EXPECT_LT(model_.energy(s.x_mm), 1e-12);
 }
@@ -245,7 +263,8 @@ TEST_F(DynamicsBox, MoreNewtonIterationsPerStepReachEquilibriumSooner) {
     Simulator sim(model_, o);
     err[k] = rel_displacement_error(model_, run(sim, sim.rest_state(), bc, 3).x_mm, ref.x_mm);
   }
-  std::printf("frozen, 3 steps of 1 ms: relative error %.2e with 1 Newton iteration, %.2e with 4\n", err[0], err[1]);
+  std::printf("frozen, 3 steps of 1 ms: relative error %.2e with 1 Newton iteration, %.2e with 4\n",
+              err[0], err[1]);
   EXPECT_LT(err[1], err[0]);
 }
 
@@ -257,8 +276,10 @@ TEST_F(DynamicsBox, SwitchingFromPoseToWrenchKeepsTheState) {
   Boundary wrench = fixtures::wrench_boundary(mesh_, -solve_static(model_, pose).reaction_wrench);
   const State before = s;
   s = run(sim, s, wrench, 20);
-  const double moved = (s.x_mm - before.x_mm).norm() / (before.x_mm - model_.rest_positions_mm()).norm();
-  std::printf("pose -> wrench switch: relative drift %.2e, plate t_y %.6f mm\n", moved, s.plate_q(1));
+  const double moved =
+      (s.x_mm - before.x_mm).norm() / (before.x_mm - model_.rest_positions_mm()).norm();
+  std::printf("pose -> wrench switch: relative drift %.2e, plate t_y %.6f mm\n", moved,
+              s.plate_q(1));
   EXPECT_LT(moved, 1e-6);
   EXPECT_NEAR(s.plate_q(1), -0.2, 1e-6);
 }
@@ -307,14 +328,17 @@ TEST_F(DynamicsDisc, ProbePressHoldAndWithdrawWithoutChatter) {
   const double ymid = 0.5 * (mesh_.V.col(1).minCoeff() + mesh_.V.col(1).maxCoeff());
   int node = -1;
   for (Eigen::Index i = 0; i < mesh_.num_vertices(); ++i)
-    if (mesh_.surface(i) == 3 && std::abs(mesh_.V(i, 1) - ymid) < 2.0 && (node < 0 || mesh_.V(i, 2) > mesh_.V(node, 2)))
+    if (mesh_.surface(i) == 3 && std::abs(mesh_.V(i, 1) - ymid) < 2.0 &&
+        (node < 0 || mesh_.V(i, 2) > mesh_.V(node, 2)))
       node = int(i);
   ASSERT_GE(node, 0);
   const Eigen::Vector3d p = mesh_.V.row(node).transpose(), n(0.0, 0.0, 1.0);
   const double r = 3.0, depth = 2.0, speed = 20.0, hold = 0.05, press = depth / speed;
   const double k_probe = default_probe_stiffness(model_);  // one rest-Hessian evaluation, once
   const auto probe_at = [&](double t) {
-    double d = t <= press ? speed * t : t <= press + hold ? depth : depth - speed * (t - press - hold);
+    double d = t <= press          ? speed * t
+               : t <= press + hold ? depth
+                                   : depth - speed * (t - press - hold);
     Boundary bc;
     bc.probes.push_back(Probe{p + (r - std::clamp(d, 0.0, depth)) * n, r, k_probe});
     return bc;
@@ -340,9 +364,11 @@ TEST_F(DynamicsDisc, ProbePressHoldAndWithdrawWithoutChatter) {
       if (k == int(std::lround((press + hold) / o.dt_s))) f_hold_end = f;
       f_prev = f;
     }
-    std::printf("probe %s: static force at 2 mm %.2f N; dynamic: max %.2f N, end of hold %.2f N, largest "
-                "change per step %.2f N\n", mu == MatrixUpdate::frozen ? "frozen" : "every iteration", f_static,
-                f_max, f_hold_end, jump);
+    std::printf(
+        "probe %s: static force at 2 mm %.2f N; dynamic: max %.2f N, end of hold %.2f N, largest "
+        "change per step %.2f N\n",
+        mu == MatrixUpdate::frozen ? "frozen" : "every iteration", f_static, f_max, f_hold_end,
+        jump);
     EXPECT_NEAR(f_hold_end, f_static, 1e-3 * f_static);
     EXPECT_LT(f_max, 1.05 * f_static);
     EXPECT_LT(jump, 0.1 * f_static);
@@ -350,7 +376,8 @@ TEST_F(DynamicsDisc, ProbePressHoldAndWithdrawWithoutChatter) {
 }
 
 TEST_F(DynamicsDisc, ImplicitEulerAtOneMillisecondIsStableAndReachesTheStaticSolution) {
-  const Boundary bc = fixtures::motion_boundary(mesh_, vec6(0.1, -0.565, 0.0, 0.0, 0.0, 0.01));  // 5 %
+  const Boundary bc =
+      fixtures::motion_boundary(mesh_, vec6(0.1, -0.565, 0.0, 0.0, 0.0, 0.01));  // 5 %
   const StaticResult ref = solve_static(model_, bc);
   ASSERT_TRUE(ref.converged) << ref.message;
   for (MatrixUpdate mu : {MatrixUpdate::frozen, MatrixUpdate::every_iteration}) {

@@ -44,15 +44,19 @@ TEST(DynamicsSlow, L4L5ExplicitStabilityLimitsMeasuredAgainstPredicted) {
   const mesh::TetMesh& m = fixtures::l4_l5(3.5);
   const MssModel model(m, fixtures::real_disc());
   Simulator sim(model, DynamicsOptions());
-  std::printf("L4-L5, real disc (E 3.22 MPa, nu 0.4557, rho 1038), %ld tets, %ld nodes, K_d %.3g N·s/mm, "
-              "node mass %.3g..%.3g t\n", long(m.num_tets()), long(m.num_vertices()), model.damping_n_s_per_mm(),
-              model.node_masses_t().minCoeff(), model.node_masses_t().maxCoeff());
+  std::printf(
+      "L4-L5, real disc (E 3.22 MPa, nu 0.4557, rho 1038), %ld tets, %ld nodes, K_d %.3g N·s/mm, "
+      "node mass %.3g..%.3g t\n",
+      long(m.num_tets()), long(m.num_vertices()), model.damping_n_s_per_mm(),
+      model.node_masses_t().minCoeff(), model.node_masses_t().maxCoeff());
   for (Integrator integ : {Integrator::explicit_euler, Integrator::symplectic_euler}) {
     const double predicted = sim.predicted_stable_dt_s(integ);
     const double lo = measured_stable_dt(model, integ, 0.5 * predicted, 2.0 * predicted, 1500, 10);
-    std::printf("  %-10s largest stable dt: measured %.4g s (1500 steps, +-0.15 %%), predicted %.4g s, "
-                "ratio %.3f\n", integ == Integrator::explicit_euler ? "explicit" : "symplectic", lo,
-                predicted, lo / predicted);
+    std::printf(
+        "  %-10s largest stable dt: measured %.4g s (1500 steps, +-0.15 %%), predicted %.4g s, "
+        "ratio %.3f\n",
+        integ == Integrator::explicit_euler ? "explicit" : "symplectic", lo, predicted,
+        lo / predicted);
     EXPECT_GE(lo / predicted, 0.98);
     EXPECT_LE(lo / predicted, 1.25);
   }
@@ -81,11 +85,14 @@ TEST(DynamicsSlow, StepAndSolveCostVersusTetrahedronCount) {
       Boundary b = bc;
       EXPECT_TRUE(sim.step(s, b).ok);  // analysis and first factorisation
       int step = 0;
-      return best_time([&] {
-        if (moving)
-          b.superior = plate_pose(vec6(0.0, -0.3 * std::cos(0.01 * ++step), 0.0, 0.0, 0.0, 0.0), b.plate_center_mm);
-        EXPECT_TRUE(sim.step(s, b).ok);
-      }, reps);
+      return best_time(
+          [&] {
+            if (moving)
+              b.superior = plate_pose(vec6(0.0, -0.3 * std::cos(0.01 * ++step), 0.0, 0.0, 0.0, 0.0),
+                                      b.plate_center_mm);
+            EXPECT_TRUE(sim.step(s, b).ok);
+          },
+          reps);
     };
     const double t_frozen = time_steps(MatrixUpdate::frozen, false, 50);
     const double t_moving = time_steps(MatrixUpdate::frozen, true, 50);
@@ -95,14 +102,18 @@ TEST(DynamicsSlow, StepAndSolveCostVersusTetrahedronCount) {
     StaticResult r;
     const double t_static = best_time([&] { r = solve_static(model, compress); }, 1, 3);
     for (Eigen::Index i = 0; i < m.num_vertices(); ++i)  // unknowns with both endplates held
-      dofs += (m.surface(i) != int(mesh::Surface::inferior_endplate) && m.surface(i) != int(mesh::Surface::superior_endplate)) ? 3 : 0;
+      dofs += (m.surface(i) != int(mesh::Surface::inferior_endplate) &&
+               m.surface(i) != int(mesh::Surface::superior_endplate))
+                  ? 3
+                  : 0;
     std::printf("%6.2f %6ld %6ld %6ld | %8.3f %8.3f | %8.3f %8.3f %8.3f | %8.1f %5d\n", cell,
                 long(m.num_tets()), long(m.num_vertices()), long(dofs), 1e3 * t_grad, 1e3 * t_hess,
                 1e3 * t_frozen, 1e3 * t_moving, 1e3 * t_every, 1e3 * t_static, r.iterations);
     EXPECT_TRUE(r.converged) << r.message;
   }
-  std::printf("impl.frz: frozen matrix, held boundary; impl.1it: frozen, boundary moving every step;\n"
-              "impl.evr: matrix refactorised every step (1 Newton iteration); static: 10 %% compression\n");
+  std::printf(
+      "impl.frz: frozen matrix, held boundary; impl.1it: frozen, boundary moving every step;\n"
+      "impl.evr: matrix refactorised every step (1 Newton iteration); static: 10 %% compression\n");
 }
 
 }  // namespace

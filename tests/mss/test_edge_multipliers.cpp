@@ -136,14 +136,17 @@ TEST(EdgeMultipliers, MainTermEnergyKeepsTheMultipliers) {
   const MssModel model(box_with_nucleus(), materials(), o);
   const Eigen::VectorXd x = perturbed(model, 0.3, 6);
   double springs = 0.0;
-  for (const EdgeSpringInfo& e : model.edge_springs()) springs += spring_energy(e, x, e.multiplier * e.k_region);
+  for (const EdgeSpringInfo& e : model.edge_springs())
+    springs += spring_energy(e, x, e.multiplier * e.k_region);
   const auto& s = o.scales[int(Term::main)].by_region;
-  const double main = s[0] * model.term_energy(x, Term::main, 0) + s[1] * model.term_energy(x, Term::main, 1);
+  const double main =
+      s[0] * model.term_energy(x, Term::main, 0) + s[1] * model.term_energy(x, Term::main, 1);
   EXPECT_NEAR(main, springs, 1e-12 * springs);
 }
 
 TEST(EdgeMultipliers, GradientAndHessianMatchFiniteDifferences) {
-  const MssModel model(box_with_nucleus(), materials(), options_with_random_multipliers(count_edges(), 7));
+  const MssModel model(box_with_nucleus(), materials(),
+                       options_with_random_multipliers(count_edges(), 7));
   const Eigen::VectorXd x = perturbed(model, 0.3, 8);
   Eigen::VectorXd g;
   model.gradient(x, g);
@@ -151,7 +154,8 @@ TEST(EdgeMultipliers, GradientAndHessianMatchFiniteDifferences) {
   model.hessian(x, HessianMode::exact, H);
   Eigen::VectorXd u;
   const double kg = model.disc_volume_rank_one(x, u);
-  const Eigen::MatrixXd Hd = Eigen::MatrixXd(H) + kg * u * u.transpose();  // the whole-disc term's rank-one part
+  const Eigen::MatrixXd Hd =
+      Eigen::MatrixXd(H) + kg * u * u.transpose();  // the whole-disc term's rank-one part
   const double h = 1e-6;
   double worst_g = 0.0, worst_h = 0.0;
   for (Eigen::Index i = 0; i < x.size(); i += 3) {
@@ -192,8 +196,10 @@ TEST(EdgeMultipliers, MainTermDerivativesStayConsistent) {
     for (Eigen::Index i = 1; i < x.size(); i += 4) {
       Eigen::VectorXd xp = x, xm = x, gp, gm;
       xp(i) += h, xm(i) -= h;
-      worst_g = std::max(worst_g, std::abs((model.term_energy(xp, Term::main, r) - model.term_energy(xm, Term::main, r)) /
-                                               (2 * h) - g(i)));
+      worst_g = std::max(worst_g, std::abs((model.term_energy(xp, Term::main, r) -
+                                            model.term_energy(xm, Term::main, r)) /
+                                               (2 * h) -
+                                           g(i)));
       model.term_gradient(xp, Term::main, r, gp);
       model.term_gradient(xm, Term::main, r, gm);
       worst_h = std::max(worst_h, ((gp - gm) / (2 * h) - Hd.col(i)).cwiseAbs().maxCoeff());
@@ -223,9 +229,11 @@ TEST(EdgeMultipliers, WrongSizeOrNonPositiveValuesAreRefused) {
   for (const Eigen::Index size : {n - 1, n + 1, Eigen::Index(1)}) {
     MssOptions o = good;
     o.edge_multipliers.resize(std::size_t(size), 1.0);
-    expect_refused([&] { MssModel(m, materials(), o); }, std::to_string(size) + " edge multipliers for " + std::to_string(n));
+    expect_refused([&] { MssModel(m, materials(), o); },
+                   std::to_string(size) + " edge multipliers for " + std::to_string(n));
   }
-  for (const double bad : {0.0, -1.0, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
+  for (const double bad : {0.0, -1.0, std::numeric_limits<double>::quiet_NaN(),
+                           std::numeric_limits<double>::infinity()}) {
     MssOptions o = good;
     o.edge_multipliers[std::size_t(n / 2)] = bad;
     expect_refused([&] { MssModel(m, materials(), o); }, "finite and > 0");
@@ -234,7 +242,8 @@ TEST(EdgeMultipliers, WrongSizeOrNonPositiveValuesAreRefused) {
   MssModel model(m, materials(), good);
   const Eigen::VectorXd x = perturbed(model, 0.3, 12);
   const double before = model.energy(x);
-  expect_refused([&] { model.set_edge_multipliers(std::vector<double>(std::size_t(n + 3), 1.0)); }, "edge multipliers");
+  expect_refused([&] { model.set_edge_multipliers(std::vector<double>(std::size_t(n + 3), 1.0)); },
+                 "edge multipliers");
   std::vector<double> negative = good.edge_multipliers;
   negative[0] = -2.0;
   expect_refused([&] { model.set_edge_multipliers(negative); }, "finite and > 0");

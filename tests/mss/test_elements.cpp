@@ -100,11 +100,13 @@ void expect_derivatives_match(const Element<N>& el, const Vec<N>& X, const char*
     Xp(i) += kStep_mm;
     Xm(i) -= kStep_mm;
     fd_g(i) = (el.energy(Xp, nullptr, nullptr, HessianMode::exact) -
-               el.energy(Xm, nullptr, nullptr, HessianMode::exact)) / (2 * kStep_mm);
+               el.energy(Xm, nullptr, nullptr, HessianMode::exact)) /
+              (2 * kStep_mm);
     fd_H.col(i) = (gradient(el, Xp) - gradient(el, Xm)) / (2 * kStep_mm);
   }
   ASSERT_GT(max_abs(g), 0.0) << "test configuration is at rest";
-  EXPECT_LE(max_abs(fd_g - g), kFdTol * max_abs(g)) << "grad\n" << g.transpose() << "\nfd\n"
+  EXPECT_LE(max_abs(fd_g - g), kFdTol * max_abs(g)) << "grad\n"
+                                                    << g.transpose() << "\nfd\n"
                                                     << fd_g.transpose();
   EXPECT_LE(max_abs(fd_H - H), kFdTol * max_abs(H)) << "hess\n" << H << "\nfd\n" << fd_H;
   // The same numbers whether or not the derivatives are asked for (to round-off: with FMA
@@ -150,7 +152,9 @@ void expect_zero_force_and_moment(const Vec<N>& X, const Vec<N>& g, const char* 
 class Configs {
  public:
   explicit Configs(unsigned seed) : rng_(seed) {}
-  double uniform(double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng_); }
+  double uniform(double lo, double hi) {
+    return std::uniform_real_distribution<double>(lo, hi)(rng_);
+  }
   Eigen::Vector3d point(double half_width) {
     return {uniform(-half_width, half_width), uniform(-half_width, half_width),
             uniform(-half_width, half_width)};
@@ -211,8 +215,12 @@ double radial_sum(const Vec<12>& X) {
   for (int j = 0; j < 4; ++j) S += (x.col(j) - xb).norm();
   return S;
 }
-double angle_of(const Vec<9>& X) { return angle_at(X.segment<3>(0), X.segment<3>(3), X.segment<3>(6)); }
-double volume_of(const Vec<12>& X) { return tet_signed_volume(Eigen::Map<const TetPoints>(X.data())); }
+double angle_of(const Vec<9>& X) {
+  return angle_at(X.segment<3>(0), X.segment<3>(3), X.segment<3>(6));
+}
+double volume_of(const Vec<12>& X) {
+  return tet_signed_volume(Eigen::Map<const TetPoints>(X.data()));
+}
 
 // Stretched (rest value below the current one) and compressed (above) for each element.
 const double kRestFactors[] = {0.7, 1.3};
@@ -227,7 +235,8 @@ TEST(Edge, DerivativesMatchFiniteDifferences) {
   for (int s = 0; s < kSamples; ++s)
     for (double f : kRestFactors) {
       const Vec<6> X = rng.edge_points();
-      expect_derivatives_match(edge(2.5, f * edge_length(X)), X, f < 1 ? "stretched" : "compressed");
+      expect_derivatives_match(edge(2.5, f * edge_length(X)), X,
+                               f < 1 ? "stretched" : "compressed");
     }
 }
 
@@ -236,7 +245,8 @@ TEST(Radial, DerivativesMatchFiniteDifferences) {
   for (int s = 0; s < kSamples; ++s)
     for (double f : kRestFactors) {
       const Vec<12> X = rng.tet();
-      expect_derivatives_match(radial(1.7, f * radial_sum(X)), X, f < 1 ? "stretched" : "compressed");
+      expect_derivatives_match(radial(1.7, f * radial_sum(X)), X,
+                               f < 1 ? "stretched" : "compressed");
     }
 }
 
@@ -245,7 +255,8 @@ TEST(Angle, DerivativesMatchFiniteDifferences) {
   for (int s = 0; s < kSamples; ++s)
     for (double dtheta : {-0.4, 0.3}) {
       const Vec<9> X = rng.angle_points();
-      expect_derivatives_match(angle(40.0, angle_of(X) + dtheta), X, dtheta < 0 ? "opened" : "closed");
+      expect_derivatives_match(angle(40.0, angle_of(X) + dtheta), X,
+                               dtheta < 0 ? "opened" : "closed");
     }
 }
 
@@ -300,7 +311,8 @@ TEST(Elements, ExactHessiansSymmetricProjectedSymmetricPsd) {
       expect_psd(Pa, "angle projected");
       expect_psd(Pv, "volume projected");
       const Vec<3> c = rng.point(10.0);
-      const auto Pp = hessian(probe(c, 2.0, 5.0), Vec<3>(c + rng.direction()), HessianMode::projected);
+      const auto Pp =
+          hessian(probe(c, 2.0, 5.0), Vec<3>(c + rng.direction()), HessianMode::projected);
       expect_symmetric(Pp, "probe projected");
       expect_psd(Pp, "probe projected");
     }
@@ -395,14 +407,16 @@ template <int N>
 void expect_rigid_invariant(const Element<N>& el, const Vec<N>& X, const Eigen::Matrix3d& R,
                             const Eigen::Vector3d& t, const char* what) {
   Vec<N> Y, gX, gY;
-  for (int i = 0; i < N / 3; ++i) Y.template segment<3>(3 * i) = R * X.template segment<3>(3 * i) + t;
+  for (int i = 0; i < N / 3; ++i)
+    Y.template segment<3>(3 * i) = R * X.template segment<3>(3 * i) + t;
   const double eX = el.energy(X, &gX, nullptr, HessianMode::exact);
   const double eY = el.energy(Y, &gY, nullptr, HessianMode::exact);
   // Translating by ~10 mm costs ~1e-15 relative in the differences of coordinates.
   EXPECT_NEAR(eY, eX, 1e-10 * eX) << what;
   // ... and the gradient turns with the body.
   Vec<N> RgX;
-  for (int i = 0; i < N / 3; ++i) RgX.template segment<3>(3 * i) = R * gX.template segment<3>(3 * i);
+  for (int i = 0; i < N / 3; ++i)
+    RgX.template segment<3>(3 * i) = R * gX.template segment<3>(3 * i);
   EXPECT_LE(max_abs(gY - RgX), 1e-10 * max_abs(gX)) << what;
 }
 
@@ -447,8 +461,10 @@ TEST(Angle, AccurateNearZeroAndPi) {
   const Eigen::Vector3d o(0, 0, 0), a(1, 0, 0);
   for (double eps : {1e-4, 1e-9, 1e-14}) {
     const Eigen::Vector3d near0(1, eps, 0), near_pi(-1, eps, 0);
-    EXPECT_NEAR(angle_at(o, a, near0), std::atan(eps), 4 * std::numeric_limits<double>::epsilon() * eps);
-    EXPECT_NEAR(angle_at(o, a, near_pi), kPi - std::atan(eps), 4 * std::numeric_limits<double>::epsilon());
+    EXPECT_NEAR(angle_at(o, a, near0), std::atan(eps),
+                4 * std::numeric_limits<double>::epsilon() * eps);
+    EXPECT_NEAR(angle_at(o, a, near_pi), kPi - std::atan(eps),
+                4 * std::numeric_limits<double>::epsilon());
   }
   const Eigen::Vector3d b(1, 1e-9, 0);
   EXPECT_EQ(std::acos(a.dot(b) / (a.norm() * b.norm())), 0.0);  // the failure atan2 avoids
@@ -462,7 +478,8 @@ TEST(Angle, ThesisTorsionForceMissesTheApexForce) {
     const double theta0 = angle_of(X) + (s % 2 ? 0.3 : -0.3);
     Vec<9> g;
     angle_spring(X.segment<3>(0), X.segment<3>(3), X.segment<3>(6), k, theta0, &g);
-    const Vector6d f = thesis_torsion_force(X.segment<3>(0), X.segment<3>(3), X.segment<3>(6), k, theta0);
+    const Vector6d f =
+        thesis_torsion_force(X.segment<3>(0), X.segment<3>(3), X.segment<3>(6), k, theta0);
     // (5.13) is right about the arm ends: minus the energy gradient there.
     EXPECT_LE(max_abs(f + g.tail<6>()), 1e-12 * max_abs(g));
     // The thesis error we fix: (5.13) gives the apex nothing, so its forces on one angle do
@@ -555,8 +572,8 @@ TEST(Probe, ZeroOutsideAndPushesOutwardsInside) {
   const double r = 2.0, k = 5.0;
   Eigen::Vector3d g;
   Eigen::Matrix3d H;
-  for (const Eigen::Vector3d& x :
-       {Eigen::Vector3d(c + Eigen::Vector3d(2.5, 0, 0)), Eigen::Vector3d(c + Eigen::Vector3d(0, 0, -2.0))}) {
+  for (const Eigen::Vector3d& x : {Eigen::Vector3d(c + Eigen::Vector3d(2.5, 0, 0)),
+                                   Eigen::Vector3d(c + Eigen::Vector3d(0, 0, -2.0))}) {
     g.setConstant(1.0);
     H.setConstant(1.0);
     EXPECT_EQ(probe_contact(x, c, r, k, &g, &H), 0.0);
@@ -594,7 +611,9 @@ TEST(Elements, DegenerateInputGivesFiniteZeroForce) {
   angle_spring(p, p, p + Eigen::Vector3d(2, 0, 0), 3.0, 1.0, &g9, &H9);
   EXPECT_EQ(max_abs(g9), 0.0);  // zero-length arm
   EXPECT_TRUE(H9.allFinite());
-  EXPECT_EQ(max_abs(thesis_torsion_force(p, p + Eigen::Vector3d(1, 0, 0), p + Eigen::Vector3d(-2, 0, 0), 3.0, 1.0)), 0.0);
+  EXPECT_EQ(max_abs(thesis_torsion_force(p, p + Eigen::Vector3d(1, 0, 0),
+                                         p + Eigen::Vector3d(-2, 0, 0), 3.0, 1.0)),
+            0.0);
 
   // A flat tet with x3 at the barycentre of all four (x3 = centroid of x0 x1 x2).
   TetPoints x;

@@ -45,12 +45,13 @@ TEST(FaceAngles, EqualsThreeAngleSpringsAtRandomDeformations) {
     }
     const double k = 3.7;
     double g[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
-    const double e = face_angle_springs<true>(x[0].data(), x[1].data(), x[2].data(), k, rest,
-                                              g[0], g[1], g[2]);
+    const double e =
+        face_angle_springs<true>(x[0].data(), x[1].data(), x[2].data(), k, rest, g[0], g[1], g[2]);
     EXPECT_DOUBLE_EQ(e, face_angle_springs<false>(x[0].data(), x[1].data(), x[2].data(), k, rest,
                                                   nullptr, nullptr, nullptr));
     double e_ref = 0.0;
-    Eigen::Vector3d g_ref[3] = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+    Eigen::Vector3d g_ref[3] = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
+                                Eigen::Vector3d::Zero()};
     for (int c = 0; c < 3; ++c) {
       const int n[3] = {c, (c + 1) % 3, (c + 2) % 3};
       Vector9d gc;
@@ -73,7 +74,8 @@ TEST(FaceAngles, RestFaceHasZeroEnergyAndForce) {
     rest.cos0[k] = std::cos(t), rest.sin0[k] = std::sin(t);
   }
   double g[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
-  EXPECT_NEAR(face_angle_springs<true>(a.data(), b.data(), c.data(), 1.0, rest, g[0], g[1], g[2]), 0.0, 1e-30);
+  EXPECT_NEAR(face_angle_springs<true>(a.data(), b.data(), c.data(), 1.0, rest, g[0], g[1], g[2]),
+              0.0, 1e-30);
   for (auto& gi : g)
     for (double v : gi) EXPECT_NEAR(v, 0.0, 1e-14);
 }

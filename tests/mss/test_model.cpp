@@ -4,12 +4,12 @@
 // dilation that check the constants (5.1), (5.2), (5.8) without looking inside.
 #include "spinesim/mss/model.hpp"
 
-#include "spinesim/mesh/tet_mesh.hpp"
 #include "spinesim/mesh/box_mesh.hpp"
+#include "spinesim/mesh/tet_mesh.hpp"
 
+#include <gtest/gtest.h>
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
-#include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
@@ -109,7 +109,9 @@ TEST(MssModel, DilationEnergiesMatchVanGelderAndBulkModulus) {
     EV += mt.youngs_modulus_mpa * mesh::tet_volume(m, t);
     KV += mt.youngs_modulus_mpa / (3.0 * (1.0 - 2.0 * mt.poisson_ratio)) * mesh::tet_volume(m, t);
   }
-  auto both = [&](Term term) { return model.term_energy(x, term, 0) + model.term_energy(x, term, 1); };
+  auto both = [&](Term term) {
+    return model.term_energy(x, term, 0) + model.term_energy(x, term, 1);
+  };
   EXPECT_NEAR(both(Term::main), 3.0 * eps * eps * EV, 1e-9 * EV * eps * eps);
   EXPECT_NEAR(both(Term::radial), 0.5 * eps * eps * EV, 1e-9 * EV * eps * eps);
   EXPECT_NEAR(both(Term::torsion), 0.0, 1e-12 * EV * eps * eps);
@@ -173,7 +175,8 @@ TEST(MssModel, TermGradientsAreDerivativesOfTermEnergies) {
       for (Eigen::Index i = 1; i < x.size(); i += 7) {
         Eigen::VectorXd xp = x, xm = x;
         xp(i) += h, xm(i) -= h;
-        const double fd = (model.term_energy(xp, term, r) - model.term_energy(xm, term, r)) / (2 * h);
+        const double fd =
+            (model.term_energy(xp, term, r) - model.term_energy(xm, term, r)) / (2 * h);
         worst = std::max(worst, std::abs(fd - g(i)));
       }
       EXPECT_LT(worst, 1e-6 * g.cwiseAbs().maxCoeff()) << "term " << static_cast<int>(term);
@@ -205,7 +208,8 @@ TEST(MssModel, TermHessiansSumToTheHessian) {
   const Eigen::VectorXd x = perturbed(model, 0.3, 10);
   std::array<RegionScales, kNumTerms> s{};
   const double values[kNumTerms][2] = {{1.5, 0.7}, {2.0, 3.0}, {0.25, 4.0}, {1.1, 0.9}, {2.5, 1.0}};
-  for (int term = 0; term < kNumTerms; ++term) s[term].by_region = {values[term][0], values[term][1]};
+  for (int term = 0; term < kNumTerms; ++term)
+    s[term].by_region = {values[term][0], values[term][1]};
   model.set_scales(s);
   Eigen::SparseMatrix<double> H, Hj;
   model.hessian(x, HessianMode::exact, H);
@@ -350,7 +354,8 @@ TEST(MssModel, TermsCanBeSwitchedOff) {
   EXPECT_EQ(model.num_angle_springs(), 0);
   const Eigen::VectorXd x = perturbed(model, 0.3, 3);
   EXPECT_EQ(model.term_energy(x, Term::torsion, 0), 0.0);
-  EXPECT_NEAR(model.energy(x), model.term_energy(x, Term::main, 0) + model.term_energy(x, Term::main, 1),
+  EXPECT_NEAR(model.energy(x),
+              model.term_energy(x, Term::main, 0) + model.term_energy(x, Term::main, 1),
               1e-12 * model.energy(x));
 }
 

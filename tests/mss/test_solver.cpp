@@ -6,8 +6,8 @@
 
 #include "solver_fixtures.hpp"
 
-#include <Eigen/SparseCholesky>
 #include <gtest/gtest.h>
+#include <Eigen/SparseCholesky>
 
 #include <cmath>
 #include <cstdio>
@@ -52,11 +52,12 @@ struct LinearReference {
   std::vector<int> free_dof;  ///< full DOF index of each free unknown
   Eigen::MatrixXd Kfp;        ///< #free x 6
   Matrix6d K6;
-  Eigen::MatrixXd Z;          ///< K_ff^-1 K_fp
+  Eigen::MatrixXd Z;  ///< K_ff^-1 K_fp
   Eigen::Vector3d c;
   const mesh::TetMesh* m;
 
-  LinearReference(const MssModel& model, const Eigen::Vector3d& center) : c(center), m(&model.mesh()) {
+  LinearReference(const MssModel& model, const Eigen::Vector3d& center)
+      : c(center), m(&model.mesh()) {
     Eigen::SparseMatrix<double> K;
     model.hessian(model.rest_positions_mm(), HessianMode::exact, K);
     const Eigen::Index n = model.num_nodes();
@@ -77,7 +78,8 @@ struct LinearReference {
     K6.setZero();
     for (Eigen::Index i = 0; i < n; ++i)
       if (m->surface(i) == 2)
-        K6 += plate_map(model.rest_positions_mm().segment<3>(3 * i) - c).transpose() * Kall_p.middleRows(3 * i, 3);
+        K6 += plate_map(model.rest_positions_mm().segment<3>(3 * i) - c).transpose() *
+              Kall_p.middleRows(3 * i, 3);
     std::vector<Eigen::Triplet<double>> trip;
     for (int col = 0; col < K.outerSize(); ++col)
       for (Eigen::SparseMatrix<double>::InnerIterator it(K, col); it; ++it)
@@ -100,7 +102,8 @@ struct LinearReference {
     const Eigen::VectorXd uf = -Z * q;
     for (std::size_t k = 0; k < free_dof.size(); ++k) u(free_dof[k]) = uf(Eigen::Index(k));
     for (Eigen::Index i = 0; i < model.num_nodes(); ++i)
-      if (m->surface(i) == 2) u.segment<3>(3 * i) = plate_map(model.rest_positions_mm().segment<3>(3 * i) - c) * q;
+      if (m->surface(i) == 2)
+        u.segment<3>(3 * i) = plate_map(model.rest_positions_mm().segment<3>(3 * i) - c) * q;
     return u;
   }
 };
@@ -115,7 +118,10 @@ Vector6d as_forces(Vector6d w, double length_mm) {
 
 class SolverBox : public ::testing::Test {
  protected:
-  SolverBox() : mesh_(two_region_box()), model_(mesh_, soft_and_softer()), c_(default_plate_center(mesh_)) {}
+  SolverBox()
+      : mesh_(two_region_box()),
+        model_(mesh_, soft_and_softer()),
+        c_(default_plate_center(mesh_)) {}
   mesh::TetMesh mesh_;
   MssModel model_;
   Eigen::Vector3d c_;
@@ -141,7 +147,8 @@ TEST_F(SolverBox, ProbesTouchOnlySurfaceNodes) {
     bc.probes.push_back({X + Eigen::Vector3d(0.05, 0.05, 0.05), 0.5, 0.0});
     const StaticResult r = solve_static(model_, bc);
     EXPECT_TRUE(r.converged) << r.message;
-    return std::make_pair((r.x_mm - model_.rest_positions_mm()).norm(), probe_forces(model_, bc, r.x_mm)[0].norm());
+    return std::make_pair((r.x_mm - model_.rest_positions_mm()).norm(),
+                          probe_forces(model_, bc, r.x_mm)[0].norm());
   };
   const auto interior = probe_at(0), wall = probe_at(3);
   EXPECT_EQ(interior.first, 0.0);
@@ -183,19 +190,22 @@ TEST_F(SolverBox, SmallMotionReactionIsMinusCondensedStiffnessTimesMotion) {
     ASSERT_TRUE(r.converged) << r.message;
     EXPECT_LT((r.plate_motion - q).norm(), 1e-15);
     const Vector6d expected = -lin.K6 * q;
-    const double err = (as_forces(r.reaction_wrench - expected, L)).norm() / as_forces(expected, L).norm();
+    const double err =
+        (as_forces(r.reaction_wrench - expected, L)).norm() / as_forces(expected, L).norm();
     EXPECT_LT(err, 10 * eps);
     if (previous > 0) {
       EXPECT_GT(previous / err, 5.0);  // linear in the load: the relative error shrinks with it
       // Reaction scales linearly: R(q) / eps is the same to O(eps).
-      EXPECT_LT(as_forces(first / 1e-2 - r.reaction_wrench / 1e-3, L).norm(), 0.05 * as_forces(first / 1e-2, L).norm());
+      EXPECT_LT(as_forces(first / 1e-2 - r.reaction_wrench / 1e-3, L).norm(),
+                0.05 * as_forces(first / 1e-2, L).norm());
     } else {
       first = r.reaction_wrench;
     }
     previous = err;
   }
   // A compressive motion pushes the plate up: F_y > 0.
-  const StaticResult down = solve_static(model_, fixtures::motion_boundary(mesh_, vec6(0, -0.01, 0, 0, 0, 0)));
+  const StaticResult down =
+      solve_static(model_, fixtures::motion_boundary(mesh_, vec6(0, -0.01, 0, 0, 0, 0)));
   EXPECT_GT(down.reaction_wrench(1), 0.0);
 }
 
@@ -212,8 +222,10 @@ TEST_F(SolverBox, WrenchAndPoseModesAgree) {
     ASSERT_TRUE(rp.converged) << rp.message;
     const double ep = as_forces(rp.reaction_wrench + w, L).norm() / as_forces(w, L).norm();
     const double ex = (rp.x_mm - rw.x_mm).norm() / (rw.x_mm - model_.rest_positions_mm()).norm();
-    std::printf("wrench x%g: |q| = %.2e, rel. reaction error wrench mode %.2e, pose mode %.2e, "
-                "positions %.2e\n", scale, rw.plate_motion.norm(), ew, ep, ex);
+    std::printf(
+        "wrench x%g: |q| = %.2e, rel. reaction error wrench mode %.2e, pose mode %.2e, "
+        "positions %.2e\n",
+        scale, rw.plate_motion.norm(), ew, ep, ex);
     EXPECT_LT(ew, 1e-2 * scale);
     EXPECT_LT(ep, 1e-2 * scale);
     EXPECT_LT(ex, 1e-2 * scale);
@@ -253,8 +265,8 @@ TEST_F(SolverBox, EquilibriumBalancesPlateFixedEndplateProbeAndNodalForces) {
   tight.relative_tolerance = 1e-12;
   const StaticResult r = solve_static(model_, bc, tight);
   ASSERT_TRUE(r.converged) << r.message;
-  std::printf("equilibrium with probe and nodal forces: %d Newton iterations to |r| = %.2e N\n", r.iterations,
-              r.residual_n);
+  std::printf("equilibrium with probe and nodal forces: %d Newton iterations to |r| = %.2e N\n",
+              r.iterations, r.residual_n);
 
   Eigen::VectorXd g;
   model_.gradient(r.x_mm, g);
@@ -267,8 +279,10 @@ TEST_F(SolverBox, EquilibriumBalancesPlateFixedEndplateProbeAndNodalForces) {
     gmax = std::max(gmax, g.segment<3>(3 * i).norm());
     if (mesh_.surface(i) == 1 || mesh_.surface(i) == 2) continue;
     Eigen::Vector3d gp;
-    probe_contact(r.x_mm.segment<3>(3 * i), probe.center_mm, probe.radius_mm, probe.stiffness_n_per_mm, &gp);
-    worst = std::max(worst, (g.segment<3>(3 * i) + gp - bc.nodal_forces_n.segment<3>(3 * i)).norm());
+    probe_contact(r.x_mm.segment<3>(3 * i), probe.center_mm, probe.radius_mm,
+                  probe.stiffness_n_per_mm, &gp);
+    worst =
+        std::max(worst, (g.segment<3>(3 * i) + gp - bc.nodal_forces_n.segment<3>(3 * i)).norm());
   }
   EXPECT_LT(worst, 1e-9 * gmax);
   EXPECT_LT(r.residual_n, 1e-8 * gmax);
@@ -279,16 +293,40 @@ TEST_F(SolverBox, EquilibriumBalancesPlateFixedEndplateProbeAndNodalForces) {
     const Eigen::Vector3d gi = g.segment<3>(3 * i);
     scale += gi.norm();
     M_all += r.x_mm.segment<3>(3 * i).cross(gi);
-    if (mesh_.surface(i) == 2) F_plate -= gi;
-    else if (mesh_.surface(i) == 1) F_inf -= gi;
-    else F_free += gi;
+    if (mesh_.surface(i) == 2)
+      F_plate -= gi;
+    else if (mesh_.surface(i) == 1)
+      F_inf -= gi;
+    else
+      F_free += gi;
   }
   const Eigen::Vector3d F_nodal = bc.nodal_forces_n.reshaped(3, model_.num_nodes()).rowwise().sum();
-  std::printf("balance: F_plate %s, F_inferior %s, F_probe %s, F_nodal %s (N)\n",
-              [&] { std::ostringstream o; o << F_plate.transpose(); return o.str(); }().c_str(),
-              [&] { std::ostringstream o; o << F_inf.transpose(); return o.str(); }().c_str(),
-              [&] { std::ostringstream o; o << fp[0].transpose(); return o.str(); }().c_str(),
-              [&] { std::ostringstream o; o << F_nodal.transpose(); return o.str(); }().c_str());
+  std::printf(
+      "balance: F_plate %s, F_inferior %s, F_probe %s, F_nodal %s (N)\n",
+      [&] {
+        std::ostringstream o;
+        o << F_plate.transpose();
+        return o.str();
+      }()
+          .c_str(),
+      [&] {
+        std::ostringstream o;
+        o << F_inf.transpose();
+        return o.str();
+      }()
+          .c_str(),
+      [&] {
+        std::ostringstream o;
+        o << fp[0].transpose();
+        return o.str();
+      }()
+          .c_str(),
+      [&] {
+        std::ostringstream o;
+        o << F_nodal.transpose();
+        return o.str();
+      }()
+          .c_str());
   // Internal forces: zero net force and moment.
   EXPECT_LT(M_all.norm(), 1e-10 * scale * 20.0);
   // The plate reaction reported is the same sum.
@@ -300,7 +338,8 @@ TEST_F(SolverBox, EquilibriumBalancesPlateFixedEndplateProbeAndNodalForces) {
 }
 
 TEST_F(SolverBox, TenPercentCompressionConverges) {
-  const StaticResult r = solve_static(model_, fixtures::motion_boundary(mesh_, vec6(0, -0.8, 0, 0, 0, 0)));
+  const StaticResult r =
+      solve_static(model_, fixtures::motion_boundary(mesh_, vec6(0, -0.8, 0, 0, 0, 0)));
   EXPECT_TRUE(r.converged) << r.message;
   EXPECT_GT(r.reaction_wrench(1), 0.0);
   std::printf("box 10%% compression: %d Newton iterations, %.3f s, F_y = %.3f N, residual %.2e N\n",
@@ -312,7 +351,8 @@ TEST_F(SolverBox, BadInputIsRefused) {
   bc.wrench(0) = std::numeric_limits<double>::quiet_NaN();
   EXPECT_THROW(solve_static(model_, bc), std::invalid_argument);
   bc = fixtures::motion_boundary(mesh_, Vector6d::Zero());
-  EXPECT_THROW(solve_static(model_, bc, StaticOptions(), Eigen::VectorXd::Zero(5)), std::invalid_argument);
+  EXPECT_THROW(solve_static(model_, bc, StaticOptions(), Eigen::VectorXd::Zero(5)),
+               std::invalid_argument);
   StaticOptions bad;
   bad.max_iterations = 0;
   EXPECT_THROW(solve_static(model_, bc, bad), std::invalid_argument);
@@ -328,7 +368,8 @@ TEST_F(SolverBox, BadInputIsRefused) {
 TEST_F(SolverBox, IterationLimitIsReportedNotHidden) {
   StaticOptions one;
   one.max_iterations = 1;
-  const StaticResult r = solve_static(model_, fixtures::motion_boundary(mesh_, vec6(0, -0.8, 0, 0.02, 0, 0)), one);
+  const StaticResult r =
+      solve_static(model_, fixtures::motion_boundary(mesh_, vec6(0, -0.8, 0, 0.02, 0, 0)), one);
   EXPECT_FALSE(r.converged);
   EXPECT_FALSE(r.message.empty());
   EXPECT_EQ(r.iterations, 1);
@@ -348,8 +389,10 @@ TEST_F(SolverBox, WholeDiscVolumeTermIsSolvedWithItsRankOneHessian) {
   const StaticResult plain = solve_static(model_, bc);
   const double dv = model.volume_mm3(r.x_mm) / model.rest_volume_mm3() - 1.0;
   const double dv_plain = model_.volume_mm3(plain.x_mm) / model_.rest_volume_mm3() - 1.0;
-  std::printf("10%% compression with the whole-disc volume term: %d Newton iterations, volume change "
-              "%.3f %% (without: %.3f %%)\n", r.iterations, 100 * dv, 100 * dv_plain);
+  std::printf(
+      "10%% compression with the whole-disc volume term: %d Newton iterations, volume change "
+      "%.3f %% (without: %.3f %%)\n",
+      r.iterations, 100 * dv, 100 * dv_plain);
   EXPECT_LE(r.iterations, plain.iterations + 2);
   EXPECT_LT(std::abs(dv), std::abs(dv_plain));
 }
@@ -357,17 +400,25 @@ TEST_F(SolverBox, WholeDiscVolumeTermIsSolvedWithItsRankOneHessian) {
 TEST(SolverDisc, L4L5TenPercentCompressionAndWrenchConverge) {
   const mesh::TetMesh& m = fixtures::l4_l5(3.5);
   const MssModel model(m, fixtures::real_disc());
-  const StaticResult r = solve_static(model, fixtures::motion_boundary(m, vec6(0, -1.13, 0, 0, 0, 0)));
+  const StaticResult r =
+      solve_static(model, fixtures::motion_boundary(m, vec6(0, -1.13, 0, 0, 0, 0)));
   EXPECT_TRUE(r.converged) << r.message;
   EXPECT_GT(r.reaction_wrench(1), 0.0);
-  std::printf("L4-L5 (%ld tets, %ld nodes) 10%% compression: %d Newton iterations, %.3f s, F_y = %.1f N\n",
-              long(m.num_tets()), long(m.num_vertices()), r.iterations, r.seconds, r.reaction_wrench(1));
+  std::printf(
+      "L4-L5 (%ld tets, %ld nodes) 10%% compression: %d Newton iterations, %.3f s, F_y = %.1f N\n",
+      long(m.num_tets()), long(m.num_vertices()), r.iterations, r.seconds, r.reaction_wrench(1));
   // The reaction of that compression, applied as a wrench, gives back about the same motion.
   const Vector6d w = -r.reaction_wrench;
   const StaticResult rw = solve_static(model, fixtures::wrench_boundary(m, w));
   EXPECT_TRUE(rw.converged) << rw.message;
-  std::printf("  as a wrench: %d Newton iterations, %.3f s, plate motion %s\n", rw.iterations, rw.seconds,
-              [&] { std::ostringstream o; o << rw.plate_motion.transpose(); return o.str(); }().c_str());
+  std::printf("  as a wrench: %d Newton iterations, %.3f s, plate motion %s\n", rw.iterations,
+              rw.seconds,
+              [&] {
+                std::ostringstream o;
+                o << rw.plate_motion.transpose();
+                return o.str();
+              }()
+                  .c_str());
   // Pure translation: the plate map is exact, so the same equilibrium comes back (the moments
   // differ only through the moved centre, far below the axial term).
   EXPECT_NEAR(rw.plate_motion(1), -1.13, 1e-6);

@@ -35,7 +35,9 @@ struct Outcome {
 
 const mesh::TetMesh& disc() { return fixtures::l4_l5(3.0); }
 
-double ten_percent_mm() { return 0.1 * MssModel(disc(), fixtures::real_disc()).cylinder().length_mm; }
+double ten_percent_mm() {
+  return 0.1 * MssModel(disc(), fixtures::real_disc()).cylinder().length_mm;
+}
 
 Outcome compress(const Variant& v) {
   MssOptions o;
@@ -63,7 +65,8 @@ TEST(MssVolume, TenPercentCompression) {
                    std::to_string(100.0 * out[i].volume_change));
   }
   // FEM reference on the same mesh: the disc material's own volume change.
-  const fem::DiscFem fem(disc(), fixtures::real_disc(), 2, fem::DiscFem::default_plate_center(disc()));
+  const fem::DiscFem fem(disc(), fixtures::real_disc(), 2,
+                         fem::DiscFem::default_plate_center(disc()));
   fem::Vector6d q = fem::Vector6d::Zero();
   q(1) = -ten_percent_mm();
   const fem::PlateSolution s = fem.solve_motion(q);

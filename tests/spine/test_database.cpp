@@ -42,7 +42,8 @@ bool failed_in_file(const DisplacementDatabase& db, int v, int d, double f) {
 
 /// Solved response of the model (relative to gravity only), as the database defines it.
 VertebraResponse direct_response(int v, const Vector3d& force_n) {
-  static const VertebraResponse baseline = solve_spine(model(), {}, shipped().info.solve).displacement;
+  static const VertebraResponse baseline =
+      solve_spine(model(), {}, shipped().info.solve).displacement;
   ExternalLoad l;
   l.vertebra = v;
   l.force_n = force_n;
@@ -73,7 +74,8 @@ TEST(PolynomialFit, RecoversAnExactCubic) {
 
 TEST(PolynomialFit, PicksTheLowestDegreeWithinTolerance) {
   Eigen::VectorXd f(12), y(12);
-  for (int k = 0; k < 12; ++k) f[k] = 50.0 * (k + 1), y[k] = 0.02 * f[k] + 1e-5 * std::sin(double(k));
+  for (int k = 0; k < 12; ++k)
+    f[k] = 50.0 * (k + 1), y[k] = 0.02 * f[k] + 1e-5 * std::sin(double(k));
   const PolynomialFit fit = fit_by_residual(f, y, 600.0);  // default: 1 % of range or 1e-3
   EXPECT_EQ(fit.coefficients.size(), 1);
   EXPECT_NEAR(fit.coefficients[0], 12.0, 1e-3);  // 0.02 mm/N over 600 N
@@ -120,7 +122,8 @@ ResponseSamples synthetic(const std::vector<int>& loaded) {
         VertebraResponse m;
         for (int j = 0; j < kDbVertebrae; ++j)
           for (int c = 0; c < kDbComponents; ++c)
-            m(j, c) = (d + 1) * (0.1 * (j + 1) * x + 0.01 * c * x * x) + (d == 4 ? 3.0 * x * x * x : 0.0);
+            m(j, c) =
+                (d + 1) * (0.1 * (j + 1) * x + 0.01 * c * x * x) + (d == 4 ? 3.0 * x * x * x : 0.0);
         r.push_back(m);
       }
       s.solved[std::size_t(v)][std::size_t(d)].assign(s.forces_n.size(), true);
@@ -194,8 +197,16 @@ TEST(ShippedDatabase, ReproducesDirectSolvesAtGridForces) {
       max_response_difference(solve_spine(model(), {}, db.info.solve).displacement, db.baseline());
   EXPECT_LT(base_mm, 1e-3);
   EXPECT_LT(base_deg, 1e-3);
-  struct Case { const char* vertebra; const char* direction; double force_n; };
-  const Case cases[] = {{"T1", "+z", 300}, {"T7", "-x", 150}, {"L3", "+y", 450}, {"T12", "-z", 100}, {"L5", "+x", 600}};
+  struct Case {
+    const char* vertebra;
+    const char* direction;
+    double force_n;
+  };
+  const Case cases[] = {{"T1", "+z", 300},
+                        {"T7", "-x", 150},
+                        {"L3", "+y", 450},
+                        {"T12", "-z", 100},
+                        {"L5", "+x", 600}};
   int checked = 0;
   for (const auto& c : cases) {
     const int v = vertebra_index(c.vertebra), d = direction_index(c.direction);
@@ -205,8 +216,10 @@ TEST(ShippedDatabase, ReproducesDirectSolvesAtGridForces) {
     db.evaluate(v, f, from_db);
     const auto [mm, deg] = max_response_difference(from_db, direct_response(v, f));
     // The fit's own worst residual bounds it; the margin covers the solver tolerance.
-    EXPECT_LE(mm, db.max_residual_translation_mm(v, d) + 2e-3) << c.vertebra << " " << c.direction << " " << c.force_n;
-    EXPECT_LE(deg, db.max_residual_rotation_deg(v, d) + 2e-3) << c.vertebra << " " << c.direction << " " << c.force_n;
+    EXPECT_LE(mm, db.max_residual_translation_mm(v, d) + 2e-3)
+        << c.vertebra << " " << c.direction << " " << c.force_n;
+    EXPECT_LE(deg, db.max_residual_rotation_deg(v, d) + 2e-3)
+        << c.vertebra << " " << c.direction << " " << c.force_n;
     ++checked;
   }
   EXPECT_GE(checked, 3);
@@ -236,8 +249,10 @@ TEST(ShippedDatabase, LateralForcesGiveMirrorImages) {
   db.evaluate(t1, Vector3d(200, 0, 0), plus);
   db.evaluate(t1, Vector3d(-200, 0, 0), minus);
   const auto [db_mm, db_deg] = max_response_difference(mirrored(plus), minus);
-  EXPECT_LE(db_mm, db.max_residual_translation_mm(t1, 0) + db.max_residual_translation_mm(t1, 1) + 1e-3);
-  EXPECT_LE(db_deg, db.max_residual_rotation_deg(t1, 0) + db.max_residual_rotation_deg(t1, 1) + 1e-3);
+  EXPECT_LE(db_mm,
+            db.max_residual_translation_mm(t1, 0) + db.max_residual_translation_mm(t1, 1) + 1e-3);
+  EXPECT_LE(db_deg,
+            db.max_residual_rotation_deg(t1, 0) + db.max_residual_rotation_deg(t1, 1) + 1e-3);
 }
 
 TEST(ShippedDatabase, RangeIsVisible) {
@@ -258,7 +273,8 @@ TEST(ShippedDatabase, RefusesBadInput) {
   EXPECT_THROW(db.evaluate(-1, Vector3d(1, 0, 0), r), std::invalid_argument);
   EXPECT_THROW(db.evaluate(17, Vector3d(1, 0, 0), r), std::invalid_argument);
   EXPECT_THROW(db.evaluate(0, Vector3d(std::nan(""), 0, 0), r), std::invalid_argument);
-  EXPECT_THROW(db.evaluate(0, Vector3d(0, std::numeric_limits<double>::infinity(), 0), r), std::invalid_argument);
+  EXPECT_THROW(db.evaluate(0, Vector3d(0, std::numeric_limits<double>::infinity(), 0), r),
+               std::invalid_argument);
   EXPECT_THROW(direction_index("+w"), std::invalid_argument);
   const DisplacementDatabase part = DisplacementDatabase::fit(synthetic({2}), FitTolerance());
   EXPECT_THROW(part.evaluate(0, Vector3d(1, 0, 0), r), std::invalid_argument);  // T1 not in it
@@ -306,7 +322,8 @@ TEST(DatabaseFile, MissingOrCorruptFilesGiveClearErrors) {
   write_file(other, R"({"kind": "something else"})");
   expect_load_error(other, "not a displacement database");
   // Well-formed JSON, wrong content: an unknown direction, a fit with too many coefficients.
-  const auto corrupt = [&](const std::string& name, const std::string& from, const std::string& to) {
+  const auto corrupt = [&](const std::string& name, const std::string& from,
+                           const std::string& to) {
     std::string bad = text;
     const std::size_t at = bad.find(from);
     EXPECT_NE(at, std::string::npos) << from;
@@ -314,7 +331,8 @@ TEST(DatabaseFile, MissingOrCorruptFilesGiveClearErrors) {
     write_file(tmp_path(name), bad);
     return tmp_path(name);
   };
-  expect_load_error(corrupt("db_direction.json", "\"direction\":\"+x\"", "\"direction\":\"+w\""), "unknown direction");
+  expect_load_error(corrupt("db_direction.json", "\"direction\":\"+x\"", "\"direction\":\"+w\""),
+                    "unknown direction");
   expect_load_error(corrupt("db_degree.json", "\"c\":[[[", "\"c\":[[[1,1,1,1,1,"), "coefficients");
 }
 

@@ -70,8 +70,10 @@ TEST(SpineEquilibrium, CoupleOnOneJointRotatesItByMOverKFlexionExtensionAndBump)
     sp::SolveOptions tight;
     tight.tolerance = 1e-7;  // N·mm: θ to ~1e-12 rad
     const sp::SpineSolution s = sp::solve_spine(m, {l}, tight);
-    const double k = M > 0 ? j.k_flexion : j.k_extension, rom = M > 0 ? j.rom_flexion : j.rom_extension;
-    const double a = std::abs(M) + (M > 0 ? (j.k_flexion - j.k_extension) * band / 2 : 0);  // the shift
+    const double k = M > 0 ? j.k_flexion : j.k_extension,
+                 rom = M > 0 ? j.rom_flexion : j.rom_extension;
+    const double a =
+        std::abs(M) + (M > 0 ? (j.k_flexion - j.k_extension) * band / 2 : 0);  // the shift
     double expect = a / k;
     if (expect > rom) {  // beyond the range, overshoot s = |θ| − rom
       const double kb = m.rom_bump_factor * k, w = m.rom_bump_onset;
@@ -93,9 +95,11 @@ TEST(SpineEquilibrium, BumpStiffnessRampsUpOverItsOnset) {
   const double w = m.rom_bump_onset, s = 0.5 * w;
   sp::ExternalLoad l;
   l.vertebra = sp::vertebra_index("L5");
-  const double shift = (j.k_flexion - j.k_extension) * (0.05 * M_PI / 180) / 2;  // see the couple test
-  l.moment_nmm =
-      Vector3d(j.k_flexion * (j.rom_flexion + s) - shift + m.rom_bump_factor * j.k_flexion * s * s / (2 * w), 0, 0);
+  const double shift =
+      (j.k_flexion - j.k_extension) * (0.05 * M_PI / 180) / 2;  // see the couple test
+  l.moment_nmm = Vector3d(
+      j.k_flexion * (j.rom_flexion + s) - shift + m.rom_bump_factor * j.k_flexion * s * s / (2 * w),
+      0, 0);
   const sp::SpineSolution sol = sp::solve_spine(m, {l});
   EXPECT_NEAR(sol.theta[3 * 16], j.rom_flexion + s, 1e-9);
 }
@@ -134,9 +138,11 @@ TEST(SpineEquilibrium, LateralForceGivesAMirrorImageResponse) {
   const sp::SpineSolution a = sp::solve_spine(m, {force_on("T1", Vector3d(200, 0, 0))});
   const sp::SpineSolution b = sp::solve_spine(m, {force_on("T1", Vector3d(-200, 0, 0))});
   // Mirror x → −x: x translation and y, z rotations change sign; y, z translations and x rotation do not.
-  const Eigen::Matrix<double, 1, 6> sign = (Eigen::Matrix<double, 1, 6>() << -1, 1, 1, 1, -1, -1).finished();
+  const Eigen::Matrix<double, 1, 6> sign =
+      (Eigen::Matrix<double, 1, 6>() << -1, 1, 1, 1, -1, -1).finished();
   for (Eigen::Index i = 0; i < a.displacement.rows(); ++i)
-    EXPECT_NEAR((a.displacement.row(i) - b.displacement.row(i).cwiseProduct(sign)).norm(), 0, 1e-4) << "vertebra " << i;
+    EXPECT_NEAR((a.displacement.row(i) - b.displacement.row(i).cwiseProduct(sign)).norm(), 0, 1e-4)
+        << "vertebra " << i;
   EXPECT_GT(std::abs(a.displacement(0, 0)), 1.0);  // T1 moves sideways, in mm
 }
 
@@ -153,9 +159,11 @@ TEST(SpineEquilibrium, SagittalLoadRecruitsLeftAndRightAlikeAndSatisfiesTheConst
     o.criterion = criterion;
     const sp::Recruitment r = sp::recruit(m, arm, b, o);
     ASSERT_TRUE(r.success) << r.status;
-    EXPECT_LT((arm * r.force_n + r.reserve_nmm - b).cwiseAbs().maxCoeff(), 1e-6 * b.cwiseAbs().maxCoeff());
+    EXPECT_LT((arm * r.force_n + r.reserve_nmm - b).cwiseAbs().maxCoeff(),
+              1e-6 * b.cwiseAbs().maxCoeff());
     for (std::size_t i = 0; i < m.muscles.size(); i += 2)
-      EXPECT_NEAR(r.force_n[Eigen::Index(i)], r.force_n[Eigen::Index(i + 1)], 1e-3 * m.muscles[i].max_force_n())
+      EXPECT_NEAR(r.force_n[Eigen::Index(i)], r.force_n[Eigen::Index(i + 1)],
+                  1e-3 * m.muscles[i].max_force_n())
           << m.muscles[i].name;
     EXPECT_GE(r.activation.minCoeff(), 0.0);
     EXPECT_LE(r.activation.maxCoeff(), 1.0);
@@ -193,7 +201,8 @@ TEST(SpineEquilibrium, FusionHoldsTheJointAndStiffensThePassiveSpine) {
   const std::vector<sp::ExternalLoad> loads = {force_on("T1", Vector3d(0, 0, 100))};
   sp::SolveOptions passive;
   passive.recruit = false;
-  const sp::SpineSolution f = sp::solve_spine(fused, loads, passive), n = sp::solve_spine(full(), loads, passive);
+  const sp::SpineSolution f = sp::solve_spine(fused, loads, passive),
+                          n = sp::solve_spine(full(), loads, passive);
   EXPECT_EQ(f.theta.segment<6>(3 * 14).norm(), 0.0);
   EXPECT_GT(n.theta.segment<6>(3 * 14).norm(), 1e-4);
   EXPECT_LT(f.displacement.row(0).head<3>().norm(), n.displacement.row(0).head<3>().norm());
@@ -268,7 +277,8 @@ TEST(SpineEquilibrium, SagittalSolveEqualsTheFullSolveWhereStable) {
 // only). A consistent factor in how F.4 is loaded or where k enters the energy fails here.
 TEST(SpineEquilibrium, LateralAndTorsionJointSpringsMatchTableF4) {
   std::ifstream in(std::string(SPINESIM_DATA_DIR) + "/thesis/F4_joint_torsional_stiffness.csv");
-  std::map<std::string, std::array<double, 4>> f4;  // flexion, extension, lateral, torsion per degree
+  std::map<std::string, std::array<double, 4>>
+      f4;  // flexion, extension, lateral, torsion per degree
   for (std::string line; std::getline(in, line);) {
     if (line.empty() || line[0] == '#' || line.rfind("level_group", 0) == 0) continue;
     std::stringstream ss(line);
@@ -284,7 +294,11 @@ TEST(SpineEquilibrium, LateralAndTorsionJointSpringsMatchTableF4) {
   ASSERT_TRUE(f4.count("T1-T12") && f4.count("L1-L5") && f4.count("L5-S1"));
   const sp::SpineModel m = bare();
   const double per_rad = 180 / M_PI;
-  struct Case { const char* vertebra; int joint; const char* group; };
+  struct Case {
+    const char* vertebra;
+    int joint;
+    const char* group;
+  };
   for (const Case c : {Case{"T7", 6, "T1-T12"}, Case{"L5", 16, "L5-S1"}, Case{"L2", 13, "L1-L5"}})
     for (int axis : {1, 2}) {  // joint coordinates: y torsion, z lateral bending
       SCOPED_TRACE(std::string(c.vertebra) + (axis == 1 ? " torsion" : " lateral bending"));

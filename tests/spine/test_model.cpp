@@ -2,8 +2,8 @@
 #include "spinesim/spine/model.hpp"
 
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 #include <unistd.h>
+#include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <filesystem>
@@ -20,7 +20,8 @@ const sp::SpineModel& model() {
 }  // namespace
 
 TEST(SpineModel, AppendixCRecomputedFromItsInputsMatchesThePrintedResults) {
-  const sp::IapStiffness s = sp::iap_from_appendix_c(std::string(SPINESIM_DATA_DIR) + "/thesis/appendix_c_iap.json");
+  const sp::IapStiffness s =
+      sp::iap_from_appendix_c(std::string(SPINESIM_DATA_DIR) + "/thesis/appendix_c_iap.json");
   std::ifstream in(std::string(SPINESIM_DATA_DIR) + "/thesis/appendix_c_iap.json");
   const auto printed = nlohmann::json::parse(in).at("thesis_results");
   EXPECT_NEAR(s.s_mean_mm2, printed.at("S_mean_mm2").get<double>(), 1e-3);
@@ -35,7 +36,8 @@ TEST(SpineModel, AppendixCRecomputedFromItsInputsMatchesThePrintedResults) {
   EXPECT_NEAR(s.bushing_m_xz_per_deg, printed.at("M_x_nmm_per_deg").get<double>(), 1.0);
   EXPECT_NEAR(s.bushing_m_y_per_deg, printed.at("M_y_nmm_per_deg").get<double>(), 1.0);
   // The bushing converts N·mm/deg to N·mm/rad.
-  EXPECT_NEAR(model().bushing.k_rotation_nmm_per_rad.x(), s.bushing_m_xz_per_deg * 180 / M_PI, 1e-6);
+  EXPECT_NEAR(model().bushing.k_rotation_nmm_per_rad.x(), s.bushing_m_xz_per_deg * 180 / M_PI,
+              1e-6);
 }
 
 TEST(SpineModel, ChainOfSeventeenVertebraeOnTableF2Joints) {
@@ -91,7 +93,8 @@ TEST(SpineModel, MusclesAreTheRightSideTablesMirrored) {
     EXPECT_DOUBLE_EQ(l.a_mm.x(), -r.a_mm.x());
     EXPECT_DOUBLE_EQ(l.b_mm.y(), r.b_mm.y());
     EXPECT_DOUBLE_EQ(l.pcsa_mm2, r.pcsa_mm2);
-    EXPECT_LE(r.a_mm.x(), 0.0) << r.name << ": the printed tables are the body's right side (x <= 0)";
+    EXPECT_LE(r.a_mm.x(), 0.0) << r.name
+                               << ": the printed tables are the body's right side (x <= 0)";
     EXPECT_GT(r.rest_length_mm, 0);
   }
   EXPECT_DOUBLE_EQ(m.muscles[0].max_force_n(), 40 * 0.7);  // NStiss_121: 40 mm² × 0.7 MPa
@@ -123,8 +126,10 @@ TEST(SpineModel, TrunkMusclesFollowTheRulesTheirFileStates) {
   const auto& il = muscle(m, "ILpT_T7_R");
   const auto& ra = muscle(m, "RA_R");
   // pars thoracis origins: T7 at the offset the F.10 pars lumborum origins have from L1.
-  EXPECT_TRUE(lt.a_mm.isApprox(centre(m, "T7") + muscle(m, "NStiss_144_R").a_mm - centre(m, "L1"), 1e-12));
-  EXPECT_TRUE(il.a_mm.isApprox(centre(m, "T7") + muscle(m, "NStiss_140_R").a_mm - centre(m, "L1"), 1e-12));
+  EXPECT_TRUE(
+      lt.a_mm.isApprox(centre(m, "T7") + muscle(m, "NStiss_144_R").a_mm - centre(m, "L1"), 1e-12));
+  EXPECT_TRUE(
+      il.a_mm.isApprox(centre(m, "T7") + muscle(m, "NStiss_140_R").a_mm - centre(m, "L1"), 1e-12));
   EXPECT_EQ(lt.body_a, 6);  // T7
   // insertions: the mean of the same column's F.10 insertions, on the ground.
   EXPECT_LT((lt.b_mm - mean_insertion(m, 144, 148)).cwiseAbs().maxCoeff(), tol);
@@ -140,8 +145,10 @@ TEST(SpineModel, TrunkMusclesFollowTheRulesTheirFileStates) {
   EXPECT_DOUBLE_EQ(ra.a_mm.z(), m.chest_front_mm.z());
   EXPECT_EQ(ra.body_a, m.ribs_body);
   EXPECT_TRUE(ra.b_mm.isApprox(muscle(m, "NStiss_176_R").b_mm, 1e-12));
-  const double sheath_x = (muscle(m, "NStiss_167_R").b_mm.x() + muscle(m, "NStiss_174_R").b_mm.x() +
-                           muscle(m, "NStiss_175_R").b_mm.x() + muscle(m, "NStiss_176_R").b_mm.x()) / 4;
+  const double sheath_x =
+      (muscle(m, "NStiss_167_R").b_mm.x() + muscle(m, "NStiss_174_R").b_mm.x() +
+       muscle(m, "NStiss_175_R").b_mm.x() + muscle(m, "NStiss_176_R").b_mm.x()) /
+      4;
   EXPECT_NEAR(ra.a_mm.x(), sheath_x, tol);
   // The pars thoracis pass behind every lumbar joint and the rectus abdominis in front of it.
   for (const auto& j : m.joints) {
@@ -171,10 +178,12 @@ TEST(SpineModel, LigamentsSpanEveryJointThoracicTakesTheMeanOfCervicalAndLumbar)
     EXPECT_EQ(l.body_a, l.joint);
     EXPECT_GT(l.rest_length_mm, 0);
     if (l.type == "ALL") {
-      EXPECT_NEAR(l.k_n_per_mm, m.joints[std::size_t(l.joint)].name[0] == 'T' ? 0.5 * (17 + 33) : 33, 1e-12);
+      EXPECT_NEAR(l.k_n_per_mm,
+                  m.joints[std::size_t(l.joint)].name[0] == 'T' ? 0.5 * (17 + 33) : 33, 1e-12);
     }
     if (l.type == "ALL") EXPECT_GT(l.a_mm.z(), m.vertebrae[std::size_t(l.joint)].centre_mm.z());
-    if (l.type == "ISL") EXPECT_LT(l.a_mm.z(), m.vertebrae[std::size_t(l.joint)].centre_mm.z() - 20);
+    if (l.type == "ISL")
+      EXPECT_LT(l.a_mm.z(), m.vertebrae[std::size_t(l.joint)].centre_mm.z() - 20);
   }
 }
 

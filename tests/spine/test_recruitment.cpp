@@ -38,7 +38,8 @@ double objective(const Eigen::VectorXd& F, const Eigen::VectorXd& fmax, const Ei
                  const std::vector<Axis>& axes, double p) {
   double f = 0;
   for (Eigen::Index i = 0; i < F.size(); ++i) f += std::pow(std::max(F(i) / fmax(i), 0.0), p);
-  for (Eigen::Index k = 0; k < r.size(); ++k) f += std::pow(r(k) >= 0 ? r(k) / axes[k].pos : -r(k) / axes[k].neg, p);
+  for (Eigen::Index k = 0; k < r.size(); ++k)
+    f += std::pow(r(k) >= 0 ? r(k) / axes[k].pos : -r(k) / axes[k].neg, p);
   return f;
 }
 
@@ -59,7 +60,8 @@ TEST(Recruitment, SatisfiesTheKktConditionsOfItsCriterion) {
   const std::vector<Axis> axes = joint_axes(m);
   ASSERT_EQ(Eigen::Index(axes.size()), b.size());
   Eigen::VectorXd fmax(Eigen::Index(m.muscles.size()));
-  for (std::size_t i = 0; i < m.muscles.size(); ++i) fmax(Eigen::Index(i)) = m.muscles[i].max_force_n();
+  for (std::size_t i = 0; i < m.muscles.size(); ++i)
+    fmax(Eigen::Index(i)) = m.muscles[i].max_force_n();
   const Eigen::VectorXd& F = rec.force_n;
   const Eigen::VectorXd& r = rec.reserve_nmm;
 
@@ -75,9 +77,11 @@ TEST(Recruitment, SatisfiesTheKktConditionsOfItsCriterion) {
     lambda(k) = p * std::pow(a, p - 1) * (r(k) >= 0 ? 1 / axes[k].pos : -1 / axes[k].neg);
   }
   Eigen::VectorXd gF(F.size());
-  for (Eigen::Index i = 0; i < F.size(); ++i) gF(i) = p * std::pow(std::max(F(i) / fmax(i), 0.0), p - 1) / fmax(i);
+  for (Eigen::Index i = 0; i < F.size(); ++i)
+    gF(i) = p * std::pow(std::max(F(i) / fmax(i), 0.0), p - 1) / fmax(i);
   const Eigen::VectorXd reduced = gF - A.transpose() * lambda;
-  const double scale = std::max(gF.cwiseAbs().maxCoeff(), (A.transpose() * lambda).cwiseAbs().maxCoeff());
+  const double scale =
+      std::max(gF.cwiseAbs().maxCoeff(), (A.transpose() * lambda).cwiseAbs().maxCoeff());
   int interior = 0, at_zero = 0;
   for (Eigen::Index i = 0; i < F.size(); ++i) {
     const double a = F(i) / fmax(i);
@@ -99,8 +103,12 @@ TEST(Recruitment, SatisfiesTheKktConditionsOfItsCriterion) {
   for (Eigen::Index i = 0; i < F.size(); ++i) {
     const double h = 1e-4 * fmax(i);
     if (F(i) + h <= fmax(i))
-      EXPECT_GE(objective(F + h * Eigen::VectorXd::Unit(F.size(), i), fmax, r - h * A.col(i), axes, p), f0 - 1e-9 * f0);
+      EXPECT_GE(
+          objective(F + h * Eigen::VectorXd::Unit(F.size(), i), fmax, r - h * A.col(i), axes, p),
+          f0 - 1e-9 * f0);
     if (F(i) - h >= 0)
-      EXPECT_GE(objective(F - h * Eigen::VectorXd::Unit(F.size(), i), fmax, r + h * A.col(i), axes, p), f0 - 1e-9 * f0);
+      EXPECT_GE(
+          objective(F - h * Eigen::VectorXd::Unit(F.size(), i), fmax, r + h * A.col(i), axes, p),
+          f0 - 1e-9 * f0);
   }
 }

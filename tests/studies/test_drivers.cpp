@@ -17,8 +17,8 @@
 #include "spinesim/studies/disc_level.hpp"
 #include "spinesim/studies/spine_studies.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
+#include <Eigen/Eigenvalues>
 
 #include <map>
 
@@ -46,7 +46,8 @@ TEST(ComparisonDriver, ErrorsAreTheirDefinitionsRecomputedFromIndependentSolves)
   const mss::MssModel model(m, mat);
   const std::vector<fem::LoadCase> cases{fem::load_case("compression"), fem::load_case("flexion")};
   const double scale = 0.3;
-  const auto cmp = calibration::compare_mss_fem(fem, model, cases, mat.name, mss::StaticOptions(), scale);
+  const auto cmp =
+      calibration::compare_mss_fem(fem, model, cases, mat.name, mss::StaticOptions(), scale);
   ASSERT_EQ(cmp.cases.size(), 2u);
   const Eigen::Vector3d c = fem.plate_center();
   for (std::size_t k = 0; k < cases.size(); ++k) {
@@ -63,7 +64,8 @@ TEST(ComparisonDriver, ErrorsAreTheirDefinitionsRecomputedFromIndependentSolves)
     const mss::StaticResult sw = mss::solve_static(model, bw);
     ASSERT_TRUE(sw.converged);
     const Eigen::MatrixX3d u = mss::displacement(model, sw.x_mm);
-    EXPECT_NEAR(r.displacement_error, (u - f.displacement_mm).norm() / f.displacement_mm.norm(), 1e-12);
+    EXPECT_NEAR(r.displacement_error, (u - f.displacement_mm).norm() / f.displacement_mm.norm(),
+                1e-12);
     // Plate-motion error: RMS rigid displacement of the difference over that of the FEM motion.
     double num = 0, den = 0;
     for (Eigen::Index i = 0; i < m.num_vertices(); ++i) {
@@ -92,10 +94,14 @@ TEST(ComparisonDriver, TheLinearFemScalesWithTheLoad) {
   const fem::DiscFem fem(m, mat, 1, fem::DiscFem::default_plate_center(m));
   const mss::MssModel model(m, mat);
   const std::vector<fem::LoadCase> cases{fem::load_case("torsion")};
-  const auto a = calibration::compare_mss_fem(fem, model, cases, mat.name, mss::StaticOptions(), 0.1);
-  const auto b = calibration::compare_mss_fem(fem, model, cases, mat.name, mss::StaticOptions(), 0.2);
-  EXPECT_LE((b.cases[0].plate_motion_fem - 2 * a.cases[0].plate_motion_fem).norm(), 1e-10 * b.cases[0].plate_motion_fem.norm());
-  EXPECT_THROW(calibration::compare_mss_fem(fem, model, cases, mat.name, mss::StaticOptions(), -1), std::invalid_argument);
+  const auto a =
+      calibration::compare_mss_fem(fem, model, cases, mat.name, mss::StaticOptions(), 0.1);
+  const auto b =
+      calibration::compare_mss_fem(fem, model, cases, mat.name, mss::StaticOptions(), 0.2);
+  EXPECT_LE((b.cases[0].plate_motion_fem - 2 * a.cases[0].plate_motion_fem).norm(),
+            1e-10 * b.cases[0].plate_motion_fem.norm());
+  EXPECT_THROW(calibration::compare_mss_fem(fem, model, cases, mat.name, mss::StaticOptions(), -1),
+               std::invalid_argument);
 }
 
 TEST(CalibrationDriver, TunedBeatsUntunedOnTrainingCasesAndTheFileApplies) {
@@ -111,7 +117,8 @@ TEST(CalibrationDriver, TunedBeatsUntunedOnTrainingCasesAndTheFileApplies) {
   for (const auto& row : o.tuned.report["train"]) {
     SCOPED_TRACE(row["name"].get<std::string>());
     EXPECT_LT(row["tuned_error_linear"].get<double>(), row["untuned_error_linear"].get<double>());
-    EXPECT_LT(row["tuned_error"].get<double>(), row["untuned_error"].get<double>());  // nonlinear check
+    EXPECT_LT(row["tuned_error"].get<double>(),
+              row["untuned_error"].get<double>());  // nonlinear check
   }
   EXPECT_EQ(o.tuned.report["holdout"].size(), 1u);
   EXPECT_EQ(calibration::check_applies(o.tuned, m, mat), "");
@@ -131,7 +138,8 @@ TEST(SpineStudyDrivers, ValidationReachesTheMcGillMomentAndComputesTheCratePoint
   EXPECT_GT(a.target_moment_nmm, 0);
   EXPECT_NEAR(a.external_moment_nmm, a.target_moment_nmm, 1e-3 * a.target_moment_nmm);
   EXPECT_GT(a.t7_force_n, 0);  // forward (+z) force
-  EXPECT_NEAR(a.joint_moment_nmm + a.other_moment_nmm, a.external_moment_nmm, 1e-6 * a.external_moment_nmm);
+  EXPECT_NEAR(a.joint_moment_nmm + a.other_moment_nmm, a.external_moment_nmm,
+              1e-6 * a.external_moment_nmm);
   EXPECT_GT(a.l5s1.axial_n, 0);  // compression
   const auto& b = s.wilke;
   EXPECT_GT(b.crate_point_mm.z(), 0);  // in front of the chest
@@ -144,9 +152,9 @@ TEST(SpineStudyDrivers, FusionAndTrendsAreCompleteAndSagittalLoadsStaySagittal) 
   EXPECT_EQ(f.findings.size(), 21u);
   for (const char* fusion : {"normal", "L3-L4", "L4-L5", "L3-L4-L5"}) {
     SCOPED_TRACE(fusion);
-    EXPECT_GT(f.run(fusion, "forward").t1_translation_mm.z(), 0);   // moves with the force
+    EXPECT_GT(f.run(fusion, "forward").t1_translation_mm.z(), 0);  // moves with the force
     EXPECT_LT(f.run(fusion, "backward").t1_translation_mm.z(), 0);
-    EXPECT_LT(f.run(fusion, "lateral").t1_translation_mm.x(), 0);   // lateral is -x
+    EXPECT_LT(f.run(fusion, "lateral").t1_translation_mm.x(), 0);          // lateral is -x
     EXPECT_NEAR(f.run(fusion, "forward").t1_translation_mm.x(), 0, 1e-6);  // mirror-symmetric model
   }
   const studies::TrendsStudy t = studies::run_trends_study(SPINESIM_DATA_DIR, 300);

@@ -31,13 +31,16 @@ TEST(Table, AlignsByDisplayColumnsAndEscapesPipesInMarkdown) {
   t.print(text, false, "");
   t.print(md, true);
   EXPECT_EQ(text.str(), "joint  Δx (mm)  N·mm\nT1-T2      1.5   |F|\nL4-L5   -12.25     7\n");
-  EXPECT_EQ(md.str(), "| joint | Δx (mm) | N·mm |\n|---|---:|---:|\n| T1-T2 | 1.5 | \\|F\\| |\n| L4-L5 | -12.25 | 7 |\n");
+  EXPECT_EQ(md.str(),
+            "| joint | Δx (mm) | N·mm |\n|---|---:|---:|\n| T1-T2 | 1.5 | \\|F\\| |\n| L4-L5 | "
+            "-12.25 | 7 |\n");
 }
 
 TEST(ProgressBar, RendersCountPercentageAndEta) {
   EXPECT_EQ(ProgressBar::render(0, 17, 0.0, "", "levels", 10), "[..........]  0/17 levels  0 %");
   // 4 of 16 done in 20 s: 5 s each, 12 left -> 60 s.
-  EXPECT_EQ(ProgressBar::render(4, 16, 20.0, "T5-T6", "", 8), "T5-T6  [##......]  4/16  25 %  ETA 1 min 0 s");
+  EXPECT_EQ(ProgressBar::render(4, 16, 20.0, "T5-T6", "", 8),
+            "T5-T6  [##......]  4/16  25 %  ETA 1 min 0 s");
   EXPECT_EQ(ProgressBar::render(16, 16, 80.0, "", "", 4), "[####]  16/16  100 %");
   EXPECT_EQ(human_duration(8.44), "8.4 s");
   EXPECT_EQ(human_duration(3725), "1 h 02 min");

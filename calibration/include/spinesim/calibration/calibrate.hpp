@@ -13,26 +13,26 @@
 namespace spinesim::calibration {
 
 struct IpoptSettings {
-  double lower_scale = 1e-3;   ///< bounds on every scale s_j (dimensionless, > 0)
+  double lower_scale = 1e-3;  ///< bounds on every scale s_j (dimensionless, > 0)
   double upper_scale = 1e3;
   int max_iterations = 300;
-  double tolerance = 1e-8;     ///< Ipopt `tol` (scaled NLP error)
+  double tolerance = 1e-8;             ///< Ipopt `tol` (scaled NLP error)
   double acceptable_tolerance = 1e-5;  ///< Ipopt `acceptable_tol`
-  int print_level = 0;         ///< Ipopt's own output (0 silent ... 12), on stdout
+  int print_level = 0;                 ///< Ipopt's own output (0 silent ... 12), on stdout
 };
 
 /// Called after every Ipopt iteration: iteration number, objective J, the scaled error.
 using Progress = std::function<void(int iteration, double objective, double inf_du)>;
 
 struct CalibrationResult {
-  bool success = false;          ///< Ipopt solved (or solved to acceptable level)
-  std::string status;            ///< Ipopt's return status, e.g. "Solve_Succeeded"
+  bool success = false;  ///< Ipopt solved (or solved to acceptable level)
+  std::string status;    ///< Ipopt's return status, e.g. "Solve_Succeeded"
   int iterations = 0;
-  int evaluations = 0;           ///< objective (+ gradient) evaluations
+  int evaluations = 0;  ///< objective (+ gradient) evaluations
   double seconds = 0;
-  double evaluation_seconds = 0; ///< time inside objective evaluations
+  double evaluation_seconds = 0;                 ///< time inside objective evaluations
   Eigen::VectorXd start_log_scales, log_scales;  ///< p at start and at the end
-  Evaluation start, final;       ///< J, its parts and the per-case errors at both ends
+  Evaluation start, final;  ///< J, its parts and the per-case errors at both ends
 };
 
 /// Checks the settings (0 < lower < upper, finite, max_iterations >= 1): throws

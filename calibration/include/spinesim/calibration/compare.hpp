@@ -37,15 +37,17 @@ namespace spinesim::calibration {
 struct CaseComparison {
   std::string name;
   fem::Vector6d wrench = fem::Vector6d::Zero();  ///< applied, global frame (N, N·mm)
-  fem::Vector6d plate_motion_fem = fem::Vector6d::Zero(), plate_motion_mss = fem::Vector6d::Zero();  ///< (mm, rad)
+  fem::Vector6d plate_motion_fem = fem::Vector6d::Zero(),
+                plate_motion_mss = fem::Vector6d::Zero();  ///< (mm, rad)
   double displacement_error = 0, plate_motion_error = 0;
-  fem::Vector6d reaction_fem = fem::Vector6d::Zero(), reaction_mss = fem::Vector6d::Zero();  ///< (N, N·mm)
+  fem::Vector6d reaction_fem = fem::Vector6d::Zero(),
+                reaction_mss = fem::Vector6d::Zero();  ///< (N, N·mm)
   double reaction_error = 0, reaction_force_error = 0, reaction_moment_error = 0;
   double max_displacement_fem_mm = 0, max_displacement_mss_mm = 0;
   Eigen::Index inverted_tets = 0;  ///< inside-out tets in the MSS wrench-loaded solution
-  bool converged = true;  ///< both MSS static solves converged
-  int iterations = 0;     ///< Newton iterations of both MSS solves
-  std::string message;    ///< why a solve did not converge
+  bool converged = true;           ///< both MSS static solves converged
+  int iterations = 0;              ///< Newton iterations of both MSS solves
+  std::string message;             ///< why a solve did not converge
 };
 
 struct MssFemComparison {
@@ -65,7 +67,9 @@ struct MssFemComparison {
 /// `load_scale` multiplies every case's wrench (1: the standard loads of fem/load_cases.hpp; the
 /// FEM is linear, so its relative errors do not depend on it, the nonlinear MSS's do).
 MssFemComparison compare_mss_fem(const fem::DiscFem& fem, const mss::MssModel& model,
-                                 const std::vector<fem::LoadCase>& cases, const std::string& material_name,
-                                 const mss::StaticOptions& options = mss::StaticOptions(), double load_scale = 1.0);
+                                 const std::vector<fem::LoadCase>& cases,
+                                 const std::string& material_name,
+                                 const mss::StaticOptions& options = mss::StaticOptions(),
+                                 double load_scale = 1.0);
 
 }  // namespace spinesim::calibration

@@ -57,9 +57,9 @@ std::vector<Knob> available_knobs(const mss::MssOptions& options);
 
 /// Linear responses of one factorisation K(s).
 struct LinearState {
-  Eigen::MatrixXd Z;    ///< #z × 6, K^-1 E_p
+  Eigen::MatrixXd Z;               ///< #z × 6, K^-1 E_p
   Matrix6d k6 = Matrix6d::Zero();  ///< condensed plate stiffness
-  Eigen::MatrixXd Phi;  ///< #z × 6, condensed modes Z K6
+  Eigen::MatrixXd Phi;             ///< #z × 6, condensed modes Z K6
 };
 
 class LinearMss {
@@ -67,7 +67,8 @@ class LinearMss {
   /// Precomputes K_j for `knobs` at the rest state of `model` (its current scales are
   /// irrelevant: every K_j is unscaled). Throws std::invalid_argument if a knob's term is off in
   /// the model, or the mesh has no superior or no inferior endplate nodes.
-  LinearMss(const mss::MssModel& model, std::vector<Knob> knobs, const Eigen::Vector3d& plate_center_mm);
+  LinearMss(const mss::MssModel& model, std::vector<Knob> knobs,
+            const Eigen::Vector3d& plate_center_mm);
   ~LinearMss();
   LinearMss(LinearMss&&) noexcept;
   LinearMss& operator=(LinearMss&&) noexcept;

@@ -35,9 +35,9 @@ namespace spinesim::calibration {
 /// The FEM's answer for one load case.
 struct CaseReference {
   std::string name;
-  Vector6d wrench = Vector6d::Zero();       ///< global frame, N and N·mm
-  Eigen::VectorXd displacement_mm;          ///< 3#vertices, interleaved, at the mesh vertices
-  Vector6d plate_motion = Vector6d::Zero(); ///< (t mm, theta rad)
+  Vector6d wrench = Vector6d::Zero();        ///< global frame, N and N·mm
+  Eigen::VectorXd displacement_mm;           ///< 3#vertices, interleaved, at the mesh vertices
+  Vector6d plate_motion = Vector6d::Zero();  ///< (t mm, theta rad)
 };
 
 /// FEM reference for a set of load cases on one mesh.
@@ -57,9 +57,9 @@ FemReference make_reference(const fem::DiscFem& fem, const mesh::TetMesh& mesh,
 double plate_rms_radius(const mesh::TetMesh& mesh, const Eigen::Vector3d& center_mm);
 
 struct Weights {
-  double reaction = 1.0;        ///< w_r
-  double stiffness = 1.0;       ///< w_k
-  double regularisation = 1e-4; ///< w_p
+  double reaction = 1.0;         ///< w_r
+  double stiffness = 1.0;        ///< w_k
+  double regularisation = 1e-4;  ///< w_p
 };
 
 struct CaseError {
@@ -70,10 +70,10 @@ struct CaseError {
 
 struct Evaluation {
   double value = 0, displacement = 0, reaction = 0, stiffness = 0, regularisation = 0;
-  Eigen::VectorXd gradient;         ///< dJ/dp (empty unless requested)
-  Eigen::MatrixXd gauss_newton;     ///< Gauss–Newton approximation of d2J/dp2 (empty unless requested)
-  std::vector<CaseError> cases;     ///< every case of the reference, training or not
-  Matrix6d k6 = Matrix6d::Zero();   ///< the linearised MSS's plate stiffness
+  Eigen::VectorXd gradient;      ///< dJ/dp (empty unless requested)
+  Eigen::MatrixXd gauss_newton;  ///< Gauss–Newton approximation of d2J/dp2 (empty unless requested)
+  std::vector<CaseError> cases;    ///< every case of the reference, training or not
+  Matrix6d k6 = Matrix6d::Zero();  ///< the linearised MSS's plate stiffness
 };
 
 /// The data terms' derivative with respect to K in adjoint form (see the header comment):
@@ -95,7 +95,8 @@ class Objective {
 
   /// J at log-scales p (and dJ/dp when `with_gradient`, plus the Gauss–Newton Hessian when
   /// `with_hessian`). Throws std::runtime_error when K(s) is not positive definite.
-  Evaluation evaluate(const Eigen::VectorXd& log_scales, bool with_gradient, bool with_hessian = false);
+  Evaluation evaluate(const Eigen::VectorXd& log_scales, bool with_gradient,
+                      bool with_hessian = false);
 
   /// The data terms of J (value = J_u + w_r J_r + w_k J_k, no regulariser) and every case's
   /// errors for `state`, the model's last solve; with `adjoint`, also dJ/dK in adjoint form

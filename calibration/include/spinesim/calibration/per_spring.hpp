@@ -47,7 +47,7 @@ struct PerSpringEvaluation {
   double value = 0;       ///< J(q)
   double smoothness = 0;  ///< mean over neighbouring pairs of (q_e - q_f)^2
   double prior = 0;       ///< mean q_e^2
-  Evaluation data;        ///< data terms (data.value = J_u + w_r J_r + w_k J_k), per-case errors, K6
+  Evaluation data;  ///< data terms (data.value = J_u + w_r J_r + w_k J_k), per-case errors, K6
   Eigen::VectorXd gradient;  ///< dJ/dq (#edges; empty unless requested)
 };
 
@@ -57,7 +57,8 @@ class PerSpringObjective {
   /// w_r and w_k); `region_log_scales`: its fitted p, held fixed; `model`: the MSS the linearised
   /// model was built from (for its edges and tetrahedra). Throws std::invalid_argument for
   /// negative or non-finite weights, a model that does not match, or scales of the wrong size.
-  PerSpringObjective(Objective& region, const mss::MssModel& model, Eigen::VectorXd region_log_scales,
+  PerSpringObjective(Objective& region, const mss::MssModel& model,
+                     Eigen::VectorXd region_log_scales,
                      PerSpringWeights weights = PerSpringWeights());
 
   /// J at q (#edges), and dJ/dq when `with_gradient`. Throws std::runtime_error when K(s, mu) is
@@ -78,8 +79,8 @@ class PerSpringObjective {
 };
 
 struct PerSpringResult {
-  bool success = false;     ///< Ipopt solved (or solved to acceptable level)
-  std::string status;       ///< Ipopt's return status
+  bool success = false;  ///< Ipopt solved (or solved to acceptable level)
+  std::string status;    ///< Ipopt's return status
   int iterations = 0, evaluations = 0;
   double seconds = 0, evaluation_seconds = 0;
   bool kept_start = false;  ///< Ipopt ended above the start's J: the region fit (q = 0) is kept

@@ -39,7 +39,9 @@ namespace spinesim::calibration {
 struct MeshFingerprint {
   Eigen::Index nodes = 0, tets = 0;
   std::string hash;
-  bool operator==(const MeshFingerprint& o) const { return nodes == o.nodes && tets == o.tets && hash == o.hash; }
+  bool operator==(const MeshFingerprint& o) const {
+    return nodes == o.nodes && tets == o.tets && hash == o.hash;
+  }
 };
 MeshFingerprint fingerprint(const mesh::TetMesh& mesh);
 
@@ -53,12 +55,12 @@ std::string disc_level(const mesh::TetMesh& mesh);
 nlohmann::json material_signature(const mesh::RegionMaterials& materials);
 
 struct TunedDisc {
-  std::string level;            ///< "" when the mesh's level was unknown
+  std::string level;  ///< "" when the mesh's level was unknown
   std::string material_name;
-  nlohmann::json material;      ///< material_signature
-  MeshFingerprint mesh;         ///< the mesh the scales were fitted on
+  nlohmann::json material;  ///< material_signature
+  MeshFingerprint mesh;     ///< the mesh the scales were fitted on
   int fem_order = 2;
-  mss::MssOptions options;      ///< terms on/off and factors; scales filled from `scales`
+  mss::MssOptions options;               ///< terms on/off and factors; scales filled from `scales`
   std::map<std::string, double> scales;  ///< knob name -> scale (> 0)
   /// Kind "per-spring": one multiplier mu_e > 0 per edge spring of the fitted mesh, in the
   /// model's edge order; empty for a region-level file.
@@ -66,7 +68,7 @@ struct TunedDisc {
   /// Kind "per-spring": edge_order_hash() of the model the multipliers were fitted on, so a
   /// change of the MSS's edge ordering can never put them on the wrong springs silently.
   std::string edge_order;
-  nlohmann::json report;        ///< the calibration's summary (free form)
+  nlohmann::json report;  ///< the calibration's summary (free form)
 
   bool per_spring() const { return !edge_multipliers.empty(); }
   /// "region" or "per-spring".

@@ -16,7 +16,8 @@ namespace spinesim::calibration {
 struct TunedSet {
   std::string material_name;
   std::string generated_by;  ///< the command that wrote it
-  nlohmann::json settings = nlohmann::json::object();  ///< how to regenerate it (mesh cell size, ...)
+  nlohmann::json settings =
+      nlohmann::json::object();  ///< how to regenerate it (mesh cell size, ...)
   std::map<std::string, TunedDisc> levels;
 };
 

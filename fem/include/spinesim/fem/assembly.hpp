@@ -29,12 +29,12 @@ using mesh::plate_map;
 
 /// Sparsity of the free–free block (lower triangle) and per-element scatter slots.
 struct FreeBlockPattern {
-  std::vector<int> free_index;         ///< #nodes: index among the free nodes, −1 otherwise
+  std::vector<int> free_index;  ///< #nodes: index among the free nodes, −1 otherwise
   Eigen::Index num_free_nodes = 0;
   /// #T·npe·npe: for local nodes (a, b) with free indices A > B, the rank of A among the
   /// higher free neighbours of B (the 3×3 block's slot in B's columns); −1 otherwise.
   std::vector<int> slot;
-  Eigen::SparseMatrix<double> lower;   ///< 3nf×3nf lower-triangular CSC pattern, values zero
+  Eigen::SparseMatrix<double> lower;  ///< 3nf×3nf lower-triangular CSC pattern, values zero
 };
 
 /// How free nodes are numbered: `spatial` along a Z-order curve (memory locality for the
@@ -46,8 +46,8 @@ FreeBlockPattern build_free_block_pattern(const FeSpace& space, const std::vecto
 
 /// Plate blocks of the reduced stiffness (see header comment).
 struct PlateCoupling {
-  Eigen::MatrixXd K_fp;   ///< 3nf×6 (N/mm | N/rad)
-  Matrix6d K_pp;          ///< 6×6
+  Eigen::MatrixXd K_fp;  ///< 3nf×6 (N/mm | N/rad)
+  Matrix6d K_pp;         ///< 6×6
 };
 
 /// Fills pattern.lower's values with K_ff and returns the plate blocks. `region` (#T) selects

@@ -57,9 +57,10 @@ struct SolverOptions {
 
 struct PlateSolution {
   Eigen::MatrixX3d displacement_mm;  ///< #V×3 displacement at the mesh vertices, mm
-  Eigen::MatrixX3d node_displacement_mm;  ///< #nodes×3 at every FE node (P2: vertices, then edge nodes)
-  Vector6d plate_motion;             ///< (t mm, theta rad)
-  Vector6d reaction_wrench;          ///< (F N, M N·mm) the disc exerts on the plate, about c
+  Eigen::MatrixX3d
+      node_displacement_mm;  ///< #nodes×3 at every FE node (P2: vertices, then edge nodes)
+  Vector6d plate_motion;     ///< (t mm, theta rad)
+  Vector6d reaction_wrench;  ///< (F N, M N·mm) the disc exerts on the plate, about c
 };
 
 /// Solver object: assembles and factorises once, then answers any number of plate loads.
@@ -78,8 +79,8 @@ class DiscFem {
   /// Default plate centre: arithmetic mean of the vertices labelled 2.
   static Eigen::Vector3d default_plate_center(const mesh::TetMesh& mesh);
 
-  PlateSolution solve_motion(const Vector6d& motion) const;   ///< (t mm, theta rad)
-  PlateSolution solve_wrench(const Vector6d& wrench) const;   ///< (F N, M N·mm)
+  PlateSolution solve_motion(const Vector6d& motion) const;  ///< (t mm, theta rad)
+  PlateSolution solve_wrench(const Vector6d& wrench) const;  ///< (F N, M N·mm)
   /// Condensed plate stiffness (symmetric positive definite), units (N/mm | N/rad ; N | N·mm/rad).
   const Matrix6d& stiffness_6x6() const;
 
@@ -89,8 +90,8 @@ class DiscFem {
   const Eigen::Vector3d& plate_center() const;  ///< c, mm
 
   int order() const;
-  Eigen::Index num_dofs() const;          ///< free displacement unknowns
-  Eigen::Index num_nodes() const;         ///< P1 vertices or P2 vertices + edge midpoints
+  Eigen::Index num_dofs() const;   ///< free displacement unknowns
+  Eigen::Index num_nodes() const;  ///< P1 vertices or P2 vertices + edge midpoints
   const Timings& timings() const;
 
  private:

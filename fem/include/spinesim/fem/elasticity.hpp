@@ -39,7 +39,8 @@ void element_stiffness_p1(const TetVertices& X, double lambda_mpa, double mu_mpa
                           Eigen::Matrix<double, 12, 12>& Ke);
 void element_stiffness_p2(const TetVertices& X, double lambda_mpa, double mu_mpa,
                           Eigen::Matrix<double, 30, 30>& Ke);
-Eigen::MatrixXd element_stiffness(int order, const TetVertices& X, const mesh::IsotropicMaterial& m);
+Eigen::MatrixXd element_stiffness(int order, const TetVertices& X,
+                                  const mesh::IsotropicMaterial& m);
 
 /// Voigt stress (MPa) at barycentric point L of an element with nodal displacements
 /// `ue` (3·npe, mm, node-major).

@@ -21,11 +21,11 @@ inline constexpr std::array<std::array<int, 2>, 6> kP2LocalEdges{
     {{0, 1}, {1, 2}, {0, 2}, {0, 3}, {1, 3}, {2, 3}}};
 
 struct FeSpace {
-  int order = 1;                       ///< 1 (P1, 4 nodes/tet) or 2 (P2, 10 nodes/tet)
-  Eigen::MatrixX3d X;                  ///< #nodes×3 node positions, mm (vertices first)
-  Eigen::MatrixXi elements;            ///< #T×(4 | 10) node indices per tet
-  Eigen::MatrixX2i edge_vertices;      ///< #edge-nodes×2 mesh vertices of each edge node (P2)
-  Eigen::Index num_vertices = 0;       ///< #V: nodes 0..#V-1 are the mesh vertices
+  int order = 1;                   ///< 1 (P1, 4 nodes/tet) or 2 (P2, 10 nodes/tet)
+  Eigen::MatrixX3d X;              ///< #nodes×3 node positions, mm (vertices first)
+  Eigen::MatrixXi elements;        ///< #T×(4 | 10) node indices per tet
+  Eigen::MatrixX2i edge_vertices;  ///< #edge-nodes×2 mesh vertices of each edge node (P2)
+  Eigen::Index num_vertices = 0;   ///< #V: nodes 0..#V-1 are the mesh vertices
 
   Eigen::Index num_nodes() const { return X.rows(); }
   int nodes_per_element() const { return int(elements.cols()); }

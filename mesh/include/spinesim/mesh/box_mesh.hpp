@@ -71,7 +71,8 @@ inline std::vector<int> boundary_vertices(const mesh::TetMesh& m) {
   std::vector<int> out;
   for (int v = 0; v < m.V.rows(); ++v) {
     const double tol = 1e-12 * (hi - lo).norm();
-    if (((m.V.row(v) - lo).array().abs() < tol).any() || ((m.V.row(v) - hi).array().abs() < tol).any())
+    if (((m.V.row(v) - lo).array().abs() < tol).any() ||
+        ((m.V.row(v) - hi).array().abs() < tol).any())
       out.push_back(v);
   }
   return out;
@@ -126,7 +127,8 @@ inline mesh::TetMesh mirrored_box_mesh(int nx_half, int ny, int nz, double lx, d
   // The plane x = 0 is now interior except on the outer faces.
   for (Eigen::Index v = 0; v < nv; ++v)
     if (std::abs(half.V(v, 0)) < 1e-12 && m.surface(v) == 3) {
-      const bool on_z_face = std::abs(half.V(v, 2) - z0) < 1e-12 || std::abs(half.V(v, 2) - z0 - lz) < 1e-12;
+      const bool on_z_face =
+          std::abs(half.V(v, 2) - z0) < 1e-12 || std::abs(half.V(v, 2) - z0 - lz) < 1e-12;
       if (!on_z_face) m.surface(v) = 0;
     }
   m.T.resize(2 * nt, 4);

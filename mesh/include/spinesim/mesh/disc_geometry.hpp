@@ -19,12 +19,12 @@ namespace spinesim::mesh {
 
 /// One level's sourced dimensions, mm.
 struct DiscDimensions {
-  std::string level;              ///< e.g. "L4-L5"
-  double lower_width_mm = 0;      ///< lateral width of the lower outline
-  double lower_depth_mm = 0;      ///< antero-posterior depth of the lower outline
+  std::string level;          ///< e.g. "L4-L5"
+  double lower_width_mm = 0;  ///< lateral width of the lower outline
+  double lower_depth_mm = 0;  ///< antero-posterior depth of the lower outline
   double upper_width_mm = 0;
   double upper_depth_mm = 0;
-  double height_mm = 0;           ///< mid-disc height
+  double height_mm = 0;  ///< mid-disc height
 };
 
 /// Nucleus share of the cross-section area (thesis 5.2.5).
@@ -46,13 +46,13 @@ class KidneyOutline {
 
   double width_mm() const { return width_; }
   double depth_mm() const { return depth_; }
-  Eigen::Vector2d point(double theta) const;         ///< (x, z) on the curve, mm
-  bool contains(const Eigen::Vector2d& xz_mm) const; ///< inside or on the curve
+  Eigen::Vector2d point(double theta) const;          ///< (x, z) on the curve, mm
+  bool contains(const Eigen::Vector2d& xz_mm) const;  ///< inside or on the curve
   /// Signed curvature (1/mm) at θ: > 0 convex, < 0 concave (posterior notch).
   double signed_curvature(double theta) const;
-  double area_mm2() const;          ///< exact up to ~1e-13 (spectral trapezoid rule)
+  double area_mm2() const;              ///< exact up to ~1e-13 (spectral trapezoid rule)
   Eigen::Vector2d centroid_mm() const;  ///< area centroid, (0, 0) up to round-off
-  double min_z_mm() const;          ///< posterior extreme; max_z = min_z + depth
+  double min_z_mm() const;              ///< posterior extreme; max_z = min_z + depth
   /// Nucleus test: the outline scaled by sqrt(kNucleusAreaFraction) about the centroid.
   bool nucleus_contains(const Eigen::Vector2d& xz_mm) const;
   /// `n` points of the outline (θ_k = 2πk/n), scaled by `scale` about the centroid.

@@ -22,7 +22,8 @@ struct IsotropicMaterial {
 
   double shear_modulus_mpa() const { return youngs_modulus_mpa / (2.0 * (1.0 + poisson_ratio)); }
   double lame_lambda_mpa() const {
-    return youngs_modulus_mpa * poisson_ratio / ((1.0 + poisson_ratio) * (1.0 - 2.0 * poisson_ratio));
+    return youngs_modulus_mpa * poisson_ratio /
+           ((1.0 + poisson_ratio) * (1.0 - 2.0 * poisson_ratio));
   }
   /// Density in the mm–N–tonne–s system, t/mm^3.
   double density_t_mm3() const { return density_kg_m3 * 1e-12; }

@@ -13,12 +13,12 @@ namespace spinesim::mesh {
 
 /// Mesh_3 criteria and optimisers; defaults run out of the box on a lumbar disc.
 struct MeshOptions {
-  double cell_size_mm = 2.0;          ///< upper bound on tet circumradius
-  double facet_distance_mm = 0.1;     ///< boundary approximation error bound
-  double facet_size_mm = 0.0;         ///< 0: same as cell_size_mm
-  double edge_size_mm = 0.0;          ///< protected sharp edges (rims); 0: same as cell_size_mm
+  double cell_size_mm = 2.0;       ///< upper bound on tet circumradius
+  double facet_distance_mm = 0.1;  ///< boundary approximation error bound
+  double facet_size_mm = 0.0;      ///< 0: same as cell_size_mm
+  double edge_size_mm = 0.0;       ///< protected sharp edges (rims); 0: same as cell_size_mm
   double facet_angle_deg = 25.0;
-  double radius_edge_ratio = 2.5;     ///< cell_radius_edge_ratio
+  double radius_edge_ratio = 2.5;  ///< cell_radius_edge_ratio
   // Optimisers, run after refinement in CGAL's order with no time limit (reproducible):
   // ODT / Lloyd at most 20 iterations; perturb and exude target a 12° minimum dihedral.
   // Measured on L4-L5 (47 × 35 × 11.3 mm): perturb + exude give min dihedral ≥ 12° from
@@ -28,7 +28,7 @@ struct MeshOptions {
   bool lloyd = false;
   bool perturb = true;
   bool exude = true;
-  std::uint32_t seed = 0;             ///< CGAL random seed, for reproducible meshes
+  std::uint32_t seed = 0;  ///< CGAL random seed, for reproducible meshes
 };
 
 /// A body given by a labelling function: 0 outside, positive label inside (the tet `region`).

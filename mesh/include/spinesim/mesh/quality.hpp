@@ -14,12 +14,12 @@ struct QualityReport {
   Eigen::Index vertices = 0, tets = 0, annulus_tets = 0, nucleus_tets = 0;
   Eigen::Index inferior_nodes = 0, superior_nodes = 0, wall_nodes = 0;
   double min_dihedral_deg = 0, max_dihedral_deg = 0;
-  double max_radius_edge_ratio = 0;   ///< circumradius / shortest edge
+  double max_radius_edge_ratio = 0;  ///< circumradius / shortest edge
   double mean_radius_edge_ratio = 0;
   double min_edge_mm = 0, max_edge_mm = 0, mean_edge_mm = 0;
-  double volume_mm3 = 0;              ///< sum of tet volumes
-  double exact_volume_mm3 = -1;       ///< <0 when unknown
-  double volume_error() const {       ///< relative, (mesh - exact)/exact; NaN when unknown
+  double volume_mm3 = 0;         ///< sum of tet volumes
+  double exact_volume_mm3 = -1;  ///< <0 when unknown
+  double volume_error() const {  ///< relative, (mesh - exact)/exact; NaN when unknown
     return exact_volume_mm3 > 0 ? (volume_mm3 - exact_volume_mm3) / exact_volume_mm3
                                 : std::numeric_limits<double>::quiet_NaN();
   }

@@ -17,7 +17,12 @@
 namespace spinesim::mesh {
 
 enum class Region : int { annulus = 1, nucleus = 2 };
-enum class Surface : int { interior = 0, inferior_endplate = 1, superior_endplate = 2, outer_wall = 3 };
+enum class Surface : int {
+  interior = 0,
+  inferior_endplate = 1,
+  superior_endplate = 2,
+  outer_wall = 3
+};
 
 /// Rigid frame of a disc: origin at the mid-disc centre, columns of `axes` are the disc's
 /// lateral (x), axial (y, inferior -> superior) and anterior (z) unit vectors, in the global
@@ -28,8 +33,8 @@ struct DiscFrame {
 };
 
 struct TetMesh {
-  Eigen::MatrixX3d V;   ///< #V×3 vertex positions, mm
-  Eigen::MatrixX4i T;   ///< #T×4 vertex indices, positively oriented
+  Eigen::MatrixX3d V;       ///< #V×3 vertex positions, mm
+  Eigen::MatrixX4i T;       ///< #T×4 vertex indices, positively oriented
   Eigen::VectorXi region;   ///< #T cell labels (Region)
   Eigen::VectorXi surface;  ///< #V point labels (Surface)
   DiscFrame frame;          ///< disc frame (identity when unknown)

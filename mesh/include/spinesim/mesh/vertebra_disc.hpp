@@ -37,12 +37,12 @@ struct VertebraDiscOptions {
 
 /// What was found between the vertebrae (all in mm, global frame unless stated).
 struct VertebraDiscInfo {
-  DiscFrame frame;                  ///< origin mid-disc at the footprint's area centroid
-  double footprint_area_mm2 = 0;    ///< area of the disc cross-section (smoothed outline)
-  double center_height_mm = 0;      ///< endplate gap at the frame origin
+  DiscFrame frame;                ///< origin mid-disc at the footprint's area centroid
+  double footprint_area_mm2 = 0;  ///< area of the disc cross-section (smoothed outline)
+  double center_height_mm = 0;    ///< endplate gap at the frame origin
   double min_height_mm = 0, max_height_mm = 0;  ///< over the footprint
-  double volume_mm3 = 0;            ///< ∫ gap dA over the footprint (quadrature)
-  double width_mm = 0, depth_mm = 0;  ///< extents of the outline along frame x and z
+  double volume_mm3 = 0;                        ///< ∫ gap dA over the footprint (quadrature)
+  double width_mm = 0, depth_mm = 0;            ///< extents of the outline along frame x and z
 };
 
 /// Finds the facing endplates and the disc body without meshing. Throws
@@ -56,7 +56,8 @@ VertebraDiscInfo analyse_vertebra_pair(const TriSurface& inferior_vertebra,
 /// Meshes the disc; the mesh is in the vertebrae's frame (between them) and carries `frame`.
 /// `info`, if given, receives the analysis. Throws as analyse_vertebra_pair.
 TetMesh mesh_disc_between_vertebrae(const TriSurface& inferior_vertebra,
-                                    const TriSurface& superior_vertebra, const MeshOptions& mesh_opt,
+                                    const TriSurface& superior_vertebra,
+                                    const MeshOptions& mesh_opt,
                                     const VertebraDiscOptions& opt = {},
                                     VertebraDiscInfo* info = nullptr);
 

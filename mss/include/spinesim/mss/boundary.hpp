@@ -54,15 +54,15 @@ struct Probe {
 enum class PlateMode { pose, wrench };
 
 struct Boundary {
-  RigidPose inferior;                 ///< pose of the nodes labelled 1
-  RigidPose superior;                 ///< pose of the nodes labelled 2 (PlateMode::pose)
+  RigidPose inferior;  ///< pose of the nodes labelled 1
+  RigidPose superior;  ///< pose of the nodes labelled 2 (PlateMode::pose)
   PlateMode plate_mode = PlateMode::pose;
-  Vector6d wrench = Vector6d::Zero(); ///< (F N, M N·mm about plate_center) for PlateMode::wrench
+  Vector6d wrench = Vector6d::Zero();  ///< (F N, M N·mm about plate_center) for PlateMode::wrench
   /// Centre c of the plate map, wrench and reported moments, mm; taken as given (set it to
   /// default_plate_center(mesh) for the documented default).
   Eigen::Vector3d plate_center_mm = Eigen::Vector3d::Zero();
   std::vector<Probe> probes;
-  Eigen::VectorXd nodal_forces_n;     ///< empty, or 3#nodes external forces, N
+  Eigen::VectorXd nodal_forces_n;  ///< empty, or 3#nodes external forces, N
 };
 
 /// Throws std::invalid_argument (one line) for non-finite poses, wrench, probes or forces,

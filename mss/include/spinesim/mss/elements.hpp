@@ -56,10 +56,9 @@ double angle_at(const Eigen::Vector3d& x0, const Eigen::Vector3d& x1, const Eige
 ///   E = 1/2 k_t (theta - theta0)^2,  theta = angle_at(x0, x1, x2).
 /// The gradient acts on the apex as well as on the arm ends: the apex force is minus the sum
 /// of the arm-end forces, which (5.13) omits.
-double angle_spring(const Eigen::Vector3d& x0, const Eigen::Vector3d& x1,
-                    const Eigen::Vector3d& x2, double k_t_nmm_per_rad, double rest_angle_rad,
-                    Vector9d* grad = nullptr, Matrix9d* hess = nullptr,
-                    HessianMode mode = HessianMode::exact);
+double angle_spring(const Eigen::Vector3d& x0, const Eigen::Vector3d& x1, const Eigen::Vector3d& x2,
+                    double k_t_nmm_per_rad, double rest_angle_rad, Vector9d* grad = nullptr,
+                    Matrix9d* hess = nullptr, HessianMode mode = HessianMode::exact);
 
 /// The thesis's literal torsional force (5.13) for comparison: forces on the two arm ends
 /// only, (f1, f2) stacked, N; the apex gets nothing. Equal to -dE/dx1, -dE/dx2 of

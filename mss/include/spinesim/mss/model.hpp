@@ -74,17 +74,17 @@ struct RegionScales {
 };
 
 struct MssOptions {
-  bool radial_springs = true;    ///< thesis (5.3)-(5.5)
-  bool torsion_springs = true;   ///< thesis (5.6)-(5.8)
-  bool volume_term = false;      ///< per-tetrahedron volume penalty (beyond the thesis)
-  bool disc_volume_term = false; ///< whole-disc volume penalty (beyond the thesis)
-  double radial_factor = 1.0;    ///< c_s in k_s = c_s E V0 / S0^2 (dimensionless)
-  double volume_factor = 1.0;    ///< c_v in k_v = c_v K_bulk / V0 (dimensionless)
+  bool radial_springs = true;     ///< thesis (5.3)-(5.5)
+  bool torsion_springs = true;    ///< thesis (5.6)-(5.8)
+  bool volume_term = false;       ///< per-tetrahedron volume penalty (beyond the thesis)
+  bool disc_volume_term = false;  ///< whole-disc volume penalty (beyond the thesis)
+  double radial_factor = 1.0;     ///< c_s in k_s = c_s E V0 / S0^2 (dimensionless)
+  double volume_factor = 1.0;     ///< c_v in k_v = c_v K_bulk / V0 (dimensionless)
   /// c_g in k_g = c_g K_mean / V0_disc (dimensionless). 10: near-incompressible disc — on L4-L5
   /// under 10 % compression dV/V = -4.2, -2.0, -0.69, -0.24 % at c_g = 1, 3, 10, 30 with the
   /// plate force saturating (1.19, 1.47, 1.62, 1.68 kN; no locking), tests/mss/test_volume.cpp.
   double disc_volume_factor = 10.0;
-  double damping_ratio = 1.0;    ///< zeta of the default K_d (dimensionless)
+  double damping_ratio = 1.0;        ///< zeta of the default K_d (dimensionless)
   double damping_n_s_per_mm = -1.0;  ///< K_d per node; < 0 means the default from damping_ratio
   std::array<RegionScales, kNumTerms> scales{};  ///< indexed by Term
   /// Per-spring multipliers mu_e of the main springs, one per edge spring in the model's edge
@@ -104,11 +104,16 @@ struct EdgeSpringInfo {
 /// Whether `options` switch `term` on (the main springs always are).
 inline bool term_enabled(const MssOptions& options, Term term) {
   switch (term) {
-    case Term::main: return true;
-    case Term::radial: return options.radial_springs;
-    case Term::torsion: return options.torsion_springs;
-    case Term::volume: return options.volume_term;
-    case Term::disc_volume: return options.disc_volume_term;
+    case Term::main:
+      return true;
+    case Term::radial:
+      return options.radial_springs;
+    case Term::torsion:
+      return options.torsion_springs;
+    case Term::volume:
+      return options.volume_term;
+    case Term::disc_volume:
+      return options.disc_volume_term;
   }
   return false;
 }
@@ -142,16 +147,16 @@ class MssModel {
   const Eigen::VectorXd& rest_positions_mm() const;  ///< 3#nodes, interleaved
   const Eigen::VectorXd& node_masses_t() const;      ///< #nodes, tonne (5.1)
   double total_mass_t() const;
-  double damping_n_s_per_mm() const;                 ///< K_d (5.11)
+  double damping_n_s_per_mm() const;  ///< K_d (5.11)
   const EquivalentCylinder& cylinder() const;
 
   Eigen::Index num_edge_springs() const;
   /// The main springs in the model's edge order (unique mesh edges sorted by (i, j)) — the
   /// order of MssOptions::edge_multipliers.
   std::vector<EdgeSpringInfo> edge_springs() const;
-  Eigen::Index num_radial_tets() const;   ///< 0 when radial springs are off
-  Eigen::Index num_angle_springs() const; ///< 0 when torsion springs are off
-  Eigen::Index num_volume_terms() const;  ///< 0 when the volume term is off
+  Eigen::Index num_radial_tets() const;    ///< 0 when radial springs are off
+  Eigen::Index num_angle_springs() const;  ///< 0 when torsion springs are off
+  Eigen::Index num_volume_terms() const;   ///< 0 when the volume term is off
 
   /// Replaces the calibration multipliers (all must be finite and > 0).
   void set_scales(const std::array<RegionScales, kNumTerms>& scales);

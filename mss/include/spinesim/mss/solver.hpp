@@ -51,15 +51,15 @@ struct StaticOptions {
 };
 
 struct StaticResult {
-  Eigen::VectorXd x_mm;              ///< 3#nodes equilibrium positions
+  Eigen::VectorXd x_mm;                      ///< 3#nodes equilibrium positions
   Vector6d plate_motion = Vector6d::Zero();  ///< (t mm, theta rad); solved (wrench) or given (pose)
   Vector6d reaction_wrench = Vector6d::Zero();  ///< force N and moment N·mm the disc exerts on
-                                                ///< the superior plate, about the moved plate centre
+      ///< the superior plate, about the moved plate centre
   bool converged = false;
   int iterations = 0;
-  double residual_n = 0;             ///< final |reduced gradient|, N
+  double residual_n = 0;  ///< final |reduced gradient|, N
   double seconds = 0;
-  std::string message;               ///< empty when converged, else why not
+  std::string message;  ///< empty when converged, else why not
 };
 
 /// Newton equilibrium. `x_start` (3#nodes) may be empty (start from rest, endplates moved).
@@ -89,7 +89,7 @@ enum class MatrixUpdate { every_iteration, frozen };
 struct DynamicsOptions {
   Integrator integrator = Integrator::implicit_euler;
   double dt_s = 1e-3;
-  int newton_iterations = 1;         ///< implicit: max Newton iterations per step (1 = Baraff–Witkin)
+  int newton_iterations = 1;  ///< implicit: max Newton iterations per step (1 = Baraff–Witkin)
   double newton_relative_tolerance = 1e-6;  ///< implicit: stop early below this residual ratio
   MatrixUpdate matrix_update = MatrixUpdate::every_iteration;
   /// Allowed distance from rest beyond the endplates' own displacement; 0 → the mesh's
@@ -98,8 +98,8 @@ struct DynamicsOptions {
 };
 
 struct State {
-  Eigen::VectorXd x_mm;   ///< 3#nodes
-  Eigen::VectorXd v_mm_s; ///< 3#nodes
+  Eigen::VectorXd x_mm;                    ///< 3#nodes
+  Eigen::VectorXd v_mm_s;                  ///< 3#nodes
   Vector6d plate_q = Vector6d::Zero();     ///< plate DOF (t mm, theta rad), PlateMode::wrench
   Vector6d plate_qdot = Vector6d::Zero();  ///< their rates, mm/s, rad/s
   double time_s = 0;

@@ -33,9 +33,9 @@
 
 namespace spinesim::spine {
 
-inline constexpr int kDbVertebrae = 17;   ///< T1…L5
-inline constexpr int kDbDirections = 6;   ///< +x, −x, +y, −y, +z, −z
-inline constexpr int kDbComponents = 6;   ///< tx, ty, tz (mm), rx, ry, rz (deg)
+inline constexpr int kDbVertebrae = 17;  ///< T1…L5
+inline constexpr int kDbDirections = 6;  ///< +x, −x, +y, −y, +z, −z
+inline constexpr int kDbComponents = 6;  ///< tx, ty, tz (mm), rx, ry, rz (deg)
 inline constexpr int kDbMaxDegree = 5;
 
 /// Per vertebra (rows, T1…L5): tx, ty, tz (mm), rx, ry, rz (deg).
@@ -51,8 +51,8 @@ Eigen::Vector3d direction_vector(int d);
 // --- fitting ---------------------------------------------------------------------------------
 
 struct FitTolerance {
-  double relative = 0.01;   ///< of the response range (max − min of the samples)
-  double absolute = 1e-3;   ///< mm or deg
+  double relative = 0.01;  ///< of the response range (max − min of the samples)
+  double absolute = 1e-3;  ///< mm or deg
   int max_degree = kDbMaxDegree;
   /// Coefficients are rounded to this quantum (mm or deg) before the residuals are computed,
   /// so the saved file is what the residuals describe.
@@ -60,7 +60,7 @@ struct FitTolerance {
 };
 
 struct PolynomialFit {
-  Eigen::VectorXd coefficients;  ///< c_1 … c_d (size d) in s = f / scale_n
+  Eigen::VectorXd coefficients;               ///< c_1 … c_d (size d) in s = f / scale_n
   double max_residual = 0, rms_residual = 0;  ///< over the samples, units of y
   bool within_tolerance = false;  ///< false: max_degree was not enough (kept, counted in reports)
 };
@@ -68,13 +68,13 @@ struct PolynomialFit {
 /// Least squares y ≈ Σ_{k=1..degree} c_k (f/scale_n)^k (no constant term) by Householder QR.
 /// Throws std::invalid_argument for sizes that differ, fewer samples than `degree`, or
 /// non-finite values.
-Eigen::VectorXd fit_zero_intercept(const Eigen::VectorXd& force_n, const Eigen::VectorXd& y, int degree,
-                                   double scale_n);
+Eigen::VectorXd fit_zero_intercept(const Eigen::VectorXd& force_n, const Eigen::VectorXd& y,
+                                   int degree, double scale_n);
 
 /// The lowest degree 1…tol.max_degree (and ≤ the sample count) meeting the tolerance, or the
 /// best of them when none does; coefficients rounded to tol.quantum.
-PolynomialFit fit_by_residual(const Eigen::VectorXd& force_n, const Eigen::VectorXd& y, double scale_n,
-                              const FitTolerance& tol = FitTolerance());
+PolynomialFit fit_by_residual(const Eigen::VectorXd& force_n, const Eigen::VectorXd& y,
+                              double scale_n, const FitTolerance& tol = FitTolerance());
 
 /// x rounded to a multiple of `quantum` (> 0; otherwise x), as the nearest double to that
 /// decimal so the file stores it in few digits.
@@ -97,11 +97,12 @@ struct FailedSolve {
 struct OutOfPlaneSolve {
   int vertebra = 0, direction = 0;
   double force_n = 0;
-  double lateral_mm = 0, lateral_deg = 0;  ///< max |tx| (mm), max |(ry, rz)| (deg) over the vertebrae
+  double lateral_mm = 0,
+         lateral_deg = 0;  ///< max |tx| (mm), max |(ry, rz)| (deg) over the vertebrae
 };
 
 struct GenerationOptions {
-  SolveOptions solve;                 ///< recruitment on by default, as in the thesis's LifeMOD runs
+  SolveOptions solve;  ///< recruitment on by default, as in the thesis's LifeMOD runs
   std::vector<int> loaded_vertebrae;  ///< empty: all 17
   double force_step_n = 50, force_max_n = 600;
   FitTolerance tolerance;
@@ -123,9 +124,9 @@ struct ResponseSamples {
   std::vector<std::array<std::vector<bool>, kDbDirections>> solved;  ///< false: see failed
   std::vector<FailedSolve> failed;
   std::vector<OutOfPlaneSolve> out_of_plane;  ///< beyond 1e-3 mm or 1e-3 deg
-  SolveOptions solve;  ///< as used
-  double seconds = 0;  ///< wall clock of all solves
-  int solves = 0;      ///< attempted, baseline included
+  SolveOptions solve;                         ///< as used
+  double seconds = 0;                         ///< wall clock of all solves
+  int solves = 0;                             ///< attempted, baseline included
   int workers = 1;
 };
 
@@ -137,8 +138,9 @@ ResponseSamples sample_responses(const SpineModel& m, const GenerationOptions& o
 /// core); the displacement (17×6) per case, or the error message in `errors[i]` (empty: ok).
 /// `progress(done, total)` is called in the calling thread.
 void solve_cases(const SpineModel& m, const std::vector<std::vector<ExternalLoad>>& loads,
-                 const SolveOptions& options, int workers, std::vector<VertebraResponse>& displacement,
-                 std::vector<std::string>& errors, const std::function<void(int, int)>& progress = {});
+                 const SolveOptions& options, int workers,
+                 std::vector<VertebraResponse>& displacement, std::vector<std::string>& errors,
+                 const std::function<void(int, int)>& progress = {});
 
 // --- the database ----------------------------------------------------------------------------
 
@@ -154,9 +156,9 @@ struct ResidualSummary {
 /// One oblique force against the database's superposition.
 struct SuperpositionCase {
   int vertebra = 0;
-  std::string plane;      ///< "xz", "xy", "yz", "xyz", "-x-y-z"
+  std::string plane;  ///< "xz", "xy", "yz", "xyz", "-x-y-z"
   Eigen::Vector3d force_n = Eigen::Vector3d::Zero();
-  bool solved = false;    ///< false: the direct solve failed (message)
+  bool solved = false;  ///< false: the direct solve failed (message)
   /// The force needs an axis fit beyond its largest solved force (solves failed there): the db
   /// error then measures extrapolation, so it is left out of the report's worst case.
   bool extrapolated = false;
@@ -166,7 +168,8 @@ struct SuperpositionCase {
   /// superposition, the former adds the fit residual.
   double db_error_translation_mm = 0, db_error_rotation_deg = 0;
   double axis_sum_error_translation_mm = 0, axis_sum_error_rotation_deg = 0;
-  double response_translation_mm = 0, response_rotation_deg = 0;  ///< max |t|, |r| of the direct response
+  double response_translation_mm = 0,
+         response_rotation_deg = 0;  ///< max |t|, |r| of the direct response
 };
 
 struct SuperpositionReport {
@@ -218,7 +221,8 @@ class DisplacementDatabase {
   /// by superposition of the axis fits. Beyond the sampled range the polynomials are
   /// extrapolated, not clamped: check in_range(). Throws std::invalid_argument for an index out
   /// of range, a vertebra not in this database, or a non-finite force.
-  void evaluate(int loaded_vertebra, const Eigen::Vector3d& force_n, Eigen::Ref<VertebraResponse> out) const;
+  void evaluate(int loaded_vertebra, const Eigen::Vector3d& force_n,
+                Eigen::Ref<VertebraResponse> out) const;
 
   /// Every |F_i| ≤ force_max_n() (the validated 600 N of thesis 3.3.5).
   bool in_range(const Eigen::Vector3d& force_n) const;
@@ -248,14 +252,19 @@ class DisplacementDatabase {
   std::vector<double> coef_;
   std::vector<unsigned char> degree_;  // [(v*6 + d)*102 + i]
   std::array<bool, kDbVertebrae> present_{};
-  std::array<std::array<double, kDbDirections>, kDbVertebrae> residual_t_{}, residual_r_{}, solved_max_{};
+  std::array<std::array<double, kDbDirections>, kDbVertebrae> residual_t_{}, residual_r_{},
+      solved_max_{};
   std::vector<double> forces_n_;
   double force_max_n_ = 600;
   VertebraResponse baseline_ = VertebraResponse::Zero();
 
   void allocate();
-  const double* block(int v, int d) const { return coef_.data() + std::size_t((v * kDbDirections + d) * kDbMaxDegree * kSeries); }
-  double* block(int v, int d) { return coef_.data() + std::size_t((v * kDbDirections + d) * kDbMaxDegree * kSeries); }
+  const double* block(int v, int d) const {
+    return coef_.data() + std::size_t((v * kDbDirections + d) * kDbMaxDegree * kSeries);
+  }
+  double* block(int v, int d) {
+    return coef_.data() + std::size_t((v * kDbDirections + d) * kDbMaxDegree * kSeries);
+  }
   void set_fit(int v, int d, int series, const Eigen::VectorXd& c);
 };
 
@@ -267,13 +276,15 @@ std::vector<SuperpositionCase> superposition_cases(const std::vector<int>& verte
 /// Direct solves of each case and of its axis components; compares both with the database.
 /// Failed direct solves are kept in the report (solved = false), never dropped.
 SuperpositionReport check_superposition(const SpineModel& m, const DisplacementDatabase& db,
-                                        std::vector<SuperpositionCase> cases, const SolveOptions& options,
-                                        int workers = 0, const std::function<void(int, int)>& progress = {});
+                                        std::vector<SuperpositionCase> cases,
+                                        const SolveOptions& options, int workers = 0,
+                                        const std::function<void(int, int)>& progress = {});
 
 /// The report as JSON text, as the file's "superposition_check" holds it (for reports).
 std::string superposition_json_text(const SuperpositionReport& report);
 
 /// The response summary of (db − reference) over the vertebrae: max |Δt| (mm), max |Δr| (deg).
-std::pair<double, double> max_response_difference(const VertebraResponse& a, const VertebraResponse& b);
+std::pair<double, double> max_response_difference(const VertebraResponse& a,
+                                                  const VertebraResponse& b);
 
 }  // namespace spinesim::spine

@@ -39,24 +39,26 @@ struct ExternalLoad {
 struct SolveOptions {
   bool recruit = true;  ///< false: muscles off (passive spine)
   RecruitmentOptions recruitment;
-  double tolerance = 1e-2;   ///< on max |∂Π/∂θ| in N·mm (generalised moments; 1e-2 N·mm = 10 µN·m)
-  double relative_tolerance = 1e-8;  ///< or max |∂Π/∂θ| ≤ this × its value at θ = 0 (round-off floor)
+  double tolerance = 1e-2;  ///< on max |∂Π/∂θ| in N·mm (generalised moments; 1e-2 N·mm = 10 µN·m)
+  double relative_tolerance =
+      1e-8;  ///< or max |∂Π/∂θ| ≤ this × its value at θ = 0 (round-off floor)
   int max_iterations = 200;
-  double fd_step = 1e-7;     ///< rad, for the finite-difference Hessian
-  bool warn_above_600n = true;  ///< SpineSolution::warnings names forces beyond 600 N (thesis limit)
+  double fd_step = 1e-7;  ///< rad, for the finite-difference Hessian
+  bool warn_above_600n =
+      true;  ///< SpineSolution::warnings names forces beyond 600 N (thesis limit)
 };
 
 /// Force the lower side of a joint exerts on everything above it, and the moment it carries.
 struct JointReaction {
   std::string joint;
-  Eigen::Vector3d force_world_n;     ///< force of the lower side on everything above, N
+  Eigen::Vector3d force_world_n;  ///< force of the lower side on everything above, N
   /// Moment about the (moved) joint point of everything acting on the part above: the moment
   /// the joint's spring carries (x > 0: flexion), N·mm.
   Eigen::Vector3d moment_world_nmm;
   /// In the lower vertebra's axes (the thesis's joint frame: F.1 orientations are 0):
-  double axial_n = 0;     ///< +y component: compression > 0
-  double shear_ap_n = 0;  ///< +z component (the lower body pushes the upper one forward)
-  double shear_lat_n = 0; ///< +x component
+  double axial_n = 0;      ///< +y component: compression > 0
+  double shear_ap_n = 0;   ///< +z component (the lower body pushes the upper one forward)
+  double shear_lat_n = 0;  ///< +x component
   /// In the disc's mid-plane frame (axis from the lower to the upper vertebra centre, as mesh/
   /// places the disc): compression and the shear magnitude in the disc plane.
   double disc_axial_n = 0, disc_shear_n = 0;
@@ -73,8 +75,8 @@ struct SpineSolution {
   Eigen::Matrix<double, Eigen::Dynamic, 6> displacement;
   std::vector<JointReaction> joints;
   Eigen::VectorXd ligament_force_n, muscle_force_n;  ///< tensions in the final posture
-  Recruitment recruitment;                          ///< the recruited forces F (reference posture)
-  Eigen::Matrix<double, 6, 1> bushing_wrench;       ///< IAP force (N) and moment (N·mm) on the ribs
+  Recruitment recruitment;                           ///< the recruited forces F (reference posture)
+  Eigen::Matrix<double, 6, 1> bushing_wrench;  ///< IAP force (N) and moment (N·mm) on the ribs
   /// Smallest eigenvalue of the tangent stiffness ∂²Π/∂θ² at the solution (N·mm/rad; ≤ 0: not
   /// stable) and the joint axis that dominates its mode.
   double min_stiffness_nmm_per_rad = 0;
@@ -102,12 +104,14 @@ SpineSolution solve_spine(const SpineModel& m, const std::vector<ExternalLoad>& 
 
 /// Total potential energy Π(θ) (N·mm) and its gradient for fixed muscle forces `muscle_force_n`
 /// (recruited F; empty = muscles off). Fused joints' coordinates get zero gradient.
-double potential(const SpineModel& m, const std::vector<ExternalLoad>& loads, const Eigen::VectorXd& muscle_force_n,
-                 const Eigen::VectorXd& theta, Eigen::VectorXd* gradient = nullptr);
+double potential(const SpineModel& m, const std::vector<ExternalLoad>& loads,
+                 const Eigen::VectorXd& muscle_force_n, const Eigen::VectorXd& theta,
+                 Eigen::VectorXd* gradient = nullptr);
 
 /// Moment arms (3 per recruited, non-fused joint × muscles) and load moments in the reference
 /// posture, as recruit() takes them.
-void recruitment_problem(const SpineModel& m, const std::vector<ExternalLoad>& loads, Eigen::MatrixXd& arm,
-                         Eigen::VectorXd& load_moment_nmm, std::vector<int>& joints);
+void recruitment_problem(const SpineModel& m, const std::vector<ExternalLoad>& loads,
+                         Eigen::MatrixXd& arm, Eigen::VectorXd& load_moment_nmm,
+                         std::vector<int>& joints);
 
 }  // namespace spinesim::spine

@@ -44,8 +44,8 @@ struct Vertebra {
 /// y = axial torsion, z = lateral bending.
 struct Joint {
   std::string name;
-  Eigen::Vector3d point_mm;  ///< table F.2
-  double k_flexion = 0, k_extension = 0, k_lateral = 0, k_torsion = 0;  ///< N·mm/rad (F.4)
+  Eigen::Vector3d point_mm;                                                     ///< table F.2
+  double k_flexion = 0, k_extension = 0, k_lateral = 0, k_torsion = 0;          ///< N·mm/rad (F.4)
   double rom_flexion = 0, rom_extension = 0, rom_lateral = 0, rom_torsion = 0;  ///< rad (F.5)
   bool fused = false;  ///< fixed joint (spinal fusion): θ ≡ 0
 };
@@ -93,8 +93,8 @@ struct PointLoad {
 /// Appendix C recomputed from its inputs (never pasted).
 struct IapStiffness {
   double s_mean_mm2 = 0, h_l1l5_mm = 0, h_mm = 0, a_mm = 0, pressure_mpa = 0;
-  double k_x = 0, k_y = 0;          ///< spring structure, N/mm (as the thesis writes them)
-  double bushing_k_xz = 0, bushing_k_y = 0;      ///< k'x = k'z = 4 k_x, k'y = 4 k_y (N/mm)
+  double k_x = 0, k_y = 0;                   ///< spring structure, N/mm (as the thesis writes them)
+  double bushing_k_xz = 0, bushing_k_y = 0;  ///< k'x = k'z = 4 k_x, k'y = 4 k_y (N/mm)
   double bushing_m_xz_per_deg = 0, bushing_m_y_per_deg = 0;  ///< M'x = M'z, M'y (N·mm/deg)
 };
 IapStiffness iap_from_appendix_c(const std::string& appendix_c_json_path);
@@ -105,8 +105,8 @@ struct ModelOptions {
   /// The LifeMOD default trunk muscles appendix F names without data (thoracic erector spinae, rectus
   /// abdominis), restored in data/spine/trunk_muscles.csv; false: the F.8-F.19 lumbar muscles only.
   bool trunk_muscles = true;
-  bool arms_forward = false;      ///< arms reaching forward (crate case) instead of hanging
-  double body_mass_kg = 0;        ///< 0: spine_model.json's value
+  bool arms_forward = false;  ///< arms reaching forward (crate case) instead of hanging
+  double body_mass_kg = 0;    ///< 0: spine_model.json's value
 };
 
 struct SpineModel {
@@ -115,22 +115,24 @@ struct SpineModel {
   std::vector<Ligament> ligaments;
   std::vector<Muscle> muscles;
   bool has_bushing = false;
-  Bushing bushing;                  ///< IAP: rib cage (T6) to pelvis
+  Bushing bushing;  ///< IAP: rib cage (T6) to pelvis
   IapStiffness iap;
-  std::vector<PointLoad> weights;   ///< gravity on vertebrae, head+neck, arms (empty without gravity)
+  std::vector<PointLoad>
+      weights;  ///< gravity on vertebrae, head+neck, arms (empty without gravity)
   std::vector<int> recruited_joints;  ///< joints whose equilibrium the muscles are recruited for
-  double muscle_q = 10;             ///< short-range stiffness factor (k = q F / L0)
-  double rom_bump_factor = 100;     ///< joint stiffness multiplier beyond the F.5 range
-  double rom_bump_onset = 0;        ///< rad over which the bump's stiffness ramps up (C² energy)
+  double muscle_q = 10;               ///< short-range stiffness factor (k = q F / L0)
+  double rom_bump_factor = 100;       ///< joint stiffness multiplier beyond the F.5 range
+  double rom_bump_onset = 0;          ///< rad over which the bump's stiffness ramps up (C² energy)
   double body_mass_kg = 70, gravity_mm_s2 = 9810;
-  Eigen::Vector3d chest_front_mm;   ///< for loads held "in front of the chest"
-  int ribs_body = 5;                ///< T6
+  Eigen::Vector3d chest_front_mm;  ///< for loads held "in front of the chest"
+  int ribs_body = 5;               ///< T6
   std::string data_dir;
 };
 
 /// Builds the model from `data_dir` (thesis/ tables, disc_morphometry.csv, spine/spine_model.json).
 /// Throws std::runtime_error naming the file for missing or malformed data.
-SpineModel load_spine_model(const std::string& data_dir, const ModelOptions& options = ModelOptions());
+SpineModel load_spine_model(const std::string& data_dir,
+                            const ModelOptions& options = ModelOptions());
 
 /// Number of joint coordinates (3 per joint, fused joints included and held at zero).
 inline int dof_count(const SpineModel& m) { return 3 * int(m.joints.size()); }

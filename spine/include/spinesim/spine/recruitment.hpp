@@ -24,7 +24,7 @@ enum class Criterion { Polynomial, MinMax };
 
 struct RecruitmentOptions {
   Criterion criterion = Criterion::Polynomial;
-  double power = 3;             ///< p of the polynomial criterion (≥ 1)
+  double power = 3;                   ///< p of the polynomial criterion (≥ 1)
   double passive_strength_scale = 1;  ///< multiplies every joint strength R = k·ROM (> 0)
   int max_iterations = 200;
   double tolerance = 1e-9;
@@ -32,13 +32,13 @@ struct RecruitmentOptions {
 
 struct Recruitment {
   bool success = false;
-  std::string status;                 ///< Ipopt's return status
+  std::string status;  ///< Ipopt's return status
   int iterations = 0;
   double objective = 0;
-  Eigen::VectorXd force_n;            ///< per muscle, N
-  Eigen::VectorXd activation;         ///< F / F_max
-  Eigen::VectorXd reserve_nmm;        ///< the joints' share r: 3 per recruited joint (x, y, z), N·mm
-  Eigen::VectorXd passive_activation; ///< |r| / R per recruited joint axis
+  Eigen::VectorXd force_n;      ///< per muscle, N
+  Eigen::VectorXd activation;   ///< F / F_max
+  Eigen::VectorXd reserve_nmm;  ///< the joints' share r: 3 per recruited joint (x, y, z), N·mm
+  Eigen::VectorXd passive_activation;  ///< |r| / R per recruited joint axis
   double max_constraint_violation_nmm = 0;
   double seconds = 0;
 };
@@ -48,7 +48,8 @@ struct Recruitment {
 /// muscles and joint must supply; `arm` (3·joints × muscles) the moment of a unit tension of each
 /// muscle about each joint (zero where a muscle does not cross it). Throws std::invalid_argument
 /// for bad options or sizes.
-Recruitment recruit(const SpineModel& m, const Eigen::MatrixXd& arm, const Eigen::VectorXd& load_moment_nmm,
+Recruitment recruit(const SpineModel& m, const Eigen::MatrixXd& arm,
+                    const Eigen::VectorXd& load_moment_nmm,
                     const RecruitmentOptions& options = RecruitmentOptions());
 
 }  // namespace spinesim::spine

@@ -63,19 +63,20 @@ struct TransferCheck {
 };
 
 struct CalibrationOutcome {
-  calibration::TunedDisc tuned;            ///< report filled; written only if `success`
-  bool success = false;                    ///< every requested stage succeeded
-  calibration::CalibrationResult result;   ///< the region fit
-  calibration::PerSpringResult per_spring; ///< the per-spring stage (if requested and the region fit succeeded)
+  calibration::TunedDisc tuned;           ///< report filled; written only if `success`
+  bool success = false;                   ///< every requested stage succeeded
+  calibration::CalibrationResult result;  ///< the region fit
+  calibration::PerSpringResult
+      per_spring;  ///< the per-spring stage (if requested and the region fit succeeded)
   bool per_spring_ran = false;
   calibration::Evaluation untuned_linear;  ///< thesis model, scales 1, linearised
   /// k6_tuned: the tuned file's model (per-spring when that stage ran); k6_region: the region fit.
-  fem::Matrix6d k6_fem = fem::Matrix6d::Zero(), k6_untuned = fem::Matrix6d::Zero(), k6_tuned = fem::Matrix6d::Zero(),
-                k6_region = fem::Matrix6d::Zero();
+  fem::Matrix6d k6_fem = fem::Matrix6d::Zero(), k6_untuned = fem::Matrix6d::Zero(),
+                k6_tuned = fem::Matrix6d::Zero(), k6_region = fem::Matrix6d::Zero();
   /// Nonlinear, all cases (empty if not requested): tuned_check is the tuned file's model,
   /// region_check the region-only fit when the per-spring stage ran.
   MssFemComparison untuned_check, tuned_check, region_check;
-  std::vector<TransferCheck> transfer;          ///< one per request.transfer_meshes
+  std::vector<TransferCheck> transfer;  ///< one per request.transfer_meshes
   double fem_seconds = 0, setup_seconds = 0, check_seconds = 0, total_seconds = 0;
 };
 
@@ -87,7 +88,8 @@ using StatusLine = std::function<void(const std::string&)>;
 /// A failed Ipopt run is returned (success false; result / per_spring say which stage and why),
 /// not thrown.
 CalibrationOutcome calibrate_disc(const mesh::TetMesh& mesh, const mesh::RegionMaterials& materials,
-                                  const CalibrationRequest& request, const StatusLine& status = StatusLine());
+                                  const CalibrationRequest& request,
+                                  const StatusLine& status = StatusLine());
 
 /// Builds the MSS for `mesh` from a tuned file, after check_applies (one-line refusal otherwise);
 /// prints check_applies's note to stderr unless quiet.
@@ -96,6 +98,7 @@ mss::MssModel tuned_model(const calibration::TunedDisc& tuned, const mesh::TetMe
 
 /// Readable summary: every case untuned vs tuned (nonlinear and linear; region-only beside
 /// per-spring when that stage ran), K6 diagonals, Ipopt.
-void print_calibration(std::ostream& os, const CalibrationOutcome& o, const CalibrationRequest& request);
+void print_calibration(std::ostream& os, const CalibrationOutcome& o,
+                       const CalibrationRequest& request);
 
 }  // namespace spinesim::studies

@@ -31,7 +31,7 @@ int demo_stages();
 struct DemoResult {
   std::string report_markdown;  ///< also written to <out>/report.md
   std::string report_path;
-  nlohmann::json summary;       ///< also written to <out>/summary.json
+  nlohmann::json summary;  ///< also written to <out>/summary.json
 };
 
 /// Runs the steps above; throws std::invalid_argument for a bad request (unknown level, bad

@@ -16,7 +16,8 @@ enum class DiscPlacement { spine, local };
 
 /// The frame of `level` for `placement` (identity for local). Throws std::invalid_argument for
 /// an unknown level.
-mesh::DiscFrame disc_level_frame(const std::string& level, DiscPlacement placement = DiscPlacement::spine);
+mesh::DiscFrame disc_level_frame(const std::string& level,
+                                 DiscPlacement placement = DiscPlacement::spine);
 
 /// The parametric disc of `level` meshed with `options`.
 mesh::TetMesh mesh_disc_level(const std::string& level, const mesh::MeshOptions& options,
@@ -26,7 +27,8 @@ mesh::TetMesh mesh_disc_level(const std::string& level, const mesh::MeshOptions&
 mesh::TetMesh mesh_disc_level(const std::string& level, double cell_size_mm);
 
 /// The structured disc of `level` (sectors × rings × layers).
-mesh::TetMesh mesh_structured_level(const std::string& level, const mesh::StructuredDiscOptions& options,
+mesh::TetMesh mesh_structured_level(const std::string& level,
+                                    const mesh::StructuredDiscOptions& options,
                                     DiscPlacement placement = DiscPlacement::spine);
 
 }  // namespace spinesim::studies

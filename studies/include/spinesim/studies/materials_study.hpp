@@ -48,25 +48,25 @@ namespace spinesim::studies {
 
 /// One model's answer for one material (FEM, untuned or tuned MSS).
 struct ModelResponse {
-  bool available = true;             ///< false: tuned MSS of a failed calibration (no numbers)
+  bool available = true;  ///< false: tuned MSS of a failed calibration (no numbers)
   fem::Vector6d stiffness_diagonal = fem::Vector6d::Zero();  ///< disc frame, N/mm and N·mm/deg
   double axial_stiffness_n_per_mm() const { return stiffness_diagonal(1); }
   double plate_axial_displacement_mm = 0;  ///< disc-frame u_y of the plate, mm (< 0 compresses)
   double max_displacement_mm = 0;
-  double volume_change = 0;          ///< (V - V0)/V0
-  double displacement_error = 0;     ///< vs the FEM (0 for the FEM itself)
-  bool converged = true;             ///< MSS static solve converged (FEM: always)
-  Eigen::Index inverted_tets = 0;    ///< MSS: inside-out tets at equilibrium
+  double volume_change = 0;        ///< (V - V0)/V0
+  double displacement_error = 0;   ///< vs the FEM (0 for the FEM itself)
+  bool converged = true;           ///< MSS static solve converged (FEM: always)
+  Eigen::Index inverted_tets = 0;  ///< MSS: inside-out tets at equilibrium
   int newton_iterations = 0;
-  std::string message;               ///< why the static solve did not converge
+  std::string message;  ///< why the static solve did not converge
 };
 
 struct MaterialResult {
   std::string material;
   double e_annulus_mpa = 0, e_nucleus_mpa = 0, nu_annulus = 0, nu_nucleus = 0;
   ModelResponse fem, untuned, tuned;
-  std::string calibration_status;    ///< Ipopt's return status
-  bool calibrated = false;           ///< Ipopt succeeded
+  std::string calibration_status;  ///< Ipopt's return status
+  bool calibrated = false;         ///< Ipopt succeeded
   int ipopt_iterations = 0;
   std::map<std::string, double> scales;  ///< tuned knob -> scale (x Van Gelder)
   double fem_seconds = 0, calibration_seconds = 0, mss_seconds = 0;
@@ -92,7 +92,8 @@ std::string describe_material(const mesh::RegionMaterials& materials);
 
 /// Readable tables, one block per quantity: materials as rows, FEM / untuned MSS / tuned MSS
 /// as columns, the unit in each block's title. Markdown tables when `markdown`.
-void print_materials(std::ostream& os, const std::vector<MaterialResult>& results, int fem_order, bool markdown);
+void print_materials(std::ostream& os, const std::vector<MaterialResult>& results, int fem_order,
+                     bool markdown);
 
 /// CSV, one row per material x model (fem, untuned, tuned); units in the column names.
 std::string materials_csv(const std::vector<MaterialResult>& results);

@@ -24,11 +24,11 @@ namespace spinesim::studies {
 
 /// How a stepped study runs: integrator, step, frames, model terms and where files go.
 struct SteppedStudyOptions {
-  std::string out = "study-out";        ///< output folder (created)
-  mss::DynamicsOptions dynamics;        ///< integrator, dt_s, Newton iterations, matrix update
+  std::string out = "study-out";  ///< output folder (created)
+  mss::DynamicsOptions dynamics;  ///< integrator, dt_s, Newton iterations, matrix update
   std::string integrator_name = "implicit";
-  int frame_every = 10;                 ///< a VTU frame every K steps
-  mss::MssOptions model;                ///< MSS terms
+  int frame_every = 10;                  ///< a VTU frame every K steps
+  mss::MssOptions model;                 ///< MSS terms
   std::string model_variant = "radial";  ///< its name for reports
 };
 
@@ -51,14 +51,16 @@ Eigen::MatrixX3d boundary_normals(const mesh::TetMesh& m);
 
 /// The outer-wall node where the ray from the disc centre in the disc-frame direction named
 /// `name` (anterior, posterior, left, right) leaves the disc: the wall node closest to the ray.
-ProbeSite pick_site(const mesh::TetMesh& m, const Eigen::MatrixX3d& normals, const std::string& name);
+ProbeSite pick_site(const mesh::TetMesh& m, const Eigen::MatrixX3d& normals,
+                    const std::string& name);
 
 struct ProbeStudyRequest {
   SteppedStudyOptions stepping;
   /// Penalty per node: 0 = the solver's default (mss::default_probe_stiffness, ~540 N/mm on
   /// L4-L5). The implicit step resolves the contacts by an active set inside each step, so the
   /// stiff default withdraws smoothly.
-  double radius_mm = 3.0, depth_mm = 2.0, speed_mm_s = 20.0, hold_s = 0.1, rest_s = 0.2, stiffness_n_per_mm = 0.0;
+  double radius_mm = 3.0, depth_mm = 2.0, speed_mm_s = 20.0, hold_s = 0.1, rest_s = 0.2,
+         stiffness_n_per_mm = 0.0;
   std::vector<std::string> sites = {"anterior", "left"};
 };
 
@@ -80,10 +82,12 @@ struct ProbeStudyResult {
 
 /// Stages: model, stepping, files (3). `m` needs endplate labels.
 ProbeStudyResult run_probe_study(const mesh::TetMesh& m, const mesh::RegionMaterials& materials,
-                                 const ProbeStudyRequest& request, const StageHooks& hooks = StageHooks());
+                                 const ProbeStudyRequest& request,
+                                 const StageHooks& hooks = StageHooks());
 
 /// The readable summary.
-void print_probe_study(std::ostream& os, const mesh::TetMesh& m, const std::string& material, const ProbeStudyResult& r);
+void print_probe_study(std::ostream& os, const mesh::TetMesh& m, const std::string& material,
+                       const ProbeStudyResult& r);
 
 /// {source, nodes, tets, volume_mm3} of a study's mesh.
 nlohmann::json study_mesh_json(const mesh::TetMesh& m);

@@ -55,10 +55,10 @@ namespace spinesim::studies {
 
 /// One statement of the thesis checked against our numbers.
 struct Finding {
-  std::string id;         ///< short key, e.g. "forward-max-tension"
-  std::string load;       ///< the load case it is about ("forward", … or "all")
-  std::string thesis;     ///< what the thesis says
-  std::string ours;       ///< our numbers
+  std::string id;      ///< short key, e.g. "forward-max-tension"
+  std::string load;    ///< the load case it is about ("forward", … or "all")
+  std::string thesis;  ///< what the thesis says
+  std::string ours;    ///< our numbers
   bool match = false;
 };
 nlohmann::json findings_json(const std::vector<Finding>& findings);
@@ -75,17 +75,19 @@ double joint_shear_n(const spine::JointReaction& r);
 // --- validation --------------------------------------------------------------------------------
 
 struct McGillCase {
-  double target_moment_nmm = 0;     ///< spine_model.json validation.mcgill_extension_moment_nmm
-  double t7_force_n = 0;            ///< found: +z force on the T7 centre
-  double external_moment_nmm = 0;   ///< M_ext at the equilibrium (see the header)
+  double target_moment_nmm = 0;    ///< spine_model.json validation.mcgill_extension_moment_nmm
+  double t7_force_n = 0;           ///< found: +z force on the T7 centre
+  double external_moment_nmm = 0;  ///< M_ext at the equilibrium (see the header)
   double external_moment_reference_nmm = 0;  ///< the same loads in the reference posture
-  double joint_moment_nmm = 0;      ///< x moment the L5-S1 joint spring carries (JointReaction; flexion +)
-  double other_moment_nmm = 0;      ///< M_ext − M_joint: carried by muscles, ligaments, IAP
+  double joint_moment_nmm =
+      0;  ///< x moment the L5-S1 joint spring carries (JointReaction; flexion +)
+  double other_moment_nmm = 0;  ///< M_ext − M_joint: carried by muscles, ligaments, IAP
   spine::JointReaction l5s1;
-  int solves = 0, iterations = 0;   ///< solve_spine calls; Newton iterations of the last
+  int solves = 0, iterations = 0;  ///< solve_spine calls; Newton iterations of the last
   double axial_lo_n = 0, axial_hi_n = 0, shear_max_n = 0;  ///< McGill & Norman's window
   /// Reference values (NaN when spine_model.json does not list them).
-  double thesis_force_n = 0, thesis_axial_n = 0, thesis_shear_n = 0, dezee_axial_n = 0, dezee_shear_n = 0;
+  double thesis_force_n = 0, thesis_axial_n = 0, thesis_shear_n = 0, dezee_axial_n = 0,
+         dezee_shear_n = 0;
   std::string source;
   bool axial_ok() const;  ///< joint-frame axial within the window
   bool shear_ok() const;  ///< joint-frame shear magnitude ≤ the maximum
@@ -109,7 +111,8 @@ struct ValidationStudy {
   double seconds = 0;
 };
 /// `model` gives the muscle set (trunk_muscles); each case sets its own loads and arm posture.
-ValidationStudy run_validation_study(const std::string& data_dir, const spine::ModelOptions& model = {},
+ValidationStudy run_validation_study(const std::string& data_dir,
+                                     const spine::ModelOptions& model = {},
                                      const StageHooks& hooks = StageHooks());
 void print_validation(std::ostream& os, const ValidationStudy& s, bool markdown);
 nlohmann::json validation_json(const ValidationStudy& s);
@@ -130,7 +133,8 @@ struct FusionRun {
   Eigen::Vector3d force_n = Eigen::Vector3d::Zero();
   Eigen::Vector3d t1_translation_mm = Eigen::Vector3d::Zero();  ///< the force's effect
   Eigen::Vector3d t1_rotation_deg = Eigen::Vector3d::Zero();    ///< the force's effect
-  Eigen::Vector3d t1_total_translation_mm = Eigen::Vector3d::Zero();  ///< from the reference posture (gravity + force)
+  Eigen::Vector3d t1_total_translation_mm =
+      Eigen::Vector3d::Zero();      ///< from the reference posture (gravity + force)
   spine::JointReaction l2l3, l5s1;  ///< totals
   int iterations = 0;
   double seconds = 0;
@@ -146,7 +150,8 @@ struct FusionStudy {
   const FusionRun& run(const std::string& fusion, const std::string& load) const;
 };
 /// `model` gives the muscle set; the study sets the fused joints itself.
-FusionStudy run_fusion_study(const std::string& data_dir, double force_n, const spine::ModelOptions& model = {},
+FusionStudy run_fusion_study(const std::string& data_dir, double force_n,
+                             const spine::ModelOptions& model = {},
                              const StageHooks& hooks = StageHooks());
 void print_fusion(std::ostream& os, const FusionStudy& s, bool markdown);
 nlohmann::json fusion_json(const FusionStudy& s);
@@ -159,7 +164,7 @@ struct TrendRun {
   Eigen::Vector3d force_n = Eigen::Vector3d::Zero();
   std::vector<std::string> pairs;   ///< "T1-T2" … "L4-L5"
   Eigen::MatrixX3d translation_mm;  ///< #pairs × 3, upper minus lower, world axes, force's effect
-  Eigen::MatrixX3d rotation_deg;    ///< #pairs × 3, joint coordinate (lower's axes), force's effect
+  Eigen::MatrixX3d rotation_deg;  ///< #pairs × 3, joint coordinate (lower's axes), force's effect
   int iterations = 0;
 };
 
@@ -170,7 +175,8 @@ struct TrendsStudy {
   bool trunk_muscles = true;  ///< the model's muscle set (spine::ModelOptions::trunk_muscles)
   double seconds = 0;
 };
-TrendsStudy run_trends_study(const std::string& data_dir, double force_n, const spine::ModelOptions& model = {},
+TrendsStudy run_trends_study(const std::string& data_dir, double force_n,
+                             const spine::ModelOptions& model = {},
                              const StageHooks& hooks = StageHooks());
 void print_trends(std::ostream& os, const TrendsStudy& s, bool markdown);
 nlohmann::json trends_json(const TrendsStudy& s);

@@ -20,7 +20,8 @@ class TextTable {
   std::size_t num_rows() const { return rows_.size(); }
 
   /// Markdown, or aligned text with `indent` before each line and `gap` spaces between columns.
-  void print(std::ostream& os, bool markdown, const std::string& indent = "  ", std::size_t gap = 2) const;
+  void print(std::ostream& os, bool markdown, const std::string& indent = "  ",
+             std::size_t gap = 2) const;
   /// Column alignment only (markdown: `---|` for every column, as plain GitHub tables).
   void set_plain_markdown(bool plain) { plain_markdown_ = plain; }
   /// Minimum display width of column `i` in text mode (headers narrower than their data).
