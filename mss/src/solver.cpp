@@ -11,6 +11,8 @@
 // lowers |r| instead (the Armijo test cannot see the decrease).
 #include "spinesim/mss/solver.hpp"
 
+#include "spinesim/common/timer.hpp"
+
 #include "external_loads.hpp"
 #include "reduced_potential.hpp"
 #include "reduced_space.hpp"
@@ -46,17 +48,22 @@ double round_off_floor(const MssModel& model, const Eigen::SparseMatrix<double>&
 
 }  // namespace
 
-StaticResult solve_static(const MssModel& model, const Boundary& bc, const StaticOptions& options,
-                          const Eigen::VectorXd& x_start) {
-  const auto t0 = std::chrono::steady_clock::now();
-  // 1. Check the input.
+/// 1. The input of a static solve, checked (std::invalid_argument, one line).
+void check_static_input(const MssModel& model, const Boundary& bc, const StaticOptions& options,
+                        const Eigen::VectorXd& x_start) {
   validate(bc, model.num_nodes());
   if (!(options.relative_tolerance > 0.0) || !std::isfinite(options.relative_tolerance))
     throw std::invalid_argument("mss: static relative tolerance must be finite and > 0");
   if (options.max_iterations < 1)
     throw std::invalid_argument("mss: static max_iterations must be >= 1");
-  const Eigen::VectorXd& X = model.rest_positions_mm();
   if (x_start.size() != 0) check_positions(x_start, model, "static start vector");
+}
+
+StaticResult solve_static(const MssModel& model, const Boundary& bc, const StaticOptions& options,
+                          const Eigen::VectorXd& x_start) {
+  const Timer t0;
+  check_static_input(model, bc, options, x_start);  // 1.
+  const Eigen::VectorXd& X = model.rest_positions_mm();
 
   // 2. Reduced space, loads, and the rest Hessian (pattern, probe default, round-off floor).
   Eigen::SparseMatrix<double> H, A;
@@ -144,7 +151,7 @@ StaticResult solve_static(const MssModel& model, const Boundary& bc, const Stati
     moved_center = bc.superior.apply(c);
   }
   res.reaction_wrench = plate_reaction(model, res.x_mm, moved_center);
-  res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  res.seconds = t0.seconds();
   return res;
 }
 

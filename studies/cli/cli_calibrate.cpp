@@ -173,8 +173,8 @@ void run_all_levels(const CalibrateArgs& a, const CalibrationRequest& rq,
   std::cout << "\nwrote " << a.out << "\n";
 }
 
-void run_calibrate(const CalibrateArgs& a) {
-  // 1. Everything checked before the work starts.
+/// The options that say what to calibrate and where to write it, checked before any work.
+void check_files_and_modes(const CalibrateArgs& a) {
   if (a.out.empty()) throw std::invalid_argument("--out tuned.json is required");
   if (a.mesh_path.empty() == a.level.empty())
     throw std::invalid_argument("give exactly one of --mesh and --level");
@@ -197,6 +197,11 @@ void run_calibrate(const CalibrateArgs& a) {
   if (!a.mesh_path.empty() && std::filesystem::exists(a.out) &&
       std::filesystem::exists(a.mesh_path) && std::filesystem::equivalent(a.out, a.mesh_path))
     throw std::invalid_argument("--out " + a.out + " is the input mesh: give another file");
+}
+
+void run_calibrate(const CalibrateArgs& a) {
+  // 1. Everything checked before the work starts.
+  check_files_and_modes(a);
   CalibrationRequest rq;
   rq.train = fem::parse_load_cases(a.train);
   rq.holdout = a.holdout.empty()     ? other_cases(rq.train)

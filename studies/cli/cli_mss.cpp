@@ -240,6 +240,33 @@ void print_summary(std::ostream& os, const MssArgs& a, const mss::MssModel& mode
      << 100.0 * j["volume_change"].get<double>() << " %\n";
 }
 
+/// The stepping options of a dynamic run, checked; the integrator (implicit for a static run).
+mss::Integrator check_stepping(const MssArgs& a) {
+  if (!a.dynamic) return mss::Integrator::implicit_euler;
+  const mss::Integrator integrator = parse_integrator(a.integrator);
+  if (!std::isfinite(a.dt_s) || a.dt_s <= 0)
+    throw std::invalid_argument("--dt must be a finite number > 0 s");
+  if (a.steps < 1) throw std::invalid_argument("a dynamic run needs --steps N with N >= 1");
+  if (a.frame_every < 0) throw std::invalid_argument("--frame-every must be >= 0");
+  if (a.newton_iterations < 1) throw std::invalid_argument("--newton must be >= 1");
+  return integrator;
+}
+
+/// --out checked (a .vtu, or a .pvd series for a dynamic run, in an existing folder); returns
+/// whether it is a series.
+bool check_output(const MssArgs& a) {
+  if (a.out.empty()) return false;
+  const bool series = fs::path(a.out).extension() == ".pvd";
+  if (fs::path(a.out).extension() != ".vtu" && !series)
+    throw std::invalid_argument("--out " + a.out +
+                                ": give a .vtu file (or a .pvd time series for a dynamic run)");
+  if (series && !a.dynamic)
+    throw std::invalid_argument("--out " + a.out +
+                                ": a .pvd time series needs a dynamic run (--dt/--steps)");
+  require_output_folder(a.out, "--out");
+  return series;
+}
+
 void run_mss(const MssArgs& a) {
   // 1. Parse and check every option before doing any work: bad input fails fast, writes nothing.
   if (a.mesh_path.empty()) throw std::invalid_argument("--mesh is required");
@@ -258,27 +285,10 @@ void run_mss(const MssArgs& a) {
   const fem::LoadCase* named = a.load_case.empty() ? nullptr : &fem::load_case(a.load_case);
   const Eigen::VectorXd center =
       a.center.empty() ? Eigen::VectorXd() : parse_numbers(a.center, 3, "--center x,y,z (mm)");
-  mss::Integrator integrator = mss::Integrator::implicit_euler;
-  if (a.dynamic) {
-    integrator = parse_integrator(a.integrator);
-    if (!std::isfinite(a.dt_s) || a.dt_s <= 0)
-      throw std::invalid_argument("--dt must be a finite number > 0 s");
-    if (a.steps < 1) throw std::invalid_argument("a dynamic run needs --steps N with N >= 1");
-    if (a.frame_every < 0) throw std::invalid_argument("--frame-every must be >= 0");
-    if (a.newton_iterations < 1) throw std::invalid_argument("--newton must be >= 1");
-  }
+  const mss::Integrator integrator = check_stepping(a);
   const ModelChoice choice =
       choose_model(a.model, a.params, a.material, a.material_option->count() > 0);
-  const bool series = !a.out.empty() && fs::path(a.out).extension() == ".pvd";
-  if (!a.out.empty()) {
-    if (fs::path(a.out).extension() != ".vtu" && !series)
-      throw std::invalid_argument("--out " + a.out +
-                                  ": give a .vtu file (or a .pvd time series for a dynamic run)");
-    if (series && !a.dynamic)
-      throw std::invalid_argument("--out " + a.out +
-                                  ": a .pvd time series needs a dynamic run (--dt/--steps)");
-    require_output_folder(a.out, "--out");
-  }
+  const bool series = check_output(a);
   const auto& materials = choice.materials;
 
   // 2. Mesh and model.

@@ -266,6 +266,36 @@ struct GridRow {
   bool ok() const { return message.empty() && error_mm <= allowed_mm && error_deg <= allowed_deg; }
 };
 
+json grid_json(const std::vector<GridRow>& rows) {
+  json grid = json::array();
+  for (const auto& r : rows)
+    grid.push_back({{"vertebra", sp::vertebra_names()[std::size_t(r.vertebra)]},
+                    {"direction", sp::direction_names()[std::size_t(r.direction)]},
+                    {"force_n", r.force_n},
+                    {"error_mm", r.error_mm},
+                    {"error_deg", r.error_deg},
+                    {"allowed_mm", r.allowed_mm},
+                    {"allowed_deg", r.allowed_deg},
+                    {"ok", r.ok()},
+                    {"message", r.message}});
+  return grid;
+}
+
+void print_grid(const std::vector<GridRow>& rows, std::ostream& os) {
+  TextTable t({"vertebra", "direction", "force (N)", "error (mm)", "allowed (mm)", "error (deg)",
+               "allowed (deg)", "verdict"},
+              2);
+  for (const auto& r : rows)
+    t.add({sp::vertebra_names()[std::size_t(r.vertebra)],
+           sp::direction_names()[std::size_t(r.direction)], fixed(r.force_n, 0),
+           fixed(r.error_mm, 4), fixed(r.allowed_mm, 4), fixed(r.error_deg, 4),
+           fixed(r.allowed_deg, 4),
+           r.ok()              ? "ok"
+           : r.message.empty() ? "MISMATCH"
+                               : "FAILED " + r.message});
+  t.print(os, false);
+}
+
 void run_check(const DatabaseArgs& a) {
   const std::string path =
       a.out_option->count() ? a.out : data_dir() + "/spine/displacement_db.json";
@@ -331,22 +361,11 @@ void run_check(const DatabaseArgs& a) {
   progress.end();
 
   if (a.json) {
-    json grid = json::array();
-    for (const auto& r : rows)
-      grid.push_back({{"vertebra", sp::vertebra_names()[std::size_t(r.vertebra)]},
-                      {"direction", sp::direction_names()[std::size_t(r.direction)]},
-                      {"force_n", r.force_n},
-                      {"error_mm", r.error_mm},
-                      {"error_deg", r.error_deg},
-                      {"allowed_mm", r.allowed_mm},
-                      {"allowed_deg", r.allowed_deg},
-                      {"ok", r.ok()},
-                      {"message", r.message}});
     print_json({{"file", path},
                 {"generated_by", db.info.generated_by},
                 {"baseline_difference_mm", base_mm},
                 {"baseline_difference_deg", base_deg},
-                {"grid", grid},
+                {"grid", grid_json(rows)},
                 {"superposition_check", json::parse(sp::superposition_json_text(sup))},
                 {"ok", all_ok}});
   } else {
@@ -356,18 +375,7 @@ void run_check(const DatabaseArgs& a) {
               << "Grid forces re-solved (error = max over vertebrae; allowed = the file's max fit "
                  "residual + "
               << margin << "):\n";
-    TextTable t({"vertebra", "direction", "force (N)", "error (mm)", "allowed (mm)", "error (deg)",
-                 "allowed (deg)", "verdict"},
-                2);
-    for (const auto& r : rows)
-      t.add({sp::vertebra_names()[std::size_t(r.vertebra)],
-             sp::direction_names()[std::size_t(r.direction)], fixed(r.force_n, 0),
-             fixed(r.error_mm, 4), fixed(r.allowed_mm, 4), fixed(r.error_deg, 4),
-             fixed(r.allowed_deg, 4),
-             r.ok()              ? "ok"
-             : r.message.empty() ? "MISMATCH"
-                                 : "FAILED " + r.message});
-    t.print(std::cout, false);
+    print_grid(rows, std::cout);
     print_superposition(sup, std::cout);
   }
   if (!all_ok)

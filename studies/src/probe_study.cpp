@@ -143,6 +143,47 @@ void check(const ProbeStudyRequest& rq) {
                                   "' (anterior, posterior, left, right)");
 }
 
+/// The summary JSON of a probe run (also written to probe.json).
+nlohmann::json probe_summary(const mesh::TetMesh& m, const mesh::RegionMaterials& materials,
+                             const mss::MssModel& model, const ProbeStudyResult& r) {
+  const ProbeStudyRequest& rq = r.request;
+  const SteppedStudyOptions& o = rq.stepping;
+  const Range& dv = r.volume_change;
+  nlohmann::json sites = nlohmann::json::array();
+  for (const auto& p : r.sites)
+    sites.push_back({{"name", p.name},
+                     {"node", p.node},
+                     {"point_mm", to_json(p.point_mm)},
+                     {"normal", to_json(p.normal)},
+                     {"start_s", p.start_s}});
+  return {{"study", "probe"},
+          {"thesis", "5.3 test 1, fig. 5.8"},
+          {"mesh", study_mesh_json(m)},
+          {"material", materials.name},
+          {"model_variant", o.model_variant},
+          {"model", mss_model_json(model, materials)},
+          {"probe",
+           {{"radius_mm", rq.radius_mm},
+            {"depth_mm", rq.depth_mm},
+            {"speed_mm_s", rq.speed_mm_s},
+            {"hold_s", rq.hold_s},
+            {"rest_s", rq.rest_s},
+            {"stiffness_n_per_mm", r.stiffness_n_per_mm},
+            {"schedule",
+             "per site: press at speed to depth, hold, withdraw, rest with the probe away"}}},
+          {"sites", sites},
+          {"integrator", o.integrator_name},
+          {"dt_s", o.dynamics.dt_s},
+          {"steps", r.steps},
+          {"max_force_n", r.max_force_n},
+          {"max_volume_change", std::isfinite(dv.lo) ? dv.extreme() : 0.0},
+          {"volume_change_range",
+           {std::isfinite(dv.lo) ? dv.lo : 0.0, std::isfinite(dv.hi) ? dv.hi : 0.0}},
+          {"max_displacement_mm", r.max_displacement_mm},
+          {"files", {{"pvd", r.pvd_path}, {"csv", r.csv_path}, {"json", r.json_path}}},
+          {"frames", r.frames}};
+}
+
 ProbeStudyResult run_probe_study(const mesh::TetMesh& m, const mesh::RegionMaterials& materials,
                                  const ProbeStudyRequest& rq, const StageHooks& hooks) {
   // 1. The model and the probe sites.
@@ -209,40 +250,7 @@ ProbeStudyResult run_probe_study(const mesh::TetMesh& m, const mesh::RegionMater
   r.csv_path = (fs::path(o.out) / "probe.csv").string();
   r.json_path = (fs::path(o.out) / "probe.json").string();
   write_text_file(r.csv_path, csv.str());
-  const Range& dv = r.volume_change;
-  nlohmann::json sites = nlohmann::json::array();
-  for (const auto& p : r.sites)
-    sites.push_back({{"name", p.name},
-                     {"node", p.node},
-                     {"point_mm", to_json(p.point_mm)},
-                     {"normal", to_json(p.normal)},
-                     {"start_s", p.start_s}});
-  r.summary = {{"study", "probe"},
-               {"thesis", "5.3 test 1, fig. 5.8"},
-               {"mesh", study_mesh_json(m)},
-               {"material", materials.name},
-               {"model_variant", o.model_variant},
-               {"model", mss_model_json(model, materials)},
-               {"probe",
-                {{"radius_mm", rq.radius_mm},
-                 {"depth_mm", rq.depth_mm},
-                 {"speed_mm_s", rq.speed_mm_s},
-                 {"hold_s", rq.hold_s},
-                 {"rest_s", rq.rest_s},
-                 {"stiffness_n_per_mm", k_probe},
-                 {"schedule",
-                  "per site: press at speed to depth, hold, withdraw, rest with the probe away"}}},
-               {"sites", sites},
-               {"integrator", o.integrator_name},
-               {"dt_s", o.dynamics.dt_s},
-               {"steps", r.steps},
-               {"max_force_n", r.max_force_n},
-               {"max_volume_change", std::isfinite(dv.lo) ? dv.extreme() : 0.0},
-               {"volume_change_range",
-                {std::isfinite(dv.lo) ? dv.lo : 0.0, std::isfinite(dv.hi) ? dv.hi : 0.0}},
-               {"max_displacement_mm", r.max_displacement_mm},
-               {"files", {{"pvd", r.pvd_path}, {"csv", r.csv_path}, {"json", r.json_path}}},
-               {"frames", r.frames}};
+  r.summary = probe_summary(m, materials, model, r);
   r.stats.add_to(r.summary);
   write_text_file(r.json_path, r.summary.dump(2) + "\n");
   hooks.end_stage();

@@ -425,6 +425,10 @@ TEST(IoVtu, BadFilesGiveOneLineErrors) {
         s[a + 20] = '*';
       },
       "base64", VtuEncoding::binary);
+}
+
+// Encodings and compression that cannot be read, corrupt or hostile.
+TEST(IoVtu, BadEncodingsGiveOneLineErrors) {
   expect_read_error(
       "appended",
       [](std::string& s) {
