@@ -54,6 +54,15 @@ record() {
   run spine-database-check spine database --check --quiet --vertebrae T7 --superposition-on T7 --magnitudes 300 --out db.json --json
   run refused-mesh mss --mesh no-such-file.vtu --case compression --json
   run refused-flag spine solve --force T7:1,2 --json
+  # Readable reports (stdout without --json) of the verbs whose drivers print them.
+  run fem-text fem --mesh d.vtu --case flexion
+  run mss-text mss --mesh d.vtu --case compression
+  run mss-dynamic-text mss --mesh s.vtu --case flexion --dt 1e-3 --steps 20 --frozen
+  run study-probe-text study probe --mesh s.vtu --out probe-text-out --quiet
+  run study-drive-text study drive --mesh s.vtu --out drive-text-out --materials real-disc,rubber --quiet
+  run study-materials-text study materials --level T7-T8 --cell-size 4 --materials real-disc,rubber --quiet
+  run spine-database-text spine database --quiet --vertebrae T7 --superposition-on T7 --magnitudes 300 --out db-text.json
+  run spine-database-check-text spine database --check --quiet --vertebrae T7 --superposition-on T7 --magnitudes 300 --out db.json
   run demo demo --out demo-out
   run demo-json demo --out demo-json-out --json --quiet
   echo "recorded $n commands in $out" >&2

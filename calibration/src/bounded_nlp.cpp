@@ -1,9 +1,10 @@
 #include "bounded_nlp.hpp"
 
+#include "spinesim/common/timer.hpp"
+
 #include <IpIpoptApplication.hpp>
 #include <IpTNLP.hpp>
 
-#include <chrono>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -11,11 +12,6 @@
 namespace spinesim::calibration::detail {
 
 namespace {
-
-using clock_type = std::chrono::steady_clock;
-double since(clock_type::time_point t0) {
-  return std::chrono::duration<double>(clock_type::now() - t0).count();
-}
 
 const char* status_name(Ipopt::ApplicationReturnStatus s) {
   using namespace Ipopt;
@@ -153,7 +149,7 @@ class BoundedNlp : public Ipopt::TNLP {
   bool evaluate(Ipopt::Index n, const Ipopt::Number* x) {
     const Eigen::Map<const Eigen::VectorXd> p(x, n);
     if (has_last_ && p == last_p_) return last_ok_;
-    const auto t0 = clock_type::now();
+    const Timer t0;
     last_p_ = p;
     has_last_ = true;
     try {
@@ -163,7 +159,7 @@ class BoundedNlp : public Ipopt::TNLP {
       last_ok_ = false;  // K not positive definite: Ipopt shortens the step
     }
     ++evaluations_;
-    eval_seconds_ += since(t0);
+    eval_seconds_ += t0.seconds();
     return last_ok_;
   }
 

@@ -1,21 +1,15 @@
 #include "spinesim/calibration/calibrate.hpp"
 
+#include "spinesim/common/timer.hpp"
+
 #include "bounded_nlp.hpp"
 
-#include <chrono>
 #include <cmath>
 #include <stdexcept>
 
 namespace spinesim::calibration {
 
-namespace {
-
-using clock_type = std::chrono::steady_clock;
-double since(clock_type::time_point t0) {
-  return std::chrono::duration<double>(clock_type::now() - t0).count();
-}
-
-}  // namespace
+namespace {}  // namespace
 
 void validate(const IpoptSettings& s) {
   if (!std::isfinite(s.lower_scale) || !std::isfinite(s.upper_scale) || s.lower_scale <= 0)
@@ -32,7 +26,7 @@ void validate(const IpoptSettings& s) {
 CalibrationResult calibrate(Objective& objective, const Eigen::VectorXd& start_log_scales,
                             const IpoptSettings& settings, const Progress& progress) {
   validate(settings);
-  const auto t0 = clock_type::now();
+  const Timer t0;
   CalibrationResult out;
   out.start_log_scales = start_log_scales.cwiseMax(std::log(settings.lower_scale))
                              .cwiseMin(std::log(settings.upper_scale));
@@ -56,7 +50,7 @@ CalibrationResult calibrate(Objective& objective, const Eigen::VectorXd& start_l
     out.success = false;
     out.status += std::string(" (final point unusable: ") + e.what() + ")";
   }
-  out.seconds = since(t0);
+  out.seconds = t0.seconds();
   return out;
 }
 

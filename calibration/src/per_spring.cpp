@@ -1,9 +1,10 @@
 #include "spinesim/calibration/per_spring.hpp"
 
+#include "spinesim/common/timer.hpp"
+
 #include "bounded_nlp.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -11,11 +12,6 @@
 namespace spinesim::calibration {
 
 namespace {
-
-using clock_type = std::chrono::steady_clock;
-double since(clock_type::time_point t0) {
-  return std::chrono::duration<double>(clock_type::now() - t0).count();
-}
 
 bool finite_non_negative(double v) { return std::isfinite(v) && v >= 0.0; }
 
@@ -121,7 +117,7 @@ PerSpringResult calibrate_per_spring(PerSpringObjective& objective, const IpoptS
     throw std::invalid_argument(
         "calibration: per-spring multiplier bounds must bracket 1 (the region fit), got [" +
         std::to_string(settings.lower_scale) + ", " + std::to_string(settings.upper_scale) + "]");
-  const auto t0 = clock_type::now();
+  const Timer t0;
   PerSpringResult out;
   const Eigen::VectorXd start = Eigen::VectorXd::Zero(objective.num_unknowns());
   out.start = objective.evaluate(start, false);  // throws if the region fit itself is unusable
@@ -154,7 +150,7 @@ PerSpringResult calibrate_per_spring(PerSpringObjective& objective, const IpoptS
     out.final = out.start;
     out.log_multipliers = start;
   }
-  out.seconds = since(t0);
+  out.seconds = t0.seconds();
   return out;
 }
 

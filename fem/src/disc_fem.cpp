@@ -1,5 +1,7 @@
 #include "spinesim/fem/disc_fem.hpp"
 
+#include "spinesim/common/timer.hpp"
+
 #include "spinesim/fem/assembly.hpp"
 #include "spinesim/fem/cholmod_solver.hpp"
 #include "spinesim/fem/fe_space.hpp"
@@ -7,7 +9,6 @@
 
 #include <Eigen/Cholesky>
 
-#include <chrono>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -15,11 +16,6 @@
 namespace spinesim::fem {
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
 
 void validate_inputs(const mesh::TetMesh& m, const mesh::RegionMaterials& materials, int order,
                      const Eigen::Vector3d& c) {
@@ -108,18 +104,18 @@ DiscFem::DiscFem(const mesh::TetMesh& mesh, const mesh::RegionMaterials& materia
     : impl_(std::make_unique<Impl>()) {
   Impl& d = *impl_;
   // 1. Validate and set up the node set, boundary roles and the K_ff sparsity.
-  auto t0 = Clock::now();
+  Timer t0;
   validate_inputs(mesh, materials, order, plate_center_mm);
   d.center = plate_center_mm;
   d.space = make_fe_space(mesh, order);
   d.roles = node_roles(node_surface_labels(d.space, mesh));
   d.pattern = build_free_block_pattern(d.space, d.roles);
-  d.timings.setup_s = seconds_since(t0);
+  d.timings.setup_s = t0.seconds();
 
   // 2. Assemble K_ff, K_fp, K_pp.
-  t0 = Clock::now();
+  t0.restart();
   d.coupling = assemble_constrained(d.space, mesh.region, materials, d.roles, d.center, d.pattern);
-  d.timings.assembly_s = seconds_since(t0);
+  d.timings.assembly_s = t0.seconds();
 
   // 3. Factorise K_ff and condense onto the plate: K6 = K_pp - K_fp^T K_ff^-1 K_fp.
   d.K6 = d.coupling.K_pp;
@@ -129,34 +125,34 @@ DiscFem::DiscFem(const mesh::TetMesh& mesh, const mesh::RegionMaterials& materia
                        (options.solver == LinearSolver::automatic && nf >= options.cg_min_dofs));
   if (use_cg) {
     // P1 block on the same mesh and roles (vertex labels are the same), factorised directly.
-    t0 = Clock::now();
+    t0.restart();
     const FeSpace p1 = make_fe_space(mesh, 1);
     const std::vector<NodeRole> p1_roles(d.roles.begin(), d.roles.begin() + p1.num_nodes());
     FreeBlockPattern coarse = build_free_block_pattern(p1, p1_roles);
     assemble_constrained(p1, mesh.region, materials, p1_roles, d.center, coarse);
-    d.timings.assembly_s += seconds_since(t0);
-    t0 = Clock::now();
+    d.timings.assembly_s += t0.seconds();
+    t0.restart();
     P2MultigridCg cg(d.pattern.lower, coarse.lower, p1_embedding(d.space, d.pattern, coarse));
-    d.timings.factorise_s = seconds_since(t0);
-    t0 = Clock::now();
+    d.timings.factorise_s = t0.seconds();
+    t0.restart();
     d.Z = cg.solve(d.coupling.K_fp, options.cg_relative_tolerance, options.cg_max_iterations);
     d.timings.cg_iterations = cg.last_iterations();
     // Energy form: exact Z gives K_pp - K_fp^T Z; an approximate Z errs only quadratically.
     const Eigen::MatrixXd KZ = d.pattern.lower.selfadjointView<Eigen::Lower>() * d.Z;
     const Matrix6d cross = d.coupling.K_fp.transpose() * d.Z;
     d.K6 += -cross - cross.transpose() + d.Z.transpose() * KZ;
-    d.timings.solve_s = seconds_since(t0);
+    d.timings.solve_s = t0.seconds();
   } else if (nf > 0) {
-    t0 = Clock::now();
+    t0.restart();
     d.solver.analyze(d.pattern.lower);
-    d.timings.analyse_s = seconds_since(t0);
-    t0 = Clock::now();
+    d.timings.analyse_s = t0.seconds();
+    t0.restart();
     d.solver.factorize(d.pattern.lower);
-    d.timings.factorise_s = seconds_since(t0);
-    t0 = Clock::now();
+    d.timings.factorise_s = t0.seconds();
+    t0.restart();
     d.Z = d.solver.solve(d.coupling.K_fp);
     d.K6.noalias() -= d.coupling.K_fp.transpose() * d.Z;
-    d.timings.solve_s = seconds_since(t0);
+    d.timings.solve_s = t0.seconds();
   }
   const double norm = d.K6.norm();
   d.asymmetry = norm > 0 ? (d.K6 - d.K6.transpose()).norm() / norm : 0.0;

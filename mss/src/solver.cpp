@@ -18,7 +18,6 @@
 #include "reduced_space.hpp"
 #include "tangent.hpp"
 
-#include <chrono>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -46,8 +45,6 @@ double round_off_floor(const MssModel& model, const Eigen::SparseMatrix<double>&
          std::sqrt(double(model.num_dofs()));
 }
 
-}  // namespace
-
 /// 1. The input of a static solve, checked (std::invalid_argument, one line).
 void check_static_input(const MssModel& model, const Boundary& bc, const StaticOptions& options,
                         const Eigen::VectorXd& x_start) {
@@ -58,6 +55,8 @@ void check_static_input(const MssModel& model, const Boundary& bc, const StaticO
     throw std::invalid_argument("mss: static max_iterations must be >= 1");
   if (x_start.size() != 0) check_positions(x_start, model, "static start vector");
 }
+
+}  // namespace
 
 StaticResult solve_static(const MssModel& model, const Boundary& bc, const StaticOptions& options,
                           const Eigen::VectorXd& x_start) {

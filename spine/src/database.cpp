@@ -3,13 +3,13 @@
 #include "spinesim/spine/database.hpp"
 
 #include "spinesim/common/atomic_file.hpp"
+#include "spinesim/common/timer.hpp"
 
 #include <Eigen/QR>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <atomic>
-#include <chrono>
 #include <cmath>
 #include <condition_variable>
 #include <cstdio>
@@ -30,10 +30,6 @@ constexpr const char* kKind = "spinesim displacement-force database";
 constexpr int kFormatVersion = 1;
 const std::array<const char*, kDbComponents> kComponentNames = {"tx_mm",  "ty_mm",  "tz_mm",
                                                                 "rx_deg", "ry_deg", "rz_deg"};
-
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 VertebraResponse as_response(const Eigen::Matrix<double, Eigen::Dynamic, 6>& d) {
   if (d.rows() != kDbVertebrae)
@@ -229,11 +225,11 @@ ResponseSamples sample_responses(const SpineModel& m, const GenerationOptions& o
         loads.push_back({load_at_centre(v, s.forces_n[std::size_t(k)] * direction_vector(d))});
         index.emplace_back(v, d, k);
       }
-  const auto t0 = std::chrono::steady_clock::now();
+  const Timer t0;
   std::vector<VertebraResponse> disp;
   std::vector<std::string> errors;
   solve_cases(m, loads, o.solve, o.workers, disp, errors, o.progress);
-  s.seconds = seconds_since(t0);
+  s.seconds = t0.seconds();
   s.solves = int(loads.size());
   s.workers = o.workers > 0 ? std::min(o.workers, s.solves)
                             : int(std::max(1u, std::thread::hardware_concurrency()));
@@ -837,7 +833,7 @@ SuperpositionReport check_superposition(const SpineModel& m, const DisplacementD
                                         std::vector<SuperpositionCase> cases,
                                         const SolveOptions& options, int workers,
                                         const std::function<void(int, int)>& progress) {
-  const auto t0 = std::chrono::steady_clock::now();
+  const Timer t0;
   // Unique load cases: the baseline, each oblique force, each of its axis components.
   std::vector<std::vector<ExternalLoad>> loads = {{}};
   std::map<std::tuple<int, double, double, double>, std::size_t> known;
@@ -915,7 +911,7 @@ SuperpositionReport check_superposition(const SpineModel& m, const DisplacementD
           rel(c.axis_sum_error_rotation_deg, c.response_rotation_deg));
   }
   r.cases = std::move(cases);
-  r.seconds = seconds_since(t0);
+  r.seconds = t0.seconds();
   return r;
 }
 

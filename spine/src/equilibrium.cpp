@@ -3,11 +3,12 @@
 // above each joint, and a modified Newton method with a finite-difference Hessian.
 #include "spinesim/spine/equilibrium.hpp"
 
+#include "spinesim/common/timer.hpp"
+
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <sstream>
 
@@ -515,7 +516,7 @@ SpineSolution solve_spine(const SpineModel& m, const std::vector<ExternalLoad>& 
   if (!(o.tolerance > 0) || o.max_iterations < 1 || !(o.fd_step > 0))
     throw std::invalid_argument(
         "solve_spine: tolerance and finite-difference step must be > 0, iterations >= 1");
-  const auto t0 = std::chrono::steady_clock::now();
+  Timer timer;
 
   VectorXd F;  // recruited muscle forces (empty: muscles off)
   if (o.recruit && !m.muscles.empty()) {
@@ -528,8 +529,7 @@ SpineSolution solve_spine(const SpineModel& m, const std::vector<ExternalLoad>& 
       throw SolveError("muscle recruitment failed (Ipopt: " + out.recruitment.status + ")");
     F = out.recruitment.force_n;
   }
-  const auto t1 = std::chrono::steady_clock::now();
-  out.seconds_recruitment = std::chrono::duration<double>(t1 - t0).count();
+  out.seconds_recruitment = timer.restart();
 
   // A symmetric model under sagittal loads has a symmetric equilibrium: solve for it in the
   // sagittal plane (deterministic; where it is unstable, which way the spine would buckle is
@@ -539,8 +539,7 @@ SpineSolution solve_spine(const SpineModel& m, const std::vector<ExternalLoad>& 
   out.theta = newton.solve(out.iterations, out.gradient_norm);
   out.converged = true;
   assess_stability(m, full, out.theta, out);
-  out.seconds_equilibrium =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+  out.seconds_equilibrium = timer.seconds();
   report(m, evaluate(m, loads, F, out.theta), out);
   return out;
 }

@@ -4,10 +4,11 @@
 // r/R⁺ − t ≤ 0 and −r/R⁻ − t ≤ 0.
 #include "spinesim/spine/recruitment.hpp"
 
+#include "spinesim/common/timer.hpp"
+
 #include <IpIpoptApplication.hpp>
 #include <IpTNLP.hpp>
 
-#include <chrono>
 #include <cmath>
 #include <mutex>
 #include <sstream>
@@ -266,7 +267,7 @@ std::mutex& ipopt_mutex() {
 
 Recruitment recruit(const SpineModel& m, const Eigen::MatrixXd& arm,
                     const Eigen::VectorXd& load_moment_nmm, const RecruitmentOptions& options) {
-  const auto t0 = std::chrono::steady_clock::now();
+  const Timer timer;
   if (!(options.power >= 2 && options.power <= 10))
     throw std::invalid_argument("recruitment power must be in [2, 10], got " +
                                 std::to_string(options.power));
@@ -338,7 +339,7 @@ Recruitment recruit(const SpineModel& m, const Eigen::MatrixXd& arm,
     out.objective = nlp->objective;
     out.max_constraint_violation_nmm = nlp->violation;
   }
-  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  out.seconds = timer.seconds();
   return out;
 }
 

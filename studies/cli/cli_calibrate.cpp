@@ -18,6 +18,7 @@
 #include "spinesim/studies/calibration_report.hpp"
 
 #include "spinesim/studies/disc_level.hpp"
+#include "spinesim/studies/level_calibration.hpp"
 
 #include "spinesim/calibration/tuned_set.hpp"
 #include "spinesim/mesh/disc_geometry.hpp"
@@ -66,31 +67,14 @@ std::vector<fem::LoadCase> other_cases(const std::vector<fem::LoadCase>& train) 
   return out;
 }
 
-/// The protocol's second mesh resolution for a parametric disc: the same disc at 1.5x the cell
-/// size, labelled with it.
-std::pair<std::string, mesh::TetMesh> coarser_mesh(const mesh::DiscDimensions& dims,
-                                                   mesh::MeshOptions opt,
-                                                   const StatusLine& status) {
-  opt.cell_size_mm *= 1.5;
-  std::ostringstream label;
-  label << "parametric " << dims.level << ", cell size " << std::setprecision(3) << opt.cell_size_mm
-        << " mm";
-  status("meshing the second resolution: " + label.str());
-  return {label.str(), mesh_disc_level(dims.level, opt)};
-}
-
-double worst(const nlohmann::json& rows, const char* key) {
-  double w = 0;
-  for (const auto& r : rows) w = std::max(w, r[key].get<double>());
-  return w;
-}
-
 /// --level all: every level's parametric disc, one tuned set file (tuned_set.hpp), written only
-/// when every level succeeded.
+/// when every level succeeded (studies/level_calibration.hpp).
 void run_all_levels(const CalibrateArgs& a, const CalibrationRequest& rq,
                     const mesh::RegionMaterials& materials) {
-  calibration::TunedSet set;
-  set.material_name = materials.name;
+  AllLevelsRequest all;
+  all.calibration = rq;
+  if (a.cell_size_option->count()) all.cell_size_mm = a.cell_size_mm;
+  all.transfer = !a.no_transfer;
   std::ostringstream cmd;
   cmd << "spinesim calibrate --level all"
       << (a.cell_size_option->count() ? " --cell-size " + std::to_string(a.cell_size_mm)
@@ -98,78 +82,23 @@ void run_all_levels(const CalibrateArgs& a, const CalibrationRequest& rq,
       << " --material " << a.material << " --terms " << a.terms << " --train " << a.train
       << (a.holdout.empty() ? "" : " --holdout " + a.holdout) << " --order " << a.order
       << " --check-load-scale " << rq.check_load_scale << (a.no_check ? " --no-check" : "");
-  set.generated_by = cmd.str();
-  set.settings = {
-      {"cell_size_rule", a.cell_size_option->count() ? "as given" : "min(2 mm, disc height / 5)"},
-      {"mesh",
-       "parametric disc (data/disc_morphometry.csv), CGAL, placed in the spine (as `mesh disc "
-       "--level`)"},
-      {"check_load_scale",
-       rq.nonlinear_check ? nlohmann::json(rq.check_load_scale) : nlohmann::json(nullptr)}};
-  TextTable table({"level", "tets", "train max (untuned>tuned)", "holdout max (untuned>tuned)",
-                   "K6 diag ratio (tuned, min-max)", "Ipopt its", "time (s)"});
-  std::vector<std::string> failed;
-  // Thin thoracic discs (4.5-7 mm) get at least five cells through the height: at 2 mm the
-  // fitted MSS stays much further off the FEM there (calibration/README.md).
-  nlohmann::json cell_by_level = nlohmann::json::object();
+  all.generated_by = cmd.str();
   // One line on a terminal: the level being calibrated, its stage, how many are done, the ETA.
   ProgressBar bar(int(mesh::disc_levels().size()), a.quiet || a.json, "levels");
-  int done = 0;
-  for (const std::string& level : mesh::disc_levels()) {
-    const StatusLine level_status = [&bar, &done, &level](const std::string& s) {
-      bar.update(done, level + ": " + s);
-    };
-    const mesh::DiscDimensions dims = mesh::disc_dimensions(level, data_dir());
-    mesh::MeshOptions opt;
-    opt.cell_size_mm =
-        a.cell_size_option->count() ? a.cell_size_mm : std::min(2.0, dims.height_mm / 5.0);
-    cell_by_level[level] = opt.cell_size_mm;
-    level_status("meshing (cell size " + std::to_string(opt.cell_size_mm).substr(0, 4) + " mm)");
-    const mesh::TetMesh m = mesh_disc_level(level, opt);
-    CalibrationRequest level_rq = rq;
-    if (!a.no_transfer) level_rq.transfer_meshes.push_back(coarser_mesh(dims, opt, level_status));
-    const CalibrationOutcome o = calibrate_disc(m, materials, level_rq, level_status);
-    ++done;
-    if (!o.result.success) {
-      failed.push_back(level + " (" + o.result.status + ")");
-      continue;
-    }
-    const auto& rep = o.tuned.report;
-    const auto& ratio = rep["stiffness_diagonal"]["ratio_tuned"];
-    double lo = 1e300, hi = 0;
-    for (const auto& v : ratio)
-      lo = std::min(lo, v.get<double>()), hi = std::max(hi, v.get<double>());
-    const auto pair = [](double u, double t) {
-      return fixed(100 * u, 0) + ">" + fixed(100 * t, 1) + "%";
-    };
-    table.add({level, std::to_string(m.num_tets()),
-               pair(worst(rep["train"], "untuned_error"), worst(rep["train"], "tuned_error")),
-               rep["holdout"].empty() ? std::string("-")
-                                      : pair(worst(rep["holdout"], "untuned_error"),
-                                             worst(rep["holdout"], "tuned_error")),
-               fixed(lo, 3) + "-" + fixed(hi, 3), std::to_string(o.result.iterations),
-               fixed(o.total_seconds, 1)});
-    set.levels.emplace(level, o.tuned);
-  }
-  set.settings["cell_size_mm"] = cell_by_level;
+  const AllLevelsResult r = calibrate_all_levels(
+      materials, all, [&bar](int done, const std::string& label) { bar.update(done, label); });
   bar.finish();
-  if (!failed.empty()) {
-    std::string list;
-    for (const auto& f : failed) list += (list.empty() ? "" : ", ") + f;
-    throw std::runtime_error("Ipopt did not converge for " + list + ": no " + a.out + " written");
-  }
-  write_text_file(a.out, calibration::to_json(set).dump(1) + "\n");
+  if (!r.failed().empty())
+    throw std::runtime_error("Ipopt did not converge for " + r.failed() + ": no " + a.out +
+                             " written");
+  write_text_file(a.out, calibration::to_json(r.set).dump(1) + "\n");
   if (a.json) {
-    nlohmann::json j = calibration::to_json(set);
+    nlohmann::json j = calibration::to_json(r.set);
     j["out"] = a.out;
     print_json(j);
     return;
   }
-  std::cout << "Calibration of all " << set.levels.size() << " levels, material " << materials.name
-            << ", terms " << a.terms
-            << " (errors: relative nodal displacement, nonlinear check at loads x "
-            << rq.check_load_scale << ")\n\n";
-  table.print(std::cout, false);
+  print_all_levels(std::cout, r, a.terms, rq.check_load_scale);
   std::cout << "\nwrote " << a.out << "\n";
 }
 
@@ -253,10 +182,9 @@ void run_calibrate(const CalibrateArgs& a) {
     opt.cell_size_mm = a.cell_size_mm;
     status("meshing " + a.level + " (cell size " + std::to_string(a.cell_size_mm).substr(0, 4) +
            " mm)");
-    const mesh::DiscDimensions dims = mesh::disc_dimensions(a.level, data_dir());
     m = mesh_disc_level(a.level, opt);  // as `mesh disc --level`
     if (!a.no_transfer && a.transfer_meshes.empty())
-      rq.transfer_meshes.push_back(coarser_mesh(dims, opt, status));
+      rq.transfer_meshes.push_back(coarser_level_mesh(a.level, opt, status));
   }
 
   // 3. Calibrate, report, write only a successful result.

@@ -113,133 +113,6 @@ mss::MssModel build_model(const mesh::TetMesh& m, const ModelChoice& c, const st
   return model;
 }
 
-/// The plate load of a run: a prescribed motion (pose mode) or a wrench, about `center`.
-struct PlateLoad {
-  bool is_wrench = false;
-  fem::Vector6d value = fem::Vector6d::Zero();  ///< (t mm, theta rad) or (F N, M N·mm), global
-  Eigen::Vector3d center = Eigen::Vector3d::Zero();
-
-  /// The boundary with the load scaled by `factor` (the ramp).
-  mss::Boundary boundary(double factor) const {
-    mss::Boundary b;
-    b.plate_center_mm = center;
-    if (is_wrench) {
-      b.plate_mode = mss::PlateMode::wrench;
-      b.wrench = factor * value;
-    } else {
-      b.superior = mss::plate_pose(factor * value, center);
-    }
-    return b;
-  }
-};
-
-/// The end state of a run and whether it failed (not converged / diverged).
-struct Outcome {
-  Eigen::VectorXd x_mm;
-  fem::Vector6d plate_motion = fem::Vector6d::Zero();  ///< (t mm, theta rad)
-  bool failed = false;
-  std::string failure;  ///< one line
-};
-
-/// Static equilibrium under the full load; fills the static JSON fields.
-Outcome solve_static_load(const mss::MssModel& model, const PlateLoad& load, Progress& progress,
-                          nlohmann::json& j) {
-  progress.begin("static equilibrium (Newton)");
-  const mss::StaticResult r = mss::solve_static(model, load.boundary(1.0));
-  progress.end(std::to_string(r.iterations) + " iterations");
-  j["reaction_wrench"] = to_json(Eigen::VectorXd(r.reaction_wrench));
-  j["converged"] = r.converged;
-  j["iterations"] = r.iterations;
-  j["residual_n"] = r.residual_n;
-  j["timings"]["solve_s"] = r.seconds;
-  Outcome o{r.x_mm, r.plate_motion};
-  o.failed = !r.converged || !r.x_mm.allFinite();
-  if (o.failed)
-    o.failure = "static solve did not converge after " + std::to_string(r.iterations) +
-                " iterations: " + one_line(r.message);
-  return o;
-}
-
-/// Steps in time: the load ramped over the first 10 % of the steps, then held; frames into
-/// `frames` (may be null) every `every` steps. Fills the dynamic JSON fields.
-Outcome step_in_time(const mss::MssModel& model, const PlateLoad& load, const MssArgs& a,
-                     mss::Integrator integrator, VtuSeries* frames, Progress& progress,
-                     nlohmann::json& j) {
-  mss::DynamicsOptions dopt;
-  dopt.integrator = integrator;
-  dopt.dt_s = a.dt_s;
-  dopt.newton_iterations = a.newton_iterations;
-  dopt.matrix_update = a.frozen ? mss::MatrixUpdate::frozen : mss::MatrixUpdate::every_iteration;
-  mss::Simulator sim(model, dopt);
-  mss::State s = sim.rest_state();
-  const int ramp = std::max(1, int(std::ceil(0.1 * a.steps)));
-  const int every = a.frame_every > 0 ? a.frame_every : std::max(1, a.steps / 100);
-  if (frames) frames->add(0.0, model, s.x_mm);
-
-  progress.begin(std::to_string(a.steps) + " steps of " + a.integrator + " Euler, dt " +
-                 std::to_string(a.dt_s) + " s");
-  StepStats stats;
-  for (int k = 1; k <= a.steps; ++k) {
-    if (!stats.step(sim, s, load.boundary(std::min(1.0, double(k) / ramp)))) break;
-    if (frames && (k % every == 0 || k == a.steps)) frames->add(s.time_s, model, s.x_mm);
-  }
-  j["timings"]["stepping_s"] = progress.end(std::to_string(stats.steps_done) + " steps");
-
-  Outcome o;
-  o.x_mm = s.x_mm;
-  const double applied =
-      std::min(1.0, double(stats.steps_done) / ramp);  // load factor of the last good step
-  o.plate_motion = load.is_wrench ? fem::Vector6d(s.plate_q) : fem::Vector6d(applied * load.value);
-  if (stats.diverged) {
-    const int k = stats.steps_done + 1;
-    std::ostringstream os;
-    os << "diverged at step " << k << " of " << a.steps << " (t = " << k * a.dt_s << " s, "
-       << a.integrator << " Euler, dt = " << a.dt_s << " s): " << stats.message;
-    if (integrator != mss::Integrator::implicit_euler) {
-      const double stable = sim.predicted_stable_dt_s(integrator);
-      if (std::isfinite(stable)) os << "; predicted stable dt < " << stable << " s";
-    }
-    o.failed = true;
-    o.failure = os.str();
-  }
-  j["integrator"] = a.integrator;
-  j["dt_s"] = a.dt_s;
-  j["steps"] = a.steps;
-  j["ramp_steps"] = ramp;
-  j["time_s"] = s.time_s;
-  j["matrix_update"] = a.frozen ? "frozen" : "every_iteration";
-  stats.add_to(j);
-  // About the moved plate centre, like StaticResult::reaction_wrench.
-  j["reaction_wrench"] = to_json(
-      Eigen::VectorXd(mss::plate_reaction(model, o.x_mm, load.center + o.plate_motion.head<3>())));
-  return o;
-}
-
-void print_summary(std::ostream& os, const MssArgs& a, const mss::MssModel& model,
-                   const std::string& material, const PlateLoad& load, const Outcome& o,
-                   const nlohmann::json& j) {
-  const mesh::TetMesh& m = model.mesh();
-  os << std::setprecision(5) << "MSS on " << a.mesh_path << " (" << m.num_vertices() << " nodes, "
-     << m.num_tets() << " tets), material " << material << ", "
-     << (a.params.empty() ? model_variant(a.model) : "tuned (" + a.params + ")") << "\n"
-     << "  springs       " << model.num_edge_springs() << " edge, " << model.num_radial_tets()
-     << " radial tets, " << model.num_angle_springs() << " angle, " << model.num_volume_terms()
-     << " volume\n"
-     << "  plate centre  " << load.center.transpose() << " mm\n";
-  if (a.dynamic)
-    os << "  dynamic       " << j["steps_done"] << " of " << a.steps << " steps, dt " << a.dt_s
-       << " s, mean step " << j["step_seconds_mean"].get<double>() * 1e3 << " ms\n";
-  else
-    os << "  static        " << (j["converged"].get<bool>() ? "converged" : "NOT converged")
-       << " in " << j["iterations"] << " Newton iterations\n";
-  const auto qd = motion_rad_to_deg(o.plate_motion);
-  os << "  plate motion  t = " << qd.head<3>().transpose()
-     << " mm, r = " << qd.tail<3>().transpose() << " deg\n"
-     << "  reaction      " << j["reaction_wrench"].dump() << " (N, N·mm)\n"
-     << "  volume        " << j["volume_mm3"].get<double>() << " mm^3, change "
-     << 100.0 * j["volume_change"].get<double>() << " %\n";
-}
-
 /// The stepping options of a dynamic run, checked; the integrator (implicit for a static run).
 mss::Integrator check_stepping(const MssArgs& a) {
   if (!a.dynamic) return mss::Integrator::implicit_euler;
@@ -274,7 +147,8 @@ void run_mss(const MssArgs& a) {
   if (loads > 1) throw std::invalid_argument("give at most one of --motion, --wrench and --case");
   if (a.static_run && a.dynamic)
     throw std::invalid_argument("give --static or --dt/--steps/--integrator, not both");
-  PlateLoad load;
+  MssRunRequest rq;
+  PlateLoad& load = rq.load;
   if (!a.motion.empty())
     load.value =
         motion_deg_to_rad(parse_numbers(a.motion, 6, "--motion tx,ty,tz,rx,ry,rz (mm, deg)"));
@@ -285,7 +159,15 @@ void run_mss(const MssArgs& a) {
   const fem::LoadCase* named = a.load_case.empty() ? nullptr : &fem::load_case(a.load_case);
   const Eigen::VectorXd center =
       a.center.empty() ? Eigen::VectorXd() : parse_numbers(a.center, 3, "--center x,y,z (mm)");
-  const mss::Integrator integrator = check_stepping(a);
+  rq.dynamic = a.dynamic;
+  rq.dynamics.integrator = check_stepping(a);
+  rq.dynamics.dt_s = a.dt_s;
+  rq.dynamics.newton_iterations = a.newton_iterations;
+  rq.dynamics.matrix_update =
+      a.frozen ? mss::MatrixUpdate::frozen : mss::MatrixUpdate::every_iteration;
+  rq.integrator_name = a.integrator;
+  rq.steps = a.steps;
+  rq.frame_every = a.frame_every;
   const ModelChoice choice =
       choose_model(a.model, a.params, a.material, a.material_option->count() > 0);
   const bool series = check_output(a);
@@ -307,46 +189,36 @@ void run_mss(const MssArgs& a) {
   const mss::MssModel model = build_model(m, choice, a.params, a.quiet || a.json);
   const double build_s = progress.end(std::to_string(model.num_edge_springs()) + " edge springs");
 
-  nlohmann::json j = {{"mesh", a.mesh_path},
-                      {"nodes", m.num_vertices()},
-                      {"tets", m.num_tets()},
-                      {"material", materials.name},
-                      {"plate_center", to_json(Eigen::VectorXd(load.center))},
-                      {"load", load.is_wrench ? "wrench" : "motion"},
-                      {"timings", {{"read_s", read_s}, {"build_s", build_s}}}};
+  // 3. Solve: static equilibrium, or steps in time (studies/mss_run.hpp).
+  std::unique_ptr<VtuSeries> frames = series ? std::make_unique<VtuSeries>(a.out) : nullptr;
+  const MssRunResult r = run_mss_load(model, rq, frames.get(), progress.hooks());
+  nlohmann::json j = mss_run_json(r);
+  j["timings"]["read_s"] = read_s;
+  j["timings"]["build_s"] = build_s;
+  j.update({{"mesh", a.mesh_path},
+            {"nodes", m.num_vertices()},
+            {"tets", m.num_tets()},
+            {"material", materials.name},
+            {"plate_center", to_json(Eigen::VectorXd(load.center))},
+            {"load", load.is_wrench ? "wrench" : "motion"},
+            {"mss_constants", choice.constants}});
   j.update(mss_model_json(model, materials));
-  j["mss_constants"] = choice.constants;
   if (!a.params.empty()) j["params"] = a.params;
   if (named) j["case"] = named->name;
-
-  // 3. Solve: static equilibrium, or steps in time.
-  std::unique_ptr<VtuSeries> frames = series ? std::make_unique<VtuSeries>(a.out) : nullptr;
-  const Outcome o = a.dynamic ? step_in_time(model, load, a, integrator, frames.get(), progress, j)
-                              : solve_static_load(model, load, progress, j);
-  j["reaction_wrench_units"] =
-      "Fx,Fy,Fz [N], Mx,My,Mz [N·mm] exerted by the disc on the plate, about the moved plate "
-      "centre";
-  j["plate_motion"] = to_json(Eigen::VectorXd(motion_rad_to_deg(o.plate_motion)));
-  j["plate_motion_units"] = "tx,ty,tz [mm], rx,ry,rz [deg]";
-  j["volume_mm3"] = model.volume_mm3(o.x_mm);
-  j["rest_volume_mm3"] = model.rest_volume_mm3();
-  j["volume_change"] = mss::volume_change(model, o.x_mm);
-  j["max_displacement_mm"] = mss::max_displacement_mm(model, o.x_mm);
-  j["inverted_tets"] = model.inverted_tets(o.x_mm);
-  if (!o.failed && j["inverted_tets"].get<Eigen::Index>() > 0)
-    std::cerr << "spinesim: warning: " << j["inverted_tets"].get<Eigen::Index>()
+  if (!r.failed && r.inverted_tets > 0)
+    std::cerr << "spinesim: warning: " << r.inverted_tets
               << " tetrahedra are inside out at the result: the load is beyond what the spring "
                  "network holds (try --volume-term or --disc-volume-term)\n";
 
   // 4. Output files, only for a run that succeeded: no NaN, no half series.
-  if (o.failed && frames) frames->discard();
-  if (!o.failed && !a.out.empty()) {
+  if (r.failed && frames) frames->discard();
+  if (!r.failed && !a.out.empty()) {
     progress.begin("writing " + a.out);
     if (frames) {
       frames->finish();
       j["frames"] = frames->num_frames();
     } else {
-      const mss::StateFields f = mss::state_fields(model, o.x_mm);
+      const mss::StateFields f = mss::state_fields(model, r.x_mm);
       mesh::write_vtu(a.out, m, f.point, f.cell);
     }
     progress.end();
@@ -357,8 +229,9 @@ void run_mss(const MssArgs& a) {
   if (a.json)
     print_json(j);
   else
-    print_summary(std::cout, a, model, materials.name, load, o, j);
-  if (o.failed) throw std::runtime_error(one_line(o.failure));
+    print_mss_run(std::cout, model, a.mesh_path, materials.name,
+                  a.params.empty() ? model_variant(a.model) : "tuned (" + a.params + ")", r);
+  if (r.failed) throw std::runtime_error(one_line(r.failure));
 }
 
 // --- mss compare -------------------------------------------------------------------------------

@@ -29,6 +29,7 @@
 #include "cli_common.hpp"
 
 #include "spinesim/studies/disc_level.hpp"
+#include "spinesim/studies/drive_study.hpp"
 #include "spinesim/studies/probe_study.hpp"
 
 #include "spinesim/mss/quantities.hpp"
@@ -133,20 +134,6 @@ mesh::TetMesh study_mesh(const StudyCommon& c, Progress& progress) {
   return m;
 }
 
-nlohmann::json mesh_json(const mesh::TetMesh& m) { return study_mesh_json(m); }
-
-double max_displacement(const mss::MssModel& model, const Eigen::VectorXd& x) {
-  return mss::max_displacement_mm(model, x);
-}
-
-/// A file-name-safe version of a material name.
-std::string file_stem(const std::string& name) {
-  std::string s = name;
-  for (char& ch : s)
-    if (!std::isalnum(static_cast<unsigned char>(ch)) && ch != '-' && ch != '_') ch = '_';
-  return s.empty() ? "material" : s;
-}
-
 // --- study probe -------------------------------------------------------------------------------
 
 struct ProbeArgs {
@@ -195,198 +182,32 @@ void run_probe(ProbeArgs a) {
 
 // --- study drive -------------------------------------------------------------------------------
 
-/// Superior-plate motion keyframes in the disc frame: axial translation (mm, negative =
-/// compression) and flexion rotation about the lateral axis (deg); linear in between.
-struct Keyframe {
-  double time_s, axial_mm, flexion_deg;
-};
-
-std::vector<Keyframe> drive_schedule(double compression_mm, double flexion_deg, double time_scale) {
-  const double c = -compression_mm, f = flexion_deg;
-  std::vector<Keyframe> keys = {{0.0, 0, 0}, {0.2, c, 0}, {0.3, c, 0}, {0.5, c, f}, {0.6, c, f},
-                                {0.8, c, 0}, {0.9, c, 0}, {1.1, 0, 0}, {1.2, 0, 0}};
-  for (auto& k : keys) k.time_s *= time_scale;
-  return keys;
-}
-
-/// The plate motion (t mm, theta rad) in the disc frame at time t.
-fem::Vector6d schedule_motion(const std::vector<Keyframe>& keys, double t) {
-  std::size_t i = 1;
-  while (i + 1 < keys.size() && keys[i].time_s < t) ++i;
-  const Keyframe &k0 = keys[i - 1], &k1 = keys[i];
-  const double w = std::clamp((t - k0.time_s) / (k1.time_s - k0.time_s), 0.0, 1.0);
-  fem::Vector6d q = fem::Vector6d::Zero();
-  q(1) = k0.axial_mm + w * (k1.axial_mm - k0.axial_mm);
-  q(3) = (k0.flexion_deg + w * (k1.flexion_deg - k0.flexion_deg)) * M_PI / 180.0;
-  return q;
-}
-
-/// Rotates a 6-vector of two 3-vectors by `axes` (local -> global) or its transpose.
-fem::Vector6d rotate6(const Eigen::Matrix3d& r, const fem::Vector6d& v) {
-  fem::Vector6d out;
-  out << r * v.head<3>(), r * v.tail<3>();
-  return out;
-}
-
 struct DriveArgs {
   StudyCommon common;
   std::string materials = "real-disc,annulus-nucleus,rubber,polyethylene";
   double compression_mm = 0.5, flexion_deg = 3.0, time_scale = 1.0;
 };
 
-struct DriveResult {
-  nlohmann::json json;
-  double peak_force_n = 0, peak_axial_n = 0, peak_moment_nmm = 0;
-  Range dv;
-  StepStats stats;
-};
-
-/// One material through the schedule; writes drive-<name>.pvd, its frames and drive-<name>.csv.
-DriveResult drive_one(const mesh::TetMesh& m, const mesh::RegionMaterials& materials,
-                      const StudyCommon& c, const mss::DynamicsOptions& dyn,
-                      const std::vector<Keyframe>& keys) {
-  const mss::MssModel model(m, materials, model_options(c.model));
-  const Eigen::Vector3d center = fem::DiscFem::default_plate_center(m);
-  const Eigen::Matrix3d& axes = m.frame.axes;
-  const std::string stem = "drive-" + file_stem(materials.name);
-  const int steps = int(std::ceil(keys.back().time_s / c.dt_s - 1e-6));
-
-  mss::Simulator sim(model, dyn);
-  mss::State s = sim.rest_state();
-  VtuSeries frames((fs::path(c.out) / (stem + ".pvd")).string());
-  frames.add(0.0, model, s.x_mm);
-  std::ostringstream csv;
-  csv << std::setprecision(10)
-      << "time_s,tx_mm,ty_mm,tz_mm,rx_deg,ry_deg,rz_deg,Fx_n,Fy_n,Fz_n,Mx_nmm,My_nmm,Mz_nmm,volume_"
-         "mm3,volume_change,"
-         "max_displacement_mm\n";
-  DriveResult r;
-  for (int k = 1; k <= steps; ++k) {
-    const fem::Vector6d q_local = schedule_motion(keys, k * c.dt_s);
-    const fem::Vector6d q = rotate6(axes, q_local);
-    mss::Boundary bc;  // inferior (L3) fixed
-    bc.superior = mss::plate_pose(q, center);
-    bc.plate_center_mm = center;
-    if (!r.stats.step(sim, s, bc)) break;
-    const fem::Vector6d w =
-        rotate6(axes.transpose(), mss::plate_reaction(model, s.x_mm, center + q.head<3>()));
-    const double dv = mss::volume_change(model, s.x_mm);
-    r.peak_force_n = std::max(r.peak_force_n, w.head<3>().norm());
-    r.peak_axial_n = std::max(r.peak_axial_n, w(1));
-    r.peak_moment_nmm = std::max(r.peak_moment_nmm, w.tail<3>().norm());
-    r.dv.add(dv);
-    const fem::Vector6d qd = motion_rad_to_deg(q_local);
-    csv << s.time_s;
-    for (int i = 0; i < 6; ++i) csv << "," << qd(i);
-    for (int i = 0; i < 6; ++i) csv << "," << w(i);
-    csv << "," << model.volume_mm3(s.x_mm) << "," << dv << "," << max_displacement(model, s.x_mm)
-        << "\n";
-    if (k % c.frame_every == 0 || k == steps) frames.add(s.time_s, model, s.x_mm);
-  }
-  frames.finish();
-  const std::string csv_path = (fs::path(c.out) / (stem + ".csv")).string();
-  write_text_file(csv_path, csv.str());
-  r.json = {{"material", materials.name},
-            {"E_mpa_annulus", materials.at(int(mesh::Region::annulus)).youngs_modulus_mpa},
-            {"E_mpa_nucleus", materials.at(int(mesh::Region::nucleus)).youngs_modulus_mpa},
-            {"peak_force_n", r.peak_force_n},
-            {"peak_axial_force_n", r.peak_axial_n},
-            {"peak_moment_nmm", r.peak_moment_nmm},
-            {"max_volume_change", std::isfinite(r.dv.lo) ? r.dv.extreme() : 0.0},
-            {"K_d_n_s_per_mm", model.damping_n_s_per_mm()},
-            {"steps", steps},
-            {"files", {{"pvd", frames.pvd_path()}, {"csv", csv_path}}},
-            {"frames", frames.num_frames()}};
-  r.stats.add_to(r.json);
-  return r;
-}
-
 void run_drive(DriveArgs a) {
   // 1. Options, checked before any work.
   StudyCommon& c = a.common;
-  const mss::DynamicsOptions dyn = check_common(c);
-  if (!std::isfinite(a.compression_mm) || !std::isfinite(a.flexion_deg))
-    throw std::invalid_argument("--compression and --flexion must be finite numbers");
-  if (!std::isfinite(a.time_scale) || a.time_scale <= 0)
-    throw std::invalid_argument("--time-scale must be finite and > 0");
-  std::vector<mesh::RegionMaterials> materials;
+  DriveStudyRequest rq;
+  rq.stepping = stepping(c, check_common(c));
+  rq.compression_mm = a.compression_mm, rq.flexion_deg = a.flexion_deg;
+  rq.time_scale = a.time_scale;
   for (const auto& name : split_list(a.materials))
-    materials.push_back(mesh::load_material(name, data_dir()));
-  if (materials.empty()) throw std::invalid_argument("--materials: give at least one material");
-  const auto keys = drive_schedule(a.compression_mm, a.flexion_deg, a.time_scale);
-  fs::create_directories(c.out);
+    rq.materials.push_back(mesh::load_material(name, data_dir()));
+  check(rq);
 
-  // 2. Disc.
-  Progress progress(1 + int(materials.size()), c.quiet || c.json);
+  // 2. Disc, then one run per material (studies/drive_study.hpp).
+  Progress progress(1 + int(rq.materials.size()), c.quiet || c.json);
   const mesh::TetMesh m = study_mesh(c, progress);
-  if (!c.json) {
-    std::cout << "Drive study (thesis 5.3, test 2) on " << m.source << " (" << m.num_tets()
-              << " tets): inferior endplate (L3) fixed, superior (L2) driven, disc frame (x "
-                 "lateral, y axial, z "
-                 "anterior), "
-              << model_variant(c.model) << " MSS, " << c.integrator << " Euler dt " << c.dt_s
-              << " s\n"
-              << "  schedule (linear in between):\n";
-    TextTable t({"time (s)", "axial (mm)", "flexion (deg)"}, 0);
-    for (const auto& k : keys)
-      t.add({significant(k.time_s, 6), significant(k.axial_mm, 6), significant(k.flexion_deg, 6)});
-    t.print(std::cout, false, "    ");
-  }
-
-  // 3. One run per material.
-  nlohmann::json runs = nlohmann::json::array();
-  std::vector<DriveResult> results;
-  for (const auto& mat : materials) {
-    progress.begin("material " + mat.name);
-    results.push_back(drive_one(m, mat, c, dyn, keys));
-    progress.end(std::to_string(results.back().stats.steps_done) + " steps");
-    runs.push_back(results.back().json);
-  }
-
-  // 4. Summary.
-  nlohmann::json schedule = nlohmann::json::array();
-  for (const auto& k : keys)
-    schedule.push_back(
-        {{"time_s", k.time_s}, {"axial_mm", k.axial_mm}, {"flexion_deg", k.flexion_deg}});
-  std::string diverged;
-  for (const auto& r : results)
-    if (r.stats.diverged)
-      diverged += (diverged.empty() ? "" : ", ") + r.json["material"].get<std::string>();
-  const std::string json_path = (fs::path(c.out) / "drive.json").string();
-  nlohmann::json j = {
-      {"study", "drive"},
-      {"thesis", "5.3 test 2, fig. 5.9"},
-      {"mesh", mesh_json(m)},
-      {"model_variant", model_variant(c.model)},
-      {"integrator", c.integrator},
-      {"dt_s", c.dt_s},
-      {"frame", "disc (x lateral, y axial, z anterior); reaction about the moved plate centre"},
-      {"schedule", schedule},
-      {"materials", runs},
-      {"diverged", !diverged.empty()},
-      {"json", json_path}};
-  write_text_file(json_path, j.dump(2) + "\n");
-  if (c.json) {
-    print_json(j);
-  } else {
-    TextTable t({"material", "E (MPa)", "peak |F| (N)", "peak Fy (N)", "peak |M| (N·mm)",
-                 "max dV/V0", "step (ms)", ""});
-    for (const auto& r : results) {
-      std::ostringstream e;  // "4.2/1" when annulus and nucleus differ
-      const double ea = r.json["E_mpa_annulus"].get<double>(),
-                   en = r.json["E_mpa_nucleus"].get<double>();
-      e << ea;
-      if (en != ea) e << "/" << en;
-      t.add({r.json["material"].get<std::string>(), e.str(), significant(r.peak_force_n, 5),
-             significant(r.peak_axial_n, 5), significant(r.peak_moment_nmm, 5),
-             significant(100 * r.json["max_volume_change"].get<double>(), 5) + "%",
-             significant(r.stats.mean_seconds() * 1e3, 5), r.stats.diverged ? "DIVERGED" : ""});
-    }
-    std::cout << "\n";
-    t.print(std::cout, false);
-    std::cout << "  wrote " << json_path << " and drive-<material>.{pvd,csv} in " << c.out << "\n";
-  }
-  if (!diverged.empty()) throw std::runtime_error("drive study diverged for: " + diverged);
+  const DriveStudyResult r = run_drive_study(m, rq, progress.hooks());
+  if (c.json)
+    print_json(r.summary);
+  else
+    print_drive_study(std::cout, m, r);
+  if (!r.diverged().empty()) throw std::runtime_error("drive study diverged for: " + r.diverged());
 }
 
 // --- study materials ---------------------------------------------------------------------------
@@ -422,71 +243,28 @@ void run_materials(const MaterialsArgs& a) {
   if (!a.csv.empty()) require_writable(a.csv, "--csv");
   const Timer t_start;
 
-  // 2. One mesh for every material.
+  // 2. One mesh for every material, then the study (studies/materials_study.hpp).
   Progress progress(1 + kStagesPerMaterial * int(materials.size()), a.quiet || a.json);
   StudyCommon c;
   c.level = a.level;
   c.cell_size_mm = a.cell_size_mm;
   const mesh::TetMesh m = study_mesh(c, progress);
-  if (!a.json) {
-    std::cout << "Material study (thesis fig. 5.9) on " << m.source << ": " << m.num_vertices()
-              << " nodes, " << m.num_tets() << " tets, cell size " << a.cell_size_mm << " mm\n"
-              << "  load: compression, F_y = -500 N on the superior plate (disc frame), inferior "
-                 "endplate fixed\n"
-              << "  FEM P" << options.fem_order
-              << ", linear | untuned MSS: thesis network, Van Gelder constants"
-              << " | tuned MSS: " << term_set_name(options.terms)
-              << " scales calibrated to the FEM | MSS: nonlinear static\n";
-    for (const auto& mat : materials)
-      std::cout << "  " << mat.name << ": " << describe_material(mat) << "\n";
-    std::cout << "\n";
-  }
+  if (!a.json) print_materials_header(std::cout, m, a.cell_size_mm, options, materials);
+  MaterialsStudy study = run_materials_study(m, materials, options, progress.hooks());
+  study.level = a.level;
+  study.cell_size_mm = a.cell_size_mm;
 
-  // 3. Per material: FEM, calibration, untuned and tuned MSS.
-  StageHooks hooks;
-  hooks.begin = [&](const std::string& what) { progress.begin(what); };
-  hooks.end = [&](const std::string& detail) { progress.end(detail); };
-  std::vector<MaterialResult> results;
-  for (const auto& mat : materials) results.push_back(study_material(m, mat, options, hooks));
-
-  // 4. Tables, CSV, summary.
-  if (!a.csv.empty()) write_text_file(a.csv, materials_csv(results));
-  std::string failed;
-  for (const auto& r : results)
-    if (!r.calibrated) failed += (failed.empty() ? "" : ", ") + r.material;
-  const fem::Vector6d w = fem::load_case("compression").wrench_local;
-  const nlohmann::json j = {
-      {"study", "materials"},
-      {"thesis", "5.3 test 2, fig. 5.9"},
-      {"level", a.level},
-      {"cell_size_mm", a.cell_size_mm},
-      {"mesh", mesh_json(m)},
-      {"fem_order", options.fem_order},
-      {"untuned",
-       "thesis network (main + radial + torsion springs), Van Gelder constants, scales 1"},
-      {"tuned_terms", term_set_name(options.terms)},
-      {"load", {{"case", "compression"}, {"wrench_local", to_json(Eigen::VectorXd(w))}}},
-      {"units",
-       {{"frame", "disc (x lateral, y axial, z anterior)"},
-        {"wrench_local", "Fx,Fy,Fz [N], Mx,My,Mz [N·mm]"},
-        {"stiffness_diagonal", "tx,ty,tz [N/mm], rx,ry,rz [N·mm/deg], linear at rest"},
-        {"plate_axial_displacement_mm",
-         "superior plate u_y under the load, mm, negative towards the inferior endplate"},
-        {"max_displacement_mm", "largest vertex displacement under the load, mm"},
-        {"volume_change",
-         "(V - V0)/V0 under the load; FEM: P1 volume of the mesh with displaced vertices"},
-        {"displacement_error", "|u_MSS - u_FEM|_F / |u_FEM|_F over the vertices, under the load"}}},
-      {"materials", materials_json(results)},
-      {"csv", a.csv.empty() ? nlohmann::json(nullptr) : nlohmann::json(a.csv)},
-      {"seconds", t_start.seconds()}};
+  // 3. Tables, CSV, summary.
+  if (!a.csv.empty()) write_text_file(a.csv, materials_csv(study.results));
   if (a.json) {
-    print_json(j);
+    print_json(materials_study_json(m, study, a.csv));
   } else {
-    print_materials(std::cout, results, options.fem_order, false);
+    print_materials(std::cout, study.results, options.fem_order, false);
     std::cout << "Total " << std::setprecision(3) << t_start.seconds() << " s"
               << (a.csv.empty() ? "" : "; wrote " + a.csv) << "\n";
   }
-  if (!failed.empty()) throw std::runtime_error("calibration failed for: " + failed);
+  if (!study.failed().empty())
+    throw std::runtime_error("calibration failed for: " + study.failed());
 }
 
 // --- registration ------------------------------------------------------------------------------

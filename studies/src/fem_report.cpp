@@ -1,10 +1,14 @@
 #include "spinesim/studies/fem_report.hpp"
 
+#include "spinesim/common/timer.hpp"
+
 #include "spinesim/studies/format.hpp"
+#include "spinesim/studies/json.hpp"
 #include "spinesim/studies/table.hpp"
 
 #include <cmath>
 #include <iomanip>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -43,6 +47,82 @@ void print_stiffness(std::ostream& os, const fem::Matrix6d& k_rad) {
     t.add(row);
   }
   t.print(os, false);
+}
+
+FemRunResult run_fem_reference(const mesh::TetMesh& m, const mesh::RegionMaterials& materials,
+                               const FemRunRequest& request, const StageHooks& hooks) {
+  const FemRunRequest& rq = request;
+  if (int(rq.motion.has_value()) + int(rq.wrench.has_value()) + int(rq.load_case != nullptr) > 1)
+    throw std::invalid_argument("give at most one of --motion, --wrench and --case");
+  FemRunResult r;
+  r.request = rq;
+  r.material = materials.name;
+  r.nodes = m.num_vertices();
+  r.tets = m.num_tets();
+  r.center = rq.center ? *rq.center : fem::DiscFem::default_plate_center(m);
+
+  hooks.begin_stage("assembling and factorising (P" + std::to_string(rq.order) + ")");
+  fem::DiscFem solver(m, materials, rq.order, r.center);
+  r.stiffness = solver.stiffness_6x6();
+  r.fem_nodes = solver.num_nodes();
+  r.dofs = solver.num_dofs();
+  hooks.end_stage(std::to_string(r.dofs) + " DOF");
+
+  hooks.begin_stage("solving");
+  const Timer timer;
+  if (rq.load_case || rq.wrench) {
+    r.applied_wrench = rq.load_case ? fem::global_wrench(*rq.load_case, m.frame) : *rq.wrench;
+    r.solution = solver.solve_wrench(r.applied_wrench);
+  } else {
+    r.solution = solver.solve_motion(rq.motion ? *rq.motion : fem::Vector6d::Zero());
+  }
+  r.load_solve_s = timer.seconds();
+  hooks.end_stage();
+  r.timings = solver.timings();
+  return r;
+}
+
+nlohmann::json fem_run_json(const FemRunResult& r, const std::string& mesh_label) {
+  const auto& t = r.timings;
+  const auto& sol = r.solution;
+  nlohmann::json j = {
+      {"mesh", mesh_label},
+      {"nodes", r.nodes},
+      {"tets", r.tets},
+      {"order", r.request.order},
+      {"fem_nodes", r.fem_nodes},
+      {"dofs", r.dofs},
+      {"material", r.material},
+      {"plate_center", to_json(Eigen::VectorXd(r.center))},
+      {"plate_motion", to_json(Eigen::VectorXd(motion_rad_to_deg(sol.plate_motion)))},
+      {"plate_motion_units", "tx,ty,tz [mm], rx,ry,rz [deg]"},
+      {"reaction_wrench", to_json(Eigen::VectorXd(sol.reaction_wrench))},
+      {"reaction_wrench_units", "Fx,Fy,Fz [N], Mx,My,Mz [N·mm] exerted by the disc on the plate"},
+      {"stiffness_6x6", to_json(Eigen::MatrixXd(stiffness_per_degree(r.stiffness)))},
+      {"stiffness_6x6_units", kStiffnessUnits},
+      {"max_displacement_mm", sol.displacement_mm.rowwise().norm().maxCoeff()},
+      {"timings",
+       {{"setup_s", t.setup_s},
+        {"assembly_s", t.assembly_s},
+        {"analyse_s", t.analyse_s},
+        {"factorise_s", t.factorise_s},
+        {"stiffness_solve_s", t.solve_s},
+        {"load_solve_s", r.load_solve_s}}}};
+  if (r.request.load_case) j["case"] = r.request.load_case->name;
+  return j;
+}
+
+void print_fem_run(std::ostream& os, const FemRunResult& r, const std::string& mesh_label) {
+  const auto q = motion_rad_to_deg(r.solution.plate_motion);
+  const auto& w = r.solution.reaction_wrench;
+  os << std::setprecision(5) << "FEM P" << r.request.order << " on " << mesh_label << " (" << r.tets
+     << " tets, " << r.dofs << " DOF), material " << r.material << "\n"
+     << "  plate centre  " << r.center.transpose() << " mm\n"
+     << "  plate motion  t = " << q.head<3>().transpose() << " mm, r = " << q.tail<3>().transpose()
+     << " deg\n"
+     << "  reaction      F = " << w.head<3>().transpose() << " N, M = " << w.tail<3>().transpose()
+     << " N·mm\n";
+  print_stiffness(os, r.stiffness);
 }
 
 }  // namespace spinesim::studies

@@ -5,6 +5,7 @@
 #include "spinesim/studies/fem_report.hpp"
 #include "spinesim/studies/json.hpp"
 #include "spinesim/studies/mss_run.hpp"
+#include "spinesim/studies/stepped_study.hpp"
 
 #include "spinesim/fem/load_cases.hpp"
 #include "spinesim/mss/model.hpp"
@@ -349,6 +350,71 @@ nlohmann::json materials_json(const std::vector<MaterialResult>& results) {
                      {"calibration_s", r.calibration_seconds},
                      {"mss_static_s", r.mss_seconds}}}});
   return out;
+}
+
+std::string MaterialsStudy::failed() const {
+  std::string list;
+  for (const auto& r : results)
+    if (!r.calibrated) list += (list.empty() ? "" : ", ") + r.material;
+  return list;
+}
+
+MaterialsStudy run_materials_study(const mesh::TetMesh& mesh,
+                                   const std::vector<mesh::RegionMaterials>& materials,
+                                   const MaterialsStudyOptions& options, const StageHooks& hooks) {
+  if (materials.empty()) throw std::invalid_argument("--materials: give at least one material");
+  const Timer timer;
+  MaterialsStudy study;
+  study.options = options;
+  for (const auto& mat : materials)
+    study.results.push_back(study_material(mesh, mat, options, hooks));
+  study.seconds = timer.seconds();
+  return study;
+}
+
+void print_materials_header(std::ostream& os, const mesh::TetMesh& m, double cell_size_mm,
+                            const MaterialsStudyOptions& options,
+                            const std::vector<mesh::RegionMaterials>& materials) {
+  os << "Material study (thesis fig. 5.9) on " << m.source << ": " << m.num_vertices() << " nodes, "
+     << m.num_tets() << " tets, cell size " << cell_size_mm << " mm\n"
+     << "  load: compression, F_y = -500 N on the superior plate (disc frame), inferior "
+        "endplate fixed\n"
+     << "  FEM P" << options.fem_order
+     << ", linear | untuned MSS: thesis network, Van Gelder constants"
+     << " | tuned MSS: " << term_set_name(options.terms)
+     << " scales calibrated to the FEM | MSS: nonlinear static\n";
+  for (const auto& mat : materials)
+    os << "  " << mat.name << ": " << describe_material(mat) << "\n";
+  os << "\n";
+}
+
+nlohmann::json materials_study_json(const mesh::TetMesh& m, const MaterialsStudy& study,
+                                    const std::string& csv) {
+  const fem::Vector6d w = fem::load_case("compression").wrench_local;
+  return {
+      {"study", "materials"},
+      {"thesis", "5.3 test 2, fig. 5.9"},
+      {"level", study.level},
+      {"cell_size_mm", study.cell_size_mm},
+      {"mesh", study_mesh_json(m)},
+      {"fem_order", study.options.fem_order},
+      {"untuned",
+       "thesis network (main + radial + torsion springs), Van Gelder constants, scales 1"},
+      {"tuned_terms", term_set_name(study.options.terms)},
+      {"load", {{"case", "compression"}, {"wrench_local", to_json(Eigen::VectorXd(w))}}},
+      {"units",
+       {{"frame", "disc (x lateral, y axial, z anterior)"},
+        {"wrench_local", "Fx,Fy,Fz [N], Mx,My,Mz [N·mm]"},
+        {"stiffness_diagonal", "tx,ty,tz [N/mm], rx,ry,rz [N·mm/deg], linear at rest"},
+        {"plate_axial_displacement_mm",
+         "superior plate u_y under the load, mm, negative towards the inferior endplate"},
+        {"max_displacement_mm", "largest vertex displacement under the load, mm"},
+        {"volume_change",
+         "(V - V0)/V0 under the load; FEM: P1 volume of the mesh with displaced vertices"},
+        {"displacement_error", "|u_MSS - u_FEM|_F / |u_FEM|_F over the vertices, under the load"}}},
+      {"materials", materials_json(study.results)},
+      {"csv", csv.empty() ? nlohmann::json(nullptr) : nlohmann::json(csv)},
+      {"seconds", study.seconds}};
 }
 
 }  // namespace spinesim::studies

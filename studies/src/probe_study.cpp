@@ -121,14 +121,8 @@ bool known_site(const std::string& name) {
 
 }  // namespace
 
-nlohmann::json study_mesh_json(const mesh::TetMesh& m) {
-  return {{"source", m.source},
-          {"nodes", m.num_vertices()},
-          {"tets", m.num_tets()},
-          {"volume_mm3", mesh::mesh_volume(m)}};
-}
-
 void check(const ProbeStudyRequest& rq) {
+  check(rq.stepping);
   for (double v : {rq.radius_mm, rq.depth_mm, rq.speed_mm_s})
     if (!std::isfinite(v) || v <= 0)
       throw std::invalid_argument("--radius, --depth and --speed must be finite and > 0");
@@ -176,7 +170,7 @@ nlohmann::json probe_summary(const mesh::TetMesh& m, const mesh::RegionMaterials
           {"dt_s", o.dynamics.dt_s},
           {"steps", r.steps},
           {"max_force_n", r.max_force_n},
-          {"max_volume_change", std::isfinite(dv.lo) ? dv.extreme() : 0.0},
+          {"max_volume_change", dv.extreme_or_zero()},
           {"volume_change_range",
            {std::isfinite(dv.lo) ? dv.lo : 0.0, std::isfinite(dv.hi) ? dv.hi : 0.0}},
           {"max_displacement_mm", r.max_displacement_mm},
@@ -205,15 +199,10 @@ ProbeStudyResult run_probe_study(const mesh::TetMesh& m, const mesh::RegionMater
       int(std::ceil(plan.total_s() / o.dynamics.dt_s - 1e-6));  // round-off must not add a step
 
   // 2. Step: both endplates fixed (identity poses), the probe moving.
-  mss::Simulator sim(model, o.dynamics);
-  mss::State s = sim.rest_state();
-  VtuSeries frames((fs::path(o.out) / "probe.pvd").string());
-  frames.add(0.0, model, s.x_mm);
-  std::ostringstream csv;
-  csv << std::setprecision(10)
-      << "time_s,site,probe_active,probe_x_mm,probe_y_mm,probe_z_mm,depth_mm,force_x_n,force_y_n,"
-         "force_z_n,force_n,"
-         "volume_mm3,volume_change,max_displacement_mm\n";
+  SteppedRun run(model, o, "probe",
+                 "time_s,site,probe_active,probe_x_mm,probe_y_mm,probe_z_mm,depth_mm,force_x_n,"
+                 "force_y_n,force_z_n,force_n,volume_mm3,volume_change,max_displacement_mm",
+                 r.steps);
   hooks.begin_stage(std::to_string(r.steps) + " steps (" + o.integrator_name + " Euler, dt " +
                     std::to_string(o.dynamics.dt_s) + " s)");
   // The default penalty costs a rest-Hessian evaluation: resolve it once, not per step.
@@ -227,29 +216,30 @@ ProbeStudyResult run_probe_study(const mesh::TetMesh& m, const mesh::RegionMater
     const Eigen::Vector3d center = site.point_mm + (rq.radius_mm - cmd.depth_mm) * site.normal;
     mss::Boundary bc;
     if (cmd.active) bc.probes.push_back({center, rq.radius_mm, k_probe});
-    if (!r.stats.step(sim, s, bc)) break;
+    if (!run.step(k, bc)) break;
+    const mss::State& s = run.state();
     const Eigen::Vector3d f =
         cmd.active ? mss::probe_forces(model, bc, s.x_mm).front() : Eigen::Vector3d::Zero();
     const double v = model.volume_mm3(s.x_mm), u = mss::max_displacement_mm(model, s.x_mm);
-    r.volume_change.add(mss::volume_change(model, s.x_mm));
+    const double dv = mss::volume_change(model, s.x_mm);
+    r.volume_change.add(dv);
     r.max_force_n = std::max(r.max_force_n, f.norm());
     r.max_displacement_mm = std::max(r.max_displacement_mm, u);
-    csv << s.time_s << "," << site.name << "," << int(cmd.active) << "," << center.x() << ","
-        << center.y() << "," << center.z() << "," << cmd.depth_mm << "," << f.x() << "," << f.y()
-        << "," << f.z() << "," << f.norm() << "," << v << "," << mss::volume_change(model, s.x_mm)
-        << "," << u << "\n";
-    if (k % o.frame_every == 0 || k == r.steps) frames.add(s.time_s, model, s.x_mm);
+    run.csv() << s.time_s << "," << site.name << "," << int(cmd.active) << "," << center.x() << ","
+              << center.y() << "," << center.z() << "," << cmd.depth_mm << "," << f.x() << ","
+              << f.y() << "," << f.z() << "," << f.norm() << "," << v << "," << dv << "," << u
+              << "\n";
   }
+  r.stats = run.stats();
   hooks.end_stage(std::to_string(r.stats.steps_done) + " steps");
 
   // 3. Files and summary.
   hooks.begin_stage("writing " + o.out);
-  frames.finish();
-  r.pvd_path = frames.pvd_path();
-  r.frames = frames.num_frames();
-  r.csv_path = (fs::path(o.out) / "probe.csv").string();
+  run.finish();
+  r.pvd_path = run.pvd_path();
+  r.frames = run.num_frames();
+  r.csv_path = run.csv_path();
   r.json_path = (fs::path(o.out) / "probe.json").string();
-  write_text_file(r.csv_path, csv.str());
   r.summary = probe_summary(m, materials, model, r);
   r.stats.add_to(r.summary);
   write_text_file(r.json_path, r.summary.dump(2) + "\n");

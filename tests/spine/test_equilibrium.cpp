@@ -313,3 +313,57 @@ TEST(SpineEquilibrium, LateralAndTorsionJointSpringsMatchTableF4) {
       EXPECT_NEAR(s.theta[3 * c.joint + axis], 100.0 / k_rad, 2e-3 * 100.0 / k_rad);
     }
 }
+
+// The IAP bushing's stiffness where it enters the energy, against appendix C recomputed from its
+// inputs (iap_from_appendix_c, N/mm and N·mm/deg): the bushing acts on T6 in parallel with the
+// joint chain, so with C the chain's compliance at the bushing point (three solves of the spine
+// without it), the spine with it must answer a wrench w by (C⁻¹ + K_b)⁻¹ w. Antisymmetric loads
+// (lateral force, torsion and lateral-bending couples) keep the symmetric chain out of its
+// flexion/extension springs, whose stiffness differs by sign. A ×2 in K_b or a deg/rad slip fails.
+TEST(SpineEquilibrium, IapBushingStiffnessMatchesAppendixC) {
+  sp::ModelOptions with;
+  with.gravity = with.ligaments = with.muscles = false;
+  const sp::SpineModel m_iap = sp::load_spine_model(SPINESIM_DATA_DIR, with);
+  const sp::SpineModel m_bare = bare();
+  ASSERT_TRUE(m_iap.has_bushing);
+  const sp::Bushing& b = m_iap.bushing;
+  const sp::IapStiffness iap =
+      sp::iap_from_appendix_c(std::string(SPINESIM_DATA_DIR) + "/thesis/appendix_c_iap.json");
+  const double per_rad = 180 / M_PI;
+  // (tx, ry, rz) block of K_b: lateral translation, torsion, lateral bending.
+  const Eigen::Vector3d k_b(iap.bushing_k_xz, iap.bushing_m_y_per_deg * per_rad,
+                            iap.bushing_m_xz_per_deg * per_rad);
+  ASSERT_GT(k_b.minCoeff(), 0);
+  const Vector3d c6 = m_iap.vertebrae[std::size_t(b.body)].centre_mm;
+  // Response (tx at the bushing point mm, ry, rz rad) to a wrench (Fx N at the point, My, Mz N·mm).
+  const auto response = [&](const sp::SpineModel& m, const Vector3d& w) {
+    sp::ExternalLoad l;
+    l.vertebra = b.body;
+    l.force_n = Vector3d(w(0), 0, 0);
+    l.has_point = true;
+    l.point_mm = b.point_mm;
+    l.moment_nmm = Vector3d(0, w(1), w(2));
+    sp::SolveOptions tight;
+    tight.tolerance = 1e-9;
+    const sp::SpineSolution s = sp::solve_spine(m, {l}, tight);
+    const Vector3d t = s.displacement.row(b.body).head<3>().transpose();
+    const Vector3d phi = s.displacement.row(b.body).tail<3>().transpose() / per_rad;
+    const Vector3d u = t + phi.cross(b.point_mm - c6);
+    return Vector3d(u.x(), phi.y(), phi.z());
+  };
+  const Vector3d scale(1.0, 100.0, 100.0);  // N, N·mm: far inside the linear range
+  Eigen::Matrix3d compliance;
+  for (int k = 0; k < 3; ++k)
+    compliance.col(k) = response(m_bare, scale(k) * Vector3d::Unit(k)) / scale(k);
+  const Eigen::Matrix3d predicted_compliance =
+      (compliance.inverse() + Eigen::Matrix3d(k_b.asDiagonal())).inverse();
+  for (const Vector3d& w : {Vector3d(1, 0, 0), Vector3d(0, 100, 0), Vector3d(0.5, -50, 80)}) {
+    SCOPED_TRACE(w.transpose());
+    const Vector3d expected = predicted_compliance * w, got = response(m_iap, w);
+    EXPECT_LE((got - expected).cwiseQuotient(predicted_compliance.diagonal()).norm(),
+              1e-3 * (expected.cwiseQuotient(predicted_compliance.diagonal()).norm()))
+        << "got " << got.transpose() << ", expected " << expected.transpose();
+  }
+  // The bushing matters at this scale (otherwise the test could not tell a wrong K_b).
+  EXPECT_LT(predicted_compliance(0, 0), 0.9 * compliance(0, 0));
+}

@@ -17,6 +17,8 @@
 #include "spinesim/studies/disc_level.hpp"
 #include "spinesim/studies/spine_studies.hpp"
 
+#include "studies_fixtures.hpp"
+
 #include <gtest/gtest.h>
 #include <Eigen/Eigenvalues>
 
@@ -28,14 +30,9 @@ using namespace spinesim;
 
 namespace {
 
-const mesh::TetMesh& structured(const std::string& level) {
-  static std::map<std::string, mesh::TetMesh> cache;
-  auto it = cache.find(level);
-  if (it == cache.end()) it = cache.emplace(level, studies::mesh_structured_level(level, {})).first;
-  return it->second;
-}
+using test::structured;
 
-mesh::RegionMaterials real_disc() { return mesh::load_material("real-disc", SPINESIM_DATA_DIR); }
+mesh::RegionMaterials real_disc() { return test::material("real-disc"); }
 
 }  // namespace
 

@@ -1,12 +1,19 @@
-// Unit conversions and readable output of the FEM plate results (shared by `fem` and `demo`).
-// The command line speaks degrees; the solver speaks radians.
+// The FEM reference of a disc mesh as a study driver (`spinesim fem`, the demo): a rigid superior
+// plate moved or loaded, the inferior endplate fixed; and the unit conversions and readable output
+// of its plate results. The command line speaks degrees; the solver speaks radians.
 #pragma once
 
 #include "spinesim/fem/disc_fem.hpp"
+#include "spinesim/fem/load_cases.hpp"
+#include "spinesim/mesh/material.hpp"
+#include "spinesim/mesh/tet_mesh.hpp"
+#include "spinesim/studies/progress.hpp"
 
 #include <nlohmann/json.hpp>
 
+#include <optional>
 #include <ostream>
+#include <string>
 
 namespace spinesim::studies {
 
@@ -22,5 +29,40 @@ inline constexpr const char* kStiffnessUnits =
     "rows Fx,Fy,Fz [N], Mx,My,Mz [N·mm]; columns tx,ty,tz [mm], rx,ry,rz [deg]";
 
 void print_stiffness(std::ostream& os, const fem::Matrix6d& k_rad);
+
+/// One load on the superior plate: a prescribed motion, a wrench, or a named load case (whose
+/// disc-frame wrench is rotated into the mesh's frame). At most one is set; none = zero motion.
+struct FemRunRequest {
+  int order = 2;
+  std::optional<Eigen::Vector3d> center;  ///< plate centre, mm; default: DiscFem's
+  std::optional<fem::Vector6d> motion;    ///< (t mm, theta rad), global
+  std::optional<fem::Vector6d> wrench;    ///< (F N, M N·mm), global
+  const fem::LoadCase* load_case = nullptr;
+};
+
+struct FemRunResult {
+  FemRunRequest request;
+  std::string material;
+  Eigen::Index nodes = 0, tets = 0, fem_nodes = 0, dofs = 0;
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();
+  fem::Vector6d applied_wrench = fem::Vector6d::Zero();  ///< of a wrench or case load
+  fem::PlateSolution solution;
+  fem::Matrix6d stiffness = fem::Matrix6d::Zero();  ///< rows (F, M), columns (t mm, theta rad)
+  fem::Timings timings;
+  double load_solve_s = 0;
+};
+
+/// Assembles, factorises and solves the one load. Stages: assembly, solve (2). Throws
+/// std::invalid_argument when more than one load is given.
+FemRunResult run_fem_reference(const mesh::TetMesh& m, const mesh::RegionMaterials& materials,
+                               const FemRunRequest& request,
+                               const StageHooks& hooks = StageHooks());
+
+/// mesh, nodes, tets, order, DOF, material, plate centre, motion (deg), reaction, 6x6 stiffness
+/// (per degree), max |u|, timings, case; with units.
+nlohmann::json fem_run_json(const FemRunResult& r, const std::string& mesh_label);
+
+/// The readable summary: plate centre, motion, reaction and the 6x6 stiffness.
+void print_fem_run(std::ostream& os, const FemRunResult& r, const std::string& mesh_label);
 
 }  // namespace spinesim::studies

@@ -87,6 +87,32 @@ MaterialResult study_material(const mesh::TetMesh& mesh, const mesh::RegionMater
                               const MaterialsStudyOptions& options = MaterialsStudyOptions(),
                               const StageHooks& hooks = StageHooks());
 
+/// The study over several materials on one mesh: one study_material() each.
+struct MaterialsStudy {
+  std::string level;  ///< for reports
+  double cell_size_mm = 0;
+  MaterialsStudyOptions options;
+  std::vector<MaterialResult> results;
+  double seconds = 0;  ///< wall-clock of the materials' runs
+  /// The materials whose calibration failed, comma-separated; empty when none did.
+  std::string failed() const;
+};
+
+/// Stages: kStagesPerMaterial per material.
+MaterialsStudy run_materials_study(const mesh::TetMesh& mesh,
+                                   const std::vector<mesh::RegionMaterials>& materials,
+                                   const MaterialsStudyOptions& options,
+                                   const StageHooks& hooks = StageHooks());
+
+/// The set-up: mesh, load, models and each material's constants.
+void print_materials_header(std::ostream& os, const mesh::TetMesh& mesh, double cell_size_mm,
+                            const MaterialsStudyOptions& options,
+                            const std::vector<mesh::RegionMaterials>& materials);
+
+/// The summary: study, level, mesh, load, units, every material's responses, `csv` (or null).
+nlohmann::json materials_study_json(const mesh::TetMesh& mesh, const MaterialsStudy& study,
+                                    const std::string& csv);
+
 /// "E 4.2/1 MPa, nu 0.45/0.49" (annulus/nucleus when they differ): for echoing the inputs.
 std::string describe_material(const mesh::RegionMaterials& materials);
 

@@ -12,6 +12,7 @@
 #include "spinesim/mss/solver.hpp"
 #include "spinesim/studies/mss_run.hpp"
 #include "spinesim/studies/progress.hpp"
+#include "spinesim/studies/stepped_study.hpp"
 
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>
@@ -21,23 +22,6 @@
 #include <vector>
 
 namespace spinesim::studies {
-
-/// How a stepped study runs: integrator, step, frames, model terms and where files go.
-struct SteppedStudyOptions {
-  std::string out = "study-out";  ///< output folder (created)
-  mss::DynamicsOptions dynamics;  ///< integrator, dt_s, Newton iterations, matrix update
-  std::string integrator_name = "implicit";
-  int frame_every = 10;                  ///< a VTU frame every K steps
-  mss::MssOptions model;                 ///< MSS terms
-  std::string model_variant = "radial";  ///< its name for reports
-};
-
-/// Min and max of a signed quantity, and the value of largest magnitude.
-struct Range {
-  double lo = INFINITY, hi = -INFINITY;
-  void add(double v) { lo = std::min(lo, v), hi = std::max(hi, v); }
-  double extreme() const { return std::abs(lo) > std::abs(hi) ? lo : hi; }
-};
 
 struct ProbeSite {
   std::string name;
@@ -88,8 +72,5 @@ ProbeStudyResult run_probe_study(const mesh::TetMesh& m, const mesh::RegionMater
 /// The readable summary.
 void print_probe_study(std::ostream& os, const mesh::TetMesh& m, const std::string& material,
                        const ProbeStudyResult& r);
-
-/// {source, nodes, tets, volume_mm3} of a study's mesh.
-nlohmann::json study_mesh_json(const mesh::TetMesh& m);
 
 }  // namespace spinesim::studies

@@ -1,0 +1,75 @@
+// Calibrating every disc level of the spine (`spinesim calibrate --level all`): each level's
+// parametric disc meshed as `mesh disc --level` does, calibrated by calibrate_disc, checked on a
+// second resolution (1.5x the cell size), gathered into one tuned set (calibration/tuned_set.hpp)
+// that is only complete when every level succeeded.
+#pragma once
+
+#include "spinesim/studies/calibration_report.hpp"
+
+#include "spinesim/calibration/tuned_set.hpp"
+#include "spinesim/mesh/mesher.hpp"
+
+#include <functional>
+#include <optional>
+#include <ostream>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace spinesim::studies {
+
+/// The protocol's second mesh resolution for a level's parametric disc: the same disc at 1.5x
+/// `options`' cell size, with a label naming it.
+std::pair<std::string, mesh::TetMesh> coarser_level_mesh(const std::string& level,
+                                                         mesh::MeshOptions options,
+                                                         const StatusLine& status = StatusLine());
+
+/// The cell size of a level's disc when none is given: min(2 mm, disc height / 5), so that the
+/// thin thoracic discs (4.5-7 mm) get at least five cells through their height (at 2 mm the
+/// fitted MSS stays much further off the FEM there: calibration/README.md).
+double default_level_cell_size_mm(const std::string& level);
+
+struct AllLevelsRequest {
+  CalibrationRequest calibration;      ///< per level; its transfer_meshes must be empty
+  std::optional<double> cell_size_mm;  ///< every level's; default: default_level_cell_size_mm
+  bool transfer = true;                ///< check each level on its second resolution
+  std::vector<std::string> levels;     ///< empty: mesh::disc_levels()
+  std::string generated_by;            ///< recorded in the set
+};
+
+/// One level's row of the report.
+struct LevelCalibration {
+  std::string level;
+  Eigen::Index tets = 0;
+  double cell_size_mm = 0;
+  bool success = false;
+  std::string status;  ///< Ipopt's status
+  int iterations = 0;
+  double seconds = 0;
+  /// Worst relative displacement error over the training / held-out cases (nonlinear check);
+  /// NaN when there is no such case.
+  double train_untuned = 0, train_tuned = 0, holdout_untuned = NAN, holdout_tuned = NAN;
+  double k6_ratio_min = 0, k6_ratio_max = 0;  ///< tuned / FEM stiffness diagonal
+};
+
+struct AllLevelsResult {
+  calibration::TunedSet set;  ///< the successful levels
+  std::vector<LevelCalibration> levels;
+  /// "T7-T8 (Maximum_Iterations_Exceeded), ..."; empty when every level succeeded.
+  std::string failed() const;
+};
+
+/// (levels done, "T7-T8: stage") as the calibration proceeds.
+using LevelProgress = std::function<void(int done, const std::string& label)>;
+
+/// Throws std::invalid_argument for a bad request (as calibrate_disc, before any meshing).
+AllLevelsResult calibrate_all_levels(const mesh::RegionMaterials& materials,
+                                     const AllLevelsRequest& request,
+                                     const LevelProgress& progress = LevelProgress());
+
+/// The table: tets, train and held-out worst errors (untuned > tuned), K6 ratio range, Ipopt
+/// iterations and time per level.
+void print_all_levels(std::ostream& os, const AllLevelsResult& r, const std::string& terms,
+                      double check_load_scale);
+
+}  // namespace spinesim::studies

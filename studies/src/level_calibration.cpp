@@ -1,0 +1,146 @@
+#include "spinesim/studies/level_calibration.hpp"
+
+#include "spinesim/mesh/disc_geometry.hpp"
+#include "spinesim/studies/data.hpp"
+#include "spinesim/studies/disc_level.hpp"
+#include "spinesim/studies/format.hpp"
+#include "spinesim/studies/table.hpp"
+
+#include <algorithm>
+#include <iomanip>
+#include <sstream>
+#include <stdexcept>
+
+namespace spinesim::studies {
+
+std::pair<std::string, mesh::TetMesh> coarser_level_mesh(const std::string& level,
+                                                         mesh::MeshOptions options,
+                                                         const StatusLine& status) {
+  const mesh::DiscDimensions dims = mesh::disc_dimensions(level, data_dir());
+  options.cell_size_mm *= 1.5;
+  std::ostringstream label;
+  label << "parametric " << dims.level << ", cell size " << std::setprecision(3)
+        << options.cell_size_mm << " mm";
+  if (status) status("meshing the second resolution: " + label.str());
+  return {label.str(), mesh_disc_level(dims.level, options)};
+}
+
+double default_level_cell_size_mm(const std::string& level) {
+  return std::min(2.0, mesh::disc_dimensions(level, data_dir()).height_mm / 5.0);
+}
+
+std::string AllLevelsResult::failed() const {
+  std::string list;
+  for (const auto& l : levels)
+    if (!l.success) list += (list.empty() ? "" : ", ") + l.level + " (" + l.status + ")";
+  return list;
+}
+
+namespace {
+
+double worst(const nlohmann::json& rows, const char* key) {
+  double w = 0;
+  for (const auto& r : rows) w = std::max(w, r[key].get<double>());
+  return w;
+}
+
+/// The report's numbers of one level, from its tuned file's report.
+void summarise(const CalibrationOutcome& o, LevelCalibration& row) {
+  row.success = o.result.success;
+  row.status = o.result.status;
+  row.iterations = o.result.iterations;
+  row.seconds = o.total_seconds;
+  if (!row.success) return;
+  const auto& rep = o.tuned.report;
+  row.train_untuned = worst(rep["train"], "untuned_error");
+  row.train_tuned = worst(rep["train"], "tuned_error");
+  if (!rep["holdout"].empty()) {
+    row.holdout_untuned = worst(rep["holdout"], "untuned_error");
+    row.holdout_tuned = worst(rep["holdout"], "tuned_error");
+  }
+  row.k6_ratio_min = 1e300, row.k6_ratio_max = 0;
+  for (const auto& v : rep["stiffness_diagonal"]["ratio_tuned"]) {
+    row.k6_ratio_min = std::min(row.k6_ratio_min, v.get<double>());
+    row.k6_ratio_max = std::max(row.k6_ratio_max, v.get<double>());
+  }
+}
+
+}  // namespace
+
+AllLevelsResult calibrate_all_levels(const mesh::RegionMaterials& materials,
+                                     const AllLevelsRequest& request,
+                                     const LevelProgress& progress) {
+  const CalibrationRequest& rq = request.calibration;
+  if (!rq.transfer_meshes.empty())
+    throw std::invalid_argument(
+        "--transfer-mesh is one disc's: with --level all each level is checked at 1.5x its cell "
+        "size");
+  if (rq.per_spring)
+    throw std::invalid_argument(
+        "--per-spring fits one mesh: --level all writes region-level scales, which transfer to "
+        "other meshes");
+  const std::vector<std::string>& levels =
+      request.levels.empty() ? mesh::disc_levels() : request.levels;
+  for (const auto& level : levels) mesh::disc_dimensions(level, data_dir());  // known levels
+
+  AllLevelsResult r;
+  r.set.material_name = materials.name;
+  r.set.generated_by = request.generated_by;
+  r.set.settings = {
+      {"cell_size_rule", request.cell_size_mm ? "as given" : "min(2 mm, disc height / 5)"},
+      {"mesh",
+       "parametric disc (data/disc_morphometry.csv), CGAL, placed in the spine (as `mesh disc "
+       "--level`)"},
+      {"check_load_scale",
+       rq.nonlinear_check ? nlohmann::json(rq.check_load_scale) : nlohmann::json(nullptr)}};
+  nlohmann::json cell_by_level = nlohmann::json::object();
+  int done = 0;
+  for (const std::string& level : levels) {
+    const StatusLine status = [&](const std::string& s) {
+      if (progress) progress(done, level + ": " + s);
+    };
+    mesh::MeshOptions opt;
+    opt.cell_size_mm =
+        request.cell_size_mm ? *request.cell_size_mm : default_level_cell_size_mm(level);
+    cell_by_level[level] = opt.cell_size_mm;
+    status("meshing (cell size " + std::to_string(opt.cell_size_mm).substr(0, 4) + " mm)");
+    const mesh::TetMesh m = mesh_disc_level(level, opt);
+    CalibrationRequest level_rq = rq;
+    if (request.transfer)
+      level_rq.transfer_meshes.push_back(coarser_level_mesh(level, opt, status));
+    const CalibrationOutcome o = calibrate_disc(m, materials, level_rq, status);
+    ++done;
+    LevelCalibration row;
+    row.level = level;
+    row.tets = m.num_tets();
+    row.cell_size_mm = opt.cell_size_mm;
+    summarise(o, row);
+    r.levels.push_back(row);
+    if (row.success) r.set.levels.emplace(level, o.tuned);
+  }
+  r.set.settings["cell_size_mm"] = cell_by_level;
+  return r;
+}
+
+void print_all_levels(std::ostream& os, const AllLevelsResult& r, const std::string& terms,
+                      double check_load_scale) {
+  TextTable table({"level", "tets", "train max (untuned>tuned)", "holdout max (untuned>tuned)",
+                   "K6 diag ratio (tuned, min-max)", "Ipopt its", "time (s)"});
+  const auto pair = [](double u, double t) {
+    return fixed(100 * u, 0) + ">" + fixed(100 * t, 1) + "%";
+  };
+  for (const auto& l : r.levels) {
+    if (!l.success) continue;
+    table.add({l.level, std::to_string(l.tets), pair(l.train_untuned, l.train_tuned),
+               std::isnan(l.holdout_untuned) ? std::string("-")
+                                             : pair(l.holdout_untuned, l.holdout_tuned),
+               fixed(l.k6_ratio_min, 3) + "-" + fixed(l.k6_ratio_max, 3),
+               std::to_string(l.iterations), fixed(l.seconds, 1)});
+  }
+  os << "Calibration of all " << r.set.levels.size() << " levels, material " << r.set.material_name
+     << ", terms " << terms << " (errors: relative nodal displacement, nonlinear check at loads x "
+     << check_load_scale << ")\n\n";
+  table.print(os, false);
+}
+
+}  // namespace spinesim::studies
