@@ -367,3 +367,59 @@ TEST(SpineEquilibrium, IapBushingStiffnessMatchesAppendixC) {
   // The bushing matters at this scale (otherwise the test could not tell a wrong K_b).
   EXPECT_LT(predicted_compliance(0, 0), 0.9 * compliance(0, 0));
 }
+
+// The ligaments' stiffness where it enters the energy: a couple M on L1 is carried, to first
+// order, by every joint below it, each joint's flexion spring in parallel with the ligaments that
+// span it. A ligament i stretches by g_i·θ (g_i = u_i·(e_x × (x_upper − p_joint)), its flexion
+// lever arm from the geometry here) and pulls with k_i·(s − toe/2) once taut past its 0.05 mm
+// toe, so θ solves M = k_f θ − (k_f − k_e) w/2 + Σ_{g_i>0} k_i g_i q(g_i θ) — one scalar equation
+// per joint, solved by bisection. A consistent ×2 where k_i enters the energy fails here.
+TEST(SpineEquilibrium, LigamentsStiffenEachJointByTheirStretchTimesLeverArm) {
+  sp::ModelOptions o;
+  o.gravity = o.muscles = o.iap = false;
+  const sp::SpineModel m = sp::load_spine_model(SPINESIM_DATA_DIR, o);
+  ASSERT_FALSE(m.ligaments.empty());
+  const double M = 3000.0;  // N·mm, flexion
+  sp::ExternalLoad l;
+  l.vertebra = sp::vertebra_index("L1");
+  l.moment_nmm = Vector3d(M, 0, 0);
+  sp::SolveOptions tight;
+  tight.tolerance = 1e-7;
+  const sp::SpineSolution s = sp::solve_spine(m, {l}, tight);
+  const double toe = 0.05, band = 0.05 * M_PI / 180;
+  const auto q = [toe](double stretch) {  // the ligament's tension per k: C¹ past the toe
+    return stretch <= 0 ? 0.0 : stretch < toe ? stretch * stretch / (2 * toe) : stretch - toe / 2;
+  };
+  double largest_share = 0;
+  for (int j = 12; j <= 16; ++j) {  // L1-L2 … L5-S1
+    const sp::Joint& joint = m.joints[std::size_t(j)];
+    SCOPED_TRACE(joint.name);
+    std::vector<std::pair<double, double>> levers;  // (k_i, g_i) of the ligaments spanning j
+    for (const sp::Ligament& lig : m.ligaments) {
+      if (lig.joint != j) continue;
+      // The upper attachment is on the vertebra above the joint (index j), the lower below.
+      const bool a_upper = lig.body_a == j;
+      const Vector3d upper = a_upper ? lig.a_mm : lig.b_mm, lower = a_upper ? lig.b_mm : lig.a_mm;
+      const Vector3d u = (upper - lower).normalized();
+      levers.emplace_back(lig.k_n_per_mm, u.dot(Vector3d::UnitX().cross(upper - joint.point_mm)));
+    }
+    ASSERT_FALSE(levers.empty());
+    const auto carried = [&](double theta) {
+      double c = joint.k_flexion * theta - (joint.k_flexion - joint.k_extension) * band / 2;
+      for (const auto& [k, g] : levers)
+        if (g > 0) c += k * g * q(g * theta);
+      return c;
+    };
+    double lo = 0, hi = M / (joint.k_flexion * 0.5);
+    for (int it = 0; it < 200; ++it) (carried(0.5 * (lo + hi)) < M ? lo : hi) = 0.5 * (lo + hi);
+    const double expected = 0.5 * (lo + hi);
+    double k_lig = 0;
+    for (const auto& [k, g] : levers)
+      if (g > 0) k_lig += k * g * g;
+    largest_share = std::max(largest_share, k_lig / (k_lig + joint.k_flexion));
+    EXPECT_NEAR(s.theta[3 * j], expected, 0.02 * expected)
+        << "ligament share of the stiffness " << k_lig / (k_lig + joint.k_flexion);
+  }
+  // The ligaments carry enough of the couple for a wrong k_i to show.
+  EXPECT_GT(largest_share, 0.3);
+}
