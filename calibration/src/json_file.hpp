@@ -1,26 +1,19 @@
 // Reading the calibration's JSON files: one place for the I/O and for naming the file in errors.
 #pragma once
 
+#include "spinesim/common/input_file.hpp"
+
 #include <nlohmann/json.hpp>
 
-#include <fstream>
 #include <stdexcept>
 #include <string>
 
 namespace spinesim::calibration::detail {
 
-/// The parsed contents of `path`; std::invalid_argument "cannot read <what> '<path>'" or
-/// "'<path>' is not valid JSON".
+/// The parsed contents of `path` (spinesim::read_json_file: a regular file, bounded in size and
+/// depth, strict JSON); std::invalid_argument naming the file and the cause.
 inline nlohmann::json read_json_file(const std::string& path, const std::string& what) {
-  std::ifstream in(path);
-  if (!in) throw std::invalid_argument("cannot read " + what + " '" + path + "'");
-  try {
-    nlohmann::json j;
-    in >> j;
-    return j;
-  } catch (const nlohmann::json::exception&) {
-    throw std::invalid_argument("'" + path + "' is not valid JSON");
-  }
+  return spinesim::read_json_file(path, what);
 }
 
 /// f(), with the file's name put in front of any refusal it throws.

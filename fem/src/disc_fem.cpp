@@ -180,15 +180,29 @@ Eigen::Vector3d DiscFem::default_plate_center(const mesh::TetMesh& mesh) {
   return sum / double(n);
 }
 
+namespace {
+
+/// A linear solve of finite data can still overflow (a wrench of 1e308 N): a solution that is not
+/// finite is an error, never a result.
+PlateSolution finite_or_refused(PlateSolution s, const char* load) {
+  if (!s.plate_motion.allFinite() || !s.reaction_wrench.allFinite() ||
+      !s.displacement_mm.allFinite())
+    throw std::invalid_argument(std::string("the ") + load +
+                                " is too large: the solution overflows double precision");
+  return s;
+}
+
+}  // namespace
+
 PlateSolution DiscFem::solve_motion(const Vector6d& motion) const {
   if (!motion.allFinite()) throw std::invalid_argument("plate motion has non-finite components");
-  return impl_->solution_for(motion);
+  return finite_or_refused(impl_->solution_for(motion), "plate motion");
 }
 
 PlateSolution DiscFem::solve_wrench(const Vector6d& wrench) const {
   if (!wrench.allFinite()) throw std::invalid_argument("plate wrench has non-finite components");
   const Vector6d q = impl_->K6_llt.solve(wrench);
-  return impl_->solution_for(q);
+  return finite_or_refused(impl_->solution_for(q), "plate wrench");
 }
 
 const Matrix6d& DiscFem::stiffness_6x6() const { return impl_->K6; }

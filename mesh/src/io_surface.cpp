@@ -8,6 +8,8 @@
 // skipped by CGAL.
 #include "spinesim/mesh/io.hpp"
 
+#include "spinesim/common/input_file.hpp"
+
 #include <CGAL/IO/polygon_soup_io.h>
 #include <CGAL/Simple_cartesian.h>
 
@@ -85,7 +87,8 @@ TriSurface read_surface(const std::string& path, double units_to_mm, UpAxis up) 
   if (ext != ".stl" && ext != ".obj" && ext != ".ply" && ext != ".off")
     fail("unknown surface file extension '" + ext + "' (use .stl, .obj, .ply or .off)");
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) fail("no such file");
+  if (!std::filesystem::is_regular_file(path, ec))
+    fail(path_kind(path).empty() ? "no such file" : "it is " + path_kind(path) + ", not a regular file");
 
   if (ext == ".stl") {
     const long bad = first_nonfinite_binary_stl_facet(path);

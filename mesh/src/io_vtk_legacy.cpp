@@ -3,6 +3,8 @@
 // The grid goes through the same checks as a VTU (vtk_grid.hpp). Contract in io.hpp.
 #include "spinesim/mesh/io.hpp"
 
+#include "spinesim/common/input_file.hpp"
+
 #include "vtk_grid.hpp"
 
 #include <algorithm>
@@ -282,7 +284,9 @@ TetMesh read_vtk_legacy(const std::string& path, std::vector<DataArray>* point_d
                         std::vector<DataArray>* cell_data) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec))
-    detail::FileError{"read_vtk", path}.fail("no such file");
+    detail::FileError{"read_vtk", path}.fail(path_kind(path).empty()
+                                                 ? "no such file"
+                                                 : "it is " + path_kind(path) + ", not a regular file");
   std::ifstream in(path, std::ios::binary);
   LegacyReader r(
       path, std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()));
@@ -334,6 +338,8 @@ TetMesh read_vtk_legacy(const std::string& path, std::vector<DataArray>* point_d
 
 TetMesh read_tet_mesh(const std::string& path, std::vector<DataArray>* point_data,
                       std::vector<DataArray>* cell_data) {
+  // Only a regular file is opened here (a FIFO would block): read_vtu names anything else.
+  if (path_kind(path) != "a regular file") return read_vtu(path, point_data, cell_data);
   std::ifstream in(path, std::ios::binary);
   char head[23] = {};
   in.read(head, sizeof head);

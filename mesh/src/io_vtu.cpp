@@ -1,6 +1,8 @@
 // VTU (VTK XML UnstructuredGrid) writer and reader; layout and contract in io.hpp.
 #include "spinesim/mesh/io.hpp"
 
+#include "spinesim/common/input_file.hpp"
+
 #include "spinesim/common/atomic_file.hpp"
 #include "vtk_grid.hpp"
 #include "write_checks.hpp"
@@ -219,8 +221,9 @@ bool vtk_type(const std::string& t, VtkType& out) {
 
 double decode_value(const unsigned char* p, VtkType t, bool swap) {
   unsigned char b[8];
-  std::memcpy(b, p, std::size_t(t.size));
-  if (swap) std::reverse(b, b + t.size);
+  const std::size_t n = std::min<std::size_t>(std::size_t(t.size), sizeof b);  // 1, 2, 4 or 8
+  std::memcpy(b, p, n);
+  if (swap) std::reverse(b, b + n);
   switch (t.kind) {
     case 'f':
       if (t.size == 4) {
@@ -615,7 +618,9 @@ TetMesh read_vtu(const std::string& path, std::vector<DataArray>* point_data,
 
   // 1. File and XML envelope; the appended payload is cut out before XML parsing.
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) r.fail("no such file");
+  if (!std::filesystem::is_regular_file(path, ec))
+    r.fail(path_kind(path).empty() ? "no such file"
+                                   : "it is " + path_kind(path) + ", not a regular file");
   std::ifstream in(path, std::ios::binary);
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   if (!in && !in.eof()) r.fail("cannot read the file");

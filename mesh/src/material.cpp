@@ -1,6 +1,8 @@
 #include "spinesim/mesh/material.hpp"
 #include "spinesim/mesh/tet_mesh.hpp"
 
+#include "spinesim/common/input_file.hpp"
+
 #include <nlohmann/json.hpp>
 
 #include <cmath>
@@ -58,6 +60,14 @@ void validate(const IsotropicMaterial& m, const std::string& what) {
     throw std::invalid_argument(what + ": non-finite material constant");
   if (!(e > 0))
     throw std::invalid_argument(what + ": Young's modulus must be > 0 MPa (got " + fmt(e) + ")");
+  // Diamond is 1.2e6 MPa, a hydrogel 1e-3 MPa: beyond these the solvers work with numbers near
+  // the ends of double precision (a wrench on an E = 1e300 disc overflows), so they are refused.
+  if (e > 1e7 || e < 1e-9)
+    throw std::invalid_argument(what + ": Young's modulus " + fmt(e) +
+                                " MPa is outside [1e-9, 1e7] MPa, beyond any solid");
+  if (rho > 1e5 || rho < 1e-3)
+    throw std::invalid_argument(what + ": density " + fmt(rho) +
+                                " kg/m^3 is outside [1e-3, 1e5] kg/m^3");
   if (!(nu > -1.0 && nu < 0.5))
     throw std::invalid_argument(what + ": Poisson's ratio must lie in (-1, 0.5) (got " + fmt(nu) +
                                 ")");
@@ -105,15 +115,7 @@ RegionMaterials load_material(const std::string& name_or_path, const std::string
     }
     path = preset;
   }
-  std::ifstream in(path);
-  if (!in) throw std::invalid_argument("cannot read material file " + path.string());
-  nlohmann::json j;
-  try {
-    in >> j;
-  } catch (const nlohmann::json::exception& e) {
-    throw std::invalid_argument("material file " + path.string() + " is not valid JSON");
-  }
-  return material_from_json(j);
+  return material_from_json(read_json_file(path.string(), "material file"));
 }
 
 }  // namespace spinesim::mesh

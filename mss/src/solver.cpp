@@ -54,6 +54,9 @@ void check_static_input(const MssModel& model, const Boundary& bc, const StaticO
   if (options.max_iterations < 1)
     throw std::invalid_argument("mss: static max_iterations must be >= 1");
   if (x_start.size() != 0) check_positions(x_start, model, "static start vector");
+  // Finite components whose norm overflows (1e155 N): no tolerance can be tested against them.
+  if (bc.plate_mode == PlateMode::wrench && !std::isfinite(bc.wrench.norm()))
+    throw std::invalid_argument("mss: the plate wrench is too large (its norm overflows)");
 }
 
 }  // namespace
@@ -93,6 +96,12 @@ StaticResult solve_static(const MssModel& model, const Boundary& bc, const Stati
     const double scale = pot.model_gradient().norm() + loads.force_scale(pot.x()) + wrench_scale;
     if (!std::isfinite(Pi) || !r.allFinite()) {
       res.message = "non-finite energy or gradient at Newton iteration " + std::to_string(it);
+      break;
+    }
+    // A residual or force scale that overflows is never "converged" (inf <= tol * inf is true).
+    if (!std::isfinite(res.residual_n) || !std::isfinite(scale)) {
+      res.message = "the forces overflow double precision at Newton iteration " +
+                    std::to_string(it) + " (load or material beyond the model's range)";
       break;
     }
     if (res.residual_n <= options.relative_tolerance * scale || res.residual_n <= floor) {

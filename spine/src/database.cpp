@@ -3,6 +3,7 @@
 #include "spinesim/spine/database.hpp"
 
 #include "spinesim/common/atomic_file.hpp"
+#include "spinesim/common/input_file.hpp"
 #include "spinesim/common/timer.hpp"
 
 #include <Eigen/QR>
@@ -705,11 +706,14 @@ void DisplacementDatabase::save(const std::string& path) const {
 }
 
 DisplacementDatabase DisplacementDatabase::load(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error("cannot read displacement database " + path);
+  json j;
+  try {
+    j = read_json_file(path, "displacement database");
+  } catch (const std::invalid_argument& e) {  // load's contract: std::runtime_error
+    throw std::runtime_error(e.what());
+  }
   DisplacementDatabase db;
   try {
-    const json j = json::parse(in);
     if (!j.is_object() || j.value("kind", "") != kKind)
       throw std::runtime_error(std::string("not a displacement database (\"kind\" is not \"") +
                                kKind + "\")");

@@ -234,6 +234,19 @@ void check_loads(const SpineModel& m, const std::vector<ExternalLoad>& loads,
         (l.has_point && !l.point_mm.allFinite()))
       throw std::invalid_argument("external load on " + m.vertebrae[std::size_t(l.vertebra)].name +
                                   " is not finite");
+    // Beyond these no body is loaded, and the solvers would run on numbers they cannot resolve
+    // (a 1e155 N force overflows its norm): refused, naming the limit.
+    const std::string& name = m.vertebrae[std::size_t(l.vertebra)].name;
+    if (!(l.force_n.norm() <= kMaxForceN))
+      throw std::invalid_argument("force on " + name + " is beyond " +
+                                  std::to_string(int(kMaxForceN)) +
+                                  " N, outside any physical load (the model is validated to 600 N)");
+    if (!(l.moment_nmm.norm() <= kMaxMomentNmm))
+      throw std::invalid_argument("couple on " + name + " is beyond " +
+                                  std::to_string(int(kMaxMomentNmm / 1000)) + " N·m");
+    if (l.has_point && !(l.point_mm.norm() <= kMaxPointMm))
+      throw std::invalid_argument("load point on " + name + " is more than " +
+                                  std::to_string(int(kMaxPointMm)) + " mm from the origin");
     if (warnings && l.force_n.norm() > kThesisForceLimitN) {
       std::ostringstream w;
       w << "force of " << l.force_n.norm() << " N on " << m.vertebrae[std::size_t(l.vertebra)].name

@@ -1,6 +1,8 @@
 // Builds the spine model from data/ (spine/README.md): no number of the model is in this file.
 #include "spinesim/spine/model.hpp"
 
+#include "spinesim/common/input_file.hpp"
+
 #include "csv_table.hpp"
 
 #include <nlohmann/json.hpp>
@@ -38,12 +40,10 @@ std::string joined(const std::vector<std::string>& names) {
 }
 
 json read_json(const fs::path& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error("cannot read " + path.string());
   try {
-    return json::parse(in);
-  } catch (const std::exception& e) {
-    throw std::runtime_error(path.string() + ": " + e.what());
+    return read_json_file(path.string(), "model file");
+  } catch (const std::invalid_argument& e) {  // broken data: the model's contract is runtime_error
+    throw std::runtime_error(e.what());
   }
 }
 

@@ -80,6 +80,8 @@ mesh::UpAxis up_axis(const std::string& u) {
 
 void run_mesh_disc(const MeshArgs& a) {
   check_mesher_flags(a);
+  require_output_folder(a.out, "--out");  // a device, FIFO or link is refused before meshing
+  if (!a.medit.empty()) require_output_folder(a.medit, "--medit");
   mesh::MeshOptions opt = a.opt;
   opt.perturb = !a.no_perturb;
   opt.exude = !a.no_exude;

@@ -105,6 +105,13 @@ void solve(const SpineSolveArgs& a) {
       l.has_point = true;
       l.point_mm = Eigen::Vector3d(parse_numbers(a.points[i], 3, "--at"));
     }
+    // Refused here, before any warning about it: one line for one mistake.
+    if (!(force.norm() <= spine::kMaxForceN))
+      throw std::invalid_argument("--force " + a.forces[i] + ": beyond " +
+                                  fixed(spine::kMaxForceN, 0) + " N, outside any physical load");
+    if (l.has_point && !(l.point_mm.norm() <= spine::kMaxPointMm))
+      throw std::invalid_argument("--at " + a.points[i] + ": more than " +
+                                  fixed(spine::kMaxPointMm, 0) + " mm from the origin");
     if (force.norm() > kValidatedForceN)
       warnings.push_back("--force " + a.forces[i] + ": |F| = " + fixed(force.norm(), 1) +
                          " N is beyond the " + fixed(kValidatedForceN, 0) +

@@ -20,6 +20,7 @@ void require_output_folder(const std::string& path, const std::string& option) {
   if (!fs::is_directory(dir))
     throw std::invalid_argument(option + " " + path + ": folder " + dir.string() +
                                 " does not exist");
+  require_replaceable(option, path);  // a device, FIFO or link is refused before the work
 }
 
 VtuSeries::VtuSeries(const std::string& pvd_path) : pvd_path_(pvd_path) {

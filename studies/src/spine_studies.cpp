@@ -2,6 +2,8 @@
 // definitions are in spine_studies.hpp.
 #include "spinesim/studies/spine_studies.hpp"
 
+#include "spinesim/common/input_file.hpp"
+
 #include "spinesim/common/timer.hpp"
 #include "spinesim/studies/format.hpp"
 #include "spinesim/studies/json.hpp"
@@ -43,12 +45,10 @@ void end(const StageHooks& h, const std::string& detail) {
 /// "crate" blocks).
 nlohmann::json read_spine_json(const std::string& data_dir) {
   const std::string path = data_dir + "/spine/spine_model.json";
-  std::ifstream is(path);
-  if (!is) throw std::runtime_error("cannot read " + path);
   try {
-    return nlohmann::json::parse(is);
-  } catch (const std::exception& e) {
-    throw std::runtime_error(path + ": " + e.what());
+    return read_json_file(path, "spine model file");
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(e.what());
   }
 }
 

@@ -317,7 +317,7 @@ TEST(DatabaseFile, MissingOrCorruptFilesGiveClearErrors) {
   std::ifstream in(kShipped);
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   write_file(truncated, text.substr(0, text.size() / 2));
-  expect_load_error(truncated, "malformed");
+  expect_load_error(truncated, "not valid JSON");
   const std::string other = tmp_path("db_other_kind.json");
   write_file(other, R"({"kind": "something else"})");
   expect_load_error(other, "not a displacement database");

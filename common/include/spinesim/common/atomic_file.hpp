@@ -1,7 +1,9 @@
 // Writing a file so that `path` either gets the complete new content or is left untouched
 // (every writer of the project: meshes, tuned discs, databases, reports). The content goes to `path + ".tmp-XXXXXX"` (same folder, so the
 // rename is atomic on POSIX file systems), is flushed and checked, then renamed over `path`.
-// On any failure the temporary file is removed and the exception propagates.
+// On any failure the temporary file is removed and the exception propagates. A `path` that
+// exists and is not a regular file (a symbolic link, directory, FIFO, socket or device) is never
+// replaced: as root, `--out /dev/null` must not turn /dev/null into a file.
 #pragma once
 
 #include <cerrno>
@@ -17,11 +19,26 @@
 
 namespace spinesim {
 
+/// Throws std::invalid_argument "<who>: <path> is <kind>, not a regular file: ..." unless `path`
+/// is absent or a regular file (lstat: a symbolic link is refused, not followed).
+inline void require_replaceable(const std::string& who, const std::string& path) {
+  struct stat st {};
+  if (::lstat(path.c_str(), &st) != 0 || S_ISREG(st.st_mode)) return;
+  const char* kind = S_ISLNK(st.st_mode)    ? "a symbolic link"
+                     : S_ISDIR(st.st_mode)  ? "a directory"
+                     : S_ISFIFO(st.st_mode) ? "a FIFO"
+                     : S_ISSOCK(st.st_mode) ? "a socket"
+                                            : "a device";
+  throw std::invalid_argument(who + ": " + path + " is " + kind +
+                              ", not a regular file: refusing to replace it (give a file name)");
+}
+
 /// Calls `fill(std::ostream&)` on a temporary file next to `path`, then renames it to `path`.
 /// `who` prefixes the error messages (e.g. "write_vtu"). Throws std::runtime_error when the
 /// operating system refuses (folder missing, permission, disk full).
 template <class Fill>
 void write_atomically(const std::string& who, const std::string& path, Fill&& fill) {
+  require_replaceable(who, path);
   std::string tmpl = path + ".tmp-XXXXXX";
   std::vector<char> name(tmpl.begin(), tmpl.end());
   name.push_back('\0');

@@ -95,7 +95,11 @@ struct SolveError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// Throws std::invalid_argument for a non-finite load or an unknown vertebra index, SolveError
+/// Loads no body sees, refused by solve_spine: 100 kN, 10 kN·m, a load point 10 m away.
+inline constexpr double kMaxForceN = 1e5, kMaxMomentNmm = 1e7, kMaxPointMm = 1e4;
+
+/// Throws std::invalid_argument for a non-finite load, one beyond any physical load (100 kN, 10 kN·m,
+/// a point 10 m away) or an unknown vertebra index, SolveError
 /// for a non-converged Newton solve.
 SpineSolution solve_spine(const SpineModel& m, const std::vector<ExternalLoad>& loads,
                           const SolveOptions& options = SolveOptions());

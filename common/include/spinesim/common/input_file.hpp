@@ -1,0 +1,120 @@
+// Reading an input file safely: only a regular file is read (a directory, FIFO, socket or device
+// is refused by name instead of blocking or failing obscurely), its size is bounded, and every
+// error names the file and the real cause in one line. JSON inputs (materials, tuned discs, the
+// spine model, databases) are also bounded in nesting depth, so a hostile file cannot exhaust the
+// stack of the parser or of the value's destructor, and are parsed strictly (nothing after the
+// value). Every JSON file the project reads goes through read_json_file.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include <cerrno>
+#include <cstddef>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+namespace spinesim {
+
+/// Limits of read_regular_file and read_json_file.
+struct InputLimits {
+  std::size_t max_bytes = std::size_t(1) << 30;  ///< 1 GiB
+  int max_json_depth = 64;                       ///< nested arrays/objects
+};
+
+/// What a path names, for messages: "a directory", "a FIFO", "a device", "a socket", "a symbolic
+/// link" (from lstat when `follow` is false), "a regular file", or "" when it does not exist.
+inline std::string path_kind(const std::string& path, bool follow = true) {
+  struct stat st {};
+  if ((follow ? ::stat(path.c_str(), &st) : ::lstat(path.c_str(), &st)) != 0) return "";
+  if (S_ISREG(st.st_mode)) return "a regular file";
+  if (S_ISDIR(st.st_mode)) return "a directory";
+  if (S_ISFIFO(st.st_mode)) return "a FIFO";
+  if (S_ISSOCK(st.st_mode)) return "a socket";
+  if (S_ISLNK(st.st_mode)) return "a symbolic link";
+  return "a device";
+}
+
+/// The whole content of the regular file `path`. Throws std::invalid_argument "cannot read
+/// <what> '<path>': <cause>" — no such file, not a regular file (named), too large, or the
+/// system's reason.
+inline std::string read_regular_file(const std::string& path, const std::string& what,
+                                     const InputLimits& limits = InputLimits()) {
+  const auto refuse = [&](const std::string& cause) {
+    return std::invalid_argument("cannot read " + what + " '" + path + "': " + cause);
+  };
+  // O_NONBLOCK: opening a FIFO with no writer must not block; it is refused below anyway.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) throw refuse(errno == ENOENT ? "no such file" : std::strerror(errno));
+  struct stat st {};
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    ::close(fd);
+    throw refuse("it is " + path_kind(path) + ", not a regular file");
+  }
+  if (std::size_t(st.st_size) > limits.max_bytes) {
+    ::close(fd);
+    throw refuse("it has " + std::to_string(st.st_size) + " bytes, more than the limit of " +
+                 std::to_string(limits.max_bytes));
+  }
+  std::string text(std::size_t(st.st_size), '\0');
+  std::size_t done = 0;
+  while (done < text.size()) {
+    const ssize_t n = ::read(fd, &text[done], text.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) break;
+    done += std::size_t(n);
+  }
+  ::close(fd);
+  text.resize(done);  // a file that shrank while read: what was there
+  return text;
+}
+
+/// The deepest nesting of arrays and objects in JSON text (brackets inside strings ignored).
+inline int json_depth(const std::string& text) {
+  int depth = 0, deepest = 0;
+  bool in_string = false, escaped = false;
+  for (const char c : text) {
+    if (in_string) {
+      if (escaped)
+        escaped = false;
+      else if (c == '\\')
+        escaped = true;
+      else if (c == '"')
+        in_string = false;
+      continue;
+    }
+    if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > deepest) deepest = depth;
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
+  return deepest;
+}
+
+/// The parsed JSON of the regular file `path`: std::invalid_argument naming the file and the
+/// cause (see read_regular_file; nested deeper than the limit; not valid JSON, with the parser's
+/// position; anything after the value).
+inline nlohmann::json read_json_file(const std::string& path, const std::string& what,
+                                     const InputLimits& limits = InputLimits()) {
+  const std::string text = read_regular_file(path, what, limits);
+  const int depth = json_depth(text);
+  if (depth > limits.max_json_depth)
+    throw std::invalid_argument(what + " '" + path + "' is nested " + std::to_string(depth) +
+                                " levels deep (the limit is " +
+                                std::to_string(limits.max_json_depth) + "): not a file of ours");
+  try {
+    return nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw std::invalid_argument(what + " '" + path + "' is not valid JSON (byte " +
+                                std::to_string(e.byte) + ")");
+  }
+}
+
+}  // namespace spinesim

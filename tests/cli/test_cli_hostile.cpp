@@ -1,0 +1,103 @@
+// Hostile input, as a user brings it by mistake or on purpose: every case exits 1 with one line
+// that names the real cause, and leaves no new file. (Regression tests of what a fuzzing session
+// found: deep JSON, FIFOs and folders as inputs, devices and links as outputs, loads whose norm
+// overflows.)
+#include "cli_runner.hpp"
+
+#include <fstream>
+
+#include <sys/stat.h>
+
+#include <set>
+
+using namespace spinesim::test_cli;
+
+namespace {
+
+/// A small structured disc, made once per test process.
+const std::string& disc() {
+  static const std::string path = [] {
+    const std::string p = tmp("hostile-disc.vtu");
+    const CliRun r = run_spinesim("mesh disc --level T7-T8 --structured --out '" + p + "'");
+    EXPECT_EQ(r.status, 0) << r.err;
+    return p;
+  }();
+  return path;
+}
+
+std::set<std::string> files_in(const fs::path& dir) {
+  std::set<std::string> out;
+  for (const auto& e : fs::recursive_directory_iterator(dir)) out.insert(e.path().string());
+  return out;
+}
+
+/// Refused in one line naming `cause`, and nothing new in the temp folder.
+void expect_refused_cleanly(const std::string& args, const std::string& cause) {
+  SCOPED_TRACE(args);
+  const auto before = files_in(tmp_dir());
+  const CliRun r = run_spinesim(args);
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_EQ(count_lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find(cause), std::string::npos) << r.err;
+  auto after = files_in(tmp_dir());
+  for (const auto& f : {tmp_dir() / "cli.stdout", tmp_dir() / "cli.stderr"})
+    after.erase(f.string());
+  for (const auto& f : before) after.erase(f);
+  EXPECT_TRUE(after.empty()) << "new file: " << *after.begin();
+}
+
+std::string quoted(const std::string& s) { return "'" + s + "'"; }
+
+}  // namespace
+
+TEST(HostileInput, DeeplyNestedJsonIsRefusedNotACrash) {
+  const std::string deep = tmp("deep.json");
+  std::ofstream(deep) << "{\"version\": " << std::string(100000, '[') << std::string(100000, ']')
+                      << "}";
+  expect_refused_cleanly(
+      "mss --mesh " + quoted(disc()) + " --params " + quoted(deep) + " --case compression",
+      "nested 100001 levels deep");
+  expect_refused_cleanly("mss compare --mesh " + quoted(disc()) + " --params " + quoted(deep),
+                         "nested 100001 levels deep");
+  expect_refused_cleanly("fem --mesh " + quoted(disc()) + " --material " + quoted(deep),
+                         "nested 100001 levels deep");
+}
+
+TEST(HostileInput, FifoAndFolderInputsAreNamedNotWaitedOn) {
+  const std::string fifo = tmp("in-fifo");
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  expect_refused_cleanly("fem --mesh " + quoted(disc()) + " --material " + quoted(fifo),
+                         "a FIFO, not a regular file");
+  expect_refused_cleanly("mss --mesh " + quoted(disc()) + " --params " + quoted(fifo),
+                         "a FIFO, not a regular file");
+  expect_refused_cleanly("fem --mesh " + quoted(fifo), "a FIFO, not a regular file");
+  expect_refused_cleanly("fem --mesh " + quoted(tmp_dir().string()),
+                         "a directory, not a regular file");
+}
+
+TEST(HostileInput, OutputsThatAreNotRegularFilesAreNeverReplaced) {
+  const std::string fifo = tmp("out-fifo"), target = tmp("target.vtu"), link = tmp("link.vtu");
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  std::ofstream(target) << "keep";
+  fs::create_symlink(target, link);
+  for (const std::string& out : {fifo, link, std::string("/dev/null")}) {
+    expect_refused_cleanly("mesh disc --level T7-T8 --structured --out " + quoted(out),
+                           "not a regular file: refusing to replace it");
+    expect_refused_cleanly("fem --mesh " + quoted(disc()) + " --out " + quoted(out),
+                           "not a regular file: refusing to replace it");
+  }
+  EXPECT_EQ(fs::status(fifo).type(), fs::file_type::fifo);
+  EXPECT_TRUE(fs::is_symlink(link));
+  EXPECT_EQ(slurp(target), "keep");
+  EXPECT_EQ(fs::status("/dev/null").type(), fs::file_type::character);
+}
+
+// An overflowing norm must never pass a convergence test (inf <= tol * inf) or give null numbers.
+TEST(HostileInput, LoadsWhoseNormOverflowsAreRefusedNotConverged) {
+  expect_refused_cleanly("mss --mesh " + quoted(disc()) + " --wrench 0,-1e155,0,0,0,0 --json",
+                         "too large");
+  expect_refused_cleanly("fem --mesh " + quoted(disc()) + " --wrench 0,-1e308,0,0,0,0 --json",
+                         "too large");
+  expect_refused_cleanly("spine solve --force T1:1e155,0,0", "outside any physical load");
+  expect_refused_cleanly("spine solve --force T1:100,0,0 --at 1e300,0,0", "from the origin");
+}
