@@ -22,7 +22,9 @@
 #include <array>
 #include <cmath>
 #include <functional>
+#include <iomanip>
 #include <memory>
+#include <sstream>
 #include <stdexcept>
 #include <unordered_map>
 #include <vector>
@@ -117,6 +119,14 @@ TetMesh to_tet_mesh(const C3t3& c3t3, const LabeledBody& body) {
 
 }  // namespace
 
+double expected_elements(double volume_mm3, double bounding_radius_mm, const MeshOptions& opt) {
+  const double r = opt.cell_size_mm, R = bounding_radius_mm;
+  const double facet = opt.facet_size_mm > 0 ? opt.facet_size_mm : r;
+  const double e = std::min(facet, std::sqrt(8.0 * R * opt.facet_distance_mm));
+  const double area = 6.0 * std::pow(volume_mm3, 2.0 / 3.0);  // a cube's: a disc has a bit more
+  return 6.0 * volume_mm3 / (r * r * r) + area / (0.43 * e * e);
+}
+
 TetMesh mesh_labeled_body(const LabeledBody& body, const MeshOptions& opt) {
   if (!body.label) throw std::invalid_argument("mesh_labeled_body: no labelling function");
   if (!(body.bounding_radius_mm > 0))
@@ -126,6 +136,21 @@ TetMesh mesh_labeled_body(const LabeledBody& body, const MeshOptions& opt) {
     throw std::invalid_argument(
         "mesh options: need cell size > 0, facet distance > 0, facet angle in (0, 30] deg and "
         "radius-edge ratio >= 2 (CGAL's termination bounds)");
+
+  // Size before work: CGAL would allocate until the machine runs out (cm read as m, 1e-6 mm).
+  const double volume = body.exact_volume_mm3 > 0
+                            ? body.exact_volume_mm3
+                            : 4.0 / 3.0 * M_PI * std::pow(body.bounding_radius_mm, 3);
+  const double expected = expected_elements(volume, body.bounding_radius_mm, opt);
+  if (!(expected <= opt.max_elements)) {
+    std::ostringstream os;
+    os << "meshing " << body.name << " would make about " << std::setprecision(2) << expected
+       << " elements (volume " << std::setprecision(3) << volume << " mm^3, cell size "
+       << opt.cell_size_mm << " mm, facet distance " << opt.facet_distance_mm
+       << " mm), more than the limit of " << opt.max_elements
+       << ": coarser options, a surface in the right units, or a higher --max-elements";
+    throw std::invalid_argument(os.str());
+  }
 
   // CGAL looks for the surface with random rays from the centre and never gives up; make sure
   // there is a body to find (probe a 24^3 lattice of the bounding cube).

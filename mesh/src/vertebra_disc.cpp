@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <limits>
 #include <memory>
 #include <sstream>
@@ -198,6 +199,7 @@ class DiscBetween {
   void set_frame(const TriSurface& inf, const TriSurface& sup);
   std::vector<char> height_fields(const TriSurface& inf, const TriSurface& sup,
                                   const VertebraDiscOptions& opt);
+  void fill_holes(const std::vector<char>& facing, const std::vector<char>& mask);
   std::vector<char> facing_region(const std::vector<char>& facing, const VertebraDiscOptions& opt,
                                   Eigen::Vector2d& c0);
   void set_outline(const std::vector<char>& mask, const Eigen::Vector2d& c0,
@@ -241,6 +243,7 @@ DiscBetween::DiscBetween(const TriSurface& inf, const TriSurface& sup,
   const std::vector<char> facing = height_fields(inf, sup, opt);
   Eigen::Vector2d c0;
   const std::vector<char> mask = facing_region(facing, opt, c0);
+  fill_holes(facing, mask);
   set_outline(mask, c0, opt);
   measure();
 }
@@ -289,6 +292,15 @@ std::vector<char> DiscBetween::height_fields(const TriSurface& inf, const TriSur
   if (!(uhi - ulo > 2 * opt.grid_step_mm && vhi - vlo > 2 * opt.grid_step_mm))
     throw std::invalid_argument(
         "the vertebrae do not face each other: their footprints along the axis do not overlap");
+  // A vertebral body is 30-60 mm across: a footprint of metres is a surface in the wrong units,
+  // and its height-field grid would not fit in memory.
+  if (uhi - ulo > opt.max_footprint_mm || vhi - vlo > opt.max_footprint_mm) {
+    std::ostringstream os;
+    os << std::setprecision(3) << "the vertebrae face each other over " << (uhi - ulo) << " x "
+       << (vhi - vlo) << " mm, more than the " << opt.max_footprint_mm
+       << " mm any vertebral body spans: a surface in the wrong units (--units)?";
+    throw std::invalid_argument(os.str());
+  }
   step_ = opt.grid_step_mm;
   u0_ = ulo;
   v0_ = vlo;
@@ -320,6 +332,50 @@ std::vector<char> DiscBetween::height_fields(const TriSurface& inf, const TriSur
         "the vertebrae do not face each other: the endplates overlap (gap <= 0 mm everywhere)");
 
   return facing;
+}
+
+// 3b. Holes in an endplate (a missing triangle of a segmented surface, a defect): inside the
+//     footprint, columns where a ray missed the endplate or hit the far side of the vertebra get
+//     heights interpolated from their facing neighbours (Laplace fill), so the disc surface and
+//     its rims stay on the endplates instead of dipping into the hole (where CGAL's protection of
+//     the rims never finished). info().filled_columns says how many.
+void DiscBetween::fill_holes(const std::vector<char>& facing, const std::vector<char>& mask) {
+  std::vector<std::size_t> holes;
+  for (std::size_t k = 0; k < mask.size(); ++k)
+    if (mask[k] && !facing[k]) holes.push_back(k);
+  info_.filled_columns = long(holes.size());
+  info_.filled_area_mm2 = double(holes.size()) * step_ * step_;
+  if (holes.empty()) return;
+  for (std::vector<double>* field : {&s_inf_, &s_sup_}) {
+    std::vector<double>& f = *field;
+    std::vector<char> known(f.size(), 0);
+    for (std::size_t k = 0; k < f.size(); ++k) known[k] = facing[k] && std::isfinite(f[k]);
+    // Start each hole column from the mean of its known neighbours (grown inwards), then relax.
+    for (int sweep = 0; sweep < 500; ++sweep) {
+      double change = 0;
+      bool unset = false;
+      for (const std::size_t k : holes) {
+        const int i = int(k % std::size_t(nu_)), j = int(k / std::size_t(nu_));
+        double sum = 0;
+        int n = 0;
+        const int nb[4][2] = {{i + 1, j}, {i - 1, j}, {i, j + 1}, {i, j - 1}};
+        for (const auto& q : nb) {
+          if (q[0] < 0 || q[1] < 0 || q[0] >= nu_ || q[1] >= nv_) continue;
+          const std::size_t m = idx(q[0], q[1]);
+          if (known[m]) sum += f[m], ++n;
+        }
+        if (n == 0) {
+          unset = unset || !known[k];
+          continue;
+        }
+        const double value = sum / n;
+        change = std::max(change, known[k] ? std::abs(value - f[k]) : INFINITY);
+        f[k] = value;
+        known[k] = 1;
+      }
+      if (!unset && change < 1e-6) break;
+    }
+  }
 }
 
 // 3. Largest 4-connected facing component, holes filled; c0 its centroid.
@@ -499,6 +555,30 @@ std::vector<std::vector<Eigen::Vector3d>> DiscBetween::feature_polylines(double 
 
 }  // namespace
 
+namespace {
+
+/// The rims CGAL protects must lie on smooth endplates: a rim that is not finite or drops by more
+/// than its own length between neighbouring samples runs into a hole or a broken part of the
+/// surface, and CGAL's edge protection never finishes on it. Refused, saying where.
+void check_rims(const std::vector<std::vector<Eigen::Vector3d>>& rims) {
+  for (const auto& rim : rims)
+    for (std::size_t k = 1; k < rim.size(); ++k) {
+      const Eigen::Vector3d &a = rim[k - 1], &b = rim[k];
+      const double run = std::hypot(b.x() - a.x(), b.z() - a.z()), rise = std::abs(b.y() - a.y());
+      if (!a.allFinite() || !b.allFinite() || rise > run + 0.05) {
+        std::ostringstream os;
+        os << std::setprecision(3) << "the endplate surface is open or broken under the disc's rim "
+           << "near (" << a.x() << ", " << a.z() << ") mm in the disc frame (the rim "
+           << (a.allFinite() && b.allFinite() ? "drops by " + std::to_string(rise) + " mm"
+                                              : "finds no endplate")
+           << "): close the surface's holes there";
+        throw std::invalid_argument(os.str());
+      }
+    }
+}
+
+}  // namespace
+
 VertebraDiscInfo analyse_vertebra_pair(const TriSurface& inferior_vertebra,
                                        const TriSurface& superior_vertebra,
                                        const VertebraDiscOptions& opt) {
@@ -519,6 +599,7 @@ TetMesh mesh_disc_between_vertebrae(const TriSurface& inferior_vertebra,
   body.bounding_radius_mm = disc->bounding_radius();
   body.exact_volume_mm3 = disc->info().volume_mm3;
   body.features = disc->feature_polylines(std::min(0.25, 0.1 * mesh_opt.cell_size_mm));
+  check_rims(body.features);
   body.name = "disc between vertebrae";
   TetMesh m = mesh_labeled_body(body, mesh_opt);
   // Local (upright) -> global: x = origin + axes x_local; a rotation keeps tet orientation.

@@ -35,6 +35,7 @@ struct MeshArgs {
   bool no_perturb = false, no_exude = false, json = false, quiet = false;
   bool structured = false;
   mesh::StructuredDiscOptions structured_opt;
+  double max_elements = mesh::MeshOptions().max_elements;
   std::vector<std::string> cgal_flags_given, structured_flags_given;  ///< filled after parsing
 };
 
@@ -54,7 +55,9 @@ void check_mesher_flags(const MeshArgs& a) {
     if (!a.inferior.empty() || !a.superior.empty())
       throw std::invalid_argument(
           "--structured meshes a parametric level: give --level, not --inferior/--superior");
-    mesh::validate(a.structured_opt);
+    mesh::StructuredDiscOptions so = a.structured_opt;
+    so.max_elements = a.max_elements;
+    mesh::validate(so);
   } else if (!a.structured_flags_given.empty()) {
     throw std::invalid_argument(joined(a.structured_flags_given) + " only apply with --structured");
   }
@@ -85,9 +88,18 @@ void run_mesh_disc(const MeshArgs& a) {
   mesh::MeshOptions opt = a.opt;
   opt.perturb = !a.no_perturb;
   opt.exude = !a.no_exude;
-  if (!(opt.cell_size_mm > 0) || !(opt.facet_distance_mm > 0) || !(opt.radius_edge_ratio >= 1.0))
-    throw std::invalid_argument(
-        "--cell-size and --facet-distance must be > 0 mm, --radius-edge >= 1");
+  // The mesher's own bounds (mesh_labeled_body), checked before any work; NaN fails every test.
+  if (!(opt.cell_size_mm > 0) || !std::isfinite(opt.cell_size_mm) ||
+      !(opt.facet_distance_mm > 0) || !std::isfinite(opt.facet_distance_mm))
+    throw std::invalid_argument("--cell-size and --facet-distance must be finite numbers > 0 mm");
+  if (!(opt.facet_size_mm >= 0) || !std::isfinite(opt.facet_size_mm))
+    throw std::invalid_argument("--facet-size must be 0 (the cell size) or a finite number > 0 mm");
+  if (!(opt.radius_edge_ratio >= 2.0) || !std::isfinite(opt.radius_edge_ratio))
+    throw std::invalid_argument("--radius-edge must be a finite number >= 2 (CGAL's bound)");
+  if (!(opt.facet_angle_deg > 0 && opt.facet_angle_deg <= 30))
+    throw std::invalid_argument("--facet-angle must lie in (0, 30] degrees (CGAL's bound)");
+  if (!(a.max_elements >= 1)) throw std::invalid_argument("--max-elements must be >= 1");
+  opt.max_elements = a.max_elements;
   const bool from_vertebrae = !a.inferior.empty() || !a.superior.empty();
   if (from_vertebrae == !a.level.empty())
     throw std::invalid_argument("give either --level or both --inferior and --superior");
@@ -115,7 +127,14 @@ void run_mesh_disc(const MeshArgs& a) {
     exact_volume = info.volume_mm3;  // quadrature of the endplate gap over the footprint
     j["inferior"] = a.inferior;
     j["superior"] = a.superior;
-    j["disc"] = {{"footprint_area_mm2", info.footprint_area_mm2},
+    if (info.filled_columns > 0)
+      std::cerr << "spinesim: warning: the endplates have holes: " << info.filled_columns
+                << " columns (" << fixed(info.filled_area_mm2, 2)
+                << " mm^2) of the disc's footprint got endplate heights interpolated from around "
+                   "them\n";
+    j["disc"] = {{"filled_columns", info.filled_columns},
+                 {"filled_area_mm2", info.filled_area_mm2},
+                 {"footprint_area_mm2", info.footprint_area_mm2},
                  {"center_height_mm", info.center_height_mm},
                  {"min_height_mm", info.min_height_mm},
                  {"max_height_mm", info.max_height_mm},
@@ -128,7 +147,8 @@ void run_mesh_disc(const MeshArgs& a) {
     const DiscPlacement placement =
         a.placement == "spine" ? DiscPlacement::spine : DiscPlacement::local;
     if (a.structured) {
-      const auto& so = a.structured_opt;
+      mesh::StructuredDiscOptions so = a.structured_opt;
+      so.max_elements = a.max_elements;
       progress.begin("meshing " + dims.level + " (structured, " + std::to_string(so.sectors) +
                      " sectors, " + std::to_string(so.rings) + " rings, " +
                      std::to_string(so.layers) + " layers)");
@@ -222,6 +242,9 @@ void register_mesh(CLI::App& app) {
       disc->add_flag("--no-exude", a->no_exude, "Skip the sliver exuder"),
       disc->add_option("--seed", a->opt.seed, "Random seed (same seed, same mesh)")
           ->capture_default_str()};
+  disc->add_option("--max-elements", a->max_elements,
+                   "Refuse, before meshing, a mesh expected to exceed this many elements")
+      ->capture_default_str();
   disc->add_flag(
       "--structured", a->structured,
       "Structured sweep mesh of a parametric level (a few hundred tets; no CGAL criteria)");

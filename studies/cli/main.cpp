@@ -13,6 +13,7 @@
 
 #include <cstdlib>
 #include <iostream>
+#include <new>
 
 // OpenBLAS (under supernodal CHOLMOD) busy-waits its worker threads; on 2-core machines any
 // other load made a P2 factorisation several times slower with 2 threads than with 1
@@ -45,10 +46,18 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     // One line and status 1, like every other error (CLI11's own exit() adds a second line
     // and uses codes such as 104 for a bad number).
-    std::cerr << "spinesim: error: " << e.what() << " (see --help)" << std::endl;
+    std::cerr << "spinesim: error: " << spinesim::studies::one_line(e.what()) << " (see --help)"
+              << std::endl;
+    return 1;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "spinesim: error: out of memory: the input asks for more than this machine has "
+                 "(a finer resolution or a larger surface than intended?)"
+              << std::endl;
     return 1;
   } catch (const std::exception& e) {
-    std::cerr << "spinesim: error: " << e.what() << std::endl;
+    // The error is always the last line, and one line: a newline in a user's string (a case
+    // or material name) is folded into it.
+    std::cerr << "spinesim: error: " << spinesim::studies::one_line(e.what()) << std::endl;
     return 1;
   }
   return 0;

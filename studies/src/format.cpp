@@ -29,7 +29,8 @@ std::string significant(double v, int digits) {
 }
 
 std::string one_line(std::string s) {
-  std::replace(s.begin(), s.end(), '\n', ' ');
+  for (char& c : s)  // newlines, carriage returns and other control characters
+    if (static_cast<unsigned char>(c) < 0x20 && c != '\t') c = ' ';
   return s;
 }
 

@@ -101,3 +101,27 @@ TEST(HostileInput, LoadsWhoseNormOverflowsAreRefusedNotConverged) {
   expect_refused_cleanly("spine solve --force T1:1e155,0,0", "outside any physical load");
   expect_refused_cleanly("spine solve --force T1:100,0,0 --at 1e300,0,0", "from the origin");
 }
+
+// Absurd resolutions are refused in a moment, before any allocation, naming the estimate.
+TEST(HostileInput, AbsurdMeshResolutionsAreRefusedBeforeMeshing) {
+  const std::string out = quoted(tmp("absurd.vtu"));
+  for (const std::string& flags :
+       {"--cell-size 1e-6", "--facet-distance 1e-9", "--facet-size 1e-6"})
+    expect_refused_cleanly("mesh disc --level L4-L5 " + flags + " --out " + out,
+                           "more than the limit of");
+  expect_refused_cleanly("mesh disc --level L4-L5 --structured --sectors 1000000 --out " + out,
+                         "more than the limit of");
+  expect_refused_cleanly("mesh disc --level L4-L5 --cell-size 3 --max-elements 100 --out " + out,
+                         "more than the limit of 100");
+  // Values the mesher cannot take are refused by the command line with the mesher's bounds.
+  expect_refused_cleanly("mesh disc --level L4-L5 --facet-size -1 --out " + out, "--facet-size");
+  expect_refused_cleanly("mesh disc --level L4-L5 --facet-size nan --out " + out, "--facet-size");
+  expect_refused_cleanly("mesh disc --level L4-L5 --radius-edge 1.5 --out " + out,
+                         "--radius-edge must be a finite number >= 2");
+}
+
+// A user's string with a newline in it still makes a one-line error.
+TEST(HostileInput, NewlinesInUserStringsStayOnTheErrorLine) {
+  expect_refused_cleanly("fem --mesh " + quoted(disc()) + " --case \"$(printf 'flex\\nion')\"",
+                         "unknown load case");
+}

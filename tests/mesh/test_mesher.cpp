@@ -7,8 +7,13 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <map>
+#include <tuple>
 
 using namespace spinesim::mesh;
 
@@ -138,4 +143,56 @@ TEST(Mesher, L4L5AtOnePointFiveMillimetres) {
   EXPECT_GE(q.min_dihedral_deg, 10.0);
   EXPECT_LT(std::abs(q.volume_error()), 0.02);
   EXPECT_NEAR(double(q.annulus_tets + q.nucleus_tets), double(q.tets), 0.0);
+}
+
+// The size estimate that guards the mesher against absurd resolutions is an estimate of what
+// CGAL makes: within a factor of two of the real count (tetrahedra + boundary triangles) at two
+// resolutions.
+TEST(Mesher, ExpectedElementsTracksTheRealCount) {
+  for (double cell : {3.0, 2.0}) {
+    MeshOptions o;
+    o.cell_size_mm = cell;
+    const TetMesh m = mesh_parametric_disc(l4_l5(), o);
+    const auto q = quality_report(m, parametric_disc_volume(l4_l5()));
+    std::map<std::array<Eigen::Index, 3>, int> faces;
+    for (Eigen::Index t = 0; t < m.num_tets(); ++t)
+      for (int k = 0; k < 4; ++k) {
+        std::array<Eigen::Index, 3> f{m.T(t, (k + 1) % 4), m.T(t, (k + 2) % 4),
+                                      m.T(t, (k + 3) % 4)};
+        std::sort(f.begin(), f.end());
+        ++faces[f];
+      }
+    double boundary = 0;
+    for (const auto& [f, n] : faces) boundary += n == 1;
+    const double real = double(q.tets) + boundary;
+    const double est = expected_elements(parametric_disc_volume(l4_l5()), 30.0, o);
+    std::printf("cell %.1f mm: %lld tets + %.0f boundary triangles, estimate %.0f\n", cell,
+                (long long)q.tets, boundary, est);
+    EXPECT_GT(est, 0.5 * real) << "cell " << cell;
+    EXPECT_LT(est, 2.0 * real) << "cell " << cell;
+  }
+}
+
+// Absurd resolutions are refused before any allocation, naming the estimate and the limit.
+TEST(Mesher, ResolutionsBeyondTheElementLimitAreRefusedAtOnce) {
+  for (const auto& [cell, distance, facet] :
+       {std::tuple{1e-6, 0.1, 0.0}, std::tuple{2.0, 1e-9, 0.0}, std::tuple{2.0, 0.1, 1e-6}}) {
+    MeshOptions o;
+    o.cell_size_mm = cell;
+    o.facet_distance_mm = distance;
+    o.facet_size_mm = facet;
+    const auto t0 = std::chrono::steady_clock::now();
+    try {
+      mesh_parametric_disc(l4_l5(), o);
+      ADD_FAILURE() << "meshed at cell " << cell;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("more than the limit of"), std::string::npos)
+          << e.what();
+    }
+    EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 5.0);
+  }
+  MeshOptions raised;  // the limit is the user's to raise
+  raised.cell_size_mm = 3.0;
+  raised.max_elements = 100;
+  EXPECT_THROW(mesh_parametric_disc(l4_l5(), raised), std::invalid_argument);
 }

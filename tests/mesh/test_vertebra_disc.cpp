@@ -99,3 +99,53 @@ TEST(VertebraDisc, RefusesBadInput) {
   aside.V.col(0).array() += 80.0;
   EXPECT_THROW(analyse_vertebra_pair(l5, aside), std::invalid_argument);
 }
+
+// A hole in an endplate, as a segmentation leaves it: with one triangle (the last face of L5's
+// file) missing, the disc still meshes — the hole's columns take their neighbours' heights and
+// the count is reported — where CGAL's rim protection used to run forever.
+TEST(VertebraDisc, OneTriangleHoleInAnEndplateIsFilledAndReported) {
+  SKIP_WITHOUT_DATA();
+  TriSurface l5 = load("L5_body.obj");
+  const TriSurface l4 = load("L4_body.obj");
+  const VertebraDiscInfo closed = analyse_vertebra_pair(l5, l4);
+  EXPECT_EQ(closed.filled_columns, 0);
+  Eigen::MatrixX3i F = l5.F.topRows(l5.F.rows() - 1);
+  l5.F = F;
+  VertebraDiscInfo info;
+  const TetMesh m = mesh_disc_between_vertebrae(l5, l4, coarse(), {}, &info);
+  EXPECT_GT(info.filled_columns, 0);
+  EXPECT_NEAR(info.filled_area_mm2, double(info.filled_columns) * 0.25 * 0.25, 1e-12);
+  EXPECT_NEAR(info.volume_mm3, closed.volume_mm3, 0.01 * closed.volume_mm3);  // a tiny hole
+  EXPECT_NO_THROW(require_endplate_labels(m));
+}
+
+// A rim over a larger open part of the endplate is refused in seconds, saying where.
+TEST(VertebraDisc, RimOverAnOpenEndplateIsRefusedNotAHang) {
+  SKIP_WITHOUT_DATA();
+  TriSurface l5 = load("L5_body.obj"), l4 = load("L4_body.obj");
+  for (TriSurface* s : {&l5, &l4}) {
+    Eigen::MatrixX3i F = s->F.topRows(s->F.rows() - 50);
+    s->F = F;
+  }
+  try {
+    mesh_disc_between_vertebrae(l5, l4, coarse(), {});
+    ADD_FAILURE() << "an open endplate under the rim was meshed";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("open or broken under the disc's rim"), std::string::npos)
+        << e.what();
+  }
+}
+
+// A surface in the wrong units (cm read as m: 100x too big) is refused before any allocation.
+TEST(VertebraDisc, SurfacesInTheWrongUnitsAreRefusedByTheirFootprint) {
+  SKIP_WITHOUT_DATA();
+  TriSurface l5 = load("L5_body.obj"), l4 = load("L4_body.obj");
+  l5.V *= 100.0;
+  l4.V *= 100.0;
+  try {
+    analyse_vertebra_pair(l5, l4);
+    ADD_FAILURE() << "a 5 m footprint was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("wrong units"), std::string::npos) << e.what();
+  }
+}

@@ -29,7 +29,19 @@ struct MeshOptions {
   bool perturb = true;
   bool exude = true;
   std::uint32_t seed = 0;  ///< CGAL random seed, for reproducible meshes
+  /// Refuse (before meshing) when the expected element count exceeds this: an absurd resolution
+  /// or a surface in the wrong units must not run a machine out of memory. See
+  /// expected_elements.
+  double max_elements = 2e6;
 };
+
+/// Expected number of elements (tetrahedra + boundary triangles) of a body of volume
+/// `volume_mm3` within a sphere of `bounding_radius_mm` meshed with `opt`: 6 V / r³ tetrahedra
+/// for cell size r (a regular tetrahedron of circumradius r has 0.51 r³; CGAL's cells average
+/// about a third of that: 3133 tetrahedra for L4-L5 at 3 mm, estimate 3353), and A / (0.43 e²)
+/// triangles of edge e = min(facet size, √(8 R · facet distance)) (the chord of a curvature
+/// radius R within the facet distance) over the area A = 6 V^(2/3) of a cube of that volume.
+double expected_elements(double volume_mm3, double bounding_radius_mm, const MeshOptions& opt);
 
 /// A body given by a labelling function: 0 outside, positive label inside (the tet `region`).
 /// `bounding_radius_mm` and `center_mm` bound the body; `exact_volume_mm3` (if known, else <0)

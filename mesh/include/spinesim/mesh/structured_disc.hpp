@@ -61,9 +61,11 @@ struct StructuredDiscOptions {
   /// (O(1/sectors^2)). true: every section stretched about its centroid so the rim polygon
   /// has the outline's exact area (rim nodes up to ~3 % of the radius outside at 12 sectors).
   bool match_area = false;
+  double max_elements = 2e6;  ///< refused above this many tetrahedra (before any allocation)
 };
 
-/// Throws std::invalid_argument (one line) unless sectors >= 6, rings >= 2, layers >= 1.
+/// Throws std::invalid_argument (one line) unless sectors >= 6, rings >= 2, layers >= 1 and the
+/// tetrahedron count is within max_elements.
 void validate(const StructuredDiscOptions& opt);
 
 /// Ring scales s_1 < ... < s_rings = 1 about the centroid (see the header comment, step 2);

@@ -30,6 +30,7 @@ struct VertebraDiscOptions {
   double facing_angle_deg = 40.0;  ///< endplate triangles: normal within this of the axis
   double max_gap_mm = 30.0;        ///< larger endplate gaps are refused as absurd
   double grid_step_mm = 0.25;      ///< column spacing of the height fields
+  double max_footprint_mm = 200;   ///< facing extents beyond this are refused (wrong units)
   double rim_margin_mm = 0.5;      ///< wall placed this far inside the facing footprint
   int outline_harmonics = 12;      ///< Fourier terms kept in the smoothed outline
   double nucleus_area_fraction = 0.4;
@@ -43,6 +44,10 @@ struct VertebraDiscInfo {
   double min_height_mm = 0, max_height_mm = 0;  ///< over the footprint
   double volume_mm3 = 0;                        ///< ∫ gap dA over the footprint (quadrature)
   double width_mm = 0, depth_mm = 0;            ///< extents of the outline along frame x and z
+  /// Footprint columns whose endplate heights were interpolated: a hole in an endplate (the ray
+  /// missed it or hit the far side of the vertebra). 0 for closed endplates.
+  long filled_columns = 0;
+  double filled_area_mm2 = 0;
 };
 
 /// Finds the facing endplates and the disc body without meshing. Throws
