@@ -88,7 +88,8 @@ TriSurface read_surface(const std::string& path, double units_to_mm, UpAxis up) 
     fail("unknown surface file extension '" + ext + "' (use .stl, .obj, .ply or .off)");
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec))
-    fail(path_kind(path).empty() ? "no such file" : "it is " + path_kind(path) + ", not a regular file");
+    fail(path_kind(path).empty() ? "no such file"
+                                 : "it is " + path_kind(path) + ", not a regular file");
 
   if (ext == ".stl") {
     const long bad = first_nonfinite_binary_stl_facet(path);

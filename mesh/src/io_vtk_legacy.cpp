@@ -284,9 +284,9 @@ TetMesh read_vtk_legacy(const std::string& path, std::vector<DataArray>* point_d
                         std::vector<DataArray>* cell_data) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec))
-    detail::FileError{"read_vtk", path}.fail(path_kind(path).empty()
-                                                 ? "no such file"
-                                                 : "it is " + path_kind(path) + ", not a regular file");
+    detail::FileError{"read_vtk", path}.fail(path_kind(path).empty() ? "no such file"
+                                                                     : "it is " + path_kind(path) +
+                                                                           ", not a regular file");
   std::ifstream in(path, std::ios::binary);
   LegacyReader r(
       path, std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()));

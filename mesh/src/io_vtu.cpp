@@ -219,6 +219,23 @@ bool vtk_type(const std::string& t, VtkType& out) {
   return false;
 }
 
+/// A count or offset attribute: decimal digits only (tinyxml2 alone reads "7.5e2" as 7).
+tinyxml2::XMLError count_attribute(const tinyxml2::XMLElement* e, const char* name,
+                                   std::int64_t* value) {
+  const char* text = e->Attribute(name);
+  if (!text) return tinyxml2::XML_NO_ATTRIBUTE;
+  std::string t(text);
+  while (!t.empty() && (t.back() == ' ' || t.back() == '\t')) t.pop_back();
+  std::size_t start = t.find_first_not_of(" \t");
+  if (start == std::string::npos || t.size() - start > 18)
+    return tinyxml2::XML_WRONG_ATTRIBUTE_TYPE;
+  t = t.substr(start);
+  if (!std::all_of(t.begin(), t.end(), [](char c) { return c >= '0' && c <= '9'; }))
+    return tinyxml2::XML_WRONG_ATTRIBUTE_TYPE;
+  *value = std::stoll(t);
+  return tinyxml2::XML_SUCCESS;
+}
+
 double decode_value(const unsigned char* p, VtkType t, bool swap) {
   unsigned char b[8];
   const std::size_t n = std::min<std::size_t>(std::size_t(t.size), sizeof b);  // 1, 2, 4 or 8
@@ -442,7 +459,7 @@ RawArray read_array(const Reader& r, const tinyxml2::XMLElement* da) {
     a.v = to_values(r, label, read_block(r, label, bytes.data(), bytes.size()), t);
   } else if (format == "appended") {
     std::int64_t offset = -1;
-    if (da->QueryInt64Attribute("offset", &offset) != tinyxml2::XML_SUCCESS)
+    if (count_attribute(da, "offset", &offset) != tinyxml2::XML_SUCCESS)
       r.fail("DataArray '" + label + "' is appended but has no offset");
     a.v = to_values(r, label, appended_block(r, label, offset), t);
   } else {
@@ -530,7 +547,7 @@ void collect_offsets(Reader& r, const tinyxml2::XMLElement* e) {
   for (const auto* c = e->FirstChildElement(); c; c = c->NextSiblingElement()) {
     std::int64_t off = 0;
     if (std::strcmp(c->Name(), "DataArray") == 0 &&
-        c->QueryInt64Attribute("offset", &off) == tinyxml2::XML_SUCCESS)
+        count_attribute(c, "offset", &off) == tinyxml2::XML_SUCCESS)
       r.appended_offsets.push_back(off);
     collect_offsets(r, c);
   }
@@ -646,10 +663,10 @@ TetMesh read_vtu(const std::string& path, std::vector<DataArray>* point_data,
 
   // 2. The grid's arrays, decoded.
   detail::RawGrid g;
-  if (piece->QueryInt64Attribute("NumberOfPoints", &g.num_points) != tinyxml2::XML_SUCCESS ||
+  if (count_attribute(piece, "NumberOfPoints", &g.num_points) != tinyxml2::XML_SUCCESS ||
       g.num_points < 0)
     r.fail("Piece has no valid NumberOfPoints");
-  if (piece->QueryInt64Attribute("NumberOfCells", &g.num_cells) != tinyxml2::XML_SUCCESS ||
+  if (count_attribute(piece, "NumberOfCells", &g.num_cells) != tinyxml2::XML_SUCCESS ||
       g.num_cells < 0)
     r.fail("Piece has no valid NumberOfCells");
   if (g.num_points == 0 || g.num_cells == 0)

@@ -133,12 +133,11 @@ void validate(const StructuredDiscOptions& opt) {
   // tets = 3 layers sectors (2 rings - 1), in double: the product of absurd counts overflows int.
   const double tets = 3.0 * opt.layers * opt.sectors * (2.0 * opt.rings - 1.0);
   if (tets > opt.max_elements)
-    throw std::invalid_argument("structured disc: " + std::to_string(opt.sectors) + " sectors, " +
-                                std::to_string(opt.rings) + " rings and " +
-                                std::to_string(opt.layers) + " layers make " +
-                                std::to_string(static_cast<long long>(tets)) +
-                                " tetrahedra, more than the limit of " +
-                                std::to_string(static_cast<long long>(opt.max_elements)));
+    throw std::invalid_argument(
+        "structured disc: " + std::to_string(opt.sectors) + " sectors, " +
+        std::to_string(opt.rings) + " rings and " + std::to_string(opt.layers) + " layers make " +
+        std::to_string(static_cast<long long>(tets)) + " tetrahedra, more than the limit of " +
+        std::to_string(static_cast<long long>(opt.max_elements)));
 }
 
 std::vector<double> structured_ring_scales(int rings) {

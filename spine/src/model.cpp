@@ -281,7 +281,11 @@ std::vector<int> parse_fusion(const std::string& levels) {
             "fusion level '" + item + "': " + joint +
             " is not a joint of adjacent vertebrae (known: " + joined(names) + ")");
       const int j = joint_index(joint);
-      if (std::find(joints.begin(), joints.end(), j) == joints.end()) joints.push_back(j);
+      // Given twice (L3-L4,L3-L4) or overlapping (L3-L4-L5,L4-L5): a typo, refused not merged.
+      if (std::find(joints.begin(), joints.end(), j) != joints.end())
+        throw std::invalid_argument("fusion level '" + item + "': joint " + joint +
+                                    " is already fused by an earlier level");
+      joints.push_back(j);
     }
   }
   if (joints.empty()) throw std::invalid_argument("no fusion level given");

@@ -9,6 +9,8 @@
 // prints the quality report (tet count, dihedral angles, radius-edge ratio, volume vs exact).
 #include "cli_common.hpp"
 
+#include "spinesim/common/atomic_file.hpp"
+
 #include "spinesim/studies/disc_level.hpp"
 #include "spinesim/studies/mesh_report.hpp"
 
@@ -89,8 +91,8 @@ void run_mesh_disc(const MeshArgs& a) {
   opt.perturb = !a.no_perturb;
   opt.exude = !a.no_exude;
   // The mesher's own bounds (mesh_labeled_body), checked before any work; NaN fails every test.
-  if (!(opt.cell_size_mm > 0) || !std::isfinite(opt.cell_size_mm) ||
-      !(opt.facet_distance_mm > 0) || !std::isfinite(opt.facet_distance_mm))
+  if (!(opt.cell_size_mm > 0) || !std::isfinite(opt.cell_size_mm) || !(opt.facet_distance_mm > 0) ||
+      !std::isfinite(opt.facet_distance_mm))
     throw std::invalid_argument("--cell-size and --facet-distance must be finite numbers > 0 mm");
   if (!(opt.facet_size_mm >= 0) || !std::isfinite(opt.facet_size_mm))
     throw std::invalid_argument("--facet-size must be 0 (the cell size) or a finite number > 0 mm");
@@ -166,8 +168,10 @@ void run_mesh_disc(const MeshArgs& a) {
   const auto q = mesh::quality_report(m, exact_volume);
 
   progress.begin("writing " + a.out);
-  mesh::write_vtu(a.out, m);
-  if (!a.medit.empty()) mesh::write_medit(a.medit, m);
+  OutputSet outputs("mesh disc");  // the VTU and the MEDIT copy: both or neither
+  mesh::write_vtu(outputs.stage(a.out), m);
+  if (!a.medit.empty()) mesh::write_medit(outputs.stage(a.medit), m);
+  outputs.commit();
   progress.end();
 
   j.update(quality_json(q));

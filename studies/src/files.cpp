@@ -42,12 +42,24 @@ void VtuSeries::add(double time_s, const mss::MssModel& model, const Eigen::Vect
   entries_.push_back({time_s, rel});
 }
 
-void VtuSeries::finish() { mesh::write_pvd(pvd_path_, entries_); }
+VtuSeries::~VtuSeries() {
+  if (finished_) return;
+  try {
+    discard();
+  } catch (...) {  // a destructor does not throw; what could not be removed stays
+  }
+}
+
+void VtuSeries::finish() {
+  mesh::write_pvd(pvd_path_, entries_);
+  finished_ = true;
+}
 
 void VtuSeries::discard() {
-  for (const std::string& f : frame_paths()) fs::remove(f);
-  entries_.clear();
+  finished_ = true;  // nothing left to clean up
   std::error_code ec;
+  for (const std::string& f : frame_paths()) fs::remove(f, ec);
+  entries_.clear();
   fs::remove(folder_, ec);  // only if empty
 }
 

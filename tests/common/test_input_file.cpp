@@ -118,3 +118,25 @@ TEST(AtomicWrite, NeverReplacesWhatIsNotARegularFile) {
   for (const auto& entry : fs::directory_iterator(fs::path(target).parent_path()))
     EXPECT_EQ(entry.path().string().find(".tmp-"), std::string::npos) << entry.path();
 }
+
+// Files that belong together appear together: a set abandoned before commit() leaves nothing.
+TEST(OutputSet, AllOrNothing) {
+  const std::string a = tmp("set-a.vtu"), b = tmp("set-b.mesh");
+  {
+    spinesim::OutputSet set("test");
+    write(set.stage(a), "a");
+    write(set.stage(b), "b");
+    // destroyed without commit, as when the second write throws
+  }
+  EXPECT_FALSE(fs::exists(a));
+  EXPECT_FALSE(fs::exists(b));
+  for (const auto& e : fs::directory_iterator(fs::path(a).parent_path()))
+    EXPECT_EQ(e.path().string().find(".staged-"), std::string::npos) << e.path();
+  spinesim::OutputSet set("test");
+  write(set.stage(a), "a");
+  write(set.stage(b), "b");
+  set.commit();
+  EXPECT_TRUE(fs::exists(a));
+  EXPECT_TRUE(fs::exists(b));
+  EXPECT_THROW(set.stage("/dev/null"), std::invalid_argument);
+}

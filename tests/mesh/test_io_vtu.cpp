@@ -389,6 +389,10 @@ TEST(IoVtu, BadFilesGiveOneLineErrors) {
       "npoints",
       [](std::string& s) { replace_once(s, "NumberOfPoints=\"8\"", "NumberOfPoints=\"9\""); },
       "NumberOfPoints");
+  expect_read_error(  // a count is an integer: "8.0e0" is not read as 8 (nor "7.5e2" as 7)
+      "npoints_float",
+      [](std::string& s) { replace_once(s, "NumberOfPoints=\"8\"", "NumberOfPoints=\"8.0e0\""); },
+      "NumberOfPoints");
   expect_read_error(
       "index_range",
       [](std::string& s) {

@@ -202,6 +202,8 @@ TEST(SpineModel, NamesAndFusionLevelsParseAndBadOnesAreRefusedByName) {
   EXPECT_THROW(sp::parse_fusion("L3-L5"), std::invalid_argument);
   EXPECT_THROW(sp::parse_fusion("L3"), std::invalid_argument);
   EXPECT_THROW(sp::parse_fusion(""), std::invalid_argument);
+  EXPECT_THROW(sp::parse_fusion("L3-L4,L3-L4"), std::invalid_argument);     // twice
+  EXPECT_THROW(sp::parse_fusion("L3-L4-L5,L4-L5"), std::invalid_argument);  // overlapping
   sp::ModelOptions o;
   o.fused_joints = sp::parse_fusion("L3-L4-L5");
   const auto fused = sp::load_spine_model(SPINESIM_DATA_DIR, o);

@@ -12,6 +12,7 @@
 #include <fstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <sys/stat.h>
@@ -65,6 +66,38 @@ void write_atomically(const std::string& who, const std::string& path, Fill&& fi
     throw;
   }
 }
+
+/// Several files written together or not at all (a mesh's VTU and its MEDIT copy): each is
+/// written to stage(path), a temporary name beside it; commit() renames them all onto their
+/// paths; a set destroyed before commit() removes what it staged. Every path is checked with
+/// require_replaceable first.
+class OutputSet {
+ public:
+  explicit OutputSet(std::string who) : who_(std::move(who)) {}
+  OutputSet(const OutputSet&) = delete;
+  OutputSet& operator=(const OutputSet&) = delete;
+  ~OutputSet() {
+    for (const auto& [tmp, path] : staged_) std::remove(tmp.c_str());
+  }
+  /// The temporary name to write `path`'s content to.
+  std::string stage(const std::string& path) {
+    require_replaceable(who_, path);
+    std::string tmp = path + ".staged-" + std::to_string(::getpid());
+    staged_.emplace_back(tmp, path);
+    return tmp;
+  }
+  void commit() {
+    for (const auto& [tmp, path] : staged_)
+      if (std::rename(tmp.c_str(), path.c_str()) != 0)
+        throw std::runtime_error(who_ + ": " + path + ": cannot replace the file (" +
+                                 std::strerror(errno) + ")");
+    staged_.clear();
+  }
+
+ private:
+  std::string who_;
+  std::vector<std::pair<std::string, std::string>> staged_;  ///< (temporary, final)
+};
 
 /// Writes `text` to `path` completely or not at all; errors name `path`.
 inline void write_text_atomically(const std::string& path, const std::string& text) {

@@ -22,12 +22,17 @@ void require_output_folder(const std::string& path, const std::string& option);
 
 /// A VTU time series of MSS states: frames `<stem>/<stem>_NNNNNN.vtu` next to `<stem>.pvd`
 /// (the PVD lists them relative to its folder). Frames are written as they come (atomically);
-/// finish() writes the PVD; discard() removes every frame written (for a failed run).
+/// finish() writes the PVD; discard() removes every frame written (for a failed run). A series
+/// destroyed before finish() — an exception, a full disk mid-way — discards itself: a run that
+/// fails leaves no half series behind.
 /// Point data `displacement` (mm), cell data `volume_change` (mss/quantities.hpp).
 class VtuSeries {
  public:
   /// `pvd_path` ends in .pvd; its folder must exist; the frame folder is created.
   explicit VtuSeries(const std::string& pvd_path);
+  ~VtuSeries();
+  VtuSeries(const VtuSeries&) = delete;
+  VtuSeries& operator=(const VtuSeries&) = delete;
   void add(double time_s, const mss::MssModel& model, const Eigen::VectorXd& x_mm);
   void finish();
   void discard();
@@ -39,6 +44,7 @@ class VtuSeries {
  private:
   std::string pvd_path_, folder_, stem_;
   std::vector<mesh::PvdEntry> entries_;
+  bool finished_ = false;
 };
 
 }  // namespace spinesim::studies
