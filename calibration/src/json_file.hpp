@@ -24,8 +24,10 @@ auto naming_file(const std::string& path, F&& f) {
   } catch (const std::invalid_argument& e) {
     throw std::invalid_argument("'" + path + "': " + e.what());
   } catch (const nlohmann::json::exception& e) {
-    throw std::invalid_argument("'" + path + "': missing or malformed field (" +
-                                std::string(e.what()) + ")");
+    std::string what = e.what();  // "[json.exception.type_error.302] type must be ...": the reason
+    if (!what.empty() && what[0] == '[' && what.find("] ") != std::string::npos)
+      what = what.substr(what.find("] ") + 2);
+    throw std::invalid_argument("'" + path + "': missing or malformed field (" + what + ")");
   }
 }
 

@@ -119,9 +119,18 @@ TriSurface read_surface(const std::string& path, double units_to_mm, UpAxis up) 
   tris.reserve(polygons.size());
   for (std::size_t f = 0; f < polygons.size(); ++f) {
     const auto& poly = polygons[f];
-    if (poly.size() < 3) fail("face #" + std::to_string(f) + " has fewer than 3 vertices");
+    // CGAL drops an index it cannot read (1e20) from the face: what is short is a bad index.
+    if (poly.size() < 3)
+      fail("face #" + std::to_string(f) + " has fewer than 3 readable vertex indices (an index " +
+           "out of range or not an integer?)");
     for (std::size_t idx : poly)
       if (idx >= nv) fail("face #" + std::to_string(f) + " has a vertex index out of range");
+    // A face naming one vertex twice is malformed (CGAL reads the index "1e20" as 1).
+    for (std::size_t a = 0; a < poly.size(); ++a)
+      for (std::size_t b = a + 1; b < poly.size(); ++b)
+        if (poly[a] == poly[b])
+          fail("face #" + std::to_string(f) + " names vertex " + std::to_string(poly[a] + 1) +
+               " twice (an index that is not an integer?)");
     for (std::size_t k = 1; k + 1 < poly.size(); ++k)
       tris.push_back({int(poly[0]), int(poly[k]), int(poly[k + 1])});
   }

@@ -94,7 +94,11 @@ RegionMaterials material_from_json(const nlohmann::json& j) {
       r.fallback = parse_one(j, "material '" + r.name + "'");
     }
   } catch (const nlohmann::json::exception& e) {
-    throw std::invalid_argument("material '" + r.name + "': " + e.what());
+    std::string what = e.what();  // "[json.exception.type_error.302] type must be ...": the reason
+    if (!what.empty() && what[0] == '[' && what.find("] ") != std::string::npos)
+      what = what.substr(what.find("] ") + 2);
+    throw std::invalid_argument("material '" + r.name + "': a field has the wrong type (" + what +
+                                ")");
   }
   return r;
 }
@@ -115,7 +119,12 @@ RegionMaterials load_material(const std::string& name_or_path, const std::string
     }
     path = preset;
   }
-  return material_from_json(read_json_file(path.string(), "material file"));
+  const nlohmann::json j = read_json_file(path.string(), "material file");
+  try {
+    return material_from_json(j);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument("material file '" + path.string() + "': " + e.what());
+  }
 }
 
 }  // namespace spinesim::mesh

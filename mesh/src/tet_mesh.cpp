@@ -24,6 +24,15 @@ void validate(const TetMesh& m) {
   if (m.num_vertices() == 0 || m.num_tets() == 0)
     throw std::invalid_argument("mesh is empty (no vertices or no tetrahedra)");
   if (!m.V.allFinite()) throw std::invalid_argument("mesh has non-finite vertex coordinates");
+  // Beyond a kilometre no body is in mm, and volumes of such coordinates overflow or lose every
+  // digit (a 1e200 mm point would be reported as a "zero-volume" tetrahedron).
+  Eigen::Index row = 0, col = 0;
+  if (m.V.cwiseAbs().maxCoeff(&row, &col) > 1e6) {
+    std::ostringstream os;
+    os << "mesh vertex #" << row << " has a coordinate of " << m.V(row, col)
+       << " mm, beyond 1e6 mm (1 km): the mesh is not in mm, or the file is corrupt";
+    throw std::invalid_argument(os.str());
+  }
   if (m.region.size() != m.num_tets())
     throw std::invalid_argument("mesh region labels: expected one per tetrahedron");
   if (m.surface.size() != m.num_vertices())

@@ -125,3 +125,13 @@ TEST(HostileInput, NewlinesInUserStringsStayOnTheErrorLine) {
   expect_refused_cleanly("fem --mesh " + quoted(disc()) + " --case \"$(printf 'flex\\nion')\"",
                          "unknown load case");
 }
+
+// A material file with a field of the wrong type: the file is named, not a raw parser code.
+TEST(HostileInput, WrongTypeInAMaterialFileNamesTheFile) {
+  const std::string bad = tmp("typed.json");
+  std::ofstream(bad) << R"({"name": "typed", "E_mpa": "soft", "nu": 0.45})";
+  expect_refused_cleanly("fem --mesh " + quoted(disc()) + " --material " + quoted(bad),
+                         "material file '" + bad + "'");
+  const CliRun r = run_spinesim("fem --mesh " + quoted(disc()) + " --material " + quoted(bad));
+  EXPECT_EQ(r.err.find("[json.exception"), std::string::npos) << r.err;
+}

@@ -167,6 +167,9 @@ TEST(IoSurface, BadInputGivesOneLineErrors) {
   expect_error(spit(dir + "/range.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n"), 1,
                "cannot be read");
   expect_error(spit(dir + "/edge.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n"), 1, "fewer than 3");
+  // An index CGAL cannot read is dropped from the face: the message says what that means.
+  expect_error(spit(dir + "/huge.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 1e20\n"), 1,
+               "not an integer");
   const float nan = std::numeric_limits<float>::quiet_NaN();
   expect_error(write_binary_stl(dir + "/nan.stl", {{0, 0, 0, 1, 0, 0, 0, nan, 0}}), 1,
                "non-finite");

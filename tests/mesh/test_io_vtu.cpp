@@ -408,6 +408,14 @@ TEST(IoVtu, BadFilesGiveOneLineErrors) {
         s.replace(first, s.find(' ', first) - first, "nan");
       },
       "non-finite");
+  expect_read_error(  // a finite coordinate no mesh in mm has: named, not a "zero-volume" tet
+      "huge_point",
+      [](std::string& s) {
+        const auto [a, b] = array_body(s, "Points");
+        const auto first = s.find_first_not_of(" \n", a);
+        s.replace(first, s.find(' ', first) - first, "1e200");
+      },
+      "beyond 1e6 mm");
   expect_read_error(
       "garbage_number",
       [](std::string& s) {
