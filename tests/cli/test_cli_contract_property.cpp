@@ -64,7 +64,8 @@ void check_contract(const std::string& args, const std::string& out) {
     ASSERT_FALSE(lines.empty());
     EXPECT_EQ(lines.back().rfind("spinesim: error:", 0), 0u) << r.err;
   } else if (args.find("--json") != std::string::npos) {
-    EXPECT_NO_THROW((void)nlohmann::json::parse(r.out)) << r.out.substr(0, 200);
+    nlohmann::json parsed;
+    EXPECT_NO_THROW(parsed = nlohmann::json::parse(r.out)) << r.out.substr(0, 200);
   }
   auto after = files_in(tmp_dir());
   for (const auto& f : {tmp_dir() / "cli.stdout", tmp_dir() / "cli.stderr"})
