@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <string>
 
@@ -55,6 +56,23 @@ inline CliRun run_spinesim(const std::string& args) {
   r.out = slurp(out.string());
   r.err = slurp(err.string());
   return r;
+}
+
+/// The files a run added to tmp_dir() (besides the runner's own stdout/stderr captures and
+/// `expected`, which may be empty): `before` is files_in(tmp_dir()) taken before the run.
+inline std::set<std::string> files_in(const fs::path& dir) {
+  std::set<std::string> out;
+  for (const auto& e : fs::recursive_directory_iterator(dir)) out.insert(e.path().string());
+  return out;
+}
+inline std::set<std::string> new_files(const std::set<std::string>& before,
+                                       const std::string& expected = "") {
+  std::set<std::string> after = files_in(tmp_dir());
+  for (const auto& f : {tmp_dir() / "cli.stdout", tmp_dir() / "cli.stderr"})
+    after.erase(f.string());
+  if (!expected.empty()) after.erase(expected);
+  for (const auto& f : before) after.erase(f);
+  return after;
 }
 
 inline int count_lines(const std::string& s) { return int(std::count(s.begin(), s.end(), '\n')); }

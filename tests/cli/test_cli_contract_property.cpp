@@ -39,12 +39,6 @@ std::string six(std::mt19937& rng, double scale) {
 
 int runs_ok = 0, runs_refused = 0;
 
-std::set<std::string> files_in(const fs::path& dir) {
-  std::set<std::string> out;
-  for (const auto& e : fs::recursive_directory_iterator(dir)) out.insert(e.path().string());
-  return out;
-}
-
 void check_contract(const std::string& args, const std::string& out) {
   SCOPED_TRACE(args);
   const auto before = files_in(tmp_dir());
@@ -67,11 +61,7 @@ void check_contract(const std::string& args, const std::string& out) {
     nlohmann::json parsed;
     EXPECT_NO_THROW(parsed = nlohmann::json::parse(r.out)) << r.out.substr(0, 200);
   }
-  auto after = files_in(tmp_dir());
-  for (const auto& f : {tmp_dir() / "cli.stdout", tmp_dir() / "cli.stderr"})
-    after.erase(f.string());
-  if (!out.empty()) after.erase(out);
-  for (const auto& f : before) after.erase(f);
+  const auto after = new_files(before, out);
   EXPECT_TRUE(after.empty()) << "stray file: " << *after.begin();
   if (!out.empty()) fs::remove(out);
 }

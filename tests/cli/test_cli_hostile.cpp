@@ -25,12 +25,6 @@ const std::string& disc() {
   return path;
 }
 
-std::set<std::string> files_in(const fs::path& dir) {
-  std::set<std::string> out;
-  for (const auto& e : fs::recursive_directory_iterator(dir)) out.insert(e.path().string());
-  return out;
-}
-
 /// Refused in one line naming `cause`, and nothing new in the temp folder.
 void expect_refused_cleanly(const std::string& args, const std::string& cause) {
   SCOPED_TRACE(args);
@@ -39,10 +33,7 @@ void expect_refused_cleanly(const std::string& args, const std::string& cause) {
   EXPECT_EQ(r.status, 1) << r.err;
   EXPECT_EQ(count_lines(r.err), 1) << r.err;
   EXPECT_NE(r.err.find(cause), std::string::npos) << r.err;
-  auto after = files_in(tmp_dir());
-  for (const auto& f : {tmp_dir() / "cli.stdout", tmp_dir() / "cli.stderr"})
-    after.erase(f.string());
-  for (const auto& f : before) after.erase(f);
+  const auto after = new_files(before);
   EXPECT_TRUE(after.empty()) << "new file: " << *after.begin();
 }
 
