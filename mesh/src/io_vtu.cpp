@@ -236,6 +236,14 @@ tinyxml2::XMLError count_attribute(const tinyxml2::XMLElement* e, const char* na
   return tinyxml2::XML_SUCCESS;
 }
 
+/// The value of type T stored (native byte order) at `b`.
+template <class T>
+T load(const unsigned char* b) {
+  T x;
+  std::memcpy(&x, b, sizeof x);
+  return x;
+}
+
 double decode_value(const unsigned char* p, VtkType t, bool swap) {
   unsigned char b[8];
   const std::size_t n = std::min<std::size_t>(std::size_t(t.size), sizeof b);  // 1, 2, 4 or 8
@@ -243,63 +251,33 @@ double decode_value(const unsigned char* p, VtkType t, bool swap) {
   if (swap) std::reverse(b, b + n);
   switch (t.kind) {
     case 'f':
-      if (t.size == 4) {
-        float f;
-        std::memcpy(&f, b, 4);
-        return f;
-      } else {
-        double d;
-        std::memcpy(&d, b, 8);
-        return d;
+      return t.size == 4 ? double(load<float>(b)) : load<double>(b);
+    case 'i':
+      switch (t.size) {
+        case 1:
+          return double(load<std::int8_t>(b));
+        case 2:
+          return double(load<std::int16_t>(b));
+        case 4:
+          return double(load<std::int32_t>(b));
+        case 8:
+          return double(load<std::int64_t>(b));
+        default:
+          return 0.0;
       }
-    case 'i': {
-      std::int64_t v = 0;
-      if (t.size == 1) {
-        std::int8_t x;
-        std::memcpy(&x, b, 1);
-        v = x;
+    default:
+      switch (t.size) {
+        case 1:
+          return double(load<std::uint8_t>(b));
+        case 2:
+          return double(load<std::uint16_t>(b));
+        case 4:
+          return double(load<std::uint32_t>(b));
+        case 8:
+          return double(load<std::uint64_t>(b));
+        default:
+          return 0.0;
       }
-      if (t.size == 2) {
-        std::int16_t x;
-        std::memcpy(&x, b, 2);
-        v = x;
-      }
-      if (t.size == 4) {
-        std::int32_t x;
-        std::memcpy(&x, b, 4);
-        v = x;
-      }
-      if (t.size == 8) {
-        std::int64_t x;
-        std::memcpy(&x, b, 8);
-        v = x;
-      }
-      return double(v);
-    }
-    default: {
-      std::uint64_t v = 0;
-      if (t.size == 1) {
-        std::uint8_t x;
-        std::memcpy(&x, b, 1);
-        v = x;
-      }
-      if (t.size == 2) {
-        std::uint16_t x;
-        std::memcpy(&x, b, 2);
-        v = x;
-      }
-      if (t.size == 4) {
-        std::uint32_t x;
-        std::memcpy(&x, b, 4);
-        v = x;
-      }
-      if (t.size == 8) {
-        std::uint64_t x;
-        std::memcpy(&x, b, 8);
-        v = x;
-      }
-      return double(v);
-    }
   }
 }
 
