@@ -1,4 +1,6 @@
-// Surface mesh import (STL/OBJ/PLY/OFF) through CGAL's polygon-soup readers; contract in io.hpp.
+// Surface mesh import (STL/OBJ/PLY/OFF); contract in io.hpp. STL and OBJ go through CGAL's
+// polygon-soup readers, OFF and PLY through our own (surface_soup.hpp: CGAL 5.5's are not safe on
+// malformed files).
 //
 // CGAL 5.5 quirks handled here: the readers append to the output and report an empty STL as a
 // success, so emptiness is checked here; the OBJ reader's index check is off by one (an index
@@ -9,6 +11,8 @@
 #include "spinesim/mesh/io.hpp"
 
 #include "spinesim/common/input_file.hpp"
+
+#include "surface_soup.hpp"
 
 #include <CGAL/IO/polygon_soup_io.h>
 #include <CGAL/Simple_cartesian.h>
@@ -50,26 +54,59 @@ Eigen::Vector3d to_spinesim_frame(const Eigen::Vector3d& p, UpAxis up) {
   return p;
 }
 
-/// CGAL merges STL vertices through a std::map keyed on the point, and a NaN key compares
-/// equivalent to anything, so a NaN vertex would silently be merged into another one. A binary
-/// STL is therefore scanned here first; returns the first bad facet or -1. (CGAL's ASCII parser
-/// does not accept "nan"/"inf" tokens, so ASCII STL fails as unreadable instead.)
-long first_nonfinite_binary_stl_facet(const std::string& path) {
+/// Checks a binary STL before CGAL reads it; returns "" or the reason to refuse it.
+///
+/// CGAL reads a file that does not begin with the word "solid" as binary, as many facets as the
+/// header counts: a count a little off (a truncated or padded file) would silently drop facets
+/// and open a hole in the surface, so the file's size must be exactly what the count says.
+/// CGAL also merges STL vertices through a std::map keyed on the point, and a NaN key compares
+/// equivalent to anything, so a NaN vertex would silently be merged into another one: binary
+/// facets are scanned for non-finite coordinates. (CGAL's ASCII parser does not accept
+/// "nan"/"inf" tokens, so ASCII STL fails as unreadable instead.)
+std::string check_binary_stl(const std::string& path) {
   std::ifstream is(path, std::ios::binary);
-  char header[80];
+  char header[80] = {};
   std::uint32_t n = 0;
-  if (!is.read(header, 80) || !is.read(reinterpret_cast<char*>(&n), 4)) return -1;
+  const bool full = bool(is.read(header, 80)) && bool(is.read(reinterpret_cast<char*>(&n), 4));
+  const bool ascii = std::strncmp(header, "solid", 5) == 0 &&
+                     (header[5] == ' ' || header[5] == '\n' || header[5] == '\r');
   std::error_code ec;
   const auto size = std::filesystem::file_size(path, ec);
-  if (ec || size != 84 + 50 * std::uint64_t(n)) return -1;  // not binary: CGAL parses it as ASCII
+  if (ascii || ec || size == 0) return "";  // ASCII, or empty: CGAL's reader says which
+  if (!full) return "too short for a binary STL (84-byte header) and not ASCII STL";
+  if (size != 84 + 50 * std::uint64_t(n))
+    return "binary STL whose header counts " + std::to_string(n) + " facets (" +
+           std::to_string(84 + 50 * std::uint64_t(n)) + " bytes) but the file has " +
+           std::to_string(size) + " bytes: truncated, padded or not an STL file";
   char facet[50];
   for (std::uint32_t f = 0; f < n && is.read(facet, 50); ++f)
     for (int k = 3; k < 12; ++k) {  // skip the normal (floats 0-2), check the 3 vertices
       float x;
       std::memcpy(&x, facet + 4 * k, 4);
-      if (!std::isfinite(x)) return long(f);
+      if (!std::isfinite(x)) return "facet #" + std::to_string(f) + " has non-finite coordinates";
     }
-  return -1;
+  return "";
+}
+
+/// STL or OBJ through CGAL's reader; `fail` throws with the reason.
+template <class Fail>
+detail::PolygonSoup read_with_cgal(const std::string& path, const std::string& ext, Fail&& fail) {
+  std::vector<Point> points;
+  std::vector<std::vector<std::size_t>> polygons;
+  bool ok = false;
+  try {
+    ok = CGAL::IO::read_polygon_soup(path, points, polygons, CGAL::parameters::verbose(false));
+  } catch (const std::exception& e) {
+    fail(std::string("cannot be read (") + e.what() + ")");
+  }
+  if (!ok)
+    fail(std::string("cannot be read as ") + (ext == ".stl" ? "STL" : "OBJ") +
+         " (corrupt file, or no faces)");
+  detail::PolygonSoup soup;
+  soup.points.reserve(points.size());
+  for (const Point& p : points) soup.points.emplace_back(p.x(), p.y(), p.z());
+  soup.polygons = std::move(polygons);
+  return soup;
 }
 
 }  // namespace
@@ -92,26 +129,25 @@ TriSurface read_surface(const std::string& path, double units_to_mm, UpAxis up) 
                                  : "it is " + path_kind(path) + ", not a regular file");
 
   if (ext == ".stl") {
-    const long bad = first_nonfinite_binary_stl_facet(path);
-    if (bad >= 0) fail("facet #" + std::to_string(bad) + " has non-finite coordinates");
+    const std::string bad = check_binary_stl(path);
+    if (!bad.empty()) fail(bad);
   }
 
   // 1. Polygon soup (no manifoldness required).
-  std::vector<Point> points;
-  std::vector<std::vector<std::size_t>> polygons;
-  bool ok = false;
-  try {
-    ok = CGAL::IO::read_polygon_soup(path, points, polygons, CGAL::parameters::verbose(false));
-  } catch (const std::exception& e) {
-    fail(std::string("cannot be read (") + e.what() + ")");
+  detail::PolygonSoup soup;
+  if (ext == ".off" || ext == ".ply") {
+    const std::string bytes = read_regular_file(path, "surface");
+    try {
+      soup = ext == ".off" ? detail::read_off_soup(bytes) : detail::read_ply_soup(bytes);
+    } catch (const std::invalid_argument& e) {
+      fail(std::string("cannot be read as ") + (ext == ".off" ? "OFF" : "PLY") + ": " + e.what());
+    }
+  } else {
+    soup = read_with_cgal(path, ext, fail);
   }
-  if (!ok) {
-    std::string format = ext.substr(1);
-    std::transform(format.begin(), format.end(), format.begin(),
-                   [](unsigned char c) { return char(std::toupper(c)); });
-    fail("cannot be read as " + format + " (corrupt file, or no faces)");
-  }
-  if (points.empty() || polygons.empty()) fail("contains no triangles");
+  if (soup.points.empty() || soup.polygons.empty()) fail("contains no triangles");
+  const auto& points = soup.points;
+  const auto& polygons = soup.polygons;
 
   // 2. Triangles (fan for polygons), with every index checked.
   const std::size_t nv = points.size();
@@ -125,12 +161,14 @@ TriSurface read_surface(const std::string& path, double units_to_mm, UpAxis up) 
            "out of range or not an integer?)");
     for (std::size_t idx : poly)
       if (idx >= nv) fail("face #" + std::to_string(f) + " has a vertex index out of range");
-    // A face naming one vertex twice is malformed (CGAL reads the index "1e20" as 1).
-    for (std::size_t a = 0; a < poly.size(); ++a)
-      for (std::size_t b = a + 1; b < poly.size(); ++b)
-        if (poly[a] == poly[b])
-          fail("face #" + std::to_string(f) + " names vertex " + std::to_string(poly[a] + 1) +
-               " twice (an index that is not an integer?)");
+    // A face naming one vertex twice is malformed (CGAL reads the index "1e20" as 1). Sorted,
+    // so that a hostile face of a million corners costs n log n, not n^2.
+    std::vector<std::size_t> sorted = poly;
+    std::sort(sorted.begin(), sorted.end());
+    const auto twice = std::adjacent_find(sorted.begin(), sorted.end());
+    if (twice != sorted.end())
+      fail("face #" + std::to_string(f) + " names vertex " + std::to_string(*twice + 1) +
+           " twice (an index that is not an integer?)");
     for (std::size_t k = 1; k + 1 < poly.size(); ++k)
       tris.push_back({int(poly[0]), int(poly[k]), int(poly[k + 1])});
   }
@@ -139,7 +177,7 @@ TriSurface read_surface(const std::string& path, double units_to_mm, UpAxis up) 
   TriSurface s;
   s.V.resize(Eigen::Index(nv), 3);
   for (std::size_t i = 0; i < nv; ++i) {
-    const Eigen::Vector3d p(points[i].x(), points[i].y(), points[i].z());
+    const Eigen::Vector3d& p = points[i];
     if (!p.allFinite()) fail("vertex #" + std::to_string(i) + " has non-finite coordinates");
     s.V.row(Eigen::Index(i)) = to_spinesim_frame(units_to_mm * p, up).transpose();
   }

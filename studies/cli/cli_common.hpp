@@ -3,6 +3,8 @@
 // the studies library (spinesim/studies/).
 #pragma once
 
+#include "flag_values.hpp"
+
 #include "spinesim/studies/data.hpp"
 #include "spinesim/studies/files.hpp"
 #include "spinesim/studies/format.hpp"
@@ -20,9 +22,6 @@ namespace spinesim::cli {
 
 using namespace spinesim::studies;  // the command line is a thin layer over the studies library
 
-/// Parses "a,b,c" into exactly n finite numbers; throws std::invalid_argument naming `what`.
-Eigen::VectorXd parse_numbers(const std::string& text, int n, const std::string& what);
-
 /// --json (one JSON object on stdout; `what` says which) and --quiet (no progress on stderr).
 void add_output_flags(CLI::App* cmd, bool& json, bool& quiet,
                       const std::string& what = "a JSON summary");
@@ -30,9 +29,6 @@ void add_output_flags(CLI::App* cmd, bool& json, bool& quiet,
 /// The plate load options of `fem` and `mss`: --motion, --wrench, --case, --center.
 void add_plate_load_options(CLI::App* cmd, std::string& motion, std::string& wrench,
                             std::string& load_case, std::string& center);
-
-/// "a,b,,c" -> {"a", "b", "c"} (empty items dropped).
-std::vector<std::string> split_list(const std::string& text);
 
 // Sub-command registration; each lives in its own cli_<verb>.cpp.
 void register_mesh(CLI::App& app);

@@ -65,24 +65,6 @@ void check_mesher_flags(const MeshArgs& a) {
   }
 }
 
-double units_to_mm(const std::string& u) {
-  static const std::map<std::string, double> table = {{"mm", 1.0}, {"cm", 10.0}, {"m", 1000.0}};
-  auto it = table.find(u);
-  if (it == table.end())
-    throw std::invalid_argument("unknown --units '" + u + "' (use mm, cm or m)");
-  return it->second;
-}
-
-mesh::UpAxis up_axis(const std::string& u) {
-  static const std::map<std::string, mesh::UpAxis> table = {
-      {"x", mesh::UpAxis::x},        {"y", mesh::UpAxis::y},        {"z", mesh::UpAxis::z},
-      {"-x", mesh::UpAxis::minus_x}, {"-y", mesh::UpAxis::minus_y}, {"-z", mesh::UpAxis::minus_z}};
-  auto it = table.find(u);
-  if (it == table.end())
-    throw std::invalid_argument("unknown --up '" + u + "' (use x, y, z, -x, -y or -z)");
-  return it->second;
-}
-
 void run_mesh_disc(const MeshArgs& a) {
   check_mesher_flags(a);
   require_output_folder(a.out, "--out");  // a device, FIFO or link is refused before meshing

@@ -50,25 +50,6 @@ struct SpineSolveArgs {
   bool no_muscles = false, no_trunk_muscles = false, no_gravity = false, json = false;
 };
 
-/// "T7:0,0,300" → vertebra index and three finite numbers; errors name the option.
-std::pair<int, Eigen::Vector3d> parse_vertebra_vector(const std::string& text,
-                                                      const std::string& option,
-                                                      const std::string& what) {
-  const auto colon = text.find(':');
-  if (colon == std::string::npos)
-    throw std::invalid_argument(option + " '" + text + "': expected VERTEBRA:" + what +
-                                " (e.g. T7:0,0,300)");
-  int vertebra = 0;
-  try {
-    vertebra = spine::vertebra_index(text.substr(0, colon));
-  } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument(option + " '" + text + "': " + e.what());
-  }
-  const Eigen::VectorXd v =
-      parse_numbers(text.substr(colon + 1), 3, option + " " + text.substr(0, colon));
-  return {vertebra, Eigen::Vector3d(v)};
-}
-
 void solve(const SpineSolveArgs& a) {
   // 1. Options and loads, checked before any work (nothing is written on bad input).
   spine::SolveOptions options;

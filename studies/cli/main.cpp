@@ -11,6 +11,8 @@
 // line included: one line on stderr, exit status 1, no partial output file.
 #include "cli_common.hpp"
 
+#include "spinesim/common/pending_output.hpp"
+
 #include <cstdlib>
 #include <iostream>
 #include <new>
@@ -21,6 +23,8 @@
 extern "C" void openblas_set_num_threads(int) __attribute__((weak));
 
 int main(int argc, char** argv) {
+  // A run killed by Ctrl-C, SIGTERM or SIGHUP removes what it had not finished writing.
+  spinesim::remove_pending_outputs_on_signals();
   if (openblas_set_num_threads && !std::getenv("OPENBLAS_NUM_THREADS")) openblas_set_num_threads(1);
   CLI::App app{
       "spinesim: finite-element-validated intervertebral-disc deformation\n"

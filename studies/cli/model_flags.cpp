@@ -52,12 +52,4 @@ std::string model_variant(const ModelFlags& f) {
   return v;
 }
 
-mss::Integrator parse_integrator(const std::string& name) {
-  if (name == "implicit") return mss::Integrator::implicit_euler;
-  if (name == "symplectic") return mss::Integrator::symplectic_euler;
-  if (name == "explicit") return mss::Integrator::explicit_euler;
-  throw std::invalid_argument("unknown --integrator '" + name +
-                              "' (implicit, symplectic, explicit)");
-}
-
 }  // namespace spinesim::cli

@@ -27,7 +27,5 @@ mss::MssOptions model_options(const ModelFlags& flags);
 /// "radial" (thesis) or "no-radial", "+volume-term", "+disc-volume-term", "+no-torsion": the
 /// variant's name for tables.
 std::string model_variant(const ModelFlags& flags);
-/// "implicit", "symplectic" or "explicit"; throws std::invalid_argument naming the choices.
-mss::Integrator parse_integrator(const std::string& name);
 
 }  // namespace spinesim::cli

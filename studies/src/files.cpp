@@ -3,9 +3,13 @@
 #include "spinesim/common/atomic_file.hpp"
 #include "spinesim/mss/quantities.hpp"
 
+#include <cctype>
 #include <cstdio>
 #include <filesystem>
+#include <set>
 #include <stdexcept>
+
+#include <unistd.h>
 
 namespace spinesim::studies {
 namespace fs = std::filesystem;
@@ -23,6 +27,29 @@ void require_output_folder(const std::string& path, const std::string& option) {
   require_replaceable(option, path);  // a device, FIFO or link is refused before the work
 }
 
+namespace {
+
+/// `<parent>/<stem>.staged-PID`: the series' staging folder, created empty.
+std::string make_staging_folder(const fs::path& pvd) {
+  const fs::path dir =
+      pvd.parent_path() / (pvd.stem().string() + ".staged-" + std::to_string(::getpid()));
+  fs::remove_all(dir);  // a folder of this process's name can only be a leftover of its own
+  fs::create_directory(dir);
+  return dir.string();
+}
+
+/// True for "<stem>_NNNNNN.vtu": a frame of a series named `stem`.
+bool is_frame_of(const std::string& file, const std::string& stem) {
+  if (file.size() != stem.size() + 11 || file.compare(0, stem.size() + 1, stem + "_") != 0 ||
+      file.compare(file.size() - 4, 4, ".vtu") != 0)
+    return false;
+  for (std::size_t k = stem.size() + 1; k < file.size() - 4; ++k)
+    if (!std::isdigit(static_cast<unsigned char>(file[k]))) return false;
+  return true;
+}
+
+}  // namespace
+
 VtuSeries::VtuSeries(const std::string& pvd_path) : pvd_path_(pvd_path) {
   const fs::path p(pvd_path);
   if (p.extension() != ".pvd")
@@ -30,7 +57,12 @@ VtuSeries::VtuSeries(const std::string& pvd_path) : pvd_path_(pvd_path) {
   require_output_folder(pvd_path, "time series");
   stem_ = p.stem().string();
   folder_ = (p.parent_path() / stem_).string();
-  fs::create_directories(folder_);
+  if (fs::exists(fs::symlink_status(folder_)) && !fs::is_directory(fs::symlink_status(folder_)))
+    throw std::invalid_argument("time series " + pvd_path + ": " + folder_ +
+                                " exists and is not a folder: refusing to replace it");
+  const SignalBlock quiet;  // no kill between creating the staging folder and registering it
+  staging_ = make_staging_folder(p);
+  pending_ = PendingOutput(staging_, PendingOutput::Kind::folder);
 }
 
 void VtuSeries::add(double time_s, const mss::MssModel& model, const Eigen::VectorXd& x_mm) {
@@ -38,7 +70,7 @@ void VtuSeries::add(double time_s, const mss::MssModel& model, const Eigen::Vect
   std::snprintf(name, sizeof name, "_%06zu.vtu", entries_.size());
   const std::string rel = stem_ + "/" + stem_ + name;
   const mss::StateFields f = mss::state_fields(model, x_mm);
-  mesh::write_vtu((fs::path(folder_) / (stem_ + name)).string(), model.mesh(), f.point, f.cell);
+  mesh::write_vtu((fs::path(staging_) / (stem_ + name)).string(), model.mesh(), f.point, f.cell);
   entries_.push_back({time_s, rel});
 }
 
@@ -51,16 +83,34 @@ VtuSeries::~VtuSeries() {
 }
 
 void VtuSeries::finish() {
-  mesh::write_pvd(pvd_path_, entries_);
+  // The PVD first, staged: if it cannot be written, nothing has moved.
+  const std::string staged_pvd = (fs::path(staging_) / (stem_ + ".pvd")).string();
+  mesh::write_pvd(staged_pvd, entries_);
+  const SignalBlock whole;  // the frames and the PVD change together
+  fs::create_directories(folder_);
+  std::set<std::string> ours;
+  for (const auto& e : entries_) {
+    const std::string file = fs::path(e.file).filename().string();
+    fs::rename(fs::path(staging_) / file, fs::path(folder_) / file);
+    ours.insert(file);
+  }
+  // Frames of an earlier series of this name that this one does not have; nothing else is touched.
+  for (const auto& e : fs::directory_iterator(folder_)) {
+    const std::string file = e.path().filename().string();
+    if (is_frame_of(file, stem_) && !ours.count(file)) fs::remove(e.path());
+  }
+  fs::rename(staged_pvd, pvd_path_);
   finished_ = true;
+  fs::remove(staging_);
+  pending_.release();
 }
 
 void VtuSeries::discard() {
   finished_ = true;  // nothing left to clean up
-  std::error_code ec;
-  for (const std::string& f : frame_paths()) fs::remove(f, ec);
   entries_.clear();
-  fs::remove(folder_, ec);  // only if empty
+  std::error_code ec;
+  fs::remove_all(staging_, ec);
+  pending_.release();
 }
 
 std::vector<std::string> VtuSeries::frame_paths() const {

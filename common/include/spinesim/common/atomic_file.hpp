@@ -1,15 +1,19 @@
 // Writing a file so that `path` either gets the complete new content or is left untouched
-// (every writer of the project: meshes, tuned discs, databases, reports). The content goes to `path + ".tmp-XXXXXX"` (same folder, so the
-// rename is atomic on POSIX file systems), is flushed and checked, then renamed over `path`.
-// On any failure the temporary file is removed and the exception propagates. A `path` that
+// (every writer of the project: meshes, tuned discs, databases, reports). The content goes to
+// `path + ".tmp-XXXXXX"` (same folder, so the rename is atomic on POSIX file systems), is flushed
+// and checked, then renamed over `path`. On any failure the temporary file is removed and the
+// exception propagates; a run killed meanwhile removes it too (pending_output.hpp). A `path` that
 // exists and is not a regular file (a symbolic link, directory, FIFO, socket or device) is never
 // replaced: as root, `--out /dev/null` must not turn /dev/null into a file.
 #pragma once
+
+#include "spinesim/common/pending_output.hpp"
 
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -43,6 +47,8 @@ void write_atomically(const std::string& who, const std::string& path, Fill&& fi
   std::string tmpl = path + ".tmp-XXXXXX";
   std::vector<char> name(tmpl.begin(), tmpl.end());
   name.push_back('\0');
+  std::optional<SignalBlock> hold;  // no kill between creating the temporary and registering it
+  hold.emplace();
   const int fd = ::mkstemp(name.data());
   if (fd < 0)
     throw std::runtime_error(who + ": " + path + ": cannot create a file there (" +
@@ -50,6 +56,8 @@ void write_atomically(const std::string& who, const std::string& path, Fill&& fi
   ::fchmod(fd, 0644);  // mkstemp makes 0600; results are meant to be shared
   ::close(fd);
   const std::string tmp(name.data());
+  PendingOutput pending(tmp);
+  hold.reset();
   try {
     {
       std::ofstream os(tmp, std::ios::binary | std::ios::trunc);
@@ -69,8 +77,9 @@ void write_atomically(const std::string& who, const std::string& path, Fill&& fi
 
 /// Several files written together or not at all (a mesh's VTU and its MEDIT copy): each is
 /// written to stage(path), a temporary name beside it; commit() renames them all onto their
-/// paths; a set destroyed before commit() removes what it staged. Every path is checked with
-/// require_replaceable first.
+/// paths, with the catchable signals held back so that a kill cannot split the set; a set
+/// destroyed before commit() — or a run killed before it — removes what it staged. Every path is
+/// checked with require_replaceable first.
 class OutputSet {
  public:
   explicit OutputSet(std::string who) : who_(std::move(who)) {}
@@ -84,19 +93,23 @@ class OutputSet {
     require_replaceable(who_, path);
     std::string tmp = path + ".staged-" + std::to_string(::getpid());
     staged_.emplace_back(tmp, path);
+    pending_.emplace_back(tmp);
     return tmp;
   }
   void commit() {
+    const SignalBlock whole;
     for (const auto& [tmp, path] : staged_)
       if (std::rename(tmp.c_str(), path.c_str()) != 0)
         throw std::runtime_error(who_ + ": " + path + ": cannot replace the file (" +
                                  std::strerror(errno) + ")");
     staged_.clear();
+    pending_.clear();
   }
 
  private:
   std::string who_;
   std::vector<std::pair<std::string, std::string>> staged_;  ///< (temporary, final)
+  std::vector<PendingOutput> pending_;                       ///< the temporaries, until commit
 };
 
 /// Writes `text` to `path` completely or not at all; errors name `path`.

@@ -2,6 +2,7 @@
 // VTU time series of mass-spring states (ParaView .pvd + frames).
 #pragma once
 
+#include "spinesim/common/pending_output.hpp"
 #include "spinesim/mesh/io.hpp"
 #include "spinesim/mss/model.hpp"
 
@@ -21,10 +22,15 @@ void write_text_file(const std::string& path, const std::string& text);
 void require_output_folder(const std::string& path, const std::string& option);
 
 /// A VTU time series of MSS states: frames `<stem>/<stem>_NNNNNN.vtu` next to `<stem>.pvd`
-/// (the PVD lists them relative to its folder). Frames are written as they come (atomically);
-/// finish() writes the PVD; discard() removes every frame written (for a failed run). A series
-/// destroyed before finish() — an exception, a full disk mid-way — discards itself: a run that
-/// fails leaves no half series behind.
+/// (the PVD lists them relative to its folder). Frames are written as they come (each
+/// atomically) into a staging folder `<stem>.staged-PID/` beside the PVD; finish() moves them
+/// into `<stem>/` — replacing the frames of an earlier series of the same name, and removing
+/// those of its frames this series does not have — then writes the PVD, with the catchable
+/// signals held back, so that the folder and the PVD always describe one complete series.
+/// discard() removes the staging folder; a series destroyed before finish() (an exception, a
+/// full disk mid-way) discards itself, and a run killed before it removes the staging folder
+/// (spinesim/common/pending_output.hpp): a run that fails leaves no half series behind, and an
+/// earlier series stays whole until the new one is complete.
 /// Point data `displacement` (mm), cell data `volume_change` (mss/quantities.hpp).
 class VtuSeries {
  public:
@@ -42,8 +48,9 @@ class VtuSeries {
   std::vector<std::string> frame_paths() const;
 
  private:
-  std::string pvd_path_, folder_, stem_;
+  std::string pvd_path_, folder_, staging_, stem_;
   std::vector<mesh::PvdEntry> entries_;
+  PendingOutput pending_;  ///< the staging folder, until finish() or discard()
   bool finished_ = false;
 };
 
