@@ -63,6 +63,8 @@ class LegacyReader : public detail::FileError {
   }
   bool binary = false;
   int version_major = 0;
+  /// The file's size: no count of values can exceed it (each takes a byte or more).
+  std::size_t size() const { return text_.size(); }
 
   bool at_end() {
     skip_space();
@@ -156,7 +158,13 @@ LegacyType type_of(LegacyReader& r, const std::string& name, const std::string& 
 std::int64_t count_of(LegacyReader& r, const std::string& word, const std::string& what) {
   std::int64_t n = -1;
   const auto res = std::from_chars(word.data(), word.data() + word.size(), n);
-  if (res.ec != std::errc() || n < 0) r.fail(what + ": '" + word + "' is not a count");
+  if (res.ec != std::errc() || res.ptr != word.data() + word.size() || n < 0)
+    r.fail(what + ": '" + word + "' is not a count");
+  // Bounded by the file's size, so that products of counts (3 coordinates a point, components
+  // times tuples) cannot overflow.
+  if (std::uint64_t(n) > r.size())
+    r.fail(what + ": the count " + word + " is more than the file's " + std::to_string(r.size()) +
+           " bytes can hold");
   return n;
 }
 

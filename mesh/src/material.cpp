@@ -78,9 +78,10 @@ void validate(const IsotropicMaterial& m, const std::string& what) {
 RegionMaterials material_from_json(const nlohmann::json& j) {
   if (!j.is_object()) throw std::invalid_argument("material: expected a JSON object");
   RegionMaterials r;
-  r.name = j.value("name", std::string("unnamed"));
+  r.name = "unnamed";
   const bool per_region = j.contains("annulus") || j.contains("nucleus");
   try {
+    r.name = j.value("name", std::string("unnamed"));
     if (per_region) {
       if (!j.contains("annulus") || !j.contains("nucleus"))
         throw std::invalid_argument("material '" + r.name +

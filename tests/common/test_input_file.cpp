@@ -83,6 +83,15 @@ TEST(ReadJsonFile, RefusesTooDeepTrailingGarbageAndNonFilesNamingThem) {
   e = refusal([&] { spinesim::read_json_file(fifo, "material file"); });
   EXPECT_NE(e.find("a FIFO, not a regular file"), std::string::npos) << e;
 
+  // Found by fuzzing: a number beyond double's range made the parser throw its own exception
+  // type, which nothing caught; now a refusal naming the file.
+  const std::string huge = tmp("huge-number.json");
+  write(huge, "{\"E_mpa\": 0.2250555265182e461}");
+  e = refusal([&] { spinesim::read_json_file(huge, "material file"); });
+  EXPECT_NE(e.find(huge), std::string::npos) << e;
+  EXPECT_NE(e.find("number overflow"), std::string::npos) << e;
+  EXPECT_EQ(e.find("[json.exception"), std::string::npos) << e;
+
   const std::string good = tmp("good.json");
   write(good, "{\"a\": [1, 2, {\"b\": \"[[[\"}]}\n");
   EXPECT_EQ(spinesim::read_json_file(good, "file")["a"][2]["b"], "[[[");

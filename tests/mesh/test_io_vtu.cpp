@@ -556,3 +556,21 @@ TEST(IoVtu, MissingFolderIsARuntimeErrorAndLeavesNothing) {
   EXPECT_THROW(write_vtu(dir + "/does/not/exist/out.vtu", cube_mesh()), std::runtime_error);
   EXPECT_TRUE(fs::is_empty(dir));
 }
+
+// Found by fuzzing: a legacy VTK count so large that 3 x count overflowed (undefined behaviour
+// before any check). Every count is now bounded by the file's size, so products of counts cannot
+// overflow; a count with trailing characters is not a count.
+TEST(IoVtu, LegacyCountsBeyondTheFileAreRefused) {
+  const std::string dir = test::fresh_tmp_dir("io_vtu_", "legacy_counts");
+  const std::string head =
+      "# vtk DataFile Version 5.1\nwritten by a test\nBINARY\n"
+      "DATASET UNSTRUCTURED_GRID\n";
+  for (const auto& [name, points] : std::vector<std::pair<std::string, std::string>>{
+           {"overflow", "3980433795905195575"}, {"beyond", "4000"}, {"suffix", "8abc"}}) {
+    const std::string path = dir + "/" + name + ".vtk";
+    std::ofstream(path, std::ios::binary) << head << "POINTS " << points << " double\n"
+                                          << std::string(64, '\0');
+    test::expect_one_line_refusal([&] { read_tet_mesh(path); }, path,
+                                  name == "suffix" ? "is not a count" : "can hold");
+  }
+}

@@ -113,6 +113,8 @@ TEST(MaterialJson, BadConstantsAreRefusedWithTheReason) {
   EXPECT_TRUE(contains(msg({{"nu", 0.3}}), "E_mpa"));
   EXPECT_TRUE(contains(msg({{"E_mpa", 1.0}}), "nu"));
   EXPECT_TRUE(contains(msg({{"E_mpa", "soft"}, {"nu", 0.3}}), "number"));
+  // Found by fuzzing: a name that is not a string escaped as the parser's own exception.
+  EXPECT_TRUE(contains(msg({{"name", 910}, {"E_mpa", 1.0}, {"nu", 0.3}}), "wrong type"));
   EXPECT_TRUE(contains(msg({{"E_mpa", 1.0}, {"nu", 0.3}, {"G_mpa", 0.4}}), "exactly one"));
   EXPECT_TRUE(contains(msg({{"annulus", {{"E_mpa", 4.2}, {"nu", 0.45}}}}), "both"));
   EXPECT_TRUE(contains(

@@ -114,6 +114,10 @@ inline nlohmann::json read_json_file(const std::string& path, const std::string&
   } catch (const nlohmann::json::parse_error& e) {
     throw std::invalid_argument(what + " '" + path + "' is not valid JSON (byte " +
                                 std::to_string(e.byte) + ")");
+  } catch (const nlohmann::json::exception& e) {  // a number beyond double's range (1e400)
+    std::string why = e.what();  // "[json.exception.out_of_range.406] number overflow ...'"
+    if (why.find("] ") != std::string::npos) why = why.substr(why.find("] ") + 2);
+    throw std::invalid_argument(what + " '" + path + "' cannot be read: " + why);
   }
 }
 
