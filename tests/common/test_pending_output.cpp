@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <thread>
 
 namespace fs = std::filesystem;
 
@@ -100,6 +101,25 @@ TEST(PendingOutput, ASignalDuringABlockWaitsForItsEnd) {
   EXPECT_EQ(WTERMSIG(status), SIGTERM);
   EXPECT_TRUE(fs::exists(a));
   EXPECT_TRUE(fs::exists(b));
+}
+
+// The signal may be delivered to another thread (OpenMP's workers): held all the same.
+TEST(PendingOutput, ASignalOnAnotherThreadDuringABlockWaitsToo) {
+  const fs::path dir = fresh_dir("block-thread");
+  const fs::path a = dir / "a.vtu";
+  const int status = in_child([&] {
+    spinesim::PendingOutput pa(a.string());
+    {
+      const spinesim::SignalBlock whole;
+      std::thread([] { ::raise(SIGTERM); }).join();  // handled on that thread, held
+      touch(a);
+      pa.release();
+    }
+    ::_exit(0);
+  });
+  ASSERT_TRUE(WIFSIGNALED(status));
+  EXPECT_EQ(WTERMSIG(status), SIGTERM);
+  EXPECT_TRUE(fs::exists(a));
 }
 
 // Every slot taken: further outputs are not tracked (and say so), and freed slots are reused.

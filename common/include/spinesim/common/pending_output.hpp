@@ -42,10 +42,15 @@ struct Slot {
   char path[kMaxPath] = {};
 };
 
-inline std::array<Slot, kSlots>& slots() {
-  static std::array<Slot, kSlots> table;
-  return table;
-}
+// Namespace-scope and constant-initialised, so that the handler never meets an initialisation
+// guard.
+inline std::array<Slot, kSlots> g_slots;
+inline std::array<Slot, kSlots>& slots() { return g_slots; }
+
+/// SignalBlock's state, process-wide (a signal may be delivered to any thread): how many blocks
+/// are open, and the signal that arrived meanwhile.
+inline std::atomic<int> g_hold_depth{0};
+inline std::atomic<int> g_held_signal{0};
 
 /// The signals a run is killed by and can catch.
 constexpr int kSignals[] = {SIGINT, SIGTERM, SIGHUP, SIGQUIT};
@@ -74,6 +79,10 @@ inline void remove_folder(const char* path) {
 }
 
 inline void on_signal(int sig) {
+  if (g_hold_depth.load() > 0) {  // a SignalBlock is open: act when it ends
+    g_held_signal.store(sig);
+    return;
+  }
   for (Slot& s : slots()) {
     if (s.state.load(std::memory_order_acquire) != kReady) continue;
     if (s.folder)
@@ -151,22 +160,18 @@ inline void remove_pending_outputs_on_signals() {
   }
 }
 
-/// While alive, the signals above wait: what happens in its scope (the renames that commit a set
-/// of outputs) is done whole before the run can be killed by them.
+/// While alive, the signals above wait, whichever thread they are delivered to: what happens in
+/// its scope (the renames that commit a set of outputs) is done whole before the run is killed.
+/// A signal that arrived meanwhile takes effect when the last open block ends.
 class SignalBlock {
  public:
-  SignalBlock() {
-    sigset_t set;
-    sigemptyset(&set);
-    for (const int sig : pending_detail::kSignals) sigaddset(&set, sig);
-    ::pthread_sigmask(SIG_BLOCK, &set, &old_);
+  SignalBlock() { pending_detail::g_hold_depth.fetch_add(1); }
+  ~SignalBlock() {
+    if (pending_detail::g_hold_depth.fetch_sub(1) != 1) return;
+    if (const int sig = pending_detail::g_held_signal.exchange(0)) ::raise(sig);
   }
-  ~SignalBlock() { ::pthread_sigmask(SIG_SETMASK, &old_, nullptr); }
   SignalBlock(const SignalBlock&) = delete;
   SignalBlock& operator=(const SignalBlock&) = delete;
-
- private:
-  sigset_t old_{};
 };
 
 }  // namespace spinesim
