@@ -45,10 +45,11 @@ struct CliRun {
   std::string out, err;
 };
 
-/// Runs spinesim with `args` (shell words), capturing stdout and stderr.
-inline CliRun run_spinesim(const std::string& args) {
+/// Runs spinesim with `args` (shell words), capturing stdout and stderr; `before` is shell text
+/// run first in the same shell (e.g. "ulimit -v 600000; ").
+inline CliRun run_spinesim(const std::string& args, const std::string& before = "") {
   const fs::path out = tmp_dir() / "cli.stdout", err = tmp_dir() / "cli.stderr";
-  const std::string cmd = std::string("'") + SPINESIM_EXE + "' " + args + " >'" + out.string() +
+  const std::string cmd = before + "'" + SPINESIM_EXE + "' " + args + " >'" + out.string() +
                           "' 2>'" + err.string() + "' </dev/null";
   const int raw = std::system(cmd.c_str());
   CliRun r;

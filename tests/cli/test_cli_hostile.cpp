@@ -250,3 +250,25 @@ TEST(HostileInput, RealVertebraeWithAHoleOrInTheWrongUnits) {
                              " --units m --up z --cell-size 3 --out " + quoted(tmp("huge.vtu")),
                          "wrong units");
 }
+
+// Asking for more memory than there is: named as such in one line, not a bare std::bad_alloc.
+// (The run's address space is limited to 600 MB; AddressSanitizer reserves terabytes of it, so
+// the test is skipped in sanitizer builds.)
+TEST(HostileInput, OutOfMemoryIsNamed) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "address-space limits do not apply under AddressSanitizer";
+#endif
+  const std::string out = tmp("too-big.vtu");
+  const auto before = files_in(tmp_dir());
+  // Allowed past the element limit on purpose, so that the allocation itself fails.
+  const CliRun r = run_spinesim(
+      "mesh disc --level L4-L5 --structured --sectors 3000 --rings 300 --layers 100 "
+      "--max-elements 1e12 --out " +
+          quoted(out),
+      "ulimit -v 600000; ");
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_EQ(count_lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("spinesim: error: out of memory"), std::string::npos) << r.err;
+  const auto added = new_files(before);
+  EXPECT_TRUE(added.empty()) << "left behind: " << *added.begin();
+}
