@@ -65,14 +65,12 @@ void check_mesher_flags(const MeshArgs& a) {
   }
 }
 
-void run_mesh_disc(const MeshArgs& a) {
-  check_mesher_flags(a);
-  require_output_folder(a.out, "--out");  // a device, FIFO or link is refused before meshing
-  if (!a.medit.empty()) require_output_folder(a.medit, "--medit");
+/// The Mesh_3 options the flags select, within the mesher's own bounds (mesh_labeled_body),
+/// checked before any work; NaN fails every test.
+mesh::MeshOptions cgal_options(const MeshArgs& a) {
   mesh::MeshOptions opt = a.opt;
   opt.perturb = !a.no_perturb;
   opt.exude = !a.no_exude;
-  // The mesher's own bounds (mesh_labeled_body), checked before any work; NaN fails every test.
   if (!(opt.cell_size_mm > 0) || !std::isfinite(opt.cell_size_mm) || !(opt.facet_distance_mm > 0) ||
       !std::isfinite(opt.facet_distance_mm))
     throw std::invalid_argument("--cell-size and --facet-distance must be finite numbers > 0 mm");
@@ -84,6 +82,35 @@ void run_mesh_disc(const MeshArgs& a) {
     throw std::invalid_argument("--facet-angle must lie in (0, 30] degrees (CGAL's bound)");
   if (!(a.max_elements >= 1)) throw std::invalid_argument("--max-elements must be >= 1");
   opt.max_elements = a.max_elements;
+  return opt;
+}
+
+/// The options a mesh was made with, for the JSON report.
+nlohmann::json options_json(const MeshArgs& a, const mesh::MeshOptions& opt) {
+  if (a.structured)
+    return {{"mesher", "structured"},
+            {"sectors", a.structured_opt.sectors},
+            {"rings", a.structured_opt.rings},
+            {"layers", a.structured_opt.layers},
+            {"match_area", a.structured_opt.match_area}};
+  else
+    return {{"mesher", "cgal"},
+            {"cell_size_mm", opt.cell_size_mm},
+            {"facet_distance_mm", opt.facet_distance_mm},
+            {"facet_size_mm", opt.facet_size_mm},
+            {"radius_edge_ratio", opt.radius_edge_ratio},
+            {"odt", opt.odt},
+            {"lloyd", opt.lloyd},
+            {"perturb", opt.perturb},
+            {"exude", opt.exude},
+            {"seed", opt.seed}};
+}
+
+void run_mesh_disc(const MeshArgs& a) {
+  check_mesher_flags(a);
+  require_output_folder(a.out, "--out");  // a device, FIFO or link is refused before meshing
+  if (!a.medit.empty()) require_output_folder(a.medit, "--medit");
+  const mesh::MeshOptions opt = cgal_options(a);
   const bool from_vertebrae = !a.inferior.empty() || !a.superior.empty();
   if (from_vertebrae == !a.level.empty())
     throw std::invalid_argument("give either --level or both --inferior and --superior");
@@ -160,23 +187,7 @@ void run_mesh_disc(const MeshArgs& a) {
   j["mesh_seconds"] = mesh_s;
   j["out"] = a.out;
   if (!a.medit.empty()) j["medit"] = a.medit;
-  if (a.structured)
-    j["options"] = {{"mesher", "structured"},
-                    {"sectors", a.structured_opt.sectors},
-                    {"rings", a.structured_opt.rings},
-                    {"layers", a.structured_opt.layers},
-                    {"match_area", a.structured_opt.match_area}};
-  else
-    j["options"] = {{"mesher", "cgal"},
-                    {"cell_size_mm", opt.cell_size_mm},
-                    {"facet_distance_mm", opt.facet_distance_mm},
-                    {"facet_size_mm", opt.facet_size_mm},
-                    {"radius_edge_ratio", opt.radius_edge_ratio},
-                    {"odt", opt.odt},
-                    {"lloyd", opt.lloyd},
-                    {"perturb", opt.perturb},
-                    {"exude", opt.exude},
-                    {"seed", opt.seed}};
+  j["options"] = options_json(a, opt);
   if (a.json)
     print_json(j);
   else
