@@ -3,9 +3,8 @@
 // reader chooses by extension), the rest is the file. Every input must be read or refused with
 // std::invalid_argument; a crash, a hang, runaway memory, a leak or undefined behaviour is a
 // finding. What is read must be a valid surface: finite vertices, indices in range.
+#include "fuzz_input.hpp"
 #include "spinesim/mesh/io.hpp"
-
-#include <unistd.h>
 
 #include <cstdint>
 #include <cstdio>
@@ -17,17 +16,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (size < 1) return 0;
   static const char* const kExtensions[] = {".stl", ".obj", ".off", ".ply"};
   const std::string path =
-      "/tmp/spinesim-fuzz-surface-" + std::to_string(::getpid()) + kExtensions[data[0] % 4];
-  if (std::FILE* f = std::fopen(path.c_str(), "wb")) {
-    std::fwrite(data + 1, 1, size - 1, f);
-    std::fclose(f);
-  }
+      spinesim::fuzz::input_file("surface", data + 1, size - 1, kExtensions[data[0] % 4]);
   try {
     const spinesim::mesh::TriSurface s =
         spinesim::mesh::read_surface(path, 1.0, spinesim::mesh::UpAxis::y);
     if (!s.V.allFinite()) std::abort();
     if (s.F.size() > 0 && (s.F.minCoeff() < 0 || s.F.maxCoeff() >= s.V.rows())) std::abort();
   } catch (const std::invalid_argument&) {}
-  std::remove(path.c_str());
   return 0;
 }

@@ -4,12 +4,11 @@
 // do, the tuned mass-spring model built from them. Every input must be used or refused with
 // std::invalid_argument; a crash, a hang, a leak or undefined behaviour (a huge number read
 // into an integer field) is a finding.
+#include "fuzz_input.hpp"
 #include "spinesim/calibration/tuned_disc.hpp"
 #include "spinesim/calibration/tuned_set.hpp"
 #include "spinesim/mesh/disc_geometry.hpp"
 #include "spinesim/mesh/structured_disc.hpp"
-
-#include <unistd.h>
 
 #include <cstdint>
 #include <cstdio>
@@ -31,11 +30,7 @@ const spinesim::mesh::TetMesh& disc() {
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  static const std::string path = "/tmp/spinesim-fuzz-tuned-" + std::to_string(::getpid());
-  if (std::FILE* f = std::fopen(path.c_str(), "wb")) {
-    std::fwrite(data, 1, size, f);
-    std::fclose(f);
-  }
+  const std::string path = spinesim::fuzz::input_file("tuned", data, size);
   namespace cal = spinesim::calibration;
   try {
     const cal::TunedDisc t = cal::read_tuned_for_mesh(path, &disc());
