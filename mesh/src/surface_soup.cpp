@@ -305,7 +305,10 @@ class PlyBody {
     if (at_ == start) refuse("the PLY body ends early");
     const std::string token = bytes_.substr(start, at_ - start);
     double v = 0;
-    if (!parse_real(token, v) || (t.integer && v != std::floor(v)))
+    // An integer type's value must also fit the type (fuzzing found 1e85 as an "int" index).
+    const double top = std::ldexp(1.0, 8 * t.bytes - (t.is_signed ? 1 : 0));
+    if (!parse_real(token, v) ||
+        (t.integer && (v != std::floor(v) || v >= top || v < (t.is_signed ? -top : 0.0))))
       refuse("PLY value '" + token.substr(0, 40) + "' is not a " +
              (t.integer ? "finite integer" : "finite number"));
     return v;

@@ -296,6 +296,9 @@ TEST(IoSurface, MalformedOffAndPlyAreRefusedWithTheReason) {
                "the PLY body ends early");
   expect_error(spit(dir + "/neg.ply", head + vertex + face + tri + "3 0 1 -1\n"), 1,
                "negative vertex index");
+  // Found by fuzzing: an ASCII value beyond its integer type (1e85 as an int index).
+  expect_error(spit(dir + "/huge.ply", head + vertex + face + tri + "3 0 1 1e85\n"), 1,
+               "is not a finite integer");
   expect_error(spit(dir + "/range.ply", head + vertex + face + tri + "3 0 1 3\n"), 1,
                "out of range");
   expect_error(spit(dir + "/noend.ply", head + vertex), 1, "no end_header");
