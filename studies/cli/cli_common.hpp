@@ -32,6 +32,7 @@ void add_plate_load_options(CLI::App* cmd, std::string& motion, std::string& wre
 
 // Sub-command registration; each lives in its own cli_<verb>.cpp.
 void register_mesh(CLI::App& app);
+void register_mesh_vertebrae(CLI::App& mesh);  ///< mesh vertebrae, under `mesh`
 void register_fem(CLI::App& app);
 void register_mss(CLI::App& app);        ///< mss, mss compare (cli_mss.cpp)
 void register_calibrate(CLI::App& app);  ///< calibrate (cli_calibrate.cpp)

@@ -197,8 +197,8 @@ void run_mesh_disc(const MeshArgs& a) {
 }  // namespace
 
 void register_mesh(CLI::App& app) {
-  auto* mesh_cmd =
-      app.add_subcommand("mesh", "Make tetrahedral disc meshes (CGAL Mesh_3 or structured sweep)");
+  auto* mesh_cmd = app.add_subcommand(
+      "mesh", "Make disc meshes (CGAL Mesh_3 or structured sweep) and vertebra surfaces");
   mesh_cmd->require_subcommand(1);
   auto a = std::make_shared<MeshArgs>();
   auto* disc = mesh_cmd->add_subcommand(
@@ -270,6 +270,7 @@ void register_mesh(CLI::App& app) {
       if (o->count() > 0) a->structured_flags_given.push_back(o->get_name());
     run_mesh_disc(*a);
   });
+  register_mesh_vertebrae(*mesh_cmd);
 }
 
 }  // namespace spinesim::cli
