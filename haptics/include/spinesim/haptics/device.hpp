@@ -1,0 +1,105 @@
+// The device layer: one interface for PHANToM-class 3-DOF devices (position in, force out,
+// stylus buttons) with a capability record per model, and the devices that need no hardware:
+// `sim` (a simulated hand holding a simulated device), `replay` (a recorded run) and `null`.
+// Units: mm, mm/s, N, s; the device frame is the scene frame (x lateral, y up, z anterior).
+#pragma once
+
+#include <Eigen/Core>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace spinesim::haptics {
+
+/// What a device model can do, with the source of each number.
+struct DeviceCapabilities {
+  std::string model;  ///< e.g. "touch"
+  std::string description;
+  Eigen::Vector3d workspace_mm = Eigen::Vector3d::Zero();  ///< width × height × depth
+  double peak_force_n = 0;                                 ///< nominal maximum exertable force
+  double continuous_force_n = 0;                           ///< sustainable (24 h) force
+  double usable_stiffness_n_per_mm = 0;  ///< the stiffness the device renders stably
+  /// The device's own viscous damping (what makes a sampled wall passive, Colgate & Brown
+  /// 1995: b > K T / 2 + |B|). Not published: an assumption for each model.
+  double physical_damping_n_s_per_mm = 0;
+  std::string source;
+};
+
+/// The models this program knows: "touch" (Geomagic Touch / PHANToM Omni), "premium-1.5"
+/// (PHANToM Premium 1.5), "omega.3" (Force Dimension). Throws std::invalid_argument for an
+/// unknown name, listing the known ones.
+const std::vector<DeviceCapabilities>& device_models();
+const DeviceCapabilities& device_model(const std::string& name);
+
+/// The largest wall stiffness that keeps a device passive at servo period T with virtual
+/// damping B (Colgate & Brown 1995): K < 2 (b − |B|) / T, b the device's physical damping.
+double passive_stiffness_limit(const DeviceCapabilities& c, double period_s,
+                               double virtual_damping_n_s_per_mm = 0);
+
+struct DeviceState {
+  Eigen::Vector3d position_mm = Eigen::Vector3d::Zero();
+  Eigen::Vector3d velocity_mm_s = Eigen::Vector3d::Zero();
+  unsigned buttons = 0;  ///< bit 0: the stylus's first button
+};
+
+class Device {
+ public:
+  virtual ~Device() = default;
+  virtual std::string name() const = 0;
+  virtual const DeviceCapabilities& capabilities() const = 0;
+  /// Opens the device; throws std::runtime_error with one line (the vendor's error text where
+  /// there is one) when it cannot.
+  virtual void open() = 0;
+  /// Zeroes the force and releases the device. Safe to call twice.
+  virtual void close() = 0;
+  /// Reads the state at the start of a servo tick; false on a device error (then the loop
+  /// zeroes the force and stops). Called from the servo thread only; must not allocate.
+  virtual bool read(DeviceState& state) = 0;
+  /// Commands a force for the rest of the tick; false on a device error. Must not allocate.
+  virtual bool write_force(const Eigen::Vector3d& force_n) = 0;
+  /// True once a scripted or replayed device has nothing more to play.
+  virtual bool finished() const { return false; }
+  /// The last error's text (empty if none).
+  virtual std::string last_error() const { return {}; }
+};
+
+/// A set-point trajectory: times (s, strictly increasing from 0 or later), positions (mm),
+/// buttons. Read from CSV `t_s,x_mm,y_mm,z_mm[,button]` with '#' comment lines.
+struct Trajectory {
+  std::vector<double> t_s;
+  std::vector<Eigen::Vector3d> position_mm;
+  std::vector<unsigned> buttons;
+  double duration_s() const { return t_s.empty() ? 0 : t_s.back(); }
+  /// Linear interpolation (held constant past the ends); no allocation.
+  Eigen::Vector3d position_at(double t) const;
+  Eigen::Vector3d velocity_at(double t) const;
+  unsigned buttons_at(double t) const;
+};
+/// Throws std::invalid_argument with one line "PATH:LINE: problem" for a missing file, a bad
+/// number, NaN/inf, times not strictly increasing, or an empty trajectory.
+Trajectory read_trajectory(const std::string& path);
+
+/// A human hand (an assumption, see haptics/README.md): mass, grip stiffness and damping pulling
+/// the stylus towards the scripted set-point.
+struct HandModel {
+  double mass_kg = 0.15;
+  double stiffness_n_per_mm = 0.4;
+  double damping_n_s_per_mm = 0.004;
+};
+
+/// `sim`: the device is a point mass held by the hand model and driven by the commanded force
+/// (held for the whole servo period, as a real device's DAC holds it), integrated with
+/// semi-implicit Euler at 10 sub-steps per period, with the device's physical damping. Each
+/// read() advances the simulation by one servo period, so the closed loop is deterministic.
+std::unique_ptr<Device> make_sim_device(const Trajectory& script, const DeviceCapabilities& caps,
+                                        double period_s, const HandModel& hand = HandModel());
+/// `replay`: plays the recorded positions and buttons tick by tick; forces are discarded.
+std::unique_ptr<Device> make_replay_device(const Trajectory& recording,
+                                           const DeviceCapabilities& caps, double period_s);
+/// `null`: stays at `position_mm`, discards forces; finished after `duration_s` (0: never).
+std::unique_ptr<Device> make_null_device(const Eigen::Vector3d& position_mm,
+                                         const DeviceCapabilities& caps, double period_s,
+                                         double duration_s);
+
+}  // namespace spinesim::haptics

@@ -1,0 +1,125 @@
+// The servo loop: its own thread, woken at absolute deadlines (clock_nanosleep, TIMER_ABSTIME)
+// every period, real-time priority when the system allows it (and the reason when it does not).
+// Each tick: read the device → render the scene at the latest poses → safety chain → command
+// the force → statistics, status and recording. A tick allocates nothing; slower threads get
+// the status through a triple buffer and the recording through a lock-free ring.
+#pragma once
+
+#include "spinesim/haptics/device.hpp"
+#include "spinesim/haptics/renderer.hpp"
+#include "spinesim/haptics/safety.hpp"
+#include "spinesim/haptics/scene.hpp"
+#include "spinesim/haptics/triple_buffer.hpp"
+
+#include <Eigen/Core>
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace spinesim::haptics {
+
+struct ServoOptions {
+  double period_s = 0.001;
+  double duration_s = 10;         ///< stop after this long (or when the device has finished)
+  bool realtime_priority = true;  ///< ask for SCHED_FIFO
+  int priority = 80;
+};
+
+/// What the servo thread publishes every tick (for a status line or a viewer).
+struct ServoStatus {
+  std::int64_t ticks = 0;
+  double time_s = 0;
+  Eigen::Vector3d probe_mm = Eigen::Vector3d::Zero(), proxy_mm = Eigen::Vector3d::Zero();
+  Eigen::Vector3d force_n = Eigen::Vector3d::Zero();
+  bool contact = false;
+  int body = -1;
+  unsigned buttons = 0;
+  double passivity_mj = 0;
+};
+
+/// One recorded tick (the `--record` file's row).
+struct TickRecord {
+  double t_s = 0;
+  Eigen::Vector3d probe_mm, force_n, proxy_mm;
+  unsigned buttons = 0;
+  bool contact = false;
+};
+
+struct Percentiles {
+  double p50 = 0, p99 = 0, p999 = 0, max = 0;
+};
+/// Percentiles of `values` (sorted copy; nearest rank). All zero when empty.
+Percentiles percentiles(std::vector<float> values);
+
+struct ServoStats {
+  std::int64_t ticks = 0;
+  double seconds = 0, rate_hz = 0;
+  Percentiles period_us, compute_us;
+  std::int64_t missed_deadlines = 0;  ///< ticks that woke a period late or ended past the next
+  double max_force_n = 0;             ///< largest commanded force
+  std::int64_t clamped_ticks = 0, limited_ticks = 0, non_finite_ticks = 0, fading_ticks = 0;
+  std::int64_t contact_ticks = 0, truncated_ticks = 0;
+  double passivity_min_mj = 0, passivity_final_mj = 0;
+  bool realtime_priority = false;
+  std::string realtime_reason;
+  std::string stop_reason;  ///< "duration", "device finished", "stopped", or the error
+  bool error = false;
+};
+
+class ServoLoop {
+ public:
+  /// The device must be open. `poses` is written by a slower thread (or once, for a static
+  /// scene); the loop only reads it.
+  ServoLoop(Device& device, ForceRenderer& renderer, const Scene& scene,
+            TripleBuffer<ScenePoses>& poses, const SafetyOptions& safety,
+            const ServoOptions& options);
+
+  /// One tick at time `now_s` (seconds since the start), `period_s` after the last one. Used by
+  /// the thread and directly by tests (then nothing is timed). No allocation.
+  void tick(double now_s, double period_s);
+
+  /// Runs the thread to the end (duration, device finished, request_stop() or an error), then
+  /// zeroes the force. `on_status` is called from the calling thread about every 100 ms (for a
+  /// live status line); it may be empty. Returns the statistics.
+  ServoStats run(const std::function<void(const ServoStatus&)>& on_status = {});
+
+  /// Asks the loop to end (any thread; async-signal-safe).
+  void request_stop() { stop_.store(true); }
+  /// Records every tick into a ring drained by `sink` on a writer thread (set before run()).
+  void record_to(std::function<void(const TickRecord*, std::size_t)> sink, std::size_t capacity);
+
+  const ServoStats& stats() const { return stats_; }
+  TripleBuffer<ServoStatus>& status() { return status_; }
+  const PassivityObserver& passivity() const { return passivity_; }
+
+ private:
+  Device& device_;
+  ForceRenderer& renderer_;
+  const Scene& scene_;
+  TripleBuffer<ScenePoses>& poses_;
+  SafetyChain safety_;
+  PassivityObserver passivity_;
+  ServoOptions options_;
+  ServoStats stats_;
+  TripleBuffer<ServoStatus> status_;
+  std::atomic<bool> stop_{false};
+  std::vector<float> period_us_, compute_us_;  ///< sized before the thread starts
+  std::size_t samples_ = 0;
+  DeviceState state_;
+  Eigen::Vector3d held_force_ = Eigen::Vector3d::Zero();  ///< commanded at the last tick
+  Eigen::Vector3d held_from_mm_ = Eigen::Vector3d::Zero();
+  // Recording: a single-producer single-consumer ring.
+  std::vector<TickRecord> ring_;
+  std::atomic<std::size_t> ring_head_{0}, ring_tail_{0};
+  std::atomic<std::int64_t> ring_dropped_{0};
+  std::function<void(const TickRecord*, std::size_t)> sink_;
+  bool device_failed_ = false;
+};
+
+/// Sets the calling thread to SCHED_FIFO at `priority`; false with the reason when it cannot.
+bool set_realtime_priority(int priority, std::string* reason);
+
+}  // namespace spinesim::haptics

@@ -1,0 +1,253 @@
+#include "spinesim/haptics/device.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+namespace spinesim::haptics {
+
+const std::vector<DeviceCapabilities>& device_models() {
+  // Sources: the vendors' specification sheets as quoted (not re-measured here). The physical
+  // damping of every model is an assumption (no vendor publishes it); it only enters the
+  // simulated device and the default-stiffness rule.
+  static const std::vector<DeviceCapabilities> models = {
+      {"touch", "Geomagic/3D Systems Touch (formerly Sensable PHANToM Omni)",
+       Eigen::Vector3d(160, 120, 70), 3.3, 0.88, 0.5, 0.002,
+       "3D Systems Touch specification sheet: workspace 160 W x 120 H x 70 D mm, maximum force "
+       "3.3 N, continuous 0.88 N, stiffness 1.02-2.31 N/mm per axis; 0.5 N/mm is the usable "
+       "stiffness the project specification takes; damping 0.002 N s/mm is an assumption"},
+      {"premium-1.5", "3D Systems PHANToM Premium 1.5", Eigen::Vector3d(381, 267, 191), 8.5, 1.4,
+       3.5, 0.004,
+       "3D Systems PHANToM Premium 1.5 specification sheet: workspace 381 x 267 x 191 mm, "
+       "maximum force 8.5 N, continuous 1.4 N, stiffness 3.5 N/mm; damping 0.004 N s/mm is an "
+       "assumption"},
+      {"omega.3", "Force Dimension omega.3", Eigen::Vector3d(160, 110, 160), 12.0, 12.0, 14.5, 0.02,
+       "Force Dimension omega.3 specification sheet: workspace 160 mm diameter x 110 mm, "
+       "continuous force 12.0 N, closed-loop stiffness 14.5 N/mm; damping 0.02 N s/mm is an "
+       "assumption"}};
+  return models;
+}
+
+const DeviceCapabilities& device_model(const std::string& name) {
+  std::string known;
+  for (const auto& m : device_models()) {
+    if (m.model == name) return m;
+    known += (known.empty() ? "" : ", ") + m.model;
+  }
+  throw std::invalid_argument("unknown device model '" + name + "' (known: " + known + ")");
+}
+
+double passive_stiffness_limit(const DeviceCapabilities& c, double period_s,
+                               double virtual_damping) {
+  return std::max(0.0,
+                  2.0 * (c.physical_damping_n_s_per_mm - std::abs(virtual_damping)) / period_s);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Trajectories
+
+namespace {
+
+std::size_t segment(const std::vector<double>& t, double at) {
+  // Index i with t[i] <= at < t[i+1] (clamped); binary search, no allocation.
+  const auto it = std::upper_bound(t.begin(), t.end(), at);
+  if (it == t.begin()) return 0;
+  return std::min(std::size_t(it - t.begin()) - 1, t.size() - 1);
+}
+
+}  // namespace
+
+Eigen::Vector3d Trajectory::position_at(double t) const {
+  if (t_s.empty()) return Eigen::Vector3d::Zero();
+  if (t <= t_s.front()) return position_mm.front();
+  if (t >= t_s.back()) return position_mm.back();
+  const std::size_t i = segment(t_s, t);
+  const double f = (t - t_s[i]) / (t_s[i + 1] - t_s[i]);
+  return position_mm[i] + f * (position_mm[i + 1] - position_mm[i]);
+}
+
+Eigen::Vector3d Trajectory::velocity_at(double t) const {
+  if (t_s.size() < 2 || t < t_s.front() || t >= t_s.back()) return Eigen::Vector3d::Zero();
+  const std::size_t i = segment(t_s, t);
+  return (position_mm[i + 1] - position_mm[i]) / (t_s[i + 1] - t_s[i]);
+}
+
+unsigned Trajectory::buttons_at(double t) const {
+  if (t_s.empty()) return 0;
+  return buttons[segment(t_s, t)];
+}
+
+Trajectory read_trajectory(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::invalid_argument(path + ": cannot read the trajectory file");
+  Trajectory tr;
+  std::string line;
+  int line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    const auto first = line.find_first_not_of(" \t\r");
+    if (first == std::string::npos || line[first] == '#') continue;
+    if (line.size() > 4096)
+      throw std::invalid_argument(path + ":" + std::to_string(line_no) + ": line too long");
+    std::vector<std::string> cells;
+    std::stringstream ss(line);
+    std::string cell;
+    while (std::getline(ss, cell, ',')) cells.push_back(cell);
+    const std::string where = path + ":" + std::to_string(line_no);
+    if (tr.t_s.empty() && !cells.empty() && cells[0].find("t_s") != std::string::npos) continue;
+    if (cells.size() != 4 && cells.size() != 5)
+      throw std::invalid_argument(where + ": expected t_s,x_mm,y_mm,z_mm[,button], got " +
+                                  std::to_string(cells.size()) + " cells");
+    double v[5] = {0, 0, 0, 0, 0};
+    for (std::size_t k = 0; k < cells.size(); ++k) {
+      char* end = nullptr;
+      v[k] = std::strtod(cells[k].c_str(), &end);
+      while (end && (*end == ' ' || *end == '\r' || *end == '\t')) ++end;
+      if (end == cells[k].c_str() || (end && *end != '\0') || !std::isfinite(v[k]))
+        throw std::invalid_argument(where + ": '" + cells[k] + "' is not a finite number");
+    }
+    if (v[0] < 0) throw std::invalid_argument(where + ": negative time");
+    if (!tr.t_s.empty() && !(v[0] > tr.t_s.back()))
+      throw std::invalid_argument(where + ": time " + cells[0] +
+                                  " s is not after the previous row's");
+    if (std::abs(v[1]) > 1e5 || std::abs(v[2]) > 1e5 || std::abs(v[3]) > 1e5)
+      throw std::invalid_argument(where + ": a position beyond 100 m");
+    if (v[4] != 0 && v[4] != 1) throw std::invalid_argument(where + ": button must be 0 or 1");
+    tr.t_s.push_back(v[0]);
+    tr.position_mm.emplace_back(v[1], v[2], v[3]);
+    tr.buttons.push_back(unsigned(v[4]));
+    if (tr.t_s.size() > 50000000) throw std::invalid_argument(path + ": more than 50 million rows");
+  }
+  if (tr.t_s.empty()) throw std::invalid_argument(path + ": no trajectory rows");
+  return tr;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Devices without hardware
+
+namespace {
+
+class SimDevice final : public Device {
+ public:
+  SimDevice(const Trajectory& script, const DeviceCapabilities& caps, double period_s,
+            const HandModel& hand)
+      : script_(script), caps_(caps), period_(period_s), hand_(hand) {
+    if (!(period_s > 0)) throw std::invalid_argument("sim device: period must be > 0");
+    if (!(hand.mass_kg > 0) || !(hand.stiffness_n_per_mm > 0) || !(hand.damping_n_s_per_mm >= 0))
+      throw std::invalid_argument("sim device: hand mass and stiffness must be > 0");
+  }
+  std::string name() const override { return "sim"; }
+  const DeviceCapabilities& capabilities() const override { return caps_; }
+  void open() override {
+    time_ = script_.t_s.empty() ? 0 : script_.t_s.front();
+    x_ = script_.position_at(time_);
+    v_.setZero();
+    force_.setZero();
+  }
+  void close() override { force_.setZero(); }
+  bool read(DeviceState& s) override {
+    // The hand and the device over one servo period with the force held (zero-order hold).
+    const int substeps = 10;
+    const double h = period_ / substeps, m = hand_.mass_kg * 1e-3;  // tonnes (mm-N-t-s)
+    for (int k = 0; k < substeps; ++k) {
+      const double t = time_ + k * h;
+      const Eigen::Vector3d a = (hand_.stiffness_n_per_mm * (script_.position_at(t) - x_) +
+                                 hand_.damping_n_s_per_mm * (script_.velocity_at(t) - v_) -
+                                 caps_.physical_damping_n_s_per_mm * v_ + force_) /
+                                m;
+      v_ += h * a;
+      x_ += h * v_;
+    }
+    time_ += period_;
+    s.position_mm = x_;
+    s.velocity_mm_s = v_;
+    s.buttons = script_.buttons_at(time_);
+    return true;
+  }
+  bool write_force(const Eigen::Vector3d& f) override {
+    force_ = f;
+    return true;
+  }
+  bool finished() const override { return time_ >= script_.duration_s(); }
+
+ private:
+  Trajectory script_;
+  DeviceCapabilities caps_;
+  double period_;
+  HandModel hand_;
+  double time_ = 0;
+  Eigen::Vector3d x_ = Eigen::Vector3d::Zero(), v_ = Eigen::Vector3d::Zero(),
+                  force_ = Eigen::Vector3d::Zero();
+};
+
+class ReplayDevice final : public Device {
+ public:
+  ReplayDevice(const Trajectory& rec, const DeviceCapabilities& caps, double period_s)
+      : rec_(rec), caps_(caps), period_(period_s) {}
+  std::string name() const override { return "replay"; }
+  const DeviceCapabilities& capabilities() const override { return caps_; }
+  void open() override { time_ = rec_.t_s.empty() ? 0 : rec_.t_s.front(); }
+  void close() override {}
+  bool read(DeviceState& s) override {
+    s.position_mm = rec_.position_at(time_);
+    s.velocity_mm_s = rec_.velocity_at(time_);
+    s.buttons = rec_.buttons_at(time_);
+    time_ += period_;
+    return true;
+  }
+  bool write_force(const Eigen::Vector3d&) override { return true; }
+  bool finished() const override { return time_ > rec_.duration_s(); }
+
+ private:
+  Trajectory rec_;
+  DeviceCapabilities caps_;
+  double period_, time_ = 0;
+};
+
+class NullDevice final : public Device {
+ public:
+  NullDevice(const Eigen::Vector3d& p, const DeviceCapabilities& caps, double period_s,
+             double duration_s)
+      : p_(p), caps_(caps), period_(period_s), duration_(duration_s) {}
+  std::string name() const override { return "null"; }
+  const DeviceCapabilities& capabilities() const override { return caps_; }
+  void open() override { time_ = 0; }
+  void close() override {}
+  bool read(DeviceState& s) override {
+    s.position_mm = p_;
+    s.velocity_mm_s.setZero();
+    s.buttons = 0;
+    time_ += period_;
+    return true;
+  }
+  bool write_force(const Eigen::Vector3d&) override { return true; }
+  bool finished() const override { return duration_ > 0 && time_ >= duration_; }
+
+ private:
+  Eigen::Vector3d p_;
+  DeviceCapabilities caps_;
+  double period_, duration_, time_ = 0;
+};
+
+}  // namespace
+
+std::unique_ptr<Device> make_sim_device(const Trajectory& script, const DeviceCapabilities& caps,
+                                        double period_s, const HandModel& hand) {
+  return std::make_unique<SimDevice>(script, caps, period_s, hand);
+}
+
+std::unique_ptr<Device> make_replay_device(const Trajectory& recording,
+                                           const DeviceCapabilities& caps, double period_s) {
+  return std::make_unique<ReplayDevice>(recording, caps, period_s);
+}
+
+std::unique_ptr<Device> make_null_device(const Eigen::Vector3d& position_mm,
+                                         const DeviceCapabilities& caps, double period_s,
+                                         double duration_s) {
+  return std::make_unique<NullDevice>(position_mm, caps, period_s, duration_s);
+}
+
+}  // namespace spinesim::haptics

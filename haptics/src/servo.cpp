@@ -1,0 +1,267 @@
+#include "spinesim/haptics/servo.hpp"
+
+#include <pthread.h>
+#include <sched.h>
+#include <time.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+#include <thread>
+
+namespace spinesim::haptics {
+
+namespace {
+
+double monotonic_s() {
+  timespec ts{};
+  ::clock_gettime(CLOCK_MONOTONIC, &ts);
+  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
+timespec to_timespec(double s) {
+  timespec ts{};
+  ts.tv_sec = time_t(std::floor(s));
+  ts.tv_nsec = long((s - std::floor(s)) * 1e9);
+  if (ts.tv_nsec >= 1000000000L) {
+    ts.tv_sec += 1;
+    ts.tv_nsec -= 1000000000L;
+  }
+  return ts;
+}
+
+}  // namespace
+
+Percentiles percentiles(std::vector<float> v) {
+  Percentiles p;
+  if (v.empty()) return p;
+  std::sort(v.begin(), v.end());
+  auto rank = [&](double q) {
+    const std::size_t i = std::size_t(std::ceil(q * double(v.size()))) - 1;
+    return double(v[std::min(i, v.size() - 1)]);
+  };
+  p.p50 = rank(0.5);
+  p.p99 = rank(0.99);
+  p.p999 = rank(0.999);
+  p.max = double(v.back());
+  return p;
+}
+
+bool set_realtime_priority(int priority, std::string* reason) {
+  sched_param sp{};
+  sp.sched_priority = priority;
+  const int rc = ::pthread_setschedparam(::pthread_self(), SCHED_FIFO, &sp);
+  if (rc == 0) {
+    if (reason) *reason = "SCHED_FIFO priority " + std::to_string(priority);
+    return true;
+  }
+  if (reason)
+    *reason = std::string("SCHED_FIFO refused (") + std::strerror(rc) +
+              "): the loop runs at normal priority; allow real-time scheduling (CAP_SYS_NICE, "
+              "or an rtprio limit in /etc/security/limits.conf) for steadier periods";
+  return false;
+}
+
+ServoLoop::ServoLoop(Device& device, ForceRenderer& renderer, const Scene& scene,
+                     TripleBuffer<ScenePoses>& poses, const SafetyOptions& safety,
+                     const ServoOptions& options)
+    : device_(device),
+      renderer_(renderer),
+      scene_(scene),
+      poses_(poses),
+      safety_(safety),
+      passivity_(device.capabilities().physical_damping_n_s_per_mm),
+      options_(options) {
+  if (!(options.period_s >= 1e-4 && options.period_s <= 0.1))
+    throw std::invalid_argument("servo period must be 0.1 to 100 ms");
+  if (!(options.duration_s > 0) || options.duration_s > 24 * 3600)
+    throw std::invalid_argument("servo duration must be > 0 s and at most a day");
+  const std::size_t capacity = std::size_t(options.duration_s / options.period_s * 1.05) + 1000;
+  period_us_.assign(std::min<std::size_t>(capacity, 100000000), 0.f);
+  compute_us_.assign(period_us_.size(), 0.f);
+  DeviceState s;
+  device_.read(s);  // the starting position (a sim device advances one period)
+  state_ = s;
+  held_from_mm_ = s.position_mm;
+  renderer_.reset(s.position_mm);
+}
+
+void ServoLoop::record_to(std::function<void(const TickRecord*, std::size_t)> sink,
+                          std::size_t capacity) {
+  sink_ = std::move(sink);
+  ring_.assign(std::max<std::size_t>(capacity, 16), TickRecord{});
+}
+
+void ServoLoop::tick(double now_s, double period_s) {
+  ServoStats& st = stats_;
+  if (device_failed_) return;
+  if (!device_.read(state_)) {
+    device_.write_force(Eigen::Vector3d::Zero());
+    device_failed_ = true;
+    st.error = true;
+    st.stop_reason = "device error";
+    stop_.store(true);
+    return;
+  }
+  // The force held over the last period did its work over the device's motion since then.
+  passivity_.add(held_force_, state_.position_mm - held_from_mm_, period_s);
+  held_from_mm_ = state_.position_mm;
+  const ScenePoses& poses = poses_.read();
+  ProbeState probe;
+  probe.position_mm = state_.position_mm;
+  probe.velocity_mm_s = state_.velocity_mm_s;
+  const RenderOutput out = renderer_.render(probe, scene_, poses, period_s);
+  SafetyTick in;
+  in.period_s = period_s;
+  in.scene_age_s = now_s - poses.time_s;
+  in.contact = out.contact;
+  in.penetration_mm = out.penetration_mm;
+  SafetyReport report;
+  const Eigen::Vector3d force = safety_.apply(out.force_n, in, &report);
+  if (!device_.write_force(force)) {
+    device_.write_force(Eigen::Vector3d::Zero());
+    device_failed_ = true;
+    st.error = true;
+    st.stop_reason = "device error";
+    stop_.store(true);
+  }
+  held_force_ = device_failed_ ? Eigen::Vector3d::Zero() : force;
+
+  ++st.ticks;
+  st.max_force_n = std::max(st.max_force_n, force.norm());
+  st.clamped_ticks += report.clamped;
+  st.limited_ticks += report.limited;
+  st.non_finite_ticks += report.non_finite;
+  st.fading_ticks += report.fading;
+  st.contact_ticks += out.contact;
+  st.truncated_ticks += out.truncated;
+
+  ServoStatus status;
+  status.ticks = st.ticks;
+  status.time_s = now_s;
+  status.probe_mm = state_.position_mm;
+  status.proxy_mm = out.proxy_mm;
+  status.force_n = force;
+  status.contact = out.contact;
+  status.body = out.body;
+  status.buttons = state_.buttons;
+  status.passivity_mj = passivity_.energy_mj();
+  status_.write(status);
+
+  if (!ring_.empty()) {
+    const std::size_t head = ring_head_.load(std::memory_order_relaxed);
+    const std::size_t next = (head + 1) % ring_.size();
+    if (next == ring_tail_.load(std::memory_order_acquire)) {
+      ring_dropped_.fetch_add(1);  // the writer fell behind: never wait for it
+    } else {
+      TickRecord& r = ring_[head];
+      r.t_s = now_s;
+      r.probe_mm = state_.position_mm;
+      r.force_n = force;
+      r.proxy_mm = out.proxy_mm;
+      r.buttons = state_.buttons;
+      r.contact = out.contact;
+      ring_head_.store(next, std::memory_order_release);
+    }
+  }
+}
+
+ServoStats ServoLoop::run(const std::function<void(const ServoStatus&)>& on_status) {
+  std::atomic<bool> done{false};
+  std::string error_text;
+  double t0 = 0;
+  auto servo = [&] {
+    std::string reason;
+    stats_.realtime_priority =
+        options_.realtime_priority && set_realtime_priority(options_.priority, &reason);
+    stats_.realtime_reason = options_.realtime_priority ? reason : "not asked for";
+    const double T = options_.period_s;
+    t0 = monotonic_s();
+    double deadline = t0, last_wake = t0;
+    try {
+      while (!stop_.load(std::memory_order_relaxed)) {
+        deadline += T;
+        const timespec ts = to_timespec(deadline);
+        while (::clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {}
+        const double wake = monotonic_s();
+        const double period = wake - last_wake;
+        last_wake = wake;
+        tick(wake - t0, period);
+        const double end = monotonic_s();
+        if (samples_ < period_us_.size()) {
+          period_us_[samples_] = float(period * 1e6);
+          compute_us_[samples_] = float((end - wake) * 1e6);
+          ++samples_;
+        }
+        if (wake - deadline > T || end > deadline + T) ++stats_.missed_deadlines;
+        if (end - deadline > 10 * T) deadline = end;  // far behind: do not burst to catch up
+        if (wake - t0 >= options_.duration_s) {
+          stats_.stop_reason = "duration";
+          break;
+        }
+        if (device_.finished()) {
+          stats_.stop_reason = "device finished";
+          break;
+        }
+      }
+    } catch (const std::exception& e) {
+      error_text = e.what();
+    }
+    device_.write_force(Eigen::Vector3d::Zero());
+    stats_.seconds = monotonic_s() - t0;
+    done.store(true);
+  };
+
+  // The recording's writer: drains the ring in blocks, never blocking the servo thread.
+  std::thread writer;
+  if (!ring_.empty() && sink_) {
+    writer = std::thread([&] {
+      std::vector<TickRecord> block;
+      auto drain = [&] {
+        block.clear();
+        std::size_t tail = ring_tail_.load(std::memory_order_relaxed);
+        const std::size_t head = ring_head_.load(std::memory_order_acquire);
+        while (tail != head) {
+          block.push_back(ring_[tail]);
+          tail = (tail + 1) % ring_.size();
+        }
+        ring_tail_.store(tail, std::memory_order_release);
+        if (!block.empty()) sink_(block.data(), block.size());
+      };
+      while (!done.load()) {
+        drain();
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      }
+      drain();
+    });
+  }
+  std::thread thread(servo);
+  while (!done.load()) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    if (on_status && !done.load()) on_status(status_.read());
+  }
+  thread.join();
+  if (writer.joinable()) writer.join();
+
+  if (!error_text.empty()) {
+    stats_.error = true;
+    stats_.stop_reason = error_text;
+  } else if (stats_.stop_reason.empty()) {
+    stats_.stop_reason = stats_.error ? "device error" : "stopped";
+  }
+  std::vector<float> period(period_us_.begin(), period_us_.begin() + long(samples_));
+  std::vector<float> compute(compute_us_.begin(), compute_us_.begin() + long(samples_));
+  // The first period is measured from the start time, not from a previous tick.
+  if (!period.empty()) period.erase(period.begin());
+  stats_.period_us = percentiles(period);
+  stats_.compute_us = percentiles(compute);
+  stats_.rate_hz = stats_.seconds > 0 ? double(stats_.ticks) / stats_.seconds : 0;
+  stats_.passivity_min_mj = passivity_.minimum_mj();
+  stats_.passivity_final_mj = passivity_.energy_mj();
+  return stats_;
+}
+
+}  // namespace spinesim::haptics
