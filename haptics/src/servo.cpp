@@ -77,6 +77,8 @@ ServoLoop::ServoLoop(Device& device, ForceRenderer& renderer, const Scene& scene
       options_(options) {
   if (!(options.period_s >= 1e-4 && options.period_s <= 0.1))
     throw std::invalid_argument("servo period must be 0.1 to 100 ms");
+  if (!(options.spin_us >= 0) || options.spin_us > 0.9e6 * options.period_s)
+    throw std::invalid_argument("servo spin time must be 0 to 90 % of the period");
   if (!(options.duration_s > 0) || options.duration_s > 24 * 3600)
     throw std::invalid_argument("servo duration must be > 0 s and at most a day");
   const std::size_t capacity = std::size_t(options.duration_s / options.period_s * 1.05) + 1000;
@@ -169,23 +171,27 @@ void ServoLoop::tick(double now_s, double period_s) {
   }
 }
 
-ServoStats ServoLoop::run(const std::function<void(const ServoStatus&)>& on_status) {
+double ServoLoop::now_s() const { return monotonic_s() - t0_; }
+
+ServoStats ServoLoop::run(const std::function<void(const ServoStatus&, double)>& every_10ms) {
   std::atomic<bool> done{false};
   std::string error_text;
-  double t0 = 0;
+  t0_ = monotonic_s();
+  const double t0 = t0_;
+  if (every_10ms) every_10ms(status_.read(), 0.0);  // e.g. the first stamped poses
   auto servo = [&] {
     std::string reason;
     stats_.realtime_priority =
         options_.realtime_priority && set_realtime_priority(options_.priority, &reason);
     stats_.realtime_reason = options_.realtime_priority ? reason : "not asked for";
     const double T = options_.period_s;
-    t0 = monotonic_s();
     double deadline = t0, last_wake = t0;
     try {
       while (!stop_.load(std::memory_order_relaxed)) {
         deadline += T;
-        const timespec ts = to_timespec(deadline);
+        const timespec ts = to_timespec(deadline - 1e-6 * options_.spin_us);
         while (::clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {}
+        while (options_.spin_us > 0 && monotonic_s() < deadline) {}
         const double wake = monotonic_s();
         const double period = wake - last_wake;
         last_wake = wake;
@@ -240,8 +246,8 @@ ServoStats ServoLoop::run(const std::function<void(const ServoStatus&)>& on_stat
   }
   std::thread thread(servo);
   while (!done.load()) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
-    if (on_status && !done.load()) on_status(status_.read());
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    if (every_10ms && !done.load()) every_10ms(status_.read(), monotonic_s() - t0);
   }
   thread.join();
   if (writer.joinable()) writer.join();

@@ -39,6 +39,8 @@ void register_calibrate(CLI::App& app);  ///< calibrate (cli_calibrate.cpp)
 void register_study(
     CLI::App& app);  ///< study probe|drive|materials|validation|fusion|trends (cli_study.cpp)
 void register_spine(CLI::App& app);  ///< spine solve (cli_spine.cpp)
+void register_haptics(CLI::App& app);        ///< haptics run|devices (cli_haptics.cpp)
+void register_haptic_plane(CLI::App& study);  ///< study haptic-plane (cli_haptics.cpp)
 void register_demo(CLI::App& app);
 void register_bench(CLI::App& app);
 void register_spine_database(

@@ -513,6 +513,7 @@ void register_study(CLI::App& app) {
   register_validation(*study);
   register_fusion(*study);
   register_trends(*study);
+  register_haptic_plane(*study);
 }
 
 }  // namespace spinesim::cli

@@ -37,6 +37,7 @@ int main(int argc, char** argv) {
   spinesim::cli::register_calibrate(app);
   spinesim::cli::register_spine(app);
   spinesim::cli::register_study(app);
+  spinesim::cli::register_haptics(app);
   spinesim::cli::register_demo(app);
   spinesim::cli::register_bench(app);
   try {

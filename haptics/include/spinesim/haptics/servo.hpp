@@ -26,6 +26,10 @@ struct ServoOptions {
   double duration_s = 10;         ///< stop after this long (or when the device has finished)
   bool realtime_priority = true;  ///< ask for SCHED_FIFO
   int priority = 80;
+  /// Sleep until this long before each deadline, then spin to it: the kernel's wake-up latency
+  /// on a virtual machine is tens to hundreds of µs (docs/benchmarks.md), spinning is not. 0:
+  /// sleep to the deadline (no CPU burnt).
+  double spin_us = 400;
 };
 
 /// What the servo thread publishes every tick (for a status line or a viewer).
@@ -82,9 +86,13 @@ class ServoLoop {
   void tick(double now_s, double period_s);
 
   /// Runs the thread to the end (duration, device finished, request_stop() or an error), then
-  /// zeroes the force. `on_status` is called from the calling thread about every 100 ms (for a
-  /// live status line); it may be empty. Returns the statistics.
-  ServoStats run(const std::function<void(const ServoStatus&)>& on_status = {});
+  /// zeroes the force. `every_10ms(status, now_s)` is called from the calling thread about every
+  /// 10 ms with the latest status and the loop's clock (s since the start, the clock scene
+  /// poses are stamped with): the slow side publishes poses and draws status there. It may be
+  /// empty. Returns the statistics.
+  ServoStats run(const std::function<void(const ServoStatus&, double)>& every_10ms = {});
+  /// Seconds on the loop's clock (valid during run()).
+  double now_s() const;
 
   /// Asks the loop to end (any thread; async-signal-safe).
   void request_stop() { stop_.store(true); }
@@ -117,6 +125,7 @@ class ServoLoop {
   std::atomic<std::int64_t> ring_dropped_{0};
   std::function<void(const TickRecord*, std::size_t)> sink_;
   bool device_failed_ = false;
+  double t0_ = 0;  ///< the loop's clock origin (CLOCK_MONOTONIC, s)
 };
 
 /// Sets the calling thread to SCHED_FIFO at `priority`; false with the reason when it cannot.

@@ -1,0 +1,76 @@
+#!/usr/bin/python3
+"""Writes the scripted hand trajectories of data/haptics/ from the parametric vertebrae.
+
+    spinesim mesh vertebrae --out /tmp/vertebrae
+    scripts/make-haptic-scripts.py /tmp/vertebrae data/haptics
+
+The trajectories are set-points of the simulated hand (t_s, x_mm, y_mm, z_mm, button) in the
+scene frame (x lateral, y up, z anterior), for a probe of radius 4 mm:
+  stroke_spinous.csv  down the spinous process tips T1 -> L5, the set-point 2 mm into them;
+  press_lumbar.csv    each lumbar body pressed 3 mm from the front, held, released;
+  press_plane.csv     the plane scene (z = 0, normal +z) pressed 3 mm at two spots.
+"""
+import os
+import sys
+
+RADIUS = 4.0
+
+
+def load_obj(path):
+    vertices = []
+    with open(path) as f:
+        for line in f:
+            if line.startswith("v "):
+                vertices.append(tuple(float(x) for x in line.split()[1:4]))
+    return vertices
+
+
+def write(path, header, rows):
+    with open(path, "w") as f:
+        f.write("# spinesim haptic script (scripts/make-haptic-scripts.py): " + header + "\n")
+        f.write("# units: s, mm; frame x lateral (right = -x), y superior, z anterior; probe radius 4 mm\n")
+        f.write("t_s,x_mm,y_mm,z_mm,button\n")
+        for t, x, y, z in rows:
+            f.write(f"{t:.3f},{x:.3f},{y:.3f},{z:.3f},0\n")
+
+
+def main():
+    src, out = sys.argv[1], sys.argv[2]
+    names = [f"T{i}" for i in range(1, 13)] + [f"L{i}" for i in range(1, 6)]
+    verts = {n: load_obj(os.path.join(src, n + ".obj")) for n in names}
+
+    # Spinous tips: the most posterior (smallest z) vertex near the midline.
+    tips = []
+    for n in names:
+        mid = [v for v in verts[n] if abs(v[0]) < 2.0]
+        tips.append(min(mid, key=lambda v: v[2]))
+    rows, t = [], 0.0
+    first = tips[0]
+    rows.append((t, 0.0, first[1], first[2] - 40.0))
+    t += 1.0
+    for tip in tips:
+        rows.append((t, 0.0, tip[1], tip[2] - RADIUS + 2.0))
+        t += 0.5
+    last = tips[-1]
+    rows.append((t + 0.5, 0.0, last[1], last[2] - 40.0))
+    write(os.path.join(out, "stroke_spinous.csv"), "stroke down the spinous processes T1-L5", rows)
+
+    # Lumbar bodies: the most anterior vertex near the midline, pressed 3 mm.
+    rows, t = [], 0.0
+    for n in ["L1", "L2", "L3", "L4", "L5"]:
+        mid = [v for v in verts[n] if abs(v[0]) < 2.0]
+        front = max(mid, key=lambda v: v[2])
+        away = (0.0, front[1], front[2] + 25.0)
+        touch = (0.0, front[1], front[2] + RADIUS - 3.0)
+        rows += [(t, *away), (t + 0.5, *touch), (t + 1.0, *touch), (t + 1.5, *away)]
+        t += 2.0
+    write(os.path.join(out, "press_lumbar.csv"), "press each lumbar body 3 mm from the front", rows)
+
+    rows = [(0.0, 0.0, 0.0, 20.0), (1.0, 0.0, 0.0, RADIUS - 3.0), (2.0, 0.0, 0.0, RADIUS - 3.0),
+            (3.0, 0.0, 0.0, 20.0), (3.5, 20.0, 10.0, 20.0), (4.5, 20.0, 10.0, RADIUS - 3.0),
+            (5.5, 20.0, 10.0, RADIUS - 3.0), (6.5, 20.0, 10.0, 20.0)]
+    write(os.path.join(out, "press_plane.csv"), "press the plane 3 mm at two spots", rows)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,185 @@
+// spinesim haptics run | devices, and spinesim study haptic-plane.
+//
+//   spinesim haptics run --scene spine|vertebra|plane [--vertebrae generated]
+//       --device sim|replay|null|openhaptics|dhd [--script TRAJ.csv | --replay REC.csv]
+//       [--duration S] [--probe-radius MM] [--renderer proxy|gao-gibson] [--record REC.csv] [--json]
+//   spinesim haptics devices
+//   spinesim study haptic-plane [--csv]
+//
+// Ctrl-C (or SIGTERM/SIGHUP/QUIT) during a run ends the loop: the force goes to zero, the device
+// is closed, the summary is printed, then the run exits by the signal.
+#include "cli_common.hpp"
+
+#include "spinesim/studies/haptic_plane_study.hpp"
+#include "spinesim/studies/haptics_run.hpp"
+
+#include <atomic>
+#include <csignal>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+
+namespace spinesim::cli {
+namespace {
+
+std::atomic<bool> g_stop{false};
+std::atomic<int> g_signal{0};
+
+void on_stop_signal(int sig) {
+  g_signal.store(sig);
+  g_stop.store(true);
+}
+
+// While alive, the terminating signals end the haptic loop instead of the process.
+class StopOnSignals {
+ public:
+  StopOnSignals() {
+    for (std::size_t i = 0; i < 4; ++i) {
+      struct sigaction sa {};
+      sa.sa_handler = on_stop_signal;
+      sigemptyset(&sa.sa_mask);
+      ::sigaction(kSignals[i], &sa, &old_[i]);
+    }
+  }
+  ~StopOnSignals() {
+    for (std::size_t i = 0; i < 4; ++i) ::sigaction(kSignals[i], &old_[i], nullptr);
+    if (const int sig = g_signal.load()) std::raise(sig);  // now the previous handler's turn
+  }
+
+ private:
+  static constexpr int kSignals[4] = {SIGINT, SIGTERM, SIGHUP, SIGQUIT};
+  struct sigaction old_[4]{};
+};
+
+struct HapticsArgs {
+  HapticsRunRequest request;
+  bool json = false, quiet = false, no_realtime = false;
+};
+
+void run_haptics_cli(HapticsArgs& a) {
+  a.request.realtime_priority = !a.no_realtime;
+  a.request.stop = &g_stop;
+  const bool live = !a.quiet && !a.json && stderr_is_terminal();
+  std::unique_ptr<ProgressBar> bar;
+  if (a.request.scene.scene != "plane")
+    bar = std::make_unique<ProgressBar>(a.request.scene.scene == "spine" ? 18 : 1,
+                                        a.quiet || a.json, "vertebrae meshed");
+  HapticsRunResult result;
+  {
+    const StopOnSignals stop;
+    result = run_haptics(
+        a.request, data_dir(),
+        [live](const haptics::ServoStatus& s) {
+          if (!live) return;
+          std::fprintf(stderr, "\r  t %6.1f s | force %5.2f N | %s        ", s.time_s,
+                       s.force_n.norm(), s.contact ? "contact" : "free   ");
+          std::fflush(stderr);
+        },
+        [&bar](int done, int) {
+          if (bar) bar->update(done);
+        });
+    if (live) std::fprintf(stderr, "\r%78s\r", "");
+    if (a.json)
+      print_json(haptics_run_json(result));
+    else
+      std::cout << haptics_run_table(result);
+    std::cout.flush();
+  }
+}
+
+struct PlaneArgs {
+  HapticPlaneRequest request;
+  bool csv = false, json = false, quiet = false;
+  std::string out;
+};
+
+void run_plane(const PlaneArgs& a) {
+  const auto result = run_haptic_plane_study(a.request);
+  if (!a.out.empty()) write_text_file(a.out, haptic_plane_csv(result));
+  if (a.json)
+    print_json(haptic_plane_json(result));
+  else if (a.csv)
+    std::cout << haptic_plane_csv(result);
+  else
+    std::cout << haptic_plane_table(result);
+}
+
+}  // namespace
+
+void register_haptics(CLI::App& app) {
+  auto* haptics_cmd = app.add_subcommand(
+      "haptics", "The 1 kHz haptic loop: touch the spine with a spherical probe");
+  haptics_cmd->require_subcommand(1);
+  auto a = std::make_shared<HapticsArgs>();
+  auto* run = haptics_cmd->add_subcommand(
+      "run", "Run the servo loop on a scene with a device (sim: a scripted hand)");
+  run->add_option("--scene", a->request.scene.scene,
+                  "spine (T1-L5 and sacrum), vertebra (L3) or plane")
+      ->capture_default_str();
+  run->add_option("--vertebrae", a->request.scene.vertebrae, "Vertebra surfaces: generated")
+      ->capture_default_str();
+  run->add_option("--triangles", a->request.scene.triangles, "Triangles per generated vertebra")
+      ->capture_default_str();
+  run->add_option("--device", a->request.device, "sim, replay, null, openhaptics or dhd")
+      ->capture_default_str();
+  run->add_option("--model", a->request.model,
+                  "Device capability record: touch, premium-1.5, omega.3 (peak force, stiffness)")
+      ->capture_default_str();
+  run->add_option("--script", a->request.script,
+                  "sim: the hand's set-point trajectory, CSV t_s,x_mm,y_mm,z_mm[,button] "
+                  "(default: data/haptics/ for the scene)");
+  run->add_option("--replay", a->request.replay, "replay: a file written by --record");
+  run->add_option("--duration", a->request.duration_s,
+                  "Seconds to run (0: the script's or recording's length; null: 10 s)")
+      ->capture_default_str();
+  run->add_option("--probe-radius", a->request.probe_radius_mm, "Probe sphere radius, mm")
+      ->capture_default_str();
+  run->add_option("--renderer", a->request.renderer,
+                  "proxy (god-object, default) or gao-gibson (the thesis's penalty method)")
+      ->capture_default_str();
+  run->add_option("--stiffness", a->request.stiffness_n_per_mm,
+                  "Rendering stiffness, N/mm (0: the device's usable stiffness within the "
+                  "Colgate-Brown passivity limit)")
+      ->capture_default_str();
+  run->add_option("--record", a->request.record, "Write every tick to this CSV (replayable)");
+  run->add_option("--spin-us", a->request.spin_us,
+                  "Spin (busy-wait) this long before each deadline instead of sleeping to it, us "
+                  "(0: sleep only; steadier periods on virtual machines for some CPU)")
+      ->capture_default_str();
+  run->add_flag("--no-realtime", a->no_realtime, "Do not ask for real-time (SCHED_FIFO) priority");
+  add_output_flags(run, a->json, a->quiet);
+  run->callback([a] { run_haptics_cli(*a); });
+
+  auto* devices = haptics_cmd->add_subcommand(
+      "devices", "List the device backends built in and the device models known");
+  auto json = std::make_shared<bool>(false);
+  devices->add_flag("--json", *json, "One JSON object on stdout");
+  devices->callback([json] {
+    if (*json)
+      print_json(haptic_devices_json());
+    else
+      std::cout << haptic_devices_table();
+  });
+}
+
+void register_haptic_plane(CLI::App& study) {
+  auto a = std::make_shared<PlaneArgs>();
+  auto* cmd = study.add_subcommand(
+      "haptic-plane",
+      "Thesis figs 4.16-4.19: Gao-Gibson force against intrusion depth for two probe sizes");
+  cmd->add_option("--radius", a->request.small_radius_mm,
+                  "Small probe radius, mm (the large one's is twice it)")
+      ->capture_default_str();
+  cmd->add_option("--step", a->request.step_mm, "Depth step, mm")->capture_default_str();
+  cmd->add_option("--spacing", a->request.spacing_mm, "Surface sample spacing, mm")
+      ->capture_default_str();
+  cmd->add_option("--stiffness", a->request.stiffness_eq410_n_per_mm,
+                  "Eq 4.10 stiffness, N/mm (eq 4.9's is matched at the small probe's peak)")
+      ->capture_default_str();
+  cmd->add_flag("--csv", a->csv, "Print the force-depth table as CSV");
+  cmd->add_option("--out", a->out, "Also write the CSV to this file");
+  add_output_flags(cmd, a->json, a->quiet);
+  cmd->callback([a] { run_plane(*a); });
+}
+
+}  // namespace spinesim::cli

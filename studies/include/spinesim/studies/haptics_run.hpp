@@ -1,0 +1,83 @@
+// The haptic loop as a study driver: build the rigid scene (the spine's 18 bodies, one vertebra
+// or a plane), open a device, run the 1 kHz servo loop with a renderer and the safety chain,
+// record the run, and report the loop's own statistics. The command line (`spinesim haptics
+// run`) and the viewer call this.
+#pragma once
+
+#include "spinesim/haptics/device.hpp"
+#include "spinesim/haptics/scene.hpp"
+#include "spinesim/haptics/servo.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <atomic>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace spinesim::studies {
+
+struct HapticSceneRequest {
+  std::string scene = "spine";          ///< spine (T1…L5 + sacrum), vertebra (L3) or plane
+  std::string vertebrae = "generated";  ///< generated (parametric) — the only source so far
+  int triangles = 6000;                 ///< per generated body
+};
+
+struct HapticScene {
+  haptics::Scene scene;
+  std::string description;
+  Eigen::Vector3d center_mm = Eigen::Vector3d::Zero();
+  double seconds = 0;
+};
+
+/// Builds the scene; `progress(done, total)` per body. Throws std::invalid_argument (one line)
+/// for an unknown scene or source.
+HapticScene build_haptic_scene(const HapticSceneRequest& r, const std::string& data_dir,
+                               const std::function<void(int, int)>& progress = {});
+
+struct HapticsRunRequest {
+  HapticSceneRequest scene;
+  std::string device = "sim";   ///< sim, replay, null, openhaptics, dhd
+  std::string model = "touch";  ///< capability record (haptics::device_models)
+  std::string script;           ///< sim: the hand's set-point trajectory (default per scene)
+  std::string replay;           ///< replay: a recorded run
+  double duration_s = 0;        ///< 0: the script's or recording's length (null: 10 s)
+  double probe_radius_mm = 4;
+  std::string renderer = "proxy";  ///< proxy or gao-gibson
+  double stiffness_n_per_mm = 0;   ///< 0: the device's usable stiffness within Colgate–Brown
+  std::string record;              ///< CSV of every tick (written whole at the end)
+  bool realtime_priority = true;
+  double spin_us = 400;                     ///< spin this long before each deadline (0: sleep only)
+  const std::atomic<bool>* stop = nullptr;  ///< set by the front end (Ctrl-C) to end the run
+};
+
+/// The shipped scripts (data/haptics/), and the default one for a scene.
+std::string default_haptic_script(const std::string& scene, const std::string& data_dir);
+
+struct HapticsRunResult {
+  HapticsRunRequest request;
+  std::string scene_description;
+  int bodies = 0, triangles = 0;
+  double scene_seconds = 0;
+  haptics::DeviceCapabilities capabilities;
+  double stiffness_n_per_mm = 0, passive_limit_n_per_mm = 0;
+  haptics::ServoStats stats;
+  std::int64_t recorded_rows = 0;
+};
+
+/// Validates everything (device, model, files, radius, output folder) before any work, builds
+/// the scene, runs the loop. `status(status)` about every 100 ms for a live line (may be empty);
+/// `scene_progress` as for build_haptic_scene. Throws std::invalid_argument (one line) for bad
+/// input, std::runtime_error for a device that cannot be opened; nothing is written then.
+HapticsRunResult run_haptics(const HapticsRunRequest& request, const std::string& data_dir,
+                             const std::function<void(const haptics::ServoStatus&)>& status = {},
+                             const std::function<void(int, int)>& scene_progress = {});
+
+nlohmann::json haptics_run_json(const HapticsRunResult& r);
+std::string haptics_run_table(const HapticsRunResult& r);
+
+/// `spinesim haptics devices`: the backends built in and the models known.
+nlohmann::json haptic_devices_json();
+std::string haptic_devices_table();
+
+}  // namespace spinesim::studies

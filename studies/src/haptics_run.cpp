@@ -1,0 +1,348 @@
+#include "spinesim/studies/haptics_run.hpp"
+
+#include "spinesim/common/atomic_file.hpp"
+#include "spinesim/common/pending_output.hpp"
+#include "spinesim/common/timer.hpp"
+#include "spinesim/haptics/renderer.hpp"
+#include "spinesim/mesh/vertebra_geometry.hpp"
+#include "spinesim/studies/files.hpp"
+#include "spinesim/studies/format.hpp"
+#include "spinesim/studies/table.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+
+#include <unistd.h>
+
+namespace spinesim::studies {
+
+namespace fs = std::filesystem;
+
+HapticScene build_haptic_scene(const HapticSceneRequest& r, const std::string& data_dir,
+                               const std::function<void(int, int)>& progress) {
+  if (r.vertebrae != "generated")
+    throw std::invalid_argument("--vertebrae " + r.vertebrae +
+                                ": only 'generated' vertebrae are available in this version");
+  const Timer timer;
+  HapticScene out;
+  if (r.scene == "plane") {
+    out.scene.add_body("plane", haptics::square_plane(100, 2));
+    out.description = "a plane z = 0 (100 x 100 mm, normal +z)";
+  } else if (r.scene == "vertebra" || r.scene == "spine") {
+    const std::vector<std::string> names =
+        r.scene == "spine" ? mesh::scene_body_names() : std::vector<std::string>{"L3"};
+    if (r.triangles < 100 || r.triangles > 200000)
+      throw std::invalid_argument("--triangles " + std::to_string(r.triangles) +
+                                  ": give 100 to 200,000 per vertebra");
+    for (std::size_t i = 0; i < names.size(); ++i) {
+      const auto v = mesh::parametric_vertebra(names[i], data_dir);
+      out.scene.add_body(names[i], mesh::mesh_vertebra(v, r.triangles).surface);
+      if (progress) progress(int(i + 1), int(names.size()));
+    }
+    out.description = r.scene == "spine"
+                          ? "the spine: parametric T1-L5 and sacrum at the reference posture"
+                          : "parametric L3 at its reference posture";
+  } else {
+    throw std::invalid_argument("--scene " + r.scene + ": give spine, vertebra or plane");
+  }
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
+  for (int i = 0; i < out.scene.size(); ++i) {
+    lo = lo.cwiseMin(out.scene.body(i).tree.bounds_min());
+    hi = hi.cwiseMax(out.scene.body(i).tree.bounds_max());
+  }
+  out.center_mm = 0.5 * (lo + hi);
+  out.seconds = timer.seconds();
+  return out;
+}
+
+std::string default_haptic_script(const std::string& scene, const std::string& data_dir) {
+  const fs::path dir = fs::path(data_dir) / "haptics";
+  if (scene == "plane") return (dir / "press_plane.csv").string();
+  if (scene == "vertebra") return (dir / "press_lumbar.csv").string();
+  return (dir / "stroke_spinous.csv").string();
+}
+
+namespace {
+
+// Refuses what cannot run, before any work: one line each.
+void check_request(const HapticsRunRequest& r) {
+  if (!(r.probe_radius_mm > 0) || !std::isfinite(r.probe_radius_mm) || r.probe_radius_mm > 100)
+    throw std::invalid_argument("--probe-radius must be > 0 and at most 100 mm");
+  if (r.renderer != "proxy" && r.renderer != "gao-gibson")
+    throw std::invalid_argument("--renderer " + r.renderer + ": give proxy or gao-gibson");
+  if (!(r.duration_s >= 0) || r.duration_s > 24 * 3600)
+    throw std::invalid_argument("--duration must be 0 (the script's length) to 86400 s");
+  if (!(r.spin_us >= 0) || r.spin_us > 900)
+    throw std::invalid_argument("--spin-us must be 0 to 900 us");
+  if (!(r.stiffness_n_per_mm >= 0) || !std::isfinite(r.stiffness_n_per_mm))
+    throw std::invalid_argument("--stiffness must be >= 0 N/mm (0: the device's default)");
+  if (r.device == "openhaptics" || r.device == "dhd")
+    throw std::runtime_error("--device " + r.device + ": this build has no " +
+                             (r.device == "dhd" ? "Force Dimension DHD" : "OpenHaptics HD") +
+                             " backend yet (spinesim haptics devices lists what there is)");
+  if (r.device != "sim" && r.device != "replay" && r.device != "null")
+    throw std::invalid_argument("--device " + r.device +
+                                ": unknown (sim, replay, null, openhaptics, dhd)");
+  if (r.device == "replay" && r.replay.empty())
+    throw std::invalid_argument("--device replay needs --replay REC.csv");
+  if (r.device != "replay" && !r.replay.empty())
+    throw std::invalid_argument("--replay is for --device replay");
+  if (r.device != "sim" && !r.script.empty())
+    throw std::invalid_argument("--script is for --device sim");
+  if (!r.record.empty()) require_output_folder(r.record, "--record");
+}
+
+void write_record_header(std::ostream& os, const HapticsRunRequest& r) {
+  os << "# spinesim haptics run: every servo tick; device " << r.device << ", renderer "
+     << r.renderer << ", probe radius " << r.probe_radius_mm << " mm\n"
+     << "# units: s, mm, N; frame x lateral (right = -x), y superior, z anterior. Columns 1-5 "
+        "are a trajectory (--device replay --replay FILE plays them)\n"
+     << "t_s,x_mm,y_mm,z_mm,button,fx_n,fy_n,fz_n,proxy_x_mm,proxy_y_mm,proxy_z_mm,contact\n";
+}
+
+}  // namespace
+
+HapticsRunResult run_haptics(const HapticsRunRequest& request, const std::string& data_dir,
+                             const std::function<void(const haptics::ServoStatus&)>& status,
+                             const std::function<void(int, int)>& scene_progress) {
+  check_request(request);
+  HapticsRunResult result;
+  result.request = request;
+  result.capabilities = haptics::device_model(request.model);
+  const double T = 1e-3;
+  // Files are read (and refused) before the scene is built.
+  haptics::Trajectory trajectory;
+  if (request.device == "sim") {
+    result.request.script = request.script.empty()
+                                ? default_haptic_script(request.scene.scene, data_dir)
+                                : request.script;
+    trajectory = haptics::read_trajectory(result.request.script);
+  } else if (request.device == "replay") {
+    trajectory = haptics::read_trajectory(request.replay);
+  }
+  double duration = request.duration_s;
+  if (duration == 0) duration = request.device == "null" ? 10.0 : trajectory.duration_s() + T;
+  result.request.duration_s = duration;
+  if (request.scene.scene != "spine" && request.scene.scene != "vertebra" &&
+      request.scene.scene != "plane")
+    throw std::invalid_argument("--scene " + request.scene.scene +
+                                ": give spine, vertebra or plane");
+
+  HapticScene scene = build_haptic_scene(request.scene, data_dir, scene_progress);
+  result.scene_description = scene.description;
+  result.bodies = scene.scene.size();
+  result.triangles = scene.scene.triangle_count();
+  result.scene_seconds = scene.seconds;
+
+  result.passive_limit_n_per_mm = haptics::passive_stiffness_limit(result.capabilities, T);
+  result.stiffness_n_per_mm = request.stiffness_n_per_mm > 0
+                                  ? request.stiffness_n_per_mm
+                                  : std::min(result.capabilities.usable_stiffness_n_per_mm,
+                                             0.5 * result.passive_limit_n_per_mm);
+  std::unique_ptr<haptics::ForceRenderer> renderer;
+  if (request.renderer == "proxy") {
+    haptics::ProxyParameters p;
+    p.radius_mm = request.probe_radius_mm;
+    p.stiffness_n_per_mm = result.stiffness_n_per_mm;
+    renderer = std::make_unique<haptics::SphereProxyRenderer>(p);
+  } else {
+    haptics::GaoGibsonParameters p;
+    p.radius_mm = request.probe_radius_mm;
+    p.stiffness = result.stiffness_n_per_mm;
+    p.sample_spacing_mm = std::min(0.25, request.probe_radius_mm / 8);
+    scene.scene.sample_surfaces(p.sample_spacing_mm);
+    renderer = std::make_unique<haptics::GaoGibsonRenderer>(p);
+  }
+
+  std::unique_ptr<haptics::Device> device;
+  if (request.device == "sim")
+    device = haptics::make_sim_device(trajectory, result.capabilities, T);
+  else if (request.device == "replay")
+    device = haptics::make_replay_device(trajectory, result.capabilities, T);
+  else
+    device = haptics::make_null_device(scene.center_mm + Eigen::Vector3d(0, 0, 150),
+                                       result.capabilities, T, duration);
+  device->open();
+
+  haptics::TripleBuffer<haptics::ScenePoses> poses{haptics::ScenePoses{}};
+  haptics::ServoOptions options;
+  options.period_s = T;
+  options.duration_s = duration;
+  options.realtime_priority = request.realtime_priority;
+  options.spin_us = request.spin_us;
+  haptics::ServoLoop loop(*device, *renderer, scene.scene, poses,
+                          haptics::SafetyOptions::for_device(result.capabilities), options);
+
+  // The recording: rows appended by the loop's writer thread to a temporary file beside the
+  // target, which is renamed onto it when the run has ended (a killed run leaves nothing).
+  std::unique_ptr<PendingOutput> pending;
+  std::ofstream record;
+  std::string record_tmp;
+  if (!request.record.empty()) {
+    record_tmp = request.record + ".partial-" + std::to_string(::getpid());
+    pending = std::make_unique<PendingOutput>(record_tmp);
+    record.open(record_tmp, std::ios::trunc);
+    if (!record) throw std::runtime_error("--record " + request.record + ": cannot write there");
+    write_record_header(record, request);
+    loop.record_to(
+        [&](const haptics::TickRecord* rows, std::size_t n) {
+          char line[256];
+          for (std::size_t i = 0; i < n; ++i) {
+            const auto& r = rows[i];
+            std::snprintf(line, sizeof line,
+                          "%.4f,%.4f,%.4f,%.4f,%u,%.5f,%.5f,%.5f,%.4f,%.4f,%.4f,%d\n", r.t_s,
+                          r.probe_mm.x(), r.probe_mm.y(), r.probe_mm.z(), r.buttons & 1u,
+                          r.force_n.x(), r.force_n.y(), r.force_n.z(), r.proxy_mm.x(),
+                          r.proxy_mm.y(), r.proxy_mm.z(), r.contact ? 1 : 0);
+            record << line;
+          }
+          record.flush();
+          result.recorded_rows += std::int64_t(n);
+        },
+        1 << 16);
+  }
+
+  int calls = 0;
+  result.stats = loop.run([&](const haptics::ServoStatus& s, double now) {
+    haptics::ScenePoses p;  // the rigid stage's bodies stay at the reference posture
+    p.time_s = now;
+    poses.write(p);
+    if (request.stop && request.stop->load()) loop.request_stop();
+    if (status && ++calls % 10 == 0) status(s);
+  });
+  device->close();
+  if (request.stop && request.stop->load()) result.stats.stop_reason = "interrupted";
+
+  if (record.is_open()) {
+    record.close();
+    if (!record)
+      throw std::runtime_error("--record " + request.record + ": write failed (disk full?)");
+    if (std::rename(record_tmp.c_str(), request.record.c_str()) != 0)
+      throw std::runtime_error("--record " + request.record + ": cannot replace the file");
+    pending->release();
+  }
+  return result;
+}
+
+nlohmann::json haptics_run_json(const HapticsRunResult& r) {
+  const auto& s = r.stats;
+  auto pct = [](const haptics::Percentiles& p) {
+    return nlohmann::json{{"p50", p.p50}, {"p99", p.p99}, {"p999", p.p999}, {"max", p.max}};
+  };
+  return {{"scene", r.request.scene.scene},
+          {"scene_description", r.scene_description},
+          {"bodies", r.bodies},
+          {"triangles", r.triangles},
+          {"scene_seconds", r.scene_seconds},
+          {"device", r.request.device},
+          {"model", r.capabilities.model},
+          {"renderer", r.request.renderer},
+          {"probe_radius_mm", r.request.probe_radius_mm},
+          {"stiffness_n_per_mm", r.stiffness_n_per_mm},
+          {"passive_stiffness_limit_n_per_mm", r.passive_limit_n_per_mm},
+          {"script", r.request.script},
+          {"duration_s", r.request.duration_s},
+          {"ticks", s.ticks},
+          {"seconds", s.seconds},
+          {"rate_hz", s.rate_hz},
+          {"period_us", pct(s.period_us)},
+          {"compute_us", pct(s.compute_us)},
+          {"missed_deadlines", s.missed_deadlines},
+          {"max_force_n", s.max_force_n},
+          {"peak_force_n", r.capabilities.peak_force_n},
+          {"clamped_ticks", s.clamped_ticks},
+          {"limited_ticks", s.limited_ticks},
+          {"non_finite_ticks", s.non_finite_ticks},
+          {"fading_ticks", s.fading_ticks},
+          {"contact_ticks", s.contact_ticks},
+          {"truncated_ticks", s.truncated_ticks},
+          {"passivity_energy_mj", {{"min", s.passivity_min_mj}, {"final", s.passivity_final_mj}}},
+          {"realtime_priority", {{"enabled", s.realtime_priority}, {"reason", s.realtime_reason}}},
+          {"spin_us", r.request.spin_us},
+          {"stop_reason", s.stop_reason},
+          {"record", r.request.record},
+          {"recorded_rows", r.recorded_rows}};
+}
+
+std::string haptics_run_table(const HapticsRunResult& r) {
+  const auto& s = r.stats;
+  std::ostringstream os;
+  os << "  scene      " << r.scene_description << " (" << r.bodies << " bodies, " << r.triangles
+     << " triangles, built in " << fixed(r.scene_seconds, 1) << " s)\n"
+     << "  device     " << r.request.device << " (" << r.capabilities.description << ", peak "
+     << fixed(r.capabilities.peak_force_n, 2) << " N)\n"
+     << "  renderer   " << r.request.renderer << ", probe radius "
+     << fixed(r.request.probe_radius_mm, 1) << " mm, stiffness " << fixed(r.stiffness_n_per_mm, 2)
+     << " N/mm (passive up to " << fixed(r.passive_limit_n_per_mm, 2) << ")\n"
+     << "  real time  " << (s.realtime_priority ? "yes" : "no") << ": " << s.realtime_reason
+     << "\n\n";
+  TextTable t({"", "p50", "p99", "p99.9", "max"});
+  auto row = [&](const std::string& name, const haptics::Percentiles& p) {
+    t.add({name, fixed(p.p50, 1), fixed(p.p99, 1), fixed(p.p999, 1), fixed(p.max, 1)});
+  };
+  row("period (us)", s.period_us);
+  row("compute (us)", s.compute_us);
+  t.print(os, false);
+  os << "\n  " << s.ticks << " ticks in " << fixed(s.seconds, 2) << " s (" << fixed(s.rate_hz, 1)
+     << " Hz), " << s.missed_deadlines << " missed deadlines, stopped: " << s.stop_reason << "\n"
+     << "  force: max " << fixed(s.max_force_n, 3) << " N; contact " << s.contact_ticks
+     << " ticks, clamped " << s.clamped_ticks << ", limited " << s.limited_ticks << ", faded "
+     << s.fading_ticks << "\n"
+     << "  passivity energy: min " << fixed(s.passivity_min_mj, 3) << " mJ, final "
+     << fixed(s.passivity_final_mj, 3) << " mJ\n";
+  if (!r.request.record.empty())
+    os << "  recorded " << r.recorded_rows << " ticks to " << r.request.record << "\n";
+  return os.str();
+}
+
+nlohmann::json haptic_devices_json() {
+  nlohmann::json backends = nlohmann::json::array();
+  backends.push_back({{"name", "sim"}, {"available", true}, {"devices", {"simulated hand"}}});
+  backends.push_back({{"name", "replay"}, {"available", true}, {"devices", {"a recorded run"}}});
+  backends.push_back({{"name", "null"}, {"available", true}, {"devices", {"a fixed point"}}});
+  backends.push_back(
+      {{"name", "openhaptics"}, {"available", false}, {"reason", "not built in this version"}});
+  backends.push_back(
+      {{"name", "dhd"}, {"available", false}, {"reason", "not built in this version"}});
+  nlohmann::json models = nlohmann::json::array();
+  for (const auto& m : haptics::device_models())
+    models.push_back(
+        {{"model", m.model},
+         {"description", m.description},
+         {"workspace_mm", {m.workspace_mm.x(), m.workspace_mm.y(), m.workspace_mm.z()}},
+         {"peak_force_n", m.peak_force_n},
+         {"continuous_force_n", m.continuous_force_n},
+         {"usable_stiffness_n_per_mm", m.usable_stiffness_n_per_mm},
+         {"physical_damping_n_s_per_mm", m.physical_damping_n_s_per_mm},
+         {"passive_stiffness_limit_at_1khz_n_per_mm", haptics::passive_stiffness_limit(m, 1e-3)},
+         {"source", m.source}});
+  return {{"backends", backends}, {"models", models}};
+}
+
+std::string haptic_devices_table() {
+  std::ostringstream os;
+  os << "backends:\n"
+     << "  sim          yes  a simulated hand holding the device (scripted set-point)\n"
+     << "  replay       yes  plays a recorded run (--record of an earlier run)\n"
+     << "  null         yes  stays at one point\n"
+     << "  openhaptics  no   not built in this version\n"
+     << "  dhd          no   not built in this version\n\n";
+  TextTable t(
+      {"model", "workspace mm", "peak N", "cont. N", "stiffness N/mm", "passive limit N/mm"});
+  for (const auto& m : haptics::device_models())
+    t.add({m.model,
+           fixed(m.workspace_mm.x(), 0) + " x " + fixed(m.workspace_mm.y(), 0) + " x " +
+               fixed(m.workspace_mm.z(), 0),
+           fixed(m.peak_force_n, 2), fixed(m.continuous_force_n, 2),
+           fixed(m.usable_stiffness_n_per_mm, 2),
+           fixed(haptics::passive_stiffness_limit(m, 1e-3), 1)});
+  t.print(os, false);
+  return os.str();
+}
+
+}  // namespace spinesim::studies
