@@ -98,11 +98,11 @@ Trajectory read_trajectory(const std::string& path) {
     while (std::getline(ss, cell, ',')) cells.push_back(cell);
     const std::string where = path + ":" + std::to_string(line_no);
     if (tr.t_s.empty() && !cells.empty() && cells[0].find("t_s") != std::string::npos) continue;
-    if (cells.size() != 4 && cells.size() != 5)
-      throw std::invalid_argument(where + ": expected t_s,x_mm,y_mm,z_mm[,button], got " +
+    if (cells.size() < 4)
+      throw std::invalid_argument(where + ": expected t_s,x_mm,y_mm,z_mm[,button,...], got " +
                                   std::to_string(cells.size()) + " cells");
     double v[5] = {0, 0, 0, 0, 0};
-    for (std::size_t k = 0; k < cells.size(); ++k) {
+    for (std::size_t k = 0; k < std::min<std::size_t>(cells.size(), 5); ++k) {
       char* end = nullptr;
       v[k] = std::strtod(cells[k].c_str(), &end);
       while (end && (*end == ' ' || *end == '\r' || *end == '\t')) ++end;

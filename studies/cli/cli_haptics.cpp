@@ -76,6 +76,7 @@ void run_haptics_cli(HapticsArgs& a) {
           std::fflush(stderr);
         },
         [&bar](int done, int) {
+          if (g_stop.load()) throw std::runtime_error("interrupted while the scene was built");
           if (bar) bar->update(done);
         });
     if (live) std::fprintf(stderr, "\r%78s\r", "");

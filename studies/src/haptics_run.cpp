@@ -195,7 +195,7 @@ HapticsRunResult run_haptics(const HapticsRunRequest& request, const std::string
           for (std::size_t i = 0; i < n; ++i) {
             const auto& r = rows[i];
             std::snprintf(line, sizeof line,
-                          "%.4f,%.4f,%.4f,%.4f,%u,%.5f,%.5f,%.5f,%.4f,%.4f,%.4f,%d\n", r.t_s,
+                          "%.6f,%.4f,%.4f,%.4f,%u,%.5f,%.5f,%.5f,%.4f,%.4f,%.4f,%d\n", r.t_s,
                           r.probe_mm.x(), r.probe_mm.y(), r.probe_mm.z(), r.buttons & 1u,
                           r.force_n.x(), r.force_n.y(), r.force_n.z(), r.proxy_mm.x(),
                           r.proxy_mm.y(), r.proxy_mm.z(), r.contact ? 1 : 0);

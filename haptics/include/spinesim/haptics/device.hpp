@@ -65,7 +65,8 @@ class Device {
 };
 
 /// A set-point trajectory: times (s, strictly increasing from 0 or later), positions (mm),
-/// buttons. Read from CSV `t_s,x_mm,y_mm,z_mm[,button]` with '#' comment lines.
+/// buttons. Read from CSV `t_s,x_mm,y_mm,z_mm[,button[,…]]` with '#' comment lines and an
+/// optional header row; columns after the fifth are ignored (a `--record` file replays).
 struct Trajectory {
   std::vector<double> t_s;
   std::vector<Eigen::Vector3d> position_mm;

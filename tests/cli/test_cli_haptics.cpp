@@ -1,0 +1,112 @@
+// spinesim haptics run | devices, study haptic-plane, mesh vertebrae: the contract (JSON keys,
+// a recording that replays), and bad input refused in one line with nothing written.
+#include "cli_runner.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <fstream>
+
+using namespace spinesim::test_cli;
+
+namespace {
+
+std::string write_file(const std::string& name, const std::string& text) {
+  const std::string path = tmp(name);
+  std::ofstream(path) << text;
+  return path;
+}
+
+}  // namespace
+
+TEST(CliHaptics, PlaneRunReportsTheLoopsStatisticsAndRecordsAReplayableRun) {
+  const std::string rec = tmp("plane_rec.csv");
+  const auto r = run_spinesim("haptics run --scene plane --device sim --duration 2 --record '" +
+                              rec + "' --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  for (const char* key :
+       {"ticks", "rate_hz", "period_us", "compute_us", "missed_deadlines", "max_force_n",
+        "clamped_ticks", "contact_ticks", "passivity_energy_mj", "realtime_priority"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  for (const char* key : {"p50", "p99", "p999", "max"}) {
+    EXPECT_TRUE(j["period_us"].contains(key));
+    EXPECT_TRUE(j["compute_us"].contains(key));
+  }
+  EXPECT_TRUE(j["realtime_priority"].contains("reason"));
+  EXPECT_NEAR(j["ticks"].get<double>(), 2000, 100);
+  EXPECT_GT(j["contact_ticks"].get<int>(), 100);  // press_plane.csv presses at 1 s
+  EXPECT_LE(j["max_force_n"].get<double>(), j["peak_force_n"].get<double>());
+  EXPECT_GE(j["passivity_energy_mj"]["min"].get<double>(), -1e-6);
+  EXPECT_EQ(j["recorded_rows"].get<int>(), j["ticks"].get<int>());
+
+  const auto replay =
+      run_spinesim("haptics run --scene plane --device replay --replay '" + rec + "' --json");
+  ASSERT_EQ(replay.status, 0) << replay.err;
+  const auto k = nlohmann::json::parse(replay.out);
+  EXPECT_NEAR(k["contact_ticks"].get<double>(), j["contact_ticks"].get<double>(), 20);
+}
+
+TEST(CliHaptics, DevicesListsBackendsAndModels) {
+  const auto r = run_spinesim("haptics devices --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["models"].size(), 3u);
+  EXPECT_EQ(j["backends"][0]["name"], "sim");
+  for (const auto& m : j["models"]) EXPECT_FALSE(m["source"].get<std::string>().empty());
+}
+
+TEST(CliHaptics, PlaneStudyReproducesTheThesisFindings) {
+  const std::string csv = tmp("plane.csv");
+  const auto r = run_spinesim("study haptic-plane --out '" + csv + "' --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_NEAR(j["small_peak_depth_eq49_mm"].get<double>(), j["small_radius_mm"].get<double>(), 0.1);
+  EXPECT_NEAR(j["large_peak_depth_eq49_mm"].get<double>(), j["large_radius_mm"].get<double>(), 0.1);
+  EXPECT_TRUE(j["large_higher_everywhere_eq49"].get<bool>());
+  EXPECT_NEAR(j["ratio_at_small_peak_eq410"].get<double>(), 1.0, 0.01);
+  EXPECT_TRUE(j["small_higher_before_peak_eq410"].get<bool>());
+  EXPECT_NE(slurp(csv).find("depth_mm,small_eq49_n"), std::string::npos);
+}
+
+TEST(CliHaptics, BadInputIsRefusedInOneLineWithNothingWritten) {
+  const std::string nan_script = write_file("nan.csv", "t_s,x_mm,y_mm,z_mm\n0,0,0,10\n1,nan,0,0\n");
+  const std::string backwards = write_file("back.csv", "0,0,0,10\n1,0,0,5\n0.5,0,0,0\n");
+  const auto before = files_in(tmp_dir());
+  const std::string rec = tmp_dir().string() + "/never.csv";
+  const std::string base = "haptics run --scene plane --duration 1 --record '" + rec + "' ";
+  expect_refused(run_spinesim(base + "--device joystick"), "unknown");
+  expect_refused(run_spinesim(base + "--device openhaptics"), "OpenHaptics");
+  expect_refused(run_spinesim(base + "--device dhd"), "DHD");
+  expect_refused(run_spinesim(base + "--probe-radius 0"), "--probe-radius");
+  expect_refused(run_spinesim(base + "--probe-radius -3"), "--probe-radius");
+  expect_refused(run_spinesim(base + "--script '" + nan_script + "'"), "not a finite number");
+  expect_refused(run_spinesim(base + "--script '" + backwards + "'"), "not after the previous");
+  expect_refused(run_spinesim(base + "--script /nonexistent.csv"), "cannot read");
+  expect_refused(run_spinesim(base + "--renderer magic"), "--renderer");
+  expect_refused(run_spinesim(base + "--scene moon"), "--scene");
+  expect_refused(run_spinesim(base + "--vertebrae /nonexistent.json"), "--vertebrae");
+  expect_refused(run_spinesim(base + "--model falcon"), "unknown device model");
+  expect_refused(run_spinesim(base + "--device replay"), "--replay");
+  expect_refused(run_spinesim("haptics run --scene plane --record /nonexistent/dir/r.csv"),
+                 "does not exist");
+  expect_refused(run_spinesim("mesh vertebrae --level C3 --out '" + tmp("vv") + "'"),
+                 "unknown vertebra");
+  expect_refused(run_spinesim("mesh vertebrae --triangles 5 --out '" + tmp("vw") + "'"),
+                 "--triangles");
+  expect_refused(run_spinesim("study haptic-plane --radius 0"), "radius");
+  EXPECT_TRUE(new_files(before).empty());
+}
+
+TEST(CliHaptics, MeshVertebraeWritesClosedSurfaces) {
+  const std::string dir = tmp("vertebrae");
+  const auto r =
+      run_spinesim("mesh vertebrae --level L4,S1 --triangles 2000 --out '" + dir + "' --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["bodies"].size(), 2u);
+  for (const auto& b : j["bodies"]) {
+    EXPECT_TRUE(b["closed"].get<bool>());
+    EXPECT_TRUE(b["oriented"].get<bool>());
+    EXPECT_TRUE(fs::exists(b["file"].get<std::string>()));
+  }
+}
