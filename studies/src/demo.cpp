@@ -1,5 +1,8 @@
 #include "spinesim/studies/demo.hpp"
 
+#include "spinesim/studies/haptic_plane_study.hpp"
+#include "spinesim/studies/haptics_run.hpp"
+
 #include "spinesim/calibration/compare.hpp"
 #include "spinesim/common/timer.hpp"
 #include "spinesim/fem/disc_fem.hpp"
@@ -69,7 +72,9 @@ class Demo {
   void mss_baseline();
   void calibration();
   void spine_studies();
+  void haptics();
   std::string report() const;
+  std::string haptics_section() const;
   nlohmann::json summary(const std::string& report_path) const;
 
  private:
@@ -101,6 +106,9 @@ class Demo {
   FusionStudy spine_fusion;
   TrendsStudy spine_trends;
   std::string validation_text, fusion_text, trends_text;
+  HapticPlaneResult haptic_plane;
+  HapticsRunResult haptic_run;
+  std::string haptic_plane_path, haptic_record_path;
 };
 
 // 1. Mesh the level between its vertebrae.
@@ -229,7 +237,23 @@ void Demo::spine_studies() {
   validation_text = v.str(), fusion_text = f.str(), trends_text = t.str();
 }
 
-// 7. The report.
+// 7. The haptic loop: the thesis's plane test of the Gao-Gibson force, and the simulated hand
+//    stroking down the spinous processes of the whole spine at 1 kHz (the proxy renderer).
+void Demo::haptics() {
+  hooks.begin_stage("haptic plane test (Gao-Gibson eqs 4.9, 4.10)");
+  haptic_plane = run_haptic_plane_study(HapticPlaneRequest());
+  haptic_plane_path = (fs::path(rq.out) / "haptic_plane.csv").string();
+  write_text_file(haptic_plane_path, haptic_plane_csv(haptic_plane));
+  hooks.end_stage(std::to_string(haptic_plane.rows.size()) + " depths");
+  hooks.begin_stage("haptic loop: simulated hand strokes the spine's spinous processes");
+  HapticsRunRequest request;
+  request.record = (fs::path(rq.out) / "haptics_stroke.csv").string();
+  haptic_record_path = request.record;
+  haptic_run = run_haptics(request, data_dir());
+  hooks.end_stage(std::to_string(haptic_run.stats.ticks) + " ticks");
+}
+
+// 8. The report.
 std::string Demo::report() const {
   const fem::Matrix6d k_local = to_disc_frame(k6, m.frame);
   std::ostringstream report;
@@ -301,8 +325,26 @@ std::string Demo::report() const {
             "(6.3-6.4)\n\n"
          << "`spinesim study trends --help` gives the protocol. " << std::setprecision(3)
          << spine_trends.seconds << " s.\n\n"
-         << trends_text;
+         << trends_text << haptics_section();
   return report.str();
+}
+
+// The report's haptics section.
+std::string Demo::haptics_section() const {
+  std::ostringstream os;
+  os << std::defaultfloat
+     << "\n## Haptics: the Gao-Gibson plane test (thesis 4.4.2, figs 4.16-4.19)\n\n"
+     << "`spinesim study haptic-plane --help` gives the protocol; the force-depth curves are in `"
+     << fs::path(haptic_plane_path).filename().string() << "`.\n\n```\n"
+     << haptic_plane_table(haptic_plane) << "```\n"
+     << "\n## Haptics: the 1 kHz loop on the whole spine\n\n"
+     << "A simulated hand (mass-spring-damper on the script's set-point) strokes down the "
+        "spinous processes\nT1-L5 with a 4 mm probe; the sphere proxy renders the 18 "
+        "parametric bodies. Every tick is in `"
+     << fs::path(haptic_record_path).filename().string()
+     << "` (replay it with\n`spinesim haptics run --device replay --replay FILE`).\n\n```\n"
+     << haptics_run_table(haptic_run) << "```\n";
+  return os.str();
 }
 
 nlohmann::json Demo::summary(const std::string& report_path) const {
@@ -324,6 +366,8 @@ nlohmann::json Demo::summary(const std::string& report_path) const {
           {"spine_validation", validation_json(spine_validation)},
           {"spine_fusion", fusion_json(spine_fusion)},
           {"spine_trends", trends_json(spine_trends)},
+          {"haptic_plane", haptic_plane_json(haptic_plane)},
+          {"haptics_run", haptics_run_json(haptic_run)},
           {"report", report_path},
           {"files", {mesh_path, result_path}}};
 }
@@ -331,7 +375,7 @@ nlohmann::json Demo::summary(const std::string& report_path) const {
 }  // namespace
 
 int demo_stages() {
-  return 5 + kStagesPerMaterial * int(std::size(kPresets)) + kValidationStages + kFusionStages +
+  return 7 + kStagesPerMaterial * int(std::size(kPresets)) + kValidationStages + kFusionStages +
          kTrendsStages;
 }
 
@@ -347,6 +391,7 @@ DemoResult run_demo(const DemoRequest& rq, const StageHooks& hooks) {
   demo.mss_baseline();
   demo.calibration();
   demo.spine_studies();
+  demo.haptics();
   DemoResult r;
   r.report_markdown = demo.report();
   r.report_path = (fs::path(rq.out) / "report.md").string();

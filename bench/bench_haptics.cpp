@@ -1,0 +1,158 @@
+// Collision queries and render ticks of the rigid stage.
+//   SphereQuery/<impl>/<radius mm>: all triangles of a parametric L3 (8000 triangles) within a
+//     sphere at random probes near the surface; impl 0 = the thesis's tree (haptics::AabbTree),
+//     1 = CGAL 5.5 AABB_tree::all_intersected_primitives(Sphere_3) (which finds the triangles
+//     crossing the sphere's surface: a subset), 2 = CGAL's box query around the ball followed by
+//     the exact ball-triangle test (the same set as ours).
+//   ProxyTick/<radius mm>, GaoGibsonTick/<radius mm>: one render() on the 18-body spine
+//     (parametric, 6000 triangles each) along the shipped spinous-process stroke.
+#include "spinesim/haptics/device.hpp"
+#include "spinesim/haptics/renderer.hpp"
+#include "spinesim/mesh/vertebra_geometry.hpp"
+
+#include <benchmark/benchmark.h>
+
+#include <CGAL/AABB_traits.h>
+#include <CGAL/AABB_tree.h>
+#include <CGAL/AABB_triangle_primitive.h>
+#include <CGAL/Simple_cartesian.h>
+
+#include <random>
+#include <vector>
+
+namespace sh = spinesim::haptics;
+namespace sm = spinesim::mesh;
+
+namespace {
+
+using K = CGAL::Simple_cartesian<double>;
+using Triangle = K::Triangle_3;
+using Iterator = std::vector<Triangle>::const_iterator;
+using CgalTree = CGAL::AABB_tree<CGAL::AABB_traits<K, CGAL::AABB_triangle_primitive<K, Iterator>>>;
+
+const sm::TriSurface& l3() {
+  static const sm::TriSurface s =
+      sm::mesh_vertebra(sm::parametric_vertebra("L3", SPINESIM_DATA_DIR), 8000).surface;
+  return s;
+}
+
+// Probe centres within 5 mm of the surface (vertex + random offset), fixed seed.
+std::vector<Eigen::Vector3d> probes(const sm::TriSurface& s, int n) {
+  std::mt19937 rng(1);
+  std::uniform_int_distribution<int> pick(0, int(s.V.rows()) - 1);
+  std::normal_distribution<double> off(0, 3);
+  std::vector<Eigen::Vector3d> p;
+  for (int i = 0; i < n; ++i)
+    p.push_back(s.V.row(pick(rng)).transpose() + Eigen::Vector3d(off(rng), off(rng), off(rng)));
+  return p;
+}
+
+void SphereQuery(benchmark::State& state) {
+  const auto& s = l3();
+  const double r = double(state.range(1));
+  const auto p = probes(s, 4096);
+  std::size_t i = 0, found = 0;
+  if (state.range(0) == 0) {
+    const sh::AabbTree tree(s.V, s.F);
+    std::vector<int> buffer(20000);
+    for (auto _ : state) {
+      found +=
+          std::size_t(tree.sphere_query(p[i++ % p.size()], r, buffer.data(), int(buffer.size())));
+      benchmark::ClobberMemory();
+    }
+  } else {
+    std::vector<Triangle> triangles;
+    for (Eigen::Index t = 0; t < s.F.rows(); ++t) {
+      auto P = [&](int k) {
+        const Eigen::Vector3d x = s.V.row(s.F(t, k));
+        return K::Point_3(x.x(), x.y(), x.z());
+      };
+      triangles.emplace_back(P(0), P(1), P(2));
+    }
+    CgalTree tree(triangles.begin(), triangles.end());
+    tree.accelerate_distance_queries();
+    std::vector<Iterator> hits;
+    hits.reserve(20000);
+    const bool ball = state.range(0) == 2;
+    for (auto _ : state) {
+      hits.clear();
+      const Eigen::Vector3d& c = p[i++ % p.size()];
+      if (!ball) {
+        tree.all_intersected_primitives(K::Sphere_3(K::Point_3(c.x(), c.y(), c.z()), r * r),
+                                        std::back_inserter(hits));
+        found += hits.size();
+      } else {
+        // The same set as ours: the box around the ball, then the exact ball-triangle test.
+        tree.all_intersected_primitives(
+            CGAL::Bbox_3(c.x() - r, c.y() - r, c.z() - r, c.x() + r, c.y() + r, c.z() + r),
+            std::back_inserter(hits));
+        for (const auto& it : hits) {
+          const Eigen::Vector3d a(it->vertex(0).x(), it->vertex(0).y(), it->vertex(0).z()),
+              b(it->vertex(1).x(), it->vertex(1).y(), it->vertex(1).z()),
+              d(it->vertex(2).x(), it->vertex(2).y(), it->vertex(2).z());
+          found += (sh::closest_point_on_triangle(c, a, b, d) - c).squaredNorm() <= r * r;
+        }
+      }
+    }
+  }
+  state.counters["triangles_per_query"] = double(found) / double(state.iterations());
+  state.SetLabel(state.range(0) == 0   ? "thesis AABB tree, ball"
+                 : state.range(0) == 1 ? "CGAL AABB_tree, Sphere_3 (surface only)"
+                                       : "CGAL AABB_tree, box + ball test");
+}
+BENCHMARK(SphereQuery)->ArgsProduct({{0, 1, 2}, {2, 5, 10}})->Unit(benchmark::kMicrosecond);
+
+struct SpineScene {
+  sh::Scene scene;
+  sh::Trajectory stroke;
+  SpineScene() {
+    for (const auto& name : sm::scene_body_names())
+      scene.add_body(
+          name, sm::mesh_vertebra(sm::parametric_vertebra(name, SPINESIM_DATA_DIR), 6000).surface);
+    stroke = sh::read_trajectory(std::string(SPINESIM_DATA_DIR) + "/haptics/stroke_spinous.csv");
+  }
+};
+SpineScene& spine() {
+  static SpineScene s;
+  return s;
+}
+
+template <class Renderer, class Params>
+void tick(benchmark::State& state, Params p) {
+  auto& s = spine();
+  Renderer renderer(p);
+  const sh::ScenePoses poses{};
+  const double T = 1e-3;
+  double t = 0;
+  renderer.reset(s.stroke.position_at(0));
+  std::size_t contacts = 0;
+  for (auto _ : state) {
+    sh::ProbeState probe{s.stroke.position_at(t), s.stroke.velocity_at(t)};
+    const auto out = renderer.render(probe, s.scene, poses, T);
+    contacts += out.contact;
+    benchmark::DoNotOptimize(out);
+    t += T;
+    if (t > s.stroke.duration_s()) t = 0;
+  }
+  state.counters["contact_fraction"] = double(contacts) / double(state.iterations());
+}
+
+void ProxyTick(benchmark::State& state) {
+  sh::ProxyParameters p;
+  p.radius_mm = double(state.range(0));
+  tick<sh::SphereProxyRenderer>(state, p);
+}
+BENCHMARK(ProxyTick)->Arg(2)->Arg(4)->Arg(10)->Unit(benchmark::kMicrosecond);
+
+void GaoGibsonTick(benchmark::State& state) {
+  auto& s = spine();
+  if (s.scene.body(0).samples.first.empty()) s.scene.sample_surfaces(0.25);
+  sh::GaoGibsonParameters p;
+  p.radius_mm = double(state.range(0));
+  tick<sh::GaoGibsonRenderer>(state, p);
+}
+BENCHMARK(GaoGibsonTick)->Arg(2)->Arg(4)->Arg(10)->Unit(benchmark::kMicrosecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();
