@@ -1,5 +1,7 @@
 #include "spinesim/haptics/device.hpp"
 
+#include "spinesim/common/input_file.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -81,8 +83,8 @@ unsigned Trajectory::buttons_at(double t) const {
 }
 
 Trajectory read_trajectory(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::invalid_argument(path + ": cannot read the trajectory file");
+  // Only a regular file is read (a FIFO or device is refused by name), at most 1 GiB.
+  std::istringstream in(read_regular_file(path, "the trajectory"));
   Trajectory tr;
   std::string line;
   int line_no = 0;
@@ -171,7 +173,8 @@ class SimDevice final : public Device {
     force_ = f;
     return true;
   }
-  bool finished() const override { return time_ >= script_.duration_s(); }
+  // The hand holds the script's last set-point for as long as the loop runs.
+  bool finished() const override { return false; }
 
  private:
   Trajectory script_;

@@ -58,6 +58,7 @@ struct HapticsArgs {
 
 void run_haptics_cli(HapticsArgs& a) {
   a.request.realtime_priority = !a.no_realtime;
+  if (a.request.scene.testdata_dir.empty()) a.request.scene.testdata_dir = testdata_dir();
   a.request.stop = &g_stop;
   const bool live = !a.quiet && !a.json && stderr_is_terminal();
   std::unique_ptr<ProgressBar> bar;
@@ -117,8 +118,13 @@ void register_haptics(CLI::App& app) {
   run->add_option("--scene", a->request.scene.scene,
                   "spine (T1-L5 and sacrum), vertebra (L3) or plane")
       ->capture_default_str();
-  run->add_option("--vertebrae", a->request.scene.vertebrae, "Vertebra surfaces: generated")
+  run->add_option("--vertebrae", a->request.scene.vertebrae,
+                  "Vertebra surfaces: generated (parametric), real (ArtiSynth L1-S1 from the test "
+                  "data, thoracic generated) or a scene JSON file (haptics/README.md)")
       ->capture_default_str();
+  run->add_option("--testdata", a->request.scene.testdata_dir,
+                  "Folder holding artisynth-lss/ (for --vertebrae real; default: "
+                  "$SPINESIM_TESTDATA_DIR or the shared test-data folder)");
   run->add_option("--triangles", a->request.scene.triangles, "Triangles per generated vertebra")
       ->capture_default_str();
   run->add_option("--device", a->request.device, "sim, replay, null, openhaptics or dhd")
@@ -143,6 +149,8 @@ void register_haptics(CLI::App& app) {
                   "Colgate-Brown passivity limit)")
       ->capture_default_str();
   run->add_option("--record", a->request.record, "Write every tick to this CSV (replayable)");
+  run->add_option("--write-scene", a->request.write_scene,
+                  "Also write each body's surface to this folder as <name>.obj (mm, world frame)");
   run->add_option("--spin-us", a->request.spin_us,
                   "Spin (busy-wait) this long before each deadline instead of sleeping to it, us "
                   "(0: sleep only; steadier periods on virtual machines for some CPU)")

@@ -23,43 +23,6 @@ namespace spinesim::studies {
 
 namespace fs = std::filesystem;
 
-HapticScene build_haptic_scene(const HapticSceneRequest& r, const std::string& data_dir,
-                               const std::function<void(int, int)>& progress) {
-  if (r.vertebrae != "generated")
-    throw std::invalid_argument("--vertebrae " + r.vertebrae +
-                                ": only 'generated' vertebrae are available in this version");
-  const Timer timer;
-  HapticScene out;
-  if (r.scene == "plane") {
-    out.scene.add_body("plane", haptics::square_plane(100, 2));
-    out.description = "a plane z = 0 (100 x 100 mm, normal +z)";
-  } else if (r.scene == "vertebra" || r.scene == "spine") {
-    const std::vector<std::string> names =
-        r.scene == "spine" ? mesh::scene_body_names() : std::vector<std::string>{"L3"};
-    if (r.triangles < 100 || r.triangles > 200000)
-      throw std::invalid_argument("--triangles " + std::to_string(r.triangles) +
-                                  ": give 100 to 200,000 per vertebra");
-    for (std::size_t i = 0; i < names.size(); ++i) {
-      const auto v = mesh::parametric_vertebra(names[i], data_dir);
-      out.scene.add_body(names[i], mesh::mesh_vertebra(v, r.triangles).surface);
-      if (progress) progress(int(i + 1), int(names.size()));
-    }
-    out.description = r.scene == "spine"
-                          ? "the spine: parametric T1-L5 and sacrum at the reference posture"
-                          : "parametric L3 at its reference posture";
-  } else {
-    throw std::invalid_argument("--scene " + r.scene + ": give spine, vertebra or plane");
-  }
-  Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
-  for (int i = 0; i < out.scene.size(); ++i) {
-    lo = lo.cwiseMin(out.scene.body(i).tree.bounds_min());
-    hi = hi.cwiseMax(out.scene.body(i).tree.bounds_max());
-  }
-  out.center_mm = 0.5 * (lo + hi);
-  out.seconds = timer.seconds();
-  return out;
-}
-
 std::string default_haptic_script(const std::string& scene, const std::string& data_dir) {
   const fs::path dir = fs::path(data_dir) / "haptics";
   if (scene == "plane") return (dir / "press_plane.csv").string();
@@ -95,6 +58,8 @@ void check_request(const HapticsRunRequest& r) {
   if (r.device != "sim" && !r.script.empty())
     throw std::invalid_argument("--script is for --device sim");
   if (!r.record.empty()) require_output_folder(r.record, "--record");
+  if (!r.write_scene.empty() && !fs::is_directory(r.write_scene))
+    throw std::invalid_argument("--write-scene " + r.write_scene + ": not an existing folder");
 }
 
 void write_record_header(std::ostream& os, const HapticsRunRequest& r) {
@@ -138,6 +103,15 @@ HapticsRunResult run_haptics(const HapticsRunRequest& request, const std::string
   result.bodies = scene.scene.size();
   result.triangles = scene.scene.triangle_count();
   result.scene_seconds = scene.seconds;
+  result.registered = scene.registered;
+  for (int i = 0; !request.write_scene.empty() && i < scene.scene.size(); ++i) {
+    const auto& tree = scene.scene.body(i).tree;
+    mesh::write_obj((fs::path(request.write_scene) / (scene.scene.body(i).name + ".obj")).string(),
+                    mesh::TriSurface{tree.vertices(), tree.triangles()},
+                    scene.scene.body(i).name + " (" + scene.sources[std::size_t(i)] +
+                        ") at the reference posture");
+  }
+  result.registration = scene.registration;
 
   result.passive_limit_n_per_mm = haptics::passive_stiffness_limit(result.capabilities, T);
   result.stiffness_n_per_mm = request.stiffness_n_per_mm > 0
@@ -239,6 +213,8 @@ nlohmann::json haptics_run_json(const HapticsRunResult& r) {
           {"bodies", r.bodies},
           {"triangles", r.triangles},
           {"scene_seconds", r.scene_seconds},
+          {"vertebrae", r.request.scene.vertebrae},
+          {"registration", r.registered ? registration_json(r.registration) : nlohmann::json()},
           {"device", r.request.device},
           {"model", r.capabilities.model},
           {"renderer", r.request.renderer},
@@ -279,6 +255,9 @@ std::string haptics_run_table(const HapticsRunResult& r) {
      << "  renderer   " << r.request.renderer << ", probe radius "
      << fixed(r.request.probe_radius_mm, 1) << " mm, stiffness " << fixed(r.stiffness_n_per_mm, 2)
      << " N/mm (passive up to " << fixed(r.passive_limit_n_per_mm, 2) << ")\n"
+     << (r.registered ? "  registered real L1-S1 to the model: residual rms " +
+                            fixed(r.registration.rms_mm, 1) + " mm\n"
+                      : std::string())
      << "  real time  " << (s.realtime_priority ? "yes" : "no") << ": " << s.realtime_reason
      << "\n\n";
   TextTable t({"", "p50", "p99", "p99.9", "max"});

@@ -82,6 +82,8 @@ TEST(CliHaptics, BadInputIsRefusedInOneLineWithNothingWritten) {
   expect_refused(run_spinesim(base + "--script '" + nan_script + "'"), "not a finite number");
   expect_refused(run_spinesim(base + "--script '" + backwards + "'"), "not after the previous");
   expect_refused(run_spinesim(base + "--script /nonexistent.csv"), "cannot read");
+  expect_refused(run_spinesim(base + "--script /dev/zero"), "not a regular file");
+  expect_refused(run_spinesim(base + "--script '" + tmp_dir().string() + "'"), "a directory");
   expect_refused(run_spinesim(base + "--renderer magic"), "--renderer");
   expect_refused(run_spinesim(base + "--scene moon"), "--scene");
   expect_refused(run_spinesim(base + "--vertebrae /nonexistent.json"), "--vertebrae");

@@ -92,7 +92,8 @@ struct HandModel {
 /// `sim`: the device is a point mass held by the hand model and driven by the commanded force
 /// (held for the whole servo period, as a real device's DAC holds it), integrated with
 /// semi-implicit Euler at 10 sub-steps per period, with the device's physical damping. Each
-/// read() advances the simulation by one servo period, so the closed loop is deterministic.
+/// read() advances the simulation by one servo period, so the closed loop is deterministic. Past
+/// the script's end the hand holds its last set-point (the loop's duration ends the run).
 std::unique_ptr<Device> make_sim_device(const Trajectory& script, const DeviceCapabilities& caps,
                                         double period_s, const HandModel& hand = HandModel());
 /// `replay`: plays the recorded positions and buttons tick by tick; forces are discarded.

@@ -7,6 +7,7 @@
 #include "spinesim/haptics/device.hpp"
 #include "spinesim/haptics/scene.hpp"
 #include "spinesim/haptics/servo.hpp"
+#include "spinesim/studies/haptic_scene.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -16,24 +17,6 @@
 #include <vector>
 
 namespace spinesim::studies {
-
-struct HapticSceneRequest {
-  std::string scene = "spine";          ///< spine (T1…L5 + sacrum), vertebra (L3) or plane
-  std::string vertebrae = "generated";  ///< generated (parametric) — the only source so far
-  int triangles = 6000;                 ///< per generated body
-};
-
-struct HapticScene {
-  haptics::Scene scene;
-  std::string description;
-  Eigen::Vector3d center_mm = Eigen::Vector3d::Zero();
-  double seconds = 0;
-};
-
-/// Builds the scene; `progress(done, total)` per body. Throws std::invalid_argument (one line)
-/// for an unknown scene or source.
-HapticScene build_haptic_scene(const HapticSceneRequest& r, const std::string& data_dir,
-                               const std::function<void(int, int)>& progress = {});
 
 struct HapticsRunRequest {
   HapticSceneRequest scene;
@@ -46,6 +29,7 @@ struct HapticsRunRequest {
   std::string renderer = "proxy";  ///< proxy or gao-gibson
   double stiffness_n_per_mm = 0;   ///< 0: the device's usable stiffness within Colgate–Brown
   std::string record;              ///< CSV of every tick (written whole at the end)
+  std::string write_scene;         ///< folder: each body's surface as <name>.obj (world, mm)
   bool realtime_priority = true;
   double spin_us = 400;                     ///< spin this long before each deadline (0: sleep only)
   const std::atomic<bool>* stop = nullptr;  ///< set by the front end (Ctrl-C) to end the run
@@ -58,6 +42,8 @@ struct HapticsRunResult {
   HapticsRunRequest request;
   std::string scene_description;
   int bodies = 0, triangles = 0;
+  bool registered = false;
+  Registration registration;  ///< of the real vertebrae, when used
   double scene_seconds = 0;
   haptics::DeviceCapabilities capabilities;
   double stiffness_n_per_mm = 0, passive_limit_n_per_mm = 0;
