@@ -53,11 +53,16 @@ class StopOnSignals {
 
 struct HapticsArgs {
   HapticsRunRequest request;
+  std::string workspace_center;
   bool json = false, quiet = false, no_realtime = false;
 };
 
 void run_haptics_cli(HapticsArgs& a) {
   a.request.realtime_priority = !a.no_realtime;
+  if (!a.workspace_center.empty()) {
+    const auto v = parse_numbers(a.workspace_center, 3, "--workspace-center");
+    a.request.workspace_center_mm = Eigen::Vector3d(v[0], v[1], v[2]);
+  }
   if (a.request.scene.testdata_dir.empty()) a.request.scene.testdata_dir = testdata_dir();
   a.request.stop = &g_stop;
   const bool live = !a.quiet && !a.json && stderr_is_terminal();
@@ -86,6 +91,9 @@ void run_haptics_cli(HapticsArgs& a) {
     else
       std::cout << haptics_run_table(result);
     std::cout.flush();
+    if (result.stats.error)
+      throw std::runtime_error("the loop stopped on an error, the force set to zero: " +
+                               result.stats.stop_reason);
   }
 }
 
@@ -136,6 +144,14 @@ void register_haptics(CLI::App& app) {
                   "sim: the hand's set-point trajectory, CSV t_s,x_mm,y_mm,z_mm[,button] "
                   "(default: data/haptics/ for the scene)");
   run->add_option("--replay", a->request.replay, "replay: a file written by --record");
+  run->add_option("--sdk-lib", a->request.sdk_library,
+                  "openhaptics/dhd: the vendor's shared library (default libHD.so / libdhd.so)");
+  run->add_option("--workspace-center", a->workspace_center,
+                  "openhaptics/dhd: scene point (x,y,z mm) at the device's origin (default: the "
+                  "scene's centre)");
+  run->add_option("--view", a->request.view,
+                  "openhaptics/dhd: the user stands at the patient's back or front")
+      ->capture_default_str();
   run->add_option("--duration", a->request.duration_s,
                   "Seconds to run (0: the script's or recording's length; null: 10 s)")
       ->capture_default_str();
@@ -161,13 +177,19 @@ void register_haptics(CLI::App& app) {
 
   auto* devices = haptics_cmd->add_subcommand(
       "devices", "List the device backends built in and the device models known");
-  auto json = std::make_shared<bool>(false);
-  devices->add_flag("--json", *json, "One JSON object on stdout");
-  devices->callback([json] {
-    if (*json)
-      print_json(haptic_devices_json());
+  struct DevicesArgs {
+    bool json = false;
+    std::string hd, dhd;
+  };
+  auto d = std::make_shared<DevicesArgs>();
+  devices->add_flag("--json", d->json, "One JSON object on stdout");
+  devices->add_option("--openhaptics-lib", d->hd, "OpenHaptics HD library to try (libHD.so)");
+  devices->add_option("--dhd-lib", d->dhd, "Force Dimension DHD library to try (libdhd.so)");
+  devices->callback([d] {
+    if (d->json)
+      print_json(haptic_devices_json(d->hd, d->dhd));
     else
-      std::cout << haptic_devices_table();
+      std::cout << haptic_devices_table(d->hd, d->dhd);
   });
 }
 

@@ -44,13 +44,19 @@ void check_request(const HapticsRunRequest& r) {
     throw std::invalid_argument("--spin-us must be 0 to 900 us");
   if (!(r.stiffness_n_per_mm >= 0) || !std::isfinite(r.stiffness_n_per_mm))
     throw std::invalid_argument("--stiffness must be >= 0 N/mm (0: the device's default)");
-  if (r.device == "openhaptics" || r.device == "dhd")
-    throw std::runtime_error("--device " + r.device + ": this build has no " +
-                             (r.device == "dhd" ? "Force Dimension DHD" : "OpenHaptics HD") +
-                             " backend yet (spinesim haptics devices lists what there is)");
-  if (r.device != "sim" && r.device != "replay" && r.device != "null")
+  if (r.device != "sim" && r.device != "replay" && r.device != "null" &&
+      r.device != "openhaptics" && r.device != "dhd")
     throw std::invalid_argument("--device " + r.device +
                                 ": unknown (sim, replay, null, openhaptics, dhd)");
+  if (r.view != "back" && r.view != "front")
+    throw std::invalid_argument("--view " + r.view + ": give back or front");
+  if (!r.sdk_library.empty() && r.device != "openhaptics" && r.device != "dhd")
+    throw std::invalid_argument("--sdk-lib is for --device openhaptics or dhd");
+  if (r.device == "openhaptics" || r.device == "dhd") {  // before anything slow
+    const auto probe = r.device == "dhd" ? haptics::probe_dhd(r.sdk_library)
+                                         : haptics::probe_openhaptics(r.sdk_library);
+    if (!probe.loaded) throw std::runtime_error(probe.detail);
+  }
   if (r.device == "replay" && r.replay.empty())
     throw std::invalid_argument("--device replay needs --replay REC.csv");
   if (r.device != "replay" && !r.replay.empty())
@@ -134,13 +140,24 @@ HapticsRunResult run_haptics(const HapticsRunRequest& request, const std::string
   }
 
   std::unique_ptr<haptics::Device> device;
-  if (request.device == "sim")
+  if (request.device == "sim") {
     device = haptics::make_sim_device(trajectory, result.capabilities, T);
-  else if (request.device == "replay")
+  } else if (request.device == "replay") {
     device = haptics::make_replay_device(trajectory, result.capabilities, T);
-  else
+  } else if (request.device == "null") {
     device = haptics::make_null_device(scene.center_mm + Eigen::Vector3d(0, 0, 150),
                                        result.capabilities, T, duration);
+  } else {
+    auto vendor = request.device == "openhaptics"
+                      ? haptics::make_openhaptics_device(result.capabilities, request.sdk_library)
+                      : haptics::make_dhd_device(result.capabilities, request.sdk_library);
+    const Eigen::Matrix3d R = request.view == "back"
+                                  ? Eigen::Matrix3d(Eigen::Vector3d(-1, 1, -1).asDiagonal())
+                                  : Eigen::Matrix3d::Identity();
+    const Eigen::Vector3d c =
+        request.workspace_center_mm.allFinite() ? request.workspace_center_mm : scene.center_mm;
+    device = haptics::map_device(std::move(vendor), R, c);
+  }
   device->open();
 
   haptics::TripleBuffer<haptics::ScenePoses> poses{haptics::ScenePoses{}};
@@ -191,6 +208,8 @@ HapticsRunResult run_haptics(const HapticsRunRequest& request, const std::string
   });
   device->close();
   if (request.stop && request.stop->load()) result.stats.stop_reason = "interrupted";
+  if (result.stats.error && !device->last_error().empty())
+    result.stats.stop_reason += ": " + device->last_error();
 
   if (record.is_open()) {
     record.close();
@@ -279,15 +298,24 @@ std::string haptics_run_table(const HapticsRunResult& r) {
   return os.str();
 }
 
-nlohmann::json haptic_devices_json() {
+nlohmann::json haptic_devices_json(const std::string& openhaptics_lib, const std::string& dhd_lib) {
   nlohmann::json backends = nlohmann::json::array();
-  backends.push_back({{"name", "sim"}, {"available", true}, {"devices", {"simulated hand"}}});
-  backends.push_back({{"name", "replay"}, {"available", true}, {"devices", {"a recorded run"}}});
-  backends.push_back({{"name", "null"}, {"available", true}, {"devices", {"a fixed point"}}});
+  backends.push_back({{"name", "sim"},
+                      {"available", true},
+                      {"devices", 1},
+                      {"detail", "a simulated hand holding the device (scripted set-point)"}});
+  backends.push_back({{"name", "replay"},
+                      {"available", true},
+                      {"devices", 1},
+                      {"detail", "plays a --record file"}});
   backends.push_back(
-      {{"name", "openhaptics"}, {"available", false}, {"reason", "not built in this version"}});
-  backends.push_back(
-      {{"name", "dhd"}, {"available", false}, {"reason", "not built in this version"}});
+      {{"name", "null"}, {"available", true}, {"devices", 1}, {"detail", "stays at one point"}});
+  for (const auto& p : {haptics::probe_openhaptics(openhaptics_lib), haptics::probe_dhd(dhd_lib)})
+    backends.push_back({{"name", p.name},
+                        {"available", p.loaded},
+                        {"library", p.library},
+                        {"devices", p.devices},
+                        {"detail", p.detail}});
   nlohmann::json models = nlohmann::json::array();
   for (const auto& m : haptics::device_models())
     models.push_back(
@@ -303,14 +331,17 @@ nlohmann::json haptic_devices_json() {
   return {{"backends", backends}, {"models", models}};
 }
 
-std::string haptic_devices_table() {
+std::string haptic_devices_table(const std::string& openhaptics_lib, const std::string& dhd_lib) {
   std::ostringstream os;
-  os << "backends:\n"
-     << "  sim          yes  a simulated hand holding the device (scripted set-point)\n"
-     << "  replay       yes  plays a recorded run (--record of an earlier run)\n"
-     << "  null         yes  stays at one point\n"
-     << "  openhaptics  no   not built in this version\n"
-     << "  dhd          no   not built in this version\n\n";
+  os << "backends (all built in; the vendor libraries are loaded when used):\n";
+  TextTable b({"backend", "usable", "devices", "detail"});
+  for (const auto& j : haptic_devices_json(openhaptics_lib, dhd_lib)["backends"]) {
+    const int n = j["devices"].get<int>();
+    b.add({j["name"].get<std::string>(), j["available"].get<bool>() ? "yes" : "no",
+           n < 0 ? "?" : std::to_string(n), one_line(j["detail"].get<std::string>())});
+  }
+  b.print(os, false);
+  os << "\n";
   TextTable t(
       {"model", "workspace mm", "peak N", "cont. N", "stiffness N/mm", "passive limit N/mm"});
   for (const auto& m : haptics::device_models())

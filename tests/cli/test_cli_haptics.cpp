@@ -46,6 +46,33 @@ TEST(CliHaptics, PlaneRunReportsTheLoopsStatisticsAndRecordsAReplayableRun) {
   EXPECT_NEAR(k["contact_ticks"].get<double>(), j["contact_ticks"].get<double>(), 20);
 }
 
+TEST(CliHaptics, VendorBackendRunsAgainstTheFakeLibraryAndReportsAFault) {
+  const std::string hd = SPINESIM_FAKE_HD;
+  const auto r = run_spinesim("haptics run --scene plane --device openhaptics --sdk-lib '" + hd +
+                              "' --duration 0.5 --no-realtime --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_NEAR(j["ticks"].get<double>(), 500, 50);
+  EXPECT_EQ(j["stop_reason"], "duration");
+  const auto fault = run_spinesim("haptics run --scene plane --device openhaptics --sdk-lib '" +
+                                      hd + "' --duration 2 --no-realtime --json",
+                                  "FAKE_HAPTIC_FAIL_AT=200 ");
+  EXPECT_EQ(fault.status, 1);
+  EXPECT_EQ(count_lines(fault.err), 1) << fault.err;
+  EXPECT_NE(fault.err.find("fake HD: device fault"), std::string::npos) << fault.err;
+  EXPECT_EQ(
+      nlohmann::json::parse(fault.out)["stop_reason"].get<std::string>().rfind("device error", 0),
+      0u);
+  const auto devices =
+      run_spinesim("haptics devices --json --dhd-lib '" + std::string(SPINESIM_FAKE_DHD) + "'");
+  ASSERT_EQ(devices.status, 0) << devices.err;
+  const auto d = nlohmann::json::parse(devices.out);
+  EXPECT_EQ(d["backends"][4]["name"], "dhd");
+  EXPECT_TRUE(d["backends"][4]["available"].get<bool>());
+  EXPECT_EQ(d["backends"][4]["devices"], 1);
+  EXPECT_FALSE(d["backends"][3]["available"].get<bool>());  // no libHD.so on this machine
+}
+
 TEST(CliHaptics, DevicesListsBackendsAndModels) {
   const auto r = run_spinesim("haptics devices --json");
   ASSERT_EQ(r.status, 0) << r.err;
@@ -75,8 +102,14 @@ TEST(CliHaptics, BadInputIsRefusedInOneLineWithNothingWritten) {
   const std::string rec = tmp_dir().string() + "/never.csv";
   const std::string base = "haptics run --scene plane --duration 1 --record '" + rec + "' ";
   expect_refused(run_spinesim(base + "--device joystick"), "unknown");
-  expect_refused(run_spinesim(base + "--device openhaptics"), "OpenHaptics");
-  expect_refused(run_spinesim(base + "--device dhd"), "DHD");
+  expect_refused(run_spinesim(base + "--device openhaptics --sdk-lib /nonexistent/libHD.so"),
+                 "cannot load /nonexistent/libHD.so");
+  expect_refused(run_spinesim(base + "--device dhd --sdk-lib /nonexistent/libdhd.so"),
+                 "cannot load /nonexistent/libdhd.so");
+  expect_refused(run_spinesim(base + "--device openhaptics --sdk-lib '" + SPINESIM_FAKE_HD + "'",
+                              "FAKE_HAPTIC_FAIL_INIT=1 "),
+                 "fake HD: no device found");
+  expect_refused(run_spinesim(base + "--device sim --sdk-lib x.so"), "--sdk-lib");
   expect_refused(run_spinesim(base + "--probe-radius 0"), "--probe-radius");
   expect_refused(run_spinesim(base + "--probe-radius -3"), "--probe-radius");
   expect_refused(run_spinesim(base + "--script '" + nan_script + "'"), "not a finite number");

@@ -105,3 +105,45 @@ std::unique_ptr<Device> make_null_device(const Eigen::Vector3d& position_mm,
                                          double duration_s);
 
 }  // namespace spinesim::haptics
+
+namespace spinesim::haptics {
+
+// --- Vendor backends, loaded at run time (dlopen), so they build and are tested everywhere ----
+//
+// Device frame of both backends: x to the user's right, y up, z towards the user (OpenHaptics's
+// convention; DHD's x towards the user, y right, z up is turned into it), mm, mm/s, N.
+
+/// What a backend found on this machine (for `spinesim haptics devices`).
+struct BackendProbe {
+  std::string name;     ///< "openhaptics" or "dhd"
+  std::string library;  ///< the shared library asked for
+  bool loaded = false;  ///< the library and every function we use were found
+  int devices = -1;     ///< devices found (−1: the SDK cannot count without opening one)
+  std::string detail;   ///< why not, or the vendor's system name
+};
+
+/// OpenHaptics HD (3D Systems Touch, PHANToM Premium …): `library` (default "libHD.so") is
+/// loaded with dlopen; the device is opened with hdInitDevice(HD_DEFAULT_DEVICE) and served by
+/// the HD scheduler, whose callback exchanges the state and the force with the servo loop
+/// through triple buffers. Function signatures and constants are those of OpenHaptics's
+/// published headers hd.h and hdDefines.h (HD_CURRENT_POSITION 0x2050, HD_CURRENT_VELOCITY
+/// 0x2051, HD_CURRENT_BUTTONS 0x2000, HD_CURRENT_FORCE 0x2700, HD_FORCE_OUTPUT 0x4000,
+/// HD_INVALID_HANDLE 0xFFFFFFFF). open() throws std::runtime_error with one line — the library
+/// or a function missing, or the vendor's error text from hdGetErrorString.
+std::unique_ptr<Device> make_openhaptics_device(const DeviceCapabilities& caps,
+                                                const std::string& library = "");
+/// Force Dimension DHD (omega.3 …): `library` (default "libdhd.so") loaded with dlopen; the
+/// SDK's calls (dhdOpen, dhdGetPosition [m], dhdGetLinearVelocity [m/s], dhdGetButtonMask,
+/// dhdSetForce [N], dhdEnableForce, dhdClose, dhdErrorGetLastStr, dhdGetDeviceCount, as
+/// declared in dhdc.h) are made from the servo thread. Errors as above.
+std::unique_ptr<Device> make_dhd_device(const DeviceCapabilities& caps,
+                                        const std::string& library = "");
+BackendProbe probe_openhaptics(const std::string& library = "");
+BackendProbe probe_dhd(const std::string& library = "");
+
+/// A device seen through a rigid map into the scene: position_scene = center + R position,
+/// force_device = Rᵀ force_scene (R a rotation, e.g. a view from behind the patient).
+std::unique_ptr<Device> map_device(std::unique_ptr<Device> device, const Eigen::Matrix3d& R,
+                                   const Eigen::Vector3d& center_mm);
+
+}  // namespace spinesim::haptics

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include <atomic>
+#include <cmath>
 #include <functional>
 #include <string>
 #include <vector>
@@ -20,7 +21,13 @@ namespace spinesim::studies {
 
 struct HapticsRunRequest {
   HapticSceneRequest scene;
-  std::string device = "sim";   ///< sim, replay, null, openhaptics, dhd
+  std::string device = "sim";  ///< sim, replay, null, openhaptics, dhd
+  std::string sdk_library;     ///< openhaptics/dhd: the vendor's shared library (default name)
+  /// openhaptics/dhd: where the device's origin lands in the scene (mm; NaN: the scene's centre)
+  /// and from where the user looks: "back" (behind the patient: device x → −x, z → −z) or
+  /// "front" (device axes = scene axes).
+  Eigen::Vector3d workspace_center_mm = Eigen::Vector3d::Constant(std::nan(""));
+  std::string view = "back";
   std::string model = "touch";  ///< capability record (haptics::device_models)
   std::string script;           ///< sim: the hand's set-point trajectory (default per scene)
   std::string replay;           ///< replay: a recorded run
@@ -62,8 +69,11 @@ HapticsRunResult run_haptics(const HapticsRunRequest& request, const std::string
 nlohmann::json haptics_run_json(const HapticsRunResult& r);
 std::string haptics_run_table(const HapticsRunResult& r);
 
-/// `spinesim haptics devices`: the backends built in and the models known.
-nlohmann::json haptic_devices_json();
-std::string haptic_devices_table();
+/// `spinesim haptics devices`: the backends built in, what each found on this machine (the
+/// vendor libraries `openhaptics_lib`/`dhd_lib`, default names when empty) and the models known.
+nlohmann::json haptic_devices_json(const std::string& openhaptics_lib = "",
+                                   const std::string& dhd_lib = "");
+std::string haptic_devices_table(const std::string& openhaptics_lib = "",
+                                 const std::string& dhd_lib = "");
 
 }  // namespace spinesim::studies
