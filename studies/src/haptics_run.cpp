@@ -335,7 +335,8 @@ std::string haptic_devices_table(const std::string& openhaptics_lib, const std::
   std::ostringstream os;
   os << "backends (all built in; the vendor libraries are loaded when used):\n";
   TextTable b({"backend", "usable", "devices", "detail"});
-  for (const auto& j : haptic_devices_json(openhaptics_lib, dhd_lib)["backends"]) {
+  const nlohmann::json all = haptic_devices_json(openhaptics_lib, dhd_lib);
+  for (const auto& j : all["backends"]) {
     const int n = j["devices"].get<int>();
     b.add({j["name"].get<std::string>(), j["available"].get<bool>() ? "yes" : "no",
            n < 0 ? "?" : std::to_string(n), one_line(j["detail"].get<std::string>())});
