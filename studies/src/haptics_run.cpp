@@ -334,7 +334,7 @@ nlohmann::json haptic_devices_json(const std::string& openhaptics_lib, const std
 std::string haptic_devices_table(const std::string& openhaptics_lib, const std::string& dhd_lib) {
   std::ostringstream os;
   os << "backends (all built in; the vendor libraries are loaded when used):\n";
-  TextTable b({"backend", "usable", "devices", "detail"});
+  TextTable b({"backend", "usable", "devices", "detail"}, 4);
   const nlohmann::json all = haptic_devices_json(openhaptics_lib, dhd_lib);
   for (const auto& j : all["backends"]) {
     const int n = j["devices"].get<int>();
