@@ -76,6 +76,108 @@ void write_record_header(std::ostream& os, const HapticsRunRequest& r) {
      << "t_s,x_mm,y_mm,z_mm,button,fx_n,fy_n,fz_n,proxy_x_mm,proxy_y_mm,proxy_z_mm,contact\n";
 }
 
+// The renderer the request names, at the result's stiffness (samples the scene for Gao-Gibson).
+std::unique_ptr<haptics::ForceRenderer> make_renderer(const HapticsRunRequest& request,
+                                                      double stiffness, haptics::Scene& scene) {
+  if (request.renderer == "proxy") {
+    haptics::ProxyParameters p;
+    p.radius_mm = request.probe_radius_mm;
+    p.stiffness_n_per_mm = stiffness;
+    return std::make_unique<haptics::SphereProxyRenderer>(p);
+  }
+  haptics::GaoGibsonParameters p;
+  p.radius_mm = request.probe_radius_mm;
+  p.stiffness = stiffness;
+  p.sample_spacing_mm = std::min(0.25, request.probe_radius_mm / 8);
+  scene.sample_surfaces(p.sample_spacing_mm);
+  return std::make_unique<haptics::GaoGibsonRenderer>(p);
+}
+
+// The device the request names; a vendor device is mapped into the scene (view, centre).
+std::unique_ptr<haptics::Device> make_device(const HapticsRunRequest& request,
+                                             const haptics::DeviceCapabilities& caps,
+                                             const haptics::Trajectory& trajectory,
+                                             const Eigen::Vector3d& scene_center, double period_s,
+                                             double duration_s) {
+  if (request.device == "sim") return haptics::make_sim_device(trajectory, caps, period_s);
+  if (request.device == "replay") return haptics::make_replay_device(trajectory, caps, period_s);
+  if (request.device == "null")
+    return haptics::make_null_device(scene_center + Eigen::Vector3d(0, 0, 150), caps, period_s,
+                                     duration_s);
+  auto vendor = request.device == "openhaptics"
+                    ? haptics::make_openhaptics_device(caps, request.sdk_library)
+                    : haptics::make_dhd_device(caps, request.sdk_library);
+  const Eigen::Matrix3d R = request.view == "back"
+                                ? Eigen::Matrix3d(Eigen::Vector3d(-1, 1, -1).asDiagonal())
+                                : Eigen::Matrix3d::Identity();
+  const Eigen::Vector3d c =
+      request.workspace_center_mm.allFinite() ? request.workspace_center_mm : scene_center;
+  return haptics::map_device(std::move(vendor), R, c);
+}
+
+// The recording: rows appended by the loop's writer thread to a temporary file beside the
+// target, renamed onto it by finish() when the run has ended (a killed run leaves nothing).
+class RecordFile {
+ public:
+  RecordFile(const HapticsRunRequest& request) : path_(request.record) {
+    tmp_ = path_ + ".partial-" + std::to_string(::getpid());
+    pending_ = std::make_unique<PendingOutput>(tmp_);
+    os_.open(tmp_, std::ios::trunc);
+    if (!os_) throw std::runtime_error("--record " + path_ + ": cannot write there");
+    write_record_header(os_, request);
+  }
+  ~RecordFile() {
+    if (os_.is_open()) os_.close();
+    if (pending_) std::remove(tmp_.c_str());
+  }
+  /// Appends rows (the writer thread).
+  void append(const haptics::TickRecord* rows, std::size_t n) {
+    char line[256];
+    for (std::size_t i = 0; i < n; ++i) {
+      const auto& r = rows[i];
+      std::snprintf(line, sizeof line, "%.6f,%.4f,%.4f,%.4f,%u,%.5f,%.5f,%.5f,%.4f,%.4f,%.4f,%d\n",
+                    r.t_s, r.probe_mm.x(), r.probe_mm.y(), r.probe_mm.z(), r.buttons & 1u,
+                    r.force_n.x(), r.force_n.y(), r.force_n.z(), r.proxy_mm.x(), r.proxy_mm.y(),
+                    r.proxy_mm.z(), r.contact ? 1 : 0);
+      os_ << line;
+    }
+    os_.flush();
+    rows_ += std::int64_t(n);
+  }
+  std::int64_t rows() const { return rows_; }
+  void finish() {
+    os_.close();
+    if (!os_) throw std::runtime_error("--record " + path_ + ": write failed (disk full?)");
+    if (std::rename(tmp_.c_str(), path_.c_str()) != 0)
+      throw std::runtime_error("--record " + path_ + ": cannot replace the file");
+    pending_.reset();
+  }
+
+ private:
+  std::string path_, tmp_;
+  std::unique_ptr<PendingOutput> pending_;
+  std::ofstream os_;
+  std::int64_t rows_ = 0;
+};
+
+// The scene's summary into the result, and its surfaces written when asked.
+void describe_scene(const HapticsRunRequest& request, const HapticScene& scene,
+                    HapticsRunResult* result) {
+  result->scene_description = scene.description;
+  result->bodies = scene.scene.size();
+  result->triangles = scene.scene.triangle_count();
+  result->scene_seconds = scene.seconds;
+  result->registered = scene.registered;
+  result->registration = scene.registration;
+  for (int i = 0; !request.write_scene.empty() && i < scene.scene.size(); ++i) {
+    const auto& tree = scene.scene.body(i).tree;
+    mesh::write_obj((fs::path(request.write_scene) / (scene.scene.body(i).name + ".obj")).string(),
+                    mesh::TriSurface{tree.vertices(), tree.triangles()},
+                    scene.scene.body(i).name + " (" + scene.sources[std::size_t(i)] +
+                        ") at the reference posture");
+  }
+}
+
 }  // namespace
 
 HapticsRunResult run_haptics(const HapticsRunRequest& request, const std::string& data_dir,
@@ -99,65 +201,17 @@ HapticsRunResult run_haptics(const HapticsRunRequest& request, const std::string
   double duration = request.duration_s;
   if (duration == 0) duration = request.device == "null" ? 10.0 : trajectory.duration_s() + T;
   result.request.duration_s = duration;
-  if (request.scene.scene != "spine" && request.scene.scene != "vertebra" &&
-      request.scene.scene != "plane")
-    throw std::invalid_argument("--scene " + request.scene.scene +
-                                ": give spine, vertebra or plane");
 
   HapticScene scene = build_haptic_scene(request.scene, data_dir, scene_progress);
-  result.scene_description = scene.description;
-  result.bodies = scene.scene.size();
-  result.triangles = scene.scene.triangle_count();
-  result.scene_seconds = scene.seconds;
-  result.registered = scene.registered;
-  for (int i = 0; !request.write_scene.empty() && i < scene.scene.size(); ++i) {
-    const auto& tree = scene.scene.body(i).tree;
-    mesh::write_obj((fs::path(request.write_scene) / (scene.scene.body(i).name + ".obj")).string(),
-                    mesh::TriSurface{tree.vertices(), tree.triangles()},
-                    scene.scene.body(i).name + " (" + scene.sources[std::size_t(i)] +
-                        ") at the reference posture");
-  }
-  result.registration = scene.registration;
-
+  describe_scene(request, scene, &result);
   result.passive_limit_n_per_mm = haptics::passive_stiffness_limit(result.capabilities, T);
   result.stiffness_n_per_mm = request.stiffness_n_per_mm > 0
                                   ? request.stiffness_n_per_mm
                                   : std::min(result.capabilities.usable_stiffness_n_per_mm,
                                              0.5 * result.passive_limit_n_per_mm);
-  std::unique_ptr<haptics::ForceRenderer> renderer;
-  if (request.renderer == "proxy") {
-    haptics::ProxyParameters p;
-    p.radius_mm = request.probe_radius_mm;
-    p.stiffness_n_per_mm = result.stiffness_n_per_mm;
-    renderer = std::make_unique<haptics::SphereProxyRenderer>(p);
-  } else {
-    haptics::GaoGibsonParameters p;
-    p.radius_mm = request.probe_radius_mm;
-    p.stiffness = result.stiffness_n_per_mm;
-    p.sample_spacing_mm = std::min(0.25, request.probe_radius_mm / 8);
-    scene.scene.sample_surfaces(p.sample_spacing_mm);
-    renderer = std::make_unique<haptics::GaoGibsonRenderer>(p);
-  }
-
-  std::unique_ptr<haptics::Device> device;
-  if (request.device == "sim") {
-    device = haptics::make_sim_device(trajectory, result.capabilities, T);
-  } else if (request.device == "replay") {
-    device = haptics::make_replay_device(trajectory, result.capabilities, T);
-  } else if (request.device == "null") {
-    device = haptics::make_null_device(scene.center_mm + Eigen::Vector3d(0, 0, 150),
-                                       result.capabilities, T, duration);
-  } else {
-    auto vendor = request.device == "openhaptics"
-                      ? haptics::make_openhaptics_device(result.capabilities, request.sdk_library)
-                      : haptics::make_dhd_device(result.capabilities, request.sdk_library);
-    const Eigen::Matrix3d R = request.view == "back"
-                                  ? Eigen::Matrix3d(Eigen::Vector3d(-1, 1, -1).asDiagonal())
-                                  : Eigen::Matrix3d::Identity();
-    const Eigen::Vector3d c =
-        request.workspace_center_mm.allFinite() ? request.workspace_center_mm : scene.center_mm;
-    device = haptics::map_device(std::move(vendor), R, c);
-  }
+  const auto renderer = make_renderer(request, result.stiffness_n_per_mm, scene.scene);
+  const auto device =
+      make_device(request, result.capabilities, trajectory, scene.center_mm, T, duration);
   device->open();
 
   haptics::TripleBuffer<haptics::ScenePoses> poses{haptics::ScenePoses{}};
@@ -168,33 +222,11 @@ HapticsRunResult run_haptics(const HapticsRunRequest& request, const std::string
   options.spin_us = request.spin_us;
   haptics::ServoLoop loop(*device, *renderer, scene.scene, poses,
                           haptics::SafetyOptions::for_device(result.capabilities), options);
-
-  // The recording: rows appended by the loop's writer thread to a temporary file beside the
-  // target, which is renamed onto it when the run has ended (a killed run leaves nothing).
-  std::unique_ptr<PendingOutput> pending;
-  std::ofstream record;
-  std::string record_tmp;
+  std::unique_ptr<RecordFile> record;
   if (!request.record.empty()) {
-    record_tmp = request.record + ".partial-" + std::to_string(::getpid());
-    pending = std::make_unique<PendingOutput>(record_tmp);
-    record.open(record_tmp, std::ios::trunc);
-    if (!record) throw std::runtime_error("--record " + request.record + ": cannot write there");
-    write_record_header(record, request);
+    record = std::make_unique<RecordFile>(request);
     loop.record_to(
-        [&](const haptics::TickRecord* rows, std::size_t n) {
-          char line[256];
-          for (std::size_t i = 0; i < n; ++i) {
-            const auto& r = rows[i];
-            std::snprintf(line, sizeof line,
-                          "%.6f,%.4f,%.4f,%.4f,%u,%.5f,%.5f,%.5f,%.4f,%.4f,%.4f,%d\n", r.t_s,
-                          r.probe_mm.x(), r.probe_mm.y(), r.probe_mm.z(), r.buttons & 1u,
-                          r.force_n.x(), r.force_n.y(), r.force_n.z(), r.proxy_mm.x(),
-                          r.proxy_mm.y(), r.proxy_mm.z(), r.contact ? 1 : 0);
-            record << line;
-          }
-          record.flush();
-          result.recorded_rows += std::int64_t(n);
-        },
+        [&record](const haptics::TickRecord* rows, std::size_t n) { record->append(rows, n); },
         1 << 16);
   }
 
@@ -210,14 +242,9 @@ HapticsRunResult run_haptics(const HapticsRunRequest& request, const std::string
   if (request.stop && request.stop->load()) result.stats.stop_reason = "interrupted";
   if (result.stats.error && !device->last_error().empty())
     result.stats.stop_reason += ": " + device->last_error();
-
-  if (record.is_open()) {
-    record.close();
-    if (!record)
-      throw std::runtime_error("--record " + request.record + ": write failed (disk full?)");
-    if (std::rename(record_tmp.c_str(), request.record.c_str()) != 0)
-      throw std::runtime_error("--record " + request.record + ": cannot replace the file");
-    pending->release();
+  if (record) {
+    record->finish();
+    result.recorded_rows = record->rows();
   }
   return result;
 }
