@@ -78,6 +78,21 @@ inline std::set<std::string> new_files(const std::set<std::string>& before,
 
 inline int count_lines(const std::string& s) { return int(std::count(s.begin(), s.end(), '\n')); }
 
+/// Starts spinesim with `args` in the background (stdout and stderr to bg.stdout and bg.stderr
+/// in tmp_dir()); `before` is shell text put before the command (e.g. "VAR=1 "). Returns its pid.
+inline pid_t start_spinesim(const std::string& args, const std::string& before = "") {
+  const std::string out = (tmp_dir() / "bg.stdout").string(),
+                    err = (tmp_dir() / "bg.stderr").string();
+  const std::string cmd =
+      before + "exec '" + SPINESIM_EXE + "' " + args + " >'" + out + "' 2>'" + err + "' </dev/null";
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  return pid;
+}
+
 /// A refused run: exit status 1, exactly one line on stderr mentioning `needle`, nothing on stdout.
 inline void expect_refused(const CliRun& r, const std::string& needle) {
   EXPECT_EQ(r.status, 1) << r.err;

@@ -4,7 +4,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cmath>
+#include <csignal>
 #include <fstream>
+#include <sstream>
 
 using namespace spinesim::test_cli;
 
@@ -71,6 +74,39 @@ TEST(CliHaptics, VendorBackendRunsAgainstTheFakeLibraryAndReportsAFault) {
   EXPECT_TRUE(d["backends"][4]["available"].get<bool>());
   EXPECT_EQ(d["backends"][4]["devices"], 1);
   EXPECT_FALSE(d["backends"][3]["available"].get<bool>());  // no libHD.so on this machine
+}
+
+// Ctrl-C during a run with a device in hand: the loop ends with the force at zero (the fake
+// vendor library records what it was sent), the summary is printed, the recording is kept
+// whole, and the program exits by the signal.
+TEST(CliHaptics, CtrlCZeroesTheForceAndKeepsTheRecording) {
+  const std::string log = tmp("ctrl_c_forces.log"), rec = tmp("ctrl_c_rec.csv");
+  const pid_t pid = start_spinesim(
+      "haptics run --scene plane --device openhaptics --sdk-lib '" + std::string(SPINESIM_FAKE_HD) +
+          "' --view front --duration 30 --no-realtime --record '" + rec + "'",
+      "FAKE_HAPTIC_LOG='" + log + "' ");
+  // The fake device reaches the plane after 2.3 s and presses on: wait for 3.5 s of frames.
+  for (int k = 0; k < 200 && count_lines(slurp(log)) < 3500; ++k) ::usleep(50000);
+  ASSERT_GE(count_lines(slurp(log)), 3500);
+  ::kill(pid, SIGINT);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFSIGNALED(status)) << status;
+  EXPECT_EQ(WTERMSIG(status), SIGINT);
+  EXPECT_NE(slurp((tmp_dir() / "bg.stdout").string()).find("stopped: interrupted"),
+            std::string::npos);
+  std::istringstream forces(slurp(log));
+  double frame, fx, fy, fz, largest = 0, last = -1;
+  while (forces >> frame >> fx >> fy >> fz) {
+    last = std::sqrt(fx * fx + fy * fy + fz * fz);
+    largest = std::max(largest, last);
+  }
+  EXPECT_GT(largest, 0.1);  // it was pressing
+  EXPECT_EQ(last, 0.0);     // and let go
+  const std::string recording = slurp(rec);
+  EXPECT_GT(count_lines(recording), 3000);
+  for (const auto& e : fs::directory_iterator(tmp_dir()))
+    EXPECT_EQ(e.path().string().find(".partial-"), std::string::npos) << e.path();
 }
 
 TEST(CliHaptics, DevicesListsBackendsAndModels) {

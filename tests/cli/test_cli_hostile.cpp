@@ -135,18 +135,6 @@ namespace {
 
 /// Starts spinesim with `args` (shell words) in the background, stdout and stderr to files in
 /// tmp_dir(); returns its pid.
-pid_t start_spinesim(const std::string& args) {
-  const std::string out = (tmp_dir() / "bg.stdout").string(),
-                    err = (tmp_dir() / "bg.stderr").string();
-  const std::string cmd = std::string("exec '") + SPINESIM_EXE + "' " + args + " >'" + out +
-                          "' 2>'" + err + "' </dev/null";
-  const pid_t pid = ::fork();
-  if (pid == 0) {
-    ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
-    ::_exit(127);
-  }
-  return pid;
-}
 
 }  // namespace
 

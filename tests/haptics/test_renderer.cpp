@@ -179,6 +179,47 @@ TEST(SphereProxy, FastSweepAcrossASpinousProcessStaysOnItsSide) {
   EXPECT_LT(gg.render(probe, scene, poses, 1e-3).force_n.dot(lateral), 0);
 }
 
+TEST(SphereProxy, SweepAcrossTheGapBetweenTwoVertebraeNeverEntersEither) {
+  // Pressed 3 mm into the front of L3's body, the device slides down across the L3-L4 disc space
+  // (empty in the rigid scene, 11 mm high, wider than the 8 mm probe) to L4's body — in one
+  // tick, in five, and slowly. The proxy may dip into the gap but never into a vertebra, and
+  // pulled straight forward afterwards it comes free.
+  sh::Scene scene;
+  scene.add_body("L3", sh::testing::vertebra("L3").surface);
+  scene.add_body("L4", sh::testing::vertebra("L4").surface);
+  const auto poses = sh::testing::identity_poses();
+  const auto l3 = sm::parametric_vertebra("L3", SPINESIM_DATA_DIR);
+  const auto l4 = sm::parametric_vertebra("L4", SPINESIM_DATA_DIR);
+  const double r = 4.0;
+  auto pressed = [&](const sm::ParametricVertebra& v) {
+    const Eigen::Vector3d front = v.frame.axes.col(2);
+    const double half_depth = 0.5 * (v.lower_depth_mm + v.upper_depth_mm) / 2;
+    return Eigen::Vector3d(v.frame.origin_mm + (half_depth + r - 3.0) * front);
+  };
+  const Eigen::Vector3d from = pressed(l3), to = pressed(l4);
+  for (int steps : {1, 5, 200}) {
+    sh::ProxyParameters p;
+    p.radius_mm = r;
+    sh::SphereProxyRenderer proxy(p);
+    proxy.reset(from + 20 * l3.frame.axes.col(2));  // start in front, then press in
+    sh::ProbeState probe;
+    probe.position_mm = from;
+    ASSERT_TRUE(proxy.render(probe, scene, poses, 1e-3).contact);
+    for (int i = 1; i <= steps; ++i) {
+      probe.position_mm = from + (to - from) * double(i) / steps;
+      const auto out = proxy.render(probe, scene, poses, 1e-3);
+      ASSERT_TRUE(clear_of_surfaces(scene, poses, out.proxy_mm, r, 1e-6)) << steps << " " << i;
+    }
+    sh::RenderOutput out;
+    for (int i = 1; i <= 60; ++i) {
+      probe.position_mm = to + 0.5 * i * l4.frame.axes.col(2);
+      out = proxy.render(probe, scene, poses, 1e-3);
+      ASSERT_TRUE(clear_of_surfaces(scene, poses, out.proxy_mm, r, 1e-6));
+    }
+    EXPECT_FALSE(out.contact) << steps << ": the proxy stayed caught";
+  }
+}
+
 TEST(SphereProxy, RandomFastTrajectoriesNeverEnterTwoVertebrae) {
   sh::Scene scene;
   scene.add_body("L3", sh::testing::vertebra("L3").surface);
