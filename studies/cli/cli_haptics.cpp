@@ -77,8 +77,9 @@ void run_haptics_cli(HapticsArgs& a) {
         a.request, data_dir(),
         [live](const haptics::ServoStatus& s) {
           if (!live) return;
-          std::fprintf(stderr, "\r  t %6.1f s | force %5.2f N | %s        ", s.time_s,
-                       s.force_n.norm(), s.contact ? "contact" : "free   ");
+          std::fprintf(stderr, "\r  t %6.1f s | %6.1f Hz | force %5.2f N | %s        ", s.time_s,
+                       s.time_s > 0 ? double(s.ticks) / s.time_s : 0.0, s.force_n.norm(),
+                       s.contact ? "contact" : "free   ");
           std::fflush(stderr);
         },
         [&bar](int done, int) {
