@@ -30,16 +30,32 @@ sh::Scene plane_scene(double spacing) {
   return scene;
 }
 
-// Outside every body by at least `r − tol`: the nearest surface point is farther than that, and
-// the probe is on its front side.
+// Generalised winding number of a closed surface about p (Jacobson et al. 2013): Σ of the
+// triangles' solid angles (Van Oosterom & Strackee 1983) over 4π; 1 inside, 0 outside.
+double winding_number(const sh::AabbTree& tree, const Eigen::Vector3d& p) {
+  const auto& V = tree.vertices();
+  const auto& F = tree.triangles();
+  double sum = 0;
+  for (Eigen::Index t = 0; t < F.rows(); ++t) {
+    const Eigen::Vector3d a = V.row(F(t, 0)).transpose() - p, b = V.row(F(t, 1)).transpose() - p,
+                          c = V.row(F(t, 2)).transpose() - p;
+    const double la = a.norm(), lb = b.norm(), lc = c.norm();
+    sum += 2 * std::atan2(a.dot(b.cross(c)),
+                          la * lb * lc + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la);
+  }
+  return sum / (4 * M_PI);
+}
+
+// Outside every body, at least `r − tol` from its surface (the proxy sphere does not overlap
+// it): the distance by the tree, inside/outside by the winding number (a nearest triangle's
+// normal cannot tell at an edge, where the probe may lie behind one face and before the other).
 bool clear_of_surfaces(const sh::Scene& scene, const sh::ScenePoses& poses,
                        const Eigen::Vector3d& p, double r, double tol) {
   const auto near = sh::nearest_surface(scene, poses, p, r + 1, false);
-  if (near.body < 0) return true;
-  if (near.distance_mm < r - tol) return false;
-  const auto& tree = scene.body(near.body).tree;
-  const Eigen::Vector3d n = poses.pose[std::size_t(near.body)].R * tree.normal(near.triangle);
-  return n.dot(p - near.point_mm) >= -tol;
+  if (near.body >= 0 && near.distance_mm < r - tol) return false;
+  for (int i = 0; i < scene.size(); ++i)
+    if (winding_number(scene.body(i).tree, sh::to_body(poses, i, p)) > 0.5) return false;
+  return true;
 }
 
 }  // namespace
@@ -197,7 +213,7 @@ TEST(SphereProxy, SweepAcrossTheGapBetweenTwoVertebraeNeverEntersEither) {
     return Eigen::Vector3d(v.frame.origin_mm + (half_depth + r - 3.0) * front);
   };
   const Eigen::Vector3d from = pressed(l3), to = pressed(l4);
-  for (int steps : {1, 5, 200}) {
+  for (int steps : {1, 5, 100}) {
     sh::ProxyParameters p;
     p.radius_mm = r;
     sh::SphereProxyRenderer proxy(p);
@@ -239,7 +255,7 @@ TEST(SphereProxy, RandomFastTrajectoriesNeverEnterTwoVertebrae) {
     sh::SphereProxyRenderer proxy(p);
     Eigen::Vector3d device = Eigen::Vector3d(0, 0.5 * (lo.y() + hi.y()), hi.z() + r + 5);
     proxy.reset(device);
-    for (int tick = 0; tick < 4000; ++tick) {
+    for (int tick = 0; tick < 2500; ++tick) {
       device += Eigen::Vector3d(step(rng), step(rng), step(rng));
       device = device.cwiseMax(lo - Eigen::Vector3d::Constant(10))
                    .cwiseMin(hi + Eigen::Vector3d::Constant(10));
@@ -251,7 +267,7 @@ TEST(SphereProxy, RandomFastTrajectoriesNeverEnterTwoVertebrae) {
       contacts += out.contact;
     }
   }
-  EXPECT_GT(contacts, 500);
+  EXPECT_GT(contacts, 300);
 }
 
 TEST(SphereProxy, RidesAMovingVertebra) {

@@ -163,7 +163,7 @@ TEST(SafetyChain, FuzzedTrajectoriesNeverExceedThePeakForce) {
     sh::SafetyChain chain(sh::SafetyOptions::for_device(caps));
     Eigen::Vector3d x = centre;  // starts inside the vertebral body
     renderer.reset(x);
-    for (int tick = 0; tick < 3000; ++tick) {
+    for (int tick = 0; tick < 2000; ++tick) {
       const Eigen::Vector3d v(step(rng), step(rng), step(rng));
       x += v;
       x = centre + (x - centre).cwiseMax(-60).cwiseMin(60);

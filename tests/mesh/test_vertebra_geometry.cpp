@@ -84,7 +84,8 @@ TEST(VertebraGeometry, SweptBoxDistanceIsExactOnItsAxes) {
 }
 
 TEST(VertebraGeometry, MeshedSurfaceIsClosedOrientedAndHasTheSolidsVolume) {
-  for (const char* name : {"T6", "L3", "S1"}) {
+  // (the sacrum's closure is checked by tests/cli/test_cli_haptics.cpp, MeshVertebrae…)
+  for (const char* name : {"T6", "L3"}) {
     const auto v = sm::parametric_vertebra(name, kData);
     const auto s = sm::mesh_vertebra(v, 3000);
     const auto check = sm::check_surface(s.surface);
@@ -94,7 +95,7 @@ TEST(VertebraGeometry, MeshedSurfaceIsClosedOrientedAndHasTheSolidsVolume) {
     EXPECT_GT(check.volume_mm3, 0) << name;
     EXPECT_GT(s.surface.F.rows(), 3000 * 0.7) << name;
     EXPECT_LT(s.surface.F.rows(), 3000 * 1.4) << name;
-    const double mc = monte_carlo_volume(v, 400000);
+    const double mc = monte_carlo_volume(v, 150000);  // ±1.2 % (one sigma) for these solids
     EXPECT_NEAR(check.volume_mm3, mc, 0.05 * mc) << name;
   }
 }
