@@ -141,7 +141,7 @@ TEST(SafetyChain, FuzzedTrajectoriesNeverExceedThePeakForce) {
   // and at most the peak.
   sh::Scene scene;
   scene.add_body("L3", sh::testing::vertebra("L3").surface);
-  scene.sample_surfaces(0.3);
+  scene.sample_surfaces(0.6);  // coarse: the force law does not matter here, only its bound
   const auto poses = sh::testing::identity_poses();
   const auto& caps = sh::device_model("touch");
   std::mt19937 rng(23);
