@@ -1,6 +1,7 @@
 // Disc between two user-supplied vertebrae; the construction is described in vertebra_disc.hpp.
 // CGAL AABB trees answer the ray queries; the meshing itself goes through mesh_labeled_body.
 #include "spinesim/mesh/vertebra_disc.hpp"
+#include "spinesim/mesh/vertebra_geometry.hpp"
 
 #include <CGAL/AABB_traits.h>
 #include <CGAL/AABB_tree.h>
@@ -45,20 +46,6 @@ void check_surface(const TriSurface& s, const char* which) {
   if (s.F.minCoeff() < 0 || s.F.maxCoeff() >= s.V.rows())
     throw std::invalid_argument(std::string(which) +
                                 " vertebra surface has a vertex index out of range");
-}
-
-// Area-weighted centroid of the triangles, mm.
-Eigen::Vector3d surface_centroid(const TriSurface& s) {
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  double area = 0;
-  for (Eigen::Index f = 0; f < s.F.rows(); ++f) {
-    const Eigen::Vector3d a = s.V.row(s.F(f, 0)), b = s.V.row(s.F(f, 1)), c = s.V.row(s.F(f, 2));
-    const double A = 0.5 * (b - a).cross(c - a).norm();
-    sum += A * (a + b + c) / 3.0;
-    area += A;
-  }
-  if (!(area > 0)) throw std::invalid_argument("vertebra surface has zero area");
-  return sum / area;
 }
 
 // One surface in the local frame with an AABB tree for ray shooting.

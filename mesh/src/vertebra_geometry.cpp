@@ -394,6 +394,19 @@ void write_obj(const std::string& path, const TriSurface& s, const std::string& 
   });
 }
 
+Eigen::Vector3d surface_centroid(const TriSurface& s) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  double area = 0;
+  for (Eigen::Index f = 0; f < s.F.rows(); ++f) {
+    const Eigen::Vector3d a = s.V.row(s.F(f, 0)), b = s.V.row(s.F(f, 1)), c = s.V.row(s.F(f, 2));
+    const double A = 0.5 * (b - a).cross(c - a).norm();
+    sum += A * (a + b + c) / 3.0;
+    area += A;
+  }
+  if (!(area > 0)) throw std::invalid_argument("vertebra surface has zero area");
+  return sum / area;
+}
+
 SurfaceCheck check_surface(const TriSurface& s) {
   SurfaceCheck c;
   std::map<std::pair<int, int>, std::pair<int, int>> edges;  // (min, max) → (forward, backward)

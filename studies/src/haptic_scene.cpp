@@ -22,19 +22,6 @@ namespace {
 
 const char* kRealFolder = "artisynth-lss";
 
-// Area-weighted centroid of a triangle soup (the surfaces need not be closed).
-Eigen::Vector3d surface_centroid(const mesh::TriSurface& s) {
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  double area = 0;
-  for (Eigen::Index f = 0; f < s.F.rows(); ++f) {
-    const Eigen::Vector3d a = s.V.row(s.F(f, 0)), b = s.V.row(s.F(f, 1)), c = s.V.row(s.F(f, 2));
-    const double A = 0.5 * (b - a).cross(c - a).norm();
-    sum += A * (a + b + c) / 3.0;
-    area += A;
-  }
-  return area > 0 ? Eigen::Vector3d(sum / area) : Eigen::Vector3d::Zero();
-}
-
 mesh::TriSurface transformed(const mesh::TriSurface& s, const Eigen::Matrix3d& R,
                              const Eigen::Vector3d& t) {
   mesh::TriSurface out = s;
@@ -60,8 +47,9 @@ mesh::TriSurface read_real(const fs::path& dir, const std::string& file, bool fl
 }
 
 bool real_needs_flip(const fs::path& dir) {
-  const Eigen::Vector3d body = surface_centroid(read_real(dir, "L3_body.obj", false));
-  const Eigen::Vector3d whole = surface_centroid(read_real(dir, "L3_Schrumpfverpacken.obj", false));
+  const Eigen::Vector3d body = mesh::surface_centroid(read_real(dir, "L3_body.obj", false));
+  const Eigen::Vector3d whole =
+      mesh::surface_centroid(read_real(dir, "L3_Schrumpfverpacken.obj", false));
   return whole.z() > body.z();
 }
 
@@ -94,7 +82,7 @@ Registration register_with(const fs::path& dir, bool flip, const std::string& da
   std::vector<Eigen::Vector3d> real, model;
   Registration reg;
   for (const auto& name : real_names()) {
-    real.push_back(surface_centroid(read_real(dir, name + "_body.obj", flip)));
+    real.push_back(mesh::surface_centroid(read_real(dir, name + "_body.obj", flip)));
     model.push_back(mesh::parametric_vertebra(name, data_dir).frame.origin_mm);
     reg.names.push_back(name);
   }

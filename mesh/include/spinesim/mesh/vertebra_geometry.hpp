@@ -104,4 +104,8 @@ struct SurfaceCheck {
 };
 SurfaceCheck check_surface(const TriSurface& s);
 
+/// Area-weighted centroid of the triangles (mm); the surface need not be closed. Throws
+/// std::invalid_argument for a surface of zero area.
+Eigen::Vector3d surface_centroid(const TriSurface& s);
+
 }  // namespace spinesim::mesh
