@@ -238,9 +238,9 @@ void check_loads(const SpineModel& m, const std::vector<ExternalLoad>& loads,
     // (a 1e155 N force overflows its norm): refused, naming the limit.
     const std::string& name = m.vertebrae[std::size_t(l.vertebra)].name;
     if (!(l.force_n.norm() <= kMaxForceN))
-      throw std::invalid_argument("force on " + name + " is beyond " +
-                                  std::to_string(int(kMaxForceN)) +
-                                  " N, outside any physical load (the model is validated to 600 N)");
+      throw std::invalid_argument(
+          "force on " + name + " is beyond " + std::to_string(int(kMaxForceN)) +
+          " N, outside any physical load (the model is validated to 600 N)");
     if (!(l.moment_nmm.norm() <= kMaxMomentNmm))
       throw std::invalid_argument("couple on " + name + " is beyond " +
                                   std::to_string(int(kMaxMomentNmm / 1000)) + " N·m");
@@ -555,6 +555,79 @@ SpineSolution solve_spine(const SpineModel& m, const std::vector<ExternalLoad>& 
   out.seconds_equilibrium = timer.seconds();
   report(m, evaluate(m, loads, F, out.theta), out);
   return out;
+}
+
+DisplacementSensitivity displacement_sensitivity(const SpineModel& m,
+                                                 const std::vector<ExternalLoad>& loads,
+                                                 const SpineSolution& solution, int load,
+                                                 const SolveOptions& o, double step_n) {
+  if (load < 0 || load >= int(loads.size()))
+    throw std::invalid_argument("displacement_sensitivity: load index out of range");
+  if (!(step_n > 0)) throw std::invalid_argument("displacement_sensitivity: step must be > 0");
+  check_loads(m, loads, nullptr);
+  const Eigen::Index rows = 6 * Eigen::Index(m.vertebrae.size());
+  auto column = [&](const SpineSolution& s) {
+    VectorXd d(rows);
+    for (Eigen::Index i = 0; i < s.displacement.rows(); ++i)
+      d.segment<6>(6 * i) = s.displacement.row(i).transpose();
+    return d;
+  };
+  if (o.recruit && !m.muscles.empty()) {
+    DisplacementSensitivity S(rows, 3);
+    const VectorXd d0 = column(solution);
+    for (int a = 0; a < 3; ++a) {
+      std::vector<ExternalLoad> shifted = loads;
+      shifted[std::size_t(load)].force_n[a] += step_n;
+      S.col(a) = (column(solve_spine(m, shifted, o)) - d0) / step_n;
+    }
+    return S;
+  }
+  const VectorXd& F = solution.recruitment.force_n;
+  const Newton full(m, loads, F, o, false);
+  const Eigen::Index nf = full.size();
+  DisplacementSensitivity S = DisplacementSensitivity::Zero(rows, 3);
+  if (nf == 0) return S;
+  const VectorXd& theta = solution.theta;
+  // ∂g/∂F_a: the gradient is affine in a dead force, so a difference of two gradients is exact
+  // up to round-off (step 1 N).
+  VectorXd g0, g1;
+  potential(m, loads, F, theta, &g0);
+  Eigen::MatrixXd dg(nf, 3);
+  for (int a = 0; a < 3; ++a) {
+    std::vector<ExternalLoad> shifted = loads;
+    shifted[std::size_t(load)].force_n[a] += 1.0;
+    potential(m, shifted, F, theta, &g1);
+    for (Eigen::Index r = 0; r < nf; ++r)
+      dg(r, a) = g1[full.coordinate(r)] - g0[full.coordinate(r)];
+  }
+  const Eigen::MatrixXd K = full.hessian(theta);
+  Eigen::LDLT<Eigen::MatrixXd> ldlt(K);
+  const Eigen::MatrixXd dtheta = -ldlt.solve(dg);  // nf × 3, rad/N
+  // displacement(θ) along each direction by central differences (h: 1e-6 rad at the largest
+  // component, well inside the finite-rotation maps' smooth range).
+  auto displacement_at = [&](const VectorXd& th, Eigen::VectorXd& d) {
+    const std::vector<Pose> P = vertebra_poses(m, th);
+    d.resize(rows);
+    for (std::size_t i = 0; i < m.vertebrae.size(); ++i) {
+      const Vector3d& C = m.vertebrae[i].centre_mm;
+      d.segment<3>(6 * Eigen::Index(i)) = P[i].apply(C) - C;
+      d.segment<3>(6 * Eigen::Index(i) + 3) = rotation_log(P[i].R) * kRadToDeg;
+    }
+  };
+  for (int a = 0; a < 3; ++a) {
+    const double scale = dtheta.col(a).cwiseAbs().maxCoeff();
+    if (!(scale > 0)) continue;
+    const double h = 1e-6 / scale;
+    VectorXd tp = theta, tm = theta, dp, dm;
+    for (Eigen::Index r = 0; r < nf; ++r) {
+      tp[full.coordinate(r)] += h * dtheta(r, a);
+      tm[full.coordinate(r)] -= h * dtheta(r, a);
+    }
+    displacement_at(tp, dp);
+    displacement_at(tm, dm);
+    S.col(a) = (dp - dm) / (2 * h);
+  }
+  return S;
 }
 
 }  // namespace spinesim::spine

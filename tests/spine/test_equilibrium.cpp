@@ -423,3 +423,77 @@ TEST(SpineEquilibrium, LigamentsStiffenEachJointByTheirStretchTimesLeverArm) {
   // The ligaments carry enough of the couple for a wrong k_i to show.
   EXPECT_GT(largest_share, 0.3);
 }
+
+namespace {
+
+/// Displacement of a solve as one column, in DisplacementSensitivity's row order.
+VectorXd displacement_column(const sp::SpineSolution& s) {
+  VectorXd d(s.displacement.size());
+  for (Eigen::Index i = 0; i < s.displacement.rows(); ++i)
+    d.segment<6>(6 * i) = s.displacement.row(i).transpose();
+  return d;
+}
+
+/// The sensitivity at `f` (hook point on T3's spinous side) against central differences of
+/// direct solves (±h N on each axis); the largest error relative to the largest response.
+double sensitivity_error(const sp::SolveOptions& o, const Vector3d& f, double h) {
+  const auto& m = full();
+  sp::ExternalLoad hook = force_on("T3", f);
+  hook.has_point = true;
+  hook.point_mm = m.vertebrae[2].centre_mm + Vector3d(3, 0, -30);
+  const sp::SpineSolution s = sp::solve_spine(m, {hook}, o);
+  const sp::DisplacementSensitivity S = sp::displacement_sensitivity(m, {hook}, s, 0, o);
+  double worst = 0, scale = 0;
+  for (int a = 0; a < 3; ++a) {
+    sp::ExternalLoad p = hook, q = hook;
+    p.force_n[a] += h;
+    q.force_n[a] -= h;
+    const VectorXd fd = (displacement_column(sp::solve_spine(m, {p}, o)) -
+                         displacement_column(sp::solve_spine(m, {q}, o))) /
+                        (2 * h);
+    worst = std::max(worst, (S.col(a) - fd).cwiseAbs().maxCoeff());
+    scale = std::max(scale, fd.cwiseAbs().maxCoeff());
+  }
+  EXPECT_GT(scale, 0);
+  return worst / scale;
+}
+
+}  // namespace
+
+TEST(SpineEquilibrium, SensitivityMatchesDifferencesOfDirectSolvesAtFixedMuscleForces) {
+  sp::SolveOptions o;
+  o.recruit = false;  // muscle forces fixed (zero): the sensitivity is then the whole derivative
+  o.tolerance = 1e-6;
+  EXPECT_LT(sensitivity_error(o, Vector3d(40, -30, 60), 2.0), 2e-3);
+}
+
+TEST(SpineEquilibrium, SensitivityWithRecruitmentPredictsANearbySolve) {
+  // Recruitment on: the sensitivity differences whole solves (forward, 5 N). The linear model
+  // d0 + S ΔF must predict a direct solve at F + ΔF far better than d0 alone does.
+  const auto& m = full();
+  sp::SolveOptions o;
+  o.tolerance = 1e-6;
+  sp::ExternalLoad hook = force_on("T1", Vector3d(20, -10, 150));
+  hook.has_point = true;
+  hook.point_mm = m.vertebrae[0].centre_mm + Vector3d(0, 5, -40);
+  const sp::SpineSolution s = sp::solve_spine(m, {hook}, o);
+  const sp::DisplacementSensitivity S = sp::displacement_sensitivity(m, {hook}, s, 0, o);
+  const VectorXd d0 = displacement_column(s);
+  for (const Vector3d& dF : {Vector3d(3, -2, 4), Vector3d(-4, 1, -3), Vector3d(0, 0, 10)}) {
+    sp::ExternalLoad moved = hook;
+    moved.force_n += dF;
+    const VectorXd d1 = displacement_column(sp::solve_spine(m, {moved}, o));
+    const double change = (d1 - d0).cwiseAbs().maxCoeff();
+    const double error = (d0 + S * dF - d1).cwiseAbs().maxCoeff();
+    std::printf("dF %g %g %g: change %.4g, linear error %.4g\n", dF.x(), dF.y(), dF.z(), change,
+                error);
+    EXPECT_LT(error, 0.2 * change);
+  }
+}
+
+TEST(SpineEquilibrium, SensitivityRefusesALoadIndexOutOfRange) {
+  const auto& m = full();
+  const sp::SpineSolution s = sp::solve_spine(m, {force_on("T1", Vector3d(0, 0, 10))});
+  EXPECT_THROW(sp::displacement_sensitivity(m, {force_on("T1", Vector3d(0, 0, 10))}, s, 1),
+               std::invalid_argument);
+}

@@ -104,6 +104,28 @@ inline constexpr double kMaxForceN = 1e5, kMaxMomentNmm = 1e7, kMaxPointMm = 1e4
 SpineSolution solve_spine(const SpineModel& m, const std::vector<ExternalLoad>& loads,
                           const SolveOptions& options = SolveOptions());
 
+/// Rows of a displacement sensitivity: vertebra i's translation (mm) and rotation vector (deg)
+/// at rows 6 i … 6 i + 5, as SpineSolution::displacement orders them.
+using DisplacementSensitivity = Eigen::Matrix<double, Eigen::Dynamic, 3>;
+
+/// The linear response of `solution` (solved by solve_spine for `loads` with `options`) to the
+/// force of loads[load]: d(displacement)/dF, 6·17 × 3, mm/N and deg/N.
+///  - Muscles off (or none): the implicit-function derivative dθ/dF = −K⁻¹ ∂g/∂F, K = ∂²Π/∂θ²
+///    over every free coordinate (central differences of the analytic gradient, as Newton's),
+///    ∂g/∂F exact (Π is linear in a dead load), then displacement(θ) differentiated by central
+///    differences along dθ/dF. One Hessian: a few ms.
+///  - Recruitment on: the recruited muscles take up most of a load, and how they share it
+///    changes with it — the derivative at fixed muscle forces is then several times too large
+///    (tests/spine). So the derivative is taken through whole solves: forward differences of
+///    solve_spine with a step of `step_n` (N) on each axis, three solves.
+/// Throws std::invalid_argument for a load index out of range or a step ≤ 0, SolveError when a
+/// differenced solve fails.
+DisplacementSensitivity displacement_sensitivity(const SpineModel& m,
+                                                 const std::vector<ExternalLoad>& loads,
+                                                 const SpineSolution& solution, int load,
+                                                 const SolveOptions& options = SolveOptions(),
+                                                 double step_n = 5.0);
+
 // --- pieces, exposed for tests and the database ---------------------------------------------
 
 /// Total potential energy Π(θ) (N·mm) and its gradient for fixed muscle forces `muscle_force_n`
