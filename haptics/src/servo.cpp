@@ -97,6 +97,11 @@ void ServoLoop::record_to(std::function<void(const TickRecord*, std::size_t)> si
   ring_.assign(std::max<std::size_t>(capacity, 16), TickRecord{});
 }
 
+void ServoLoop::set_compliant_stage(CompliantStage* stage) {
+  stage_ = stage;
+  stage_poses_ = poses_.read();
+}
+
 void ServoLoop::tick(double now_s, double period_s) {
   ServoStats& st = stats_;
   if (device_failed_) return;
@@ -111,18 +116,25 @@ void ServoLoop::tick(double now_s, double period_s) {
   // The force held over the last period did its work over the device's motion since then.
   passivity_.add(held_force_, state_.position_mm - held_from_mm_, period_s);
   held_from_mm_ = state_.position_mm;
-  const ScenePoses& poses = poses_.read();
+  const ScenePoses* poses = &poses_.read();
+  if (stage_) {
+    stage_poses_.time_s = poses->time_s;
+    stage_->update(state_, last_out_, period_s, stage_poses_);
+    poses = &stage_poses_;
+  }
   ProbeState probe;
   probe.position_mm = state_.position_mm;
   probe.velocity_mm_s = state_.velocity_mm_s;
-  const RenderOutput out = renderer_.render(probe, scene_, poses, period_s);
+  const RenderOutput out = renderer_.render(probe, scene_, *poses, period_s);
+  last_out_ = out;
   SafetyTick in;
   in.period_s = period_s;
-  in.scene_age_s = now_s - poses.time_s;
+  in.scene_age_s = now_s - poses->time_s;
   in.contact = out.contact;
   in.penetration_mm = out.penetration_mm;
   SafetyReport report;
-  const Eigen::Vector3d force = safety_.apply(out.force_n, in, &report);
+  const Eigen::Vector3d force =
+      safety_.apply(stage_ ? stage_->blend(out.force_n) : out.force_n, in, &report);
   if (!device_.write_force(force)) {
     device_.write_force(Eigen::Vector3d::Zero());
     device_failed_ = true;
@@ -151,6 +163,7 @@ void ServoLoop::tick(double now_s, double period_s) {
   status.body = out.body;
   status.buttons = state_.buttons;
   status.passivity_mj = passivity_.energy_mj();
+  if (stage_) status.hook = stage_->state();
   status_.write(status);
 
   if (!ring_.empty()) {
@@ -166,6 +179,16 @@ void ServoLoop::tick(double now_s, double period_s) {
       r.proxy_mm = out.proxy_mm;
       r.buttons = state_.buttons;
       r.contact = out.contact;
+      r.compliant = stage_ != nullptr;
+      if (stage_) {
+        r.hook = stage_->state();
+        const auto& body = stage_->bodies();
+        for (int i = 0; i < kSpineVertebrae; ++i) {
+          const spine::Pose& p = poses->pose[std::size_t(body[std::size_t(i)])];
+          r.R[std::size_t(i)] = p.R.cast<float>();
+          r.t[std::size_t(i)] = p.t.cast<float>();
+        }
+      }
       ring_head_.store(next, std::memory_order_release);
     }
   }

@@ -17,11 +17,13 @@
 
 namespace sh = spinesim::haptics;
 
-// --- allocation counter: counts operator new calls while armed ------------------------------
-namespace {
+// --- allocation counter (allocation_counter.hpp): the replacement operators -----------------
+namespace spinesim::haptics::testing {
 std::atomic<bool> g_count_allocations{false};
 std::atomic<long> g_allocations{0};
-}  // namespace
+}  // namespace spinesim::haptics::testing
+using spinesim::haptics::testing::g_allocations;
+using spinesim::haptics::testing::g_count_allocations;
 
 void* operator new(std::size_t n) {
   if (g_count_allocations.load(std::memory_order_relaxed)) g_allocations.fetch_add(1);

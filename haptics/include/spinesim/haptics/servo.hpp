@@ -5,6 +5,7 @@
 // the status through a triple buffer and the recording through a lock-free ring.
 #pragma once
 
+#include "spinesim/haptics/compliant_stage.hpp"
 #include "spinesim/haptics/device.hpp"
 #include "spinesim/haptics/renderer.hpp"
 #include "spinesim/haptics/safety.hpp"
@@ -42,6 +43,7 @@ struct ServoStatus {
   int body = -1;
   unsigned buttons = 0;
   double passivity_mj = 0;
+  HookState hook;  ///< the compliant stage's hook (attached = false without one)
 };
 
 /// One recorded tick (the `--record` file's row).
@@ -50,6 +52,12 @@ struct TickRecord {
   Eigen::Vector3d probe_mm, force_n, proxy_mm;
   unsigned buttons = 0;
   bool contact = false;
+  // The compliant stage (when there is one): the hook and every vertebra's rigid motion from the
+  // reference posture (x ↦ R x + t; single precision is 0.1 µm over the spine).
+  bool compliant = false;
+  HookState hook;
+  std::array<Eigen::Matrix3f, kSpineVertebrae> R;
+  std::array<Eigen::Vector3f, kSpineVertebrae> t;
 };
 
 struct Percentiles {
@@ -96,6 +104,9 @@ class ServoLoop {
 
   /// Asks the loop to end (any thread; async-signal-safe).
   void request_stop() { stop_.store(true); }
+  /// Adds the compliant stage (set before run()): each tick it moves the vertebrae for the
+  /// hook's force before the render, and its spring's force is blended into the hand's.
+  void set_compliant_stage(CompliantStage* stage);
   /// Records every tick into a ring drained by `sink` on a writer thread (set before run()).
   void record_to(std::function<void(const TickRecord*, std::size_t)> sink, std::size_t capacity);
 
@@ -125,6 +136,9 @@ class ServoLoop {
   std::atomic<std::int64_t> ring_dropped_{0};
   std::function<void(const TickRecord*, std::size_t)> sink_;
   bool device_failed_ = false;
+  CompliantStage* stage_ = nullptr;
+  ScenePoses stage_poses_;  ///< the scene's poses with the stage's vertebrae, kept across ticks
+  RenderOutput last_out_;
   double t0_ = 0;  ///< the loop's clock origin (CLOCK_MONOTONIC, s)
 };
 

@@ -1,0 +1,200 @@
+// The compliant stage (thesis 4.5): with the stylus button pressed while the probe touches a
+// vertebra, a virtual spring joins the probe to a hook point fixed in that vertebra; the spring's
+// force (scaled up: a desktop device gives a few newtons, the spine is dragged with hundreds)
+// loads the spine at the hook point, every vertebra moves, and the rigid stage's surfaces and the
+// proxy move with them, so the user feels the spine give. Releasing the button ends it.
+//
+// How the vertebrae follow the hook force is a SpineResponse, evaluated in every servo tick:
+//   - DatabaseResponse: the thesis's method — the displacement–force polynomials
+//     (spine/database.hpp), the force taken at the vertebra's centre, oblique forces by
+//     superposition of the axis fits;
+//   - MultirateSpine (default): the full equilibrium solver (spine/equilibrium.hpp) runs
+//     continuously in a worker thread with the latest hook force and point, and hands the servo
+//     loop its solution d0 at force F0 and the sensitivity S = ∂d/∂F there (a "local model",
+//     Çavuşoğlu & Tendick 2000); each tick predicts d = d0 + S (F − F0).
+// Both give each vertebra's motion relative to the spine under gravity alone (the scene shows
+// the vertebrae at the reference posture, so at zero hook force nothing moves).
+//
+// Units: mm, N, s. Frame: the spine's (x lateral, y superior, z anterior).
+#pragma once
+
+#include "spinesim/haptics/device.hpp"
+#include "spinesim/haptics/renderer.hpp"
+#include "spinesim/haptics/scene.hpp"
+#include "spinesim/haptics/triple_buffer.hpp"
+#include "spinesim/spine/database.hpp"
+#include "spinesim/spine/equilibrium.hpp"
+
+#include <Eigen/Core>
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <thread>
+
+namespace spinesim::haptics {
+
+inline constexpr int kSpineVertebrae = 17;  ///< T1…L5
+
+/// Per vertebra T1…L5: translation of its F.1 centre (mm) and rotation vector (deg, world axes)
+/// — spine::SpineSolution::displacement's layout.
+using SpineDisplacement = Eigen::Matrix<double, kSpineVertebrae, 6>;
+
+/// The load the hook puts on the spine: a force (N, world) at a point fixed in a vertebra
+/// (reference coordinates, mm). vertebra −1: no load.
+struct HookLoad {
+  int vertebra = -1;
+  Eigen::Vector3d point_mm = Eigen::Vector3d::Zero();
+  Eigen::Vector3d force_n = Eigen::Vector3d::Zero();
+};
+
+/// The rigid motion that takes the spine from displacement `from` to displacement `to` (both
+/// absolute, from the reference posture): per vertebra x ↦ R x + t with R = R_to R_fromᵀ,
+/// written into poses.pose[body_of[i]]. No allocation.
+void relative_poses(const std::vector<Eigen::Vector3d>& centres_mm, const SpineDisplacement& from,
+                    const SpineDisplacement& to, const std::array<int, kSpineVertebrae>& body_of,
+                    ScenePoses& poses);
+
+class SpineResponse {
+ public:
+  virtual ~SpineResponse() = default;
+  virtual const char* name() const = 0;
+  /// Displacement of every vertebra relative to gravity alone under `load` (zero for no load).
+  /// Called in the servo tick: no allocation, no lock, no wait.
+  virtual void predict(const HookLoad& load, SpineDisplacement& relative) = 0;
+  /// The absolute displacement under gravity alone (what `relative` is relative to).
+  virtual const SpineDisplacement& baseline() const = 0;
+  /// Largest hook force (N) this answers for; the stage clamps the force to it.
+  virtual double max_force_n() const = 0;
+  /// Starts and stops a worker thread, if there is one.
+  virtual void start() {}
+  virtual void stop() {}
+};
+
+/// The thesis's displacement–force database. The hook point is not used (the database knows
+/// forces at the vertebra centres); each force component is clamped to the largest force its
+/// axis fit was solved for, so the polynomials are never extrapolated.
+class DatabaseResponse final : public SpineResponse {
+ public:
+  explicit DatabaseResponse(const spine::DisplacementDatabase& db);
+  const char* name() const override { return "database"; }
+  void predict(const HookLoad& load, SpineDisplacement& relative) override;
+  const SpineDisplacement& baseline() const override { return baseline_; }
+  double max_force_n() const override { return db_.force_max_n(); }
+
+ private:
+  const spine::DisplacementDatabase& db_;
+  SpineDisplacement baseline_;
+};
+
+/// The worker's latest linearisation: the solution at F0 and ∂d/∂F there.
+struct LocalSpineModel {
+  int vertebra = -1;  ///< −1: nothing solved yet
+  Eigen::Vector3d point_mm = Eigen::Vector3d::Zero(), force_n = Eigen::Vector3d::Zero();
+  SpineDisplacement relative = SpineDisplacement::Zero();  ///< at force_n
+  Eigen::Matrix<double, 6 * kSpineVertebrae, 3> sensitivity =
+      Eigen::Matrix<double, 6 * kSpineVertebrae, 3>::Zero();  ///< mm/N, deg/N; rows 6 i + c
+  std::int64_t solve = 0;                                     ///< sequence number
+  double solved_at_s = 0;                                     ///< on the worker's clock
+};
+
+struct MultirateOptions {
+  spine::SolveOptions solve;  ///< recruitment on by default, as the database was made
+  double max_force_n = 600;   ///< the thesis's validated range (3.3.5)
+  /// Forward-difference step of the sensitivity (spine::displacement_sensitivity), N.
+  double sensitivity_step_n = 5;
+};
+
+/// The worker: solve at the latest hook load, differentiate, publish, repeat. It idles while
+/// there is no hook. predict() uses the latest model when it was made for the same vertebra and
+/// hook point; before the first one arrives for a new hook it predicts no motion (the hook's force
+/// ramps up from zero over the first ~0.3 s, several solves' time).
+class MultirateSpine final : public SpineResponse {
+ public:
+  /// Solves the gravity-only baseline here (throws spine::SolveError if it fails).
+  MultirateSpine(const spine::SpineModel& model, const MultirateOptions& options);
+  ~MultirateSpine() override;
+  const char* name() const override { return "multirate"; }
+  void predict(const HookLoad& load, SpineDisplacement& relative) override;
+  const SpineDisplacement& baseline() const override { return baseline_; }
+  double max_force_n() const override { return options_.max_force_n; }
+  void start() override;
+  void stop() override;
+
+  struct Stats {
+    std::int64_t solves = 0, failures = 0;
+    double busy_s = 0;         ///< time spent solving and differentiating
+    double mean_update_s = 0;  ///< per published model (solve + sensitivity)
+    std::string last_error;
+  };
+  /// After stop().
+  const Stats& stats() const { return stats_; }
+  /// One update for `load` on the calling thread (the worker's body; tests call it directly).
+  LocalSpineModel solve(const HookLoad& load) const;
+
+ private:
+  void run();
+
+  const spine::SpineModel& model_;
+  MultirateOptions options_;
+  SpineDisplacement baseline_;
+  TripleBuffer<HookLoad> request_;
+  TripleBuffer<LocalSpineModel> model_out_;
+  std::atomic<bool> stop_{false};
+  std::thread worker_;
+  Stats stats_;
+};
+
+struct CouplingParameters {
+  double stiffness_n_per_mm = 0.2;  ///< felt spring, within the device's usable stiffness
+  double damping_n_s_per_mm = 0;    ///< felt, on the probe's velocity relative to the hook
+  double force_scale = 100;         ///< spine force per felt force (N/N)
+  double ramp_s = 0.3;              ///< attach and release blend over this long
+  unsigned button_mask = 1;         ///< the stylus button that hooks
+};
+
+/// The stage's state after a tick (for the status line and the recording).
+struct HookState {
+  bool attached = false;                                   ///< button held on a hooked vertebra
+  double gain = 0;                                         ///< the attach/release blend, 0…1
+  HookLoad load;                                           ///< on the spine
+  Eigen::Vector3d hook_mm = Eigen::Vector3d::Zero();       ///< the hook point, world
+  Eigen::Vector3d felt_force_n = Eigen::Vector3d::Zero();  ///< the spring's force on the hand
+  bool clamped = false;  ///< the spine force was limited to the response's max_force_n
+};
+
+/// Drives a SpineResponse from the device and the renderer, inside the servo tick.
+class CompliantStage {
+ public:
+  /// `body_of[i]`: the scene body of vertebra i (T1…L5). Throws std::invalid_argument for
+  /// a stiffness or scale ≤ 0, a negative damping or ramp.
+  CompliantStage(SpineResponse& response, const std::vector<Eigen::Vector3d>& centres_mm,
+                 const std::array<int, kSpineVertebrae>& body_of, const CouplingParameters& p);
+
+  /// Before the render: hooks on a button press while the last render touched a vertebra (at
+  /// the proxy's centre), updates the hook force from the previous poses, and predicts the poses
+  /// for it into `poses` (bodies of T1…L5; others untouched). No allocation.
+  void update(const DeviceState& device, const RenderOutput& last, double dt_s, ScenePoses& poses);
+  /// After the render: the force for the hand — the rendered contact force blended with the
+  /// hook spring's by the attach gain.
+  Eigen::Vector3d blend(const Eigen::Vector3d& contact_force_n) const;
+
+  const HookState& state() const { return state_; }
+  const SpineDisplacement& displacement() const { return relative_; }  ///< last prediction
+  SpineResponse& response() { return response_; }
+  const std::array<int, kSpineVertebrae>& bodies() const { return body_of_; }
+
+ private:
+  SpineResponse& response_;
+  std::vector<Eigen::Vector3d> centres_;
+  std::array<int, kSpineVertebrae> body_of_;
+  CouplingParameters p_;
+  HookState state_;
+  SpineDisplacement relative_ = SpineDisplacement::Zero(), absolute_;
+  unsigned last_buttons_ = 0;
+  Eigen::Vector3d last_hook_mm_ = Eigen::Vector3d::Zero();
+};
+
+}  // namespace spinesim::haptics

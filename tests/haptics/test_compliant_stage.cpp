@@ -1,0 +1,275 @@
+// The compliant stage: relative poses move the centres as the displacements say; the hook
+// attaches only on a press while touching a vertebra, at the proxy; the spine force is the
+// scaled spring, clamped, ramped in and out, and the hand feels its reaction; a closed loop with
+// a scripted hand drags a vertebra the way it pulls without allocating; the multirate spine's
+// local model reproduces its own solve and predicts a nearby one.
+#include "spinesim/haptics/compliant_stage.hpp"
+#include "spinesim/haptics/servo.hpp"
+
+#include "allocation_counter.hpp"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <thread>
+
+namespace sh = spinesim::haptics;
+namespace sp = spinesim::spine;
+using Eigen::Vector3d;
+
+namespace {
+
+/// A closed box of half-size h centred at c (12 triangles, outward normals).
+spinesim::mesh::TriSurface box(const Vector3d& c, double h) {
+  spinesim::mesh::TriSurface s;
+  s.V.resize(8, 3);
+  for (int i = 0; i < 8; ++i)
+    s.V.row(i) = (c + h * Vector3d(i & 1 ? 1 : -1, i & 2 ? 1 : -1, i & 4 ? 1 : -1)).transpose();
+  s.F.resize(12, 3);
+  s.F << 0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4, 2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6,
+      1, 3, 5, 3, 7, 5;
+  return s;
+}
+
+/// 17 "vertebrae" as 10 mm boxes 30 mm apart along y (T1 on top), body i = vertebra i.
+struct Column {
+  sh::Scene scene;
+  std::vector<Vector3d> centres;
+  std::array<int, sh::kSpineVertebrae> body_of{};
+  Column() {
+    for (int i = 0; i < sh::kSpineVertebrae; ++i) {
+      centres.push_back(Vector3d(0, 600 - 30.0 * i, 0));
+      scene.add_body("V" + std::to_string(i), box(centres.back(), 5));
+      body_of[std::size_t(i)] = i;
+    }
+  }
+};
+
+/// A linear spine: the hooked vertebra translates by F / k, the others by half that.
+class LinearSpine final : public sh::SpineResponse {
+ public:
+  explicit LinearSpine(double k, double max_n = 600) : k_(k), max_(max_n) {}
+  const char* name() const override { return "linear"; }
+  void predict(const sh::HookLoad& load, sh::SpineDisplacement& d) override {
+    d.setZero();
+    if (load.vertebra < 0) return;
+    for (int i = 0; i < sh::kSpineVertebrae; ++i)
+      d.row(i).head<3>() = (i == load.vertebra ? 1.0 : 0.5) * load.force_n.transpose() / k_;
+  }
+  const sh::SpineDisplacement& baseline() const override { return base_; }
+  double max_force_n() const override { return max_; }
+
+ private:
+  double k_, max_;
+  sh::SpineDisplacement base_ = sh::SpineDisplacement::Zero();
+};
+
+sh::DeviceState at(const Vector3d& p, unsigned buttons) {
+  sh::DeviceState s;
+  s.position_mm = p;
+  s.buttons = buttons;
+  return s;
+}
+
+sh::RenderOutput touching(int body, const Vector3d& proxy) {
+  sh::RenderOutput r;
+  r.contact = true;
+  r.body = body;
+  r.proxy_mm = proxy;
+  return r;
+}
+
+}  // namespace
+
+TEST(CompliantStage, RelativePosesTakeOneDisplacementToTheOther) {
+  Column col;
+  sh::SpineDisplacement from = sh::SpineDisplacement::Random() * 10,
+                        to = sh::SpineDisplacement::Random() * 10;
+  sh::ScenePoses poses;
+  sh::relative_poses(col.centres, from, to, col.body_of, poses);
+  for (int i = 0; i < sh::kSpineVertebrae; ++i) {
+    const Vector3d c = col.centres[std::size_t(i)];
+    const Vector3d moved_from = c + from.row(i).head<3>().transpose();
+    const Vector3d moved_to = c + to.row(i).head<3>().transpose();
+    EXPECT_LT((poses.pose[std::size_t(i)].apply(moved_from) - moved_to).norm(), 1e-9);
+    EXPECT_LT((poses.pose[std::size_t(i)].R * poses.pose[std::size_t(i)].R.transpose() -
+               Eigen::Matrix3d::Identity())
+                  .norm(),
+              1e-12);
+  }
+  sh::relative_poses(col.centres, from, from, col.body_of, poses);
+  EXPECT_LT((poses.pose[3].R - Eigen::Matrix3d::Identity()).norm(), 1e-12);
+  EXPECT_LT(poses.pose[3].t.norm(), 1e-9);
+}
+
+TEST(CompliantStage, HooksOnlyOnAPressWhileTouchingAVertebra) {
+  Column col;
+  LinearSpine spine(10);
+  sh::CouplingParameters p;
+  p.ramp_s = 0;
+  sh::CompliantStage stage(spine, col.centres, col.body_of, p);
+  sh::ScenePoses poses;
+  const Vector3d proxy = col.centres[2] + Vector3d(0, 0, 9);
+  stage.update(at(proxy, 1), sh::RenderOutput{}, 1e-3, poses);  // pressed, no contact
+  EXPECT_FALSE(stage.state().attached);
+  stage.update(at(proxy, 1), touching(2, proxy), 1e-3, poses);  // held, not a new press
+  EXPECT_FALSE(stage.state().attached);
+  stage.update(at(proxy, 0), touching(2, proxy), 1e-3, poses);
+  stage.update(at(proxy, 1), touching(2, proxy), 1e-3, poses);  // the press
+  ASSERT_TRUE(stage.state().attached);
+  EXPECT_EQ(stage.state().load.vertebra, 2);
+  EXPECT_LT((stage.state().load.point_mm - proxy).norm(), 1e-12);  // poses were identity
+  stage.update(at(proxy, 0), touching(2, proxy), 1e-3, poses);
+  EXPECT_FALSE(stage.state().attached);
+  EXPECT_EQ(stage.state().load.vertebra, -1);  // no ramp: released at once
+}
+
+TEST(CompliantStage, SpringLoadsTheSpineScaledAndTheHandFeelsItsReaction) {
+  Column col;
+  const double k_spine = 20;  // N/mm
+  LinearSpine spine(k_spine);
+  sh::CouplingParameters p;
+  p.stiffness_n_per_mm = 0.2;
+  p.force_scale = 50;
+  p.ramp_s = 0.1;
+  sh::CompliantStage stage(spine, col.centres, col.body_of, p);
+  sh::ScenePoses poses;
+  const Vector3d hook = col.centres[0] + Vector3d(0, 0, 5);
+  stage.update(at(hook, 0), touching(0, hook), 1e-3, poses);
+  stage.update(at(hook, 1), touching(0, hook), 1e-3, poses);
+  // Pull 10 mm forward and hold: the gain ramps to 1 over 0.1 s, then the spring and the spine
+  // settle where k_c·s·(probe − hook) = k_spine·(hook − hook0), hook − hook0 = d.
+  const Vector3d pull = hook + Vector3d(0, 0, 10);
+  double last_gain = 0;
+  for (int k = 0; k < 400; ++k) {
+    stage.update(at(pull, 1), sh::RenderOutput{}, 1e-3, poses);
+    EXPECT_GE(stage.state().gain, last_gain);
+    last_gain = stage.state().gain;
+  }
+  EXPECT_DOUBLE_EQ(stage.state().gain, 1.0);
+  const double ks = p.stiffness_n_per_mm * p.force_scale;  // 10 N/mm on the spine
+  const double d = ks * 10 / (ks + k_spine);               // series springs
+  EXPECT_NEAR(stage.state().hook_mm.z() - hook.z(), d, 1e-6);
+  EXPECT_NEAR(stage.state().load.force_n.z(), k_spine * d, 1e-4);
+  EXPECT_LT((stage.state().felt_force_n + stage.state().load.force_n / p.force_scale).norm(),
+            1e-12);
+  // The vertebra below moved half as far (the linear spine's rule), through the poses.
+  EXPECT_NEAR(poses.pose[1].apply(col.centres[1]).z() - col.centres[1].z(), d / 2, 1e-6);
+  // With contact force c the hand feels the spring alone once hooked.
+  EXPECT_LT((stage.blend(Vector3d(1, 2, 3)) - stage.state().felt_force_n).norm(), 1e-12);
+  // Release: the gain ramps down to zero, the spine returns.
+  for (int k = 0; k < 200; ++k) stage.update(at(pull, 0), sh::RenderOutput{}, 1e-3, poses);
+  EXPECT_EQ(stage.state().gain, 0.0);
+  EXPECT_LT((poses.pose[0].t).norm(), 1e-12);
+}
+
+TEST(CompliantStage, SpineForceIsClampedToWhatTheResponseAnswersFor) {
+  Column col;
+  LinearSpine spine(1e6, 100);  // rigid, 100 N at most
+  sh::CouplingParameters p;
+  p.ramp_s = 0;
+  p.force_scale = 1000;
+  sh::CompliantStage stage(spine, col.centres, col.body_of, p);
+  sh::ScenePoses poses;
+  const Vector3d hook = col.centres[5];
+  stage.update(at(hook, 0), touching(5, hook), 1e-3, poses);
+  stage.update(at(hook, 1), touching(5, hook), 1e-3, poses);
+  stage.update(at(hook + Vector3d(30, 0, 0), 1), sh::RenderOutput{}, 1e-3, poses);
+  EXPECT_TRUE(stage.state().clamped);
+  EXPECT_NEAR(stage.state().load.force_n.norm(), 100, 1e-9);
+  EXPECT_NEAR(stage.state().felt_force_n.norm(), 0.1, 1e-12);
+}
+
+TEST(CompliantStage, BadCouplingIsRefused) {
+  Column col;
+  LinearSpine spine(10);
+  sh::CouplingParameters p;
+  p.stiffness_n_per_mm = 0;
+  EXPECT_THROW(sh::CompliantStage(spine, col.centres, col.body_of, p), std::invalid_argument);
+  p = sh::CouplingParameters();
+  p.force_scale = -1;
+  EXPECT_THROW(sh::CompliantStage(spine, col.centres, col.body_of, p), std::invalid_argument);
+  auto missing = col.body_of;
+  missing[4] = -1;
+  EXPECT_THROW(sh::CompliantStage(spine, col.centres, missing, sh::CouplingParameters()),
+               std::invalid_argument);
+}
+
+TEST(CompliantStage, ClosedLoopDragMovesTheVertebraWithoutAllocating) {
+  Column col;
+  LinearSpine spine(20);
+  const auto& caps = sh::device_model("touch");
+  // The hand comes down onto T1's box from the front, presses the button, pulls forward 20 mm.
+  const Vector3d c = col.centres[0];
+  sh::Trajectory script;
+  script.t_s = {0, 0.3, 0.4, 1.4, 2.0};
+  script.position_mm = {c + Vector3d(0, 0, 20), c + Vector3d(0, 0, 7), c + Vector3d(0, 0, 7),
+                        c + Vector3d(0, 0, 27), c + Vector3d(0, 0, 27)};
+  script.buttons = {0, 0, 1, 1, 1};
+  auto device = sh::make_sim_device(script, caps, 1e-3);
+  device->open();
+  sh::ProxyParameters pp;
+  pp.radius_mm = 3;
+  sh::SphereProxyRenderer proxy(pp);
+  sh::TripleBuffer<sh::ScenePoses> poses{sh::ScenePoses{}};
+  sh::ServoOptions so;
+  so.duration_s = 3;
+  sh::ServoLoop loop(*device, proxy, col.scene, poses, sh::SafetyOptions::for_device(caps), so);
+  sh::CouplingParameters p;
+  p.stiffness_n_per_mm = 0.2;
+  p.force_scale = 100;
+  sh::CompliantStage stage(spine, col.centres, col.body_of, p);
+  loop.set_compliant_stage(&stage);
+  loop.record_to([](const sh::TickRecord*, std::size_t) {}, 4096);
+  long allocations = 0;
+  {
+    sh::testing::CountAllocations count;
+    for (int k = 1; k <= 2000; ++k) {
+      sh::ScenePoses fresh;
+      fresh.time_s = k * 1e-3;
+      poses.write(fresh);
+      loop.tick(k * 1e-3, 1e-3);
+    }
+    allocations = count.allocations();
+  }
+  EXPECT_EQ(allocations, 0);
+  const sh::HookState& h = stage.state();
+  ASSERT_TRUE(h.attached);
+  EXPECT_EQ(h.load.vertebra, 0);
+  EXPECT_GT(h.hook_mm.z() - c.z(), 2.0);  // T1 came forward
+  EXPECT_GT(h.load.force_n.z(), 40.0);    // pulled by the scaled spring
+  EXPECT_LT(std::abs(h.load.force_n.x()), 1e-6 * h.load.force_n.norm() + 1e-9);
+  EXPECT_GT(loop.passivity().minimum_mj(), -1.0);  // the coupling injected no energy
+}
+
+TEST(MultirateSpine, LocalModelReproducesItsSolveAndPredictsANearbyOne) {
+  const sp::SpineModel m = sp::load_spine_model(SPINESIM_DATA_DIR);
+  sh::MultirateOptions o;
+  sh::MultirateSpine spine(m, o);
+  sh::HookLoad load;
+  load.vertebra = 0;
+  load.point_mm = m.vertebrae[0].centre_mm + Vector3d(0, 5, -40);
+  load.force_n = Vector3d(0, 0, 150);
+  const sh::LocalSpineModel local = spine.solve(load);
+  // Its solve, directly: the relative displacement is solve − gravity.
+  sp::ExternalLoad l;
+  l.vertebra = 0;
+  l.force_n = load.force_n;
+  l.has_point = true;
+  l.point_mm = load.point_mm;
+  const sp::SpineSolution direct = sp::solve_spine(m, {l}, o.solve);
+  EXPECT_LT((local.relative - (direct.displacement - spine.baseline())).cwiseAbs().maxCoeff(),
+            1e-9);
+  // The worker publishes it; predict() at F0 returns it, at F0 + ΔF follows the sensitivity.
+  spine.start();
+  sh::SpineDisplacement d;
+  for (int k = 0; k < 5000; ++k) {
+    spine.predict(load, d);
+    if (d.cwiseAbs().maxCoeff() > 0) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  spine.stop();
+  EXPECT_LT((d - local.relative).cwiseAbs().maxCoeff(), 1e-9);
+  EXPECT_GE(spine.stats().solves, 1);
+  EXPECT_GT(local.relative(0, 2), 1.0);  // T1 comes forward by millimetres under 150 N
+}
