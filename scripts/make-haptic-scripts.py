@@ -8,7 +8,11 @@ The trajectories are set-points of the simulated hand (t_s, x_mm, y_mm, z_mm, bu
 scene frame (x lateral, y up, z anterior), for a probe of radius 4 mm:
   stroke_spinous.csv  down the spinous process tips T1 -> L5, the set-point 2 mm into them;
   press_lumbar.csv    each lumbar body pressed 3 mm from the front, held, released;
-  press_plane.csv     the plane scene (z = 0, normal +z) pressed 3 mm at two spots.
+  press_plane.csv     the plane scene (z = 0, normal +z) pressed 3 mm at two spots;
+  drag_t1_{lateral,sagittal,oblique}.csv  the compliant stage (thesis 4.5, 6.3): the hand comes to
+                      T1's spinous tip from behind, presses the button there, drags T1 40 mm
+                      (to the left, backwards, or left-up-backwards), holds, brings it back and
+                      lets go.
 """
 import os
 import sys
@@ -30,8 +34,10 @@ def write(path, header, rows):
         f.write("# spinesim haptic script (scripts/make-haptic-scripts.py): " + header + "\n")
         f.write("# units: s, mm; frame x lateral (right = -x), y superior, z anterior; probe radius 4 mm\n")
         f.write("t_s,x_mm,y_mm,z_mm,button\n")
-        for t, x, y, z in rows:
-            f.write(f"{t:.3f},{x:.3f},{y:.3f},{z:.3f},0\n")
+        for row in rows:
+            t, x, y, z = row[:4]
+            button = row[4] if len(row) > 4 else 0
+            f.write(f"{t:.3f},{x:.3f},{y:.3f},{z:.3f},{button}\n")
 
 
 def main():
@@ -70,6 +76,21 @@ def main():
             (3.0, 0.0, 0.0, 20.0), (3.5, 20.0, 10.0, 20.0), (4.5, 20.0, 10.0, RADIUS - 3.0),
             (5.5, 20.0, 10.0, RADIUS - 3.0), (6.5, 20.0, 10.0, 20.0)]
     write(os.path.join(out, "press_plane.csv"), "press the plane 3 mm at two spots", rows)
+
+    # Drags of T1 from its spinous tip: approach, press (button), drag 40 mm, hold, return, let go.
+    tip = tips[0]
+    touch = (0.0, tip[1], tip[2] - RADIUS + 1.0)
+    away = (0.0, tip[1], tip[2] - 30.0)
+    cases = {"lateral": (1.0, 0.0, 0.0), "sagittal": (0.0, 0.0, -1.0),
+             "oblique": (0.6, 0.3, -0.742)}
+    for name, d in cases.items():
+        n = sum(c * c for c in d) ** 0.5
+        far = tuple(touch[k] + 40.0 * d[k] / n for k in range(3))
+        rows = [(0.0, *away, 0), (0.8, *touch, 0), (1.0, *touch, 1), (1.5, *touch, 1),
+                (3.5, *far, 1), (4.5, *far, 1), (6.0, *touch, 1), (6.5, *touch, 0),
+                (7.5, *away, 0)]
+        write(os.path.join(out, f"drag_t1_{name}.csv"),
+              f"drag T1 {name}ly 40 mm from its spinous tip (button held 1.0-6.5 s)", rows)
 
 
 if __name__ == "__main__":

@@ -71,7 +71,8 @@ MultirateSpine::MultirateSpine(const spine::SpineModel& model, const MultirateOp
 
 MultirateSpine::~MultirateSpine() { stop(); }
 
-LocalSpineModel MultirateSpine::solve(const HookLoad& load) const {
+LocalSpineModel MultirateSpine::solve(const HookLoad& load, const LocalSpineModel* previous,
+                                      bool full) const {
   spine::ExternalLoad l;
   l.vertebra = load.vertebra;
   l.force_n = load.force_n;
@@ -84,13 +85,26 @@ LocalSpineModel MultirateSpine::solve(const HookLoad& load) const {
   out.point_mm = load.point_mm;
   out.force_n = load.force_n;
   out.relative = s.displacement - baseline_;
-  out.sensitivity = spine::displacement_sensitivity(model_, loads, s, 0, options_.solve,
-                                                    options_.sensitivity_step_n);
+  if (previous && !full) {
+    // Broyden: the smallest change of S that maps the last force step onto the last response
+    // step.
+    out.sensitivity = previous->sensitivity;
+    const Eigen::Vector3d dF = load.force_n - previous->force_n;
+    if (dF.squaredNorm() > 1e-6) {
+      Eigen::Matrix<double, 6 * kSpineVertebrae, 1> dd;
+      for (int i = 0; i < kSpineVertebrae; ++i)
+        dd.segment<6>(6 * i) = (out.relative.row(i) - previous->relative.row(i)).transpose();
+      out.sensitivity += (dd - out.sensitivity * dF) * dF.transpose() / dF.squaredNorm();
+    }
+    return out;
+  }
+  out.sensitivity = spine::displacement_sensitivity(
+      model_, loads, s, 0, options_.solve, options_.sensitivity_step_n,
+      full ? spine::SensitivityMethod::automatic : spine::SensitivityMethod::fixed_muscles);
   return out;
 }
 
 void MultirateSpine::predict(const HookLoad& load, SpineDisplacement& relative) {
-  request_.write(load);
   const LocalSpineModel& m = model_out_.read();
   if (load.vertebra < 0 || m.vertebra != load.vertebra || m.point_mm != load.point_mm) {
     relative.setZero();
@@ -116,7 +130,8 @@ void MultirateSpine::stop() {
 
 void MultirateSpine::run() {
   HookLoad last;
-  std::int64_t sequence = 0;
+  LocalSpineModel model;
+  std::int64_t sequence = 0, since_full = 0;
   Timer clock;
   while (!stop_.load()) {
     const HookLoad load = request_.read();
@@ -125,12 +140,18 @@ void MultirateSpine::run() {
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
       continue;
     }
+    const bool same_hook = model.vertebra == load.vertebra && model.point_mm == load.point_mm;
+    const bool recruited = options_.solve.recruit && !model_.muscles.empty();
+    // A new hook: one solve and the cheap derivative first, so the spine gives at once.
+    const bool full = same_hook && (!recruited || since_full >= options_.full_sensitivity_every);
     Timer t;
     try {
-      LocalSpineModel m = solve(load);
-      m.solve = ++sequence;
-      m.solved_at_s = clock.seconds();
-      model_out_.write(m);
+      model = solve(load, same_hook ? &model : nullptr, full);
+      since_full = full ? 0 : since_full + 1;
+      if (!same_hook) since_full = options_.full_sensitivity_every;  // full next time
+      model.solve = ++sequence;
+      model.solved_at_s = clock.seconds();
+      model_out_.write(model);
       ++stats_.solves;
       last = load;
     } catch (const std::exception& e) {
@@ -184,24 +205,54 @@ void CompliantStage::update(const DeviceState& device, const RenderOutput& last,
     s.felt_force_n.setZero();
     s.clamped = false;
   } else {
-    const int body = body_of_[std::size_t(s.load.vertebra)];
-    s.hook_mm = poses.pose[std::size_t(body)].apply(s.load.point_mm);
-    const Eigen::Vector3d hook_velocity =
-        dt_s > 0 ? Eigen::Vector3d((s.hook_mm - last_hook_mm_) / dt_s) : Eigen::Vector3d::Zero();
-    last_hook_mm_ = s.hook_mm;
-    Eigen::Vector3d spring = s.gain * p_.stiffness_n_per_mm * (device.position_mm - s.hook_mm);
-    Eigen::Vector3d spine_force = p_.force_scale * spring;
+    const double spring = s.gain * p_.force_scale * p_.stiffness_n_per_mm;  // on the spine, N/mm
+    Eigen::Vector3d spine_force = equilibrium_force(device.position_mm, spring);
     const double most = response_.max_force_n();
     s.clamped = !(spine_force.norm() <= most);
     if (s.clamped) spine_force *= most / spine_force.norm();
     if (!spine_force.allFinite()) spine_force.setZero();
     s.load.force_n = spine_force;
+    s.hook_mm = hook_at(spine_force);
+    const Eigen::Vector3d hook_velocity =
+        dt_s > 0 ? Eigen::Vector3d((s.hook_mm - last_hook_mm_) / dt_s) : Eigen::Vector3d::Zero();
+    last_hook_mm_ = s.hook_mm;
     s.felt_force_n = -spine_force / p_.force_scale -
                      s.gain * p_.damping_n_s_per_mm * (device.velocity_mm_s - hook_velocity);
   }
   response_.predict(s.load, relative_);
+  response_.publish(s.load);
   absolute_ = response_.baseline() + relative_;
   relative_poses(centres_, response_.baseline(), absolute_, body_of_, poses);
+}
+
+Eigen::Vector3d CompliantStage::hook_at(const Eigen::Vector3d& force) {
+  HookLoad load = state_.load;
+  load.force_n = force;
+  response_.predict(load, relative_);
+  const int v = load.vertebra;
+  const auto& base = response_.baseline();
+  const spine::Pose a = pose_of(centres_[std::size_t(v)], base.row(v));
+  const spine::Pose b = pose_of(centres_[std::size_t(v)], base.row(v) + relative_.row(v));
+  return b.apply(a.R.transpose() * (load.point_mm - a.t));
+}
+
+Eigen::Vector3d CompliantStage::equilibrium_force(const Eigen::Vector3d& probe_mm,
+                                                  double spring_n_per_mm) {
+  // g(F) = F − c (probe − hook(F)) = 0 from the last tick's force; the hook point in the
+  // response's reference posture is load.point_mm, carried by the vertebra's relative motion.
+  Eigen::Vector3d F = state_.load.force_n;
+  if (!F.allFinite()) F.setZero();
+  const double delta = 1.0;  // N, the Jacobian's difference step
+  for (int it = 0; it < 3; ++it) {
+    const Eigen::Vector3d h0 = hook_at(F);
+    const Eigen::Vector3d g = F - spring_n_per_mm * (probe_mm - h0);
+    if (g.norm() < 1e-3) break;
+    Eigen::Matrix3d J = Eigen::Matrix3d::Identity();
+    for (int a = 0; a < 3; ++a)
+      J.col(a) += spring_n_per_mm * (hook_at(F + delta * Eigen::Vector3d::Unit(a)) - h0) / delta;
+    F -= J.partialPivLu().solve(g);
+  }
+  return F;
 }
 
 Eigen::Vector3d CompliantStage::blend(const Eigen::Vector3d& contact_force_n) const {

@@ -163,7 +163,13 @@ void ServoLoop::tick(double now_s, double period_s) {
   status.body = out.body;
   status.buttons = state_.buttons;
   status.passivity_mj = passivity_.energy_mj();
-  if (stage_) status.hook = stage_->state();
+  if (stage_) {
+    const HookState& h = stage_->state();
+    status.hook = h;
+    st.hooked_ticks += h.attached;
+    st.spine_clamped_ticks += h.clamped;
+    st.max_spine_force_n = std::max(st.max_spine_force_n, h.load.force_n.norm());
+  }
   status_.write(status);
 
   if (!ring_.empty()) {
@@ -174,6 +180,7 @@ void ServoLoop::tick(double now_s, double period_s) {
     } else {
       TickRecord& r = ring_[head];
       r.t_s = now_s;
+      r.tick = st.ticks;
       r.probe_mm = state_.position_mm;
       r.force_n = force;
       r.proxy_mm = out.proxy_mm;

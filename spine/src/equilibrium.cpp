@@ -560,7 +560,8 @@ SpineSolution solve_spine(const SpineModel& m, const std::vector<ExternalLoad>& 
 DisplacementSensitivity displacement_sensitivity(const SpineModel& m,
                                                  const std::vector<ExternalLoad>& loads,
                                                  const SpineSolution& solution, int load,
-                                                 const SolveOptions& o, double step_n) {
+                                                 const SolveOptions& o, double step_n,
+                                                 SensitivityMethod method) {
   if (load < 0 || load >= int(loads.size()))
     throw std::invalid_argument("displacement_sensitivity: load index out of range");
   if (!(step_n > 0)) throw std::invalid_argument("displacement_sensitivity: step must be > 0");
@@ -572,7 +573,7 @@ DisplacementSensitivity displacement_sensitivity(const SpineModel& m,
       d.segment<6>(6 * i) = s.displacement.row(i).transpose();
     return d;
   };
-  if (o.recruit && !m.muscles.empty()) {
+  if (o.recruit && !m.muscles.empty() && method == SensitivityMethod::automatic) {
     DisplacementSensitivity S(rows, 3);
     const VectorXd d0 = column(solution);
     for (int a = 0; a < 3; ++a) {

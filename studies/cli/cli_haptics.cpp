@@ -77,9 +77,18 @@ void run_haptics_cli(HapticsArgs& a) {
         a.request, data_dir(),
         [live](const haptics::ServoStatus& s) {
           if (!live) return;
-          std::fprintf(stderr, "\r  t %6.1f s | %6.1f Hz | force %5.2f N | %s        ", s.time_s,
-                       s.time_s > 0 ? double(s.ticks) / s.time_s : 0.0, s.force_n.norm(),
-                       s.contact ? "contact" : "free   ");
+          if (s.hook.attached || s.hook.gain > 0)
+            std::fprintf(stderr,
+                         "\r  t %6.1f s | %6.1f Hz | force %5.2f N | hooked %s, spine %6.1f N  ",
+                         s.time_s, s.time_s > 0 ? double(s.ticks) / s.time_s : 0.0,
+                         s.force_n.norm(),
+                         spine::vertebra_names()[std::size_t(std::max(0, s.hook.load.vertebra))]
+                             .c_str(),
+                         s.hook.load.force_n.norm());
+          else
+            std::fprintf(stderr, "\r  t %6.1f s | %6.1f Hz | force %5.2f N | %s        ",
+                         s.time_s, s.time_s > 0 ? double(s.ticks) / s.time_s : 0.0,
+                         s.force_n.norm(), s.contact ? "contact" : "free   ");
           std::fflush(stderr);
         },
         [&bar](int done, int) {
@@ -173,6 +182,22 @@ void register_haptics(CLI::App& app) {
                   "(0: sleep only; steadier periods on virtual machines for some CPU)")
       ->capture_default_str();
   run->add_flag("--no-realtime", a->no_realtime, "Do not ask for real-time (SCHED_FIFO) priority");
+  run->add_option("--spine", a->request.spine,
+                  "Compliant stage (--scene spine): press the stylus button on a vertebra to drag "
+                  "it; multirate (equilibrium solves in a worker + their sensitivity) or database "
+                  "(the thesis's displacement-force polynomials)");
+  run->add_option("--database", a->request.database,
+                  "--spine database: the database file (default data/spine/displacement_db.json)");
+  run->add_option("--force-scale", a->request.force_scale,
+                  "Spine force per felt force, N/N (default: 600 N on the spine at the device's "
+                  "peak force)");
+  run->add_option("--coupling-stiffness", a->request.coupling_stiffness_n_per_mm,
+                  "Felt stiffness of the hook spring, N/mm (default: the rendering stiffness)");
+  run->add_option("--coupling-damping", a->request.coupling_damping_n_s_per_mm,
+                  "Felt damping of the hook spring, N*s/mm")
+      ->capture_default_str();
+  run->add_flag("--no-recruit{false}", a->request.spine_recruit,
+                "--spine multirate: passive spine solves (muscles off)");
   add_output_flags(run, a->json, a->quiet);
   run->callback([a] { run_haptics_cli(*a); });
 

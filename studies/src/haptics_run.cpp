@@ -1,12 +1,13 @@
 #include "spinesim/studies/haptics_run.hpp"
 
 #include "spinesim/common/atomic_file.hpp"
-#include "spinesim/common/pending_output.hpp"
 #include "spinesim/common/timer.hpp"
+#include "spinesim/haptics/compliant_stage.hpp"
 #include "spinesim/haptics/renderer.hpp"
 #include "spinesim/mesh/vertebra_geometry.hpp"
 #include "spinesim/studies/files.hpp"
 #include "spinesim/studies/format.hpp"
+#include "spinesim/studies/haptic_recording.hpp"
 #include "spinesim/studies/table.hpp"
 
 #include <cmath>
@@ -17,7 +18,6 @@
 #include <sstream>
 #include <stdexcept>
 
-#include <unistd.h>
 
 namespace spinesim::studies {
 
@@ -63,17 +63,31 @@ void check_request(const HapticsRunRequest& r) {
     throw std::invalid_argument("--replay is for --device replay");
   if (r.device != "sim" && !r.script.empty())
     throw std::invalid_argument("--script is for --device sim");
+  if (!r.spine.empty() && r.spine != "multirate" && r.spine != "database")
+    throw std::invalid_argument("--spine " + r.spine + ": give multirate or database");
+  if (!r.spine.empty() && r.scene.scene != "spine")
+    throw std::invalid_argument("--spine needs --scene spine (the compliant stage drags the spine)");
+  if (r.spine.empty() && (r.force_scale != 0 || r.coupling_stiffness_n_per_mm != 0 ||
+                          !r.database.empty()))
+    throw std::invalid_argument(
+        "--force-scale, --coupling-stiffness and --database are for --spine multirate|database");
+  if (!(r.force_scale >= 0) || !std::isfinite(r.force_scale))
+    throw std::invalid_argument("--force-scale must be > 0 (0: the default)");
+  if (!(r.coupling_stiffness_n_per_mm >= 0) || !std::isfinite(r.coupling_stiffness_n_per_mm) ||
+      !(r.coupling_damping_n_s_per_mm >= 0) || !std::isfinite(r.coupling_damping_n_s_per_mm))
+    throw std::invalid_argument("--coupling-stiffness and --coupling-damping must be >= 0");
+  if (!r.spine.empty() && r.force_scale > 0) {
+    // Both responses answer for the thesis's validated 600 N (3.3.5).
+    const double peak = haptics::device_model(r.model).peak_force_n;
+    if (r.force_scale * peak > 600 * (1 + 1e-9))
+      throw std::invalid_argument("--force-scale " + fixed(r.force_scale, 1) + " puts " +
+                                  fixed(r.force_scale * peak, 0) +
+                                  " N on the spine at the device's peak force, beyond the 600 N "
+                                  "the spine answers for");
+  }
   if (!r.record.empty()) require_output_folder(r.record, "--record");
   if (!r.write_scene.empty() && !fs::is_directory(r.write_scene))
     throw std::invalid_argument("--write-scene " + r.write_scene + ": not an existing folder");
-}
-
-void write_record_header(std::ostream& os, const HapticsRunRequest& r) {
-  os << "# spinesim haptics run: every servo tick; device " << r.device << ", renderer "
-     << r.renderer << ", probe radius " << r.probe_radius_mm << " mm\n"
-     << "# units: s, mm, N; frame x lateral (right = -x), y superior, z anterior. Columns 1-5 "
-        "are a trajectory (--device replay --replay FILE plays them)\n"
-     << "t_s,x_mm,y_mm,z_mm,button,fx_n,fy_n,fz_n,proxy_x_mm,proxy_y_mm,proxy_z_mm,contact\n";
 }
 
 // The renderer the request names, at the result's stiffness (samples the scene for Gao-Gibson).
@@ -115,51 +129,6 @@ std::unique_ptr<haptics::Device> make_device(const HapticsRunRequest& request,
   return haptics::map_device(std::move(vendor), R, c);
 }
 
-// The recording: rows appended by the loop's writer thread to a temporary file beside the
-// target, renamed onto it by finish() when the run has ended (a killed run leaves nothing).
-class RecordFile {
- public:
-  RecordFile(const HapticsRunRequest& request) : path_(request.record) {
-    tmp_ = path_ + ".partial-" + std::to_string(::getpid());
-    pending_ = std::make_unique<PendingOutput>(tmp_);
-    os_.open(tmp_, std::ios::trunc);
-    if (!os_) throw std::runtime_error("--record " + path_ + ": cannot write there");
-    write_record_header(os_, request);
-  }
-  ~RecordFile() {
-    if (os_.is_open()) os_.close();
-    if (pending_) std::remove(tmp_.c_str());
-  }
-  /// Appends rows (the writer thread).
-  void append(const haptics::TickRecord* rows, std::size_t n) {
-    char line[256];
-    for (std::size_t i = 0; i < n; ++i) {
-      const auto& r = rows[i];
-      std::snprintf(line, sizeof line, "%.6f,%.4f,%.4f,%.4f,%u,%.5f,%.5f,%.5f,%.4f,%.4f,%.4f,%d\n",
-                    r.t_s, r.probe_mm.x(), r.probe_mm.y(), r.probe_mm.z(), r.buttons & 1u,
-                    r.force_n.x(), r.force_n.y(), r.force_n.z(), r.proxy_mm.x(), r.proxy_mm.y(),
-                    r.proxy_mm.z(), r.contact ? 1 : 0);
-      os_ << line;
-    }
-    os_.flush();
-    rows_ += std::int64_t(n);
-  }
-  std::int64_t rows() const { return rows_; }
-  void finish() {
-    os_.close();
-    if (!os_) throw std::runtime_error("--record " + path_ + ": write failed (disk full?)");
-    if (std::rename(tmp_.c_str(), path_.c_str()) != 0)
-      throw std::runtime_error("--record " + path_ + ": cannot replace the file");
-    pending_.reset();
-  }
-
- private:
-  std::string path_, tmp_;
-  std::unique_ptr<PendingOutput> pending_;
-  std::ofstream os_;
-  std::int64_t rows_ = 0;
-};
-
 // The scene's summary into the result, and its surfaces written when asked.
 void describe_scene(const HapticsRunRequest& request, const HapticScene& scene,
                     HapticsRunResult* result) {
@@ -175,6 +144,73 @@ void describe_scene(const HapticsRunRequest& request, const HapticScene& scene,
                     mesh::TriSurface{tree.vertices(), tree.triangles()},
                     scene.scene.body(i).name + " (" + scene.sources[std::size_t(i)] +
                         ") at the reference posture");
+  }
+}
+
+// The compliant stage of a request: the spine model, the response and the stage.
+struct CompliantSetup {
+  std::unique_ptr<spine::SpineModel> model;
+  std::unique_ptr<spine::DisplacementDatabase> database;
+  std::unique_ptr<haptics::SpineResponse> response;
+  std::unique_ptr<haptics::CompliantStage> stage;
+};
+
+CompliantSetup make_compliant_stage(const HapticsRunRequest& request, const std::string& data_dir,
+                                    const haptics::Scene& scene, HapticsRunResult& result) {
+  CompliantSetup c;
+  c.model = std::make_unique<spine::SpineModel>(spine::load_spine_model(data_dir));
+  if (request.spine == "database") {
+    const std::string path = request.database.empty()
+                                 ? (fs::path(data_dir) / "spine" / "displacement_db.json").string()
+                                 : request.database;
+    c.database =
+        std::make_unique<spine::DisplacementDatabase>(spine::DisplacementDatabase::load(path));
+    c.response = std::make_unique<haptics::DatabaseResponse>(*c.database);
+  } else {
+    haptics::MultirateOptions o;
+    o.solve.recruit = request.spine_recruit;
+    c.response = std::make_unique<haptics::MultirateSpine>(*c.model, o);
+  }
+  const double peak = result.capabilities.peak_force_n;
+  const double most = c.response->max_force_n();
+  haptics::CouplingParameters p;
+  p.force_scale = request.force_scale > 0 ? request.force_scale : most / peak;
+  if (p.force_scale * peak > most * (1 + 1e-9))
+    throw std::invalid_argument(
+        "--force-scale " + fixed(p.force_scale, 1) + " puts " + fixed(p.force_scale * peak, 0) +
+        " N on the spine at the device's peak force, beyond the " + fixed(most, 0) +
+        " N the " + request.spine + " spine answers for");
+  p.stiffness_n_per_mm = request.coupling_stiffness_n_per_mm > 0
+                             ? request.coupling_stiffness_n_per_mm
+                             : result.stiffness_n_per_mm;
+  if (p.stiffness_n_per_mm > result.passive_limit_n_per_mm)
+    throw std::invalid_argument("--coupling-stiffness " + fixed(p.stiffness_n_per_mm, 2) +
+                                " N/mm is beyond the device's passive limit (" +
+                                fixed(result.passive_limit_n_per_mm, 2) + " N/mm)");
+  p.damping_n_s_per_mm = request.coupling_damping_n_s_per_mm;
+  std::vector<Eigen::Vector3d> centres;
+  std::array<int, haptics::kSpineVertebrae> body_of{};
+  for (int i = 0; i < haptics::kSpineVertebrae; ++i) {
+    centres.push_back(c.model->vertebrae[std::size_t(i)].centre_mm);
+    body_of[std::size_t(i)] = scene.index(spine::vertebra_names()[std::size_t(i)]);
+  }
+  c.stage = std::make_unique<haptics::CompliantStage>(*c.response, centres, body_of, p);
+  result.spine = request.spine;
+  result.force_scale = p.force_scale;
+  result.coupling_stiffness_n_per_mm = p.stiffness_n_per_mm;
+  result.spine_max_force_n = most;
+  return c;
+}
+
+void finish_compliant(CompliantSetup& c, HapticsRunResult* result) {
+  c.response->stop();
+  if (auto* m = dynamic_cast<haptics::MultirateSpine*>(c.response.get())) {
+    const auto& st = m->stats();
+    result->worker_solves = st.solves;
+    result->worker_failures = st.failures;
+    result->worker_update_ms = 1e3 * st.mean_update_s;
+    result->worker_rate_hz = st.mean_update_s > 0 ? 1.0 / st.mean_update_s : 0;
+    result->worker_error = st.last_error;
   }
 }
 
@@ -222,12 +258,22 @@ HapticsRunResult run_haptics(const HapticsRunRequest& request, const std::string
   options.spin_us = request.spin_us;
   haptics::ServoLoop loop(*device, *renderer, scene.scene, poses,
                           haptics::SafetyOptions::for_device(result.capabilities), options);
-  std::unique_ptr<RecordFile> record;
+  CompliantSetup compliant;
+  if (!request.spine.empty()) {
+    compliant = make_compliant_stage(request, data_dir, scene.scene, result);
+    loop.set_compliant_stage(compliant.stage.get());
+    compliant.response->start();
+  }
+  std::unique_ptr<HapticRecordingWriter> record;
   if (!request.record.empty()) {
-    record = std::make_unique<RecordFile>(request);
-    loop.record_to(
-        [&record](const haptics::TickRecord* rows, std::size_t n) { record->append(rows, n); },
-        1 << 16);
+    std::ostringstream what;
+    what << "device " << request.device << ", renderer " << request.renderer << ", probe radius "
+         << request.probe_radius_mm << " mm";
+    record = std::make_unique<HapticRecordingWriter>(request.record, what.str(),
+                                                     compliant.model.get(), request.spine);
+    loop.record_to([&record](const haptics::TickRecord* rows,
+                             std::size_t n) { record->append(rows, n); },
+                   1 << 13);
   }
 
   int calls = 0;
@@ -239,6 +285,7 @@ HapticsRunResult run_haptics(const HapticsRunRequest& request, const std::string
     if (status && ++calls % 10 == 0) status(s);
   });
   device->close();
+  if (compliant.response) finish_compliant(compliant, &result);
   if (request.stop && request.stop->load()) result.stats.stop_reason = "interrupted";
   if (result.stats.error && !device->last_error().empty())
     result.stats.stop_reason += ": " + device->last_error();
@@ -288,7 +335,22 @@ nlohmann::json haptics_run_json(const HapticsRunResult& r) {
           {"spin_us", r.request.spin_us},
           {"stop_reason", s.stop_reason},
           {"record", r.request.record},
-          {"recorded_rows", r.recorded_rows}};
+          {"recorded_rows", r.recorded_rows},
+          {"compliant_stage",
+           r.spine.empty()
+               ? nlohmann::json()
+               : nlohmann::json{{"spine", r.spine},
+                                {"force_scale", r.force_scale},
+                                {"coupling_stiffness_n_per_mm", r.coupling_stiffness_n_per_mm},
+                                {"spine_max_force_n", r.spine_max_force_n},
+                                {"hooked_ticks", s.hooked_ticks},
+                                {"max_spine_force_n", s.max_spine_force_n},
+                                {"spine_clamped_ticks", s.spine_clamped_ticks},
+                                {"worker_solves", r.worker_solves},
+                                {"worker_failures", r.worker_failures},
+                                {"worker_update_ms", r.worker_update_ms},
+                                {"worker_rate_hz", r.worker_rate_hz},
+                                {"worker_error", r.worker_error}}}};
 }
 
 std::string haptics_run_table(const HapticsRunResult& r) {
@@ -320,6 +382,16 @@ std::string haptics_run_table(const HapticsRunResult& r) {
      << s.fading_ticks << "\n"
      << "  passivity energy: min " << fixed(s.passivity_min_mj, 3) << " mJ, final "
      << fixed(s.passivity_final_mj, 3) << " mJ\n";
+  if (!r.spine.empty()) {
+    os << "  spine: " << r.spine << ", force scale " << fixed(r.force_scale, 1)
+       << " (spine N per felt N), coupling " << fixed(r.coupling_stiffness_n_per_mm, 2)
+       << " N/mm; hooked " << s.hooked_ticks << " ticks, spine force max "
+       << fixed(s.max_spine_force_n, 1) << " N (clamped " << s.spine_clamped_ticks << ")\n";
+    if (r.spine == "multirate")
+      os << "  worker: " << r.worker_solves << " updates, " << fixed(r.worker_update_ms, 1)
+         << " ms each (" << fixed(r.worker_rate_hz, 1) << " Hz), " << r.worker_failures
+         << " failed" << (r.worker_error.empty() ? "" : ": " + r.worker_error) << "\n";
+  }
   if (!r.request.record.empty())
     os << "  recorded " << r.recorded_rows << " ticks to " << r.request.record << "\n";
   return os.str();

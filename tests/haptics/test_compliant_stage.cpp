@@ -262,6 +262,7 @@ TEST(MultirateSpine, LocalModelReproducesItsSolveAndPredictsANearbyOne) {
             1e-9);
   // The worker publishes it; predict() at F0 returns it, at F0 + ΔF follows the sensitivity.
   spine.start();
+  spine.publish(load);
   sh::SpineDisplacement d;
   for (int k = 0; k < 5000; ++k) {
     spine.predict(load, d);

@@ -62,8 +62,11 @@ class SpineResponse {
   virtual ~SpineResponse() = default;
   virtual const char* name() const = 0;
   /// Displacement of every vertebra relative to gravity alone under `load` (zero for no load).
-  /// Called in the servo tick: no allocation, no lock, no wait.
+  /// Called in the servo tick, several times (the stage solves for the force that is in
+  /// equilibrium with its spring): no allocation, no lock, no wait.
   virtual void predict(const HookLoad& load, SpineDisplacement& relative) = 0;
+  /// The tick's final load, once per tick (a worker solves for it).
+  virtual void publish(const HookLoad&) {}
   /// The absolute displacement under gravity alone (what `relative` is relative to).
   virtual const SpineDisplacement& baseline() const = 0;
   /// Largest hook force (N) this answers for; the stage clamps the force to it.
@@ -105,12 +108,18 @@ struct MultirateOptions {
   double max_force_n = 600;   ///< the thesis's validated range (3.3.5)
   /// Forward-difference step of the sensitivity (spine::displacement_sensitivity), N.
   double sensitivity_step_n = 5;
+  /// With recruitment, the full sensitivity (three extra solves) every this many updates; in
+  /// between, Broyden's secant update from consecutive solves keeps it current at one solve per
+  /// update.
+  int full_sensitivity_every = 8;
 };
 
-/// The worker: solve at the latest hook load, differentiate, publish, repeat. It idles while
-/// there is no hook. predict() uses the latest model when it was made for the same vertebra and
-/// hook point; before the first one arrives for a new hook it predicts no motion (the hook's force
-/// ramps up from zero over the first ~0.3 s, several solves' time).
+/// The worker: solve at the latest hook load, update the sensitivity, publish, repeat. It idles
+/// while there is no hook. A new hook starts from one solve and the fixed-muscle derivative
+/// (cheap, too compliant with recruitment), then the full sensitivity, then secant updates.
+/// predict() uses the latest model when it was made for the same vertebra and hook point; before
+/// the first one arrives for a new hook it predicts no motion (the hook's force ramps up from
+/// zero over ~0.3 s).
 class MultirateSpine final : public SpineResponse {
  public:
   /// Solves the gravity-only baseline here (throws spine::SolveError if it fails).
@@ -118,6 +127,7 @@ class MultirateSpine final : public SpineResponse {
   ~MultirateSpine() override;
   const char* name() const override { return "multirate"; }
   void predict(const HookLoad& load, SpineDisplacement& relative) override;
+  void publish(const HookLoad& load) override { request_.write(load); }
   const SpineDisplacement& baseline() const override { return baseline_; }
   double max_force_n() const override { return options_.max_force_n; }
   void start() override;
@@ -131,8 +141,11 @@ class MultirateSpine final : public SpineResponse {
   };
   /// After stop().
   const Stats& stats() const { return stats_; }
-  /// One update for `load` on the calling thread (the worker's body; tests call it directly).
-  LocalSpineModel solve(const HookLoad& load) const;
+  /// One update for `load` on the calling thread (the worker's body; tests call it directly):
+  /// the solve, and the sensitivity — `previous` (same hook) updated by the secant, or new
+  /// (`full`: through whole solves; otherwise at fixed muscle forces).
+  LocalSpineModel solve(const HookLoad& load, const LocalSpineModel* previous = nullptr,
+                        bool full = true) const;
 
  private:
   void run();
@@ -174,8 +187,11 @@ class CompliantStage {
                  const std::array<int, kSpineVertebrae>& body_of, const CouplingParameters& p);
 
   /// Before the render: hooks on a button press while the last render touched a vertebra (at
-  /// the proxy's centre), updates the hook force from the previous poses, and predicts the poses
-  /// for it into `poses` (bodies of T1…L5; others untouched). No allocation.
+  /// the proxy's centre); finds the hook force F in equilibrium with the spring,
+  /// F = s·k·(probe − hook(F)) with hook(F) from the response (Newton, finite-difference 3×3
+  /// Jacobian: taking the hook from the previous tick instead is a fixed-point iteration with a
+  /// gain of s·k times the spine's compliance, ~30 at T1, and diverges); predicts the poses for
+  /// it into `poses` (bodies of T1…L5; others untouched). No allocation.
   void update(const DeviceState& device, const RenderOutput& last, double dt_s, ScenePoses& poses);
   /// After the render: the force for the hand — the rendered contact force blended with the
   /// hook spring's by the attach gain.
@@ -193,6 +209,9 @@ class CompliantStage {
   CouplingParameters p_;
   HookState state_;
   SpineDisplacement relative_ = SpineDisplacement::Zero(), absolute_;
+  /// The hook point in the world under `force` (predicts into relative_).
+  Eigen::Vector3d hook_at(const Eigen::Vector3d& force);
+  Eigen::Vector3d equilibrium_force(const Eigen::Vector3d& probe_mm, double spring_n_per_mm);
   unsigned last_buttons_ = 0;
   Eigen::Vector3d last_hook_mm_ = Eigen::Vector3d::Zero();
 };

@@ -49,6 +49,7 @@ struct ServoStatus {
 /// One recorded tick (the `--record` file's row).
 struct TickRecord {
   double t_s = 0;
+  std::int64_t tick = 0;  ///< 1, 2, … (a gap: rows the writer lost)
   Eigen::Vector3d probe_mm, force_n, proxy_mm;
   unsigned buttons = 0;
   bool contact = false;
@@ -74,6 +75,9 @@ struct ServoStats {
   double max_force_n = 0;             ///< largest commanded force
   std::int64_t clamped_ticks = 0, limited_ticks = 0, non_finite_ticks = 0, fading_ticks = 0;
   std::int64_t contact_ticks = 0, truncated_ticks = 0;
+  /// The compliant stage: ticks hooked, the largest force on the spine, ticks it was clamped.
+  std::int64_t hooked_ticks = 0, spine_clamped_ticks = 0;
+  double max_spine_force_n = 0;
   double passivity_min_mj = 0, passivity_final_mj = 0;
   bool realtime_priority = false;
   std::string realtime_reason;

@@ -120,11 +120,13 @@ using DisplacementSensitivity = Eigen::Matrix<double, Eigen::Dynamic, 3>;
 ///    solve_spine with a step of `step_n` (N) on each axis, three solves.
 /// Throws std::invalid_argument for a load index out of range or a step ≤ 0, SolveError when a
 /// differenced solve fails.
-DisplacementSensitivity displacement_sensitivity(const SpineModel& m,
-                                                 const std::vector<ExternalLoad>& loads,
-                                                 const SpineSolution& solution, int load,
-                                                 const SolveOptions& options = SolveOptions(),
-                                                 double step_n = 5.0);
+/// `fixed_muscles` forces the first method even when the muscles are recruited (a cheap first
+/// guess that overestimates the response; tests/spine measure by how much).
+enum class SensitivityMethod { automatic, fixed_muscles };
+DisplacementSensitivity displacement_sensitivity(
+    const SpineModel& m, const std::vector<ExternalLoad>& loads, const SpineSolution& solution,
+    int load, const SolveOptions& options = SolveOptions(), double step_n = 5.0,
+    SensitivityMethod method = SensitivityMethod::automatic);
 
 // --- pieces, exposed for tests and the database ---------------------------------------------
 

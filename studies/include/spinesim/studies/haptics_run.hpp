@@ -35,7 +35,14 @@ struct HapticsRunRequest {
   double probe_radius_mm = 4;
   std::string renderer = "proxy";  ///< proxy or gao-gibson
   double stiffness_n_per_mm = 0;   ///< 0: the device's usable stiffness within Colgate–Brown
-  std::string record;              ///< CSV of every tick (written whole at the end)
+  std::string record;  ///< CSV of every tick, synced to disk block by block as the loop runs
+  /// The compliant stage (scene "spine" only): "" (off), "multirate" or "database".
+  std::string spine;
+  std::string database;              ///< the database file ("": data/spine/displacement_db.json)
+  double coupling_stiffness_n_per_mm = 0;  ///< felt hook spring (0: the rendering stiffness)
+  double coupling_damping_n_s_per_mm = 0;  ///< felt, relative to the hook
+  double force_scale = 0;  ///< spine N per felt N (0: the spine's 600 N at the device's peak)
+  bool spine_recruit = true;  ///< muscles recruited in the spine solves (as the database)
   std::string write_scene;         ///< folder: each body's surface as <name>.obj (world, mm)
   bool realtime_priority = true;
   double spin_us = 400;                     ///< spin this long before each deadline (0: sleep only)
@@ -56,6 +63,12 @@ struct HapticsRunResult {
   double stiffness_n_per_mm = 0, passive_limit_n_per_mm = 0;
   haptics::ServoStats stats;
   std::int64_t recorded_rows = 0;
+  // The compliant stage (spine empty: off).
+  std::string spine;
+  double coupling_stiffness_n_per_mm = 0, force_scale = 0, spine_max_force_n = 0;
+  std::int64_t worker_solves = 0, worker_failures = 0;
+  double worker_update_ms = 0, worker_rate_hz = 0;  ///< per update (solve + sensitivity)
+  std::string worker_error;
 };
 
 /// Validates everything (device, model, files, radius, output folder) before any work, builds

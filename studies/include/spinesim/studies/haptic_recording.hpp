@@ -1,0 +1,74 @@
+// The `--record` file of `spinesim haptics run` (docs/file-formats.md "Haptic recordings"):
+// CSV, one row per servo tick, written while the loop runs — appended in blocks by the loop's
+// writer thread, each block flushed and synced to disk (fdatasync), so a run killed at any moment
+// leaves a file that reads up to its last synced block. A clean end appends the line
+// "# end: N ticks"; the reader says when it is missing.
+//
+// Columns: t_s,x_mm,y_mm,z_mm,button (a trajectory: `--device replay` plays them), the force on
+// the hand, the proxy, contact, the tick number; with the compliant stage also the hook
+// (attached, vertebra, world point, the force on the spine) and every vertebra's rigid motion
+// from the reference posture: its F.1 centre's displacement (mm) and its rotation vector (deg).
+// The header names the spine model by a fingerprint of its geometry, so a recording is never
+// replayed on another model.
+#pragma once
+
+#include "spinesim/haptics/servo.hpp"
+#include "spinesim/spine/model.hpp"
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace spinesim::studies {
+
+/// 16 hex digits (FNV-1a) over the model's vertebra centres, joint points and fused joints.
+std::string spine_model_fingerprint(const spine::SpineModel& m);
+
+class HapticRecordingWriter {
+ public:
+  /// Opens `path` (replacing a file there) and writes the header. `model` is null without the
+  /// compliant stage. Throws std::runtime_error when the file cannot be written.
+  HapticRecordingWriter(const std::string& path, const std::string& description,
+                        const spine::SpineModel* model, const std::string& response);
+  ~HapticRecordingWriter();
+  /// Appends rows, flushes and syncs them (the loop's writer thread).
+  void append(const haptics::TickRecord* rows, std::size_t n);
+  /// Appends the end line and closes; throws std::runtime_error on a failed write.
+  void finish();
+  std::int64_t rows() const { return rows_; }
+
+ private:
+  std::string path_;
+  std::FILE* file_ = nullptr;
+  std::vector<Eigen::Vector3d> centres_;
+  std::int64_t rows_ = 0;
+  bool failed_ = false;
+};
+
+/// One recorded tick of a compliant-stage run.
+struct DragFrame {
+  double t_s = 0;
+  std::int64_t tick = 0;
+  bool attached = false;
+  int hook_vertebra = -1;
+  Eigen::Vector3d probe_mm, proxy_mm, hand_force_n, hook_mm, spine_force_n;
+  /// Per vertebra T1…L5: centre displacement (mm), rotation vector (deg).
+  Eigen::Matrix<double, 17, 6> motion;
+  /// The rigid motion of vertebra i (x ↦ R x + t, reference coordinates).
+  spine::Pose pose(const spine::SpineModel& m, int i) const;
+};
+
+struct DragRecording {
+  std::string path, fingerprint, response;
+  std::vector<DragFrame> frames;
+  bool complete = false;  ///< the end line is there (false: a killed run, read to its last row)
+};
+
+/// Reads a compliant-stage recording for `model`. Throws std::invalid_argument with one line for
+/// a file that is not one (no spine columns), one from another spine model, missing ticks (a
+/// gap in the tick numbers), a bad number, a hook force beyond what the spine solve accepts
+/// (spine::kMaxForceN) or no rows. A last line cut off mid-row (a killed run) is dropped.
+DragRecording read_drag_recording(const std::string& path, const spine::SpineModel& model);
+
+}  // namespace spinesim::studies

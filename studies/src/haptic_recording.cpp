@@ -1,0 +1,230 @@
+#include "spinesim/studies/haptic_recording.hpp"
+
+#include "spinesim/common/input_file.hpp"
+#include "spinesim/spine/equilibrium.hpp"
+#include "spinesim/spine/kinematics.hpp"
+
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <sstream>
+#include <stdexcept>
+
+namespace spinesim::studies {
+
+namespace {
+
+constexpr double kRadToDeg = 180.0 / M_PI;
+constexpr int kCommonColumns = 13, kHookColumns = 8, kVertebrae = 17;
+constexpr int kDragColumns = kCommonColumns + kHookColumns + 6 * kVertebrae;
+
+void fnv(std::uint64_t& h, double v) {
+  unsigned char b[sizeof v];
+  std::memcpy(b, &v, sizeof v);
+  for (unsigned char c : b) h = (h ^ c) * 1099511628211ull;
+}
+
+}  // namespace
+
+std::string spine_model_fingerprint(const spine::SpineModel& m) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (const auto& v : m.vertebrae)
+    for (int a = 0; a < 3; ++a) fnv(h, v.centre_mm[a]);
+  for (const auto& j : m.joints) {
+    for (int a = 0; a < 3; ++a) fnv(h, j.point_mm[a]);
+    fnv(h, j.fused ? 1.0 : 0.0);
+  }
+  char out[17];
+  std::snprintf(out, sizeof out, "%016llx", static_cast<unsigned long long>(h));
+  return out;
+}
+
+HapticRecordingWriter::HapticRecordingWriter(const std::string& path,
+                                             const std::string& description,
+                                             const spine::SpineModel* model,
+                                             const std::string& response)
+    : path_(path) {
+  file_ = std::fopen(path.c_str(), "w");
+  if (!file_) throw std::runtime_error("--record " + path + ": cannot write there");
+  std::fprintf(file_,
+               "# spinesim haptics recording 1: every servo tick; %s\n"
+               "# units: s, mm, N, deg; frame x lateral (right = -x), y superior, z anterior. "
+               "Columns 1-5 are a trajectory (--device replay --replay FILE plays them)\n",
+               description.c_str());
+  if (model)
+    std::fprintf(file_,
+                 "# spine model %s; compliant stage %s; vertebra motion: the F.1 centre's "
+                 "displacement (mm) and the rotation vector (deg) from the reference posture\n",
+                 spine_model_fingerprint(*model).c_str(), response.c_str());
+  std::fprintf(file_, "t_s,x_mm,y_mm,z_mm,button,fx_n,fy_n,fz_n,proxy_x_mm,proxy_y_mm,proxy_z_mm,"
+                      "contact,tick");
+  if (model) {
+    std::fprintf(file_, ",attached,hook_vertebra,hook_x_mm,hook_y_mm,hook_z_mm,spine_fx_n,"
+                        "spine_fy_n,spine_fz_n");
+    for (const auto& v : model->vertebrae) {
+      centres_.push_back(v.centre_mm);
+      for (const char* c : {"tx_mm", "ty_mm", "tz_mm", "rx_deg", "ry_deg", "rz_deg"})
+        std::fprintf(file_, ",%s_%s", v.name.c_str(), c);
+    }
+  }
+  std::fputc('\n', file_);
+  if (std::fflush(file_) != 0) failed_ = true;
+}
+
+HapticRecordingWriter::~HapticRecordingWriter() {
+  if (file_) std::fclose(file_);
+}
+
+void HapticRecordingWriter::append(const haptics::TickRecord* rows, std::size_t n) {
+  if (!file_) return;
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto& r = rows[i];
+    std::fprintf(file_, "%.6f,%.4f,%.4f,%.4f,%u,%.5f,%.5f,%.5f,%.4f,%.4f,%.4f,%d,%lld", r.t_s,
+                 r.probe_mm.x(), r.probe_mm.y(), r.probe_mm.z(), r.buttons & 1u, r.force_n.x(),
+                 r.force_n.y(), r.force_n.z(), r.proxy_mm.x(), r.proxy_mm.y(), r.proxy_mm.z(),
+                 r.contact ? 1 : 0, static_cast<long long>(r.tick));
+    if (!centres_.empty()) {
+      const auto& h = r.hook;
+      std::fprintf(file_, ",%d,%d,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f", h.attached ? 1 : 0,
+                   h.load.vertebra, h.hook_mm.x(), h.hook_mm.y(), h.hook_mm.z(),
+                   h.load.force_n.x(), h.load.force_n.y(), h.load.force_n.z());
+      for (std::size_t v = 0; v < centres_.size(); ++v) {
+        const Eigen::Matrix3d R = r.R[v].cast<double>();
+        const Eigen::Vector3d d = R * centres_[v] + r.t[v].cast<double>() - centres_[v];
+        const Eigen::Vector3d rot = spine::rotation_log(R) * kRadToDeg;
+        std::fprintf(file_, ",%.5f,%.5f,%.5f,%.5f,%.5f,%.5f", d.x(), d.y(), d.z(), rot.x(),
+                     rot.y(), rot.z());
+      }
+    }
+    std::fputc('\n', file_);
+  }
+  rows_ += std::int64_t(n);
+  // A block on disk before the next: a killed run keeps everything up to here.
+  if (std::fflush(file_) != 0 || ::fdatasync(::fileno(file_)) != 0) failed_ = true;
+}
+
+void HapticRecordingWriter::finish() {
+  if (!file_) return;
+  std::fprintf(file_, "# end: %lld ticks\n", static_cast<long long>(rows_));
+  const bool ok = std::fflush(file_) == 0 && ::fdatasync(::fileno(file_)) == 0;
+  const bool closed = std::fclose(file_) == 0;
+  file_ = nullptr;
+  if (failed_ || !ok || !closed)
+    throw std::runtime_error("--record " + path_ + ": write failed (disk full?)");
+}
+
+spine::Pose DragFrame::pose(const spine::SpineModel& m, int i) const {
+  const Eigen::Vector3d& c = m.vertebrae[std::size_t(i)].centre_mm;
+  spine::Pose p;
+  p.R = spine::rotation_exp(motion.row(i).tail<3>().transpose() / kRadToDeg);
+  p.t = c + motion.row(i).head<3>().transpose() - p.R * c;
+  return p;
+}
+
+namespace {
+
+/// Parses one data row into `f`; false with `why` when a cell is not a finite number.
+bool parse_row(const std::string& line, DragFrame& f, std::string& why) {
+  double v[kDragColumns];
+  const char* p = line.c_str();
+  for (int k = 0; k < kDragColumns; ++k) {
+    char* end = nullptr;
+    errno = 0;
+    v[k] = std::strtod(p, &end);
+    if (end == p || !std::isfinite(v[k])) {
+      why = "column " + std::to_string(k + 1) + " is not a finite number";
+      return false;
+    }
+    p = end;
+    if (k + 1 < kDragColumns) {
+      if (*p != ',') {
+        why = "expected " + std::to_string(kDragColumns) + " columns, got " + std::to_string(k + 1);
+        return false;
+      }
+      ++p;
+    }
+  }
+  while (*p == ' ' || *p == '\r') ++p;
+  if (*p != '\0') {
+    why = "more than " + std::to_string(kDragColumns) + " columns";
+    return false;
+  }
+  f.t_s = v[0];
+  f.probe_mm = Eigen::Vector3d(v[1], v[2], v[3]);
+  f.hand_force_n = Eigen::Vector3d(v[5], v[6], v[7]);
+  f.proxy_mm = Eigen::Vector3d(v[8], v[9], v[10]);
+  f.tick = std::int64_t(v[12]);
+  f.attached = v[13] != 0;
+  f.hook_vertebra = int(v[14]);
+  f.hook_mm = Eigen::Vector3d(v[15], v[16], v[17]);
+  f.spine_force_n = Eigen::Vector3d(v[18], v[19], v[20]);
+  for (int i = 0; i < kVertebrae; ++i)
+    for (int c = 0; c < 6; ++c) f.motion(i, c) = v[kCommonColumns + kHookColumns + 6 * i + c];
+  return true;
+}
+
+}  // namespace
+
+DragRecording read_drag_recording(const std::string& path, const spine::SpineModel& model) {
+  const std::string text = read_regular_file(path, "the recording");
+  DragRecording rec;
+  rec.path = path;
+  std::istringstream in(text);
+  std::string line;
+  int line_no = 0;
+  bool header = false;
+  const std::string ours = spine_model_fingerprint(model);
+  while (std::getline(in, line)) {
+    ++line_no;
+    const std::string where = path + ":" + std::to_string(line_no);
+    // A last line without its newline is a row the killed run did not finish: dropped.
+    if (in.eof() && !text.empty() && text.back() != '\n') break;
+    if (line.rfind("# spine model ", 0) == 0) {
+      std::istringstream h(line.substr(14));
+      h >> rec.fingerprint;
+      if (!rec.fingerprint.empty() && rec.fingerprint.back() == ';') rec.fingerprint.pop_back();
+      std::string word;
+      h >> word >> word >> rec.response;
+      if (!rec.response.empty() && rec.response.back() == ';') rec.response.pop_back();
+      if (rec.fingerprint != ours)
+        throw std::invalid_argument(where + ": recorded with another spine model (fingerprint " +
+                                    rec.fingerprint + ", this model " + ours + ")");
+      continue;
+    }
+    if (line.rfind("# end:", 0) == 0) {
+      rec.complete = true;
+      continue;
+    }
+    if (line.empty() || line[0] == '#') continue;
+    if (!header) {
+      if (rec.fingerprint.empty())
+        throw std::invalid_argument(path + ": not a compliant-stage recording (no spine model "
+                                           "line: record with haptics run --spine …)");
+      header = true;
+      continue;
+    }
+    DragFrame f;
+    std::string why;
+    if (!parse_row(line, f, why)) throw std::invalid_argument(where + ": " + why);
+    if (!rec.frames.empty() && f.tick != rec.frames.back().tick + 1)
+      throw std::invalid_argument(where + ": missing frames: tick " + std::to_string(f.tick) +
+                                  " follows tick " + std::to_string(rec.frames.back().tick));
+    if (!(f.spine_force_n.norm() <= spine::kMaxForceN))
+      throw std::invalid_argument(where + ": a hook force beyond " +
+                                  std::to_string(int(spine::kMaxForceN)) +
+                                  " N, more than the spine solve accepts");
+    if (f.hook_vertebra < -1 || f.hook_vertebra >= kVertebrae)
+      throw std::invalid_argument(where + ": hook vertebra out of range");
+    rec.frames.push_back(f);
+  }
+  if (rec.fingerprint.empty())
+    throw std::invalid_argument(path + ": not a compliant-stage recording (no spine model line: "
+                                       "record with haptics run --spine …)");
+  if (rec.frames.empty()) throw std::invalid_argument(path + ": no recorded ticks");
+  return rec;
+}
+
+}  // namespace spinesim::studies
