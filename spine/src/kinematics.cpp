@@ -63,4 +63,12 @@ std::vector<Pose> vertebra_poses(const SpineModel& m, const Eigen::VectorXd& the
   return poses;
 }
 
+Pose pose_from_displacement(const Eigen::Vector3d& centre_mm, const Eigen::Vector3d& translation_mm,
+                            const Eigen::Vector3d& rotation_deg) {
+  Pose p;
+  p.R = rotation_exp(rotation_deg * (M_PI / 180.0));
+  p.t = centre_mm + translation_mm - p.R * centre_mm;
+  return p;
+}
+
 }  // namespace spinesim::spine

@@ -41,6 +41,7 @@ void register_study(
 void register_spine(CLI::App& app);  ///< spine solve (cli_spine.cpp)
 void register_haptics(CLI::App& app);        ///< haptics run|devices (cli_haptics.cpp)
 void register_haptic_plane(CLI::App& study);  ///< study haptic-plane (cli_haptics.cpp)
+void register_haptic_drag(CLI::App& study);   ///< study haptic-drag (cli_haptics.cpp)
 void register_demo(CLI::App& app);
 void register_bench(CLI::App& app);
 void register_spine_database(

@@ -5,11 +5,13 @@
 //       [--duration S] [--probe-radius MM] [--renderer proxy|gao-gibson] [--record REC.csv] [--json]
 //   spinesim haptics devices
 //   spinesim study haptic-plane [--csv]
+//   spinesim study haptic-drag [--case lateral|sagittal|oblique] --out DIR [--json]
 //
 // Ctrl-C (or SIGTERM/SIGHUP/QUIT) during a run ends the loop: the force goes to zero, the device
 // is closed, the summary is printed, then the run exits by the signal.
 #include "cli_common.hpp"
 
+#include "spinesim/studies/haptic_drag_study.hpp"
 #include "spinesim/studies/haptic_plane_study.hpp"
 #include "spinesim/studies/haptics_run.hpp"
 
@@ -237,6 +239,39 @@ void register_haptic_plane(CLI::App& study) {
   cmd->add_option("--out", a->out, "Also write the CSV to this file");
   add_output_flags(cmd, a->json, a->quiet);
   cmd->callback([a] { run_plane(*a); });
+}
+
+void register_haptic_drag(CLI::App& study) {
+  struct DragArgs {
+    HapticDragRequest request;
+    std::string which;
+    bool json = false, quiet = false, no_realtime = false;
+  };
+  auto a = std::make_shared<DragArgs>();
+  auto* cmd = study.add_subcommand(
+      "haptic-drag",
+      "Thesis 4.5/6.3: a scripted hand drags T1 with the multirate spine and with the "
+      "displacement-force database; pose error of each against direct solves, vertebra-pair "
+      "motions as CSV");
+  cmd->add_option("--case", a->which, "lateral, sagittal or oblique (default: all three)");
+  cmd->add_option("--out", a->request.out, "Folder for the recordings and CSVs")->required();
+  cmd->add_option("--sample-every", a->request.sample_every_s,
+                  "Direct solves this often while hooked, s")
+      ->capture_default_str();
+  cmd->add_flag("--no-realtime", a->no_realtime, "Do not ask for real-time priority");
+  add_output_flags(cmd, a->json, a->quiet);
+  cmd->callback([a] {
+    if (!a->which.empty()) a->request.cases = {a->which};
+    a->request.realtime_priority = !a->no_realtime;
+    const bool show = !a->quiet && !a->json && stderr_is_terminal();
+    const auto r = run_haptic_drag_study(a->request, data_dir(), [show](const std::string& s) {
+      if (show) std::fprintf(stderr, "  %s ...\n", s.c_str());
+    });
+    if (a->json)
+      print_json(haptic_drag_json(r));
+    else
+      std::cout << haptic_drag_table(r);
+  });
 }
 
 }  // namespace spinesim::cli

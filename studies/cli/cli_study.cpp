@@ -514,6 +514,7 @@ void register_study(CLI::App& app) {
   register_fusion(*study);
   register_trends(*study);
   register_haptic_plane(*study);
+  register_haptic_drag(*study);
 }
 
 }  // namespace spinesim::cli

@@ -18,7 +18,7 @@ namespace spinesim::studies {
 namespace {
 
 constexpr double kRadToDeg = 180.0 / M_PI;
-constexpr int kCommonColumns = 13, kHookColumns = 8, kVertebrae = 17;
+constexpr int kCommonColumns = 13, kHookColumns = 11, kVertebrae = 17;
 constexpr int kDragColumns = kCommonColumns + kHookColumns + 6 * kVertebrae;
 
 void fnv(std::uint64_t& h, double v) {
@@ -62,8 +62,8 @@ HapticRecordingWriter::HapticRecordingWriter(const std::string& path,
   std::fprintf(file_, "t_s,x_mm,y_mm,z_mm,button,fx_n,fy_n,fz_n,proxy_x_mm,proxy_y_mm,proxy_z_mm,"
                       "contact,tick");
   if (model) {
-    std::fprintf(file_, ",attached,hook_vertebra,hook_x_mm,hook_y_mm,hook_z_mm,spine_fx_n,"
-                        "spine_fy_n,spine_fz_n");
+    std::fprintf(file_, ",attached,hook_vertebra,hook_ref_x_mm,hook_ref_y_mm,hook_ref_z_mm,"
+                        "hook_x_mm,hook_y_mm,hook_z_mm,spine_fx_n,spine_fy_n,spine_fz_n");
     for (const auto& v : model->vertebrae) {
       centres_.push_back(v.centre_mm);
       for (const char* c : {"tx_mm", "ty_mm", "tz_mm", "rx_deg", "ry_deg", "rz_deg"})
@@ -88,8 +88,9 @@ void HapticRecordingWriter::append(const haptics::TickRecord* rows, std::size_t 
                  r.contact ? 1 : 0, static_cast<long long>(r.tick));
     if (!centres_.empty()) {
       const auto& h = r.hook;
-      std::fprintf(file_, ",%d,%d,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f", h.attached ? 1 : 0,
-                   h.load.vertebra, h.hook_mm.x(), h.hook_mm.y(), h.hook_mm.z(),
+      std::fprintf(file_, ",%d,%d,%.5f,%.5f,%.5f,%.4f,%.4f,%.4f,%.5f,%.5f,%.5f",
+                   h.attached ? 1 : 0, h.load.vertebra, h.load.point_mm.x(), h.load.point_mm.y(),
+                   h.load.point_mm.z(), h.hook_mm.x(), h.hook_mm.y(), h.hook_mm.z(),
                    h.load.force_n.x(), h.load.force_n.y(), h.load.force_n.z());
       for (std::size_t v = 0; v < centres_.size(); ++v) {
         const Eigen::Matrix3d R = r.R[v].cast<double>();
@@ -117,11 +118,9 @@ void HapticRecordingWriter::finish() {
 }
 
 spine::Pose DragFrame::pose(const spine::SpineModel& m, int i) const {
-  const Eigen::Vector3d& c = m.vertebrae[std::size_t(i)].centre_mm;
-  spine::Pose p;
-  p.R = spine::rotation_exp(motion.row(i).tail<3>().transpose() / kRadToDeg);
-  p.t = c + motion.row(i).head<3>().transpose() - p.R * c;
-  return p;
+  return spine::pose_from_displacement(m.vertebrae[std::size_t(i)].centre_mm,
+                                       motion.row(i).head<3>().transpose(),
+                                       motion.row(i).tail<3>().transpose());
 }
 
 namespace {
@@ -159,8 +158,9 @@ bool parse_row(const std::string& line, DragFrame& f, std::string& why) {
   f.tick = std::int64_t(v[12]);
   f.attached = v[13] != 0;
   f.hook_vertebra = int(v[14]);
-  f.hook_mm = Eigen::Vector3d(v[15], v[16], v[17]);
-  f.spine_force_n = Eigen::Vector3d(v[18], v[19], v[20]);
+  f.hook_ref_mm = Eigen::Vector3d(v[15], v[16], v[17]);
+  f.hook_mm = Eigen::Vector3d(v[18], v[19], v[20]);
+  f.spine_force_n = Eigen::Vector3d(v[21], v[22], v[23]);
   for (int i = 0; i < kVertebrae; ++i)
     for (int c = 0; c < 6; ++c) f.motion(i, c) = v[kCommonColumns + kHookColumns + 6 * i + c];
   return true;

@@ -26,6 +26,11 @@ Eigen::Vector3d rotation_log(const Eigen::Matrix3d& R);
 Eigen::Matrix3d right_jacobian(const Eigen::Vector3d& phi);
 Eigen::Matrix3d left_jacobian_inverse(const Eigen::Vector3d& phi);
 
+/// The rigid motion that moves `centre_mm` by `translation_mm` and turns about it by the
+/// rotation vector `rotation_deg` (SpineSolution::displacement's row as a pose).
+Pose pose_from_displacement(const Eigen::Vector3d& centre_mm, const Eigen::Vector3d& translation_mm,
+                            const Eigen::Vector3d& rotation_deg);
+
 /// Poses of the 17 vertebrae for joint coordinates θ (size dof_count(m)).
 std::vector<Pose> vertebra_poses(const SpineModel& m, const Eigen::VectorXd& theta);
 

@@ -53,6 +53,7 @@ struct DragFrame {
   bool attached = false;
   int hook_vertebra = -1;
   Eigen::Vector3d probe_mm, proxy_mm, hand_force_n, hook_mm, spine_force_n;
+  Eigen::Vector3d hook_ref_mm;  ///< the hook point in its vertebra's reference coordinates
   /// Per vertebra T1…L5: centre displacement (mm), rotation vector (deg).
   Eigen::Matrix<double, 17, 6> motion;
   /// The rigid motion of vertebra i (x ↦ R x + t, reference coordinates).
