@@ -101,7 +101,8 @@ void measure_pose_error(const spine::SpineModel& m, const DragRecording& rec,
   // ill-conditioned where the motion passes through zero, at the start and the return).
   for (int i = 0; i < kVertebrae; ++i)
     for (double e : et[std::size_t(i)])
-      if (out.hook_motion_max_mm > 0) ep[std::size_t(i)].push_back(100 * e / out.hook_motion_max_mm);
+      if (out.hook_motion_max_mm > 0)
+        ep[std::size_t(i)].push_back(100 * e / out.hook_motion_max_mm);
   for (int i = 0; i < kVertebrae; ++i) {
     out.translation_mm[std::size_t(i)] = percentiles_of(et[std::size_t(i)]);
     out.rotation_deg[std::size_t(i)] = percentiles_of(er[std::size_t(i)]);
@@ -130,8 +131,8 @@ std::string pairs_csv(const spine::SpineModel& m, const DragRecording& rec) {
       const Eigen::Vector3d r = spine::rotation_log(low.R.transpose() * up.R) * kRadToDeg;
       char line[256];
       std::snprintf(line, sizeof line, "%.3f,%s-%s,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f\n", f.t_s,
-                    names[std::size_t(i)].c_str(), names[std::size_t(i + 1)].c_str(), d.x(),
-                    d.y(), d.z(), r.x(), r.y(), r.z());
+                    names[std::size_t(i)].c_str(), names[std::size_t(i + 1)].c_str(), d.x(), d.y(),
+                    d.z(), r.x(), r.y(), r.z());
       os << line;
     }
   }
@@ -212,10 +213,10 @@ nlohmann::json haptic_drag_json(const HapticDragResult& r) {
     for (const auto& m : c.methods) {
       nlohmann::json per = nlohmann::json::object();
       for (int i = 0; i < kVertebrae; ++i)
-        per[names[std::size_t(i)]] = {{"translation_mm", pct(m.translation_mm[std::size_t(i)])},
-                                      {"rotation_deg", pct(m.rotation_deg[std::size_t(i)])},
-                                      {"percent_of_hook_motion",
-                                       pct(m.relative_percent[std::size_t(i)])}};
+        per[names[std::size_t(i)]] = {
+            {"translation_mm", pct(m.translation_mm[std::size_t(i)])},
+            {"rotation_deg", pct(m.rotation_deg[std::size_t(i)])},
+            {"percent_of_hook_motion", pct(m.relative_percent[std::size_t(i)])}};
       methods.push_back({{"method", m.method},
                          {"recording", m.recording},
                          {"samples", m.samples},
@@ -238,15 +239,15 @@ std::string haptic_drag_table(const HapticDragResult& r) {
   for (const auto& c : r.cases) {
     os << "T1 dragged " << c.name << " (vertebra pairs: " << c.pairs_csv << ")\n";
     TextTable t({"method", "samples", "hook motion max (mm)", "T1 error p50 / p95 (% of motion)",
-                 "T1 p95 (mm)", "worst vertebra p95 (mm)", "spine force max (N)",
-                 "solves/s", "compute p99 (us)"});
+                 "T1 p95 (mm)", "worst vertebra p95 (mm)", "spine force max (N)", "solves/s",
+                 "compute p99 (us)"});
     for (const auto& m : c.methods) {
       double worst = 0;
       for (const auto& p : m.translation_mm) worst = std::max(worst, p.p95);
       t.add({m.method, std::to_string(m.samples), fixed(m.hook_motion_max_mm, 1),
              fixed(m.relative_percent[0].p50, 1) + " / " + fixed(m.relative_percent[0].p95, 1),
-             fixed(m.translation_mm[0].p95, 2),
-             fixed(worst, 2), fixed(m.stats.max_spine_force_n, 0),
+             fixed(m.translation_mm[0].p95, 2), fixed(worst, 2),
+             fixed(m.stats.max_spine_force_n, 0),
              m.method == "multirate" ? fixed(m.worker_rate_hz, 1) : "-",
              fixed(m.stats.compute_us.p99, 1)});
     }

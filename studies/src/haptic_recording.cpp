@@ -59,11 +59,13 @@ HapticRecordingWriter::HapticRecordingWriter(const std::string& path,
                  "# spine model %s; compliant stage %s; vertebra motion: the F.1 centre's "
                  "displacement (mm) and the rotation vector (deg) from the reference posture\n",
                  spine_model_fingerprint(*model).c_str(), response.c_str());
-  std::fprintf(file_, "t_s,x_mm,y_mm,z_mm,button,fx_n,fy_n,fz_n,proxy_x_mm,proxy_y_mm,proxy_z_mm,"
-                      "contact,tick");
+  std::fprintf(file_,
+               "t_s,x_mm,y_mm,z_mm,button,fx_n,fy_n,fz_n,proxy_x_mm,proxy_y_mm,proxy_z_mm,"
+               "contact,tick");
   if (model) {
-    std::fprintf(file_, ",attached,hook_vertebra,hook_ref_x_mm,hook_ref_y_mm,hook_ref_z_mm,"
-                        "hook_x_mm,hook_y_mm,hook_z_mm,spine_fx_n,spine_fy_n,spine_fz_n");
+    std::fprintf(file_,
+                 ",attached,hook_vertebra,hook_ref_x_mm,hook_ref_y_mm,hook_ref_z_mm,"
+                 "hook_x_mm,hook_y_mm,hook_z_mm,spine_fx_n,spine_fy_n,spine_fz_n");
     for (const auto& v : model->vertebrae) {
       centres_.push_back(v.centre_mm);
       for (const char* c : {"tx_mm", "ty_mm", "tz_mm", "rx_deg", "ry_deg", "rz_deg"})
@@ -88,16 +90,16 @@ void HapticRecordingWriter::append(const haptics::TickRecord* rows, std::size_t 
                  r.contact ? 1 : 0, static_cast<long long>(r.tick));
     if (!centres_.empty()) {
       const auto& h = r.hook;
-      std::fprintf(file_, ",%d,%d,%.5f,%.5f,%.5f,%.4f,%.4f,%.4f,%.5f,%.5f,%.5f",
-                   h.attached ? 1 : 0, h.load.vertebra, h.load.point_mm.x(), h.load.point_mm.y(),
-                   h.load.point_mm.z(), h.hook_mm.x(), h.hook_mm.y(), h.hook_mm.z(),
-                   h.load.force_n.x(), h.load.force_n.y(), h.load.force_n.z());
+      std::fprintf(file_, ",%d,%d,%.5f,%.5f,%.5f,%.4f,%.4f,%.4f,%.5f,%.5f,%.5f", h.attached ? 1 : 0,
+                   h.load.vertebra, h.load.point_mm.x(), h.load.point_mm.y(), h.load.point_mm.z(),
+                   h.hook_mm.x(), h.hook_mm.y(), h.hook_mm.z(), h.load.force_n.x(),
+                   h.load.force_n.y(), h.load.force_n.z());
       for (std::size_t v = 0; v < centres_.size(); ++v) {
         const Eigen::Matrix3d R = r.R[v].cast<double>();
         const Eigen::Vector3d d = R * centres_[v] + r.t[v].cast<double>() - centres_[v];
         const Eigen::Vector3d rot = spine::rotation_log(R) * kRadToDeg;
-        std::fprintf(file_, ",%.5f,%.5f,%.5f,%.5f,%.5f,%.5f", d.x(), d.y(), d.z(), rot.x(),
-                     rot.y(), rot.z());
+        std::fprintf(file_, ",%.5f,%.5f,%.5f,%.5f,%.5f,%.5f", d.x(), d.y(), d.z(), rot.x(), rot.y(),
+                     rot.z());
       }
     }
     std::fputc('\n', file_);
@@ -201,8 +203,9 @@ DragRecording read_drag_recording(const std::string& path, const spine::SpineMod
     if (line.empty() || line[0] == '#') continue;
     if (!header) {
       if (rec.fingerprint.empty())
-        throw std::invalid_argument(path + ": not a compliant-stage recording (no spine model "
-                                           "line: record with haptics run --spine …)");
+        throw std::invalid_argument(path +
+                                    ": not a compliant-stage recording (no spine model "
+                                    "line: record with haptics run --spine …)");
       header = true;
       continue;
     }
@@ -221,8 +224,9 @@ DragRecording read_drag_recording(const std::string& path, const spine::SpineMod
     rec.frames.push_back(f);
   }
   if (rec.fingerprint.empty())
-    throw std::invalid_argument(path + ": not a compliant-stage recording (no spine model line: "
-                                       "record with haptics run --spine …)");
+    throw std::invalid_argument(path +
+                                ": not a compliant-stage recording (no spine model line: "
+                                "record with haptics run --spine …)");
   if (rec.frames.empty()) throw std::invalid_argument(path + ": no recorded ticks");
   return rec;
 }

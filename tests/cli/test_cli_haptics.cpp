@@ -181,3 +181,62 @@ TEST(CliHaptics, MeshVertebraeWritesClosedSurfaces) {
     EXPECT_TRUE(fs::exists(b["file"].get<std::string>()));
   }
 }
+
+// The compliant stage from the command line: a scripted drag of T1 hooks, loads the spine and
+// records every vertebra; a run killed mid-drag (SIGKILL: nothing can clean up) leaves a
+// recording whose every complete row is whole; bad compliant-stage input is refused.
+TEST(CliHaptics, DragOfT1RecordsTheSpineAndAKilledRunLeavesReadableRows) {
+  const std::string rec = tmp("drag_rec.csv");
+  const std::string script = std::string(SPINESIM_DATA_DIR) + "/haptics/drag_t1_lateral.csv";
+  const auto r = run_spinesim(
+      "haptics run --scene spine --triangles 1500 --spine multirate "
+      "--script '" +
+      script + "' --duration 3 --no-realtime --record '" + rec + "' --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  const auto& c = j["compliant_stage"];
+  EXPECT_EQ(c["spine"], "multirate");
+  EXPECT_GT(c["hooked_ticks"].get<int>(), 1500);  // the button is held from 1.0 s
+  EXPECT_GT(c["max_spine_force_n"].get<double>(), 20.0);
+  EXPECT_GT(c["worker_solves"].get<int>(), 5);
+  EXPECT_EQ(c["worker_failures"].get<int>(), 0);
+  const std::string text = slurp(rec);
+  EXPECT_NE(text.find("# spine model "), std::string::npos);
+  EXPECT_NE(text.find("L5_rz_deg"), std::string::npos);
+  EXPECT_NE(text.find("# end: "), std::string::npos);
+
+  const std::string killed = tmp("drag_killed.csv");
+  const pid_t pid = start_spinesim(
+      "haptics run --scene spine --triangles 1500 --spine multirate "
+      "--script '" +
+      script + "' --no-realtime --record '" + killed + "'");
+  for (int k = 0; k < 600 && count_lines(slurp(killed)) < 1500; ++k) ::usleep(50000);
+  ::kill(pid, SIGKILL);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  const std::string part = slurp(killed);
+  ASSERT_GT(count_lines(part), 1000);
+  EXPECT_EQ(part.find("# end: "), std::string::npos);
+  // Every complete data row has all 132 columns (13 + 11 hook + 6 × 17 vertebrae).
+  std::istringstream rows(part);
+  std::string line;
+  int complete = 0;
+  while (std::getline(rows, line)) {
+    if (rows.eof()) break;  // a last row without its newline may be cut
+    if (line.empty() || line[0] == '#' || line[0] == 't') continue;
+    EXPECT_EQ(std::count(line.begin(), line.end(), ','), 125) << line.substr(0, 60);
+    ++complete;
+  }
+  EXPECT_GT(complete, 1000);
+}
+
+TEST(CliHaptics, BadCompliantStageInputIsRefused) {
+  const std::string rec = tmp("never_drag.csv");
+  const std::string base = "haptics run --duration 1 --record '" + rec + "' ";
+  expect_refused(run_spinesim(base + "--scene plane --spine multirate"), "--scene spine");
+  expect_refused(run_spinesim(base + "--scene spine --spine magic"), "--spine");
+  expect_refused(run_spinesim(base + "--scene spine --spine database --force-scale 1000"),
+                 "beyond the 600 N");
+  expect_refused(run_spinesim(base + "--scene plane --force-scale 10"), "--spine");
+  EXPECT_FALSE(fs::exists(rec));
+}
