@@ -102,15 +102,19 @@ void ServoLoop::set_compliant_stage(CompliantStage* stage) {
   stage_poses_ = poses_.read();
 }
 
+void ServoLoop::fail_device() {
+  device_.write_force(Eigen::Vector3d::Zero());
+  device_failed_ = true;
+  stats_.error = true;
+  stats_.stop_reason = "device error";
+  stop_.store(true);
+}
+
 void ServoLoop::tick(double now_s, double period_s) {
   ServoStats& st = stats_;
   if (device_failed_) return;
   if (!device_.read(state_)) {
-    device_.write_force(Eigen::Vector3d::Zero());
-    device_failed_ = true;
-    st.error = true;
-    st.stop_reason = "device error";
-    stop_.store(true);
+    fail_device();
     return;
   }
   // The force held over the last period did its work over the device's motion since then.
@@ -136,11 +140,7 @@ void ServoLoop::tick(double now_s, double period_s) {
   const Eigen::Vector3d force =
       safety_.apply(stage_ ? stage_->blend(out.force_n) : out.force_n, in, &report);
   if (!device_.write_force(force)) {
-    device_.write_force(Eigen::Vector3d::Zero());
-    device_failed_ = true;
-    st.error = true;
-    st.stop_reason = "device error";
-    stop_.store(true);
+    fail_device();
   }
   held_force_ = device_failed_ ? Eigen::Vector3d::Zero() : force;
 

@@ -140,6 +140,8 @@ class ServoLoop {
   std::atomic<std::int64_t> ring_dropped_{0};
   std::function<void(const TickRecord*, std::size_t)> sink_;
   bool device_failed_ = false;
+  /// A device read or write failed: zero force, stop, report (no allocation: the reason is a literal).
+  void fail_device();
   CompliantStage* stage_ = nullptr;
   ScenePoses stage_poses_;  ///< the scene's poses with the stage's vertebrae, kept across ticks
   RenderOutput last_out_;
