@@ -62,6 +62,8 @@ MultirateSpine::MultirateSpine(const spine::SpineModel& model, const MultirateOp
   if (!(options.max_force_n > 0) || options.max_force_n > spine::kMaxForceN)
     throw std::invalid_argument("multirate spine: the largest hook force must be > 0 and at most " +
                                 std::to_string(int(spine::kMaxForceN)) + " N");
+  if (options.handover_ticks < 0 || options.handover_ticks > 1000)
+    throw std::invalid_argument("multirate spine: the handover must be 0 to 1000 ticks");
   const spine::SpineSolution gravity = spine::solve_spine(model, {}, options.solve);
   baseline_ = gravity.displacement;
 }
@@ -101,16 +103,48 @@ LocalSpineModel MultirateSpine::solve(const HookLoad& load, const LocalSpineMode
   return out;
 }
 
+namespace {
+
+bool made_for(const LocalSpineModel& m, const HookLoad& load) {
+  return load.vertebra >= 0 && m.vertebra == load.vertebra && m.point_mm == load.point_mm;
+}
+
+/// The local model's linear prediction at `force`, into `out` (or blended into it with weight w).
+void linear_prediction(const LocalSpineModel& m, const Eigen::Vector3d& force, double w,
+                       SpineDisplacement& out) {
+  const Eigen::Vector3d dF = force - m.force_n;
+  for (int i = 0; i < kSpineVertebrae; ++i)
+    for (int c = 0; c < 6; ++c)
+      out(i, c) =
+          (1 - w) * out(i, c) + w * (m.relative(i, c) + m.sensitivity.row(6 * i + c).dot(dF));
+}
+
+}  // namespace
+
 void MultirateSpine::predict(const HookLoad& load, SpineDisplacement& relative) {
   const LocalSpineModel& m = model_out_.read();
-  if (load.vertebra < 0 || m.vertebra != load.vertebra || m.point_mm != load.point_mm) {
+  if (m.solve != current_.solve) {  // a new model: hand over from the one in use
+    previous_ = current_;
+    current_ = m;
+    handover_left_ =
+        made_for(previous_, load) && made_for(current_, load) ? options_.handover_ticks : 0;
+  }
+  if (!made_for(current_, load)) {
     relative.setZero();
     return;
   }
-  const Eigen::Vector3d dF = load.force_n - m.force_n;
-  for (int i = 0; i < kSpineVertebrae; ++i)
-    for (int c = 0; c < 6; ++c)
-      relative(i, c) = m.relative(i, c) + m.sensitivity.row(6 * i + c).dot(dF);
+  relative.setZero();
+  double w = 1;
+  if (handover_left_ > 0) {
+    linear_prediction(previous_, load.force_n, 1, relative);
+    w = 1.0 - double(handover_left_) / double(options_.handover_ticks + 1);
+  }
+  linear_prediction(current_, load.force_n, w, relative);
+}
+
+void MultirateSpine::publish(const HookLoad& load) {
+  if (handover_left_ > 0) --handover_left_;
+  request_.write(load);
 }
 
 void MultirateSpine::start() {

@@ -12,6 +12,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <map>
 #include <stdexcept>
 
 namespace spinesim::mesh {
@@ -29,15 +30,18 @@ void write_pvd(const std::string& path, const std::vector<PvdEntry>& entries) {
   // 1. Refuse bad input before touching the disk.
   const std::string who = "write_pvd: " + path + ": ";
   if (entries.empty()) throw std::invalid_argument(who + "no datasets to list");
+  std::map<int, double> last_time;  // per part
   for (std::size_t i = 0; i < entries.size(); ++i) {
     const PvdEntry& e = entries[i];
     const std::string which = "dataset " + std::to_string(i);
+    if (e.part < 0) throw std::invalid_argument(who + which + " has a negative part");
     if (!std::isfinite(e.time_s))
       throw std::invalid_argument(who + which + " has a non-finite time");
-    if (i > 0 && !(e.time_s > entries[i - 1].time_s))
+    const auto last = last_time.find(e.part);
+    if (last != last_time.end() && !(e.time_s > last->second))
       throw std::invalid_argument(who + which + ": times must be strictly increasing (" +
-                                  shortest(entries[i - 1].time_s) + " then " + shortest(e.time_s) +
-                                  ")");
+                                  shortest(last->second) + " then " + shortest(e.time_s) + ")");
+    last_time[e.part] = e.time_s;
     if (e.file.empty()) throw std::invalid_argument(who + which + " has an empty file name");
     for (char c : e.file)
       if (static_cast<unsigned char>(c) < 0x20)
@@ -50,8 +54,8 @@ void write_pvd(const std::string& path, const std::vector<PvdEntry>& entries) {
        << "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
        << "  <Collection>\n";
     for (const PvdEntry& e : entries)
-      os << "    <DataSet timestep=\"" << shortest(e.time_s) << "\" group=\"\" part=\"0\" file=\""
-         << detail::xml_escape(e.file) << "\"/>\n";
+      os << "    <DataSet timestep=\"" << shortest(e.time_s) << "\" group=\"\" part=\"" << e.part
+         << "\" file=\"" << detail::xml_escape(e.file) << "\"/>\n";
     os << "  </Collection>\n"
        << "</VTKFile>\n";
   });

@@ -120,15 +120,41 @@ void write_ascii_value(std::ostream& os, T v) {
   os.write(buf, res.ptr - buf);
 }
 
+/// VTK's compressed layout: the header [#blocks, block size, last block size, compressed sizes…]
+/// (UInt64) base64-encoded on its own, then the compressed blocks base64-encoded together.
+void write_zlib_blocks(const unsigned char* data, std::size_t nbytes, std::ostream& os) {
+  constexpr std::size_t kBlock = 32768;
+  const std::size_t nblocks = (nbytes + kBlock - 1) / kBlock;
+  std::vector<std::uint64_t> header = {nblocks, kBlock, nbytes % kBlock};
+  std::vector<unsigned char> packed;
+  for (std::size_t k = 0; k < nblocks; ++k) {
+    const std::size_t size = std::min(kBlock, nbytes - k * kBlock);
+    uLongf csize = compressBound(uLong(size));
+    const std::size_t at = packed.size();
+    packed.resize(at + csize);
+    if (compress2(packed.data() + at, &csize, data + k * kBlock, uLong(size), 6) != Z_OK)
+      throw std::runtime_error("write_vtu: zlib could not compress a block");
+    packed.resize(at + csize);
+    header.push_back(csize);
+  }
+  std::vector<unsigned char> head(header.size() * sizeof(std::uint64_t));
+  std::memcpy(head.data(), header.data(), head.size());
+  base64_encode(head, os);
+  base64_encode(packed, os);
+}
+
 /// One <DataArray> with `n` values of C++ type T (VTK type name `vtk_type`), tuple-major.
 template <class T>
 void write_data_array(std::ostream& os, const char* vtk_type, const std::string& name, int ncomp,
                       const std::vector<T>& data, VtuEncoding enc, const char* indent) {
   os << indent << "<DataArray type=\"" << vtk_type << "\" Name=\"" << detail::xml_escape(name)
      << "\" NumberOfComponents=\"" << ncomp << "\" format=\""
-     << (enc == VtuEncoding::binary ? "binary" : "ascii") << "\">\n"
+     << (enc == VtuEncoding::ascii ? "ascii" : "binary") << "\">\n"
      << indent << "  ";
-  if (enc == VtuEncoding::binary) {
+  if (enc == VtuEncoding::zlib) {
+    write_zlib_blocks(reinterpret_cast<const unsigned char*>(data.data()), data.size() * sizeof(T),
+                      os);
+  } else if (enc == VtuEncoding::binary) {
     const std::uint64_t nbytes = data.size() * sizeof(T);
     std::vector<unsigned char> bytes(sizeof nbytes + nbytes);
     std::memcpy(bytes.data(), &nbytes, sizeof nbytes);
@@ -163,7 +189,7 @@ void check_arrays(const std::string& path, const std::vector<DataArray>& arrays,
     const std::string head = "write_vtu: " + path + ": " + kind + " array '" + a.name + "'";
     if (a.name.empty())
       throw std::invalid_argument("write_vtu: " + path + ": a " + kind + " array has no name");
-    if (a.name == reserved)
+    if (*reserved && a.name == reserved)
       throw std::invalid_argument(head + " uses a reserved name (written from the mesh labels)");
     if (a.values.rows() != rows || a.values.cols() < 1)
       throw std::invalid_argument(head + " has " + std::to_string(a.values.rows()) + "x" +
@@ -568,7 +594,8 @@ void write_vtu(const std::string& path, const TetMesh& m, const std::vector<Data
   write_atomically("write_vtu", path, [&](std::ostream& os) {
     os << "<?xml version=\"1.0\"?>\n"
        << "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" "
-          "header_type=\"UInt64\">\n"
+          "header_type=\"UInt64\""
+       << (enc == VtuEncoding::zlib ? " compressor=\"vtkZLibDataCompressor\"" : "") << ">\n"
        << "  <UnstructuredGrid>\n"
        << "    <FieldData>\n";
     write_data_array(os, "Float64", "disc_frame", 12, frame, VtuEncoding::ascii, "      ");
@@ -590,6 +617,59 @@ void write_vtu(const std::string& path, const TetMesh& m, const std::vector<Data
     os << "      </CellData>\n"
        << "      <Points>\n";
     write_data_array(os, "Float64", "Points", 3, row_major(m.V), enc, in);
+    os << "      </Points>\n"
+       << "      <Cells>\n";
+    write_data_array(os, "Int64", "connectivity", 1, connectivity, enc, in);
+    write_data_array(os, "Int64", "offsets", 1, offsets, enc, in);
+    write_data_array(os, "UInt8", "types", 1, types, enc, in);
+    os << "      </Cells>\n"
+       << "    </Piece>\n"
+       << "  </UnstructuredGrid>\n"
+       << "</VTKFile>\n";
+  });
+}
+
+void write_surface_vtu(const std::string& path, const TriSurface& s,
+                       const std::vector<DataArray>& point_data,
+                       const std::vector<DataArray>& cell_data, const VtuWriteOptions& options) {
+  const std::string who = "write_vtu: " + path + ": ";
+  if (s.V.rows() == 0 || s.F.rows() == 0)
+    throw std::invalid_argument(who + "surface is empty (no vertices or no triangles)");
+  if (!s.V.allFinite())
+    throw std::invalid_argument(who + "vertex coordinates contain non-finite values");
+  if (s.F.minCoeff() < 0 || s.F.maxCoeff() >= s.V.rows())
+    throw std::invalid_argument(who + "a triangle has a vertex index out of range");
+  check_arrays(path, point_data, s.V.rows(), "point", "");
+  check_arrays(path, cell_data, s.F.rows(), "cell", "");
+  if (!host_is_little_endian())
+    throw std::runtime_error(who + "writing VTU on a big-endian host is not implemented");
+
+  const std::size_t nf = std::size_t(s.F.rows());
+  std::vector<std::int64_t> connectivity(3 * nf), offsets(nf);
+  const std::vector<std::uint8_t> types(nf, std::uint8_t(5));  // VTK_TRIANGLE
+  for (std::size_t f = 0; f < nf; ++f) {
+    for (int k = 0; k < 3; ++k) connectivity[3 * f + std::size_t(k)] = s.F(Eigen::Index(f), k);
+    offsets[f] = std::int64_t(3 * (f + 1));
+  }
+  const VtuEncoding enc = options.encoding;
+  write_atomically("write_vtu", path, [&](std::ostream& os) {
+    const char* in = "        ";
+    os << "<?xml version=\"1.0\"?>\n"
+       << "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" "
+          "header_type=\"UInt64\""
+       << (enc == VtuEncoding::zlib ? " compressor=\"vtkZLibDataCompressor\"" : "") << ">\n"
+       << "  <UnstructuredGrid>\n"
+       << "    <Piece NumberOfPoints=\"" << s.V.rows() << "\" NumberOfCells=\"" << nf << "\">\n"
+       << "      <PointData>\n";
+    for (const DataArray& a : point_data)
+      write_data_array(os, "Float64", a.name, int(a.values.cols()), row_major(a.values), enc, in);
+    os << "      </PointData>\n"
+       << "      <CellData>\n";
+    for (const DataArray& a : cell_data)
+      write_data_array(os, "Float64", a.name, int(a.values.cols()), row_major(a.values), enc, in);
+    os << "      </CellData>\n"
+       << "      <Points>\n";
+    write_data_array(os, "Float64", "Points", 3, row_major(s.V), enc, in);
     os << "      </Points>\n"
        << "      <Cells>\n";
     write_data_array(os, "Int64", "connectivity", 1, connectivity, enc, in);

@@ -1,5 +1,6 @@
 #include "spinesim/mss/disc_set.hpp"
 
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -39,6 +40,17 @@ int DiscSet::threads() const { return impl_->threads; }
 const MssModel& DiscSet::model(int i) const { return *impl_->discs.at(std::size_t(i)).model; }
 const State& DiscSet::state(int i) const { return impl_->discs.at(std::size_t(i)).state; }
 
+void DiscSet::set_state(int i, State state) {
+  Impl::Disc& d = impl_->discs.at(std::size_t(i));
+  if (state.x_mm.size() != d.model->num_dofs() || state.v_mm_s.size() != d.model->num_dofs())
+    throw std::invalid_argument("DiscSet: disc " + std::to_string(i) + ": a state of " +
+                                std::to_string(state.x_mm.size()) + " positions for " +
+                                std::to_string(d.model->num_dofs()) + " degrees of freedom");
+  if (!state.x_mm.allFinite() || !state.v_mm_s.allFinite() || !std::isfinite(state.time_s))
+    throw std::invalid_argument("DiscSet: disc " + std::to_string(i) + ": non-finite state");
+  d.state = std::move(state);
+}
+
 double DiscSet::total_tets() const {
   double n = 0;
   for (const auto& d : impl_->discs) n += double(d.model->mesh().num_tets());
@@ -49,11 +61,15 @@ const std::vector<StepReport>& DiscSet::step(const std::vector<Boundary>& bcs) {
   if (bcs.size() != impl_->discs.size())
     throw std::invalid_argument("DiscSet: " + std::to_string(bcs.size()) + " boundaries for " +
                                 std::to_string(impl_->discs.size()) + " discs");
-  const int n = size();
-  auto one = [&](int i) {
+  for_each([&](int i) {
     Impl::Disc& d = impl_->discs[std::size_t(i)];
     impl_->reports[std::size_t(i)] = d.sim->step(d.state, bcs[std::size_t(i)]);
-  };
+  });
+  return impl_->reports;
+}
+
+void DiscSet::for_each(const std::function<void(int)>& work) const {
+  const int n = size();
 #if defined(_OPENMP)
   if (impl_->threads > 1) {
     // Exceptions must not leave an OpenMP region: catch per disc, rethrow the first after it.
@@ -61,18 +77,17 @@ const std::vector<StepReport>& DiscSet::step(const std::vector<Boundary>& bcs) {
 #pragma omp parallel for schedule(dynamic) num_threads(impl_->threads)
     for (int i = 0; i < n; ++i) {
       try {
-        one(i);
+        work(i);
       } catch (const std::exception& e) {
         errors[std::size_t(i)] = e.what();
       }
     }
     for (const auto& e : errors)
       if (!e.empty()) throw std::runtime_error(e);
-    return impl_->reports;
+    return;
   }
 #endif
-  for (int i = 0; i < n; ++i) one(i);
-  return impl_->reports;
+  for (int i = 0; i < n; ++i) work(i);
 }
 
 }  // namespace spinesim::mss

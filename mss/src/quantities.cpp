@@ -1,5 +1,7 @@
 #include "spinesim/mss/quantities.hpp"
 
+#include <cmath>
+
 #include "spinesim/mss/elements.hpp"
 
 namespace spinesim::mss {
@@ -28,6 +30,24 @@ Eigen::VectorXd tet_volume_change(const MssModel& model, const Eigen::VectorXd& 
     dv(t) = (tet_signed_volume(x) - v0) / v0;
   }
   return dv;
+}
+
+Eigen::VectorXd tet_edge_strain(const MssModel& model, const Eigen::VectorXd& x_mm) {
+  const mesh::TetMesh& m = model.mesh();
+  const Eigen::VectorXd& X = model.rest_positions_mm();
+  static constexpr int kEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+  Eigen::VectorXd strain(m.num_tets());
+  for (Eigen::Index t = 0; t < m.num_tets(); ++t) {
+    double extreme = 0;
+    for (const auto& e : kEdges) {
+      const Eigen::Index a = 3 * m.T(t, e[0]), b = 3 * m.T(t, e[1]);
+      const double rest = (X.segment<3>(b) - X.segment<3>(a)).norm();
+      const double e_ab = (x_mm.segment<3>(b) - x_mm.segment<3>(a)).norm() / rest - 1.0;
+      if (std::abs(e_ab) > std::abs(extreme)) extreme = e_ab;
+    }
+    strain(t) = extreme;
+  }
+  return strain;
 }
 
 double volume_change(const MssModel& model, const Eigen::VectorXd& x_mm) {

@@ -4,6 +4,7 @@
 //   spinesim calibrate --mesh disc.vtu --out tuned.json
 //   spinesim calibrate --level L4-L5 --train compression,flexion --holdout torsion --out tuned.json --json
 //   spinesim calibrate --level L4-L5 --per-spring [--smoothness 1e-3] --out tuned.json
+//   spinesim calibrate --level all --structured --out data/tuned_structured_discs.json
 //
 // Protocol: the FEM (P2 by default) answers every training and held-out case; Ipopt fits the
 // per-region scales of the chosen terms to the training cases only (calibration/objective.hpp);
@@ -52,6 +53,7 @@ struct CalibrateArgs {
   bool no_transfer = false;
   bool no_check = false, json = false, quiet = false;
   bool per_spring = false;
+  bool structured = false;  ///< the level's structured (haptic-resolution) disc, default options
   calibration::PerSpringWeights per_spring_weights;
   CLI::Option* smoothness_option = nullptr;
   int per_spring_max_iterations = calibration::per_spring_ipopt_defaults().max_iterations;
@@ -75,8 +77,9 @@ void run_all_levels(const CalibrateArgs& a, const CalibrationRequest& rq,
   all.calibration = rq;
   if (a.cell_size_option->count()) all.cell_size_mm = a.cell_size_mm;
   all.transfer = !a.no_transfer;
+  if (a.structured) all.structured = mesh::StructuredDiscOptions();
   std::ostringstream cmd;
-  cmd << "spinesim calibrate --level all"
+  cmd << "spinesim calibrate --level all" << (a.structured ? " --structured" : "")
       << (a.cell_size_option->count() ? " --cell-size " + std::to_string(a.cell_size_mm)
                                       : std::string())
       << " --material " << a.material << " --terms " << a.terms << " --train " << a.train
@@ -107,6 +110,10 @@ void check_files_and_modes(const CalibrateArgs& a) {
   if (a.out.empty()) throw std::invalid_argument("--out tuned.json is required");
   if (a.mesh_path.empty() == a.level.empty())
     throw std::invalid_argument("give exactly one of --mesh and --level");
+  if (a.structured && a.level.empty())
+    throw std::invalid_argument("--structured meshes a level: give --level, not --mesh");
+  if (a.structured && a.cell_size_option->count())
+    throw std::invalid_argument("--cell-size is the CGAL mesher's: --structured takes none");
   if (a.order != 1 && a.order != 2) throw std::invalid_argument("--order must be 1 or 2");
   if (!(a.cell_size_mm > 0)) throw std::invalid_argument("--cell-size must be > 0 mm");
   if (a.level == "all" && !a.transfer_meshes.empty())
@@ -177,6 +184,14 @@ void run_calibrate(const CalibrateArgs& a) {
   if (!a.mesh_path.empty()) {
     status("reading " + a.mesh_path);
     m = mesh::read_tet_mesh(a.mesh_path);
+  } else if (a.structured) {
+    status("meshing " + a.level + " (structured)");
+    m = mesh_structured_level(a.level, mesh::StructuredDiscOptions());
+    mesh::StructuredDiscOptions finer;
+    finer.sectors += 4;
+    if (!a.no_transfer && a.transfer_meshes.empty())
+      rq.transfer_meshes.emplace_back("structured, " + std::to_string(finer.sectors) + " sectors",
+                                      mesh_structured_level(a.level, finer));
   } else {
     mesh::MeshOptions opt;
     opt.cell_size_mm = a.cell_size_mm;
@@ -261,6 +276,10 @@ void register_calibrate(CLI::App& app) {
                   "Also check the tuned scales on this mesh of the same disc (repeatable; with "
                   "--level the default is "
                   "the same disc at 1.5x the cell size)");
+  cmd->add_flag("--structured", a->structured,
+                "With --level: calibrate the level's structured disc (12 sectors x 3 rings x 2 "
+                "layers, as `mesh disc --structured`: the mesh the spine's offline discs simulate; "
+                "its second resolution has 16 sectors)");
   cmd->add_flag("--no-transfer", a->no_transfer, "With --level: skip the second-resolution check");
   cmd->add_flag("--per-spring", a->per_spring,
                 "After the region fit, one stiffness multiplier per main spring "

@@ -191,6 +191,7 @@ void register_spine(CLI::App& app) {
 
   // `spinesim spine database` (thesis 3.5) lives in cli_spine_database.cpp.
   register_spine_database(*spine_cmd);
+  register_spine_discs(*spine_cmd);
 }
 
 }  // namespace spinesim::cli

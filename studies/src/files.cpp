@@ -66,12 +66,17 @@ VtuSeries::VtuSeries(const std::string& pvd_path) : pvd_path_(pvd_path) {
 }
 
 void VtuSeries::add(double time_s, const mss::MssModel& model, const Eigen::VectorXd& x_mm) {
+  add(time_s, 0, [&](const std::string& path) {
+    const mss::StateFields f = mss::state_fields(model, x_mm);
+    mesh::write_vtu(path, model.mesh(), f.point, f.cell);
+  });
+}
+
+void VtuSeries::add(double time_s, int part, const std::function<void(const std::string&)>& write) {
   char name[64];
   std::snprintf(name, sizeof name, "_%06zu.vtu", entries_.size());
-  const std::string rel = stem_ + "/" + stem_ + name;
-  const mss::StateFields f = mss::state_fields(model, x_mm);
-  mesh::write_vtu((fs::path(staging_) / (stem_ + name)).string(), model.mesh(), f.point, f.cell);
-  entries_.push_back({time_s, rel});
+  write((fs::path(staging_) / (stem_ + name)).string());
+  entries_.push_back({time_s, stem_ + "/" + stem_ + name, part});
 }
 
 VtuSeries::~VtuSeries() {

@@ -86,39 +86,62 @@ AllLevelsResult calibrate_all_levels(const mesh::RegionMaterials& materials,
   AllLevelsResult r;
   r.set.material_name = materials.name;
   r.set.generated_by = request.generated_by;
-  r.set.settings = {
-      {"cell_size_rule", request.cell_size_mm ? "as given" : "min(2 mm, disc height / 5)"},
-      {"mesh",
-       "parametric disc (data/disc_morphometry.csv), CGAL, placed in the spine (as `mesh disc "
-       "--level`)"},
-      {"check_load_scale",
-       rq.nonlinear_check ? nlohmann::json(rq.check_load_scale) : nlohmann::json(nullptr)}};
+  r.set.settings = {{"check_load_scale", rq.nonlinear_check ? nlohmann::json(rq.check_load_scale)
+                                                            : nlohmann::json(nullptr)}};
+  if (request.structured) {
+    mesh::validate(*request.structured);
+    r.set.settings["mesh"] =
+        "structured disc (data/disc_morphometry.csv), placed in the spine (as `mesh disc --level "
+        "--structured`)";
+    r.set.settings["structured"] = {{"sectors", request.structured->sectors},
+                                    {"rings", request.structured->rings},
+                                    {"layers", request.structured->layers},
+                                    {"match_area", request.structured->match_area}};
+  } else {
+    r.set.settings["mesh"] =
+        "parametric disc (data/disc_morphometry.csv), CGAL, placed in the spine (as `mesh disc "
+        "--level`)";
+    r.set.settings["cell_size_rule"] =
+        request.cell_size_mm ? "as given" : "min(2 mm, disc height / 5)";
+  }
   nlohmann::json cell_by_level = nlohmann::json::object();
   int done = 0;
   for (const std::string& level : levels) {
     const StatusLine status = [&](const std::string& s) {
       if (progress) progress(done, level + ": " + s);
     };
-    mesh::MeshOptions opt;
-    opt.cell_size_mm =
-        request.cell_size_mm ? *request.cell_size_mm : default_level_cell_size_mm(level);
-    cell_by_level[level] = opt.cell_size_mm;
-    status("meshing (cell size " + std::to_string(opt.cell_size_mm).substr(0, 4) + " mm)");
-    const mesh::TetMesh m = mesh_disc_level(level, opt);
     CalibrationRequest level_rq = rq;
-    if (request.transfer)
-      level_rq.transfer_meshes.push_back(coarser_level_mesh(level, opt, status));
+    mesh::TetMesh m;
+    LevelCalibration row;
+    if (request.structured) {
+      status("meshing (structured)");
+      m = mesh_structured_level(level, *request.structured);
+      mesh::StructuredDiscOptions finer = *request.structured;
+      finer.sectors += 4;
+      if (request.transfer)
+        level_rq.transfer_meshes.emplace_back(
+            "structured, " + std::to_string(finer.sectors) + " sectors",
+            mesh_structured_level(level, finer));
+    } else {
+      mesh::MeshOptions opt;
+      opt.cell_size_mm =
+          request.cell_size_mm ? *request.cell_size_mm : default_level_cell_size_mm(level);
+      cell_by_level[level] = opt.cell_size_mm;
+      row.cell_size_mm = opt.cell_size_mm;
+      status("meshing (cell size " + std::to_string(opt.cell_size_mm).substr(0, 4) + " mm)");
+      m = mesh_disc_level(level, opt);
+      if (request.transfer)
+        level_rq.transfer_meshes.push_back(coarser_level_mesh(level, opt, status));
+    }
     const CalibrationOutcome o = calibrate_disc(m, materials, level_rq, status);
     ++done;
-    LevelCalibration row;
     row.level = level;
     row.tets = m.num_tets();
-    row.cell_size_mm = opt.cell_size_mm;
     summarise(o, row);
     r.levels.push_back(row);
     if (row.success) r.set.levels.emplace(level, o.tuned);
   }
-  r.set.settings["cell_size_mm"] = cell_by_level;
+  if (!request.structured) r.set.settings["cell_size_mm"] = cell_by_level;
   return r;
 }
 

@@ -205,6 +205,41 @@ TEST(CliHaptics, DragOfT1RecordsTheSpineAndAKilledRunLeavesReadableRows) {
   EXPECT_NE(text.find("L5_rz_deg"), std::string::npos);
   EXPECT_NE(text.find("# end: "), std::string::npos);
 
+  // The offline discs of that drag: a ParaView series python3-meshio reads, frame by frame.
+  const std::string out = tmp("drag_discs");
+  const auto d = run_spinesim("spine discs --record '" + rec + "' --out '" + out +
+                              "' --vertebra-triangles 150 --frame-period 0.1 --json");
+  ASSERT_EQ(d.status, 0) << d.err;
+  const auto dj = nlohmann::json::parse(d.out);
+  EXPECT_EQ(dj["steps"].get<int>(), 2999);  // 3000 ticks of 1 ms
+  EXPECT_EQ(dj["discs"].get<int>(), 17);
+  EXPECT_GT(dj["speedup_over_real_time"].get<double>(), 0);
+  ASSERT_EQ(dj["per_disc"].size(), 17u);
+  EXPECT_GT(dj["per_disc"][0]["peak_rotation_deg"].get<double>(), 0.1);  // T1-T2 bends
+  for (const auto& disc : dj["per_disc"]) {
+    EXPECT_EQ(disc["inverted_tets_max"].get<int>(), 0) << disc["level"];
+    EXPECT_EQ(disc["rejected_steps"].get<int>(), 0) << disc["level"];
+  }
+  if (std::system("/usr/bin/python3 -c 'import meshio' >/dev/null 2>&1") == 0) {
+    const std::string script = tmp("read_pvd.py");
+    std::ofstream(script)
+        << "import sys, os, meshio, xml.etree.ElementTree as ET\n"
+           "p = sys.argv[1]\n"
+           "sets = ET.parse(p).getroot().find('Collection').findall('DataSet')\n"
+           "kinds = set()\n"
+           "for s in sets:\n"
+           "    m = meshio.read(os.path.join(os.path.dirname(p), s.get('file')))\n"
+           "    kinds.add((s.get('part'), tuple(sorted(m.cells_dict))))\n"
+           "print(len(sets), sorted(kinds))\n";
+    const std::string read_out = tmp("read_pvd.out");
+    const std::string py =
+        "/usr/bin/python3 '" + script + "' '" + out + "/spine.pvd' > '" + read_out + "' 2>&1";
+    ASSERT_EQ(std::system(py.c_str()), 0) << slurp(read_out);
+    const int frames = dj["frames"].get<int>();
+    EXPECT_EQ(slurp(read_out),
+              std::to_string(2 * frames) + " [('0', ('tetra',)), ('1', ('triangle',))]\n");
+  }
+
   const std::string killed = tmp("drag_killed.csv");
   const pid_t pid = start_spinesim(
       "haptics run --scene spine --triangles 1500 --spine multirate "
@@ -228,6 +263,21 @@ TEST(CliHaptics, DragOfT1RecordsTheSpineAndAKilledRunLeavesReadableRows) {
     ++complete;
   }
   EXPECT_GT(complete, 1000);
+}
+
+TEST(CliHaptics, OfflineDiscsRefuseBadInputInOneLineWithNothingWritten) {
+  const std::string out = tmp("never_discs");
+  const std::string plane = tmp("plane_only.csv");
+  ASSERT_EQ(run_spinesim("haptics run --scene plane --device sim --duration 0.2 --no-realtime "
+                         "--record '" +
+                         plane + "'")
+                .status,
+            0);
+  expect_refused(run_spinesim("spine discs --record '" + plane + "' --out '" + out + "'"),
+                 "not a compliant-stage recording");
+  expect_refused(run_spinesim("spine discs --record /nonexistent.csv --out '" + out + "'"),
+                 "nonexistent");
+  EXPECT_FALSE(fs::exists(out));
 }
 
 TEST(CliHaptics, BadCompliantStageInputIsRefused) {

@@ -274,3 +274,59 @@ TEST(MultirateSpine, LocalModelReproducesItsSolveAndPredictsANearbyOne) {
   EXPECT_GE(spine.stats().solves, 1);
   EXPECT_GT(local.relative(0, 2), 1.0);  // T1 comes forward by millimetres under 150 N
 }
+
+namespace {
+
+/// Largest tick-to-tick change of T1's predicted displacement while the force on T1 grows
+/// steadily and the worker keeps publishing new local models (about 1.5 s of 1 ms ticks).
+double largest_tick_jump_mm(const sp::SpineModel& m, int handover_ticks, int& models_seen) {
+  sh::MultirateOptions o;
+  o.handover_ticks = handover_ticks;
+  sh::MultirateSpine spine(m, o);
+  sh::HookLoad load;
+  load.vertebra = 0;
+  load.point_mm = m.vertebrae[0].centre_mm + Vector3d(0, 5, -40);
+  spine.start();
+  sh::SpineDisplacement d, last;
+  double jump = 0;
+  bool started = false;
+  models_seen = 0;
+  for (int k = 0; k < 1500; ++k) {
+    load.force_n = Vector3d(0.12 * k, 0, 0.05 * k);  // up to 180 N lateral, 75 N anterior
+    spine.predict(load, d);
+    if (started) jump = std::max(jump, (d.row(0).head<3>() - last.row(0).head<3>()).norm());
+    started = started || d.cwiseAbs().maxCoeff() > 0;
+    last = d;
+    spine.publish(load);
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  spine.stop();
+  models_seen = int(spine.stats().solves);
+  return jump;
+}
+
+}  // namespace
+
+// A new local model takes over gradually: without the handover the prediction steps by the
+// previous model's error at each update; with it the steps shrink (by about the handover length
+// when the updates are further apart than the handover).
+TEST(MultirateSpine, NewLocalModelsAreBlendedInWithoutAStep) {
+  const sp::SpineModel m = sp::load_spine_model(SPINESIM_DATA_DIR);
+  int n0 = 0, n20 = 0;
+  const double at_once = largest_tick_jump_mm(m, 0, n0);
+  const double blended = largest_tick_jump_mm(m, 20, n20);
+  ASSERT_GE(n0, 5);  // the worker kept up (else there is nothing to compare)
+  ASSERT_GE(n20, 5);
+  // Steady growth alone moves T1 about S·ΔF ≈ 0.01-0.02 mm a tick; the updates add more.
+  EXPECT_GT(at_once, 0.03);
+  EXPECT_LT(blended, 0.5 * at_once) << "at once " << at_once << " mm, blended " << blended << " mm";
+  RecordProperty("jump_at_once_um", int(1000 * at_once));
+  RecordProperty("jump_blended_um", int(1000 * blended));
+  EXPECT_THROW(
+      {
+        sh::MultirateOptions o;
+        o.handover_ticks = -1;
+        sh::MultirateSpine bad(m, o);
+      },
+      std::invalid_argument);
+}

@@ -103,6 +103,26 @@ TEST(IoPvd, ShortestTimesAndOneLinePerDataset) {
   EXPECT_EQ(count_files(dir), 1);  // no temporary left behind
 }
 
+// Parts: each part's times increase on their own; the part number is written.
+TEST(IoPvd, PartsShareTimesAndAreWritten) {
+  const std::string dir = tmp_dir("parts");
+  const std::string path = dir + "/two.pvd";
+  write_pvd(path, {{0.0, "d0.vtu", 0}, {0.0, "v0.vtu", 1}, {0.5, "d1.vtu", 0}, {0.5, "v1.vtu", 1}});
+  const std::string text = slurp(path);
+  EXPECT_NE(text.find("part=\"1\" file=\"v1.vtu\""), std::string::npos) << text;
+  EXPECT_NE(text.find("part=\"0\" file=\"d1.vtu\""), std::string::npos) << text;
+  test::expect_one_line_refusal(
+      [&] {
+        write_pvd(path, {{0.0, "a.vtu", 1}, {0.0, "b.vtu", 1}});
+      },
+      path, "strictly increasing");
+  test::expect_one_line_refusal(
+      [&] {
+        write_pvd(path, {{0.0, "a.vtu", -1}});
+      },
+      path, "negative part");
+}
+
 TEST(IoPvd, BadInputIsRefusedWithoutTouchingTheFile) {
   const std::string dir = tmp_dir("bad");
   const std::string path = dir + "/keep.pvd";

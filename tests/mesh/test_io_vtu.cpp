@@ -126,6 +126,23 @@ void round_trip(VtuEncoding enc, const std::string& name) {
 
 TEST(IoVtu, RoundTripBinaryIsBitExact) { round_trip(VtuEncoding::binary, "rt_binary"); }
 TEST(IoVtu, RoundTripAsciiIsExact) { round_trip(VtuEncoding::ascii, "rt_ascii"); }
+TEST(IoVtu, RoundTripZlibIsBitExact) { round_trip(VtuEncoding::zlib, "rt_zlib"); }
+
+// Several 32 KiB blocks (a partial last one) and a compressor declared on the file.
+TEST(IoVtu, ZlibSplitsLargeArraysIntoBlocksAndShrinksThem) {
+  const std::string dir = tmp_dir("zlib_blocks");
+  const TetMesh m = cube_mesh();
+  Eigen::MatrixXd big(m.num_tets(), 5000);  // 5000 doubles a row: 40 kB, more than a block
+  for (Eigen::Index i = 0; i < big.size(); ++i) big.data()[i] = double(i % 97);
+  write_vtu(dir + "/z.vtu", m, {}, {{"big", big}}, {VtuEncoding::zlib});
+  write_vtu(dir + "/b.vtu", m, {}, {{"big", big}}, {VtuEncoding::binary});
+  EXPECT_NE(slurp(dir + "/z.vtu").find("compressor=\"vtkZLibDataCompressor\""), std::string::npos);
+  EXPECT_LT(fs::file_size(dir + "/z.vtu"), fs::file_size(dir + "/b.vtu") / 5);
+  std::vector<DataArray> cd;
+  read_vtu(dir + "/z.vtu", nullptr, &cd);
+  ASSERT_EQ(cd.size(), 1u);
+  EXPECT_TRUE((cd[0].values.array() == big.array()).all());
+}
 
 TEST(IoVtu, BinaryIsTheDefaultAndDeclaresItsLayout) {
   const std::string path = tmp_dir("layout") + "/cube.vtu";
@@ -192,8 +209,10 @@ TEST(IoVtu, MeshioReadsWhatWeWrite) {
   if (!has_meshio()) GTEST_SKIP() << "/usr/bin/python3 with meshio not available";
   const TetMesh m = cube_mesh();
   const auto pd = point_arrays(m);
-  for (VtuEncoding enc : {VtuEncoding::binary, VtuEncoding::ascii}) {
-    const std::string dir = tmp_dir(enc == VtuEncoding::binary ? "meshio_bin" : "meshio_ascii");
+  for (VtuEncoding enc : {VtuEncoding::binary, VtuEncoding::ascii, VtuEncoding::zlib}) {
+    const std::string dir = tmp_dir(enc == VtuEncoding::binary  ? "meshio_bin"
+                                    : enc == VtuEncoding::ascii ? "meshio_ascii"
+                                                                : "meshio_zlib");
     const std::string path = dir + "/cube.vtu";
     write_vtu(path, m, pd, {}, {enc});
     std::istringstream out(run_python(dir, kMeshioSummary, path));
@@ -215,6 +234,39 @@ TEST(IoVtu, MeshioReadsWhatWeWrite) {
       EXPECT_EQ(f, want) << "disc_frame[" << k << "]";
     }
   }
+}
+
+// A triangle surface (vertebrae in a time series): meshio reads its triangles, points and cell
+// array, in both binary encodings.
+TEST(IoVtu, MeshioReadsATriangleSurface) {
+  if (!has_meshio()) GTEST_SKIP() << "/usr/bin/python3 with meshio not available";
+  TriSurface s;
+  s.V.resize(4, 3);
+  s.V << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1.5;
+  s.F.resize(4, 3);
+  s.F << 0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3;
+  Eigen::MatrixXd body(4, 1);
+  body << 0, 1, 2, 3;
+  for (VtuEncoding enc : {VtuEncoding::binary, VtuEncoding::zlib}) {
+    const std::string dir = tmp_dir(enc == VtuEncoding::zlib ? "surf_zlib" : "surf_bin");
+    write_surface_vtu(dir + "/s.vtu", s, {{"height", s.V.col(2)}}, {{"body", body}}, {enc});
+    const std::string out = run_python(dir,
+                                       "import sys, meshio\n"
+                                       "m = meshio.read(sys.argv[1])\n"
+                                       "t = m.cells_dict['triangle']\n"
+                                       "print(len(m.points), len(t), int(t.sum()), "
+                                       "m.points[:, 2].sum(), m.point_data['height'].sum(), "
+                                       "m.cell_data['body'][0].sum())\n",
+                                       dir + "/s.vtu");
+    EXPECT_EQ(out, "4 4 18 1.5 1.5 6.0\n");
+  }
+  const std::string bad = tmp_dir("surf_bad") + "/s.vtu";
+  EXPECT_THROW(write_surface_vtu(bad, s, {}, {{"body", Eigen::MatrixXd::Zero(3, 1)}}),
+               std::invalid_argument);  // 3 values for 4 triangles
+  TriSurface out_of_range = s;
+  out_of_range.F(2, 1) = 4;
+  EXPECT_THROW(write_surface_vtu(bad, out_of_range), std::invalid_argument);
+  EXPECT_FALSE(fs::exists(bad));
 }
 
 // Every encoding of a tetrahedral mesh that python3-meshio writes — VTU ascii; binary with

@@ -48,3 +48,36 @@ TEST(DiscSet, BadInputIsRefused) {
 
 }  // namespace
 }  // namespace spinesim::mss
+
+namespace spinesim::mss {
+namespace {
+
+// for_each runs every disc once, over the threads; set_state replaces one disc's state and
+// refuses a state of the wrong size.
+TEST(DiscSet, ForEachVisitsEveryDiscOnceAndSetStateChecksTheSize) {
+  const mesh::TetMesh m = fixtures::small_box();
+  DiscSet set(2);
+  for (int i = 0; i < 5; ++i) set.add(MssModel(m, fixtures::real_disc()), DynamicsOptions());
+  std::vector<int> visits(5, 0);
+  set.for_each([&](int i) { ++visits[std::size_t(i)]; });
+  EXPECT_EQ(visits, std::vector<int>(5, 1));
+  EXPECT_THROW(set.for_each([](int i) {
+    if (i == 3) throw std::runtime_error("disc 3 failed");
+  }),
+               std::runtime_error);
+  State s = set.state(2);
+  s.x_mm.array() += 0.01;
+  s.time_s = 0.5;
+  set.set_state(2, s);
+  EXPECT_EQ(set.state(2).x_mm, s.x_mm);
+  EXPECT_EQ(set.state(2).time_s, 0.5);
+  State wrong = s;
+  wrong.x_mm.resize(3);
+  EXPECT_THROW(set.set_state(2, wrong), std::invalid_argument);
+  State nan = s;
+  nan.v_mm_s(0) = std::nan("");
+  EXPECT_THROW(set.set_state(2, nan), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace spinesim::mss

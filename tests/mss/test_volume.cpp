@@ -14,6 +14,7 @@
 // loses 1.2 % at 24x the FEM's force).
 #include "solver_fixtures.hpp"
 #include "spinesim/fem/disc_fem.hpp"
+#include "spinesim/mss/quantities.hpp"
 #include "spinesim/mss/solver.hpp"
 
 #include <gtest/gtest.h>
@@ -86,6 +87,43 @@ TEST(MssVolume, TenPercentCompression) {
   EXPECT_LT(std::abs(out[2].volume_change - fem_change), 0.01);
   // The target: the whole-disc volume term keeps |dV/V| under 1 %.
   EXPECT_LT(std::abs(out[3].volume_change), 0.01);
+}
+
+}  // namespace
+}  // namespace spinesim::mss
+
+namespace spinesim::mss {
+namespace {
+
+// The per-tet spring strain: a uniform stretch by s gives s on every tet, a rigid motion 0, and
+// the largest-magnitude edge wins with its sign (brute force over the six edges).
+TEST(MssQuantities, EdgeStrainIsTheLargestEdgeStrainPerTet) {
+  const MssModel model(fixtures::small_box(), fixtures::real_disc());
+  const Eigen::VectorXd X = model.rest_positions_mm();
+  const Eigen::Index n = model.num_nodes();
+  Eigen::VectorXd x = X * 1.03;
+  EXPECT_LT((tet_edge_strain(model, x).array() - 0.03).abs().maxCoeff(), 1e-12);
+  const Eigen::Matrix3d R =
+      Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  for (Eigen::Index i = 0; i < n; ++i)
+    x.segment<3>(3 * i) = R * X.segment<3>(3 * i) + Eigen::Vector3d(5, -2, 1);
+  EXPECT_LT(tet_edge_strain(model, x).cwiseAbs().maxCoeff(), 1e-12);
+  x = X;
+  for (Eigen::Index i = 0; i < n; ++i) x(3 * i + 1) *= 0.9 + 0.05 * std::sin(double(i));
+  const Eigen::VectorXd e = tet_edge_strain(model, x);
+  const mesh::TetMesh& m = model.mesh();
+  for (Eigen::Index t = 0; t < m.num_tets(); ++t) {
+    double want = 0;
+    for (int a = 0; a < 4; ++a)
+      for (int b = a + 1; b < 4; ++b) {
+        const Eigen::Index i = m.T(t, a), j = m.T(t, b);
+        const double s = (x.segment<3>(3 * j) - x.segment<3>(3 * i)).norm() /
+                             (X.segment<3>(3 * j) - X.segment<3>(3 * i)).norm() -
+                         1;
+        if (std::abs(s) > std::abs(want)) want = s;
+      }
+    EXPECT_NEAR(e(t), want, 1e-14) << "tet " << t;
+  }
 }
 
 }  // namespace

@@ -112,14 +112,19 @@ struct MultirateOptions {
   /// between, Broyden's secant update from consecutive solves keeps it current at one solve per
   /// update.
   int full_sensitivity_every = 8;
+  /// A new local model of the same hook takes over from the previous one over this many ticks
+  /// (the two predictions blended linearly), so that a worker update does not step the spine:
+  /// without it T1 jumped by up to 0.6 mm in one tick when a new solve arrived (measured on the
+  /// lateral drag). 0: switch at once.
+  int handover_ticks = 20;
 };
 
 /// The worker: solve at the latest hook load, update the sensitivity, publish, repeat. It idles
 /// while there is no hook. A new hook starts from one solve and the fixed-muscle derivative
 /// (cheap, too compliant with recruitment), then the full sensitivity, then secant updates.
-/// predict() uses the latest model when it was made for the same vertebra and hook point; before
-/// the first one arrives for a new hook it predicts no motion (the hook's force ramps up from
-/// zero over ~0.3 s).
+/// predict() uses the latest model when it was made for the same vertebra and hook point (blended
+/// in from the previous one over MultirateOptions::handover_ticks); before the first one arrives
+/// for a new hook it predicts no motion (the hook's force ramps up from zero over ~0.3 s).
 class MultirateSpine final : public SpineResponse {
  public:
   /// Solves the gravity-only baseline here (throws spine::SolveError if it fails).
@@ -127,7 +132,7 @@ class MultirateSpine final : public SpineResponse {
   ~MultirateSpine() override;
   const char* name() const override { return "multirate"; }
   void predict(const HookLoad& load, SpineDisplacement& relative) override;
-  void publish(const HookLoad& load) override { request_.write(load); }
+  void publish(const HookLoad& load) override;
   const SpineDisplacement& baseline() const override { return baseline_; }
   double max_force_n() const override { return options_.max_force_n; }
   void start() override;
@@ -158,6 +163,9 @@ class MultirateSpine final : public SpineResponse {
   std::atomic<bool> stop_{false};
   std::thread worker_;
   Stats stats_;
+  // The servo thread's side: the model in use, the one it is taking over from, ticks left.
+  LocalSpineModel current_, previous_;
+  int handover_left_ = 0;
 };
 
 struct CouplingParameters {

@@ -34,9 +34,16 @@ struct DataArray {
   Eigen::MatrixXd values;
 };
 
-/// How VTU DataArrays are encoded: inline base64 raw binary (compact, bit-exact; default) or
-/// ASCII text (human readable, also exact).
-enum class VtuEncoding { binary, ascii };
+/// A triangle surface (vertebra, endplate patch).
+struct TriSurface {
+  Eigen::MatrixX3d V;  ///< #V×3, mm, spinesim frame
+  Eigen::MatrixX3i F;  ///< #F×3, 0-based vertex indices
+};
+
+/// How VTU DataArrays are encoded: inline base64 raw binary (compact, bit-exact; default),
+/// ASCII text (human readable, also exact), or inline base64 binary compressed in 32 KiB zlib
+/// blocks (VTK's vtkZLibDataCompressor; bit-exact, for long time series).
+enum class VtuEncoding { binary, ascii, zlib };
 
 struct VtuWriteOptions {
   VtuEncoding encoding = VtuEncoding::binary;
@@ -49,6 +56,14 @@ struct VtuWriteOptions {
 void write_vtu(const std::string& path, const TetMesh& m,
                const std::vector<DataArray>& point_data = {},
                const std::vector<DataArray>& cell_data = {}, const VtuWriteOptions& options = {});
+
+/// Writes a triangle surface as a VTU (VTK_TRIANGLE cells) with extra point and cell arrays —
+/// the vertebrae beside the discs of a time series. Same checks, encoding and atomic write as
+/// write_vtu (no reserved names; indices must be in range).
+void write_surface_vtu(const std::string& path, const TriSurface& s,
+                       const std::vector<DataArray>& point_data = {},
+                       const std::vector<DataArray>& cell_data = {},
+                       const VtuWriteOptions& options = {});
 
 /// Reads a VTU with a single Piece, in every encoding the VTK XML format allows: DataArrays
 /// format="ascii", "binary" (inline base64) or "appended" (<AppendedData> raw or base64, arrays
@@ -88,12 +103,6 @@ TetMesh read_tet_mesh(const std::string& path, std::vector<DataArray>* point_dat
 /// discs such triangles are rare and sit on the rim. Atomic write as for write_vtu.
 void write_medit(const std::string& path, const TetMesh& m);
 
-/// A triangle surface (vertebra, endplate patch).
-struct TriSurface {
-  Eigen::MatrixX3d V;  ///< #V×3, mm, spinesim frame
-  Eigen::MatrixX3i F;  ///< #F×3, 0-based vertex indices
-};
-
 /// The file's axis that points superior (up).
 enum class UpAxis { x, y, z, minus_x, minus_y, minus_z };
 
@@ -115,19 +124,21 @@ enum class UpAxis { x, y, z, minus_x, minus_y, minus_z };
 /// non-finite coordinates; also for units_to_mm that is not finite and positive.
 TriSurface read_surface(const std::string& path, double units_to_mm, UpAxis up);
 
-/// One dataset of a ParaView data collection: the time it shows (s) and its file. A relative
-/// `file` is resolved by ParaView against the .pvd file's folder.
+/// One dataset of a ParaView data collection: the time it shows (s), its file and the part it
+/// belongs to (a collection of several parts shows them together at each time: discs and
+/// vertebrae, say). A relative `file` is resolved by ParaView against the .pvd file's folder.
 struct PvdEntry {
   double time_s = 0.0;
   std::string file;
+  int part = 0;  ///< >= 0
 };
 
 /// Writes a ParaView data collection (.pvd: VTKFile type="Collection", one
-/// <DataSet timestep=".." group="" part="0" file=".."/> per entry, times in the shortest
+/// <DataSet timestep=".." group="" part=".." file=".."/> per entry, times in the shortest
 /// round-trip decimal form, names XML-escaped) — the time series of VTU frames. Refuses
-/// (std::invalid_argument, one line naming `path`) an empty list, non-finite or not strictly
-/// increasing times and empty file names; the listed files need not exist yet. Atomic write
-/// as for write_vtu.
+/// (std::invalid_argument, one line naming `path`) an empty list, a negative part, non-finite
+/// times or times not strictly increasing within a part, and empty file names; the listed files
+/// need not exist yet. Atomic write as for write_vtu.
 void write_pvd(const std::string& path, const std::vector<PvdEntry>& entries);
 
 }  // namespace spinesim::mesh

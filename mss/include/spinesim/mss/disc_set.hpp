@@ -7,6 +7,7 @@
 #include "spinesim/mss/model.hpp"
 #include "spinesim/mss/solver.hpp"
 
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -27,12 +28,19 @@ class DiscSet {
 
   const MssModel& model(int i) const;
   const State& state(int i) const;
+  /// Replaces disc i's state (an equilibrium to start from, say); throws std::invalid_argument
+  /// for a state of the wrong size or with non-finite values.
+  void set_state(int i, State state);
   double total_tets() const;
 
   /// Advances every disc by its dt; bcs[i] is disc i's boundary at the end of the step
   /// (throws std::invalid_argument if bcs.size() != size()). A rejected step leaves that disc
   /// unchanged and is reported in its StepReport; the others still advance.
   const std::vector<StepReport>& step(const std::vector<Boundary>& bcs);
+
+  /// Calls work(i) for every disc i, over the set's threads as step() does (work on different
+  /// discs must be independent); the first exception is rethrown after all have run.
+  void for_each(const std::function<void(int)>& work) const;
 
  private:
   struct Impl;

@@ -20,6 +20,10 @@ double max_displacement_mm(const MssModel& model, const Eigen::VectorXd& x_mm);
 /// Relative volume change (V_t − V0_t)/V0_t of every tetrahedron (signed volumes), #T.
 Eigen::VectorXd tet_volume_change(const MssModel& model, const Eigen::VectorXd& x_mm);
 
+/// Spring strain of every tetrahedron: of its six edges' strains (l − L)/L, the one of largest
+/// magnitude (signed: > 0 stretched, < 0 compressed), #T.
+Eigen::VectorXd tet_edge_strain(const MssModel& model, const Eigen::VectorXd& x_mm);
+
 /// Relative volume change of the whole disc at x, (V − V0)/V0.
 double volume_change(const MssModel& model, const Eigen::VectorXd& x_mm);
 

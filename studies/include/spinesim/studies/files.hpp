@@ -8,6 +8,7 @@
 
 #include <Eigen/Core>
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -40,6 +41,9 @@ class VtuSeries {
   VtuSeries(const VtuSeries&) = delete;
   VtuSeries& operator=(const VtuSeries&) = delete;
   void add(double time_s, const mss::MssModel& model, const Eigen::VectorXd& x_mm);
+  /// A frame of part `part` (>= 0) written by `write` to the staging path it is given (a VTU);
+  /// every part's times must increase.
+  void add(double time_s, int part, const std::function<void(const std::string&)>& write);
   void finish();
   void discard();
   const std::string& pvd_path() const { return pvd_path_; }

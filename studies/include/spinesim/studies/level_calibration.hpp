@@ -8,6 +8,7 @@
 
 #include "spinesim/calibration/tuned_set.hpp"
 #include "spinesim/mesh/mesher.hpp"
+#include "spinesim/mesh/structured_disc.hpp"
 
 #include <functional>
 #include <optional>
@@ -33,8 +34,11 @@ struct AllLevelsRequest {
   CalibrationRequest calibration;      ///< per level; its transfer_meshes must be empty
   std::optional<double> cell_size_mm;  ///< every level's; default: default_level_cell_size_mm
   bool transfer = true;                ///< check each level on its second resolution
-  std::vector<std::string> levels;     ///< empty: mesh::disc_levels()
-  std::string generated_by;            ///< recorded in the set
+  /// Set: calibrate each level's structured disc of these options (the mesh the spine's offline
+  /// discs simulate) instead of the CGAL disc; its second resolution has 4 more sectors.
+  std::optional<mesh::StructuredDiscOptions> structured;
+  std::vector<std::string> levels;  ///< empty: mesh::disc_levels()
+  std::string generated_by;         ///< recorded in the set
 };
 
 /// One level's row of the report.
