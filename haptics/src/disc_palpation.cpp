@@ -1,0 +1,282 @@
+#include "spinesim/haptics/disc_palpation.hpp"
+
+#include "spinesim/mss/quantities.hpp"
+
+#include <pthread.h>
+#include <sched.h>
+#include <time.h>
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <array>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <map>
+#include <stdexcept>
+
+namespace spinesim::haptics {
+
+namespace {
+
+double monotonic_s() {
+  timespec ts{};
+  ::clock_gettime(CLOCK_MONOTONIC, &ts);
+  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
+timespec to_timespec(double s) {
+  timespec ts{};
+  ts.tv_sec = time_t(std::floor(s));
+  ts.tv_nsec = long((s - std::floor(s)) * 1e9);
+  if (ts.tv_nsec >= 1000000000L) ts.tv_sec += 1, ts.tv_nsec -= 1000000000L;
+  return ts;
+}
+
+void require(bool ok, const char* what) {
+  if (!ok) throw std::invalid_argument(std::string("disc palpation: ") + what);
+}
+
+mss::DynamicsOptions dynamics(const DiscPalpationOptions& o) {
+  require(std::isfinite(o.coupling_stiffness_n_per_mm) && o.coupling_stiffness_n_per_mm > 0,
+          "the coupling stiffness must be > 0 N/mm");
+  require(std::isfinite(o.coupling_damping_n_s_per_mm) && o.coupling_damping_n_s_per_mm >= 0,
+          "the coupling damping must be >= 0 N·s/mm");
+  require(std::isfinite(o.probe_radius_mm) && o.probe_radius_mm > 0,
+          "the probe radius must be > 0 mm");
+  require(std::isfinite(o.probe_penalty_n_per_mm) && o.probe_penalty_n_per_mm >= 0,
+          "the probe penalty must be >= 0 N/mm (0: the default)");
+  require(std::isfinite(o.dt_s) && o.dt_s > 0 && o.dt_s <= 0.01, "the step must be in (0, 10] ms");
+  require(o.newton_iterations >= 1 && o.newton_iterations <= 20,
+          "the Newton iterations must be 1 to 20");
+  mss::DynamicsOptions d;
+  d.integrator = mss::Integrator::implicit_euler;
+  d.dt_s = o.dt_s;
+  d.newton_iterations = o.newton_iterations;
+  d.matrix_update = mss::MatrixUpdate::frozen;
+  return d;
+}
+
+}  // namespace
+
+double surface_gap_mm(const mesh::TetMesh& m) {
+  // Boundary faces (the faces of exactly one tet) of the outer wall.
+  std::map<std::array<int, 3>, int> count;
+  static constexpr int kFaces[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};
+  for (Eigen::Index t = 0; t < m.num_tets(); ++t)
+    for (const auto& f : kFaces) {
+      std::array<int, 3> key = {m.T(t, f[0]), m.T(t, f[1]), m.T(t, f[2])};
+      std::sort(key.begin(), key.end());
+      ++count[key];
+    }
+  double gap = 0;
+  for (const auto& [key, n] : count) {
+    if (n != 1) continue;
+    const int l = m.surface(key[0]);
+    if ((l == 1 || l == 2) && m.surface(key[1]) == l && m.surface(key[2]) == l)
+      continue;  // an endplate face: the vertebra covers it
+    const Eigen::Vector3d a = m.V.row(key[0]), b = m.V.row(key[1]), c = m.V.row(key[2]);
+    // Circumradius |ab| |bc| |ca| / (4 area).
+    const double area2 = (b - a).cross(c - a).norm();
+    if (area2 <= 0) continue;
+    gap = std::max(gap, (b - a).norm() * (c - b).norm() * (a - c).norm() / (2 * area2));
+  }
+  return gap;
+}
+
+DiscPalpation::DiscPalpation(const mss::MssModel& model, const mss::Boundary& plates,
+                             const DiscPalpationOptions& options)
+    : model_(model), options_(options), sim_(model, dynamics(options)), bc_(plates) {
+  mss::validate(bc_, model.num_nodes());
+  const double gap = surface_gap_mm(model.mesh());
+  if (!(options.probe_radius_mm > gap)) {
+    char why[256];
+    std::snprintf(why, sizeof why,
+                  "disc palpation: a probe of radius %.1f mm would slip between the disc's surface "
+                  "nodes (up to %.1f mm from the nearest): give a larger radius or a finer disc",
+                  options.probe_radius_mm, gap);
+    throw std::invalid_argument(why);
+  }
+  state_ = sim_.rest_state();
+  k_p_ = options.probe_penalty_n_per_mm > 0 ? options.probe_penalty_n_per_mm
+                                            : mss::default_probe_stiffness(model);
+  mss::Probe probe;
+  probe.radius_mm = options.probe_radius_mm;
+  probe.stiffness_n_per_mm = k_p_;
+  probe.center_mm = Eigen::Vector3d::Constant(1e9);  // far away until the first step
+  bc_.probes = {probe};
+  for (Eigen::Index i = 0; i < model.num_nodes(); ++i)
+    if (model.mesh().surface(i) != 0) surface_nodes_.push_back(i);
+  last_.probe_mm = Eigen::Vector3d::Constant(1e9);
+  out_.write(last_);
+}
+
+DiscPalpation::~DiscPalpation() { stop(); }
+
+Eigen::Vector3d DiscPalpation::place_probe(const Eigen::Vector3d& device) const {
+  // The nodes that can touch the probe on its way from the device towards the surface.
+  const double r = options_.probe_radius_mm, kc = options_.coupling_stiffness_n_per_mm;
+  const Eigen::VectorXd& x = state_.x_mm;
+  auto energy = [&](const Eigen::Vector3d& p, Eigen::Vector3d* g, Eigen::Matrix3d* H) {
+    double e = 0.5 * kc * (p - device).squaredNorm();
+    if (g) *g = kc * (p - device);
+    if (H) *H = kc * Eigen::Matrix3d::Identity();
+    for (const Eigen::Index i : surface_nodes_) {
+      const Eigen::Vector3d d = p - x.segment<3>(3 * i);
+      const double dist2 = d.squaredNorm();
+      if (dist2 >= r * r) continue;
+      const double dist = std::sqrt(dist2), pen = r - dist;
+      e += 0.5 * k_p_ * pen * pen;
+      if (dist < 1e-12) continue;  // no direction to push along
+      const Eigen::Vector3d n = d / dist;
+      if (g) *g -= k_p_ * pen * n;
+      if (H) *H += k_p_ * n * n.transpose();  // Gauss-Newton: the convex part
+    }
+    return e;
+  };
+  // From where the probe was (the node penalty is symmetric about each node: started from a
+  // device already past the wall's nodes, the minimum on the inner side would be found), in
+  // steps of at most r/4, so that it cannot jump over the wall's nodes.
+  Eigen::Vector3d p = last_.probe_mm.allFinite() && (last_.probe_mm - device).norm() < 1e6
+                          ? last_.probe_mm
+                          : device;
+  Eigen::Vector3d g;
+  Eigen::Matrix3d H;
+  double e = energy(p, &g, &H);
+  const double max_step = 0.25 * r;
+  for (int it = 0; it < 200; ++it) {
+    Eigen::Vector3d step = -H.ldlt().solve(g);
+    if (step.norm() > max_step) step *= max_step / step.norm();
+    double alpha = 1;
+    Eigen::Vector3d q = p + step;
+    double eq = energy(q, nullptr, nullptr);
+    while (eq > e + 1e-4 * alpha * g.dot(step) && alpha > 1e-6) {
+      alpha *= 0.5;
+      q = p + alpha * step;
+      eq = energy(q, nullptr, nullptr);
+    }
+    p = q;
+    e = energy(p, &g, &H);
+    if (alpha * step.norm() < 1e-7) break;
+  }
+  // Free of the disc the minimiser is the device itself (up to round-off): say so exactly.
+  if ((p - device).norm() < 1e-9) return device;
+  return p;
+}
+
+bool DiscPalpation::touches_disc(const Eigen::Vector3d& point) const {
+  const double r = options_.probe_radius_mm;
+  const Eigen::VectorXd& x = state_.x_mm;
+  for (const Eigen::Index i : surface_nodes_)
+    if ((point - x.segment<3>(3 * i)).squaredNorm() < r * r) return true;
+  const mesh::TetMesh& m = model_.mesh();
+  for (Eigen::Index t = 0; t < m.num_tets(); ++t) {
+    const Eigen::Vector3d a = x.segment<3>(3 * m.T(t, 0));
+    Eigen::Matrix3d E;
+    for (int k = 1; k < 4; ++k) E.col(k - 1) = x.segment<3>(3 * m.T(t, k)) - a;
+    const Eigen::Vector3d l = E.partialPivLu().solve(point - a);
+    if (l.minCoeff() >= 0 && l.sum() <= 1) return true;
+  }
+  return false;
+}
+
+const DiscContact& DiscPalpation::step(const Eigen::Vector3d& device_mm) {
+  const auto t0 = std::chrono::steady_clock::now();
+  // Until the device has been outside the disc once, the probe is not put in: started inside,
+  // the probe would be held on the inner side of the wall and pull the hand deeper.
+  if (!armed_ && !touches_disc(device_mm)) {
+    armed_ = true;
+    last_.probe_mm = device_mm;  // the probe starts from here, outside
+  }
+  const Eigen::Vector3d p = armed_ ? place_probe(device_mm) : device_mm;
+  bc_.probes[0].center_mm = p;
+  const mss::StepReport report = sim_.step(state_, bc_);
+  ++last_.step;
+  last_.probe_mm = p;
+  last_.contact = p != device_mm;
+  last_.force_n = last_.contact ? mss::probe_forces(model_, bc_, state_.x_mm)[0]
+                                : Eigen::Vector3d::Zero().eval();
+  last_.volume_change = mss::volume_change(model_, state_.x_mm);
+  last_.failed = !report.ok;
+  last_.step_us =
+      std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count();
+  return last_;
+}
+
+void DiscPalpation::start() {
+  if (thread_.joinable()) return;
+  stats_ = Stats();
+  stats_.step_us.reserve(std::size_t(3600.0 / options_.dt_s));  // an hour of steps
+  stop_.store(false);
+  thread_ = std::thread([this] { run(); });
+}
+
+void DiscPalpation::stop() {
+  stop_.store(true);
+  if (thread_.joinable()) thread_.join();
+}
+
+void DiscPalpation::run() {
+  if (options_.realtime_priority) {
+    sched_param sp{};
+    sp.sched_priority = options_.priority;
+    const int rc = ::pthread_setschedparam(::pthread_self(), SCHED_FIFO, &sp);
+    stats_.realtime_priority = rc == 0;
+    stats_.realtime_reason = rc == 0
+                                 ? "SCHED_FIFO priority " + std::to_string(options_.priority)
+                                 : std::string("SCHED_FIFO refused (") + std::strerror(rc) + ")";
+  } else {
+    stats_.realtime_reason = "not asked for";
+  }
+  double deadline = monotonic_s() + options_.dt_s;
+  while (!stop_.load()) {
+    const timespec ts = to_timespec(deadline);
+    while (::clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {}
+    const DiscContact& c = step(device_.read());
+    out_.write(c);
+    ++stats_.steps;
+    stats_.failed_steps += c.failed;
+    if (stats_.step_us.size() < stats_.step_us.capacity())
+      stats_.step_us.push_back(float(c.step_us));
+    stats_.max_force_n = std::max(stats_.max_force_n, c.force_n.norm());
+    stats_.min_volume_change = std::min(stats_.min_volume_change, c.volume_change);
+    stats_.max_volume_change = std::max(stats_.max_volume_change, c.volume_change);
+    deadline += options_.dt_s;
+    const double now = monotonic_s();
+    if (now > deadline) {  // this step ended past the next one's start: skip, do not pile up
+      ++stats_.overruns;
+      deadline = now + options_.dt_s;
+    }
+  }
+}
+
+DiscCouplingRenderer::DiscCouplingRenderer(ForceRenderer& rigid, DiscPalpation& disc)
+    : rigid_(rigid), palpation_(disc) {}
+
+void DiscCouplingRenderer::reset(const Eigen::Vector3d& device_mm) {
+  rigid_.reset(device_mm);
+  palpation_.set_device(device_mm);
+}
+
+RenderOutput DiscCouplingRenderer::render(const ProbeState& probe, const Scene& scene,
+                                          const ScenePoses& poses, double dt_s) {
+  RenderOutput out = rigid_.render(probe, scene, poses, dt_s);
+  palpation_.set_device(probe.position_mm);
+  disc_ = palpation_.latest();
+  if (!disc_.contact) return out;
+  const DiscPalpationOptions& o = palpation_.options();
+  const Eigen::Vector3d f = o.coupling_stiffness_n_per_mm * (disc_.probe_mm - probe.position_mm) -
+                            o.coupling_damping_n_s_per_mm * probe.velocity_mm_s;
+  out.force_n += f;
+  if (!out.contact) {
+    out.contact = true;
+    out.proxy_mm = disc_.probe_mm;
+    out.penetration_mm = (disc_.probe_mm - probe.position_mm).norm();
+  }
+  return out;
+}
+
+}  // namespace spinesim::haptics
