@@ -2,7 +2,8 @@
 """Writes the scripted hand trajectories of data/haptics/ from the parametric vertebrae.
 
     spinesim mesh vertebrae --out /tmp/vertebrae
-    scripts/make-haptic-scripts.py /tmp/vertebrae data/haptics
+    spinesim mesh disc --level L4-L5 --cell-size 2.5 --out /tmp/disc-L4-L5.vtu
+    scripts/make-haptic-scripts.py /tmp/vertebrae data/haptics /tmp/disc-L4-L5.vtu
 
 The trajectories are set-points of the simulated hand (t_s, x_mm, y_mm, z_mm, button) in the
 scene frame (x lateral, y up, z anterior), for a probe of radius 4 mm:
@@ -13,6 +14,9 @@ scene frame (x lateral, y up, z anterior), for a probe of radius 4 mm:
                       T1's spinous tip from behind, presses the button there, drags T1 40 mm
                       (to the left, backwards, or left-up-backwards), holds, brings it back and
                       lets go.
+  press_disc_l4l5.csv the L4-L5 disc (scene disc) pressed at its anterior wall at mid-height,
+                      along the disc's anterior axis: 2 mm, then 4 mm past first touch, each held
+                      (needs the disc mesh and /usr/bin/python3's meshio).
 """
 import os
 import sys
@@ -91,6 +95,30 @@ def main():
                 (7.5, *away, 0)]
         write(os.path.join(out, f"drag_t1_{name}.csv"),
               f"drag T1 {name}ly 40 mm from its spinous tip (button held 1.0-6.5 s)", rows)
+
+    if len(sys.argv) > 3:
+        write_disc_press(sys.argv[3], out)
+
+
+def write_disc_press(disc_vtu, out):
+    """As studies::disc_anterior_wall: the most anterior node within the middle third of the
+    height, in the disc's frame (the VTU's disc_frame: origin, then the x, y, z axes)."""
+    import meshio
+    import numpy as np
+    m = meshio.read(disc_vtu)
+    f = np.asarray(m.field_data["disc_frame"], dtype=float).ravel()
+    origin, axes = f[:3], f[3:].reshape(3, 3).T  # columns: the local x, y, z axes
+    local = (m.points - origin) @ axes
+    lo, hi = local[:, 1].min(), local[:, 1].max()
+    middle = np.abs(local[:, 1] - 0.5 * (lo + hi)) < (hi - lo) / 6
+    wall = m.points[np.where(middle)[0][np.argmax(local[middle, 2])]]
+    n = axes[:, 2]
+    at = lambda d: tuple(wall + (RADIUS - d) * n)  # probe surface d mm past the wall
+    away = at(-12.0)
+    rows = [(0.0, *away), (1.0, *at(-1.0)), (2.0, *at(2.0)), (3.0, *at(2.0)), (3.5, *at(-1.0)),
+            (4.5, *at(4.0)), (5.5, *at(4.0)), (6.0, *at(-1.0)), (7.0, *away)]
+    write(os.path.join(out, "press_disc_l4l5.csv"),
+          "press the L4-L5 disc's anterior wall 2 mm, then 4 mm (scene disc)", rows)
 
 
 if __name__ == "__main__":

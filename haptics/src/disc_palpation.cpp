@@ -266,6 +266,11 @@ RenderOutput DiscCouplingRenderer::render(const ProbeState& probe, const Scene& 
   RenderOutput out = rigid_.render(probe, scene, poses, dt_s);
   palpation_.set_device(probe.position_mm);
   disc_ = palpation_.latest();
+  out.disc = true;
+  out.disc_contact = disc_.contact;
+  out.disc_volume_change = disc_.volume_change;
+  out.disc_force_n = disc_.force_n;
+  out.disc_probe_mm = disc_.contact ? disc_.probe_mm : probe.position_mm;
   if (!disc_.contact) return out;
   const DiscPalpationOptions& o = palpation_.options();
   const Eigen::Vector3d f = o.coupling_stiffness_n_per_mm * (disc_.probe_mm - probe.position_mm) -

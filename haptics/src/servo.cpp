@@ -163,6 +163,10 @@ void ServoLoop::tick(double now_s, double period_s) {
   status.body = out.body;
   status.buttons = state_.buttons;
   status.passivity_mj = passivity_.energy_mj();
+  status.disc = out.disc;
+  status.disc_contact = out.disc_contact;
+  status.disc_volume_change = out.disc_volume_change;
+  status.disc_force_n = out.disc_force_n;
   if (stage_) {
     const HookState& h = stage_->state();
     status.hook = h;
@@ -186,6 +190,11 @@ void ServoLoop::tick(double now_s, double period_s) {
       r.proxy_mm = out.proxy_mm;
       r.buttons = state_.buttons;
       r.contact = out.contact;
+      r.disc = out.disc;
+      r.disc_contact = out.disc_contact;
+      r.disc_volume_change = float(out.disc_volume_change);
+      r.disc_force_n = out.disc_force_n.cast<float>();
+      r.disc_probe_mm = out.disc_probe_mm.cast<float>();
       r.compliant = stage_ != nullptr;
       if (stage_) {
         r.hook = stage_->state();

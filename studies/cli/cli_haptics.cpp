@@ -70,7 +70,9 @@ void run_haptics_cli(HapticsArgs& a) {
   const bool live = !a.quiet && !a.json && stderr_is_terminal();
   std::unique_ptr<ProgressBar> bar;
   if (a.request.scene.scene != "plane")
-    bar = std::make_unique<ProgressBar>(a.request.scene.scene == "spine" ? 18 : 1,
+    bar = std::make_unique<ProgressBar>(a.request.scene.scene == "spine"  ? 18
+                                        : a.request.scene.scene == "disc" ? 2
+                                                                          : 1,
                                         a.quiet || a.json, "vertebrae meshed");
   HapticsRunResult result;
   {
@@ -79,18 +81,23 @@ void run_haptics_cli(HapticsArgs& a) {
         a.request, data_dir(),
         [live](const haptics::ServoStatus& s) {
           if (!live) return;
-          if (s.hook.attached || s.hook.gain > 0)
+          if (s.disc)
             std::fprintf(stderr,
-                         "\r  t %6.1f s | %6.1f Hz | force %5.2f N | hooked %s, spine %6.1f N  ",
+                         "\r  t %6.1f s | %6.1f Hz | force %5.2f N | disc %s, %5.2f N, volume "
+                         "%+7.3f %%  ",
                          s.time_s, s.time_s > 0 ? double(s.ticks) / s.time_s : 0.0,
-                         s.force_n.norm(),
-                         spine::vertebra_names()[std::size_t(std::max(0, s.hook.load.vertebra))]
-                             .c_str(),
-                         s.hook.load.force_n.norm());
+                         s.force_n.norm(), s.disc_contact ? "pressed" : "free   ",
+                         s.disc_force_n.norm(), 100 * s.disc_volume_change);
+          else if (s.hook.attached || s.hook.gain > 0)
+            std::fprintf(
+                stderr, "\r  t %6.1f s | %6.1f Hz | force %5.2f N | hooked %s, spine %6.1f N  ",
+                s.time_s, s.time_s > 0 ? double(s.ticks) / s.time_s : 0.0, s.force_n.norm(),
+                spine::vertebra_names()[std::size_t(std::max(0, s.hook.load.vertebra))].c_str(),
+                s.hook.load.force_n.norm());
           else
-            std::fprintf(stderr, "\r  t %6.1f s | %6.1f Hz | force %5.2f N | %s        ",
-                         s.time_s, s.time_s > 0 ? double(s.ticks) / s.time_s : 0.0,
-                         s.force_n.norm(), s.contact ? "contact" : "free   ");
+            std::fprintf(stderr, "\r  t %6.1f s | %6.1f Hz | force %5.2f N | %s        ", s.time_s,
+                         s.time_s > 0 ? double(s.ticks) / s.time_s : 0.0, s.force_n.norm(),
+                         s.contact ? "contact" : "free   ");
           std::fflush(stderr);
         },
         [&bar](int done, int) {
@@ -136,7 +143,17 @@ void register_haptics(CLI::App& app) {
   auto* run = haptics_cmd->add_subcommand(
       "run", "Run the servo loop on a scene with a device (sim: a scripted hand)");
   run->add_option("--scene", a->request.scene.scene,
-                  "spine (T1-L5 and sacrum), vertebra (L3) or plane")
+                  "spine (T1-L5 and sacrum), vertebra (L3), disc (a tuned disc between its two "
+                  "vertebrae, --level) or plane")
+      ->capture_default_str();
+  run->add_option("--level", a->request.scene.level,
+                  "--scene disc: the disc level (T1-T2 ... L5-S1)")
+      ->capture_default_str();
+  run->add_option("--params", a->request.disc_params,
+                  "--scene disc: tuned set or tuned.json (default: data/tuned_discs.json)");
+  run->add_option("--disc-budget-us", a->request.disc_budget_us,
+                  "--scene disc: the disc step's p99 must fit this; at start the finest mesh "
+                  "(2, 2.5, 3, 4 mm cells) that does is chosen")
       ->capture_default_str();
   run->add_option("--vertebrae", a->request.scene.vertebrae,
                   "Vertebra surfaces: generated (parametric), real (ArtiSynth L1-S1 from the test "
@@ -194,9 +211,10 @@ void register_haptics(CLI::App& app) {
                   "Spine force per felt force, N/N (default: 600 N on the spine at the device's "
                   "peak force)");
   run->add_option("--coupling-stiffness", a->request.coupling_stiffness_n_per_mm,
-                  "Felt stiffness of the hook spring, N/mm (default: the rendering stiffness)");
+                  "Felt stiffness of the hook spring (--spine) or of the disc coupling (--scene "
+                  "disc), N/mm (default: the rendering stiffness)");
   run->add_option("--coupling-damping", a->request.coupling_damping_n_s_per_mm,
-                  "Felt damping of the hook spring, N*s/mm")
+                  "Felt damping of the hook spring or the disc coupling, N*s/mm")
       ->capture_default_str();
   run->add_flag("--no-recruit{false}", a->request.spine_recruit,
                 "--spine multirate: passive spine solves (muscles off)");

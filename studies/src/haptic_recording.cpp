@@ -45,8 +45,8 @@ std::string spine_model_fingerprint(const spine::SpineModel& m) {
 HapticRecordingWriter::HapticRecordingWriter(const std::string& path,
                                              const std::string& description,
                                              const spine::SpineModel* model,
-                                             const std::string& response)
-    : path_(path) {
+                                             const std::string& response, bool disc)
+    : path_(path), disc_(disc) {
   file_ = std::fopen(path.c_str(), "w");
   if (!file_) throw std::runtime_error("--record " + path + ": cannot write there");
   std::fprintf(file_,
@@ -62,6 +62,10 @@ HapticRecordingWriter::HapticRecordingWriter(const std::string& path,
   std::fprintf(file_,
                "t_s,x_mm,y_mm,z_mm,button,fx_n,fy_n,fz_n,proxy_x_mm,proxy_y_mm,proxy_z_mm,"
                "contact,tick");
+  if (disc)
+    std::fprintf(file_,
+                 ",disc_contact,disc_probe_x_mm,disc_probe_y_mm,disc_probe_z_mm,disc_fx_n,"
+                 "disc_fy_n,disc_fz_n,disc_volume_change");
   if (model) {
     std::fprintf(file_,
                  ",attached,hook_vertebra,hook_ref_x_mm,hook_ref_y_mm,hook_ref_z_mm,"
@@ -88,6 +92,11 @@ void HapticRecordingWriter::append(const haptics::TickRecord* rows, std::size_t 
                  r.probe_mm.x(), r.probe_mm.y(), r.probe_mm.z(), r.buttons & 1u, r.force_n.x(),
                  r.force_n.y(), r.force_n.z(), r.proxy_mm.x(), r.proxy_mm.y(), r.proxy_mm.z(),
                  r.contact ? 1 : 0, static_cast<long long>(r.tick));
+    if (disc_)
+      std::fprintf(file_, ",%d,%.4f,%.4f,%.4f,%.5f,%.5f,%.5f,%.7f", r.disc_contact ? 1 : 0,
+                   r.disc_probe_mm.x(), r.disc_probe_mm.y(), r.disc_probe_mm.z(),
+                   r.disc_force_n.x(), r.disc_force_n.y(), r.disc_force_n.z(),
+                   r.disc_volume_change);
     if (!centres_.empty()) {
       const auto& h = r.hook;
       std::fprintf(file_, ",%d,%d,%.5f,%.5f,%.5f,%.4f,%.4f,%.4f,%.5f,%.5f,%.5f", h.attached ? 1 : 0,

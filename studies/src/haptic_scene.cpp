@@ -2,6 +2,7 @@
 
 #include "spinesim/common/input_file.hpp"
 #include "spinesim/common/timer.hpp"
+#include "spinesim/mesh/disc_geometry.hpp"
 #include "spinesim/mesh/io.hpp"
 #include "spinesim/mesh/vertebra_geometry.hpp"
 
@@ -187,8 +188,14 @@ HapticScene build_haptic_scene(const HapticSceneRequest& r, const std::string& d
                                const std::function<void(int, int)>& progress) {
   const Timer timer;
   HapticScene out;
-  if (r.scene != "plane" && r.scene != "vertebra" && r.scene != "spine")
-    throw std::invalid_argument("--scene " + r.scene + ": give spine, vertebra or plane");
+  if (r.scene != "plane" && r.scene != "vertebra" && r.scene != "spine" && r.scene != "disc")
+    throw std::invalid_argument("--scene " + r.scene + ": give spine, vertebra, disc or plane");
+  std::vector<std::string> level_bodies;
+  if (r.scene == "disc") {
+    mesh::disc_dimensions(r.level, data_dir);  // a known level
+    const std::size_t dash = r.level.find('-');
+    level_bodies = {r.level.substr(0, dash), r.level.substr(dash + 1)};
+  }
   if (r.triangles < 100 || r.triangles > 200000)
     throw std::invalid_argument("--triangles " + std::to_string(r.triangles) +
                                 ": give 100 to 200,000 per vertebra");
@@ -219,8 +226,9 @@ HapticScene build_haptic_scene(const HapticSceneRequest& r, const std::string& d
     out.sources.push_back("generated");
     out.description = "a plane z = 0 (100 x 100 mm, normal +z)";
   } else {
-    const std::vector<std::string> names =
-        r.scene == "spine" ? mesh::scene_body_names() : std::vector<std::string>{"L3"};
+    const std::vector<std::string> names = r.scene == "spine"  ? mesh::scene_body_names()
+                                           : r.scene == "disc" ? level_bodies
+                                                               : std::vector<std::string>{"L3"};
     for (std::size_t i = 0; i < names.size(); ++i) {
       const auto it = given.find(names[i]);
       if (it != given.end()) {
@@ -238,7 +246,9 @@ HapticScene build_haptic_scene(const HapticSceneRequest& r, const std::string& d
                                                      : "scene file + parametric";
     out.description = r.scene == "spine"
                           ? "the spine T1-L5 + sacrum (" + what + ") at the reference posture"
-                          : "L3 (" + what + ") at its reference posture";
+                      : r.scene == "disc" ? "the " + r.level + " disc between " + names[0] +
+                                                " and " + names[1] + " (" + what + ")"
+                                          : "L3 (" + what + ") at its reference posture";
   }
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
   for (int i = 0; i < out.scene.size(); ++i) {

@@ -1,10 +1,13 @@
 #include "spinesim/studies/haptics_run.hpp"
 
 #include "spinesim/common/atomic_file.hpp"
+#include "spinesim/common/machine.hpp"
 #include "spinesim/common/timer.hpp"
 #include "spinesim/haptics/compliant_stage.hpp"
+#include "spinesim/haptics/disc_palpation.hpp"
 #include "spinesim/haptics/renderer.hpp"
 #include "spinesim/mesh/vertebra_geometry.hpp"
+#include "spinesim/studies/disc_palpation_setup.hpp"
 #include "spinesim/studies/files.hpp"
 #include "spinesim/studies/format.hpp"
 #include "spinesim/studies/haptic_recording.hpp"
@@ -18,7 +21,6 @@
 #include <sstream>
 #include <stdexcept>
 
-
 namespace spinesim::studies {
 
 namespace fs = std::filesystem;
@@ -27,6 +29,7 @@ std::string default_haptic_script(const std::string& scene, const std::string& d
   const fs::path dir = fs::path(data_dir) / "haptics";
   if (scene == "plane") return (dir / "press_plane.csv").string();
   if (scene == "vertebra") return (dir / "press_lumbar.csv").string();
+  if (scene == "disc") return (dir / "press_disc_l4l5.csv").string();
   return (dir / "stroke_spinous.csv").string();
 }
 
@@ -66,11 +69,16 @@ void check_request(const HapticsRunRequest& r) {
   if (!r.spine.empty() && r.spine != "multirate" && r.spine != "database")
     throw std::invalid_argument("--spine " + r.spine + ": give multirate or database");
   if (!r.spine.empty() && r.scene.scene != "spine")
-    throw std::invalid_argument("--spine needs --scene spine (the compliant stage drags the spine)");
-  if (r.spine.empty() && (r.force_scale != 0 || r.coupling_stiffness_n_per_mm != 0 ||
-                          !r.database.empty()))
     throw std::invalid_argument(
-        "--force-scale, --coupling-stiffness and --database are for --spine multirate|database");
+        "--spine needs --scene spine (the compliant stage drags the spine)");
+  if (r.spine.empty() && (r.force_scale != 0 || !r.database.empty()))
+    throw std::invalid_argument("--force-scale and --database are for --spine multirate|database");
+  if (r.spine.empty() && r.scene.scene != "disc" &&
+      (r.coupling_stiffness_n_per_mm != 0 || r.coupling_damping_n_s_per_mm != 0))
+    throw std::invalid_argument(
+        "--coupling-stiffness and --coupling-damping are for --spine or --scene disc");
+  if (r.scene.scene != "disc" && (!r.disc_params.empty() || r.disc_budget_us != 500))
+    throw std::invalid_argument("--params and --disc-budget-us are for --scene disc");
   if (!(r.force_scale >= 0) || !std::isfinite(r.force_scale))
     throw std::invalid_argument("--force-scale must be > 0 (0: the default)");
   if (!(r.coupling_stiffness_n_per_mm >= 0) || !std::isfinite(r.coupling_stiffness_n_per_mm) ||
@@ -176,10 +184,10 @@ CompliantSetup make_compliant_stage(const HapticsRunRequest& request, const std:
   haptics::CouplingParameters p;
   p.force_scale = request.force_scale > 0 ? request.force_scale : most / peak;
   if (p.force_scale * peak > most * (1 + 1e-9))
-    throw std::invalid_argument(
-        "--force-scale " + fixed(p.force_scale, 1) + " puts " + fixed(p.force_scale * peak, 0) +
-        " N on the spine at the device's peak force, beyond the " + fixed(most, 0) +
-        " N the " + request.spine + " spine answers for");
+    throw std::invalid_argument("--force-scale " + fixed(p.force_scale, 1) + " puts " +
+                                fixed(p.force_scale * peak, 0) +
+                                " N on the spine at the device's peak force, beyond the " +
+                                fixed(most, 0) + " N the " + request.spine + " spine answers for");
   p.stiffness_n_per_mm = request.coupling_stiffness_n_per_mm > 0
                              ? request.coupling_stiffness_n_per_mm
                              : result.stiffness_n_per_mm;
@@ -214,6 +222,49 @@ void finish_compliant(CompliantSetup& c, HapticsRunResult* result) {
   }
 }
 
+/// The disc scene's disc, at the finest resolution that fits the budget, coupled at the request's
+/// stiffness (default: the rendering stiffness, within the device's passive limit).
+DiscSetup make_disc(const HapticsRunRequest& request, const std::string& data_dir,
+                    HapticsRunResult& result) {
+  DiscSceneRequest d;
+  d.level = request.scene.level;
+  d.params = request.disc_params;
+  d.budget_us = request.disc_budget_us;
+  d.palpation.coupling_stiffness_n_per_mm = request.coupling_stiffness_n_per_mm > 0
+                                                ? request.coupling_stiffness_n_per_mm
+                                                : result.stiffness_n_per_mm;
+  if (d.palpation.coupling_stiffness_n_per_mm > result.passive_limit_n_per_mm)
+    throw std::invalid_argument("--coupling-stiffness " +
+                                fixed(d.palpation.coupling_stiffness_n_per_mm, 2) +
+                                " N/mm is beyond the device's passive limit (" +
+                                fixed(result.passive_limit_n_per_mm, 2) + " N/mm)");
+  d.palpation.coupling_damping_n_s_per_mm = request.coupling_damping_n_s_per_mm;
+  d.palpation.probe_radius_mm = request.probe_radius_mm;
+  d.palpation.realtime_priority = request.realtime_priority;
+  DiscSetup setup = make_disc_setup(d, data_dir);
+  result.disc_level = d.level;
+  result.disc_tets = setup.chosen.tets;
+  result.disc_cell_size_mm = setup.chosen.cell_size_mm;
+  result.disc_tuned_file = setup.tuned_file;
+  result.disc_note = setup.note;
+  result.disc_candidates = setup.tried;
+  result.coupling_stiffness_n_per_mm = d.palpation.coupling_stiffness_n_per_mm;
+  return setup;
+}
+
+void finish_disc(DiscSetup& d, HapticsRunResult* result) {
+  d.palpation->stop();
+  const auto& st = d.palpation->stats();
+  result->disc_steps = st.steps;
+  result->disc_overruns = st.overruns;
+  result->disc_failed_steps = st.failed_steps;
+  result->disc_step_us = haptics::percentiles(st.step_us);
+  result->disc_max_force_n = st.max_force_n;
+  result->disc_volume_change_min = st.min_volume_change;
+  result->disc_volume_change_max = st.max_volume_change;
+  result->disc_thread = st.realtime_reason;
+}
+
 }  // namespace
 
 HapticsRunResult run_haptics(const HapticsRunRequest& request, const std::string& data_dir,
@@ -245,7 +296,14 @@ HapticsRunResult run_haptics(const HapticsRunRequest& request, const std::string
                                   ? request.stiffness_n_per_mm
                                   : std::min(result.capabilities.usable_stiffness_n_per_mm,
                                              0.5 * result.passive_limit_n_per_mm);
-  const auto renderer = make_renderer(request, result.stiffness_n_per_mm, scene.scene);
+  const auto rigid = make_renderer(request, result.stiffness_n_per_mm, scene.scene);
+  DiscSetup disc;
+  std::unique_ptr<haptics::DiscCouplingRenderer> coupled;
+  if (request.scene.scene == "disc") {
+    disc = make_disc(request, data_dir, result);
+    coupled = std::make_unique<haptics::DiscCouplingRenderer>(*rigid, *disc.palpation);
+  }
+  haptics::ForceRenderer& renderer = coupled ? *coupled : *rigid;
   const auto device =
       make_device(request, result.capabilities, trajectory, scene.center_mm, T, duration);
   device->open();
@@ -256,7 +314,7 @@ HapticsRunResult run_haptics(const HapticsRunRequest& request, const std::string
   options.duration_s = duration;
   options.realtime_priority = request.realtime_priority;
   options.spin_us = request.spin_us;
-  haptics::ServoLoop loop(*device, *renderer, scene.scene, poses,
+  haptics::ServoLoop loop(*device, renderer, scene.scene, poses,
                           haptics::SafetyOptions::for_device(result.capabilities), options);
   CompliantSetup compliant;
   if (!request.spine.empty()) {
@@ -269,13 +327,18 @@ HapticsRunResult run_haptics(const HapticsRunRequest& request, const std::string
     std::ostringstream what;
     what << "device " << request.device << ", renderer " << request.renderer << ", probe radius "
          << request.probe_radius_mm << " mm";
-    record = std::make_unique<HapticRecordingWriter>(request.record, what.str(),
-                                                     compliant.model.get(), request.spine);
-    loop.record_to([&record](const haptics::TickRecord* rows,
-                             std::size_t n) { record->append(rows, n); },
-                   1 << 13);
+    if (disc.palpation)
+      what << "; disc " << result.disc_level << " (" << result.disc_tets << " tets, "
+           << result.disc_tuned_file << ")";
+    record =
+        std::make_unique<HapticRecordingWriter>(request.record, what.str(), compliant.model.get(),
+                                                request.spine, disc.palpation != nullptr);
+    loop.record_to(
+        [&record](const haptics::TickRecord* rows, std::size_t n) { record->append(rows, n); },
+        1 << 13);
   }
 
+  if (disc.palpation) disc.palpation->start();
   int calls = 0;
   result.stats = loop.run([&](const haptics::ServoStatus& s, double now) {
     haptics::ScenePoses p;  // the rigid stage's bodies stay at the reference posture
@@ -286,6 +349,7 @@ HapticsRunResult run_haptics(const HapticsRunRequest& request, const std::string
   });
   device->close();
   if (compliant.response) finish_compliant(compliant, &result);
+  if (disc.palpation) finish_disc(disc, &result);
   if (request.stop && request.stop->load()) result.stats.stop_reason = "interrupted";
   if (result.stats.error && !device->last_error().empty())
     result.stats.stop_reason += ": " + device->last_error();
@@ -295,6 +359,39 @@ HapticsRunResult run_haptics(const HapticsRunRequest& request, const std::string
   }
   return result;
 }
+
+namespace {
+
+nlohmann::json disc_json(const HapticsRunResult& r) {
+  if (r.disc_level.empty()) return nlohmann::json();
+  nlohmann::json tried = nlohmann::json::array();
+  for (const auto& c : r.disc_candidates)
+    tried.push_back({{"cell_size_mm", c.cell_size_mm},
+                     {"tets", c.tets},
+                     {"step_us", {{"p50", c.step_us.p50}, {"p99", c.step_us.p99}}},
+                     {"fits", c.fits}});
+  const auto& p = r.disc_step_us;
+  return {
+      {"level", r.disc_level},
+      {"tets", r.disc_tets},
+      {"cell_size_mm", r.disc_cell_size_mm},
+      {"tuned", r.disc_tuned_file},
+      {"cpu", cpu_description()},
+      {"thread", "own thread at 1 kHz behind a virtual coupling"},
+      {"thread_priority", r.disc_thread},
+      {"budget_us", r.request.disc_budget_us},
+      {"budget_check", tried},
+      {"note", r.disc_note},
+      {"coupling_stiffness_n_per_mm", r.coupling_stiffness_n_per_mm},
+      {"steps", r.disc_steps},
+      {"overruns", r.disc_overruns},
+      {"failed_steps", r.disc_failed_steps},
+      {"step_us", {{"p50", p.p50}, {"p99", p.p99}, {"p999", p.p999}, {"max", p.max}}},
+      {"max_contact_force_n", r.disc_max_force_n},
+      {"volume_change", {{"min", r.disc_volume_change_min}, {"max", r.disc_volume_change_max}}}};
+}
+
+}  // namespace
 
 nlohmann::json haptics_run_json(const HapticsRunResult& r) {
   const auto& s = r.stats;
@@ -350,7 +447,8 @@ nlohmann::json haptics_run_json(const HapticsRunResult& r) {
                                 {"worker_failures", r.worker_failures},
                                 {"worker_update_ms", r.worker_update_ms},
                                 {"worker_rate_hz", r.worker_rate_hz},
-                                {"worker_error", r.worker_error}}}};
+                                {"worker_error", r.worker_error}}},
+          {"disc_palpation", disc_json(r)}};
 }
 
 std::string haptics_run_table(const HapticsRunResult& r) {
@@ -389,8 +487,23 @@ std::string haptics_run_table(const HapticsRunResult& r) {
        << fixed(s.max_spine_force_n, 1) << " N (clamped " << s.spine_clamped_ticks << ")\n";
     if (r.spine == "multirate")
       os << "  worker: " << r.worker_solves << " updates, " << fixed(r.worker_update_ms, 1)
-         << " ms each (" << fixed(r.worker_rate_hz, 1) << " Hz), " << r.worker_failures
-         << " failed" << (r.worker_error.empty() ? "" : ": " + r.worker_error) << "\n";
+         << " ms each (" << fixed(r.worker_rate_hz, 1) << " Hz), " << r.worker_failures << " failed"
+         << (r.worker_error.empty() ? "" : ": " + r.worker_error) << "\n";
+  }
+  if (!r.disc_level.empty()) {
+    const auto& p = r.disc_step_us;
+    os << "  disc: " << r.disc_level << ", " << r.disc_tets << " tets (CGAL "
+       << fixed(r.disc_cell_size_mm, 1) << " mm, " << r.disc_tuned_file
+       << "), own thread at 1 kHz behind a coupling of " << fixed(r.coupling_stiffness_n_per_mm, 2)
+       << " N/mm\n"
+       << "  disc step (us): p50 " << fixed(p.p50, 0) << ", p99 " << fixed(p.p99, 0) << ", max "
+       << fixed(p.max, 0) << "; " << r.disc_steps << " steps, " << r.disc_overruns
+       << " overran the 1 ms, " << r.disc_failed_steps << " rejected; on " << cpu_description()
+       << "\n"
+       << "  disc: contact force max " << fixed(r.disc_max_force_n, 2) << " N, volume change "
+       << fixed(100 * r.disc_volume_change_min, 3) << " .. "
+       << fixed(100 * r.disc_volume_change_max, 3) << " %\n";
+    if (!r.disc_note.empty()) os << "  note: " << r.disc_note << "\n";
   }
   if (!r.request.record.empty())
     os << "  recorded " << r.recorded_rows << " ticks to " << r.request.record << "\n";

@@ -280,6 +280,68 @@ TEST(CliHaptics, OfflineDiscsRefuseBadInputInOneLineWithNothingWritten) {
   EXPECT_FALSE(fs::exists(out));
 }
 
+// Disc palpation: the scripted press of the L4-L5 disc runs; the budget check's choice and the
+// disc thread's statistics are reported; the recording carries the disc's contact, force and
+// volume change; the loop stays passive; bad disc input is refused in one line.
+TEST(CliHaptics, DiscPalpationPressesTheTunedDiscAndRecordsItsResponse) {
+  const std::string rec = tmp("disc_rec.csv");
+  const auto r = run_spinesim(
+      "haptics run --scene disc --level L4-L5 --triangles 1500 --no-realtime --disc-budget-us 900 "
+      "--record '" +
+      rec + "' --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  const auto& d = j["disc_palpation"];
+  ASSERT_TRUE(d.is_object()) << r.out.substr(0, 400);
+  EXPECT_EQ(d["level"], "L4-L5");
+  EXPECT_GT(d["tets"].get<long>(), 1000);
+  EXPECT_FALSE(d["cpu"].get<std::string>().empty());
+  ASSERT_FALSE(d["budget_check"].empty());
+  EXPECT_TRUE(d["budget_check"].back()["fits"].get<bool>());
+  EXPECT_GT(d["steps"].get<long>(), 5000);  // the 7 s script at 1 kHz, less start-up
+  EXPECT_EQ(d["failed_steps"].get<long>(), 0);
+  EXPECT_GT(d["max_contact_force_n"].get<double>(), 0.3);  // pressed 4 mm at 0.5 N/mm coupling
+  EXPECT_LT(d["volume_change"]["min"].get<double>(), 0.0);
+  EXPECT_GE(j["passivity_energy_mj"]["min"].get<double>(), 0.0);
+  const std::string text = slurp(rec);
+  const auto header = text.find("t_s,");
+  ASSERT_NE(header, std::string::npos);
+  EXPECT_NE(text.find("disc_volume_change", header), std::string::npos);
+  // Some row has the disc in contact with a non-zero force.
+  std::istringstream rows(text.substr(header));
+  std::string line;
+  std::getline(rows, line);
+  int pressed = 0;
+  while (std::getline(rows, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::vector<double> v;
+    std::stringstream ss(line);
+    for (std::string c; std::getline(ss, c, ',');) v.push_back(std::stod(c));
+    ASSERT_EQ(v.size(), 21u);  // 13 common + 8 disc columns
+    if (v[13] == 1 && std::hypot(v[17], v[18], v[19]) > 0.1) ++pressed;
+  }
+  EXPECT_GT(pressed, 1000);
+}
+
+TEST(CliHaptics, BadDiscInputIsRefused) {
+  const std::string rec = tmp("never_disc.csv");
+  const std::string base = "haptics run --duration 1 --record '" + rec + "' ";
+  expect_refused(run_spinesim(base + "--scene disc --level L9-L10"), "L9-L10");
+  expect_refused(run_spinesim(base + "--scene spine --disc-budget-us 300"), "--scene disc");
+  expect_refused(run_spinesim(base + "--scene disc --disc-budget-us 1 --triangles 300"),
+                 "no resolution");
+  // A tuned set without the level.
+  const std::string set = tmp("one_level.json");
+  {
+    auto j = nlohmann::json::parse(slurp(std::string(SPINESIM_DATA_DIR) + "/tuned_discs.json"));
+    for (auto it = j["levels"].begin(); it != j["levels"].end();)
+      it = it.key() == "T7-T8" ? std::next(it) : j["levels"].erase(it);
+    std::ofstream(set) << j.dump();
+  }
+  expect_refused(run_spinesim(base + "--scene disc --level L4-L5 --params '" + set + "'"), "L4-L5");
+  EXPECT_FALSE(fs::exists(rec));
+}
+
 TEST(CliHaptics, BadCompliantStageInputIsRefused) {
   const std::string rec = tmp("never_drag.csv");
   const std::string base = "haptics run --duration 1 --record '" + rec + "' ";

@@ -33,6 +33,12 @@ struct RenderOutput {
   Eigen::Vector3d proxy_mm = Eigen::Vector3d::Zero();  ///< the proxy (Gao–Gibson: the probe)
   int candidates = 0;                                  ///< triangles looked at this tick
   bool truncated = false;                              ///< a fixed buffer was too small
+  /// Disc palpation (disc_palpation.hpp): the disc's state this render used.
+  bool disc = false;
+  bool disc_contact = false;
+  double disc_volume_change = 0;                            ///< (V - V0) / V0
+  Eigen::Vector3d disc_force_n = Eigen::Vector3d::Zero();   ///< the disc's force on its probe
+  Eigen::Vector3d disc_probe_mm = Eigen::Vector3d::Zero();  ///< the simulated probe
 };
 
 class ForceRenderer {

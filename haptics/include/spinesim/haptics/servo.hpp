@@ -44,6 +44,10 @@ struct ServoStatus {
   unsigned buttons = 0;
   double passivity_mj = 0;
   HookState hook;  ///< the compliant stage's hook (attached = false without one)
+  /// Disc palpation (disc = false without it): contact, volume change, the disc's force.
+  bool disc = false, disc_contact = false;
+  double disc_volume_change = 0;
+  Eigen::Vector3d disc_force_n = Eigen::Vector3d::Zero();
 };
 
 /// One recorded tick (the `--record` file's row).
@@ -57,6 +61,10 @@ struct TickRecord {
   // reference posture (x ↦ R x + t; single precision is 0.1 µm over the spine).
   bool compliant = false;
   HookState hook;
+  // Disc palpation (disc = false without it).
+  bool disc = false, disc_contact = false;
+  float disc_volume_change = 0;
+  Eigen::Vector3f disc_force_n = Eigen::Vector3f::Zero(), disc_probe_mm = Eigen::Vector3f::Zero();
   std::array<Eigen::Matrix3f, kSpineVertebrae> R;
   std::array<Eigen::Vector3f, kSpineVertebrae> t;
 };

@@ -29,8 +29,11 @@ class HapticRecordingWriter {
  public:
   /// Opens `path` (replacing a file there) and writes the header. `model` is null without the
   /// compliant stage. Throws std::runtime_error when the file cannot be written.
+  /// `disc`: disc palpation columns after the common ones (disc_contact, the simulated probe,
+  /// the disc's force on it, its volume change).
   HapticRecordingWriter(const std::string& path, const std::string& description,
-                        const spine::SpineModel* model, const std::string& response);
+                        const spine::SpineModel* model, const std::string& response,
+                        bool disc = false);
   ~HapticRecordingWriter();
   /// Appends rows, flushes and syncs them (the loop's writer thread).
   void append(const haptics::TickRecord* rows, std::size_t n);
@@ -43,6 +46,7 @@ class HapticRecordingWriter {
   std::FILE* file_ = nullptr;
   std::vector<Eigen::Vector3d> centres_;
   std::int64_t rows_ = 0;
+  bool disc_ = false;
   bool failed_ = false;
 };
 

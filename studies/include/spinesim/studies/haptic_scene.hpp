@@ -21,7 +21,8 @@
 namespace spinesim::studies {
 
 struct HapticSceneRequest {
-  std::string scene = "spine";          ///< spine (T1…L5 + sacrum), vertebra (L3) or plane
+  std::string scene = "spine";  ///< spine (T1…L5 + sacrum), vertebra (L3), disc (its two) or plane
+  std::string level = "L4-L5";  ///< disc: the level whose two vertebrae are the rigid bodies
   std::string vertebrae = "generated";  ///< generated, real, or a scene JSON file
   int triangles = 6000;                 ///< per generated body
   std::string testdata_dir;             ///< for `real`: the folder holding artisynth-lss/

@@ -7,6 +7,7 @@
 #include "spinesim/haptics/device.hpp"
 #include "spinesim/haptics/scene.hpp"
 #include "spinesim/haptics/servo.hpp"
+#include "spinesim/studies/disc_palpation_setup.hpp"
 #include "spinesim/studies/haptic_scene.hpp"
 
 #include <nlohmann/json.hpp>
@@ -38,12 +39,16 @@ struct HapticsRunRequest {
   std::string record;  ///< CSV of every tick, synced to disk block by block as the loop runs
   /// The compliant stage (scene "spine" only): "" (off), "multirate" or "database".
   std::string spine;
-  std::string database;              ///< the database file ("": data/spine/displacement_db.json)
+  std::string database;  ///< the database file ("": data/spine/displacement_db.json)
   double coupling_stiffness_n_per_mm = 0;  ///< felt hook spring (0: the rendering stiffness)
   double coupling_damping_n_s_per_mm = 0;  ///< felt, relative to the hook
-  double force_scale = 0;  ///< spine N per felt N (0: the spine's 600 N at the device's peak)
+  double force_scale = 0;     ///< spine N per felt N (0: the spine's 600 N at the device's peak)
   bool spine_recruit = true;  ///< muscles recruited in the spine solves (as the database)
-  std::string write_scene;         ///< folder: each body's surface as <name>.obj (world, mm)
+  /// Disc palpation (scene "disc"): the tuned parameters ("": data/tuned_discs.json) and the
+  /// budget the disc's step must fit (us); the coupling is coupling_stiffness/damping.
+  std::string disc_params;
+  double disc_budget_us = 500;
+  std::string write_scene;  ///< folder: each body's surface as <name>.obj (world, mm)
   bool realtime_priority = true;
   double spin_us = 400;                     ///< spin this long before each deadline (0: sleep only)
   const std::atomic<bool>* stop = nullptr;  ///< set by the front end (Ctrl-C) to end the run
@@ -69,6 +74,14 @@ struct HapticsRunResult {
   std::int64_t worker_solves = 0, worker_failures = 0;
   double worker_update_ms = 0, worker_rate_hz = 0;  ///< per update (solve + sensitivity)
   std::string worker_error;
+  // Disc palpation (disc_level empty: off).
+  std::string disc_level, disc_tuned_file, disc_note, disc_thread;
+  long disc_tets = 0;
+  double disc_cell_size_mm = 0;
+  std::vector<DiscCandidate> disc_candidates;  ///< the budget check, finest first
+  std::int64_t disc_steps = 0, disc_overruns = 0, disc_failed_steps = 0;
+  haptics::Percentiles disc_step_us;
+  double disc_max_force_n = 0, disc_volume_change_min = 0, disc_volume_change_max = 0;
 };
 
 /// Validates everything (device, model, files, radius, output folder) before any work, builds

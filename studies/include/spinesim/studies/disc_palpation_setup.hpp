@@ -1,0 +1,53 @@
+// The disc scene of the haptic loop (`haptics run --scene disc --level L4-L5`): the level's tuned
+// mass-spring disc between its two vertebrae, meshed at the finest resolution whose step fits the
+// budget on this machine. At start, for each candidate cell size (finest first) the disc is meshed
+// (CGAL, as `mesh disc --level`), built with its tuned parameters, and stepped 300 times with the
+// probe pressed 2 mm into its anterior wall; the first whose step p99 fits the budget is used.
+// What could not be held (no candidate of >= min_tets fits) is said in `note`.
+#pragma once
+
+#include "spinesim/haptics/disc_palpation.hpp"
+#include "spinesim/haptics/servo.hpp"
+#include "spinesim/mesh/tet_mesh.hpp"
+#include "spinesim/mss/model.hpp"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace spinesim::studies {
+
+struct DiscSceneRequest {
+  std::string level = "L4-L5";
+  std::string params;      ///< tuned set or tuned.json; "": data/tuned_discs.json
+  double budget_us = 500;  ///< the disc step's p99 must fit this (half the 1 ms tick)
+  std::vector<double> cell_sizes_mm = {2.0, 2.5, 3.0, 4.0};  ///< finest first
+  int min_tets = 5000;  ///< below this the note says the target resolution was not held
+  haptics::DiscPalpationOptions palpation;
+};
+
+struct DiscCandidate {
+  double cell_size_mm = 0;
+  long tets = 0;
+  haptics::Percentiles step_us;
+  bool fits = false;
+};
+
+struct DiscSetup {
+  std::unique_ptr<mss::MssModel> model;  ///< owns its mesh
+  std::unique_ptr<haptics::DiscPalpation> palpation;
+  std::vector<DiscCandidate> tried;
+  DiscCandidate chosen;
+  std::string tuned_file, note;
+};
+
+/// Throws std::invalid_argument (one line) for an unknown level, a level without tuned
+/// parameters, bad palpation options, or when no candidate fits the budget (naming the fastest).
+DiscSetup make_disc_setup(const DiscSceneRequest& request, const std::string& data_dir,
+                          const std::function<void(const std::string&)>& stage = {});
+
+/// The disc's anterior wall point at mid-height and its outward normal (spine frame): where the
+/// budget check presses, and where the shipped script presses.
+std::pair<Eigen::Vector3d, Eigen::Vector3d> disc_anterior_wall(const mesh::TetMesh& disc);
+
+}  // namespace spinesim::studies

@@ -1,0 +1,111 @@
+#include "spinesim/studies/disc_palpation_setup.hpp"
+
+#include "spinesim/calibration/tuned_set.hpp"
+#include "spinesim/mss/boundary.hpp"
+#include "spinesim/studies/disc_level.hpp"
+#include "spinesim/studies/format.hpp"
+
+#include <filesystem>
+#include <optional>
+#include <stdexcept>
+
+namespace spinesim::studies {
+namespace fs = std::filesystem;
+
+std::pair<Eigen::Vector3d, Eigen::Vector3d> disc_anterior_wall(const mesh::TetMesh& disc) {
+  // In the disc's frame: the node furthest anterior (+z) within the middle third of the height.
+  const Eigen::Matrix3d& A = disc.frame.axes;
+  const Eigen::MatrixX3d local = (disc.V.rowwise() - disc.frame.origin_mm.transpose()) * A;
+  const double h = local.col(1).maxCoeff() - local.col(1).minCoeff();
+  const double mid = 0.5 * (local.col(1).maxCoeff() + local.col(1).minCoeff());
+  Eigen::Index best = -1;
+  for (Eigen::Index i = 0; i < disc.V.rows(); ++i)
+    if (std::abs(local(i, 1) - mid) < h / 6 && (best < 0 || local(i, 2) > local(best, 2))) best = i;
+  if (best < 0) throw std::invalid_argument("disc palpation: the disc mesh has no wall nodes");
+  return {disc.V.row(best).transpose(), A.col(2)};
+}
+
+namespace {
+
+/// The step's percentiles with the probe pressed 2 mm into the anterior wall (after 50 steps of
+/// approach from 10 mm out and 50 of pressing in).
+haptics::Percentiles measure_step(haptics::DiscPalpation& p, const mesh::TetMesh& m) {
+  const auto [wall, n] = disc_anterior_wall(m);
+  const double r = p.options().probe_radius_mm;
+  std::vector<float> us;
+  for (int k = 0; k < 400; ++k) {
+    const double depth = k < 50 ? -10.0 : std::min(2.0, -10.0 + 12.0 * (k - 50) / 50.0);
+    const haptics::DiscContact& c = p.step(wall - (depth - r) * n);
+    if (k >= 100) us.push_back(float(c.step_us));
+  }
+  return haptics::percentiles(us);
+}
+
+mss::Boundary held_plates(const mesh::TetMesh& m) {
+  mss::Boundary bc;
+  bc.plate_center_mm = mss::default_plate_center(m);
+  return bc;
+}
+
+}  // namespace
+
+DiscSetup make_disc_setup(const DiscSceneRequest& request, const std::string& data_dir,
+                          const std::function<void(const std::string&)>& stage) {
+  if (!(request.budget_us > 0) || request.budget_us > 1e6)
+    throw std::invalid_argument("--disc-budget-us must be > 0 and at most 1 s");
+  if (request.cell_sizes_mm.empty())
+    throw std::invalid_argument("disc palpation: no candidate resolution");
+  DiscSetup s;
+  s.tuned_file =
+      request.params.empty() ? (fs::path(data_dir) / "tuned_discs.json").string() : request.params;
+  // The level and its tuned parameters, refused before any meshing.
+  mesh::disc_dimensions(request.level, data_dir);
+  std::optional<calibration::TunedSet> set;
+  try {
+    set = calibration::read_tuned_set(s.tuned_file);
+  } catch (const std::invalid_argument&) {  // a single tuned.json: checked on the mesh below
+  }
+  if (set) calibration::tuned_level(*set, request.level);  // names the levels it has
+  for (const double cell : request.cell_sizes_mm) {
+    if (stage) stage("meshing " + request.level + " at " + fixed(cell, 1) + " mm, timing its step");
+    mesh::MeshOptions mo;
+    mo.cell_size_mm = cell;
+    const mesh::TetMesh m = mesh_disc_level(request.level, mo);
+    const calibration::TunedDisc tuned = calibration::read_tuned_for_mesh(s.tuned_file, &m);
+    auto model = std::make_unique<mss::MssModel>(
+        calibration::build_tuned_model(tuned, m, tuned.materials()));
+    DiscCandidate c;
+    c.cell_size_mm = cell;
+    c.tets = long(m.num_tets());
+    {
+      haptics::DiscPalpationOptions quiet = request.palpation;
+      haptics::DiscPalpation trial(*model, held_plates(model->mesh()), quiet);
+      c.step_us = measure_step(trial, model->mesh());
+    }
+    c.fits = c.step_us.p99 <= request.budget_us;
+    s.tried.push_back(c);
+    if (!c.fits) continue;
+    s.chosen = c;
+    s.palpation = std::make_unique<haptics::DiscPalpation>(*model, held_plates(model->mesh()),
+                                                           request.palpation);
+    s.model = std::move(model);
+    break;
+  }
+  if (!s.palpation) {
+    const DiscCandidate& last = s.tried.back();
+    throw std::invalid_argument(
+        "disc palpation: no resolution of " + request.level + " steps within " +
+        fixed(request.budget_us, 0) + " us here (the coarsest, " + std::to_string(last.tets) +
+        " tets, took p99 " + fixed(last.step_us.p99, 0) + " us): give a larger --disc-budget-us");
+  }
+  if (s.chosen.tets < request.min_tets) {
+    const DiscCandidate& finest = s.tried.front();
+    s.note = "could not hold " + std::to_string(request.min_tets) + " tets within " +
+             fixed(request.budget_us, 0) + " us on this CPU (" + std::to_string(finest.tets) +
+             " tets: step p99 " + fixed(finest.step_us.p99, 0) + " us); running " +
+             std::to_string(s.chosen.tets) + " tets";
+  }
+  return s;
+}
+
+}  // namespace spinesim::studies
