@@ -135,6 +135,18 @@ void run_plane(const PlaneArgs& a) {
 
 }  // namespace
 
+/// The disc scene's flags of `haptics run`.
+void add_disc_flags(CLI::App* run, HapticsRunRequest& request) {
+  run->add_option("--level", request.scene.level, "--scene disc: the disc level (T1-T2 ... L5-S1)")
+      ->capture_default_str();
+  run->add_option("--params", request.disc_params,
+                  "--scene disc: tuned set or tuned.json (default: data/tuned_discs.json)");
+  run->add_option("--disc-budget-us", request.disc_budget_us,
+                  "--scene disc: the disc step's p99 must fit this; at start the finest mesh "
+                  "(2, 2.5, 3, 4 mm cells) that does is chosen")
+      ->capture_default_str();
+}
+
 void register_haptics(CLI::App& app) {
   auto* haptics_cmd = app.add_subcommand(
       "haptics", "The 1 kHz haptic loop: touch the spine with a spherical probe");
@@ -146,15 +158,7 @@ void register_haptics(CLI::App& app) {
                   "spine (T1-L5 and sacrum), vertebra (L3), disc (a tuned disc between its two "
                   "vertebrae, --level) or plane")
       ->capture_default_str();
-  run->add_option("--level", a->request.scene.level,
-                  "--scene disc: the disc level (T1-T2 ... L5-S1)")
-      ->capture_default_str();
-  run->add_option("--params", a->request.disc_params,
-                  "--scene disc: tuned set or tuned.json (default: data/tuned_discs.json)");
-  run->add_option("--disc-budget-us", a->request.disc_budget_us,
-                  "--scene disc: the disc step's p99 must fit this; at start the finest mesh "
-                  "(2, 2.5, 3, 4 mm cells) that does is chosen")
-      ->capture_default_str();
+  add_disc_flags(run, a->request);
   run->add_option("--vertebrae", a->request.scene.vertebrae,
                   "Vertebra surfaces: generated (parametric), real (ArtiSynth L1-S1 from the test "
                   "data, thoracic generated) or a scene JSON file (haptics/README.md)")

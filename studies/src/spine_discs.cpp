@@ -183,6 +183,23 @@ void write_vertebrae_frame(const std::string& path, CombinedVertebrae& c,
   mesh::write_surface_vtu(path, c.moved, {}, {{"body", c.body}}, {mesh::VtuEncoding::zlib});
 }
 
+std::string motion_header(const std::string& recording) {
+  return "# the hybrid spine's discs over " + recording +
+         ": the upper plate centre's displacement and the rotation vector relative to the lower "
+         "vertebra, in the disc's axes (x lateral, y axial, z anterior), the volume change "
+         "(V-V0)/V0, inverted tets, and the reaction on the upper plate about its centre\n"
+         "t_s,level,dx_mm,dy_mm,dz_mm,rx_deg,ry_deg,rz_deg,volume_change,inverted_tets,fx_n,fy_n,"
+         "fz_n,mx_nmm,my_nmm,mz_nmm\n";
+}
+
+/// One frame of the series: the discs (part 0) and, if given, the vertebrae (part 1).
+void add_frame(VtuSeries& series, CombinedDiscs& discs, const mss::DiscSet& set,
+               CombinedVertebrae* vertebrae, const spine::SpineModel& m, const DragFrame& f) {
+  series.add(f.t_s, 0, [&](const std::string& p) { write_discs_frame(p, discs, set); });
+  if (vertebrae)
+    series.add(f.t_s, 1, [&](const std::string& p) { write_vertebrae_frame(p, *vertebrae, m, f); });
+}
+
 void check(const SpineDiscsRequest& r) {
   if (r.recording.empty())
     throw std::invalid_argument("--record: give a compliant-stage recording");
@@ -325,13 +342,7 @@ SpineDiscsResult run_spine_discs(const SpineDiscsRequest& request, const std::st
   CombinedDiscs all_discs = combine(discs);
   CombinedVertebrae all_vertebrae = combine(surfaces, model);
   std::ostringstream motion;
-  motion << "# the hybrid spine's discs over " << request.recording
-         << ": the upper plate centre's displacement and the rotation vector relative to the "
-            "lower vertebra, in the disc's axes (x lateral, y axial, z anterior), the volume "
-            "change (V-V0)/V0, inverted tets, and the reaction on the upper plate about its "
-            "centre\n"
-            "t_s,level,dx_mm,dy_mm,dz_mm,rx_deg,ry_deg,rz_deg,volume_change,inverted_tets,"
-            "fx_n,fy_n,fz_n,mx_nmm,my_nmm,mz_nmm\n";
+  motion << motion_header(request.recording);
   std::vector<mss::Boundary> bcs(runs.size());
   std::vector<DiscSample> samples(runs.size());
   double next_frame = -INFINITY;
@@ -360,11 +371,8 @@ SpineDiscsResult run_spine_discs(const SpineDiscsRequest& request, const std::st
     r.measuring_s += measuring.seconds();
     if (frame) {
       next_frame = f.t_s + request.frame_period_s;
-      series.add(f.t_s, 0, [&](const std::string& p) { write_discs_frame(p, all_discs, set); });
-      if (request.vertebra_triangles > 0)
-        series.add(f.t_s, 1, [&](const std::string& p) {
-          write_vertebrae_frame(p, all_vertebrae, model, f);
-        });
+      add_frame(series, all_discs, set, request.vertebra_triangles > 0 ? &all_vertebrae : nullptr,
+                model, f);
       ++r.frames;
     }
     if (progress && (k % 100 == 0 || k == n - 1)) progress(k + 1, n);
