@@ -6,9 +6,18 @@
 //     the exact ball-triangle test (the same set as ours).
 //   ProxyTick/<radius mm>, GaoGibsonTick/<radius mm>: one render() on the 18-body spine
 //     (parametric, 6000 triangles each) along the shipped spinous-process stroke.
+//   DiscPalpationStep/<cell size, 0.1 mm>/<pressed>: one disc-thread step (haptics/
+//     disc_palpation.hpp) of the L4-L5 CGAL disc with the tuned model's terms (main, radial,
+//     torsion springs and the per-tet volume term; the scales do not change the cost), the 4 mm
+//     probe free (0) or held 2 mm into the anterior wall (1); frozen implicit Euler at 1 ms.
 #include "spinesim/haptics/device.hpp"
+#include "spinesim/haptics/disc_palpation.hpp"
 #include "spinesim/haptics/renderer.hpp"
+#include "spinesim/mesh/disc_geometry.hpp"
+#include "spinesim/mesh/material.hpp"
+#include "spinesim/mesh/mesher.hpp"
 #include "spinesim/mesh/vertebra_geometry.hpp"
+#include "spinesim/mss/boundary.hpp"
 
 #include <benchmark/benchmark.h>
 
@@ -154,5 +163,39 @@ void GaoGibsonTick(benchmark::State& state) {
 BENCHMARK(GaoGibsonTick)->Arg(2)->Arg(4)->Arg(10)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
+
+void DiscPalpationStep(benchmark::State& state) {
+  sm::MeshOptions mo;
+  mo.cell_size_mm = 0.1 * double(state.range(0));
+  const sm::TetMesh m =
+      sm::mesh_parametric_disc(sm::disc_dimensions("L4-L5", SPINESIM_DATA_DIR), mo,
+                               sm::disc_frame_in_spine("L4-L5", SPINESIM_DATA_DIR));
+  spinesim::mss::MssOptions o;
+  o.volume_term = true;
+  const spinesim::mss::MssModel model(m, sm::load_material("real-disc", SPINESIM_DATA_DIR), o);
+  spinesim::mss::Boundary bc;
+  bc.plate_center_mm = spinesim::mss::default_plate_center(m);
+  sh::DiscPalpationOptions po;
+  po.realtime_priority = false;
+  sh::DiscPalpation p(model, bc, po);
+  // The anterior wall at mid-height (as studies::disc_anterior_wall).
+  const Eigen::MatrixX3d local = (m.V.rowwise() - m.frame.origin_mm.transpose()) * m.frame.axes;
+  const double mid = 0.5 * (local.col(1).maxCoeff() + local.col(1).minCoeff());
+  const double h = local.col(1).maxCoeff() - local.col(1).minCoeff();
+  Eigen::Index best = -1;
+  for (Eigen::Index i = 0; i < m.V.rows(); ++i)
+    if (std::abs(local(i, 1) - mid) < h / 6 && (best < 0 || local(i, 2) > local(best, 2))) best = i;
+  const Eigen::Vector3d wall = m.V.row(best).transpose(), n = m.frame.axes.col(2);
+  const bool pressed = state.range(1) != 0;
+  for (int k = 0; k <= 100; ++k)  // approach and press in, untimed
+    p.step(wall + (4.0 + 10.0 - (pressed ? 12.0 : 0.0) * k / 100.0) * n);
+  const Eigen::Vector3d device = wall + (pressed ? 2.0 : 14.0) * n;
+  for (auto _ : state) benchmark::DoNotOptimize(p.step(device).force_n);
+  state.counters["tets"] = double(m.num_tets());
+}
+BENCHMARK(DiscPalpationStep)
+    ->ArgsProduct({{20, 25, 30, 40}, {0, 1}})
+    ->Unit(benchmark::kMicrosecond)
+    ->Iterations(500);
 
 BENCHMARK_MAIN();

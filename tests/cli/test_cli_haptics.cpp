@@ -211,7 +211,8 @@ TEST(CliHaptics, DragOfT1RecordsTheSpineAndAKilledRunLeavesReadableRows) {
                               "' --vertebra-triangles 150 --frame-period 0.1 --json");
   ASSERT_EQ(d.status, 0) << d.err;
   const auto dj = nlohmann::json::parse(d.out);
-  EXPECT_EQ(dj["steps"].get<int>(), 2999);  // 3000 ticks of 1 ms
+  // One step per recorded tick after the first (a loaded machine runs fewer than 3000 ticks).
+  EXPECT_EQ(dj["steps"].get<long>(), j["recorded_rows"].get<long>() - 1);
   EXPECT_EQ(dj["discs"].get<int>(), 17);
   EXPECT_GT(dj["speedup_over_real_time"].get<double>(), 0);
   ASSERT_EQ(dj["per_disc"].size(), 17u);
