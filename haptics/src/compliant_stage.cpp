@@ -1,9 +1,9 @@
 #include "spinesim/haptics/compliant_stage.hpp"
 
+#include "blas_threads.hpp"
+
 #include "spinesim/common/timer.hpp"
 #include "spinesim/spine/kinematics.hpp"
-
-#include <dlfcn.h>
 
 #include <algorithm>
 #include <chrono>
@@ -149,12 +149,8 @@ void MultirateSpine::publish(const HookLoad& load) {
 
 void MultirateSpine::start() {
   if (worker_.joinable()) return;
-  // The worker's solves reach OpenBLAS through Ipopt's linear solver; OpenBLAS's own threads
-  // busy-wait, and beside the servo thread on a 2-core machine they took the period's p99.9 from
-  // 1.07 to 3.8 ms (docs/benchmarks.md). One BLAS thread, if the BLAS is OpenBLAS.
-  using SetThreads = void (*)(int);
-  if (auto set = reinterpret_cast<SetThreads>(::dlsym(RTLD_DEFAULT, "openblas_set_num_threads")))
-    set(1);
+  // The worker's solves reach OpenBLAS through Ipopt's linear solver (blas_threads.hpp).
+  detail::use_one_blas_thread();
   stop_.store(false);
   worker_ = std::thread([this] { run(); });
 }

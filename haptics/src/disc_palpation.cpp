@@ -2,6 +2,8 @@
 
 #include "spinesim/mss/quantities.hpp"
 
+#include "blas_threads.hpp"
+
 #include <pthread.h>
 #include <sched.h>
 #include <time.h>
@@ -90,6 +92,9 @@ double surface_gap_mm(const mesh::TetMesh& m) {
 DiscPalpation::DiscPalpation(const mss::MssModel& model, const mss::Boundary& plates,
                              const DiscPalpationOptions& options)
     : model_(model), options_(options), sim_(model, dynamics(options)), bc_(plates) {
+  // CHOLMOD's supernodal solves call OpenBLAS, whose threads busy-wait beside the servo thread
+  // (blas_threads.hpp); measured: the 5,099-tet step pressed took 1.5 ms with them.
+  detail::use_one_blas_thread();
   mss::validate(bc_, model.num_nodes());
   const double gap = surface_gap_mm(model.mesh());
   if (!(options.probe_radius_mm > gap)) {
