@@ -281,6 +281,8 @@ void register_haptic_drag(CLI::App& study) {
                   "Direct solves this often while hooked, s")
       ->capture_default_str();
   cmd->add_flag("--no-realtime", a->no_realtime, "Do not ask for real-time priority");
+  cmd->add_flag("--no-discs{false}", a->request.discs,
+                "Skip the 17 offline discs driven by each multirate recording");
   add_output_flags(cmd, a->json, a->quiet);
   cmd->callback([a] {
     if (!a->which.empty()) a->request.cases = {a->which};

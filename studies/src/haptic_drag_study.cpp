@@ -196,6 +196,15 @@ HapticDragResult run_haptic_drag_study(const HapticDragRequest& request,
         c.methods.push_back(centre);
       }
     }
+    if (request.discs && std::find(request.methods.begin(), request.methods.end(), "multirate") !=
+                             request.methods.end()) {
+      if (stage) stage(name + " drag: the 17 offline discs");
+      SpineDiscsRequest d;
+      d.recording = (fs::path(request.out) / ("drag_" + name + "_multirate.csv")).string();
+      d.out = (fs::path(request.out) / ("discs_" + name)).string();
+      c.discs = run_spine_discs(d, data_dir);
+      c.has_discs = true;
+    }
     result.cases.push_back(c);
   }
   result.seconds = timer.seconds();
@@ -229,7 +238,10 @@ nlohmann::json haptic_drag_json(const HapticDragResult& r) {
                          {"max_spine_force_n", m.stats.max_spine_force_n},
                          {"vertebrae", per}});
     }
-    cases.push_back({{"case", c.name}, {"pairs_csv", c.pairs_csv}, {"methods", methods}});
+    cases.push_back({{"case", c.name},
+                     {"pairs_csv", c.pairs_csv},
+                     {"methods", methods},
+                     {"discs", c.has_discs ? spine_discs_json(c.discs) : nlohmann::json()}});
   }
   return {{"cases", cases}, {"seconds", r.seconds}};
 }
@@ -252,6 +264,18 @@ std::string haptic_drag_table(const HapticDragResult& r) {
              fixed(m.stats.compute_us.p99, 1)});
     }
     t.print(os, false);
+    if (c.has_discs) {
+      const auto& d = c.discs;
+      double rot = 0, force = 0;
+      std::string at_rot, at_force;
+      for (const auto& p : d.peaks) {
+        if (p.rotation_deg > rot) rot = p.rotation_deg, at_rot = p.level;
+        if (p.force_n > force) force = p.force_n, at_force = p.level;
+      }
+      os << "  offline discs: " << d.pvd << ", " << d.table_csv << "; " << fixed(d.speedup(), 2)
+         << "x real time stepping; largest rotation " << fixed(rot, 2) << " deg (" << at_rot
+         << "), reaction " << fixed(force, 1) << " N (" << at_force << ")\n";
+    }
     os << "\n";
   }
   os << "(errors against direct equilibrium solves at the recorded hook force and point; "

@@ -3,10 +3,12 @@
 // and the thesis's displacement–force database — recording every tick; then, at sampled ticks
 // while hooked, the recorded vertebra motions are compared with direct equilibrium solves at the
 // recorded hook force and point: the pose error of each method. Also written: the relative
-// translation and rotation of every vertebra pair over the drag (figs 6.12–6.25, 6.38–6.47).
+// translation and rotation of every vertebra pair over the drag (figs 6.12–6.25, 6.38–6.47), and
+// the 17 offline discs driven by the multirate recording (`spine discs`).
 #pragma once
 
 #include "spinesim/studies/haptics_run.hpp"
+#include "spinesim/studies/spine_discs.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -25,6 +27,9 @@ struct HapticDragRequest {
   double min_force_n = 5;         ///< samples below this hook force are skipped
   bool realtime_priority = true;  ///< for the haptic runs
   int triangles = 5000;           ///< per generated vertebra
+  /// Also drive the 17 offline discs with each case's multirate recording (spine_discs.hpp) into
+  /// <out>/discs_<case>/ (thesis 5.4, 6.4).
+  bool discs = true;
 };
 
 /// Percentiles over the samples of one vertebra's error.
@@ -47,6 +52,8 @@ struct DragCaseResult {
   std::string name;
   std::vector<DragMethodResult> methods;
   std::string pairs_csv;  ///< path of the vertebra-pair motions (from the multirate run)
+  bool has_discs = false;
+  SpineDiscsResult discs;  ///< the offline discs of the multirate recording
 };
 
 struct HapticDragResult {
