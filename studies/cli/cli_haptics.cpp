@@ -145,6 +145,9 @@ void add_disc_flags(CLI::App* run, HapticsRunRequest& request) {
                   "--scene disc: the disc step's p99 must fit this; at start the finest mesh "
                   "(2, 2.5, 3, 4 mm cells) that does is chosen")
       ->capture_default_str();
+  run->add_option("--disc-cell-size", request.disc_cell_size_mm,
+                  "--scene disc: use this CGAL cell size (mm) instead of the budget check's "
+                  "choice (its step is still measured and reported)");
 }
 
 void register_haptics(CLI::App& app) {

@@ -66,7 +66,12 @@ DiscSetup make_disc_setup(const DiscSceneRequest& request, const std::string& da
   } catch (const std::invalid_argument&) {  // a single tuned.json: checked on the mesh below
   }
   if (set) calibration::tuned_level(*set, request.level);  // names the levels it has
-  for (const double cell : request.cell_sizes_mm) {
+  const bool fixed_size = request.fixed_cell_size_mm > 0;
+  if (fixed_size && !(request.fixed_cell_size_mm >= 0.5 && request.fixed_cell_size_mm <= 10))
+    throw std::invalid_argument("--disc-cell-size must be 0.5 to 10 mm (0: the budget check)");
+  const std::vector<double> cells =
+      fixed_size ? std::vector<double>{request.fixed_cell_size_mm} : request.cell_sizes_mm;
+  for (const double cell : cells) {
     if (stage) stage("meshing " + request.level + " at " + fixed(cell, 1) + " mm, timing its step");
     mesh::MeshOptions mo;
     mo.cell_size_mm = cell;
@@ -84,7 +89,10 @@ DiscSetup make_disc_setup(const DiscSceneRequest& request, const std::string& da
     }
     c.fits = c.step_us.p99 <= request.budget_us;
     s.tried.push_back(c);
-    if (!c.fits) continue;
+    if (!c.fits && !fixed_size) continue;
+    if (!c.fits)
+      s.note = "the asked " + fixed(cell, 1) + " mm disc's step (p99 " + fixed(c.step_us.p99, 0) +
+               " us) does not fit the " + fixed(request.budget_us, 0) + " us budget";
     s.chosen = c;
     s.palpation = std::make_unique<haptics::DiscPalpation>(*model, held_plates(model->mesh()),
                                                            request.palpation);
@@ -98,7 +106,7 @@ DiscSetup make_disc_setup(const DiscSceneRequest& request, const std::string& da
         fixed(request.budget_us, 0) + " us here (the coarsest, " + std::to_string(last.tets) +
         " tets, took p99 " + fixed(last.step_us.p99, 0) + " us): give a larger --disc-budget-us");
   }
-  if (s.chosen.tets < request.min_tets) {
+  if (!fixed_size && s.chosen.tets < request.min_tets) {
     const DiscCandidate& finest = s.tried.front();
     s.note = "could not hold " + std::to_string(request.min_tets) + " tets within " +
              fixed(request.budget_us, 0) + " us on this CPU (" + std::to_string(finest.tets) +

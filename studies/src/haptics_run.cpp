@@ -77,8 +77,10 @@ void check_request(const HapticsRunRequest& r) {
       (r.coupling_stiffness_n_per_mm != 0 || r.coupling_damping_n_s_per_mm != 0))
     throw std::invalid_argument(
         "--coupling-stiffness and --coupling-damping are for --spine or --scene disc");
-  if (r.scene.scene != "disc" && (!r.disc_params.empty() || r.disc_budget_us != 500))
-    throw std::invalid_argument("--params and --disc-budget-us are for --scene disc");
+  if (r.scene.scene != "disc" &&
+      (!r.disc_params.empty() || r.disc_budget_us != 500 || r.disc_cell_size_mm != 0))
+    throw std::invalid_argument(
+        "--params, --disc-budget-us and --disc-cell-size are for --scene disc");
   if (!(r.force_scale >= 0) || !std::isfinite(r.force_scale))
     throw std::invalid_argument("--force-scale must be > 0 (0: the default)");
   if (!(r.coupling_stiffness_n_per_mm >= 0) || !std::isfinite(r.coupling_stiffness_n_per_mm) ||
@@ -230,6 +232,7 @@ DiscSetup make_disc(const HapticsRunRequest& request, const std::string& data_di
   d.level = request.scene.level;
   d.params = request.disc_params;
   d.budget_us = request.disc_budget_us;
+  d.fixed_cell_size_mm = request.disc_cell_size_mm;
   d.palpation.coupling_stiffness_n_per_mm = request.coupling_stiffness_n_per_mm > 0
                                                 ? request.coupling_stiffness_n_per_mm
                                                 : result.stiffness_n_per_mm;

@@ -287,7 +287,7 @@ TEST(CliHaptics, OfflineDiscsRefuseBadInputInOneLineWithNothingWritten) {
 TEST(CliHaptics, DiscPalpationPressesTheTunedDiscAndRecordsItsResponse) {
   const std::string rec = tmp("disc_rec.csv");
   const auto r = run_spinesim(
-      "haptics run --scene disc --level L4-L5 --triangles 1500 --no-realtime --disc-budget-us 900 "
+      "haptics run --scene disc --level L4-L5 --triangles 1500 --no-realtime --disc-cell-size 4 "
       "--record '" +
       rec + "' --json");
   ASSERT_EQ(r.status, 0) << r.err;
@@ -297,9 +297,9 @@ TEST(CliHaptics, DiscPalpationPressesTheTunedDiscAndRecordsItsResponse) {
   EXPECT_EQ(d["level"], "L4-L5");
   EXPECT_GT(d["tets"].get<long>(), 1000);
   EXPECT_FALSE(d["cpu"].get<std::string>().empty());
-  ASSERT_FALSE(d["budget_check"].empty());
-  EXPECT_TRUE(d["budget_check"].back()["fits"].get<bool>());
-  EXPECT_GT(d["steps"].get<long>(), 5000);  // the 7 s script at 1 kHz, less start-up
+  ASSERT_EQ(d["budget_check"].size(), 1u);  // the asked resolution, measured
+  EXPECT_EQ(d["tets"].get<long>(), d["budget_check"][0]["tets"].get<long>());
+  EXPECT_GT(d["steps"].get<long>(), 100);  // the disc thread ran (its rate is the machine's)
   EXPECT_EQ(d["failed_steps"].get<long>(), 0);
   EXPECT_GT(d["max_contact_force_n"].get<double>(), 0.3);  // pressed 4 mm at 0.5 N/mm coupling
   EXPECT_LT(d["volume_change"]["min"].get<double>(), 0.0);
@@ -321,7 +321,7 @@ TEST(CliHaptics, DiscPalpationPressesTheTunedDiscAndRecordsItsResponse) {
     ASSERT_EQ(v.size(), 21u);  // 13 common + 8 disc columns
     if (v[13] == 1 && std::hypot(v[17], v[18], v[19]) > 0.1) ++pressed;
   }
-  EXPECT_GT(pressed, 1000);
+  EXPECT_GT(pressed, 100);
 }
 
 TEST(CliHaptics, BadDiscInputIsRefused) {
@@ -330,7 +330,8 @@ TEST(CliHaptics, BadDiscInputIsRefused) {
   expect_refused(run_spinesim(base + "--scene disc --level L9-L10"), "L9-L10");
   expect_refused(run_spinesim(base + "--scene spine --disc-budget-us 300"), "--scene disc");
   expect_refused(run_spinesim(base + "--scene disc --disc-budget-us 1 --triangles 300"),
-                 "no resolution");
+                 "no resolution");  // nothing steps within 1 us
+  expect_refused(run_spinesim(base + "--scene disc --disc-cell-size 0.1"), "--disc-cell-size");
   // A tuned set without the level.
   const std::string set = tmp("one_level.json");
   {

@@ -23,6 +23,8 @@ struct DiscSceneRequest {
   double budget_us = 500;  ///< the disc step's p99 must fit this (half the 1 ms tick)
   std::vector<double> cell_sizes_mm = {2.0, 2.5, 3.0, 4.0};  ///< finest first
   int min_tets = 5000;  ///< below this the note says the target resolution was not held
+  /// > 0: use this cell size whatever its step costs (measured and reported, not chosen by).
+  double fixed_cell_size_mm = 0;
   haptics::DiscPalpationOptions palpation;
 };
 

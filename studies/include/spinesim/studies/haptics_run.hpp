@@ -48,7 +48,8 @@ struct HapticsRunRequest {
   /// budget the disc's step must fit (us); the coupling is coupling_stiffness/damping.
   std::string disc_params;
   double disc_budget_us = 500;
-  std::string write_scene;  ///< folder: each body's surface as <name>.obj (world, mm)
+  double disc_cell_size_mm = 0;  ///< > 0: this resolution, not the budget check's choice
+  std::string write_scene;       ///< folder: each body's surface as <name>.obj (world, mm)
   bool realtime_priority = true;
   double spin_us = 400;                     ///< spin this long before each deadline (0: sleep only)
   const std::atomic<bool>* stop = nullptr;  ///< set by the front end (Ctrl-C) to end the run
