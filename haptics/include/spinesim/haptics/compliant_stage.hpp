@@ -146,6 +146,8 @@ class MultirateSpine final : public SpineResponse {
   };
   /// After stop().
   const Stats& stats() const { return stats_; }
+  /// Servo side (the thread calling predict): sequence number of the local model in use.
+  std::int64_t model_in_use() const { return current_.solve; }
   /// One update for `load` on the calling thread (the worker's body; tests call it directly):
   /// the solve, and the sensitivity — `previous` (same hook) updated by the secant, or new
   /// (`full`: through whole solves; otherwise at fixed muscle forces).
