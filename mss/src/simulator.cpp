@@ -257,13 +257,22 @@ bool Simulator::Impl::contact_direction(const ExternalLoads& loads, const Eigen:
   // rank-one part) uses their sparsity (3 rows, or the 6 plate DOF), so a pass costs O(n #active)
   // instead of a solve and a dense W^T Z (which took ~1 ms a step at 5,000 tets pressed).
   const Eigen::Index r0 = base_W.cols();
+  // Constant over the passes: y0 = A^-1 (-r - sum_{p0>0} k p0 P^T n), one triangular solve; each
+  // pair's column z = A^-1 P^T (e_i sqrt(k) n), made when the pair is first active (its
+  // k p0 P^T n term is sqrt(k) p0 z).
   contact_y0 = -r;
+  for (const Pair& c : pairs) {
+    if (!(c.p0 > 0.0)) continue;
+    const Eigen::Vector3d v = -c.k * c.p0 * c.n;
+    if (space.role(c.node) == detail::NodeRole::free)
+      contact_y0.segment<3>(3 * space.free_index(c.node)) += v;
+    else
+      contact_y0.tail<6>() +=
+          detail::plate_map(model->rest_positions_mm().segment<3>(3 * c.node) - space.center())
+              .transpose() *
+          v;
+  }
   tangent.cholesky().solve_in_place(contact_y0);
-  // Constant over the passes: y0 = A^-1 (-r - sum_{p0>0} k p0 P^T n); each pair's column
-  // z = A^-1 P^T (e_i sqrt(k) n), made when the pair is first active (its k p0 P^T n term is
-  // sqrt(k) p0 z).
-  for (const Pair& c : pairs)
-    if (c.p0 > 0.0) add_inverse(c.node, c.n, -c.k * c.p0, contact_y0);
   contact_Zall.resize(contact_y0.size(), Eigen::Index(pairs.size()));
   std::vector<char> made(pairs.size(), 0);
   bool settled = false;
