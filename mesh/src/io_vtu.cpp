@@ -183,6 +183,39 @@ std::vector<double> row_major(const Eigen::MatrixXd& M) {
   return v;
 }
 
+/// The extra Float64 arrays of a PointData or CellData section.
+void write_extra_arrays(std::ostream& os, const std::vector<DataArray>& arrays, VtuEncoding enc,
+                        const char* indent) {
+  for (const DataArray& a : arrays)
+    write_data_array(os, "Float64", a.name, int(a.values.cols()), row_major(a.values), enc, indent);
+}
+
+/// <Points> and <Cells> (one VTK cell type, `cells` a row per cell) and the closing tags.
+template <class Cells>
+void write_points_cells_and_close(std::ostream& os, const Eigen::MatrixX3d& points,
+                                  const Cells& cells, std::uint8_t vtk_type, VtuEncoding enc) {
+  const char* in = "        ";
+  const std::size_t n = std::size_t(cells.rows()), k = std::size_t(cells.cols());
+  std::vector<std::int64_t> connectivity(k * n), offsets(n);
+  const std::vector<std::uint8_t> types(n, vtk_type);
+  for (std::size_t c = 0; c < n; ++c) {
+    for (std::size_t j = 0; j < k; ++j)
+      connectivity[k * c + j] = cells(Eigen::Index(c), Eigen::Index(j));
+    offsets[c] = std::int64_t(k * (c + 1));
+  }
+  os << "      <Points>\n";
+  write_data_array(os, "Float64", "Points", 3, row_major(points), enc, in);
+  os << "      </Points>\n"
+     << "      <Cells>\n";
+  write_data_array(os, "Int64", "connectivity", 1, connectivity, enc, in);
+  write_data_array(os, "Int64", "offsets", 1, offsets, enc, in);
+  write_data_array(os, "UInt8", "types", 1, types, enc, in);
+  os << "      </Cells>\n"
+     << "    </Piece>\n"
+     << "  </UnstructuredGrid>\n"
+     << "</VTKFile>\n";
+}
+
 void check_arrays(const std::string& path, const std::vector<DataArray>& arrays, Eigen::Index rows,
                   const char* kind, const char* reserved) {
   for (const DataArray& a : arrays) {
@@ -573,14 +606,8 @@ void write_vtu(const std::string& path, const TetMesh& m, const std::vector<Data
   if (!host_is_little_endian())
     throw std::runtime_error(who + "writing VTU on a big-endian host is not implemented");
 
-  // 2. Flatten everything into VTK order.
+  // 2. Flatten the labels and the frame.
   const std::size_t nt = std::size_t(m.num_tets());
-  std::vector<std::int64_t> connectivity(4 * nt), offsets(nt);
-  std::vector<std::uint8_t> types(nt, std::uint8_t(10));  // VTK_TETRA
-  for (std::size_t t = 0; t < nt; ++t) {
-    for (int k = 0; k < 4; ++k) connectivity[4 * t + std::size_t(k)] = m.T(Eigen::Index(t), k);
-    offsets[t] = std::int64_t(4 * (t + 1));
-  }
   const std::vector<std::int32_t> region(m.region.data(), m.region.data() + m.region.size());
   const std::vector<std::int32_t> surface(m.surface.data(), m.surface.data() + m.surface.size());
   std::vector<double> frame(12);
@@ -607,25 +634,13 @@ void write_vtu(const std::string& path, const TetMesh& m, const std::vector<Data
        << "      <PointData Scalars=\"surface\">\n";
     const char* in = "        ";
     write_data_array(os, "Int32", "surface", 1, surface, enc, in);
-    for (const DataArray& a : point_data)
-      write_data_array(os, "Float64", a.name, int(a.values.cols()), row_major(a.values), enc, in);
+    write_extra_arrays(os, point_data, enc, in);
     os << "      </PointData>\n"
        << "      <CellData Scalars=\"region\">\n";
     write_data_array(os, "Int32", "region", 1, region, enc, in);
-    for (const DataArray& a : cell_data)
-      write_data_array(os, "Float64", a.name, int(a.values.cols()), row_major(a.values), enc, in);
-    os << "      </CellData>\n"
-       << "      <Points>\n";
-    write_data_array(os, "Float64", "Points", 3, row_major(m.V), enc, in);
-    os << "      </Points>\n"
-       << "      <Cells>\n";
-    write_data_array(os, "Int64", "connectivity", 1, connectivity, enc, in);
-    write_data_array(os, "Int64", "offsets", 1, offsets, enc, in);
-    write_data_array(os, "UInt8", "types", 1, types, enc, in);
-    os << "      </Cells>\n"
-       << "    </Piece>\n"
-       << "  </UnstructuredGrid>\n"
-       << "</VTKFile>\n";
+    write_extra_arrays(os, cell_data, enc, in);
+    os << "      </CellData>\n";
+    write_points_cells_and_close(os, m.V, m.T, 10, enc);  // VTK_TETRA
   });
 }
 
@@ -645,12 +660,6 @@ void write_surface_vtu(const std::string& path, const TriSurface& s,
     throw std::runtime_error(who + "writing VTU on a big-endian host is not implemented");
 
   const std::size_t nf = std::size_t(s.F.rows());
-  std::vector<std::int64_t> connectivity(3 * nf), offsets(nf);
-  const std::vector<std::uint8_t> types(nf, std::uint8_t(5));  // VTK_TRIANGLE
-  for (std::size_t f = 0; f < nf; ++f) {
-    for (int k = 0; k < 3; ++k) connectivity[3 * f + std::size_t(k)] = s.F(Eigen::Index(f), k);
-    offsets[f] = std::int64_t(3 * (f + 1));
-  }
   const VtuEncoding enc = options.encoding;
   write_atomically("write_vtu", path, [&](std::ostream& os) {
     const char* in = "        ";
@@ -661,24 +670,12 @@ void write_surface_vtu(const std::string& path, const TriSurface& s,
        << "  <UnstructuredGrid>\n"
        << "    <Piece NumberOfPoints=\"" << s.V.rows() << "\" NumberOfCells=\"" << nf << "\">\n"
        << "      <PointData>\n";
-    for (const DataArray& a : point_data)
-      write_data_array(os, "Float64", a.name, int(a.values.cols()), row_major(a.values), enc, in);
+    write_extra_arrays(os, point_data, enc, in);
     os << "      </PointData>\n"
        << "      <CellData>\n";
-    for (const DataArray& a : cell_data)
-      write_data_array(os, "Float64", a.name, int(a.values.cols()), row_major(a.values), enc, in);
-    os << "      </CellData>\n"
-       << "      <Points>\n";
-    write_data_array(os, "Float64", "Points", 3, row_major(s.V), enc, in);
-    os << "      </Points>\n"
-       << "      <Cells>\n";
-    write_data_array(os, "Int64", "connectivity", 1, connectivity, enc, in);
-    write_data_array(os, "Int64", "offsets", 1, offsets, enc, in);
-    write_data_array(os, "UInt8", "types", 1, types, enc, in);
-    os << "      </Cells>\n"
-       << "    </Piece>\n"
-       << "  </UnstructuredGrid>\n"
-       << "</VTKFile>\n";
+    write_extra_arrays(os, cell_data, enc, in);
+    os << "      </CellData>\n";
+    write_points_cells_and_close(os, s.V, s.F, 5, enc);  // VTK_TRIANGLE
   });
 }
 
