@@ -1,8 +1,10 @@
 #include "spinesim/haptics/disc_palpation.hpp"
 
+#include "spinesim/haptics/servo.hpp"
 #include "spinesim/mss/quantities.hpp"
 
 #include "blas_threads.hpp"
+#include "monotonic_clock.hpp"
 
 #include <pthread.h>
 #include <sched.h>
@@ -22,21 +24,10 @@
 
 namespace spinesim::haptics {
 
+using detail::monotonic_s;
+using detail::to_timespec;
+
 namespace {
-
-double monotonic_s() {
-  timespec ts{};
-  ::clock_gettime(CLOCK_MONOTONIC, &ts);
-  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
-}
-
-timespec to_timespec(double s) {
-  timespec ts{};
-  ts.tv_sec = time_t(std::floor(s));
-  ts.tv_nsec = long((s - std::floor(s)) * 1e9);
-  if (ts.tv_nsec >= 1000000000L) ts.tv_sec += 1, ts.tv_nsec -= 1000000000L;
-  return ts;
-}
 
 void require(bool ok, const char* what) {
   if (!ok) throw std::invalid_argument(std::string("disc palpation: ") + what);
@@ -225,17 +216,9 @@ void DiscPalpation::stop() {
 }
 
 void DiscPalpation::run() {
-  if (options_.realtime_priority) {
-    sched_param sp{};
-    sp.sched_priority = options_.priority;
-    const int rc = ::pthread_setschedparam(::pthread_self(), SCHED_FIFO, &sp);
-    stats_.realtime_priority = rc == 0;
-    stats_.realtime_reason = rc == 0
-                                 ? "SCHED_FIFO priority " + std::to_string(options_.priority)
-                                 : std::string("SCHED_FIFO refused (") + std::strerror(rc) + ")";
-  } else {
-    stats_.realtime_reason = "not asked for";
-  }
+  stats_.realtime_priority = options_.realtime_priority &&
+                             set_realtime_priority(options_.priority, &stats_.realtime_reason);
+  if (!options_.realtime_priority) stats_.realtime_reason = "not asked for";
   double deadline = monotonic_s() + options_.dt_s;
   while (!stop_.load()) {
     const timespec ts = to_timespec(deadline);

@@ -1,5 +1,7 @@
 #include "spinesim/haptics/servo.hpp"
 
+#include "monotonic_clock.hpp"
+
 #include <pthread.h>
 #include <sched.h>
 #include <time.h>
@@ -14,26 +16,8 @@
 
 namespace spinesim::haptics {
 
-namespace {
-
-double monotonic_s() {
-  timespec ts{};
-  ::clock_gettime(CLOCK_MONOTONIC, &ts);
-  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
-}
-
-timespec to_timespec(double s) {
-  timespec ts{};
-  ts.tv_sec = time_t(std::floor(s));
-  ts.tv_nsec = long((s - std::floor(s)) * 1e9);
-  if (ts.tv_nsec >= 1000000000L) {
-    ts.tv_sec += 1;
-    ts.tv_nsec -= 1000000000L;
-  }
-  return ts;
-}
-
-}  // namespace
+using detail::monotonic_s;
+using detail::to_timespec;
 
 Percentiles percentiles(std::vector<float> v) {
   Percentiles p;
