@@ -4,6 +4,8 @@
 // (benchmark argument, µm); the tet count is a counter. Material: real-disc (E 3.22 MPa,
 // nu 0.4557, rho 1038 kg/m^3), thesis springs (main + radial + torsion).
 //   Gradient        — MssModel::gradient (all internal forces), the per-step force evaluation
+//   TermGradient    — one term's gradient (0 main, 1 radial, 2 torsion, 3 per-tet volume),
+//                     both regions, 2.5 mm L4-L5 disc: the force evaluation's parts
 //   Hessian         — MssModel::hessian (exact), refilled in its fixed pattern
 //   ImplicitFrozen  — one implicit Euler step, dt 1 ms, one Newton iteration on the rest
 //                     factorisation (MatrixUpdate::frozen): the real-time haptic step
@@ -92,6 +94,23 @@ void Gradient(benchmark::State& state) {
   set_counters(state, model);
 }
 
+/// One term's gradient (argument: Term index; region 0 and 1 both), on the 2.5 mm L4-L5 disc
+/// with the per-tet volume term on: where the force evaluation's time goes.
+void TermGradient(benchmark::State& state) {
+  static const MssModel model = [] {
+    MssOptions o;
+    o.volume_term = true;
+    return MssModel(disc_mesh("L4-L5", 2.5), real_disc(), o);
+  }();
+  const auto term = static_cast<Term>(state.range(0));
+  Eigen::VectorXd x = model.rest_positions_mm() * 1.01, g;
+  for (auto _ : state) {
+    for (int region = 0; region < 2; ++region) model.term_gradient(x, term, region, g);
+    benchmark::ClobberMemory();
+  }
+  set_counters(state, model);
+}
+
 void Hessian(benchmark::State& state) {
   const MssModel& model = disc_model(state.range(0) / 1000.0);
   Eigen::VectorXd x = model.rest_positions_mm() * 1.01;
@@ -170,6 +189,7 @@ void sizes(benchmark::internal::Benchmark* b) {
 }  // namespace
 
 BENCHMARK(Gradient)->Apply(sizes);
+BENCHMARK(TermGradient)->DenseRange(0, 3)->Unit(benchmark::kMicrosecond);
 BENCHMARK(Hessian)->Apply(sizes);
 BENCHMARK(ImplicitFrozen)->Apply(sizes);
 BENCHMARK(ImplicitNewton)->Apply(sizes);

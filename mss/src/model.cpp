@@ -4,6 +4,7 @@
 
 #include "face_angles.hpp"
 #include "hessian_pattern.hpp"
+#include "tet_terms.hpp"
 
 #include <Eigen/Geometry>
 
@@ -119,6 +120,8 @@ struct MssModel::Impl {
   std::vector<AngleFace> faces;  // angle springs, three per face
   std::vector<TetTerm> radial;
   std::vector<TetTerm> volume;
+  // radial[i] and volume[i] (when on) in one list for the blocked gradient kernel, scaled k.
+  std::vector<detail::TetTermBlockInput> tet_block;
   bool disc_volume_on = false;
   double disc_k_unscaled = 0, disc_k = 0;  // k_g, N/mm^5
 
@@ -148,6 +151,13 @@ struct MssModel::Impl {
   /// one loop behind energy, gradient, term_energy and term_gradient.
   double accumulate(const Eigen::VectorXd& x, const bool* terms, KSelect sel,
                     Eigen::VectorXd* grad) const;
+  /// radial[i] and volume[i] as the blocked kernel's input, stiffnesses by `sel` (0 for a term
+  /// not wanted).
+  std::vector<detail::TetTermBlockInput> tet_block_input(KSelect sel, bool want_radial,
+                                                         bool want_volume) const;
+  /// Energy and accumulated gradient of the radial and per-tet volume terms wanted.
+  double tet_terms_gradient(const double* x, KSelect sel, bool want_radial, bool want_volume,
+                            double* g) const;
   /// Sparse Hessian of the selected terms (the whole-disc term without its rank-one part).
   void assemble_hessian(const Eigen::VectorXd& x, HessianMode mode, const bool* terms, KSelect sel,
                         Eigen::SparseMatrix<double>& H) const;
@@ -388,6 +398,7 @@ void MssModel::Impl::apply_scales() {
     a.k = scale(Term::torsion, 0) * a.k_part[0] + scale(Term::torsion, 1) * a.k_part[1];
   for (auto& t : radial) t.k = scale(Term::radial, t.region) * t.k_unscaled;
   for (auto& t : volume) t.k = scale(Term::volume, t.region) * t.k_unscaled;
+  tet_block = tet_block_input(KSelect{}, !radial.empty(), !volume.empty());
   disc_k = scale(Term::disc_volume, 0) * disc_k_unscaled;
 }
 
@@ -519,23 +530,19 @@ double MssModel::Impl::accumulate(const Eigen::VectorXd& x, const bool* terms, K
                                             sel.angle(f), f.rest, nullptr, nullptr, nullptr);
     }
   }
-  const Eigen::MatrixX4i& T = m.mesh.T;
-  auto tet_loop = [&](const std::vector<TetTerm>& list, auto kernel) {
-    Vector12d g;
-    for (const TetTerm& t : list) {
-      energy += kernel(tet_points(x, T, t.t), sel.tet(t), t.rest, grad ? &g : nullptr);
-      if (grad)
-        for (int c = 0; c < 4; ++c) grad->segment<3>(3 * T(t.t, c)) += g.segment<3>(3 * c);
-    }
-  };
-  if (terms[static_cast<int>(Term::radial)])
-    tet_loop(m.radial, [](const TetPoints& p, double k, double rest, Vector12d* g) {
-      return radial_springs(p, k, rest, g);
-    });
-  if (terms[static_cast<int>(Term::volume)])
-    tet_loop(m.volume, [](const TetPoints& p, double k, double rest, Vector12d* g) {
-      return volume_penalty(p, k, rest, g);
-    });
+  const bool want_radial = terms[static_cast<int>(Term::radial)] && !m.radial.empty();
+  const bool want_volume = terms[static_cast<int>(Term::volume)] && !m.volume.empty();
+  if (grad && (want_radial || want_volume)) {
+    energy += tet_terms_gradient(xp, sel, want_radial, want_volume, grad->data());
+  } else if (!grad) {  // energy only (line searches): one tet at a time
+    const Eigen::MatrixX4i& T = m.mesh.T;
+    if (want_radial)
+      for (const TetTerm& t : m.radial)
+        energy += radial_springs(tet_points(x, T, t.t), sel.tet(t), t.rest);
+    if (want_volume)
+      for (const TetTerm& t : m.volume)
+        energy += volume_penalty(tet_points(x, T, t.t), sel.tet(t), t.rest);
+  }
   if (terms[static_cast<int>(Term::disc_volume)] && m.disc_volume_on) {
     const double k = sel.disc(m.disc_k, m.disc_k_unscaled);
     Eigen::VectorXd u;
@@ -544,6 +551,38 @@ double MssModel::Impl::accumulate(const Eigen::VectorXd& x, const bool* terms, K
     if (grad) *grad += (k * excess) * u;
   }
   return energy;
+}
+
+std::vector<detail::TetTermBlockInput> MssModel::Impl::tet_block_input(KSelect sel,
+                                                                       bool want_radial,
+                                                                       bool want_volume) const {
+  // radial and volume hold every tet in order when on (build_tet_terms).
+  const std::size_t nt = want_radial ? radial.size() : want_volume ? volume.size() : 0;
+  std::vector<detail::TetTermBlockInput> in(nt);
+  for (std::size_t i = 0; i < nt; ++i) {
+    detail::TetTermBlockInput& b = in[i];
+    b.t = want_radial ? radial[i].t : volume[i].t;
+    b.k_radial = want_radial ? sel.tet(radial[i]) : 0.0;
+    b.rest_sum = want_radial ? radial[i].rest : 0.0;
+    b.k_volume = want_volume ? sel.tet(volume[i]) : 0.0;
+    b.rest_volume = want_volume ? volume[i].rest : 0.0;
+  }
+  return in;
+}
+
+double MssModel::Impl::tet_terms_gradient(const double* x, KSelect sel, bool want_radial,
+                                          bool want_volume, double* g) const {
+  // The scaled total with every tet term the model has: the list kept by apply_scales;
+  // otherwise (calibration's per-term, per-region gradients) one made for the call.
+  const bool cached =
+      sel.region < 0 && want_radial == !radial.empty() && want_volume == !volume.empty();
+  const std::vector<detail::TetTermBlockInput> made =
+      cached ? std::vector<detail::TetTermBlockInput>()
+             : tet_block_input(sel, want_radial, want_volume);
+  const std::vector<detail::TetTermBlockInput>& in = cached ? tet_block : made;
+  if (want_radial && want_volume) return detail::tet_terms_all<true, true>(in, mesh.T, x, g);
+  if (want_radial) return detail::tet_terms_all<true, false>(in, mesh.T, x, g);
+  return detail::tet_terms_all<false, true>(in, mesh.T, x, g);
 }
 
 void MssModel::hessian(const Eigen::VectorXd& x, HessianMode mode,
