@@ -85,30 +85,53 @@ inline double face_angle_springs(const double* x0, const double* x1, const doubl
   return energy;
 }
 
-/// All faces at once, in blocks of kBlock: gather the corners into structure-of-arrays buffers,
-/// run the branch-free series path of face_angle_springs<true> over the block (a plain loop the
-/// compiler vectorises), redo the rare faces outside the series range (or flat) with the scalar
-/// kernel, and scatter-add the gradients. `Face` has v[3] and rest; k_of(face) its stiffness.
-/// Same energy and gradient as the scalar loop up to round-off (tests/mss/test_model.cpp).
+/// Faces packed for face_angle_springs_blocks: kFaceBlock faces in structure-of-arrays form
+/// (corner indices, rest cos and sin, stiffness), so the hot loop reads 68 bytes a face in
+/// sequence instead of the model's whole face records. Padding lanes repeat the last face with
+/// k = 0.
+inline constexpr int kFaceBlock = 8;
+struct FaceBlock {
+  int n = 0;  ///< faces in use
+  int v[3][kFaceBlock];
+  double c0[3][kFaceBlock], s0[3][kFaceBlock], k[kFaceBlock];
+};
+
+/// `faces` (each with v[3] and rest) in blocks; k_of(face) is its stiffness.
 template <class Face, class KOf>
-double face_angle_springs_all(const std::vector<Face>& faces, KOf k_of, const double* x,
-                              double* g) {
-  constexpr int B = 8;
-  double energy = 0.0;
-  alignas(64) double P[9][B], C0[3][B], S0[3][B], K[B], E[B], G[9][B];
-  alignas(64) int ok[B];
-  const std::size_t nf = faces.size();
-  for (std::size_t b = 0; b < nf; b += B) {
-    const int n = static_cast<int>(std::min<std::size_t>(B, nf - b));
-    for (int f = 0; f < B; ++f) {  // gather; padding lanes repeat the last face with k = 0
-      const Face& face = faces[b + static_cast<std::size_t>(std::min(f, n - 1))];
+std::vector<FaceBlock> pack_faces(const std::vector<Face>& faces, KOf k_of) {
+  constexpr int B = kFaceBlock;
+  std::vector<FaceBlock> blocks((faces.size() + B - 1) / B);
+  for (std::size_t b = 0; b < blocks.size(); ++b) {
+    FaceBlock& out = blocks[b];
+    out.n = static_cast<int>(std::min<std::size_t>(B, faces.size() - b * B));
+    for (int f = 0; f < B; ++f) {
+      const Face& face = faces[b * B + static_cast<std::size_t>(std::min(f, out.n - 1))];
       for (int c = 0; c < 3; ++c) {
-        for (int d = 0; d < 3; ++d) P[3 * c + d][f] = x[3 * face.v[c] + d];
-        C0[c][f] = face.rest.cos0[c];
-        S0[c][f] = face.rest.sin0[c];
+        out.v[c][f] = face.v[c];
+        out.c0[c][f] = face.rest.cos0[c];
+        out.s0[c][f] = face.rest.sin0[c];
       }
-      K[f] = f < n ? k_of(face) : 0.0;
+      out.k[f] = f < out.n ? k_of(face) : 0.0;
     }
+  }
+  return blocks;
+}
+
+/// All faces at once, block by block: gather the corners' positions, run the branch-free series
+/// path of face_angle_springs<true> over the block (a plain loop the compiler vectorises), redo
+/// the rare faces outside the series range (or flat) with the scalar kernel, and scatter-add the
+/// gradients. Same energy and gradient as the scalar loop up to round-off
+/// (tests/mss/test_face_angles.cpp, tests/mss/test_model.cpp).
+inline double face_angle_springs_blocks(const std::vector<FaceBlock>& blocks, const double* x,
+                                        double* g) {
+  constexpr int B = kFaceBlock;
+  double energy = 0.0;
+  alignas(64) double P[9][B], E[B], G[9][B];
+  alignas(64) int ok[B];
+  for (const FaceBlock& fb : blocks) {
+    for (int f = 0; f < B; ++f)  // gather
+      for (int c = 0; c < 3; ++c)
+        for (int d = 0; d < 3; ++d) P[3 * c + d][f] = x[3 * fb.v[c][f] + d];
     for (int f = 0; f < B; ++f) {  // the vectorised part: same formulas as face_angle_springs
       const double a0 = P[3][f] - P[0][f], a1 = P[4][f] - P[1][f], a2 = P[5][f] - P[2][f];  // e01
       const double b0 = P[6][f] - P[3][f], b1 = P[7][f] - P[4][f], b2 = P[8][f] - P[5][f];  // e12
@@ -119,16 +142,22 @@ double face_angle_springs_all(const std::vector<Face>& faces, KOf k_of, const do
                    l20 = c0 * c0 + c2 * c2 + c1 * c1;
       const double d0 = -(a0 * c0 + a1 * c1 + a2 * c2), d1 = -(b0 * a0 + b1 * a1 + b2 * a2),
                    d2 = -(c0 * b0 + c1 * b1 + c2 * b2);
-      const double y0 = sq * C0[0][f] - d0 * S0[0][f], x0 = d0 * C0[0][f] + sq * S0[0][f];
-      const double y1 = sq * C0[1][f] - d1 * S0[1][f], x1 = d1 * C0[1][f] + sq * S0[1][f];
-      const double y2 = sq * C0[2][f] - d2 * S0[2][f], x2 = d2 * C0[2][f] + sq * S0[2][f];
+      const double C0 = fb.c0[0][f], C1 = fb.c0[1][f], C2 = fb.c0[2][f];
+      const double S0 = fb.s0[0][f], S1 = fb.s0[1][f], S2 = fb.s0[2][f];
+      const double y0 = sq * C0 - d0 * S0, x0 = d0 * C0 + sq * S0;
+      const double y1 = sq * C1 - d1 * S1, x1 = d1 * C1 + sq * S1;
+      const double y2 = sq * C2 - d2 * S2, x2 = d2 * C2 + sq * S2;
       ok[f] = (x0 > 0.0) & (x1 > 0.0) & (x2 > 0.0) & (std::abs(y0) < 0.1 * x0) &
               (std::abs(y1) < 0.1 * x1) & (std::abs(y2) < 0.1 * x2) & (sq > 0.0);
       const double t0 = atan_series(y0 / x0), t1 = atan_series(y1 / x1), t2 = atan_series(y2 / x2);
-      E[f] = 0.5 * K[f] * (t0 * t0 + t1 * t1 + t2 * t2);
-      const double f0 = K[f] * t0 / sq, f1 = K[f] * t1 / sq, f2 = K[f] * t2 / sq;
-      const double q0 = d0 / l01, q1 = d1 / l12, q2 = d2 / l20;  // corner c: d_c / |a|^2
-      const double r0 = d0 / l20, r1 = d1 / l01, r2 = d2 / l12;  // corner c: d_c / |b|^2
+      const double K = fb.k[f];
+      E[f] = 0.5 * K * (t0 * t0 + t1 * t1 + t2 * t2);
+      const double ks = K / sq;
+      const double f0 = ks * t0, f1 = ks * t1, f2 = ks * t2;
+      // Three reciprocals of the squared edge lengths instead of six quotients d_c / |.|^2.
+      const double i01 = 1.0 / l01, i12 = 1.0 / l12, i20 = 1.0 / l20;
+      const double q0 = d0 * i01, q1 = d1 * i12, q2 = d2 * i20;  // corner c: d_c / |a|^2
+      const double r0 = d0 * i20, r1 = d1 * i01, r2 = d2 * i12;  // corner c: d_c / |b|^2
       const double A[3] = {a0, a1, a2}, Bv[3] = {b0, b1, b2}, Cv[3] = {c0, c1, c2};
       for (int d = 0; d < 3; ++d) {
         const double ga0 = f0 * (q0 * A[d] + Cv[d]), gb0 = f0 * (-r0 * Cv[d] - A[d]);
@@ -139,20 +168,30 @@ double face_angle_springs_all(const std::vector<Face>& faces, KOf k_of, const do
         G[6 + d][f] = gb0 + ga1 - (ga2 + gb2);
       }
     }
-    for (int f = 0; f < n; ++f) {
-      const Face& face = faces[b + static_cast<std::size_t>(f)];
+    for (int f = 0; f < fb.n; ++f) {
+      const int v0 = fb.v[0][f], v1 = fb.v[1][f], v2 = fb.v[2][f];
       if (!ok[f]) {  // outside the series range or a flat triangle: the scalar kernel
+        FaceRest rest;
+        for (int c = 0; c < 3; ++c) rest.cos0[c] = fb.c0[c][f], rest.sin0[c] = fb.s0[c][f];
         double gs[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
-        E[f] = face_angle_springs<true>(x + 3 * face.v[0], x + 3 * face.v[1], x + 3 * face.v[2],
-                                        K[f], face.rest, gs, gs + 3, gs + 6);
+        E[f] = face_angle_springs<true>(x + 3 * v0, x + 3 * v1, x + 3 * v2, fb.k[f], rest, gs,
+                                        gs + 3, gs + 6);
         for (int r = 0; r < 9; ++r) G[r][f] = gs[r];
       }
       energy += E[f];
+      const int v[3] = {v0, v1, v2};
       for (int c = 0; c < 3; ++c)
-        for (int d = 0; d < 3; ++d) g[3 * face.v[c] + d] += G[3 * c + d][f];
+        for (int d = 0; d < 3; ++d) g[3 * v[c] + d] += G[3 * c + d][f];
     }
   }
   return energy;
+}
+
+/// face_angle_springs_blocks over `faces` packed for this call (k_of(face) their stiffness).
+template <class Face, class KOf>
+double face_angle_springs_all(const std::vector<Face>& faces, KOf k_of, const double* x,
+                              double* g) {
+  return face_angle_springs_blocks(pack_faces(faces, k_of), x, g);
 }
 
 }  // namespace spinesim::mss

@@ -117,7 +117,8 @@ struct MssModel::Impl {
   double rest_volume = 0;
 
   std::vector<EdgeSpring> edges;
-  std::vector<AngleFace> faces;  // angle springs, three per face
+  std::vector<AngleFace> faces;        // angle springs, three per face
+  std::vector<FaceBlock> face_blocks;  // faces packed for the gradient kernel, scaled k
   std::vector<TetTerm> radial;
   std::vector<TetTerm> volume;
   // radial[i] and volume[i] (when on) in one list for the blocked gradient kernel, scaled k.
@@ -396,6 +397,7 @@ void MssModel::Impl::apply_scales() {
   }
   for (auto& a : faces)
     a.k = scale(Term::torsion, 0) * a.k_part[0] + scale(Term::torsion, 1) * a.k_part[1];
+  face_blocks = pack_faces(faces, [](const AngleFace& f) { return f.k; });
   for (auto& t : radial) t.k = scale(Term::radial, t.region) * t.k_unscaled;
   for (auto& t : volume) t.k = scale(Term::volume, t.region) * t.k_unscaled;
   tet_block = tet_block_input(KSelect{}, !radial.empty(), !volume.empty());
@@ -522,8 +524,10 @@ double MssModel::Impl::accumulate(const Eigen::VectorXd& x, const bool* terms, K
   }
   if (terms[static_cast<int>(Term::torsion)]) {
     if (grad) {
-      energy += face_angle_springs_all(
-          m.faces, [&sel](const AngleFace& f) { return sel.angle(f); }, xp, grad->data());
+      energy += sel.region < 0 ? face_angle_springs_blocks(m.face_blocks, xp, grad->data())
+                               : face_angle_springs_all(
+                                     m.faces, [&sel](const AngleFace& f) { return sel.angle(f); },
+                                     xp, grad->data());
     } else {
       for (const AngleFace& f : m.faces)
         energy += face_angle_springs<false>(xp + 3 * f.v[0], xp + 3 * f.v[1], xp + 3 * f.v[2],
