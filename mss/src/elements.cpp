@@ -12,10 +12,9 @@ namespace spinesim::mss {
 
 namespace {
 
-// Below this length (mm) a direction (edge, radial arm, probe normal, angle arm) is undefined.
-// Meshes are validated upstream (edges ~1 mm), so this only catches coincident points. The
-// comparisons are written so that a NaN input falls through and propagates, not hidden.
-constexpr double kMinLength_mm = 1e-12;
+// Below kMinLength_mm (elements.hpp) a direction (edge, radial arm, probe normal, angle arm) is
+// undefined. Meshes are validated upstream (edges ~1 mm), so this only catches coincident points.
+// The comparisons are written so that a NaN input falls through and propagates, not hidden.
 // Below this sin(theta) the arms are collinear and the angle's gradient direction undefined.
 constexpr double kMinSin = 1e-12;
 

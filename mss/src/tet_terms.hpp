@@ -10,6 +10,8 @@
 // gathering and scattering the same four corners twice; see docs/benchmarks.md.
 #pragma once
 
+#include "spinesim/mss/elements.hpp"
+
 #include <Eigen/Core>
 
 #include <algorithm>
@@ -27,10 +29,6 @@ struct TetTermBlockInput {
   double k_volume;     ///< k_v, N/mm^5
   double rest_volume;  ///< V0, mm^3
 };
-
-/// Radial lengths below this have no direction (a vertex at the barycentre): zero subgradient,
-/// as radial_springs.
-inline constexpr double kTetTermMinLength_mm = 1e-12;
 
 /// Energy of the radial springs (when with_radial) and volume penalties (when with_volume) of
 /// `tets` at positions x (3n); adds the gradient to g (3n). T: the mesh's tets (rows of four
@@ -68,7 +66,7 @@ double tet_terms_all(const std::vector<TetTermBlockInput>& tets, const Eigen::Ma
                        r2 = P[3 * c + 2][f] - bc[2];
           const double len = std::sqrt(r0 * r0 + r1 * r1 + r2 * r2);
           S += len;
-          const double inv = len < kTetTermMinLength_mm ? 0.0 : 1.0 / len;
+          const double inv = len < kMinLength_mm ? 0.0 : 1.0 / len;
           u[c][0] = r0 * inv, u[c][1] = r1 * inv, u[c][2] = r2 * inv;
         }
         es = S - S0[f];

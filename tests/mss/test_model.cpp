@@ -4,6 +4,8 @@
 // dilation that check the constants (5.1), (5.2), (5.8) without looking inside.
 #include "spinesim/mss/model.hpp"
 
+#include "spinesim/mss/elements.hpp"
+
 #include "spinesim/mesh/box_mesh.hpp"
 #include "spinesim/mesh/tet_mesh.hpp"
 
@@ -64,6 +66,27 @@ Eigen::VectorXd rigidly_moved(const Eigen::VectorXd& x, const Eigen::Matrix3d& R
 
 Eigen::Matrix3d some_rotation() {
   return Eigen::AngleAxisd(0.7, Eigen::Vector3d(1.0, -2.0, 0.5).normalized()).toRotationMatrix();
+}
+
+// volume_mm3 goes through the outer surface: it must equal the sum of signed tet volumes at any
+// deformation, tets inverted by a large one included (the brute-force oracle: the tet loop).
+TEST(MssModel, VolumeThroughTheSurfaceEqualsTheSumOfSignedTetVolumes) {
+  const mesh::TetMesh m = two_region_box();
+  const MssModel model(m, two_regions());
+  for (const double amplitude : {0.0, 0.3, 3.0}) {
+    Eigen::VectorXd x = rigidly_moved(perturbed(model, amplitude, 41), some_rotation(),
+                                      Eigen::Vector3d(150.0, -300.0, 40.0));
+    double tets = 0.0;
+    int inverted = 0;
+    for (Eigen::Index t = 0; t < m.num_tets(); ++t) {
+      TetPoints p;
+      for (int k = 0; k < 4; ++k) p.col(k) = x.segment<3>(3 * m.T(t, k));
+      tets += tet_signed_volume(p);
+      inverted += tet_signed_volume(p) < 0;
+    }
+    EXPECT_NEAR(model.volume_mm3(x), tets, 1e-11 * model.rest_volume_mm3()) << amplitude;
+    if (amplitude == 3.0) EXPECT_GT(inverted, 0);  // the large one does invert some
+  }
 }
 
 TEST(MssModel, MassesAddUpToDensityTimesVolume) {

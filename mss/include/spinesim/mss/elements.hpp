@@ -34,6 +34,10 @@ using TetPoints = Eigen::Matrix<double, 3, 4>;
 
 enum class HessianMode { exact, projected };
 
+/// Lengths below this have no direction (coincident spring ends, a vertex at its tet's
+/// barycentre, the probe centre on a node): the elements take the zero (sub)gradient there.
+inline constexpr double kMinLength_mm = 1e-12;
+
 /// Main (edge) spring, thesis (5.12):  E = 1/2 k (|x1 - x0| - L0)^2.
 /// k in N/mm (Van Gelder (5.2): k = sum_tets E_j V_j / L0^2), L0 rest length mm.
 double edge_spring(const Eigen::Vector3d& x0, const Eigen::Vector3d& x1, double k_n_per_mm,
