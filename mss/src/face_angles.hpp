@@ -89,7 +89,7 @@ inline double face_angle_springs(const double* x0, const double* x1, const doubl
 /// (corner indices, rest cos and sin, stiffness), so the hot loop reads 68 bytes a face in
 /// sequence instead of the model's whole face records. Padding lanes repeat the last face with
 /// k = 0.
-inline constexpr int kFaceBlock = 8;
+inline constexpr int kFaceBlock = 16;
 struct FaceBlock {
   int n = 0;  ///< faces in use
   int v[3][kFaceBlock];

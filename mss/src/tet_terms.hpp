@@ -36,7 +36,7 @@ struct TetTermBlockInput {
 template <bool with_radial, bool with_volume>
 double tet_terms_all(const std::vector<TetTermBlockInput>& tets, const Eigen::MatrixX4i& T,
                      const double* x, double* g) {
-  constexpr int B = 8;
+  constexpr int B = 16;
   double energy = 0.0;
   alignas(64) double P[12][B], KR[B], S0[B], KV[B], V0[B], E[B], G[12][B];
   const std::size_t nt = tets.size();
