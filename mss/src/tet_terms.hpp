@@ -1,5 +1,5 @@
 // The per-tetrahedron terms of the MSS force evaluation — the radial springs (thesis
-// (5.3)-(5.5)) and the per-tet volume penalty — over all tets at once, in blocks of kBlock:
+// (5.3)-(5.5)) and the per-tet volume penalty — over all tets at once, in blocks of 16:
 // gather the four corners into structure-of-arrays buffers, run both formulas over the block as
 // plain loops the compiler vectorises, scatter-add the gradients. Same energy and gradient as
 // radial_springs and volume_penalty (elements.hpp) one tet at a time, up to round-off
