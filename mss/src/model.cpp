@@ -120,6 +120,8 @@ struct MssModel::Impl {
   // disc volume by the divergence theorem; about the rest centroid for round-off.
   std::vector<std::array<int, 3>> outer_faces;
   Eigen::Vector3d volume_origin = Eigen::Vector3d::Zero();
+  double outer_rest_volume = 0;  // the rest volume that way (rest_volume_mm3)
+  double outer_volume(const Eigen::VectorXd& x) const;
   void build_outer_faces();
 
   std::vector<EdgeSpring> edges;
@@ -414,6 +416,7 @@ void MssModel::Impl::build_outer_faces() {
     for (int c = 0; c < std::abs(count); ++c)
       outer_faces.push_back(count > 0 ? key : std::array<int, 3>{key[0], key[2], key[1]});
   volume_origin = X.reshaped(3, X.size() / 3).rowwise().mean();
+  outer_rest_volume = outer_volume(X);
 }
 
 void MssModel::Impl::apply_scales() {
@@ -487,7 +490,9 @@ Eigen::Index MssModel::num_angle_springs() const {
 Eigen::Index MssModel::num_volume_terms() const {
   return static_cast<Eigen::Index>(impl_->volume.size());
 }
-double MssModel::rest_volume_mm3() const { return impl_->rest_volume; }
+// Through the outer surface, as volume_mm3, so that volume_change is exactly zero at rest; it
+// differs from the tet sum (rest_volume, which the whole-disc term uses) by round-off only.
+double MssModel::rest_volume_mm3() const { return impl_->outer_rest_volume; }
 
 void MssModel::set_scales(const std::array<RegionScales, kNumTerms>& scales) {
   MssOptions o = impl_->options;
@@ -774,11 +779,15 @@ Eigen::Index MssModel::inverted_tets(const Eigen::VectorXd& x) const {
 
 double MssModel::volume_mm3(const Eigen::VectorXd& x) const {
   check_size(x, num_nodes());
-  // The sum of signed tet volumes through the outer surface (build_outer_faces): a third of the
-  // work of the tet loop on the palpation discs, which report their volume every step.
-  const Eigen::Vector3d o = impl_->volume_origin;
+  return impl_->outer_volume(x);
+}
+
+// The sum of signed tet volumes through the outer surface (build_outer_faces): a third of the
+// work of the tet loop on the palpation discs, which report their volume every step.
+double MssModel::Impl::outer_volume(const Eigen::VectorXd& x) const {
+  const Eigen::Vector3d o = volume_origin;
   double v = 0.0;
-  for (const auto& f : impl_->outer_faces) {
+  for (const auto& f : outer_faces) {
     const Eigen::Vector3d a = x.segment<3>(3 * f[0]) - o, b = x.segment<3>(3 * f[1]) - o,
                           c = x.segment<3>(3 * f[2]) - o;
     v += a.dot(b.cross(c));

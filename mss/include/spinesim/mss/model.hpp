@@ -192,12 +192,14 @@ class MssModel {
   /// term is off.
   double disc_volume_rank_one(const Eigen::VectorXd& x_mm, Eigen::VectorXd& u) const;
 
-  /// Sum of signed tetrahedron volumes at x, mm^3.
+  /// Sum of signed tetrahedron volumes at x, mm^3 (evaluated through the outer surface: the same
+  /// sum up to round-off, at a third of the cost).
   double volume_mm3(const Eigen::VectorXd& x_mm) const;
   /// Tetrahedra turned inside out at x (signed volume <= 0). Edge, radial and angle springs
   /// barely resist inversion, so an overloaded thesis network can reach an "equilibrium" with
   /// inverted tets (seen: 500 N on a thoracic disc); the volume terms prevent it.
   Eigen::Index inverted_tets(const Eigen::VectorXd& x_mm) const;
+  /// volume_mm3 at the rest positions (so that a disc at rest has exactly zero volume change).
   double rest_volume_mm3() const;
 
  private:
