@@ -14,6 +14,7 @@ packages=(
   zlib1g-dev liblzma-dev   # compressed VTU files (VTK's zlib and LZMA compressors)
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-meshio python3-numpy   # independent VTU reader used by the tests
+  python3-matplotlib python3-markdown    # the demo's report.html and its plots (scripts/report.py)
   clang libclang-rt-14-dev # libFuzzer, for the fuzz targets of the file readers (fuzz/)
 )
 

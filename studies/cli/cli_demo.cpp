@@ -4,7 +4,8 @@
 //
 // The steps are the demo driver's (studies/demo.hpp): mesh the L4-L5 disc between its
 // vertebrae, its FEM reference, the material study, the untuned MSS against the FEM, the
-// calibration protocol, the spine studies; VTU results, report.md and summary.json in --out.
+// calibration protocol, the spine studies; VTU results, report.md, summary.json and report.html
+// with plots in --out.
 #include "cli_common.hpp"
 
 #include "spinesim/studies/demo.hpp"
@@ -23,10 +24,12 @@ struct DemoArgs {
 void run(const DemoArgs& a) {
   Progress progress(demo_stages(), a.quiet || a.json);
   const DemoResult r = run_demo(a.request, progress.hooks());
-  if (a.json)
+  if (a.json) {
     print_json(r.summary);
-  else
+  } else {
     std::cout << r.report_markdown << "\nReport written to " << r.report_path << "\n";
+    std::cout << (r.html.written ? "" : "note: ") << r.html.message << "\n";
+  }
 }
 
 }  // namespace

@@ -375,7 +375,7 @@ nlohmann::json Demo::summary(const std::string& report_path) const {
 }  // namespace
 
 int demo_stages() {
-  return 7 + kStagesPerMaterial * int(std::size(kPresets)) + kValidationStages + kFusionStages +
+  return 8 + kStagesPerMaterial * int(std::size(kPresets)) + kValidationStages + kFusionStages +
          kTrendsStages;
 }
 
@@ -398,6 +398,9 @@ DemoResult run_demo(const DemoRequest& rq, const StageHooks& hooks) {
   write_text_file(r.report_path, r.report_markdown);
   r.summary = demo.summary(r.report_path);
   write_text_file((fs::path(rq.out) / "summary.json").string(), r.summary.dump(2) + "\n");
+  hooks.begin_stage("plots and report.html");
+  r.html = write_html_report(rq.out);
+  hooks.end_stage(r.html.written ? "written" : "not written");
   return r;
 }
 

@@ -6,10 +6,11 @@
 // against that FEM on all eight cases (calibration/compare.hpp); 5. the calibration protocol
 // (calibration_report.hpp): Ipopt on four training cases, four held out; 6. the spine
 // (spine_studies.hpp): validation (3.4), fusion (6.1) and trends (6.3-6.4); 7. VTU results,
-// report.md and summary.json in the output folder.
+// report.md and summary.json in the output folder; 8. report.html with plots (html_report.hpp).
 #pragma once
 
 #include "spinesim/mesh/mesher.hpp"
+#include "spinesim/studies/html_report.hpp"
 #include "spinesim/studies/progress.hpp"
 
 #include <nlohmann/json.hpp>
@@ -32,6 +33,7 @@ struct DemoResult {
   std::string report_markdown;  ///< also written to <out>/report.md
   std::string report_path;
   nlohmann::json summary;  ///< also written to <out>/summary.json
+  HtmlReport html;         ///< <out>/report.html, or why it was not written
 };
 
 /// Runs the steps above; throws std::invalid_argument for a bad request (unknown level, bad

@@ -1,0 +1,251 @@
+#!/usr/bin/python3
+"""Plots and report.html for `spinesim demo`.
+
+Reads what the demo wrote in DIR (summary.json, haptic_plane.csv, haptics_stroke.csv, report.md)
+and writes DIR/plots/*.png and DIR/report.html: each figure beside the caption of its counterpart
+in the thesis and our numbers, then the text report. Any error is one line on stderr and exit
+status 2 (report.md is left as it is).
+
+    /usr/bin/python3 scripts/report.py DIR
+
+Needs python3-matplotlib and python3-markdown (Debian packages; scripts/install-deps.sh).
+"""
+import csv
+import html
+import json
+import os
+import sys
+
+
+def fail(message):
+    print(f"report: {message}; report.html not written", file=sys.stderr)
+    sys.exit(2)
+
+
+try:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+except ImportError:
+    fail("python3-matplotlib is missing (apt-get install python3-matplotlib)")
+try:
+    import markdown
+except ImportError:
+    fail("python3-markdown is missing (apt-get install python3-markdown)")
+
+
+class Figure:
+    """One figure of the report: file name, title, the thesis counterpart and our numbers."""
+
+    def __init__(self, name, title, thesis, ours):
+        self.name, self.title, self.thesis, self.ours = name, title, thesis, ours
+
+
+def read_csv(path):
+    """Rows of a CSV whose comment lines start with '#', as dicts of floats."""
+    with open(path, newline="") as f:
+        lines = [line for line in f if not line.startswith("#")]
+    rows = list(csv.DictReader(lines))
+    if not rows:
+        raise ValueError(f"{path}: no data rows")
+    return [{k: float(v) for k, v in r.items()} for r in rows]
+
+
+def save(fig, out_dir, name):
+    fig.tight_layout()
+    fig.savefig(os.path.join(out_dir, "plots", name), dpi=110)
+    plt.close(fig)
+
+
+def haptic_plane(d, out_dir):
+    rows = read_csv(os.path.join(d, "haptic_plane.csv"))
+    depth = [r["depth_mm"] for r in rows]
+    fig, axes = plt.subplots(1, 2, figsize=(10, 3.8))
+    for ax, eq, unit in ((axes[0], "eq49", "eq 4.9 (sum over sample points)"),
+                         (axes[1], "eq410", "eq 4.10 (normalised, improved)")):
+        for probe, colour in (("small", "tab:blue"), ("large", "tab:red")):
+            radius = 5 if probe == "small" else 10
+            ax.plot(depth, [r[f"{probe}_{eq}_n"] for r in rows], color=colour,
+                    label=f"r = {radius} mm, sampled")
+            ax.plot(depth, [r[f"{probe}_{eq}_exact_n"] for r in rows], color=colour,
+                    linestyle="--", linewidth=0.8, label=f"r = {radius} mm, closed form")
+        ax.set_xlabel("intrusion depth (mm)")
+        ax.set_ylabel("force magnitude (N)")
+        ax.set_title(unit)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+    save(fig, out_dir, "haptic_plane.png")
+    peak = max(rows, key=lambda r: r["small_eq49_n"])
+    ratio49 = peak["large_eq49_n"] / peak["small_eq49_n"]
+    ratio410 = peak["large_eq410_n"] / peak["small_eq410_n"]
+    return Figure(
+        "haptic_plane.png", "Gao–Gibson force against intrusion depth (probes through a plane)",
+        "Figs 4.16, 4.18, 4.19: the force peaks at depth = radius; with eq 4.9 the larger probe "
+        "is over twice as strong at the small probe's peak (\"over 40\" against \"less than 20\" "
+        "units); with eq 4.10 both are \"nearly the same\" there.",
+        f"small probe's peak at {peak['depth_mm']:.2f} mm; large/small there: eq 4.9 "
+        f"{ratio49:.2f}, eq 4.10 {ratio410:.4f}.")
+
+
+def calibration(s, out_dir):
+    c = s["calibration"]
+    cases = [(r["name"], "train", r) for r in c["train"]] + \
+            [(r["name"], "held out", r) for r in c["holdout"]]
+    names = [f"{n}\n({kind})" for n, kind, _ in cases]
+    before = [100 * r["untuned_error"] for _, _, r in cases]
+    after = [100 * r["tuned_error"] for _, _, r in cases]
+    fig, ax = plt.subplots(figsize=(10, 3.8))
+    x = range(len(cases))
+    ax.bar([i - 0.2 for i in x], before, 0.4, label="thesis constants (untuned)", color="0.6")
+    ax.bar([i + 0.2 for i in x], after, 0.4, label="tuned (Ipopt)", color="tab:green")
+    ax.set_xticks(list(x))
+    ax.set_xticklabels(names, fontsize=8)
+    ax.set_ylabel("MSS displacement error vs FEM (%)")
+    ax.grid(axis="y", alpha=0.3)
+    ax.legend()
+    save(fig, out_dir, "calibration.png")
+    held = [r for _, kind, r in cases if kind == "held out"]
+    worst = max(held, key=lambda r: r["tuned_error"])
+    return Figure(
+        "calibration.png", f"MSS against FEM, before and after tuning ({s['level']})",
+        "Ch. 5.3: the thesis sets the spring constants from the material (eqs 5.1–5.8) and "
+        "shows the disc compressing (fig 5.9); it never compares the MSS with an FE reference.",
+        f"mean error {sum(before) / len(before):.1f} % untuned → {sum(after) / len(after):.1f} % "
+        f"tuned; worst held-out case {worst['name']} {100 * worst['tuned_error']:.1f} %.")
+
+
+def materials(s, out_dir):
+    m = s["materials"]
+    names = [r["material"] for r in m]
+    fig, axes = plt.subplots(1, 2, figsize=(10, 3.8))
+    x = range(len(m))
+    axes[0].bar([i - 0.2 for i in x], [100 * r["untuned"]["displacement_error"] for r in m], 0.4,
+                label="untuned", color="0.6")
+    axes[0].bar([i + 0.2 for i in x], [100 * r["tuned"]["displacement_error"] for r in m], 0.4,
+                label="tuned", color="tab:green")
+    axes[0].set_ylabel("MSS displacement error vs FEM (%)")
+    axes[0].set_title("compression")
+    axes[0].legend()
+    for k, (key, label, colour) in enumerate((("fem", "FEM", "tab:blue"),
+                                              ("untuned", "MSS untuned", "0.6"),
+                                              ("tuned", "MSS tuned", "tab:green"))):
+        axes[1].bar([i + (k - 1) * 0.27 for i in x], [r[key]["axial_stiffness_n_per_mm"] for r in m],
+                    0.27, label=label, color=colour)
+    axes[1].set_yscale("log")
+    axes[1].set_ylabel("axial stiffness (N/mm)")
+    axes[1].legend(fontsize=8)
+    for ax in axes:
+        ax.set_xticks(list(x))
+        ax.set_xticklabels(names, fontsize=8)
+        ax.grid(axis="y", alpha=0.3)
+    save(fig, out_dir, "materials.png")
+    return Figure(
+        "materials.png", "The materials study: each preset's disc, FEM and MSS",
+        "Fig 5.9: disc compression with different materials (pictures of the deformed MSS disc; "
+        "no numbers).",
+        "; ".join(f"{r['material']}: FEM {r['fem']['axial_stiffness_n_per_mm']:.0f} N/mm, tuned "
+                  f"MSS error {100 * r['tuned']['displacement_error']:.1f} %" for r in m) + ".")
+
+
+def validation(s, out_dir):
+    v = s["spine_validation"]
+    mc, wi = v["mcgill"], v["wilke"]
+    windows = [
+        ("L5-S1 axial, lifting\n(McGill & Norman)", mc["axial_n"], mc["target"]["axial_range_n"],
+         mc["thesis"]["axial_n"]),
+        ("L5-S1 shear, lifting\n(McGill & Norman)", mc["shear_n"], [0, mc["target"]["shear_max_n"]],
+         mc["thesis"]["shear_n"]),
+        ("L4-L5 axial, crate\n(Wilke et al.)", wi["axial_n"], wi["target"]["axial_range_n"],
+         wi["thesis"]["axial_n"]),
+    ]
+    fig, ax = plt.subplots(figsize=(10, 3.8))
+    for i, (label, ours, band, thesis) in enumerate(windows):
+        ax.add_patch(plt.Rectangle((i - 0.4, band[0]), 0.8, band[1] - band[0], color="tab:green",
+                                   alpha=0.2, label="target window" if i == 0 else None))
+        ax.bar(i - 0.15, ours, 0.3, color="tab:blue", label="ours" if i == 0 else None)
+        ax.bar(i + 0.15, thesis, 0.3, color="0.6", label="thesis" if i == 0 else None)
+    ax.set_xticks(range(len(windows)))
+    ax.set_xticklabels([w[0] for w in windows], fontsize=8)
+    ax.set_ylabel("force (N)")
+    ax.set_xlim(-0.6, len(windows) - 0.4)
+    ax.grid(axis="y", alpha=0.3)
+    ax.legend()
+    save(fig, out_dir, "validation.png")
+    verdict = "inside" if v["pass"] else "outside"
+    return Figure(
+        "validation.png", "The spine's validation windows",
+        "Ch. 3.4: 1,260 N on T7 gives 4,582 N axial and 625 N shear at L5-S1 (McGill & Norman's "
+        "lift); the crate held in front of the chest loads L4-L5 with 3,162 N (Wilke et al.).",
+        f"{mc['axial_n']:.0f} N axial / {mc['shear_n']:.0f} N shear at L5-S1 and {wi['axial_n']:.0f} N "
+        f"at L4-L5: {verdict} every window.")
+
+
+def haptic_stroke(d, out_dir):
+    rows = read_csv(os.path.join(d, "haptics_stroke.csv"))
+    t = [r["t_s"] for r in rows]
+    f = [(r["fx_n"] ** 2 + r["fy_n"] ** 2 + r["fz_n"] ** 2) ** 0.5 for r in rows]
+    fig, ax = plt.subplots(figsize=(10, 3.2))
+    ax.plot(t, f, linewidth=0.8)
+    ax.set_xlabel("time (s)")
+    ax.set_ylabel("|force| on the hand (N)")
+    ax.grid(alpha=0.3)
+    save(fig, out_dir, "haptic_stroke.png")
+    contact = sum(r["contact"] > 0 for r in rows)
+    return Figure(
+        "haptic_stroke.png", "The simulated hand strokes the spinous processes (1 kHz loop)",
+        "Ch. 4.5 and 6.3: the thesis's users touched the spine in the haptic loop; it shows no "
+        "force record.",
+        f"{len(rows)} ticks, {contact} in contact, peak {max(f):.2f} N.")
+
+
+def write_html(d, figures, report_md):
+    parts = ["<!DOCTYPE html><html><head><meta charset='utf-8'><title>spinesim demo report</title>",
+             "<style>body{font-family:sans-serif;max-width:1100px;margin:2em auto;padding:0 1em}"
+             "figure{margin:2em 0;border-top:1px solid #ccc;padding-top:1em}img{max-width:100%}"
+             ".thesis{color:#555}table{border-collapse:collapse}td,th{border:1px solid #ccc;"
+             "padding:2px 6px}pre{background:#f6f6f6;padding:0.5em;overflow-x:auto}</style>",
+             "</head><body><h1>spinesim demo report</h1><h2>Figures</h2>"]
+    for f in figures:
+        parts.append(f"<figure><h3>{html.escape(f.title)}</h3>"
+                     f"<img src='plots/{f.name}' alt='{html.escape(f.title)}'>"
+                     f"<figcaption><p class='thesis'><b>Thesis:</b> {html.escape(f.thesis)}</p>"
+                     f"<p><b>Ours:</b> {html.escape(f.ours)}</p></figcaption></figure>")
+    parts.append("<h2>Text report</h2>")
+    parts.append(markdown.markdown(report_md, extensions=["tables", "fenced_code"]))
+    parts.append("</body></html>")
+    with open(os.path.join(d, "report.html"), "w") as f:
+        f.write("\n".join(parts))
+
+
+def main(argv):
+    if len(argv) != 2 or argv[1] in ("-h", "--help"):
+        print(__doc__.strip())
+        return 0 if len(argv) == 2 else 2
+    d = argv[1]
+    summary_path = os.path.join(d, "summary.json")
+    try:
+        with open(summary_path) as f:
+            s = json.load(f)
+        with open(os.path.join(d, "report.md")) as f:
+            report_md = f.read()
+    except (OSError, ValueError) as e:
+        fail(f"cannot read the demo's output in {d}: {e}")
+    os.makedirs(os.path.join(d, "plots"), exist_ok=True)
+    figures = []
+    try:
+        figures.append(haptic_plane(d, d))
+        figures.append(calibration(s, d))
+        figures.append(materials(s, d))
+        figures.append(validation(s, d))
+        figures.append(haptic_stroke(d, d))
+    except (OSError, ValueError, KeyError, TypeError, ZeroDivisionError) as e:
+        fail(f"bad input in {d}: {type(e).__name__} {e}")
+    write_html(d, figures, report_md)
+    print(f"report: {os.path.join(d, 'report.html')} with {len(figures)} plots in "
+          f"{os.path.join(d, 'plots')}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))

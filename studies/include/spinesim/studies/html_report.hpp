@@ -1,0 +1,20 @@
+// The demo's HTML report with plots: scripts/report.py (python3-matplotlib, python3-markdown)
+// run by Debian's /usr/bin/python3 on a folder the demo wrote (summary.json, haptic_plane.csv,
+// haptics_stroke.csv, report.md), writing <folder>/report.html and <folder>/plots/*.png.
+#pragma once
+
+#include <string>
+
+namespace spinesim::studies {
+
+struct HtmlReport {
+  bool written = false;
+  std::string path;     ///< <folder>/report.html
+  std::string message;  ///< the script's one line: what it wrote, or why it wrote nothing
+};
+
+/// Runs the report script on `folder`. Never throws for the script's own failures (a missing
+/// python3 or plotting library, bad input): they come back as written = false and one line.
+HtmlReport write_html_report(const std::string& folder);
+
+}  // namespace spinesim::studies

@@ -1,0 +1,153 @@
+// The demo's HTML report (studies/html_report.hpp, scripts/report.py) on a small demo folder made
+// here: every plot is written and shown in report.html; a missing or broken input is one line and
+// no report.html. Needs Debian's python3 with matplotlib and markdown (scripts/install-deps.sh).
+#include "spinesim/studies/html_report.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <unistd.h>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace fs = std::filesystem;
+using spinesim::studies::write_html_report;
+
+namespace {
+
+bool have_plotting() {
+  return fs::exists("/usr/bin/python3") &&
+         std::system("/usr/bin/python3 -c 'import matplotlib, markdown' >/dev/null 2>&1") == 0;
+}
+
+std::string fresh_dir(const std::string& name) {
+  const fs::path p = fs::path(SPINESIM_TEST_TMP) / (name + "-" + std::to_string(::getpid()));
+  fs::remove_all(p);
+  fs::create_directories(p);
+  return p.string();
+}
+
+void write(const fs::path& path, const std::string& text) { std::ofstream(path) << text; }
+
+std::string read(const fs::path& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+nlohmann::json load_case(const std::string& name, double untuned, double tuned) {
+  return {{"name", name}, {"untuned_error", untuned}, {"tuned_error", tuned}};
+}
+
+nlohmann::json material(const std::string& name, double k_fem) {
+  return {{"material", name},
+          {"fem", {{"axial_stiffness_n_per_mm", k_fem}}},
+          {"untuned", {{"axial_stiffness_n_per_mm", 0.7 * k_fem}, {"displacement_error", 0.5}}},
+          {"tuned", {{"axial_stiffness_n_per_mm", 1.01 * k_fem}, {"displacement_error", 0.08}}}};
+}
+
+/// What the demo writes, small: two load cases, two materials, ten depths, a few ticks.
+std::string demo_folder(const std::string& name) {
+  const std::string d = fresh_dir(name);
+  nlohmann::json s;
+  s["level"] = "L4-L5";
+  s["calibration"]["train"] = {load_case("compression", 0.52, 0.07)};
+  s["calibration"]["holdout"] = {load_case("tension", 0.51, 0.06)};
+  s["materials"] = {material("real-disc", 718), material("rubber", 8400)};
+  s["spine_validation"] = {
+      {"pass", true},
+      {"mcgill",
+       {{"axial_n", 4220.0},
+        {"shear_n", 52.0},
+        {"target", {{"axial_range_n", {3929.0, 4688.0}}, {"shear_max_n", 650.0}}},
+        {"thesis", {{"axial_n", 4582.0}, {"shear_n", 625.0}}}}},
+      {"wilke",
+       {{"axial_n", 3525.0},
+        {"target", {{"axial_range_n", {2754.0, 3726.0}}}},
+        {"thesis", {{"axial_n", 3161.6}}}}}};
+  write(fs::path(d) / "summary.json", s.dump(2));
+  std::string plane =
+      "# comment\ndepth_mm,small_eq49_n,large_eq49_n,small_eq410_n,large_eq410_n,"
+      "small_eq49_exact_n,large_eq49_exact_n,small_eq410_exact_n,large_eq410_exact_n\n";
+  for (int k = 0; k <= 10; ++k) {
+    const double x = k, s49 = x * (10 - x), l49 = 4 * s49;
+    plane += std::to_string(x) + "," + std::to_string(s49) + "," + std::to_string(l49) + "," +
+             std::to_string(s49) + "," + std::to_string(s49) + "," + std::to_string(s49) + "," +
+             std::to_string(l49) + "," + std::to_string(s49) + "," + std::to_string(s49) + "\n";
+  }
+  write(fs::path(d) / "haptic_plane.csv", plane);
+  write(fs::path(d) / "haptics_stroke.csv",
+        "# recording\nt_s,x_mm,y_mm,z_mm,button,fx_n,fy_n,fz_n,proxy_x_mm,proxy_y_mm,proxy_z_mm,"
+        "contact,tick\n0.001,0,0,0,0,0,0,0,0,0,0,0,1\n0.002,0,0,0,0,0.3,0.4,0,0,0,0,1,2\n");
+  write(fs::path(d) / "report.md", "# Demo\n\n| a | b |\n|---|---|\n| 1 | 2 |\n");
+  return d;
+}
+
+}  // namespace
+
+TEST(HtmlReport, WritesEveryPlotAndShowsThemInTheHtml) {
+  if (!have_plotting()) GTEST_SKIP() << "/usr/bin/python3 with matplotlib and markdown missing";
+  const std::string d = demo_folder("html-report");
+  const auto r = write_html_report(d);
+  ASSERT_TRUE(r.written) << r.message;
+  EXPECT_NE(r.message.find("5 plots"), std::string::npos) << r.message;
+  const std::string html = read(r.path);
+  for (const char* png : {"haptic_plane.png", "calibration.png", "materials.png", "validation.png",
+                          "haptic_stroke.png"}) {
+    const fs::path file = fs::path(d) / "plots" / png;
+    ASSERT_TRUE(fs::exists(file)) << png;
+    EXPECT_GT(fs::file_size(file), 5000u) << png;  // a drawn figure, not an empty canvas
+    EXPECT_EQ(read(file).substr(1, 3), "PNG") << png;
+    EXPECT_NE(html.find(std::string("plots/") + png), std::string::npos) << png;
+  }
+  EXPECT_NE(html.find("<table>"), std::string::npos);  // report.md's table, as HTML
+  EXPECT_NE(html.find("Thesis:"), std::string::npos);
+  // Our numbers from the input beside the thesis's: the eq 4.9 ratio at the small peak is 4.
+  EXPECT_NE(html.find("eq 4.9 4.00"), std::string::npos);
+}
+
+TEST(HtmlReport, MissingOrBrokenInputIsOneLineAndNoReport) {
+  if (!have_plotting()) GTEST_SKIP() << "/usr/bin/python3 with matplotlib and markdown missing";
+  const std::string empty = fresh_dir("html-report-empty");
+  auto r = write_html_report(empty);
+  EXPECT_FALSE(r.written);
+  EXPECT_FALSE(fs::exists(r.path));
+  EXPECT_EQ(r.message.find('\n'), std::string::npos);
+  EXPECT_NE(r.message.find("summary.json"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("report.html not written"), std::string::npos) << r.message;
+
+  const std::string d = demo_folder("html-report-broken");
+  write(fs::path(d) / "haptic_plane.csv", "depth_mm,small_eq49_n\n0,zero\n");
+  r = write_html_report(d);
+  EXPECT_FALSE(r.written);
+  EXPECT_FALSE(fs::exists(r.path));
+  EXPECT_NE(r.message.find("bad input"), std::string::npos) << r.message;
+
+  // A stale report.html from an earlier run does not survive a failed one.
+  write(fs::path(d) / "report.html", "old");
+  r = write_html_report(d);
+  EXPECT_FALSE(fs::exists(r.path));
+}
+
+TEST(HtmlReport, AMissingPlottingLibraryIsOneClearLine) {
+  if (!fs::exists("/usr/bin/python3")) GTEST_SKIP() << "/usr/bin/python3 missing";
+  const std::string d = demo_folder("html-report-nolib");
+  // A matplotlib that cannot be imported, first on the path.
+  const fs::path fake = fs::path(d) / "fake" / "matplotlib";
+  fs::create_directories(fake);
+  write(fake / "__init__.py", "raise ImportError('not installed')\n");
+  const fs::path out = fs::path(d) / "out.txt";
+  const std::string command = "PYTHONPATH='" + (fs::path(d) / "fake").string() +
+                              "' /usr/bin/python3 '" SPINESIM_SCRIPTS_DIR "/report.py' '" + d +
+                              "' >'" + out.string() + "' 2>&1";
+  EXPECT_NE(std::system(command.c_str()), 0);
+  const std::string said = read(out);
+  EXPECT_EQ(said,
+            "report: python3-matplotlib is missing (apt-get install python3-matplotlib); "
+            "report.html not written\n");
+  EXPECT_FALSE(fs::exists(fs::path(d) / "report.html"));
+}
