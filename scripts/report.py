@@ -42,14 +42,22 @@ class Figure:
         self.name, self.title, self.thesis, self.ours = name, title, thesis, ours
 
 
-def read_csv(path):
-    """Rows of a CSV whose comment lines start with '#', as dicts of floats."""
+def read_csv(path, text_columns=()):
+    """Rows of a CSV whose comment lines start with '#', as dicts of floats (but text_columns)."""
     with open(path, newline="") as f:
         lines = [line for line in f if not line.startswith("#")]
     rows = list(csv.DictReader(lines))
     if not rows:
         raise ValueError(f"{path}: no data rows")
-    return [{k: float(v) for k, v in r.items()} for r in rows]
+    return [{k: (v if k in text_columns else float(v)) for k, v in r.items()} for r in rows]
+
+
+def findings_text(study):
+    """'n of m thesis findings reproduced (ids that differ: …)' from a study's findings."""
+    f = study["findings"]
+    differ = [x["id"] for x in f if not x["match"]]
+    text = f"{len(f) - len(differ)} of {len(f)} thesis findings reproduced"
+    return text + (f" (differ: {', '.join(differ)})" if differ else "")
 
 
 def save(fig, out_dir, name):
@@ -181,6 +189,72 @@ def validation(s, out_dir):
         f"at L4-L5: {verdict} every window.")
 
 
+def spine_t1(d, s, out_dir):
+    rows = read_csv(os.path.join(d, "spine_trends.csv"), text_columns=("load", "pair"))
+    loads = list(dict.fromkeys(r["load"] for r in rows))
+    fig, axes = plt.subplots(2, len(loads), figsize=(12, 6.5), sharex=True)
+    for j, load in enumerate(loads):
+        run = [r for r in rows if r["load"] == load]
+        pairs = [r["pair"] for r in run]
+        for i, (keys, unit) in enumerate(((("dx_mm", "dy_mm", "dz_mm"), "relative translation (mm)"),
+                                          (("theta_x_deg", "theta_y_deg", "theta_z_deg"),
+                                           "relative rotation (deg)"))):
+            ax = axes[i][j]
+            for key, axis, colour in zip(keys, "xyz", ("tab:red", "tab:green", "tab:blue")):
+                ax.plot(range(len(run)), [r[key] for r in run], marker="o", markersize=3,
+                        color=colour, label=f"{axis}")
+            ax.axhline(0, color="0.5", linewidth=0.6)
+            ax.grid(alpha=0.3)
+            if j == 0:
+                ax.set_ylabel(unit)
+            if i == 0:
+                ax.set_title(f"{load} force on T1")
+            ax.set_xticks(range(len(run)))
+            ax.set_xticklabels(pairs, rotation=90, fontsize=7)
+        axes[0][j].legend(fontsize=8, title="axis", title_fontsize=8)
+    save(fig, out_dir, "spine_t1.png")
+    force = s["spine_trends"].get("force_n", 300)
+    return Figure(
+        "spine_t1.png", f"Every vertebra pair under a {force:.0f} N force on T1 (upper minus lower)",
+        "Figs 6.12–6.25 (x, y, z relative translations of the pairs T1–T9 and T9–L5 under "
+        "lateral, forward and backward force on T1) and 6.38–6.47 (relative rotations).",
+        findings_text(s["spine_trends"]) + ".")
+
+
+def fusion(d, s, out_dir):
+    rows = read_csv(os.path.join(d, "spine_fusion.csv"), text_columns=("fusion", "load"))
+    fusions = list(dict.fromkeys(r["fusion"] for r in rows))
+    loads = list(dict.fromkeys(r["load"] for r in rows))
+    fig, axes = plt.subplots(1, 2, figsize=(12, 4))
+    width = 0.8 / len(fusions)
+    for k, name in enumerate(fusions):
+        axes[0].bar([i + (k - (len(fusions) - 1) / 2) * width for i in range(len(loads))],
+                    [next(r["t1_translation_mm"] for r in rows
+                          if r["fusion"] == name and r["load"] == load) for load in loads],
+                    width, label=name)
+    axes[0].set_xticks(range(len(loads)))
+    axes[0].set_xticklabels([f"{load} force" for load in loads])
+    axes[0].set_ylabel("T1 translation by the force (mm)")
+    axes[0].legend(fontsize=8, title="fusion", title_fontsize=8)
+    joints = (("l2l3_resultant_n", "L2-L3"), ("l5s1_resultant_n", "L5-S1"))
+    forward = [r for r in rows if r["load"] == loads[0]]
+    for k, name in enumerate(fusions):
+        r = next(x for x in forward if x["fusion"] == name)
+        axes[1].bar([i + (k - (len(fusions) - 1) / 2) * width for i in range(len(joints))],
+                    [r[key] for key, _ in joints], width, label=name)
+    axes[1].set_xticks(range(len(joints)))
+    axes[1].set_xticklabels([f"{label} ({loads[0]} force)" for _, label in joints])
+    axes[1].set_ylabel("joint force, resultant (N)")
+    for ax in axes:
+        ax.grid(axis="y", alpha=0.3)
+    save(fig, out_dir, "fusion.png")
+    return Figure(
+        "fusion.png", "Spinal fusion at L3-L4, L4-L5 and L3-L4-L5 against the normal spine",
+        "Figs 6.1–6.3: the fused spines move T1 less than the normal one, L3-L4 less than "
+        "L4-L5, L3-L4-L5 least; figs 6.4–6.6: the forces on the joints next to a fusion rise.",
+        findings_text(s["spine_fusion"]) + ".")
+
+
 def haptic_stroke(d, out_dir):
     rows = read_csv(os.path.join(d, "haptics_stroke.csv"))
     t = [r["t_s"] for r in rows]
@@ -238,6 +312,8 @@ def main(argv):
         figures.append(calibration(s, d))
         figures.append(materials(s, d))
         figures.append(validation(s, d))
+        figures.append(spine_t1(d, s, d))
+        figures.append(fusion(d, s, d))
         figures.append(haptic_stroke(d, d))
     except (OSError, ValueError, KeyError, TypeError, ZeroDivisionError) as e:
         fail(f"bad input in {d}: {type(e).__name__} {e}")

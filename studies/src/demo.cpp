@@ -235,6 +235,9 @@ void Demo::spine_studies() {
   print_fusion(f, spine_fusion, true);
   print_trends(t, spine_trends, true);
   validation_text = v.str(), fusion_text = f.str(), trends_text = t.str();
+  // The per-run numbers behind the findings, for the report's plots (scripts/report.py).
+  write_text_file((fs::path(rq.out) / "spine_fusion.csv").string(), fusion_csv(spine_fusion));
+  write_text_file((fs::path(rq.out) / "spine_trends.csv").string(), trends_csv(spine_trends));
 }
 
 // 7. The haptic loop: the thesis's plane test of the Gao-Gibson force, and the simulated hand

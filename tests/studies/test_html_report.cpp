@@ -69,7 +69,21 @@ std::string demo_folder(const std::string& name) {
        {{"axial_n", 3525.0},
         {"target", {{"axial_range_n", {2754.0, 3726.0}}}},
         {"thesis", {{"axial_n", 3161.6}}}}}};
+  const nlohmann::json finding = {{"id", "some-finding"}, {"match", true}};
+  s["spine_trends"] = {{"force_n", 300.0}, {"findings", {finding}}};
+  s["spine_fusion"] = {{"findings", {finding, {{"id", "other"}, {"match", false}}}}};
   write(fs::path(d) / "summary.json", s.dump(2));
+  std::string trends = "load,pair,dx_mm,dy_mm,dz_mm,theta_x_deg,theta_y_deg,theta_z_deg\n";
+  for (const char* load : {"lateral", "forward"})
+    for (const char* pair : {"T1-T2", "T2-T3", "T3-T4"})
+      trends += std::string(load) + "," + pair + ",-1.5,0.2,0.1,0.3,-0.4,2.0\n";
+  write(fs::path(d) / "spine_trends.csv", trends);
+  std::string fusion =
+      "fusion,load,t1_translation_mm,l2l3_resultant_n,l5s1_resultant_n,other_column\n";
+  for (const char* f : {"normal", "L3-L4"})
+    for (const char* load : {"forward", "lateral"})
+      fusion += std::string(f) + "," + load + ",29.4,1674.6,2684.2,1\n";
+  write(fs::path(d) / "spine_fusion.csv", fusion);
   std::string plane =
       "# comment\ndepth_mm,small_eq49_n,large_eq49_n,small_eq410_n,large_eq410_n,"
       "small_eq49_exact_n,large_eq49_exact_n,small_eq410_exact_n,large_eq410_exact_n\n";
@@ -94,10 +108,10 @@ TEST(HtmlReport, WritesEveryPlotAndShowsThemInTheHtml) {
   const std::string d = demo_folder("html-report");
   const auto r = write_html_report(d);
   ASSERT_TRUE(r.written) << r.message;
-  EXPECT_NE(r.message.find("5 plots"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("7 plots"), std::string::npos) << r.message;
   const std::string html = read(r.path);
   for (const char* png : {"haptic_plane.png", "calibration.png", "materials.png", "validation.png",
-                          "haptic_stroke.png"}) {
+                          "spine_t1.png", "fusion.png", "haptic_stroke.png"}) {
     const fs::path file = fs::path(d) / "plots" / png;
     ASSERT_TRUE(fs::exists(file)) << png;
     EXPECT_GT(fs::file_size(file), 5000u) << png;  // a drawn figure, not an empty canvas
@@ -108,6 +122,7 @@ TEST(HtmlReport, WritesEveryPlotAndShowsThemInTheHtml) {
   EXPECT_NE(html.find("Thesis:"), std::string::npos);
   // Our numbers from the input beside the thesis's: the eq 4.9 ratio at the small peak is 4.
   EXPECT_NE(html.find("eq 4.9 4.00"), std::string::npos);
+  EXPECT_NE(html.find("1 of 2 thesis findings reproduced (differ: other)"), std::string::npos);
 }
 
 TEST(HtmlReport, MissingOrBrokenInputIsOneLineAndNoReport) {
