@@ -15,6 +15,8 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-meshio python3-numpy   # independent VTU reader used by the tests
   python3-matplotlib python3-markdown    # the demo's report.html and its plots (scripts/report.py)
+  libglfw3-dev libimgui-dev libstb-dev libgl-dev   # `spinesim view` (GLFW, Dear ImGui, PNG)
+  libgl1-mesa-dri xvfb xauth             # Mesa's software OpenGL and a virtual X server (view tests)
   clang libclang-rt-14-dev # libFuzzer, for the fuzz targets of the file readers (fuzz/)
 )
 

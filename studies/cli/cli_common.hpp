@@ -43,6 +43,7 @@ void register_haptics(CLI::App& app);         ///< haptics run|devices (cli_hapt
 void register_haptic_plane(CLI::App& study);  ///< study haptic-plane (cli_haptics.cpp)
 void register_haptic_drag(CLI::App& study);   ///< study haptic-drag (cli_haptics.cpp)
 void register_demo(CLI::App& app);
+void register_view(CLI::App& app);
 void register_bench(CLI::App& app);
 void register_spine_database(
     CLI::App& spine);  ///< spine database, under `spine` (cli_spine_database.cpp)

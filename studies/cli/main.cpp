@@ -39,6 +39,7 @@ int main(int argc, char** argv) {
   spinesim::cli::register_study(app);
   spinesim::cli::register_haptics(app);
   spinesim::cli::register_demo(app);
+  spinesim::cli::register_view(app);
   spinesim::cli::register_bench(app);
   try {
     app.parse(argc, argv);
