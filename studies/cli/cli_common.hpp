@@ -8,6 +8,7 @@
 #include "spinesim/studies/data.hpp"
 #include "spinesim/studies/files.hpp"
 #include "spinesim/studies/format.hpp"
+#include "spinesim/studies/haptic_scene.hpp"
 #include "spinesim/studies/json.hpp"
 #include "spinesim/studies/progress.hpp"
 #include "spinesim/studies/table.hpp"
@@ -44,6 +45,9 @@ void register_haptic_plane(CLI::App& study);  ///< study haptic-plane (cli_hapti
 void register_haptic_drag(CLI::App& study);   ///< study haptic-drag (cli_haptics.cpp)
 void register_demo(CLI::App& app);
 void register_view(CLI::App& app);
+
+/// --scene, --vertebrae, --testdata, --triangles: the haptic scene's flags (haptics run, view).
+void add_scene_flags(CLI::App* cmd, studies::HapticSceneRequest& scene);
 void register_bench(CLI::App& app);
 void register_spine_database(
     CLI::App& spine);  ///< spine database, under `spine` (cli_spine_database.cpp)

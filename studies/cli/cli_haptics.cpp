@@ -150,6 +150,22 @@ void add_disc_flags(CLI::App* run, HapticsRunRequest& request) {
                   "choice (its step is still measured and reported)");
 }
 
+void add_scene_flags(CLI::App* cmd, studies::HapticSceneRequest& scene) {
+  cmd->add_option("--scene", scene.scene,
+                  "spine (T1-L5 and sacrum), vertebra (L3), disc (a tuned disc between its two "
+                  "vertebrae, --level) or plane")
+      ->capture_default_str();
+  cmd->add_option("--vertebrae", scene.vertebrae,
+                  "Vertebra surfaces: generated (parametric), real (ArtiSynth L1-S1 from the test "
+                  "data, thoracic generated) or a scene JSON file (haptics/README.md)")
+      ->capture_default_str();
+  cmd->add_option("--testdata", scene.testdata_dir,
+                  "Folder holding artisynth-lss/ (for --vertebrae real; default: "
+                  "$SPINESIM_TESTDATA_DIR or the shared test-data folder)");
+  cmd->add_option("--triangles", scene.triangles, "Triangles per generated vertebra")
+      ->capture_default_str();
+}
+
 void register_haptics(CLI::App& app) {
   auto* haptics_cmd = app.add_subcommand(
       "haptics", "The 1 kHz haptic loop: touch the spine with a spherical probe");
@@ -157,20 +173,8 @@ void register_haptics(CLI::App& app) {
   auto a = std::make_shared<HapticsArgs>();
   auto* run = haptics_cmd->add_subcommand(
       "run", "Run the servo loop on a scene with a device (sim: a scripted hand)");
-  run->add_option("--scene", a->request.scene.scene,
-                  "spine (T1-L5 and sacrum), vertebra (L3), disc (a tuned disc between its two "
-                  "vertebrae, --level) or plane")
-      ->capture_default_str();
+  add_scene_flags(run, a->request.scene);
   add_disc_flags(run, a->request);
-  run->add_option("--vertebrae", a->request.scene.vertebrae,
-                  "Vertebra surfaces: generated (parametric), real (ArtiSynth L1-S1 from the test "
-                  "data, thoracic generated) or a scene JSON file (haptics/README.md)")
-      ->capture_default_str();
-  run->add_option("--testdata", a->request.scene.testdata_dir,
-                  "Folder holding artisynth-lss/ (for --vertebrae real; default: "
-                  "$SPINESIM_TESTDATA_DIR or the shared test-data folder)");
-  run->add_option("--triangles", a->request.scene.triangles, "Triangles per generated vertebra")
-      ->capture_default_str();
   run->add_option("--device", a->request.device, "sim, replay, null, openhaptics or dhd")
       ->capture_default_str();
   run->add_option("--model", a->request.model,

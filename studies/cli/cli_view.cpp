@@ -57,14 +57,8 @@ void run(const ViewArgs& a) {
 void register_view(CLI::App& app) {
   auto a = std::make_shared<ViewArgs>();
   auto* cmd = app.add_subcommand("view", "Show the scene in a 3-D window (orbit, pan, zoom)");
-  cmd->add_option("--scene", a->scene.scene, "spine (T1-L5 and sacrum), vertebra (L3) or disc")
-      ->capture_default_str();
+  add_scene_flags(cmd, a->scene);
   cmd->add_option("--level", a->scene.level, "disc scene: the level whose vertebrae are shown")
-      ->capture_default_str();
-  cmd->add_option("--vertebrae", a->scene.vertebrae,
-                  "Vertebra surfaces: generated, real (ArtiSynth L1-S1) or a scene JSON file")
-      ->capture_default_str();
-  cmd->add_option("--triangles", a->scene.triangles, "Triangles per generated vertebra")
       ->capture_default_str();
   cmd->add_option("--width", a->view.width, "Window width, pixels")->capture_default_str();
   cmd->add_option("--height", a->view.height, "Window height, pixels")->capture_default_str();
