@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """Plots and report.html for `spinesim demo`.
 
-Reads what the demo wrote in DIR (summary.json, haptic_plane.csv, haptics_stroke.csv, report.md)
+Reads what the demo wrote in DIR (summary.json, report.md, haptic_plane.csv, haptics_stroke.csv,
+spine_trends.csv, spine_fusion.csv, probe/probe.csv)
 and writes DIR/plots/*.png and DIR/report.html: each figure beside the caption of its counterpart
 in the thesis and our numbers, then the text report. Any error is one line on stderr and exit
 status 2 (report.md is left as it is).
@@ -94,6 +95,32 @@ def haptic_plane(d, out_dir):
         "units); with eq 4.10 both are \"nearly the same\" there.",
         f"small probe's peak at {peak['depth_mm']:.2f} mm; large/small there: eq 4.9 "
         f"{ratio49:.2f}, eq 4.10 {ratio410:.4f}.")
+
+
+def probe_test(d, out_dir):
+    rows = read_csv(os.path.join(d, "probe", "probe.csv"), text_columns=("site",))
+    sites = list(dict.fromkeys(r["site"] for r in rows))
+    fig, axes = plt.subplots(1, 2, figsize=(10, 3.8))
+    for site in sites:
+        run = [r for r in rows if r["site"] == site]
+        t = [r["time_s"] for r in run]
+        axes[0].plot(t, [r["force_n"] for r in run], label=f"{site} wall")
+        axes[1].plot(t, [100 * r["volume_change"] for r in run], label=f"{site} wall")
+    axes[0].set_ylabel("probe force (N)")
+    axes[1].set_ylabel("disc volume change (%)")
+    for ax in axes:
+        ax.set_xlabel("time (s)")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+    save(fig, out_dir, "probe_test.png")
+    dv = min(r["volume_change"] for r in rows)
+    depth = max(r["depth_mm"] for r in rows)
+    return Figure(
+        "probe_test.png", "A rigid probe pressed into the disc wall (the untuned MSS disc)",
+        "Fig 5.8 (test 1 of ch. 5.3): the disc deforms consistently and its volume is preserved "
+        "under continuous deformation (pictures; no numbers).",
+        f"pressed {depth:.1f} mm at {len(sites)} sites: peak force "
+        f"{max(r['force_n'] for r in rows):.1f} N, volume change down to {100 * dv:.3f} %.")
 
 
 def calibration(s, out_dir):
@@ -309,6 +336,7 @@ def main(argv):
     figures = []
     try:
         figures.append(haptic_plane(d, d))
+        figures.append(probe_test(d, d))
         figures.append(calibration(s, d))
         figures.append(materials(s, d))
         figures.append(validation(s, d))

@@ -23,6 +23,7 @@
 #include "spinesim/studies/json.hpp"
 #include "spinesim/studies/materials_study.hpp"
 #include "spinesim/studies/mesh_report.hpp"
+#include "spinesim/studies/probe_study.hpp"
 #include "spinesim/studies/spine_studies.hpp"
 #include "spinesim/studies/table.hpp"
 
@@ -70,6 +71,7 @@ class Demo {
   void fem_load_cases();
   void material_study();
   void mss_baseline();
+  void probe_test();
   void calibration();
   void spine_studies();
   void haptics();
@@ -96,6 +98,7 @@ class Demo {
   std::string constants_table, material_table;
   double materials_seconds = 0;
   MssFemComparison mss_vs_fem;
+  ProbeStudyResult probe;
   std::string mss_table;
   double mss_seconds = 0;
   CalibrationRequest calibration_request = demo_calibration_request();
@@ -210,6 +213,17 @@ void Demo::mss_baseline() {
   std::ostringstream os;
   print_comparison(os, mss_vs_fem, true);
   mss_table = os.str();
+}
+
+// 4b. Thesis 5.3, test 1 (fig. 5.8): a rigid sphere pressed into the wall of the untuned disc,
+//     force and disc volume tracked (probe_study.hpp); its CSV feeds the report's plot.
+void Demo::probe_test() {
+  ProbeStudyRequest r;
+  r.stepping.out = (fs::path(rq.out) / "probe").string();
+  r.stepping.frame_every = 250;  // a few VTU frames for ParaView; the plot uses the CSV
+  probe = run_probe_study(m, real_disc, r, hooks);
+  if (probe.stats.diverged)
+    throw std::runtime_error("demo: the probe test diverged: " + probe.stats.message);
 }
 
 // 5. The calibration protocol on the real disc: train on four cases, hold out four, untuned
@@ -364,6 +378,7 @@ nlohmann::json Demo::summary(const std::string& report_path) const {
           {"materials", materials_json(materials)},
           {"materials_seconds", materials_seconds},
           {"mss_vs_fem", comparison_json(mss_vs_fem)},
+          {"probe_test", probe.summary},
           {"calibration", calibrated.tuned.report},
           {"calibration_scales", calibrated.tuned.scales},
           {"spine_validation", validation_json(spine_validation)},
@@ -378,7 +393,7 @@ nlohmann::json Demo::summary(const std::string& report_path) const {
 }  // namespace
 
 int demo_stages() {
-  return 8 + kStagesPerMaterial * int(std::size(kPresets)) + kValidationStages + kFusionStages +
+  return 11 + kStagesPerMaterial * int(std::size(kPresets)) + kValidationStages + kFusionStages +
          kTrendsStages;
 }
 
@@ -392,6 +407,7 @@ DemoResult run_demo(const DemoRequest& rq, const StageHooks& hooks) {
   demo.fem_load_cases();
   demo.material_study();
   demo.mss_baseline();
+  demo.probe_test();
   demo.calibration();
   demo.spine_studies();
   demo.haptics();

@@ -84,6 +84,10 @@ std::string demo_folder(const std::string& name) {
     for (const char* load : {"forward", "lateral"})
       fusion += std::string(f) + "," + load + ",29.4,1674.6,2684.2,1\n";
   write(fs::path(d) / "spine_fusion.csv", fusion);
+  fs::create_directories(fs::path(d) / "probe");
+  write(fs::path(d) / "probe" / "probe.csv",
+        "time_s,site,depth_mm,force_n,volume_change\n0.001,anterior,0.5,3.0,-0.0001\n"
+        "0.002,anterior,1.0,6.0,-0.0002\n0.003,left,0.5,2.0,-0.0001\n");
   std::string plane =
       "# comment\ndepth_mm,small_eq49_n,large_eq49_n,small_eq410_n,large_eq410_n,"
       "small_eq49_exact_n,large_eq49_exact_n,small_eq410_exact_n,large_eq410_exact_n\n";
@@ -108,10 +112,10 @@ TEST(HtmlReport, WritesEveryPlotAndShowsThemInTheHtml) {
   const std::string d = demo_folder("html-report");
   const auto r = write_html_report(d);
   ASSERT_TRUE(r.written) << r.message;
-  EXPECT_NE(r.message.find("7 plots"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("8 plots"), std::string::npos) << r.message;
   const std::string html = read(r.path);
   for (const char* png : {"haptic_plane.png", "calibration.png", "materials.png", "validation.png",
-                          "spine_t1.png", "fusion.png", "haptic_stroke.png"}) {
+                          "spine_t1.png", "fusion.png", "haptic_stroke.png", "probe_test.png"}) {
     const fs::path file = fs::path(d) / "plots" / png;
     ASSERT_TRUE(fs::exists(file)) << png;
     EXPECT_GT(fs::file_size(file), 5000u) << png;  // a drawn figure, not an empty canvas

@@ -3,7 +3,8 @@
 // Steps: 1. mesh the disc level between its vertebrae (thesis tables F.1/F.2 placement);
 // 2. FEM reference (real-disc material): the 6x6 disc stiffness and the eight named load cases;
 // 3. the material study (materials_study.hpp, thesis fig. 5.9); 4. the untuned mass-spring disc
-// against that FEM on all eight cases (calibration/compare.hpp); 5. the calibration protocol
+// against that FEM on all eight cases (calibration/compare.hpp), and the probe test of thesis 5.3
+// (probe_study.hpp, fig. 5.8) into <out>/probe; 5. the calibration protocol
 // (calibration_report.hpp): Ipopt on four training cases, four held out; 6. the spine
 // (spine_studies.hpp): validation (3.4), fusion (6.1) and trends (6.3-6.4); 7. VTU results,
 // report.md and summary.json in the output folder; 8. report.html with plots (html_report.hpp).
