@@ -681,13 +681,11 @@ void write_surface_vtu(const std::string& path, const TriSurface& s,
 
 // ==========================================================================================
 
-TetMesh read_vtu(const std::string& path, std::vector<DataArray>* point_data,
-                 std::vector<DataArray>* cell_data) {
-  using tinyxml2::XMLElement;
-  Reader r;
-  r.who = "read_vtu";
-  r.path = path;
+namespace {
 
+/// Steps 1-2 of every VTU reader: the file, its XML envelope and the grid's arrays, decoded.
+detail::RawGrid read_raw_vtu(Reader& r, const std::string& path) {
+  using tinyxml2::XMLElement;
   // 1. File and XML envelope; the appended payload is cut out before XML parsing.
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec))
@@ -748,9 +746,26 @@ TetMesh read_vtu(const std::string& path, std::vector<DataArray>* point_data,
       grid->FirstChildElement("FieldData");  // other field arrays are not decoded
   if (const XMLElement* da = find_named(field, "disc_frame")) g.disc_frame = read_array(r, da);
   if (const XMLElement* da = find_named(field, "source")) g.source = read_array(r, da);
+  return g;
+}
 
+}  // namespace
+
+TetMesh read_vtu(const std::string& path, std::vector<DataArray>* point_data,
+                 std::vector<DataArray>* cell_data) {
+  Reader r;
+  r.who = "read_vtu";
+  r.path = path;
+  detail::RawGrid g = read_raw_vtu(r, path);
   // 3. The mesh, checked (vtk_grid.cpp).
   return detail::assemble_tet_mesh(r, std::move(g), point_data, cell_data);
+}
+
+VtuGrid read_vtu_grid(const std::string& path) {
+  Reader r;
+  r.who = "read_vtu";
+  r.path = path;
+  return detail::assemble_grid(r, read_raw_vtu(r, path));
 }
 
 }  // namespace spinesim::mesh

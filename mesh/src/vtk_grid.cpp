@@ -202,4 +202,56 @@ TetMesh assemble_tet_mesh(const FileError& e, RawGrid g, std::vector<DataArray>*
   return m;
 }
 
+VtuGrid assemble_grid(const FileError& e, const RawGrid& g) {
+  const std::int64_t np = g.num_points, nc = g.num_cells;
+  if (np == 0 || nc == 0) e.fail("mesh is empty (NumberOfPoints or NumberOfCells is 0)");
+  if (g.points.ncomp != 3 || std::int64_t(g.points.v.size()) != 3 * np)
+    e.fail("Points must hold NumberOfPoints points of 3 components");
+  VtuGrid out;
+  out.V.resize(np, 3);
+  for (std::int64_t i = 0; i < np; ++i)
+    for (int j = 0; j < 3; ++j) {
+      const double x = g.points.v[std::size_t(3 * i + j)];
+      if (!std::isfinite(x)) e.fail("point coordinates contain non-finite values");
+      out.V(i, j) = x;
+    }
+  if (std::int64_t(g.offsets.size()) != nc || std::int64_t(g.types.size()) != nc)
+    e.fail("Cells offsets/types do not match NumberOfCells");
+  const std::int64_t type = g.types.front();
+  if (type != kVtkTetra && type != 5)
+    e.fail("cell #0 is a " + cell_type_name(type) + "; only tetrahedra (10) or triangles (5)");
+  const int corners = type == kVtkTetra ? 4 : 3;
+  out.cell_type = int(type);
+  out.cells.resize(nc, corners);
+  for (std::int64_t c = 0; c < nc; ++c)
+    if (g.types[std::size_t(c)] != type)
+      e.fail("cell #" + std::to_string(c) + " is a " + cell_type_name(g.types[std::size_t(c)]) +
+             ", cell #0 a " + cell_type_name(type) + ": one kind of cell only");
+  if (std::int64_t(g.connectivity.size()) != corners * nc)
+    e.fail("connectivity has " + std::to_string(g.connectivity.size()) + " entries, expected " +
+           std::to_string(corners * nc));
+  for (std::int64_t c = 0; c < nc; ++c) {
+    if (g.offsets[std::size_t(c)] != corners * (c + 1))
+      e.fail("cell #" + std::to_string(c) + " offsets are inconsistent with its type");
+    for (int k = 0; k < corners; ++k) {
+      const std::int64_t v = g.connectivity[std::size_t(corners * c + k)];
+      if (v < 0 || v >= np) e.fail("connectivity refers to a point out of range");
+      out.cells(c, k) = int(v);
+    }
+  }
+  const auto arrays = [&](const std::vector<RawArray>& in, std::int64_t count, const char* kind,
+                          std::vector<DataArray>& to) {
+    for (const RawArray& a : in) {
+      if (std::int64_t(a.v.size()) != count * a.ncomp)
+        e.fail(std::string(kind) + " '" + a.name + "' has the wrong number of tuples");
+      for (double x : a.v)
+        if (!std::isfinite(x)) e.fail(std::string(kind) + " '" + a.name + "' is not finite");
+      to.push_back({a.name, to_matrix(a)});
+    }
+  };
+  arrays(g.point_data, np, "PointData", out.point_data);
+  arrays(g.cell_data, nc, "CellData", out.cell_data);
+  return out;
+}
+
 }  // namespace spinesim::mesh::detail

@@ -47,4 +47,8 @@ std::vector<std::int64_t> as_integers(const FileError& e, const RawArray& a, dou
 TetMesh assemble_tet_mesh(const FileError& e, RawGrid grid, std::vector<DataArray>* point_data,
                           std::vector<DataArray>* cell_data);
 
+/// Checks the grid (one cell kind: tetrahedra or triangles; finite points; array lengths) and
+/// keeps it as stored: the read_vtu_grid contract in io.hpp.
+VtuGrid assemble_grid(const FileError& e, const RawGrid& grid);
+
 }  // namespace spinesim::mesh::detail

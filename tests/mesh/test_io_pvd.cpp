@@ -148,3 +148,52 @@ TEST(IoPvd, MissingFolderIsAnOperatingSystemError) {
   EXPECT_THROW(write_pvd(dir + "/no/such/folder/s.pvd", {{0.0, "a.vtu"}}), std::runtime_error);
   EXPECT_EQ(count_files(dir), 0);
 }
+
+// The reader gives back what the writer wrote (times to the last bit, parts, names), relative
+// names resolved against the collection's folder, absolute ones kept.
+TEST(IoPvd, ReaderReturnsWhatTheWriterWrote) {
+  const std::string dir = tmp_dir("read_back");
+  const std::string path = dir + "/series.pvd";
+  std::vector<PvdEntry> written = sample_entries();
+  written.push_back({0.0, "v0.vtu", 1});
+  write_pvd(path, written);
+  const std::vector<PvdEntry> read = read_pvd(path);
+  ASSERT_EQ(read.size(), written.size());
+  for (std::size_t i = 0; i < read.size(); ++i) {
+    EXPECT_EQ(read[i].time_s, written[i].time_s) << i;  // bit for bit
+    EXPECT_EQ(read[i].part, written[i].part) << i;
+    const fs::path w(written[i].file);
+    EXPECT_EQ(read[i].file, w.is_absolute() ? w.string() : (fs::path(dir) / w).string()) << i;
+  }
+}
+
+TEST(IoPvd, ReaderRefusesBadCollectionsInOneLine) {
+  const std::string dir = tmp_dir("read_bad");
+  const auto write = [&](const std::string& name, const std::string& text) {
+    std::ofstream(dir + "/" + name) << text;
+    return dir + "/" + name;
+  };
+  const std::string head = "<VTKFile type=\"Collection\"><Collection>";
+  const std::string tail = "</Collection></VTKFile>";
+  test::expect_one_line_refusal([&] { read_pvd(dir + "/absent.pvd"); }, "absent.pvd",
+                                "no such file");
+  const std::string junk = write("junk.pvd", "not xml <<<");
+  test::expect_one_line_refusal([&] { read_pvd(junk); }, junk, "XML");
+  const std::string grid = write("grid.pvd", "<VTKFile type=\"UnstructuredGrid\"/>");
+  test::expect_one_line_refusal([&] { read_pvd(grid); }, grid, "Collection");
+  const std::string empty = write("empty.pvd", head + tail);
+  test::expect_one_line_refusal([&] { read_pvd(empty); }, empty, "no datasets");
+  const std::string nan = write("nan.pvd", head + "<DataSet timestep=\"nan\" file=\"a\"/>" + tail);
+  test::expect_one_line_refusal([&] { read_pvd(nan); }, nan, "finite");
+  const std::string back =
+      write("back.pvd", head +
+                            "<DataSet timestep=\"1\" file=\"a\"/><DataSet timestep=\"0.5\" "
+                            "file=\"b\"/>" +
+                            tail);
+  test::expect_one_line_refusal([&] { read_pvd(back); }, back, "strictly increasing");
+  const std::string part =
+      write("part.pvd", head + "<DataSet timestep=\"1\" part=\"-2\" file=\"a\"/>" + tail);
+  test::expect_one_line_refusal([&] { read_pvd(part); }, part, "part");
+  const std::string nofile = write("nofile.pvd", head + "<DataSet timestep=\"1\"/>" + tail);
+  test::expect_one_line_refusal([&] { read_pvd(nofile); }, nofile, "no file");
+}

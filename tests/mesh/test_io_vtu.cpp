@@ -269,6 +269,58 @@ TEST(IoVtu, MeshioReadsATriangleSurface) {
   EXPECT_FALSE(fs::exists(bad));
 }
 
+// The playback reader: a surface and a tet mesh come back exactly as written (points, cells,
+// arrays) in every encoding the writers have, an inverted tet included (a deformed frame);
+// mixed cell kinds are refused in one line.
+TEST(IoVtu, GridReaderReturnsWhatTheWritersWrote) {
+  TriSurface s;
+  s.V.resize(4, 3);
+  s.V << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1.5;
+  s.F.resize(4, 3);
+  s.F << 0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3;
+  Eigen::MatrixXd body(4, 1);
+  body << 0, 1, 2, 3;
+  TetMesh m;
+  m.V = s.V;
+  m.T.resize(1, 4);
+  m.T << 0, 2, 1, 3;  // inverted: read_vtu would refuse it, the grid reader keeps it
+  m.surface = Eigen::VectorXi::Zero(4);
+  m.region = Eigen::VectorXi::Ones(1);
+  const Eigen::MatrixXd u = Eigen::MatrixXd::Constant(4, 3, 0.25);
+  for (VtuEncoding enc : {VtuEncoding::binary, VtuEncoding::ascii, VtuEncoding::zlib}) {
+    const std::string dir = tmp_dir("grid_" + std::to_string(int(enc)));
+    write_surface_vtu(dir + "/s.vtu", s, {}, {{"body", body}}, {enc});
+    const VtuGrid g = read_vtu_grid(dir + "/s.vtu");
+    EXPECT_EQ(g.cell_type, 5);
+    EXPECT_EQ(g.V, s.V);
+    EXPECT_EQ(g.cells, Eigen::MatrixXi(s.F));
+    ASSERT_NE(g.cell_array("body"), nullptr);
+    EXPECT_EQ(g.cell_array("body")->values, body);
+    EXPECT_EQ(g.point_array("body"), nullptr);
+    write_vtu(dir + "/t.vtu", m, {{"displacement", u}}, {}, {enc});
+    const VtuGrid t = read_vtu_grid(dir + "/t.vtu");
+    EXPECT_EQ(t.cell_type, 10);
+    EXPECT_EQ(t.cells, Eigen::MatrixXi(m.T));
+    ASSERT_NE(t.point_array("displacement"), nullptr);
+    EXPECT_EQ(t.point_array("displacement")->values, u);
+    ASSERT_NE(t.cell_array("region"), nullptr);  // kept as an ordinary array
+    EXPECT_THROW(read_vtu(dir + "/t.vtu"), std::invalid_argument);
+  }
+  const std::string dir = tmp_dir("grid_mixed");
+  std::ofstream(dir + "/mixed.vtu")
+      << "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\"><UnstructuredGrid>"
+         "<Piece NumberOfPoints=\"4\" NumberOfCells=\"2\"><Points><DataArray type=\"Float64\" "
+         "NumberOfComponents=\"3\" format=\"ascii\">0 0 0 1 0 0 0 1 0 0 0 1</DataArray></Points>"
+         "<Cells><DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">0 1 2 0 1 2 3"
+         "</DataArray><DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">3 7</DataArray>"
+         "<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">5 10</DataArray></Cells>"
+         "</Piece></UnstructuredGrid></VTKFile>";
+  test::expect_one_line_refusal([&] { read_vtu_grid(dir + "/mixed.vtu"); }, "mixed.vtu",
+                                "one kind of cell");
+  test::expect_one_line_refusal([&] { read_vtu_grid(dir + "/absent.vtu"); }, "absent.vtu",
+                                "no such file");
+}
+
 // Every encoding of a tetrahedral mesh that python3-meshio writes — VTU ascii; binary with
 // compression none/zlib/lzma and 32/64-bit headers; legacy VTK 4.2 and 5.1, ascii and binary —
 // plus the appended encodings meshio does not write (ParaView's default), made by a small numpy

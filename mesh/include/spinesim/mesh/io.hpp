@@ -82,6 +82,24 @@ void write_surface_vtu(const std::string& path, const TriSurface& s,
 TetMesh read_vtu(const std::string& path, std::vector<DataArray>* point_data = nullptr,
                  std::vector<DataArray>* cell_data = nullptr);
 
+/// A VTU as stored, for playing a time series back: points, cells of one kind and every data
+/// array (`region` and `surface` too), with no geometric checks (a deformed frame may hold
+/// inverted tetrahedra).
+struct VtuGrid {
+  Eigen::MatrixX3d V;     ///< #V×3
+  Eigen::MatrixXi cells;  ///< #C×4 (tetrahedra) or #C×3 (triangles)
+  int cell_type = 0;      ///< 10 (VTK_TETRA) or 5 (VTK_TRIANGLE)
+  std::vector<DataArray> point_data, cell_data;
+  /// The array called `name` (nullptr when absent).
+  const DataArray* point_array(const std::string& name) const;
+  const DataArray* cell_array(const std::string& name) const;
+};
+
+/// Reads a VTU as read_vtu does (every encoding), holding only tetrahedra or only triangles.
+/// Throws std::invalid_argument "read_vtu: PATH: problem" (one line) for a bad file, mixed or
+/// other cell types, non-finite coordinates or arrays of the wrong length.
+VtuGrid read_vtu_grid(const std::string& path);
+
 /// Reads a legacy VTK unstructured grid (.vtk): ASCII or BINARY (big-endian), file versions
 /// up to 4.2 (CELLS as "count ids…" lists) and 5.1 (OFFSETS + CONNECTIVITY); POINT_DATA and
 /// CELL_DATA as SCALARS, VECTORS, NORMALS, TENSORS or FIELD arrays; dataset FIELD data
@@ -140,5 +158,11 @@ struct PvdEntry {
 /// times or times not strictly increasing within a part, and empty file names; the listed files
 /// need not exist yet. Atomic write as for write_vtu.
 void write_pvd(const std::string& path, const std::vector<PvdEntry>& entries);
+
+/// Reads a ParaView data collection: its <DataSet> entries in file order, each `file` resolved
+/// against the .pvd's folder. Throws std::invalid_argument "read_pvd: PATH: problem" (one line)
+/// for a missing or unreadable file, no entries, a bad timestep or part, an empty file name, or
+/// times not strictly increasing within a part. The listed files are not opened.
+std::vector<PvdEntry> read_pvd(const std::string& path);
 
 }  // namespace spinesim::mesh
