@@ -132,14 +132,38 @@ Trajectory read_trajectory(const std::string& path) {
 
 namespace {
 
+/// The hand and the device over one servo period with the force held (zero-order hold): a
+/// point mass pulled by the hand's spring and damper towards `set_point(t)` (t from the period's
+/// start) with the device's physical damping, semi-implicit Euler in 10 sub-steps.
+template <class SetPoint, class SetVelocity>
+void hold_for_one_period(const HandModel& hand, const DeviceCapabilities& caps, double period,
+                         const Eigen::Vector3d& force, Eigen::Vector3d& x, Eigen::Vector3d& v,
+                         const SetPoint& set_point, const SetVelocity& set_velocity) {
+  const int substeps = 10;
+  const double h = period / substeps, m = hand.mass_kg * 1e-3;  // tonnes (mm-N-t-s)
+  for (int k = 0; k < substeps; ++k) {
+    const double t = k * h;
+    const Eigen::Vector3d a = (hand.stiffness_n_per_mm * (set_point(t) - x) +
+                               hand.damping_n_s_per_mm * (set_velocity(t) - v) -
+                               caps.physical_damping_n_s_per_mm * v + force) /
+                              m;
+    v += h * a;
+    x += h * v;
+  }
+}
+
+void check_hand(const char* who, double period_s, const HandModel& hand) {
+  if (!(period_s > 0)) throw std::invalid_argument(std::string(who) + ": period must be > 0");
+  if (!(hand.mass_kg > 0) || !(hand.stiffness_n_per_mm > 0) || !(hand.damping_n_s_per_mm >= 0))
+    throw std::invalid_argument(std::string(who) + ": hand mass and stiffness must be > 0");
+}
+
 class SimDevice final : public Device {
  public:
   SimDevice(const Trajectory& script, const DeviceCapabilities& caps, double period_s,
             const HandModel& hand)
       : script_(script), caps_(caps), period_(period_s), hand_(hand) {
-    if (!(period_s > 0)) throw std::invalid_argument("sim device: period must be > 0");
-    if (!(hand.mass_kg > 0) || !(hand.stiffness_n_per_mm > 0) || !(hand.damping_n_s_per_mm >= 0))
-      throw std::invalid_argument("sim device: hand mass and stiffness must be > 0");
+    check_hand("sim device", period_s, hand);
   }
   std::string name() const override { return "sim"; }
   const DeviceCapabilities& capabilities() const override { return caps_; }
@@ -151,18 +175,10 @@ class SimDevice final : public Device {
   }
   void close() override { force_.setZero(); }
   bool read(DeviceState& s) override {
-    // The hand and the device over one servo period with the force held (zero-order hold).
-    const int substeps = 10;
-    const double h = period_ / substeps, m = hand_.mass_kg * 1e-3;  // tonnes (mm-N-t-s)
-    for (int k = 0; k < substeps; ++k) {
-      const double t = time_ + k * h;
-      const Eigen::Vector3d a = (hand_.stiffness_n_per_mm * (script_.position_at(t) - x_) +
-                                 hand_.damping_n_s_per_mm * (script_.velocity_at(t) - v_) -
-                                 caps_.physical_damping_n_s_per_mm * v_ + force_) /
-                                m;
-      v_ += h * a;
-      x_ += h * v_;
-    }
+    hold_for_one_period(
+        hand_, caps_, period_, force_, x_, v_,
+        [&](double since) { return script_.position_at(time_ + since); },
+        [&](double since) { return script_.velocity_at(time_ + since); });
     time_ += period_;
     s.position_mm = x_;
     s.velocity_mm_s = v_;
@@ -184,6 +200,68 @@ class SimDevice final : public Device {
   double time_ = 0;
   Eigen::Vector3d x_ = Eigen::Vector3d::Zero(), v_ = Eigen::Vector3d::Zero(),
                   force_ = Eigen::Vector3d::Zero();
+};
+
+class MouseDevice final : public Device {
+ public:
+  MouseDevice(TripleBuffer<PointerInput>& input, const Eigen::Vector3d& start,
+              const DeviceCapabilities& caps, double period_s, double max_speed,
+              const HandModel& hand)
+      : input_(input),
+        start_(start),
+        caps_(caps),
+        period_(period_s),
+        speed_(max_speed),
+        hand_(hand) {
+    check_hand("mouse device", period_s, hand);
+    if (!(max_speed > 0) || !std::isfinite(max_speed) || !start.allFinite())
+      throw std::invalid_argument("mouse device: the speed must be > 0 and the start finite");
+  }
+  std::string name() const override { return "mouse"; }
+  const DeviceCapabilities& capabilities() const override { return caps_; }
+  void open() override {
+    x_ = set_ = start_;
+    v_.setZero();
+    force_.setZero();
+    quit_ = false;
+  }
+  void close() override { force_.setZero(); }
+  bool read(DeviceState& s) override {
+    const PointerInput& in = input_.read();
+    quit_ = in.quit;
+    // The set-point glides towards the pointer's at the speed limit (a non-finite one is held).
+    Eigen::Vector3d step = Eigen::Vector3d::Zero();
+    if (in.set_point_mm.allFinite()) {
+      step = in.set_point_mm - set_;
+      const double most = speed_ * period_;
+      if (step.norm() > most) step *= most / step.norm();
+    }
+    const Eigen::Vector3d from = set_, velocity = step / period_;
+    hold_for_one_period(
+        hand_, caps_, period_, force_, x_, v_,
+        [&](double since) -> Eigen::Vector3d { return from + since * velocity; },
+        [&](double) { return velocity; });
+    set_ = from + step;
+    s.position_mm = x_;
+    s.velocity_mm_s = v_;
+    s.buttons = in.buttons;
+    return true;
+  }
+  bool write_force(const Eigen::Vector3d& f) override {
+    force_ = f;
+    return true;
+  }
+  bool finished() const override { return quit_; }
+
+ private:
+  TripleBuffer<PointerInput>& input_;
+  Eigen::Vector3d start_;
+  DeviceCapabilities caps_;
+  double period_, speed_;
+  HandModel hand_;
+  bool quit_ = false;
+  Eigen::Vector3d x_ = Eigen::Vector3d::Zero(), v_ = Eigen::Vector3d::Zero(),
+                  set_ = Eigen::Vector3d::Zero(), force_ = Eigen::Vector3d::Zero();
 };
 
 class ReplayDevice final : public Device {
@@ -240,6 +318,13 @@ class NullDevice final : public Device {
 std::unique_ptr<Device> make_sim_device(const Trajectory& script, const DeviceCapabilities& caps,
                                         double period_s, const HandModel& hand) {
   return std::make_unique<SimDevice>(script, caps, period_s, hand);
+}
+
+std::unique_ptr<Device> make_mouse_device(TripleBuffer<PointerInput>& input,
+                                          const Eigen::Vector3d& start_mm,
+                                          const DeviceCapabilities& caps, double period_s,
+                                          double max_speed_mm_s, const HandModel& hand) {
+  return std::make_unique<MouseDevice>(input, start_mm, caps, period_s, max_speed_mm_s, hand);
 }
 
 std::unique_ptr<Device> make_replay_device(const Trajectory& recording,

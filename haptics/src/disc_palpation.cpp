@@ -108,6 +108,7 @@ DiscPalpation::DiscPalpation(const mss::MssModel& model, const mss::Boundary& pl
     if (model.mesh().surface(i) != 0) surface_nodes_.push_back(i);
   last_.probe_mm = Eigen::Vector3d::Constant(1e9);
   out_.write(last_);
+  positions_.reset(state_.x_mm);
 }
 
 DiscPalpation::~DiscPalpation() { stop(); }
@@ -226,6 +227,8 @@ void DiscPalpation::run() {
     const DiscContact& c = step(device_.read());
     out_.write(c);
     ++stats_.steps;
+    // Same-size copy assignment: no allocation on the disc thread.
+    if (stats_.steps % kPositionsEvery == 0) positions_.write(state_.x_mm);
     stats_.failed_steps += c.failed;
     if (stats_.step_us.size() < stats_.step_us.capacity())
       stats_.step_us.push_back(float(c.step_us));

@@ -151,6 +151,12 @@ void ServoLoop::tick(double now_s, double period_s) {
   status.disc_contact = out.disc_contact;
   status.disc_volume_change = out.disc_volume_change;
   status.disc_force_n = out.disc_force_n;
+  status.disc_probe_mm = out.disc_probe_mm;
+  status.poses = *poses;
+  status.period_us = timing_.period_us;
+  status.compute_us = timing_.compute_us;
+  status.recent_jitter_us = std::max(timing_.jitter_block, timing_.jitter_last_block);
+  status.recent_compute_us = std::max(timing_.compute_block, timing_.compute_last_block);
   if (stage_) {
     const HookState& h = stage_->state();
     status.hook = h;
@@ -194,6 +200,16 @@ void ServoLoop::tick(double now_s, double period_s) {
   }
 }
 
+void ServoLoop::RecentTiming::add(float period, float compute, float T_us) {
+  period_us = period, compute_us = compute;
+  jitter_block = std::max(jitter_block, std::abs(period - T_us));
+  compute_block = std::max(compute_block, compute);
+  if (++in_block == 1000) {
+    jitter_last_block = jitter_block, compute_last_block = compute_block;
+    jitter_block = compute_block = 0, in_block = 0;
+  }
+}
+
 double ServoLoop::now_s() const { return monotonic_s() - t0_; }
 
 ServoStats ServoLoop::run(const std::function<void(const ServoStatus&, double)>& every_10ms) {
@@ -220,6 +236,7 @@ ServoStats ServoLoop::run(const std::function<void(const ServoStatus&, double)>&
         last_wake = wake;
         tick(wake - t0, period);
         const double end = monotonic_s();
+        timing_.add(float(period * 1e6), float((end - wake) * 1e6), float(T * 1e6));
         if (samples_ < period_us_.size()) {
           period_us_[samples_] = float(period * 1e6);
           compute_us_[samples_] = float((end - wake) * 1e6);

@@ -298,9 +298,17 @@ TEST(ServoLoop, ThreadKeepsTimeAndZeroesTheForceAtTheEnd) {
   loop.record_to([&](const sh::TickRecord*, std::size_t n) { recorded += n; }, 1 << 12);
   // The scene publisher is this thread: it stamps the poses once, so the data go stale after
   // 50 ms and the watchdog fades the force — which is what a stalled slow thread must cause.
-  const auto stats = loop.run();
+  sh::ServoStatus last;
+  const auto stats = loop.run([&](const sh::ServoStatus& s, double) { last = s; });
   EXPECT_EQ(stats.stop_reason, "duration");
   EXPECT_NEAR(double(stats.ticks), 500, 25);
+  // The status carries the loop's own timing (for a viewer's panel) and the poses rendered.
+  EXPECT_GT(last.ticks, 400);
+  EXPECT_GT(last.period_us, 0);
+  EXPECT_GT(last.compute_us, 0);
+  EXPECT_GE(last.recent_compute_us, last.compute_us);
+  EXPECT_GE(last.recent_jitter_us, std::abs(last.period_us - 1000.f));
+  EXPECT_TRUE(last.poses.pose[0].R.isIdentity());
   EXPECT_NEAR(stats.period_us.p50, 1000, 100);
   EXPECT_EQ(recorded, std::size_t(stats.ticks));
   EXPECT_GT(stats.fading_ticks, 300);

@@ -4,6 +4,8 @@
 // Units: mm, mm/s, N, s; the device frame is the scene frame (x lateral, y up, z anterior).
 #pragma once
 
+#include "spinesim/haptics/triple_buffer.hpp"
+
 #include <Eigen/Core>
 
 #include <memory>
@@ -96,6 +98,27 @@ struct HandModel {
 /// the script's end the hand holds its last set-point (the loop's duration ends the run).
 std::unique_ptr<Device> make_sim_device(const Trajectory& script, const DeviceCapabilities& caps,
                                         double period_s, const HandModel& hand = HandModel());
+/// What a pointing device (the viewer's mouse and keyboard) gives the `mouse` device, written by
+/// the GUI thread: where the cursor and the wheel put the hand's set-point in the scene (mm), the
+/// buttons (bit 0: the stylus button), and whether the window has been closed.
+struct PointerInput {
+  Eigen::Vector3d set_point_mm = Eigen::Vector3d::Zero();
+  unsigned buttons = 0;
+  bool quit = false;
+};
+
+/// `mouse`: the mouse as a 3-DOF device. A simulated hand holds a simulated stylus (as `sim`)
+/// and pulls it towards a set-point that follows the pointer's at no more than `max_speed_mm_s`
+/// (a jump of the cursor becomes a glide, never a blow), starting at `start_mm`; the rendered
+/// force acts on the stylus, so the probe stops at surfaces and the hook drags the spine as with
+/// a real device, and the viewer shows the force that would be felt. Reads `input` every tick
+/// (no allocation, no wait); finished once `input` says quit.
+std::unique_ptr<Device> make_mouse_device(TripleBuffer<PointerInput>& input,
+                                          const Eigen::Vector3d& start_mm,
+                                          const DeviceCapabilities& caps, double period_s,
+                                          double max_speed_mm_s = 250,
+                                          const HandModel& hand = HandModel());
+
 /// `replay`: plays the recorded positions and buttons tick by tick; forces are discarded.
 std::unique_ptr<Device> make_replay_device(const Trajectory& recording,
                                            const DeviceCapabilities& caps, double period_s);

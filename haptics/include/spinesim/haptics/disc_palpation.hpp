@@ -89,6 +89,11 @@ class DiscPalpation {
   /// Servo side: publish the device position / read the latest contact. No allocation, no wait.
   void set_device(const Eigen::Vector3d& device_mm) { device_.write(device_mm); }
   const DiscContact& latest() { return out_.read(); }
+  /// Graphics side (one reader): the disc's node positions (3 #nodes, mm), published by the disc
+  /// thread every `kPositionsEvery` steps (a copy of ~100 kB is not made every millisecond).
+  /// No allocation, no wait.
+  const Eigen::VectorXd& latest_positions() { return positions_.read(); }
+  static constexpr int kPositionsEvery = 10;
 
   const mss::MssModel& model() const { return model_; }
   const mss::State& state() const { return state_; }
@@ -122,6 +127,7 @@ class DiscPalpation {
   DiscContact last_;
   TripleBuffer<Eigen::Vector3d> device_;
   TripleBuffer<DiscContact> out_;
+  TripleBuffer<Eigen::VectorXd> positions_;  ///< every slot sized at construction
   std::atomic<bool> stop_{false};
   std::thread thread_;
   Stats stats_;

@@ -48,6 +48,12 @@ struct ServoStatus {
   bool disc = false, disc_contact = false;
   double disc_volume_change = 0;
   Eigen::Vector3d disc_force_n = Eigen::Vector3d::Zero();
+  Eigen::Vector3d disc_probe_mm = Eigen::Vector3d::Zero();  ///< the disc thread's probe
+  /// The bodies' poses this tick's render used (the compliant stage's vertebrae moved).
+  ScenePoses poses;
+  /// The loop's own timing (0 for ticks not run by run()): the last period and the last tick's
+  /// compute time, and the largest |period − T| and compute time over the last 1,000–2,000 ticks.
+  float period_us = 0, compute_us = 0, recent_jitter_us = 0, recent_compute_us = 0;
 };
 
 /// One recorded tick (the `--record` file's row).
@@ -153,6 +159,13 @@ class ServoLoop {
   CompliantStage* stage_ = nullptr;
   ScenePoses stage_poses_;  ///< the scene's poses with the stage's vertebrae, kept across ticks
   RenderOutput last_out_;
+  /// The timing run() measures, published with the next tick's status.
+  struct RecentTiming {
+    float period_us = 0, compute_us = 0;
+    float jitter_block = 0, compute_block = 0, jitter_last_block = 0, compute_last_block = 0;
+    int in_block = 0;
+    void add(float period, float compute, float T_us);
+  } timing_;
   double t0_ = 0;  ///< the loop's clock origin (CLOCK_MONOTONIC, s)
 };
 

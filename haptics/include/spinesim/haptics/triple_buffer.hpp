@@ -17,6 +17,11 @@ class TripleBuffer {
   explicit TripleBuffer(const T& initial) {
     for (auto& s : slots_) s = initial;
   }
+  /// Fills every slot with `value` (before the threads start: not thread-safe), e.g. to size
+  /// vectors once so that later copies do not allocate.
+  void reset(const T& value) {
+    for (auto& s : slots_) s = value;
+  }
   /// Writer: publishes `value` (the reader sees it at its next read()).
   void write(const T& value) {
     slots_[write_] = value;
