@@ -15,39 +15,6 @@
 namespace spinesim::mesh {
 namespace {
 
-/// Outward faces of a positively oriented tet (det[v1-v0, v2-v0, v3-v0] > 0): the normal of
-/// each (right-hand rule) points away from the opposite vertex.
-constexpr int kOutwardFaces[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
-
-struct BoundaryFace {
-  std::array<int, 3> v;  // outward orientation
-  int count = 0;
-};
-
-/// Faces used by exactly one tet, outward oriented, in first-seen order.
-std::vector<std::array<int, 3>> boundary_faces(const TetMesh& m) {
-  std::map<std::array<int, 3>, BoundaryFace> faces;  // key: sorted vertex indices
-  std::vector<std::array<int, 3>> order;
-  for (Eigen::Index t = 0; t < m.num_tets(); ++t)
-    for (const auto& f : kOutwardFaces) {
-      const std::array<int, 3> v = {m.T(t, f[0]), m.T(t, f[1]), m.T(t, f[2])};
-      std::array<int, 3> key = v;
-      std::sort(key.begin(), key.end());
-      auto [it, inserted] = faces.try_emplace(key);
-      if (inserted) {
-        it->second.v = v;
-        order.push_back(key);
-      }
-      ++it->second.count;
-    }
-  std::vector<std::array<int, 3>> out;
-  for (const auto& key : order) {
-    const BoundaryFace& f = faces.at(key);
-    if (f.count == 1) out.push_back(f.v);
-  }
-  return out;
-}
-
 void put_double(std::ostream& os, double x) {
   char buf[32];
   const auto res = std::to_chars(buf, buf + sizeof buf, x);  // shortest exact form
@@ -63,10 +30,11 @@ void write_medit(const std::string& path, const TetMesh& m) {
 
   // 2. Boundary triangles and their labels: the label all three vertices share, if nonzero,
   //    else outer wall.
-  const auto tris = boundary_faces(m);
-  std::vector<int> tri_ref(tris.size());
-  for (std::size_t i = 0; i < tris.size(); ++i) {
-    const int a = m.surface(tris[i][0]), b = m.surface(tris[i][1]), c = m.surface(tris[i][2]);
+  const Eigen::MatrixX3i tris = boundary_faces(m.T);
+  std::vector<int> tri_ref(std::size_t(tris.rows()));
+  for (std::size_t i = 0; i < tri_ref.size(); ++i) {
+    const Eigen::Index r = Eigen::Index(i);
+    const int a = m.surface(tris(r, 0)), b = m.surface(tris(r, 1)), c = m.surface(tris(r, 2));
     tri_ref[i] = (a == b && b == c && a != 0) ? a : int(Surface::outer_wall);
   }
 
@@ -84,10 +52,10 @@ void write_medit(const std::string& path, const TetMesh& m) {
     for (Eigen::Index t = 0; t < m.num_tets(); ++t)
       os << m.T(t, 0) + 1 << ' ' << m.T(t, 1) + 1 << ' ' << m.T(t, 2) + 1 << ' ' << m.T(t, 3) + 1
          << ' ' << m.region(t) << '\n';
-    os << "\nTriangles\n" << tris.size() << "\n";
-    for (std::size_t i = 0; i < tris.size(); ++i)
-      os << tris[i][0] + 1 << ' ' << tris[i][1] + 1 << ' ' << tris[i][2] + 1 << ' ' << tri_ref[i]
-         << '\n';
+    os << "\nTriangles\n" << tris.rows() << "\n";
+    for (Eigen::Index i = 0; i < tris.rows(); ++i)
+      os << tris(i, 0) + 1 << ' ' << tris(i, 1) + 1 << ' ' << tris(i, 2) + 1 << ' '
+         << tri_ref[std::size_t(i)] << '\n';
     os << "\nEnd\n";
   });
 }

@@ -2,7 +2,10 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <map>
 #include <sstream>
 #include <stdexcept>
 
@@ -63,6 +66,40 @@ void require_endplate_labels(const TetMesh& m) {
     throw std::invalid_argument(
         "mesh has no endplate labels (point data 'surface' needs nodes labelled 1 = inferior "
         "and 2 = superior endplate)");
+}
+
+Eigen::MatrixX3i boundary_faces(const Eigen::MatrixXi& T, Eigen::VectorXi* owner) {
+  // Face k of a tet is opposite corner k, ordered so that its normal points away from it.
+  static constexpr int kOutward[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+  struct Seen {
+    int count = 0;
+    Eigen::Index tet = 0;
+    int face = 0;
+  };
+  std::map<std::array<int, 3>, Seen> faces;  // key: sorted vertex indices
+  std::vector<std::array<int, 3>> order;
+  for (Eigen::Index t = 0; t < T.rows(); ++t)
+    for (int f = 0; f < 4; ++f) {
+      std::array<int, 3> key = {T(t, kOutward[f][0]), T(t, kOutward[f][1]), T(t, kOutward[f][2])};
+      std::sort(key.begin(), key.end());
+      auto [it, inserted] = faces.try_emplace(key);
+      if (inserted) {
+        it->second.tet = t, it->second.face = f;
+        order.push_back(key);
+      }
+      ++it->second.count;
+    }
+  std::vector<const Seen*> once;
+  for (const auto& key : order)
+    if (const Seen& s = faces.at(key); s.count == 1) once.push_back(&s);
+  Eigen::MatrixX3i F(Eigen::Index(once.size()), 3);
+  if (owner) owner->resize(F.rows());
+  for (Eigen::Index i = 0; i < F.rows(); ++i) {
+    const Seen& s = *once[std::size_t(i)];
+    for (int k = 0; k < 3; ++k) F(i, k) = T(s.tet, kOutward[s.face][k]);
+    if (owner) (*owner)(i) = int(s.tet);
+  }
+  return F;
 }
 
 }  // namespace spinesim::mesh

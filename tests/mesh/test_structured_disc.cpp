@@ -251,3 +251,29 @@ TEST(StructuredDisc, BadOptionsAreRefused) {
   bad.height_mm = 0;
   EXPECT_THROW(mesh_structured_disc(bad), std::invalid_argument);
 }
+
+// The boundary of a disc: closed (every edge on exactly two boundary faces, in opposite
+// directions: consistently oriented), outward (the divergence theorem gives back the mesh's
+// volume), each face on the tet that owns it.
+TEST(BoundaryFaces, ClosedOutwardAndOwned) {
+  const TetMesh m = mesh_structured_disc(disc_dimensions("L4-L5", kData));
+  Eigen::VectorXi owner;
+  const Eigen::MatrixX3i F = boundary_faces(m.T, &owner);
+  ASSERT_GT(F.rows(), 0);
+  std::map<std::pair<int, int>, int> directed;
+  double volume = 0;
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    for (int k = 0; k < 3; ++k) ++directed[{F(f, k), F(f, (k + 1) % 3)}];
+    const Eigen::Vector3d a = m.V.row(F(f, 0)), b = m.V.row(F(f, 1)), c = m.V.row(F(f, 2));
+    volume += a.dot(b.cross(c)) / 6;  // signed volume of the cone from the origin
+    int shared = 0;
+    for (int k = 0; k < 3; ++k)
+      for (int j = 0; j < 4; ++j) shared += F(f, k) == m.T(owner(f), j);
+    EXPECT_EQ(shared, 3) << f;
+  }
+  for (const auto& [edge, n] : directed) {
+    EXPECT_EQ(n, 1);
+    EXPECT_EQ(directed.count({edge.second, edge.first}), 1u);
+  }
+  EXPECT_NEAR(volume, mesh_volume(m), 1e-9 * mesh_volume(m));
+}

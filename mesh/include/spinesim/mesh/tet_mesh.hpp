@@ -55,6 +55,11 @@ double mesh_volume(const TetMesh& m);
 /// (relative to the mean edge length cubed), label arrays of the wrong size.
 void validate(const TetMesh& m);
 
+/// The boundary of tetrahedra `T` (#T×4): the faces used by exactly one tet, oriented outward
+/// (for positively oriented tets), in the order their tets come; `owner` (when not null) gets
+/// each face's tet.
+Eigen::MatrixX3i boundary_faces(const Eigen::MatrixXi& T, Eigen::VectorXi* owner = nullptr);
+
 /// Throws std::invalid_argument unless both endplate labels (1 and 2) are present.
 void require_endplate_labels(const TetMesh& m);
 
