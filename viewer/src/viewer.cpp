@@ -10,6 +10,8 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <array>
+#include <cstdint>
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
@@ -25,23 +27,29 @@ constexpr float kPi = 3.14159265358979f;
 const char* kVertexShader = R"(#version 330 core
 layout(location = 0) in vec3 position;
 layout(location = 1) in vec3 normal;
+layout(location = 2) in vec3 vertex_color;
 uniform mat4 model, view, projection;
 out vec3 eye_normal;
+out vec3 face_color;
 void main() {
   mat4 mv = view * model;
   eye_normal = mat3(mv) * normal;
+  face_color = vertex_color;
   gl_Position = projection * mv * vec4(position, 1.0);
 }
 )";
 
 const char* kFragmentShader = R"(#version 330 core
 in vec3 eye_normal;
+in vec3 face_color;
 uniform vec3 color;
+uniform int per_face;
 out vec4 fragment;
 void main() {
   // A headlight: the light comes from the eye; both faces lit (open or inward-facing surfaces).
   float d = abs(normalize(eye_normal).z);
-  fragment = vec4(color * (0.25 + 0.75 * d), 1.0);
+  vec3 c = per_face != 0 ? face_color : color;
+  fragment = vec4(c * (0.25 + 0.75 * d), 1.0);
 }
 )";
 
@@ -77,36 +85,115 @@ GLuint link_program() {
   return p;
 }
 
-/// One body on the GPU: flat-shaded triangles (three vertices each, with the face normal).
+/// Triangles on the GPU: three vertices each with the face normal and the face colour.
 struct GpuMesh {
   GLuint vao = 0, vbo = 0;
   GLsizei vertices = 0;
+  std::uint64_t revision = 0;
+  bool per_face = false;
+  void release() {
+    if (vbo) glDeleteBuffers(1, &vbo);
+    if (vao) glDeleteVertexArrays(1, &vao);
+    vao = vbo = 0;
+    vertices = 0;
+  }
 };
 
-GpuMesh upload(const Body& b) {
+void upload(GpuMesh& m, const Eigen::MatrixX3d& V, const Eigen::MatrixX3i& F,
+            const Eigen::MatrixX3f& colors) {
   std::vector<float> data;
-  data.reserve(std::size_t(b.F.rows()) * 18);
-  for (Eigen::Index f = 0; f < b.F.rows(); ++f) {
-    const Eigen::Vector3d a = b.V.row(b.F(f, 0)), c1 = b.V.row(b.F(f, 1)), c2 = b.V.row(b.F(f, 2));
+  data.reserve(std::size_t(F.rows()) * 27);
+  const bool per_face = colors.rows() == F.rows() && F.rows() > 0;
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    const Eigen::Vector3d a = V.row(F(f, 0)), c1 = V.row(F(f, 1)), c2 = V.row(F(f, 2));
     Eigen::Vector3d n = (c1 - a).cross(c2 - a);
     n = n.norm() > 0 ? Eigen::Vector3d(n.normalized()) : Eigen::Vector3d::UnitY();
-    for (const Eigen::Vector3d& p : {a, c1, c2})
+    const Eigen::Vector3f c = per_face ? Eigen::Vector3f(colors.row(f)) : Eigen::Vector3f::Ones();
+    for (const Eigen::Vector3d& p : {a, c1, c2}) {
       for (const double v : {p.x(), p.y(), p.z(), n.x(), n.y(), n.z()}) data.push_back(float(v));
+      for (int k = 0; k < 3; ++k) data.push_back(c(k));
+    }
   }
-  GpuMesh m;
-  m.vertices = GLsizei(data.size() / 6);
-  glGenVertexArrays(1, &m.vao);
-  glGenBuffers(1, &m.vbo);
+  if (!m.vao) {
+    glGenVertexArrays(1, &m.vao);
+    glGenBuffers(1, &m.vbo);
+  }
+  m.vertices = GLsizei(data.size() / 9);
+  m.per_face = per_face;
   glBindVertexArray(m.vao);
   glBindBuffer(GL_ARRAY_BUFFER, m.vbo);
   glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(data.size() * sizeof(float)), data.data(),
-               GL_STATIC_DRAW);
-  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), nullptr);
-  glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float),
-                        reinterpret_cast<void*>(3 * sizeof(float)));
-  glEnableVertexAttribArray(0);
-  glEnableVertexAttribArray(1);
-  return m;
+               GL_DYNAMIC_DRAW);
+  const GLsizei stride = 9 * sizeof(float);
+  for (GLuint k = 0; k < 3; ++k) {
+    glVertexAttribPointer(k, 3, GL_FLOAT, GL_FALSE, stride,
+                          reinterpret_cast<void*>(std::uintptr_t(3 * k * sizeof(float))));
+    glEnableVertexAttribArray(k);
+  }
+}
+
+/// A unit sphere (an icosahedron subdivided twice) and a unit arrow along +z (a shaft of radius
+/// 1 from z = 0 to 1, a cone of radius 2 and height 1 from z = 1 to 2): scaled per marker.
+Eigen::MatrixX3d sphere_vertices(Eigen::MatrixX3i& F) {
+  const double g = (1 + std::sqrt(5.0)) / 2;
+  std::vector<Eigen::Vector3d> v = {{-1, g, 0}, {1, g, 0}, {-1, -g, 0}, {1, -g, 0},
+                                    {0, -1, g}, {0, 1, g}, {0, -1, -g}, {0, 1, -g},
+                                    {g, 0, -1}, {g, 0, 1}, {-g, 0, -1}, {-g, 0, 1}};
+  std::vector<std::array<int, 3>> f = {
+      {0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+      {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
+      {3, 8, 9},  {4, 9, 5},  {2, 4, 11},  {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
+  for (int level = 0; level < 2; ++level) {
+    std::vector<std::array<int, 3>> next;
+    for (const auto& t : f) {
+      int m[3];
+      for (int k = 0; k < 3; ++k) {
+        v.push_back(0.5 * (v[std::size_t(t[std::size_t(k)])] + v[std::size_t(t[(k + 1) % 3])]));
+        m[k] = int(v.size()) - 1;
+      }
+      next.push_back({t[0], m[0], m[2]});
+      next.push_back({t[1], m[1], m[0]});
+      next.push_back({t[2], m[2], m[1]});
+      next.push_back({m[0], m[1], m[2]});
+    }
+    f = next;
+  }
+  Eigen::MatrixX3d V(Eigen::Index(v.size()), 3);
+  for (std::size_t i = 0; i < v.size(); ++i) V.row(Eigen::Index(i)) = v[i].normalized();
+  F.resize(Eigen::Index(f.size()), 3);
+  for (std::size_t i = 0; i < f.size(); ++i)
+    F.row(Eigen::Index(i)) << f[i][0], f[i][1], f[i][2];
+  return V;
+}
+
+Eigen::MatrixX3d arrow_vertices(Eigen::MatrixX3i& F) {
+  const int n = 16;
+  std::vector<Eigen::Vector3d> v;
+  std::vector<std::array<int, 3>> f;
+  for (int i = 0; i < n; ++i) {
+    const double a = 2 * kPi * i / n, c = std::cos(a), s = std::sin(a);
+    v.push_back({c, s, 0});      // 4 i: shaft bottom
+    v.push_back({c, s, 1});      // 4 i + 1: shaft top
+    v.push_back({2 * c, 2 * s, 1});  // 4 i + 2: cone base
+    v.push_back({0, 0, 2});      // 4 i + 3: tip
+  }
+  for (int i = 0; i < n; ++i) {  // the shaft's 2 n triangles first (drawn on their own)
+    const int j = (i + 1) % n;
+    f.push_back({4 * i, 4 * j, 4 * j + 1});
+    f.push_back({4 * i, 4 * j + 1, 4 * i + 1});
+  }
+  for (int i = 0; i < n; ++i) {  // then the head: the cone and its underside ring
+    const int j = (i + 1) % n;
+    f.push_back({4 * i + 2, 4 * j + 2, 4 * i + 3});
+    f.push_back({4 * i + 1, 4 * j + 1, 4 * j + 2});
+    f.push_back({4 * i + 1, 4 * j + 2, 4 * i + 2});
+  }
+  Eigen::MatrixX3d V(Eigen::Index(v.size()), 3);
+  for (std::size_t i = 0; i < v.size(); ++i) V.row(Eigen::Index(i)) = v[i];
+  F.resize(Eigen::Index(f.size()), 3);
+  for (std::size_t i = 0; i < f.size(); ++i)
+    F.row(Eigen::Index(i)) << f[i][0], f[i][1], f[i][2];
+  return V;
 }
 
 /// Orbit camera about a target: yaw about the superior (y) axis, pitch above the horizontal.
@@ -145,34 +232,111 @@ struct Camera {
   }
 };
 
-/// Mouse: left drag orbits, right drag pans, the wheel zooms (unless ImGui wants the mouse).
-struct Mouse {
-  double x = 0, y = 0;
-  bool left = false, right = false;
+/// Pixel (x right, y down) to a world ray, and back, for a viewport of w × h pixels.
+struct Projector {
+  Eigen::Matrix4f view, proj;
+  int w = 1, h = 1;
+  Eigen::Vector2d to_pixel(const Eigen::Vector3d& p) const {
+    const Eigen::Vector4f c = proj * view * Eigen::Vector4f(float(p.x()), float(p.y()),
+                                                            float(p.z()), 1.0f);
+    return {(c.x() / c.w() + 1) * 0.5 * w, (1 - c.y() / c.w()) * 0.5 * h};
+  }
+  void to_ray(double x, double y, Eigen::Vector3d& origin, Eigen::Vector3d& dir) const {
+    const Eigen::Matrix4f inv = (proj * view).inverse();
+    const float nx = float(2 * x / w - 1), ny = float(1 - 2 * y / h);
+    Eigen::Vector4f a = inv * Eigen::Vector4f(nx, ny, -1, 1), b = inv * Eigen::Vector4f(nx, ny, 1, 1);
+    a /= a.w(), b /= b.w();
+    origin = a.head<3>().cast<double>();
+    dir = (b - a).head<3>().cast<double>().normalized();
+  }
 };
-
-void handle_input(GLFWwindow* w, Camera& cam, Mouse& mouse) {
-  double x = 0, y = 0;
-  glfwGetCursorPos(w, &x, &y);
-  const bool want = ImGui::GetCurrentContext() && ImGui::GetIO().WantCaptureMouse;
-  const bool left = glfwGetMouseButton(w, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS && !want;
-  const bool right = glfwGetMouseButton(w, GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS && !want;
-  const float dx = float(x - mouse.x), dy = float(y - mouse.y);
-  if (left && mouse.left) {
-    cam.yaw += 0.005f * dx;
-    cam.pitch = std::clamp(cam.pitch + 0.005f * dy, -1.5f, 1.5f);
-  }
-  if (right && mouse.right) {
-    const Eigen::Matrix4f v = cam.view();
-    const float scale = cam.distance * 0.0015f;
-    cam.target +=
-        scale * (-dx * v.block<1, 3>(0, 0).transpose() + dy * v.block<1, 3>(1, 0).transpose());
-  }
-  mouse = {x, y, left, right};
-}
 
 double scroll_accumulated = 0;
 void on_scroll(GLFWwindow*, double, double dy) { scroll_accumulated += dy; }
+
+/// Mouse and keyboard: the camera (orbit, pan, zoom) and the pointer for the controller.
+class Input {
+ public:
+  Pointer pointer;
+
+  void handle(GLFWwindow* w, Camera& cam, bool device_mode, const Projector& pr,
+              const ViewOptions& o, double now_s) {
+    double x = 0, y = 0;
+    unsigned scripted_buttons = 0;
+    double scripted_wheel = 0;
+    const bool scripted = !o.cursor_script.empty();
+    if (scripted) {
+      Eigen::Vector3d p;
+      script_at(o.cursor_script, now_s, p, scripted_buttons, scripted_wheel);
+      const Eigen::Vector2d px = pr.to_pixel(p);
+      x = px.x(), y = px.y();
+    } else {
+      glfwGetCursorPos(w, &x, &y);
+    }
+    const bool want = ImGui::GetCurrentContext() && ImGui::GetIO().WantCaptureMouse && !scripted;
+    const auto held = [&](int b) { return glfwGetMouseButton(w, b) == GLFW_PRESS && !want; };
+    const bool left = held(GLFW_MOUSE_BUTTON_LEFT), right = held(GLFW_MOUSE_BUTTON_RIGHT),
+               middle = held(GLFW_MOUSE_BUTTON_MIDDLE);
+    const bool shift = glfwGetKey(w, GLFW_KEY_LEFT_SHIFT) == GLFW_PRESS ||
+                       glfwGetKey(w, GLFW_KEY_RIGHT_SHIFT) == GLFW_PRESS;
+    const float dx = float(x - x_), dy = float(y - y_);
+    const bool orbit = device_mode ? right : left, pan = device_mode ? middle : right;
+    if (orbit && orbit_) {
+      cam.yaw += 0.005f * dx;
+      cam.pitch = std::clamp(cam.pitch + 0.005f * dy, -1.5f, 1.5f);
+    }
+    if (pan && pan_) {
+      const Eigen::Matrix4f v = cam.view();
+      const float scale = cam.distance * 0.0015f;
+      cam.target +=
+          scale * (-dx * v.block<1, 3>(0, 0).transpose() + dy * v.block<1, 3>(1, 0).transpose());
+    }
+    x_ = x, y_ = y, orbit_ = orbit, pan_ = pan;
+
+    double wheel = scroll_accumulated;
+    scroll_accumulated = 0;
+    if (want) wheel = 0;
+    Pointer& p = pointer;
+    p.wheel = 0;
+    if (device_mode && !shift) {
+      p.wheel = wheel + scripted_wheel;
+    } else {
+      cam.distance *= float(std::pow(0.9, wheel));
+    }
+    int ww = 0, wh = 0;
+    glfwGetWindowSize(w, &ww, &wh);
+    // Cursor pixels are window coordinates; the projector works in framebuffer pixels.
+    const double sx = scripted ? 1.0 : double(pr.w) / std::max(ww, 1),
+                 sy = scripted ? 1.0 : double(pr.h) / std::max(wh, 1);
+    p.inside = !want && x >= 0 && y >= 0 && x * sx < pr.w && y * sy < pr.h &&
+               (scripted || glfwGetWindowAttrib(w, GLFW_HOVERED));
+    pr.to_ray(x * sx, y * sy, p.ray_origin, p.ray_direction);
+    p.view_direction = (cam.target - cam.eye()).normalized().cast<double>();
+    const bool space = glfwGetKey(w, GLFW_KEY_SPACE) == GLFW_PRESS && !want;
+    p.buttons = scripted ? scripted_buttons : ((device_mode && (left || space)) ? 1u : 0u);
+    p.camera_moving = device_mode && (right || middle);
+  }
+
+ private:
+  double x_ = 0, y_ = 0;
+  bool orbit_ = false, pan_ = false;
+  std::size_t wheel_step_ = 0;  ///< script steps whose wheel has been turned
+
+  void script_at(const std::vector<ViewOptions::CursorStep>& s, double t, Eigen::Vector3d& p,
+                 unsigned& buttons, double& wheel) {
+    std::size_t i = 0;
+    while (i + 1 < s.size() && s[i + 1].t_s <= t) ++i;
+    if (t <= s.front().t_s || i + 1 >= s.size()) {
+      p = t <= s.front().t_s ? s.front().point_mm : s.back().point_mm;
+    } else {
+      const double f = (t - s[i].t_s) / (s[i + 1].t_s - s[i].t_s);
+      p = s[i].point_mm + f * (s[i + 1].point_mm - s[i].point_mm);
+    }
+    buttons = t >= s.front().t_s ? s[i].buttons : 0;
+    wheel = 0;
+    while (wheel_step_ < s.size() && s[wheel_step_].t_s <= t) wheel += s[wheel_step_++].wheel;
+  }
+};
 
 void write_png(const std::string& path, int width, int height) {
   std::vector<unsigned char> pixels(std::size_t(width) * std::size_t(height) * 3);
@@ -207,6 +371,126 @@ GLFWwindow* open_window(const ViewOptions& o) {
   return w;
 }
 
+/// Everything on the GPU and the drawing of one frame.
+class Renderer {
+ public:
+  Renderer() : program_(link_program()) {
+    Eigen::MatrixX3i F;
+    const Eigen::MatrixX3d V = sphere_vertices(F);
+    upload(sphere_, V, F, {});
+    const Eigen::MatrixX3d A = arrow_vertices(F);
+    upload(arrow_, A, F, {});
+  }
+  ~Renderer() {
+    for (GpuMesh& m : bodies_) m.release();
+    sphere_.release();
+    arrow_.release();
+    glDeleteProgram(program_);
+  }
+  void draw(const SceneFrame& scene, const Eigen::Matrix4f& view, const Eigen::Matrix4f& proj) {
+    glUseProgram(program_);
+    glUniformMatrix4fv(glGetUniformLocation(program_, "view"), 1, GL_FALSE, view.data());
+    glUniformMatrix4fv(glGetUniformLocation(program_, "projection"), 1, GL_FALSE, proj.data());
+    if (bodies_.size() < scene.bodies.size()) bodies_.resize(scene.bodies.size());
+    for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
+      const Body& b = scene.bodies[i];
+      if (!b.visible || b.F.rows() == 0) continue;
+      GpuMesh& m = bodies_[i];
+      if (!m.vao || m.revision != b.revision) {
+        upload(m, b.V, b.F, b.face_colors);
+        m.revision = b.revision;
+      }
+      Eigen::Matrix4f model = Eigen::Matrix4f::Identity();
+      model.topLeftCorner<3, 3>() = b.R.cast<float>();
+      model.topRightCorner<3, 1>() = b.t.cast<float>();
+      draw_mesh(m, model, b.color);
+    }
+    for (const Marker& mk : scene.markers) draw_marker(mk);
+  }
+
+ private:
+  GLuint program_;
+  std::vector<GpuMesh> bodies_;
+  GpuMesh sphere_, arrow_;
+
+  void draw_mesh(const GpuMesh& m, const Eigen::Matrix4f& model, const Eigen::Vector3f& color) {
+    glUniformMatrix4fv(glGetUniformLocation(program_, "model"), 1, GL_FALSE, model.data());
+    glUniform3fv(glGetUniformLocation(program_, "color"), 1, color.data());
+    glUniform1i(glGetUniformLocation(program_, "per_face"), m.per_face ? 1 : 0);
+    glBindVertexArray(m.vao);
+    glDrawArrays(GL_TRIANGLES, 0, m.vertices);
+  }
+  void draw_marker(const Marker& mk) {
+    Eigen::Matrix4f model = Eigen::Matrix4f::Identity();
+    const float r = float(mk.radius_mm);
+    if (mk.kind == Marker::Kind::sphere) {
+      model.topLeftCorner<3, 3>() = r * Eigen::Matrix3f::Identity();
+      model.topRightCorner<3, 1>() = mk.a.cast<float>();
+      draw_mesh(sphere_, model, mk.color);
+      return;
+    }
+    const Eigen::Vector3d d = mk.b - mk.a;
+    const double length = d.norm();
+    if (!(length > 0)) return;
+    // The unit arrow is 2 long (shaft 1, head 1): the head takes min(40 %, 6 r) of the length.
+    const double head = std::min(0.4 * length, 6.0 * mk.radius_mm);
+    const Eigen::Vector3d z = d / length;
+    const Eigen::Vector3d x =
+        (std::abs(z.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY())
+            .cross(z)
+            .normalized();
+    const Eigen::Vector3d y = z.cross(x);
+    Eigen::Matrix3d R;
+    R << x, y, z;
+    // The shaft scaled to length - head, the head (z 1..2) to `head`: two draws.
+    Eigen::Matrix3d S = Eigen::Vector3d(r, r, length - head).asDiagonal();
+    model.topLeftCorner<3, 3>() = (R * S).cast<float>();
+    model.topRightCorner<3, 1>() = mk.a.cast<float>();
+    glUniformMatrix4fv(glGetUniformLocation(program_, "model"), 1, GL_FALSE, model.data());
+    glUniform3fv(glGetUniformLocation(program_, "color"), 1, mk.color.data());
+    glUniform1i(glGetUniformLocation(program_, "per_face"), 0);
+    glBindVertexArray(arrow_.vao);
+    glDrawArrays(GL_TRIANGLES, 0, 16 * 2 * 3);  // the shaft alone
+    // The whole unit arrow scaled to `head`: its cone is the head, its shaft lies in the shaft.
+    S = Eigen::Vector3d(r, r, head).asDiagonal();
+    model.topLeftCorner<3, 3>() = (R * S).cast<float>();
+    model.topRightCorner<3, 1>() = (mk.a + (length - 2 * head) * z).cast<float>();
+    draw_mesh(arrow_, model, mk.color);
+  }
+};
+
+/// A still scene.
+class StillController final : public Controller {
+ public:
+  explicit StillController(const std::vector<Body>& bodies) : bodies_(bodies) {}
+  void update(SceneFrame& scene, const Pointer&) override {
+    if (scene.bodies.empty()) scene.bodies = bodies_;
+  }
+
+ private:
+  const std::vector<Body>& bodies_;
+};
+
+bool bounds(const SceneFrame& s, Eigen::Vector3d& lo, Eigen::Vector3d& hi) {
+  lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
+  bool any = false;
+  for (const Body& b : s.bodies) {
+    if (!b.visible) continue;
+    for (Eigen::Index i = 0; i < b.V.rows(); ++i) {
+      const Eigen::Vector3d p = b.R * b.V.row(i).transpose() + b.t;
+      lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+      any = true;
+    }
+  }
+  return any;
+}
+
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  return v[std::min(v.size() - 1, std::size_t(q * double(v.size())))];
+}
+
 }  // namespace
 
 void check(const ViewOptions& o) {
@@ -214,10 +498,24 @@ void check(const ViewOptions& o) {
     throw std::invalid_argument("view: the window must be 64 to 8192 pixels each way");
   if (!o.screenshot.empty() && o.frames < 1)
     throw std::invalid_argument("view: --frames must be at least 1");
+  if (!(o.screenshot_after_s >= 0) || o.screenshot_after_s > 3600)
+    throw std::invalid_argument("view: the screenshot time must be 0 to 3600 s");
+  for (std::size_t i = 0; i < o.cursor_script.size(); ++i) {
+    const auto& c = o.cursor_script[i];
+    if (!std::isfinite(c.t_s) || !c.point_mm.allFinite() || !std::isfinite(c.wheel) ||
+        (i > 0 && !(c.t_s > o.cursor_script[i - 1].t_s)))
+      throw std::invalid_argument("view: cursor script step " + std::to_string(i + 1) +
+                                  ": times must increase and values be finite");
+  }
 }
 
 ViewResult view(const std::vector<Body>& bodies, const ViewOptions& o) {
   if (bodies.empty()) throw std::invalid_argument("view: nothing to show (no bodies)");
+  StillController still(bodies);
+  return view(still, o);
+}
+
+ViewResult view(Controller& controller, const ViewOptions& o) {
   check(o);
   GLFWwindow* w = open_window(o);
   glfwSetScrollCallback(w, on_scroll);
@@ -231,87 +529,128 @@ ViewResult view(const std::vector<Body>& bodies, const ViewOptions& o) {
   ImGui_ImplGlfw_InitForOpenGL(w, true);
   ImGui_ImplOpenGL3_Init("#version 330 core");
 
-  const GLuint program = link_program();
-  std::vector<GpuMesh> meshes;
-  Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
-  long triangles = 0;
-  for (const Body& b : bodies) {
-    meshes.push_back(upload(b));
-    triangles += long(b.F.rows());
-    for (Eigen::Index i = 0; i < b.V.rows(); ++i) {
-      const Eigen::Vector3d p = b.R * b.V.row(i).transpose() + b.t;
-      lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  std::vector<double> frame_ms;
+  try {
+    Renderer renderer;
+    SceneFrame scene;
+    Camera cam;
+    bool framed = false;
+    Input input;
+    glEnable(GL_DEPTH_TEST);
+    const auto start = std::chrono::steady_clock::now();
+    auto last = start;
+    const auto seconds = [&] {
+      return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    };
+    while (!glfwWindowShouldClose(w)) {
+      glfwPollEvents();
+      int fw = 0, fh = 0;
+      glfwGetFramebufferSize(w, &fw, &fh);
+      Projector pr{cam.view(), cam.projection(float(fw) / float(std::max(fh, 1))),
+                   std::max(fw, 1), std::max(fh, 1)};
+      input.handle(w, cam, controller.takes_pointer(), pr, o, seconds());
+      controller.update(scene, input.pointer);
+      Eigen::Vector3d lo, hi;
+      const auto reset = [&] {
+        if (bounds(scene, lo, hi))
+          cam.frame((0.5 * (lo + hi)).cast<float>(), float(0.5 * (hi - lo).norm())), framed = true;
+      };
+      if (!framed) reset();
+      glViewport(0, 0, fw, fh);
+      glClearColor(0.12f, 0.13f, 0.15f, 1.0f);
+      glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+      renderer.draw(scene, cam.view(), cam.projection(float(fw) / float(std::max(fh, 1))));
+      if (o.panel) {
+        ImGui_ImplOpenGL3_NewFrame();
+        ImGui_ImplGlfw_NewFrame();
+        ImGui::NewFrame();
+        ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_Once);
+        ImGui::Begin("spinesim", nullptr, ImGuiWindowFlags_AlwaysAutoResize);
+        long triangles = 0;
+        for (const Body& b : scene.bodies) triangles += b.visible ? long(b.F.rows()) : 0;
+        ImGui::Text("%d bodies, %ld triangles", int(scene.bodies.size()), triangles);
+        ImGui::Text("frame %.1f ms (%s)", frame_ms.empty() ? 0.0 : frame_ms.back(),
+                    r.renderer.c_str());
+        if (ImGui::Button("reset camera")) reset();
+        ImGui::TextDisabled(controller.takes_pointer()
+                                ? "cursor: probe, left/space: button, wheel: depth; right drag: "
+                                  "orbit, middle: pan, shift+wheel: zoom"
+                                : "left drag: orbit, right drag: pan, wheel: zoom");
+        ImGui::Separator();
+        controller.panel();
+        ImGui::End();
+        ImGui::Render();
+        ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+      }
+      ++r.frames;
+      const auto now = std::chrono::steady_clock::now();
+      frame_ms.push_back(std::chrono::duration<double, std::milli>(now - last).count());
+      last = now;
+      if (!o.screenshot.empty() && r.frames >= o.frames && seconds() >= o.screenshot_after_s) {
+        write_png(o.screenshot, fw, fh);
+        break;
+      }
+      glfwSwapBuffers(w);
     }
+    r.mean_frame_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+            .count() /
+        std::max(1, r.frames);
+  } catch (...) {
+    controller.closing();
+    ImGui_ImplOpenGL3_Shutdown();
+    ImGui_ImplGlfw_Shutdown();
+    ImGui::DestroyContext();
+    glfwDestroyWindow(w);
+    glfwTerminate();
+    throw;
   }
-  Camera cam;
-  const auto reset = [&] {
-    cam.frame((0.5 * (lo + hi)).cast<float>(), float(0.5 * (hi - lo).norm()));
-  };
-  reset();
-  Mouse mouse;
-  glEnable(GL_DEPTH_TEST);
-
-  const auto start = std::chrono::steady_clock::now();
-  while (!glfwWindowShouldClose(w)) {
-    glfwPollEvents();
-    handle_input(w, cam, mouse);
-    cam.distance *= float(std::pow(0.9, scroll_accumulated));
-    scroll_accumulated = 0;
-    int fw = 0, fh = 0;
-    glfwGetFramebufferSize(w, &fw, &fh);
-    glViewport(0, 0, fw, fh);
-    glClearColor(0.12f, 0.13f, 0.15f, 1.0f);
-    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-    glUseProgram(program);
-    const Eigen::Matrix4f view = cam.view(),
-                          proj = cam.projection(float(fw) / float(std::max(fh, 1)));
-    glUniformMatrix4fv(glGetUniformLocation(program, "view"), 1, GL_FALSE, view.data());
-    glUniformMatrix4fv(glGetUniformLocation(program, "projection"), 1, GL_FALSE, proj.data());
-    for (std::size_t i = 0; i < bodies.size(); ++i) {
-      Eigen::Matrix4f model = Eigen::Matrix4f::Identity();
-      model.topLeftCorner<3, 3>() = bodies[i].R.cast<float>();
-      model.topRightCorner<3, 1>() = bodies[i].t.cast<float>();
-      glUniformMatrix4fv(glGetUniformLocation(program, "model"), 1, GL_FALSE, model.data());
-      glUniform3fv(glGetUniformLocation(program, "color"), 1, bodies[i].color.data());
-      glBindVertexArray(meshes[i].vao);
-      glDrawArrays(GL_TRIANGLES, 0, meshes[i].vertices);
-    }
-    if (o.panel) {
-      ImGui_ImplOpenGL3_NewFrame();
-      ImGui_ImplGlfw_NewFrame();
-      ImGui::NewFrame();
-      ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_Once);
-      ImGui::Begin("spinesim");
-      ImGui::Text("%d bodies, %ld triangles", int(bodies.size()), triangles);
-      ImGui::Text("frame %.1f ms", 1000.0 / std::max(1e-3, double(ImGui::GetIO().Framerate)));
-      ImGui::Text("%s", r.renderer.c_str());
-      if (ImGui::Button("reset camera")) reset();
-      ImGui::TextDisabled("left drag: orbit, right drag: pan, wheel: zoom");
-      ImGui::End();
-      ImGui::Render();
-      ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
-    }
-    ++r.frames;
-    if (!o.screenshot.empty() && r.frames >= o.frames) {
-      write_png(o.screenshot, fw, fh);
-      break;
-    }
-    glfwSwapBuffers(w);
-  }
-  r.mean_frame_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count() /
-      std::max(1, r.frames);
+  controller.closing();
+  r.p50_frame_ms = percentile(frame_ms, 0.5);
+  r.p99_frame_ms = percentile(frame_ms, 0.99);
   ImGui_ImplOpenGL3_Shutdown();
   ImGui_ImplGlfw_Shutdown();
   ImGui::DestroyContext();
-  for (GpuMesh& m : meshes) {
-    glDeleteBuffers(1, &m.vbo);
-    glDeleteVertexArrays(1, &m.vao);
-  }
-  glDeleteProgram(program);
   glfwDestroyWindow(w);
   glfwTerminate();
   return r;
+}
+
+Eigen::Vector3f colormap(double value, double lo, double hi) {
+  if (!std::isfinite(value) || !(hi > lo)) return {0.5f, 0.5f, 0.5f};
+  const auto lerp = [](const Eigen::Vector3f& a, const Eigen::Vector3f& b, double f) {
+    return Eigen::Vector3f(a + float(f) * (b - a));
+  };
+  if (lo < 0 && hi > 0) {  // diverging about 0 (Moreland's cool-warm ends, white middle)
+    const Eigen::Vector3f blue(0.23f, 0.30f, 0.75f), white(0.87f, 0.87f, 0.87f),
+        red(0.71f, 0.02f, 0.15f);
+    if (value < 0) return lerp(white, blue, std::min(1.0, value / lo));
+    return lerp(white, red, std::min(1.0, value / hi));
+  }
+  // Sequential: five stops along viridis.
+  static const Eigen::Vector3f stops[5] = {{0.267f, 0.005f, 0.329f},
+                                           {0.231f, 0.322f, 0.545f},
+                                           {0.129f, 0.569f, 0.549f},
+                                           {0.369f, 0.788f, 0.384f},
+                                           {0.993f, 0.906f, 0.144f}};
+  const double f = std::clamp((value - lo) / (hi - lo), 0.0, 1.0) * 4;
+  const int i = std::min(3, int(f));
+  return lerp(stops[i], stops[i + 1], f - i);
+}
+
+void color_legend(const char* label, double lo, double hi) {
+  ImGui::Text("%s", label);
+  const ImVec2 p = ImGui::GetCursorScreenPos();
+  const float width = 220, height = 14;
+  ImDrawList* draw = ImGui::GetWindowDrawList();
+  const int n = 32;
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector3f c = colormap(lo + (hi - lo) * (i + 0.5) / n, lo, hi);
+    draw->AddRectFilled(ImVec2(p.x + width * i / n, p.y), ImVec2(p.x + width * (i + 1) / n, p.y + height),
+                        ImGui::ColorConvertFloat4ToU32(ImVec4(c.x(), c.y(), c.z(), 1)));
+  }
+  ImGui::Dummy(ImVec2(width, height));
+  ImGui::Text("%-12.3g%*s%12.3g", lo, 6, "", hi);
 }
 
 }  // namespace spinesim::viewer
