@@ -143,10 +143,11 @@ void hold_for_one_period(const HandModel& hand, const DeviceCapabilities& caps, 
   const double h = period / substeps, m = hand.mass_kg * 1e-3;  // tonnes (mm-N-t-s)
   for (int k = 0; k < substeps; ++k) {
     const double t = k * h;
-    const Eigen::Vector3d a = (hand.stiffness_n_per_mm * (set_point(t) - x) +
-                               hand.damping_n_s_per_mm * (set_velocity(t) - v) -
-                               caps.physical_damping_n_s_per_mm * v + force) /
-                              m;
+    Eigen::Vector3d grip = hand.stiffness_n_per_mm * (set_point(t) - x) +
+                           hand.damping_n_s_per_mm * (set_velocity(t) - v);
+    if (hand.max_force_n > 0 && grip.norm() > hand.max_force_n)
+      grip *= hand.max_force_n / grip.norm();
+    const Eigen::Vector3d a = (grip - caps.physical_damping_n_s_per_mm * v + force) / m;
     v += h * a;
     x += h * v;
   }
@@ -154,7 +155,8 @@ void hold_for_one_period(const HandModel& hand, const DeviceCapabilities& caps, 
 
 void check_hand(const char* who, double period_s, const HandModel& hand) {
   if (!(period_s > 0)) throw std::invalid_argument(std::string(who) + ": period must be > 0");
-  if (!(hand.mass_kg > 0) || !(hand.stiffness_n_per_mm > 0) || !(hand.damping_n_s_per_mm >= 0))
+  if (!(hand.mass_kg > 0) || !(hand.stiffness_n_per_mm > 0) || !(hand.damping_n_s_per_mm >= 0) ||
+      !(hand.max_force_n >= 0))
     throw std::invalid_argument(std::string(who) + ": hand mass and stiffness must be > 0");
 }
 
@@ -214,6 +216,7 @@ class MouseDevice final : public Device {
         speed_(max_speed),
         hand_(hand) {
     check_hand("mouse device", period_s, hand);
+    if (hand_.max_force_n == 0) hand_.max_force_n = caps.continuous_force_n;
     if (!(max_speed > 0) || !std::isfinite(max_speed) || !start.allFinite())
       throw std::invalid_argument("mouse device: the speed must be > 0 and the start finite");
   }

@@ -9,6 +9,7 @@
 #include "spinesim/studies/files.hpp"
 #include "spinesim/studies/format.hpp"
 #include "spinesim/studies/haptic_scene.hpp"
+#include "spinesim/studies/haptics_run.hpp"
 #include "spinesim/studies/json.hpp"
 #include "spinesim/studies/progress.hpp"
 #include "spinesim/studies/table.hpp"
@@ -48,6 +49,17 @@ void register_view(CLI::App& app);
 
 /// --scene, --vertebrae, --testdata, --triangles: the haptic scene's flags (haptics run, view).
 void add_scene_flags(CLI::App* cmd, studies::HapticSceneRequest& scene);
+
+/// A haptic session's flags (scene, disc, device, renderer, compliant stage …), shared by
+/// `haptics run` and `view` (`viewer`: the help names the mouse device).
+struct HapticsRunFlags {
+  studies::HapticsRunRequest request;
+  std::string workspace_center;
+  bool no_realtime = false;
+};
+void add_haptics_run_flags(CLI::App* cmd, HapticsRunFlags& flags, bool viewer);
+/// After parsing: --workspace-center, --no-realtime and the test-data folder into the request.
+void resolve_haptics_run_flags(HapticsRunFlags& flags);
 void register_bench(CLI::App& app);
 void register_spine_database(
     CLI::App& spine);  ///< spine database, under `spine` (cli_spine_database.cpp)

@@ -54,18 +54,16 @@ class StopOnSignals {
 };
 
 struct HapticsArgs {
-  HapticsRunRequest request;
-  std::string workspace_center;
-  bool json = false, quiet = false, no_realtime = false;
+  HapticsRunFlags flags;
+  bool json = false, quiet = false;
 };
 
-void run_haptics_cli(HapticsArgs& a) {
-  a.request.realtime_priority = !a.no_realtime;
-  if (!a.workspace_center.empty()) {
-    const auto v = parse_numbers(a.workspace_center, 3, "--workspace-center");
-    a.request.workspace_center_mm = Eigen::Vector3d(v[0], v[1], v[2]);
-  }
-  if (a.request.scene.testdata_dir.empty()) a.request.scene.testdata_dir = testdata_dir();
+void run_haptics_cli(HapticsArgs& args) {
+  resolve_haptics_run_flags(args.flags);
+  struct {
+    HapticsRunRequest& request;
+    bool json, quiet;
+  } a{args.flags.request, args.json, args.quiet};
   a.request.stop = &g_stop;
   const bool live = !a.quiet && !a.json && stderr_is_terminal();
   std::unique_ptr<ProgressBar> bar;
@@ -166,6 +164,78 @@ void add_scene_flags(CLI::App* cmd, studies::HapticSceneRequest& scene) {
       ->capture_default_str();
 }
 
+void add_haptics_run_flags(CLI::App* cmd, HapticsRunFlags& f, bool viewer) {
+  add_scene_flags(cmd, f.request.scene);
+  add_disc_flags(cmd, f.request);
+  cmd->add_option("--device", f.request.device,
+                  viewer
+                      ? "mouse (the pointer is the probe's hand), sim, replay, null, openhaptics, "
+                        "dhd, or none (the scene alone)"
+                      : "sim, replay, null, openhaptics or dhd (mouse: in spinesim view)")
+      ->capture_default_str();
+  cmd->add_option("--model", f.request.model,
+                  "Device capability record: touch, premium-1.5, omega.3 (peak force, stiffness)")
+      ->capture_default_str();
+  cmd->add_option("--script", f.request.script,
+                  "sim: the hand's set-point trajectory, CSV t_s,x_mm,y_mm,z_mm[,button] "
+                  "(default: data/haptics/ for the scene)");
+  cmd->add_option("--replay", f.request.replay, "replay: a file written by --record");
+  cmd->add_option("--sdk-lib", f.request.sdk_library,
+                  "openhaptics/dhd: the vendor's shared library (default libHD.so / libdhd.so)");
+  cmd->add_option("--workspace-center", f.workspace_center,
+                  "openhaptics/dhd: scene point (x,y,z mm) at the device's origin (default: the "
+                  "scene's centre)");
+  cmd->add_option("--view", f.request.view,
+                  "openhaptics/dhd: the user stands at the patient's back or front")
+      ->capture_default_str();
+  cmd->add_option("--duration", f.request.duration_s,
+                  "Seconds to run (0: the script's or recording's length; null: 10 s)")
+      ->capture_default_str();
+  cmd->add_option("--probe-radius", f.request.probe_radius_mm, "Probe sphere radius, mm")
+      ->capture_default_str();
+  cmd->add_option("--renderer", f.request.renderer,
+                  "proxy (god-object, default) or gao-gibson (the thesis's penalty method)")
+      ->capture_default_str();
+  cmd->add_option("--stiffness", f.request.stiffness_n_per_mm,
+                  "Rendering stiffness, N/mm (0: the device's usable stiffness within the "
+                  "Colgate-Brown passivity limit)")
+      ->capture_default_str();
+  cmd->add_option("--record", f.request.record, "Write every tick to this CSV (replayable)");
+  cmd->add_option("--write-scene", f.request.write_scene,
+                  "Also write each body's surface to this folder as <name>.obj (mm, world frame)");
+  cmd->add_option("--spin-us", f.request.spin_us,
+                  "Spin (busy-wait) this long before each deadline instead of sleeping to it, us "
+                  "(0: sleep only; steadier periods on virtual machines for some CPU)")
+      ->capture_default_str();
+  cmd->add_flag("--no-realtime", f.no_realtime, "Do not ask for real-time (SCHED_FIFO) priority");
+  cmd->add_option("--spine", f.request.spine,
+                  "Compliant stage (--scene spine): press the stylus button on a vertebra to drag "
+                  "it; multirate (equilibrium solves in a worker + their sensitivity) or database "
+                  "(the thesis's displacement-force polynomials)");
+  cmd->add_option("--database", f.request.database,
+                  "--spine database: the database file (default data/spine/displacement_db.json)");
+  cmd->add_option("--force-scale", f.request.force_scale,
+                  "Spine force per felt force, N/N (default: 600 N on the spine at the device's "
+                  "peak force)");
+  cmd->add_option("--coupling-stiffness", f.request.coupling_stiffness_n_per_mm,
+                  "Felt stiffness of the hook spring (--spine) or of the disc coupling (--scene "
+                  "disc), N/mm (default: the rendering stiffness)");
+  cmd->add_option("--coupling-damping", f.request.coupling_damping_n_s_per_mm,
+                  "Felt damping of the hook spring or the disc coupling, N*s/mm")
+      ->capture_default_str();
+  cmd->add_flag("--no-recruit{false}", f.request.spine_recruit,
+                "--spine multirate: passive spine solves (muscles off)");
+}
+
+void resolve_haptics_run_flags(HapticsRunFlags& f) {
+  f.request.realtime_priority = !f.no_realtime;
+  if (!f.workspace_center.empty()) {
+    const auto v = parse_numbers(f.workspace_center, 3, "--workspace-center");
+    f.request.workspace_center_mm = Eigen::Vector3d(v[0], v[1], v[2]);
+  }
+  if (f.request.scene.testdata_dir.empty()) f.request.scene.testdata_dir = testdata_dir();
+}
+
 void register_haptics(CLI::App& app) {
   auto* haptics_cmd = app.add_subcommand(
       "haptics", "The 1 kHz haptic loop: touch the spine with a spherical probe");
@@ -173,62 +243,7 @@ void register_haptics(CLI::App& app) {
   auto a = std::make_shared<HapticsArgs>();
   auto* run = haptics_cmd->add_subcommand(
       "run", "Run the servo loop on a scene with a device (sim: a scripted hand)");
-  add_scene_flags(run, a->request.scene);
-  add_disc_flags(run, a->request);
-  run->add_option("--device", a->request.device, "sim, replay, null, openhaptics or dhd")
-      ->capture_default_str();
-  run->add_option("--model", a->request.model,
-                  "Device capability record: touch, premium-1.5, omega.3 (peak force, stiffness)")
-      ->capture_default_str();
-  run->add_option("--script", a->request.script,
-                  "sim: the hand's set-point trajectory, CSV t_s,x_mm,y_mm,z_mm[,button] "
-                  "(default: data/haptics/ for the scene)");
-  run->add_option("--replay", a->request.replay, "replay: a file written by --record");
-  run->add_option("--sdk-lib", a->request.sdk_library,
-                  "openhaptics/dhd: the vendor's shared library (default libHD.so / libdhd.so)");
-  run->add_option("--workspace-center", a->workspace_center,
-                  "openhaptics/dhd: scene point (x,y,z mm) at the device's origin (default: the "
-                  "scene's centre)");
-  run->add_option("--view", a->request.view,
-                  "openhaptics/dhd: the user stands at the patient's back or front")
-      ->capture_default_str();
-  run->add_option("--duration", a->request.duration_s,
-                  "Seconds to run (0: the script's or recording's length; null: 10 s)")
-      ->capture_default_str();
-  run->add_option("--probe-radius", a->request.probe_radius_mm, "Probe sphere radius, mm")
-      ->capture_default_str();
-  run->add_option("--renderer", a->request.renderer,
-                  "proxy (god-object, default) or gao-gibson (the thesis's penalty method)")
-      ->capture_default_str();
-  run->add_option("--stiffness", a->request.stiffness_n_per_mm,
-                  "Rendering stiffness, N/mm (0: the device's usable stiffness within the "
-                  "Colgate-Brown passivity limit)")
-      ->capture_default_str();
-  run->add_option("--record", a->request.record, "Write every tick to this CSV (replayable)");
-  run->add_option("--write-scene", a->request.write_scene,
-                  "Also write each body's surface to this folder as <name>.obj (mm, world frame)");
-  run->add_option("--spin-us", a->request.spin_us,
-                  "Spin (busy-wait) this long before each deadline instead of sleeping to it, us "
-                  "(0: sleep only; steadier periods on virtual machines for some CPU)")
-      ->capture_default_str();
-  run->add_flag("--no-realtime", a->no_realtime, "Do not ask for real-time (SCHED_FIFO) priority");
-  run->add_option("--spine", a->request.spine,
-                  "Compliant stage (--scene spine): press the stylus button on a vertebra to drag "
-                  "it; multirate (equilibrium solves in a worker + their sensitivity) or database "
-                  "(the thesis's displacement-force polynomials)");
-  run->add_option("--database", a->request.database,
-                  "--spine database: the database file (default data/spine/displacement_db.json)");
-  run->add_option("--force-scale", a->request.force_scale,
-                  "Spine force per felt force, N/N (default: 600 N on the spine at the device's "
-                  "peak force)");
-  run->add_option("--coupling-stiffness", a->request.coupling_stiffness_n_per_mm,
-                  "Felt stiffness of the hook spring (--spine) or of the disc coupling (--scene "
-                  "disc), N/mm (default: the rendering stiffness)");
-  run->add_option("--coupling-damping", a->request.coupling_damping_n_s_per_mm,
-                  "Felt damping of the hook spring or the disc coupling, N*s/mm")
-      ->capture_default_str();
-  run->add_flag("--no-recruit{false}", a->request.spine_recruit,
-                "--spine multirate: passive spine solves (muscles off)");
+  add_haptics_run_flags(run, a->flags, false);
   add_output_flags(run, a->json, a->quiet);
   run->callback([a] { run_haptics_cli(*a); });
 

@@ -33,10 +33,9 @@ std::string default_haptic_script(const std::string& scene, const std::string& d
   return (dir / "stroke_spinous.csv").string();
 }
 
-namespace {
+namespace {}  // namespace
 
-// Refuses what cannot run, before any work: one line each.
-void check_request(const HapticsRunRequest& r) {
+void check_haptics_request(const HapticsRunRequest& r) {
   if (!(r.probe_radius_mm > 0) || !std::isfinite(r.probe_radius_mm) || r.probe_radius_mm > 100)
     throw std::invalid_argument("--probe-radius must be > 0 and at most 100 mm");
   if (r.renderer != "proxy" && r.renderer != "gao-gibson")
@@ -47,10 +46,14 @@ void check_request(const HapticsRunRequest& r) {
     throw std::invalid_argument("--spin-us must be 0 to 900 us");
   if (!(r.stiffness_n_per_mm >= 0) || !std::isfinite(r.stiffness_n_per_mm))
     throw std::invalid_argument("--stiffness must be >= 0 N/mm (0: the device's default)");
+  if (r.device == "mouse" && !(r.live && r.live->pointer))
+    throw std::invalid_argument(
+        "--device mouse is the viewer's pointer: run it with spinesim view --device mouse");
   if (r.device != "sim" && r.device != "replay" && r.device != "null" &&
-      r.device != "openhaptics" && r.device != "dhd")
+      r.device != "openhaptics" && r.device != "dhd" && r.device != "mouse")
     throw std::invalid_argument("--device " + r.device +
-                                ": unknown (sim, replay, null, openhaptics, dhd)");
+                                ": unknown (sim, replay, null, openhaptics, dhd; mouse in the "
+                                "viewer)");
   if (r.view != "back" && r.view != "front")
     throw std::invalid_argument("--view " + r.view + ": give back or front");
   if (!r.sdk_library.empty() && r.device != "openhaptics" && r.device != "dhd")
@@ -100,6 +103,8 @@ void check_request(const HapticsRunRequest& r) {
     throw std::invalid_argument("--write-scene " + r.write_scene + ": not an existing folder");
 }
 
+namespace {
+
 // The renderer the request names, at the result's stiffness (samples the scene for Gao-Gibson).
 std::unique_ptr<haptics::ForceRenderer> make_renderer(const HapticsRunRequest& request,
                                                       double stiffness, haptics::Scene& scene) {
@@ -122,7 +127,9 @@ std::unique_ptr<haptics::Device> make_device(const HapticsRunRequest& request,
                                              const haptics::DeviceCapabilities& caps,
                                              const haptics::Trajectory& trajectory,
                                              const Eigen::Vector3d& scene_center, double period_s,
-                                             double duration_s) {
+                                             double duration_s, const Eigen::Vector3d& start) {
+  if (request.device == "mouse")
+    return haptics::make_mouse_device(*request.live->pointer, start, caps, period_s);
   if (request.device == "sim") return haptics::make_sim_device(trajectory, caps, period_s);
   if (request.device == "replay") return haptics::make_replay_device(trajectory, caps, period_s);
   if (request.device == "null")
@@ -137,6 +144,19 @@ std::unique_ptr<haptics::Device> make_device(const HapticsRunRequest& request,
   const Eigen::Vector3d c =
       request.workspace_center_mm.allFinite() ? request.workspace_center_mm : scene_center;
   return haptics::map_device(std::move(vendor), R, c);
+}
+
+// Where a mouse starts: 25 mm behind (posterior to) the scene's bodies, at their centre's height.
+Eigen::Vector3d behind_the_scene(const haptics::Scene& scene) {
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
+  for (int i = 0; i < scene.size(); ++i) {
+    const Eigen::MatrixX3d& V = scene.body(i).tree.vertices();
+    lo = lo.cwiseMin(V.colwise().minCoeff().transpose());
+    hi = hi.cwiseMax(V.colwise().maxCoeff().transpose());
+  }
+  if (scene.size() == 0) return Eigen::Vector3d::Zero();
+  const Eigen::Vector3d c = 0.5 * (lo + hi);
+  return {c.x(), c.y(), lo.z() - 25};
 }
 
 // The scene's summary into the result, and its surfaces written when asked.
@@ -273,7 +293,7 @@ void finish_disc(DiscSetup& d, HapticsRunResult* result) {
 HapticsRunResult run_haptics(const HapticsRunRequest& request, const std::string& data_dir,
                              const std::function<void(const haptics::ServoStatus&)>& status,
                              const std::function<void(int, int)>& scene_progress) {
-  check_request(request);
+  check_haptics_request(request);
   HapticsRunResult result;
   result.request = request;
   result.capabilities = haptics::device_model(request.model);
@@ -289,7 +309,10 @@ HapticsRunResult run_haptics(const HapticsRunRequest& request, const std::string
     trajectory = haptics::read_trajectory(request.replay);
   }
   double duration = request.duration_s;
-  if (duration == 0) duration = request.device == "null" ? 10.0 : trajectory.duration_s() + T;
+  if (duration == 0)
+    duration = request.device == "null"    ? 10.0
+               : request.device == "mouse" ? 3600.0  // until the window closes
+                                           : trajectory.duration_s() + T;
   result.request.duration_s = duration;
 
   HapticScene scene = build_haptic_scene(request.scene, data_dir, scene_progress);
@@ -307,8 +330,9 @@ HapticsRunResult run_haptics(const HapticsRunRequest& request, const std::string
     coupled = std::make_unique<haptics::DiscCouplingRenderer>(*rigid, *disc.palpation);
   }
   haptics::ForceRenderer& renderer = coupled ? *coupled : *rigid;
+  const Eigen::Vector3d start = behind_the_scene(scene.scene);
   const auto device =
-      make_device(request, result.capabilities, trajectory, scene.center_mm, T, duration);
+      make_device(request, result.capabilities, trajectory, scene.center_mm, T, duration, start);
   device->open();
 
   haptics::TripleBuffer<haptics::ScenePoses> poses{haptics::ScenePoses{}};
@@ -341,14 +365,25 @@ HapticsRunResult run_haptics(const HapticsRunRequest& request, const std::string
         1 << 13);
   }
 
+  if (request.live && request.live->ready)
+    request.live->ready({scene, disc.model.get(), result.disc_level, result.capabilities,
+                         result.stiffness_n_per_mm, request.probe_radius_mm, request.device,
+                         request.spine, start});
   if (disc.palpation) disc.palpation->start();
   int calls = 0;
+  HapticsLiveFrame live;
   result.stats = loop.run([&](const haptics::ServoStatus& s, double now) {
     haptics::ScenePoses p;  // the rigid stage's bodies stay at the reference posture
     p.time_s = now;
     poses.write(p);
     if (request.stop && request.stop->load()) loop.request_stop();
     if (status && ++calls % 10 == 0) status(s);
+    if (request.live && request.live->frame) {
+      live.status = s;
+      live.loop_time_s = now;
+      if (disc.palpation) live.disc_x_mm = disc.palpation->latest_positions();
+      request.live->frame(live);
+    }
   });
   device->close();
   if (compliant.response) finish_compliant(compliant, &result);

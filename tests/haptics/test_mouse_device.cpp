@@ -57,12 +57,35 @@ TEST(MouseDevice, AJumpOfTheCursorIsAGlideAtTheSpeedLimitThatSettlesOnIt) {
 
 TEST(MouseDevice, AHeldForceIsBalancedByTheHandsSpring) {
   Rig rig(Eigen::Vector3d::Zero());
-  const Eigen::Vector3d f(0.4, -0.2, 0.1);  // N
+  const Eigen::Vector3d f(0.4, -0.2, 0.1);  // N, within the Touch's continuous 0.88 N
   rig.device->write_force(f);
   const auto s = rig.run(5000);
   // Static equilibrium: k (set - x) + F = 0 (the damping terms vanish at rest).
   const Eigen::Vector3d expected = f / rig.hand.stiffness_n_per_mm;
   EXPECT_NEAR((s.position_mm - expected).norm(), 0, 1e-3) << s.position_mm.transpose();
+}
+
+// A set-point far behind a wall: the hand pushes with the device's continuous force at most, so
+// a wall holding that force stops the stylus.
+TEST(MouseDevice, TheHandPushesWithAtMostTheContinuousForce) {
+  Rig rig(Eigen::Vector3d::Zero());
+  rig.point(Eigen::Vector3d(0, 0, -200));
+  const double most = sh::device_model("touch").continuous_force_n;
+  sh::DeviceState s;
+  double deepest = 0;
+  for (int i = 0; i < 4000; ++i) {
+    rig.device->read(s);
+    // A wall at z = -10 mm, 2 N/mm (penalty), clamped at the device's peak force.
+    const double pen = std::max(0.0, -10 - s.position_mm.z());
+    rig.device->write_force(Eigen::Vector3d(0, 0, std::min(2 * pen, 3.3)));
+    deepest = std::max(deepest, pen);
+  }
+  EXPECT_NEAR(std::max(0.0, -10 - s.position_mm.z()), most / 2, 0.02);  // at rest: 2 pen = most
+  // On the way in the stylus arrives at up to about the glide speed: the wall also takes its
+  // kinetic energy, pen <= F/k + v sqrt(m/k) (+30 % for the hand's own overshoot of the glide).
+  // Without the limit the grip spring pushed it 180 mm through.
+  const double m = 0.15, k = 2000, v = 0.25;  // kg, N/m, m/s
+  EXPECT_LT(deepest, most / 2 + 1.3 * 1e3 * v * std::sqrt(m / k));
 }
 
 TEST(MouseDevice, NonFiniteSetPointIsHeldButtonsPassAndQuitFinishes) {

@@ -11,11 +11,12 @@
 
 #include <algorithm>
 #include <array>
-#include <cstdint>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace spinesim::viewer {
@@ -139,10 +140,10 @@ Eigen::MatrixX3d sphere_vertices(Eigen::MatrixX3i& F) {
   std::vector<Eigen::Vector3d> v = {{-1, g, 0}, {1, g, 0}, {-1, -g, 0}, {1, -g, 0},
                                     {0, -1, g}, {0, 1, g}, {0, -1, -g}, {0, 1, -g},
                                     {g, 0, -1}, {g, 0, 1}, {-g, 0, -1}, {-g, 0, 1}};
-  std::vector<std::array<int, 3>> f = {
-      {0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-      {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
-      {3, 8, 9},  {4, 9, 5},  {2, 4, 11},  {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
+  std::vector<std::array<int, 3>> f = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
+                                       {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+                                       {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
+                                       {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
   for (int level = 0; level < 2; ++level) {
     std::vector<std::array<int, 3>> next;
     for (const auto& t : f) {
@@ -161,8 +162,7 @@ Eigen::MatrixX3d sphere_vertices(Eigen::MatrixX3i& F) {
   Eigen::MatrixX3d V(Eigen::Index(v.size()), 3);
   for (std::size_t i = 0; i < v.size(); ++i) V.row(Eigen::Index(i)) = v[i].normalized();
   F.resize(Eigen::Index(f.size()), 3);
-  for (std::size_t i = 0; i < f.size(); ++i)
-    F.row(Eigen::Index(i)) << f[i][0], f[i][1], f[i][2];
+  for (std::size_t i = 0; i < f.size(); ++i) F.row(Eigen::Index(i)) << f[i][0], f[i][1], f[i][2];
   return V;
 }
 
@@ -172,10 +172,10 @@ Eigen::MatrixX3d arrow_vertices(Eigen::MatrixX3i& F) {
   std::vector<std::array<int, 3>> f;
   for (int i = 0; i < n; ++i) {
     const double a = 2 * kPi * i / n, c = std::cos(a), s = std::sin(a);
-    v.push_back({c, s, 0});      // 4 i: shaft bottom
-    v.push_back({c, s, 1});      // 4 i + 1: shaft top
+    v.push_back({c, s, 0});          // 4 i: shaft bottom
+    v.push_back({c, s, 1});          // 4 i + 1: shaft top
     v.push_back({2 * c, 2 * s, 1});  // 4 i + 2: cone base
-    v.push_back({0, 0, 2});      // 4 i + 3: tip
+    v.push_back({0, 0, 2});          // 4 i + 3: tip
   }
   for (int i = 0; i < n; ++i) {  // the shaft's 2 n triangles first (drawn on their own)
     const int j = (i + 1) % n;
@@ -191,15 +191,14 @@ Eigen::MatrixX3d arrow_vertices(Eigen::MatrixX3i& F) {
   Eigen::MatrixX3d V(Eigen::Index(v.size()), 3);
   for (std::size_t i = 0; i < v.size(); ++i) V.row(Eigen::Index(i)) = v[i];
   F.resize(Eigen::Index(f.size()), 3);
-  for (std::size_t i = 0; i < f.size(); ++i)
-    F.row(Eigen::Index(i)) << f[i][0], f[i][1], f[i][2];
+  for (std::size_t i = 0; i < f.size(); ++i) F.row(Eigen::Index(i)) << f[i][0], f[i][1], f[i][2];
   return V;
 }
 
 /// Orbit camera about a target: yaw about the superior (y) axis, pitch above the horizontal.
 struct Camera {
   Eigen::Vector3f target = Eigen::Vector3f::Zero();
-  float distance = 1000, yaw = 0, pitch = 0.1f, fov = 35.0f * kPi / 180.0f;
+  float distance = 1000, yaw = 0, pitch = 0, fov = 35.0f * kPi / 180.0f;
 
   Eigen::Vector3f eye() const {
     const Eigen::Vector3f dir(std::cos(pitch) * std::cos(yaw), std::sin(pitch),
@@ -227,8 +226,8 @@ struct Camera {
   void frame(const Eigen::Vector3f& c, float r) {
     target = c;
     distance = 1.15f * r / std::sin(0.5f * fov);
-    yaw = 0;  // the eye on the body's right (-x): a sagittal view, anterior to the screen's right
-    pitch = 0.1f;
+    yaw = 0;    // the eye on the body's right (-x): a sagittal view, anterior to the screen's right
+    pitch = 0;  // level: the mouse's probe then moves in a sagittal plane
   }
 };
 
@@ -237,14 +236,15 @@ struct Projector {
   Eigen::Matrix4f view, proj;
   int w = 1, h = 1;
   Eigen::Vector2d to_pixel(const Eigen::Vector3d& p) const {
-    const Eigen::Vector4f c = proj * view * Eigen::Vector4f(float(p.x()), float(p.y()),
-                                                            float(p.z()), 1.0f);
+    const Eigen::Vector4f c =
+        proj * view * Eigen::Vector4f(float(p.x()), float(p.y()), float(p.z()), 1.0f);
     return {(c.x() / c.w() + 1) * 0.5 * w, (1 - c.y() / c.w()) * 0.5 * h};
   }
   void to_ray(double x, double y, Eigen::Vector3d& origin, Eigen::Vector3d& dir) const {
     const Eigen::Matrix4f inv = (proj * view).inverse();
     const float nx = float(2 * x / w - 1), ny = float(1 - 2 * y / h);
-    Eigen::Vector4f a = inv * Eigen::Vector4f(nx, ny, -1, 1), b = inv * Eigen::Vector4f(nx, ny, 1, 1);
+    Eigen::Vector4f a = inv * Eigen::Vector4f(nx, ny, -1, 1),
+                    b = inv * Eigen::Vector4f(nx, ny, 1, 1);
     a /= a.w(), b /= b.w();
     origin = a.head<3>().cast<double>();
     dir = (b - a).head<3>().cast<double>().normalized();
@@ -538,17 +538,20 @@ ViewResult view(Controller& controller, const ViewOptions& o) {
     Input input;
     glEnable(GL_DEPTH_TEST);
     const auto start = std::chrono::steady_clock::now();
-    auto last = start;
+    auto last = start, first_shown = start;
+    int shown = 0;
     const auto seconds = [&] {
       return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     };
-    while (!glfwWindowShouldClose(w)) {
+    while (!glfwWindowShouldClose(w) && !controller.done()) {
+      const auto frame_start = std::chrono::steady_clock::now();
       glfwPollEvents();
       int fw = 0, fh = 0;
       glfwGetFramebufferSize(w, &fw, &fh);
-      Projector pr{cam.view(), cam.projection(float(fw) / float(std::max(fh, 1))),
-                   std::max(fw, 1), std::max(fh, 1)};
-      input.handle(w, cam, controller.takes_pointer(), pr, o, seconds());
+      Projector pr{cam.view(), cam.projection(float(fw) / float(std::max(fh, 1))), std::max(fw, 1),
+                   std::max(fh, 1)};
+      const double clock = controller.clock_s(seconds());
+      input.handle(w, cam, controller.takes_pointer(), pr, o, std::max(clock, 0.0));
       controller.update(scene, input.pointer);
       Eigen::Vector3d lo, hi;
       const auto reset = [&] {
@@ -564,12 +567,16 @@ ViewResult view(Controller& controller, const ViewOptions& o) {
         ImGui_ImplOpenGL3_NewFrame();
         ImGui_ImplGlfw_NewFrame();
         ImGui::NewFrame();
+        // Top left, a third of the window wide at most: the scene is framed in the middle.
         ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_Once);
-        ImGui::Begin("spinesim", nullptr, ImGuiWindowFlags_AlwaysAutoResize);
+        ImGui::SetNextWindowSize(ImVec2(std::clamp(fw / 3.0f, 300.0f, 460.0f), 0),
+                                 ImGuiCond_Always);  // 0: the height fits the contents
+        ImGui::Begin("spinesim", nullptr, ImGuiWindowFlags_NoResize);
+        ImGui::PushTextWrapPos(0);
         long triangles = 0;
         for (const Body& b : scene.bodies) triangles += b.visible ? long(b.F.rows()) : 0;
         ImGui::Text("%d bodies, %ld triangles", int(scene.bodies.size()), triangles);
-        ImGui::Text("frame %.1f ms (%s)", frame_ms.empty() ? 0.0 : frame_ms.back(),
+        ImGui::Text("frame %.1f ms to draw (%s)", frame_ms.empty() ? 0.0 : frame_ms.back(),
                     r.renderer.c_str());
         if (ImGui::Button("reset camera")) reset();
         ImGui::TextDisabled(controller.takes_pointer()
@@ -578,24 +585,34 @@ ViewResult view(Controller& controller, const ViewOptions& o) {
                                 : "left drag: orbit, right drag: pan, wheel: zoom");
         ImGui::Separator();
         controller.panel();
+        ImGui::PopTextWrapPos();
         ImGui::End();
         ImGui::Render();
         ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
       }
       ++r.frames;
-      const auto now = std::chrono::steady_clock::now();
-      frame_ms.push_back(std::chrono::duration<double, std::milli>(now - last).count());
-      last = now;
-      if (!o.screenshot.empty() && r.frames >= o.frames && seconds() >= o.screenshot_after_s) {
+      // At most 60 frames a second even without vsync (Xvfb, some drivers): the CPU the
+      // graphics do not need stays with the servo and disc threads.
+      const auto worked = std::chrono::steady_clock::now();
+      if (!scene.bodies.empty()) {  // the frames of a scene, not of the wait for one
+        frame_ms.push_back(std::chrono::duration<double, std::milli>(worked - frame_start).count());
+        if (shown == 0) first_shown = frame_start;
+        ++shown;
+      }
+      const auto due = last + std::chrono::microseconds(16667);
+      if (worked < due) std::this_thread::sleep_until(due);
+      last = std::chrono::steady_clock::now();
+      if (!o.screenshot.empty() && r.frames >= o.frames && clock >= o.screenshot_after_s) {
         write_png(o.screenshot, fw, fh);
         break;
       }
       glfwSwapBuffers(w);
     }
-    r.mean_frame_ms =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-            .count() /
-        std::max(1, r.frames);
+    double total = 0;
+    for (double ms : frame_ms) total += ms;
+    r.mean_frame_ms = frame_ms.empty() ? 0 : total / double(frame_ms.size());
+    const double span = std::chrono::duration<double>(last - first_shown).count();
+    r.rate_hz = shown > 1 && span > 0 ? (shown - 1) / span : 0;
   } catch (...) {
     controller.closing();
     ImGui_ImplOpenGL3_Shutdown();
@@ -646,7 +663,8 @@ void color_legend(const char* label, double lo, double hi) {
   const int n = 32;
   for (int i = 0; i < n; ++i) {
     const Eigen::Vector3f c = colormap(lo + (hi - lo) * (i + 0.5) / n, lo, hi);
-    draw->AddRectFilled(ImVec2(p.x + width * i / n, p.y), ImVec2(p.x + width * (i + 1) / n, p.y + height),
+    draw->AddRectFilled(ImVec2(p.x + width * i / n, p.y),
+                        ImVec2(p.x + width * (i + 1) / n, p.y + height),
                         ImGui::ColorConvertFloat4ToU32(ImVec4(c.x(), c.y(), c.z(), 1)));
   }
   ImGui::Dummy(ImVec2(width, height));

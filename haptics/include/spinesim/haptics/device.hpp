@@ -89,6 +89,9 @@ struct HandModel {
   double mass_kg = 0.15;
   double stiffness_n_per_mm = 0.4;
   double damping_n_s_per_mm = 0.004;
+  /// The most the hand pushes or pulls with (N; 0: no limit). A person holding a desktop device
+  /// pushes with a few newtons, not with whatever a far set-point would ask of the grip spring.
+  double max_force_n = 0;
 };
 
 /// `sim`: the device is a point mass held by the hand model and driven by the commanded force
@@ -109,7 +112,9 @@ struct PointerInput {
 
 /// `mouse`: the mouse as a 3-DOF device. A simulated hand holds a simulated stylus (as `sim`)
 /// and pulls it towards a set-point that follows the pointer's at no more than `max_speed_mm_s`
-/// (a jump of the cursor becomes a glide, never a blow), starting at `start_mm`; the rendered
+/// (a jump of the cursor becomes a glide, never a blow), starting at `start_mm`, with at most the
+/// device's continuous force when the hand model sets no limit of its own (so a cursor behind a
+/// wall does not push the probe through it: a person would not either); the rendered
 /// force acts on the stylus, so the probe stops at surfaces and the hook drags the spine as with
 /// a real device, and the viewer shows the force that would be felt. Reads `input` every tick
 /// (no allocation, no wait); finished once `input` says quit.

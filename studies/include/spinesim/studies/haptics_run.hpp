@@ -18,11 +18,42 @@
 #include <string>
 #include <vector>
 
+namespace spinesim::mss {
+class MssModel;
+}
+
 namespace spinesim::studies {
+
+/// What a viewer gets once a session is set up (on the session's thread, before the loop
+/// starts; the references are valid only during the call: copy what is needed).
+struct HapticsLiveSetup {
+  const HapticScene& scene;
+  const mss::MssModel* disc = nullptr;  ///< the palpated disc (scene "disc"), else null
+  std::string disc_level;
+  haptics::DeviceCapabilities capabilities;
+  double stiffness_n_per_mm = 0, probe_radius_mm = 0;
+  std::string device, spine;  ///< the device's name; the compliant stage ("": none)
+  Eigen::Vector3d device_start_mm = Eigen::Vector3d::Zero();  ///< mouse: where the probe starts
+};
+
+/// What a viewer gets about every 10 ms while the loop runs (from the slow side).
+struct HapticsLiveFrame {
+  haptics::ServoStatus status;
+  double loop_time_s = 0;     ///< the loop's clock
+  Eigen::VectorXd disc_x_mm;  ///< the disc's node positions (empty without a disc)
+};
+
+/// A viewer's hooks into a session: the mouse device's input (needed for --device mouse), the
+/// set-up and the frames. Both callbacks run on the session's thread and must be quick.
+struct HapticsLiveHooks {
+  haptics::TripleBuffer<haptics::PointerInput>* pointer = nullptr;
+  std::function<void(const HapticsLiveSetup&)> ready;
+  std::function<void(const HapticsLiveFrame&)> frame;
+};
 
 struct HapticsRunRequest {
   HapticSceneRequest scene;
-  std::string device = "sim";  ///< sim, replay, null, openhaptics, dhd
+  std::string device = "sim";  ///< sim, replay, null, openhaptics, dhd; mouse (with live hooks)
   std::string sdk_library;     ///< openhaptics/dhd: the vendor's shared library (default name)
   /// openhaptics/dhd: where the device's origin lands in the scene (mm; NaN: the scene's centre)
   /// and from where the user looks: "back" (behind the patient: device x → −x, z → −z) or
@@ -53,6 +84,7 @@ struct HapticsRunRequest {
   bool realtime_priority = true;
   double spin_us = 400;                     ///< spin this long before each deadline (0: sleep only)
   const std::atomic<bool>* stop = nullptr;  ///< set by the front end (Ctrl-C) to end the run
+  const HapticsLiveHooks* live = nullptr;   ///< a viewer's hooks (null: none)
 };
 
 /// The shipped scripts (data/haptics/), and the default one for a scene.
@@ -84,6 +116,10 @@ struct HapticsRunResult {
   haptics::Percentiles disc_step_us;
   double disc_max_force_n = 0, disc_volume_change_min = 0, disc_volume_change_max = 0;
 };
+
+/// Refuses what cannot run (flags, device backend, output folders), before any work: throws
+/// std::invalid_argument (one line), std::runtime_error for a vendor library that is missing.
+void check_haptics_request(const HapticsRunRequest& request);
 
 /// Validates everything (device, model, files, radius, output folder) before any work, builds
 /// the scene, runs the loop. `status(status)` about every 100 ms for a live line (may be empty);

@@ -55,8 +55,8 @@ struct Pointer {
   bool inside = false;  ///< the cursor is in the window and not over the panel
   Eigen::Vector3d ray_origin = Eigen::Vector3d::Zero(), ray_direction = Eigen::Vector3d::UnitZ();
   Eigen::Vector3d view_direction = Eigen::Vector3d::UnitX();  ///< from the eye into the scene
-  unsigned buttons = 0;  ///< bit 0: the stylus button (left button or space)
-  double wheel = 0;      ///< notches since the last frame (+: away from the eye)
+  unsigned buttons = 0;        ///< bit 0: the stylus button (left button or space)
+  double wheel = 0;            ///< notches since the last frame (+: away from the eye)
   bool camera_moving = false;  ///< right or middle button held: the camera moves
 };
 
@@ -70,6 +70,11 @@ class Controller {
   virtual void panel() {}
   /// True: the pointer drives a device (see the header comment).
   virtual bool takes_pointer() const { return false; }
+  /// The clock (s) the cursor script and the screenshot time count on, given the window's
+  /// (seconds since it opened); negative: not started (no screenshot yet, the script waits).
+  virtual double clock_s(double window_s) const { return window_s; }
+  /// True: close the window (e.g. the session failed).
+  virtual bool done() const { return false; }
   /// Called once when the window closes (or after the screenshot).
   virtual void closing() {}
 };
@@ -79,9 +84,9 @@ struct ViewOptions {
   int width = 1280, height = 800;  ///< window size, pixels
   std::string screenshot;          ///< PNG path: render, write, close
   int frames = 3;                  ///< frames before the screenshot (>= 1)
-  double screenshot_after_s = 0;   ///< ... and at least this long after the window opened
+  double screenshot_after_s = 0;   ///< ... and not before this time (Controller::clock_s)
   bool panel = true;               ///< the ImGui panel
-  /// Scripted pointer (tests and demos): at `t_s` after the window opened, the cursor is where
+  /// Scripted pointer (tests and demos): at `t_s` (Controller::clock_s), the cursor is where
   /// the world point `point_mm` appears on the screen (linear in between), with `buttons` held
   /// and `wheel` notches turned at that step. Replaces the real cursor when not empty.
   struct CursorStep {
@@ -95,8 +100,10 @@ struct ViewOptions {
 
 struct ViewResult {
   int frames = 0;
-  double mean_frame_ms = 0;  ///< wall time per frame, updating, rendering and swapping
-  double p50_frame_ms = 0, p99_frame_ms = 0;
+  /// Wall time to make a frame (input, the controller's update, drawing, the panel, reading the
+  /// screenshot), over the frames that showed a scene; the swap and the 60 Hz cap excluded.
+  double mean_frame_ms = 0, p50_frame_ms = 0, p99_frame_ms = 0;
+  double rate_hz = 0;      ///< frames shown per second (at most 60)
   std::string renderer;    ///< GL_RENDERER, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
   std::string gl_version;  ///< GL_VERSION
 };

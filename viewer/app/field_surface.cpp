@@ -1,0 +1,54 @@
+#include "field_surface.hpp"
+
+#include "spinesim/mesh/tet_mesh.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace spinesim::viewer {
+
+DiscField disc_field(const std::string& name) {
+  for (int i = 0; i < 3; ++i)
+    if (name == kDiscFieldNames[i]) return DiscField(i);
+  throw std::invalid_argument("--field " + name +
+                              ": give displacement, spring_strain or volume_change");
+}
+
+FieldSurface::FieldSurface(const Eigen::MatrixXi& T) : F_(mesh::boundary_faces(T, &owner_)) {}
+
+Eigen::VectorXd FieldSurface::from_points(const Eigen::VectorXd& p) const {
+  Eigen::VectorXd out(F_.rows());
+  for (Eigen::Index f = 0; f < F_.rows(); ++f)
+    out(f) = (p(F_(f, 0)) + p(F_(f, 1)) + p(F_(f, 2))) / 3;
+  return out;
+}
+
+Eigen::VectorXd FieldSurface::from_cells(const Eigen::VectorXd& c) const {
+  Eigen::VectorXd out(F_.rows());
+  for (Eigen::Index f = 0; f < F_.rows(); ++f) out(f) = c(owner_(f));
+  return out;
+}
+
+void FieldSurface::range(const Eigen::VectorXd& v, double floor, double& lo, double& hi) {
+  const double a = v.size() ? v.minCoeff() : 0, b = v.size() ? v.maxCoeff() : 0;
+  if (a < 0) {
+    hi = std::max({std::abs(a), std::abs(b), floor});
+    lo = -hi;
+  } else {
+    lo = 0;
+    hi = std::max(b, floor);
+  }
+}
+
+void FieldSurface::fill(Body& body, const Eigen::MatrixX3d& V, const Eigen::VectorXd& values,
+                        double lo, double hi) const {
+  body.V = V;
+  body.F = F_;
+  body.face_colors.resize(F_.rows(), 3);
+  for (Eigen::Index f = 0; f < F_.rows(); ++f)
+    body.face_colors.row(f) = colormap(values(f), lo, hi).transpose();
+  ++body.revision;
+}
+
+}  // namespace spinesim::viewer
