@@ -184,12 +184,16 @@ nlohmann::json registration_json(const Registration& r) {
           {"rms_mm", r.rms_mm}};
 }
 
+void check_scene_name(const std::string& scene) {
+  if (scene != "plane" && scene != "vertebra" && scene != "spine" && scene != "disc")
+    throw std::invalid_argument("--scene " + scene + ": give spine, vertebra, disc or plane");
+}
+
 HapticScene build_haptic_scene(const HapticSceneRequest& r, const std::string& data_dir,
                                const std::function<void(int, int)>& progress) {
   const Timer timer;
   HapticScene out;
-  if (r.scene != "plane" && r.scene != "vertebra" && r.scene != "spine" && r.scene != "disc")
-    throw std::invalid_argument("--scene " + r.scene + ": give spine, vertebra, disc or plane");
+  check_scene_name(r.scene);
   std::vector<std::string> level_bodies;
   if (r.scene == "disc") {
     mesh::disc_dimensions(r.level, data_dir);  // a known level

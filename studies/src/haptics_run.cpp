@@ -36,6 +36,7 @@ std::string default_haptic_script(const std::string& scene, const std::string& d
 namespace {}  // namespace
 
 void check_haptics_request(const HapticsRunRequest& r) {
+  check_scene_name(r.scene.scene);
   if (!(r.probe_radius_mm > 0) || !std::isfinite(r.probe_radius_mm) || r.probe_radius_mm > 100)
     throw std::invalid_argument("--probe-radius must be > 0 and at most 100 mm");
   if (r.renderer != "proxy" && r.renderer != "gao-gibson")

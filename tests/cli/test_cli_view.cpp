@@ -1,12 +1,20 @@
 // `spinesim view`: a screenshot of the spine under Xvfb (Mesa's software renderer) shows the spine
-// where the camera puts it, and a missing display is one line and a non-zero exit.
+// where the camera puts it; pressing the disc colours it and draws the force arrow; the mouse
+// (a scripted cursor) hooks T1 and drags the spine; a series plays back; a missing display, a
+// bad option or a mouse without the viewer is one line and a non-zero exit.
 #include "cli_runner.hpp"
 
 #include <gtest/gtest.h>
 #include <stb_image.h>
 
+#include <nlohmann/json.hpp>
+
+#include "spinesim/mesh/io.hpp"
+
 #include <filesystem>
+#include <fstream>
 #include <memory>
+#include <sstream>
 
 namespace spinesim::test_cli {
 namespace {
@@ -57,6 +65,169 @@ TEST(CliView, ScreenshotShowsTheSpineUprightInTheMiddle) {
   EXPECT_NEAR(0.5 * (x0 + x1), 0.5 * im.width, 0.15 * im.width);
   EXPECT_GT(y0, 0);  // nothing cut off at the top or bottom
   EXPECT_LT(y1, im.height - 1);
+}
+
+/// Pixels of the sequential colour map's upper half (teal, green, yellow: G dominant), which
+/// neither bone (R > G), the probe (B > G), the proxy (white) nor the arrow (magenta) has.
+int colormap_high_pixels(const Image& im) {
+  int n = 0;
+  for (int y = 0; y < im.height; ++y)
+    for (int x = 0; x < im.width; ++x) {
+      const unsigned char* p = im.at(x, y);
+      n += p[1] > 90 && p[1] > p[0] + 15 && p[1] >= p[2];
+    }
+  return n;
+}
+
+/// Pixels of the force arrow (magenta).
+int magenta_pixels(const Image& im) {
+  int n = 0;
+  for (int y = 0; y < im.height; ++y)
+    for (int x = 0; x < im.width; ++x) {
+      const unsigned char* p = im.at(x, y);
+      n += p[0] > 120 && p[2] > 120 && p[1] < 60;
+    }
+  return n;
+}
+
+// The shipped press of the L4-L5 disc (sim hand): free at 0.3 s, pressed 2 mm at 2.5 s. Free: the
+// disc is one colour (the map's lowest: nothing displaced) and there is no force arrow; pressed:
+// the faces under the probe take the map's upper colours and the arrow is there.
+TEST(CliView, PressedDiscIsColouredAndTheForceArrowShows) {
+  if (!have_xvfb()) GTEST_SKIP() << "xvfb-run missing (apt-get install xvfb)";
+  int high[2] = {0, 0}, arrow[2] = {0, 0};
+  const char* at[2] = {"0.3", "2.5"};
+  for (int k = 0; k < 2; ++k) {
+    const std::string png = tmp(std::string("disc_") + at[k] + ".png");
+    std::filesystem::remove(png);
+    const CliRun r = run_spinesim(
+        std::string("view --scene disc --device sim --disc-cell-size 4 --no-realtime --no-panel "
+                    "--width 640 --height 480 --json --screenshot-at ") +
+            at[k] + " --screenshot '" + png + "'",
+        "xvfb-run -a -s '-screen 0 800x600x24' ");
+    ASSERT_EQ(r.status, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_GT(j["view"]["session_frames"].get<int>(), 0);
+    const Image im = load_png(png);
+    ASSERT_TRUE(im.rgb) << png;
+    high[k] = colormap_high_pixels(im);
+    arrow[k] = magenta_pixels(im);
+  }
+  EXPECT_EQ(high[0], 0);
+  EXPECT_GT(high[1], 20);
+  EXPECT_EQ(arrow[0], 0);
+  EXPECT_GT(arrow[1], 20);
+}
+
+// The mouse as the device: a scripted cursor touches T1's spinous process from behind, holds the
+// button and moves 63 mm posteriorly; the hook takes T1 and the recorded T1 moves posteriorly.
+TEST(CliView, TheMouseHooksT1AndTheSpineFollows) {
+  if (!have_xvfb()) GTEST_SKIP() << "xvfb-run missing (apt-get install xvfb)";
+  const std::string script = tmp("drag_t1.csv"), rec = tmp("drag_t1_rec.csv");
+  // T1's spinous process tip of the generated spine is at (0, 531.5, -90.1) mm.
+  std::ofstream(script) << "t_s,x_mm,y_mm,z_mm,button\n0,0,531.5,-130,0\n2.0,0,531.5,-130,0\n"
+                           "3.0,0,531.5,-87,0\n3.5,0,531.5,-87,1\n4.0,0,531.5,-87,1\n"
+                           "6.0,0,531.5,-150,1\n";
+  const CliRun r = run_spinesim(
+      "view --spine multirate --no-realtime --no-panel --width 400 "
+      "--height 500 --json --screenshot-at 6.5 --screenshot '" +
+          tmp("drag_t1.png") + "' --cursor-script '" + script + "' --record '" + rec + "'",
+      "xvfb-run -a -s '-screen 0 640x600x24' ");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["device"], "mouse") << j["device"];
+  EXPECT_GT(j["compliant_stage"]["hooked_ticks"].get<int>(), 1000);
+  EXPECT_GT(j["compliant_stage"]["max_spine_force_n"].get<double>(), 50);
+  // The recording's last row: T1's centre displacement.
+  std::ifstream in(rec);
+  std::string line, header, last;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    if (header.empty())
+      header = line;
+    else
+      last = line;
+  }
+  const auto column = [](const std::string& row, int i) {
+    std::stringstream ss(row);
+    std::string cell;
+    for (int k = 0; k <= i; ++k) std::getline(ss, cell, ',');
+    return std::stod(cell);
+  };
+  std::stringstream hs(header);
+  std::string name;
+  int tz = -1;
+  for (int i = 0; std::getline(hs, name, ','); ++i)
+    if (name == "T1_tz_mm") tz = i;
+  ASSERT_GE(tz, 0) << header;
+  ASSERT_FALSE(last.empty());
+  EXPECT_LT(column(last, tz), -5) << "T1 did not move posteriorly";
+}
+
+// A series the program could have written: a tet "disc" whose top moves over three frames and a
+// triangle "vertebra"; played back paused at the last frame it shows both; a field the series
+// lacks is refused naming those it has; a time outside it is refused.
+TEST(CliView, ASeriesPlaysBack) {
+  namespace sm = spinesim::mesh;
+  const std::string dir = tmp("series");
+  std::filesystem::create_directories(dir);
+  sm::TetMesh m;
+  m.V.resize(4, 3);
+  m.V << -20, 0, -20, 20, 0, -20, 0, 0, 20, 0, 30, 0;
+  m.T.resize(1, 4);
+  m.T << 0, 1, 2, 3;
+  if (sm::tet_volume(m, 0) < 0) std::swap(m.T(0, 1), m.T(0, 2));
+  m.surface = Eigen::VectorXi::Zero(4);
+  m.region = Eigen::VectorXi::Ones(1);
+  sm::TriSurface v{m.V.array() - 40, Eigen::MatrixX3i(3, 3)};
+  v.F << 0, 1, 2, 0, 1, 3, 1, 2, 3;
+  std::vector<sm::PvdEntry> entries;
+  for (int f = 0; f < 3; ++f) {
+    Eigen::MatrixXd u = Eigen::MatrixXd::Zero(4, 3);
+    u(3, 1) = -2.0 * f;
+    sm::TetMesh moved = m;
+    moved.V += u;
+    const std::string name = "d" + std::to_string(f) + ".vtu";
+    sm::write_vtu(dir + "/" + name, moved, {{"displacement", u}},
+                  {{"volume_change", Eigen::MatrixXd::Constant(1, 1, -0.01 * f)}});
+    sm::write_surface_vtu(dir + "/v" + std::to_string(f) + ".vtu", v);
+    entries.push_back({0.5 * f, name, 0});
+    entries.push_back({0.5 * f, "v" + std::to_string(f) + ".vtu", 1});
+  }
+  sm::write_pvd(dir + "/s.pvd", entries);
+  if (have_xvfb()) {
+    const std::string png = tmp("series.png");
+    const CliRun r = run_spinesim("view --play '" + dir + "/s.pvd' --at 1 --paused --json " +
+                                      "--field volume_change --width 320 --height 240 --no-panel "
+                                      "--screenshot '" +
+                                      png + "'",
+                                  "xvfb-run -a -s '-screen 0 640x480x24' ");
+    ASSERT_EQ(r.status, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["series"]["times"], 3);
+    EXPECT_EQ(j["series"]["last_s"], 1.0);
+    EXPECT_EQ(j["series"]["fields"], nlohmann::json({"displacement", "volume_change"}));
+    const Image im = load_png(png);
+    ASSERT_TRUE(im.rgb);
+    int bone = 0, blue = 0;  // the vertebra; the tet at the diverging map's cold end (-0.02)
+    for (int y = 0; y < im.height; ++y)
+      for (int x = 0; x < im.width; ++x) {
+        const unsigned char* p = im.at(x, y);
+        bone += p[0] > 90 && p[0] > p[2] + 20;
+        blue += p[2] > 70 && p[2] > p[0] + 40;
+      }
+    EXPECT_GT(bone, 50);
+    EXPECT_GT(blue, 50);
+  }
+  expect_refused(run_spinesim("view --play '" + dir + "/s.pvd' --field stress"),
+                 "displacement, volume_change");
+  expect_refused(run_spinesim("view --play '" + dir + "/s.pvd' --at 5"), "outside");
+  expect_refused(run_spinesim("view --play '" + dir + "/absent.pvd'"), "no such file");
+}
+
+TEST(CliView, TheMouseIsTheViewersDevice) {
+  expect_refused(run_spinesim("haptics run --device mouse"), "spinesim view --device mouse");
+  expect_refused(run_spinesim("view --field pressure"), "displacement, spring_strain");
 }
 
 TEST(CliView, NoDisplayIsOneLineAndNonZero) {

@@ -15,7 +15,7 @@ DiscField disc_field(const std::string& name) {
                               ": give displacement, spring_strain or volume_change");
 }
 
-FieldSurface::FieldSurface(const Eigen::MatrixXi& T) : F_(mesh::boundary_faces(T, &owner_)) {}
+FieldSurface::FieldSurface(const Eigen::MatrixXi& T) { F_ = mesh::boundary_faces(T, &owner_); }
 
 Eigen::VectorXd FieldSurface::from_points(const Eigen::VectorXd& p) const {
   Eigen::VectorXd out(F_.rows());

@@ -21,9 +21,9 @@ namespace spinesim::viewer {
 namespace {
 
 // Marker colours and scales.
-const Eigen::Vector3f kProbe(0.35f, 0.65f, 1.0f), kProxy(0.2f, 0.85f, 0.3f),
+const Eigen::Vector3f kProbe(0.35f, 0.65f, 1.0f), kProxy(1.0f, 1.0f, 1.0f),
     kForce(1.0f, 0.0f, 1.0f), kHook(1.0f, 0.85f, 0.1f), kSpineForce(1.0f, 0.5f, 0.0f),
-    kSetPoint(0.9f, 0.9f, 0.9f);
+    kSetPoint(0.6f, 0.6f, 0.6f);
 constexpr double kForceArrowMmPerN = 15;   ///< the force on the hand
 constexpr double kSpineArrowMmPerN = 0.1;  ///< the hook's force on the spine
 constexpr double kWheelStepMm = 5;         ///< a wheel notch moves the mouse's probe this far
@@ -51,6 +51,11 @@ class SessionController final : public Controller {
     };
     request_.live = &hooks_;
     request_.stop = &stop_;
+  }
+  ~SessionController() override { closing(); }
+
+  /// The session starts with the window's first frame (a window that cannot open costs nothing).
+  void start() {
     thread_ = std::thread([this] {
       try {
         result_ = studies::run_haptics(request_, data_dir_);
@@ -61,9 +66,9 @@ class SessionController final : public Controller {
       ended_.store(true);
     });
   }
-  ~SessionController() override { closing(); }
 
   void update(SceneFrame& scene, const Pointer& pointer) override {
+    if (!thread_.joinable() && !stop_.load()) start();
     if (!ready_.load()) return;
     if (scene.bodies.empty()) {
       scene.bodies = setup_.bodies;
@@ -89,6 +94,8 @@ class SessionController final : public Controller {
   }
 
   void panel() override;
+  // The disc is pressed at its anterior wall: look from the front right.
+  float initial_yaw() const override { return setup_.disc ? -0.785f : 0.0f; }
   bool takes_pointer() const override { return setup_.device == "mouse" && ready_.load(); }
   double clock_s(double) const override {
     if (ended_.load()) return std::numeric_limits<double>::infinity();
@@ -196,13 +203,13 @@ class SessionController final : public Controller {
     double floor = 0;
     if (field_ == DiscField::displacement) {
       values = setup_.disc_surface.from_points(mss::displacement(m, x).rowwise().norm());
-      floor = 0.05;  // mm
+      floor = 1e-4;  // mm: a disc at rest shows its lowest colour, a pressed one its pattern
     } else if (field_ == DiscField::spring_strain) {
       values = setup_.disc_surface.from_cells(mss::tet_edge_strain(m, x));
-      floor = 0.01;
+      floor = 1e-5;
     } else {
       values = setup_.disc_surface.from_cells(mss::tet_volume_change(m, x));
-      floor = 0.01;
+      floor = 1e-5;
     }
     FieldSurface::range(values, floor, lo_, hi_);
     const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>> V(
@@ -225,7 +232,7 @@ class SessionController final : public Controller {
     const Eigen::Vector3d held = s.disc_contact ? s.disc_probe_mm : s.proxy_mm;
     if (s.contact || s.disc_contact) sphere(held, r * 1.02, kProxy);
     if (s.force_n.norm() > 0.02)
-      arrow(held, held + kForceArrowMmPerN * s.force_n, std::max(0.6, 0.18 * r), kForce);
+      arrow(held, held + kForceArrowMmPerN * s.force_n, std::max(0.6, 0.3 * r), kForce);
     if (setup_.device == "mouse") sphere(set_point_, 0.35 * r, kSetPoint);
     if (s.hook.attached || s.hook.gain > 0) {
       sphere(s.hook.hook_mm, 0.5 * r, kHook);

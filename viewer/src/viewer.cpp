@@ -555,8 +555,11 @@ ViewResult view(Controller& controller, const ViewOptions& o) {
       controller.update(scene, input.pointer);
       Eigen::Vector3d lo, hi;
       const auto reset = [&] {
-        if (bounds(scene, lo, hi))
-          cam.frame((0.5 * (lo + hi)).cast<float>(), float(0.5 * (hi - lo).norm())), framed = true;
+        if (bounds(scene, lo, hi)) {
+          cam.frame((0.5 * (lo + hi)).cast<float>(), float(0.5 * (hi - lo).norm()));
+          cam.yaw = controller.initial_yaw();
+          framed = true;
+        }
       };
       if (!framed) reset();
       glViewport(0, 0, fw, fh);

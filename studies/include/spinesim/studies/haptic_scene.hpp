@@ -49,6 +49,9 @@ struct HapticScene {
   double seconds = 0;
 };
 
+/// Throws std::invalid_argument (one line) unless `scene` is spine, vertebra, disc or plane.
+void check_scene_name(const std::string& scene);
+
 /// Builds the scene; `progress(done, total)` per body. Throws std::invalid_argument (one line)
 /// for an unknown scene or source, a missing test-data folder (for `real`), or a bad scene file.
 HapticScene build_haptic_scene(const HapticSceneRequest& r, const std::string& data_dir,

@@ -68,6 +68,9 @@ class Controller {
   virtual void update(SceneFrame& scene, const Pointer& pointer) = 0;
   /// The panel's contents: Dear ImGui calls, inside the viewer's panel window.
   virtual void panel() {}
+  /// The first view's yaw about the superior axis (rad): 0 is the sagittal view from the body's
+  /// right, -pi/4 looks from the front right.
+  virtual float initial_yaw() const { return 0; }
   /// True: the pointer drives a device (see the header comment).
   virtual bool takes_pointer() const { return false; }
   /// The clock (s) the cursor script and the screenshot time count on, given the window's
