@@ -300,6 +300,17 @@ def haptic_stroke(d, out_dir):
         f"{len(rows)} ticks, {contact} in contact, peak {max(f):.2f} N.")
 
 
+def viewer_screenshots(d):
+    """The viewer's pictures the demo took (DIR/viewer.json, PNGs in DIR/plots/), if any."""
+    path = os.path.join(d, "viewer.json")
+    if not os.path.exists(path):
+        return []
+    with open(path) as f:
+        shots = json.load(f)
+    return [Figure(x["file"], x["title"], x["thesis"], x["ours"]) for x in shots
+            if os.path.exists(os.path.join(d, "plots", x["file"]))]
+
+
 def write_html(d, figures, report_md):
     parts = ["<!DOCTYPE html><html><head><meta charset='utf-8'><title>spinesim demo report</title>",
              "<style>body{font-family:sans-serif;max-width:1100px;margin:2em auto;padding:0 1em}"
@@ -343,10 +354,11 @@ def main(argv):
         figures.append(spine_t1(d, s, d))
         figures.append(fusion(d, s, d))
         figures.append(haptic_stroke(d, d))
+        figures += viewer_screenshots(d)
     except (OSError, ValueError, KeyError, TypeError, ZeroDivisionError) as e:
         fail(f"bad input in {d}: {type(e).__name__} {e}")
     write_html(d, figures, report_md)
-    print(f"report: {os.path.join(d, 'report.html')} with {len(figures)} plots in "
+    print(f"report: {os.path.join(d, 'report.html')} with {len(figures)} figures in "
           f"{os.path.join(d, 'plots')}")
     return 0
 

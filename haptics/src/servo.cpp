@@ -94,6 +94,39 @@ void ServoLoop::fail_device() {
   stop_.store(true);
 }
 
+void ServoLoop::publish_status(double now_s, const Eigen::Vector3d& force, const RenderOutput& out,
+                               const ScenePoses& poses) {
+  ServoStats& st = stats_;
+  ServoStatus status;
+  status.ticks = st.ticks;
+  status.time_s = now_s;
+  status.probe_mm = state_.position_mm;
+  status.proxy_mm = out.proxy_mm;
+  status.force_n = force;
+  status.contact = out.contact;
+  status.body = out.body;
+  status.buttons = state_.buttons;
+  status.passivity_mj = passivity_.energy_mj();
+  status.disc = out.disc;
+  status.disc_contact = out.disc_contact;
+  status.disc_volume_change = out.disc_volume_change;
+  status.disc_force_n = out.disc_force_n;
+  status.disc_probe_mm = out.disc_probe_mm;
+  status.poses = poses;
+  status.period_us = timing_.period_us;
+  status.compute_us = timing_.compute_us;
+  status.recent_jitter_us = std::max(timing_.jitter_block, timing_.jitter_last_block);
+  status.recent_compute_us = std::max(timing_.compute_block, timing_.compute_last_block);
+  if (stage_) {
+    const HookState& h = stage_->state();
+    status.hook = h;
+    st.hooked_ticks += h.attached;
+    st.spine_clamped_ticks += h.clamped;
+    st.max_spine_force_n = std::max(st.max_spine_force_n, h.load.force_n.norm());
+  }
+  status_.write(status);
+}
+
 void ServoLoop::tick(double now_s, double period_s) {
   ServoStats& st = stats_;
   if (device_failed_) return;
@@ -137,34 +170,7 @@ void ServoLoop::tick(double now_s, double period_s) {
   st.contact_ticks += out.contact;
   st.truncated_ticks += out.truncated;
 
-  ServoStatus status;
-  status.ticks = st.ticks;
-  status.time_s = now_s;
-  status.probe_mm = state_.position_mm;
-  status.proxy_mm = out.proxy_mm;
-  status.force_n = force;
-  status.contact = out.contact;
-  status.body = out.body;
-  status.buttons = state_.buttons;
-  status.passivity_mj = passivity_.energy_mj();
-  status.disc = out.disc;
-  status.disc_contact = out.disc_contact;
-  status.disc_volume_change = out.disc_volume_change;
-  status.disc_force_n = out.disc_force_n;
-  status.disc_probe_mm = out.disc_probe_mm;
-  status.poses = *poses;
-  status.period_us = timing_.period_us;
-  status.compute_us = timing_.compute_us;
-  status.recent_jitter_us = std::max(timing_.jitter_block, timing_.jitter_last_block);
-  status.recent_compute_us = std::max(timing_.compute_block, timing_.compute_last_block);
-  if (stage_) {
-    const HookState& h = stage_->state();
-    status.hook = h;
-    st.hooked_ticks += h.attached;
-    st.spine_clamped_ticks += h.clamped;
-    st.max_spine_force_n = std::max(st.max_spine_force_n, h.load.force_n.norm());
-  }
-  status_.write(status);
+  publish_status(now_s, force, out, *poses);
 
   if (!ring_.empty()) {
     const std::size_t head = ring_head_.load(std::memory_order_relaxed);

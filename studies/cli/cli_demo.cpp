@@ -7,6 +7,7 @@
 // calibration protocol, the spine studies; VTU results, report.md, summary.json and report.html
 // with plots in --out.
 #include "cli_common.hpp"
+#include "demo_screenshots.hpp"
 
 #include "spinesim/studies/demo.hpp"
 
@@ -18,12 +19,14 @@ namespace {
 
 struct DemoArgs {
   DemoRequest request;
-  bool json = false, quiet = false;
+  bool json = false, quiet = false, no_screenshots = false;
 };
 
 void run(const DemoArgs& a) {
   Progress progress(demo_stages(), a.quiet || a.json);
-  const DemoResult r = run_demo(a.request, progress.hooks());
+  DemoRequest request = a.request;
+  if (!a.no_screenshots) request.viewer_screenshots = take_demo_screenshots;
+  const DemoResult r = run_demo(request, progress.hooks());
   if (a.json) {
     print_json(r.summary);
   } else {
@@ -44,6 +47,9 @@ void register_demo(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--order", a->request.fem_order, "FEM element order 1 or 2")
       ->capture_default_str();
+  cmd->add_flag("--no-screenshots", a->no_screenshots,
+                "Leave the viewer's pictures out of the report (they run spinesim view under "
+                "xvfb-run when there is no display)");
   add_output_flags(cmd, a->json, a->quiet);
   cmd->callback([a] { run(*a); });
 }

@@ -393,7 +393,7 @@ nlohmann::json Demo::summary(const std::string& report_path) const {
 }  // namespace
 
 int demo_stages() {
-  return 11 + kStagesPerMaterial * int(std::size(kPresets)) + kValidationStages + kFusionStages +
+  return 12 + kStagesPerMaterial * int(std::size(kPresets)) + kValidationStages + kFusionStages +
          kTrendsStages;
 }
 
@@ -417,6 +417,9 @@ DemoResult run_demo(const DemoRequest& rq, const StageHooks& hooks) {
   write_text_file(r.report_path, r.report_markdown);
   r.summary = demo.summary(r.report_path);
   write_text_file((fs::path(rq.out) / "summary.json").string(), r.summary.dump(2) + "\n");
+  hooks.begin_stage("viewer screenshots");
+  r.viewer_note = rq.viewer_screenshots ? rq.viewer_screenshots(rq.out) : "not asked for";
+  hooks.end_stage(r.viewer_note);
   hooks.begin_stage("plots and report.html");
   r.html = write_html_report(rq.out);
   hooks.end_stage(r.html.written ? "written" : "not written");

@@ -289,6 +289,26 @@ void finish_disc(DiscSetup& d, HapticsRunResult* result) {
   result->disc_thread = st.realtime_reason;
 }
 
+// The --record file, fed by the loop's writer thread (null without --record).
+std::unique_ptr<HapticRecordingWriter> start_recording(const HapticsRunRequest& request,
+                                                       const HapticsRunResult& result,
+                                                       const spine::SpineModel* model, bool disc,
+                                                       haptics::ServoLoop& loop) {
+  if (request.record.empty()) return nullptr;
+  std::ostringstream what;
+  what << "device " << request.device << ", renderer " << request.renderer << ", probe radius "
+       << request.probe_radius_mm << " mm";
+  if (disc)
+    what << "; disc " << result.disc_level << " (" << result.disc_tets << " tets, "
+         << result.disc_tuned_file << ")";
+  auto record = std::make_unique<HapticRecordingWriter>(request.record, what.str(), model,
+                                                        request.spine, disc);
+  HapticRecordingWriter* sink = record.get();
+  loop.record_to([sink](const haptics::TickRecord* rows, std::size_t n) { sink->append(rows, n); },
+                 1 << 13);
+  return record;
+}
+
 }  // namespace
 
 HapticsRunResult run_haptics(const HapticsRunRequest& request, const std::string& data_dir,
@@ -350,21 +370,8 @@ HapticsRunResult run_haptics(const HapticsRunRequest& request, const std::string
     loop.set_compliant_stage(compliant.stage.get());
     compliant.response->start();
   }
-  std::unique_ptr<HapticRecordingWriter> record;
-  if (!request.record.empty()) {
-    std::ostringstream what;
-    what << "device " << request.device << ", renderer " << request.renderer << ", probe radius "
-         << request.probe_radius_mm << " mm";
-    if (disc.palpation)
-      what << "; disc " << result.disc_level << " (" << result.disc_tets << " tets, "
-           << result.disc_tuned_file << ")";
-    record =
-        std::make_unique<HapticRecordingWriter>(request.record, what.str(), compliant.model.get(),
-                                                request.spine, disc.palpation != nullptr);
-    loop.record_to(
-        [&record](const haptics::TickRecord* rows, std::size_t n) { record->append(rows, n); },
-        1 << 13);
-  }
+  const std::unique_ptr<HapticRecordingWriter> record =
+      start_recording(request, result, compliant.model.get(), disc.palpation != nullptr, loop);
 
   if (request.live && request.live->ready)
     request.live->ready({scene, disc.model.get(), result.disc_level, result.capabilities,

@@ -267,8 +267,8 @@ void SessionController::panel() {
               static_cast<long long>(session_frames_.load()));
   const std::string body =
       s.body >= 0 && std::size_t(s.body) < setup_.bodies.size() ? setup_.bodies[s.body].name : "";
-  ImGui::Text("force %.2f N %s%s", s.force_n.norm(), s.contact ? "touching " : "free",
-              body.c_str());
+  ImGui::Text("force %.2f N %s%s", s.force_n.norm(),
+              s.contact ? "touching " : (s.hook.attached ? "hooked" : "free"), body.c_str());
   ImGui::Text("probe %.1f %.1f %.1f mm | absorbed %+.1f mJ (passive: >= 0)", s.probe_mm.x(),
               s.probe_mm.y(), s.probe_mm.z(), s.passivity_mj);
   if (s.hook.attached || s.hook.gain > 0) {

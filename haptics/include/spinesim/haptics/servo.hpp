@@ -156,6 +156,9 @@ class ServoLoop {
   bool device_failed_ = false;
   /// A device read or write failed: zero force, stop, report (no allocation: the reason is a literal).
   void fail_device();
+  /// The tick's status for the slower threads (and the stage's hook statistics).
+  void publish_status(double now_s, const Eigen::Vector3d& force, const RenderOutput& out,
+                      const ScenePoses& poses);
   CompliantStage* stage_ = nullptr;
   ScenePoses stage_poses_;  ///< the scene's poses with the stage's vertebrae, kept across ticks
   RenderOutput last_out_;

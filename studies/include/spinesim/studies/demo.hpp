@@ -16,6 +16,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <functional>
 #include <string>
 
 namespace spinesim::studies {
@@ -25,6 +26,10 @@ struct DemoRequest {
   std::string level = "L4-L5";
   double cell_size_mm = mesh::MeshOptions().cell_size_mm;
   int fem_order = 2;
+  /// Pictures of the viewer for the report, made by the front end (which has the viewer) before
+  /// report.html is written: given the output folder, it writes DIR/plots/view_*.png and
+  /// DIR/viewer.json and returns one line saying what it did (empty: not asked for).
+  std::function<std::string(const std::string&)> viewer_screenshots;
 };
 
 /// Progress stages of run_demo (for Progress).
@@ -33,8 +38,9 @@ int demo_stages();
 struct DemoResult {
   std::string report_markdown;  ///< also written to <out>/report.md
   std::string report_path;
-  nlohmann::json summary;  ///< also written to <out>/summary.json
-  HtmlReport html;         ///< <out>/report.html, or why it was not written
+  nlohmann::json summary;   ///< also written to <out>/summary.json
+  HtmlReport html;          ///< <out>/report.html, or why it was not written
+  std::string viewer_note;  ///< what DemoRequest::viewer_screenshots did
 };
 
 /// Runs the steps above; throws std::invalid_argument for a bad request (unknown level, bad
