@@ -515,124 +515,136 @@ ViewResult view(const std::vector<Body>& bodies, const ViewOptions& o) {
   return view(still, o);
 }
 
-ViewResult view(Controller& controller, const ViewOptions& o) {
-  check(o);
-  GLFWwindow* w = open_window(o);
-  glfwSetScrollCallback(w, on_scroll);
-  ViewResult r;
-  r.renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
-  r.gl_version = reinterpret_cast<const char*>(glGetString(GL_VERSION));
+namespace {
 
-  IMGUI_CHECKVERSION();
-  ImGui::CreateContext();
-  ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini left behind
-  ImGui_ImplGlfw_InitForOpenGL(w, true);
-  ImGui_ImplOpenGL3_Init("#version 330 core");
-
-  std::vector<double> frame_ms;
-  try {
-    Renderer renderer;
-    SceneFrame scene;
-    Camera cam;
-    bool framed = false;
-    Input input;
-    glEnable(GL_DEPTH_TEST);
-    const auto start = std::chrono::steady_clock::now();
-    auto last = start, first_shown = start;
-    int shown = 0;
-    const auto seconds = [&] {
-      return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    };
-    while (!glfwWindowShouldClose(w) && !controller.done()) {
-      const auto frame_start = std::chrono::steady_clock::now();
-      glfwPollEvents();
-      int fw = 0, fh = 0;
-      glfwGetFramebufferSize(w, &fw, &fh);
-      Projector pr{cam.view(), cam.projection(float(fw) / float(std::max(fh, 1))), std::max(fw, 1),
-                   std::max(fh, 1)};
-      const double clock = controller.clock_s(seconds());
-      input.handle(w, cam, controller.takes_pointer(), pr, o, std::max(clock, 0.0));
-      controller.update(scene, input.pointer);
-      Eigen::Vector3d lo, hi;
-      const auto reset = [&] {
-        if (bounds(scene, lo, hi)) {
-          cam.frame((0.5 * (lo + hi)).cast<float>(), float(0.5 * (hi - lo).norm()));
-          cam.yaw = controller.initial_yaw();
-          framed = true;
-        }
-      };
-      if (!framed) reset();
-      glViewport(0, 0, fw, fh);
-      glClearColor(0.12f, 0.13f, 0.15f, 1.0f);
-      glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-      renderer.draw(scene, cam.view(), cam.projection(float(fw) / float(std::max(fh, 1))));
-      if (o.panel) {
-        ImGui_ImplOpenGL3_NewFrame();
-        ImGui_ImplGlfw_NewFrame();
-        ImGui::NewFrame();
-        // Top left, a third of the window wide at most: the scene is framed in the middle.
-        ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_Once);
-        ImGui::SetNextWindowSize(ImVec2(std::clamp(fw / 3.0f, 300.0f, 460.0f), 0),
-                                 ImGuiCond_Always);  // 0: the height fits the contents
-        ImGui::Begin("spinesim", nullptr, ImGuiWindowFlags_NoResize);
-        ImGui::PushTextWrapPos(0);
-        long triangles = 0;
-        for (const Body& b : scene.bodies) triangles += b.visible ? long(b.F.rows()) : 0;
-        ImGui::Text("%d bodies, %ld triangles", int(scene.bodies.size()), triangles);
-        ImGui::Text("frame %.1f ms to draw (%s)", frame_ms.empty() ? 0.0 : frame_ms.back(),
-                    r.renderer.c_str());
-        if (ImGui::Button("reset camera")) reset();
-        ImGui::TextDisabled(controller.takes_pointer()
-                                ? "cursor: probe, left/space: button, wheel: depth; right drag: "
-                                  "orbit, middle: pan, shift+wheel: zoom"
-                                : "left drag: orbit, right drag: pan, wheel: zoom");
-        ImGui::Separator();
-        controller.panel();
-        ImGui::PopTextWrapPos();
-        ImGui::End();
-        ImGui::Render();
-        ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
-      }
-      ++r.frames;
-      // At most 60 frames a second even without vsync (Xvfb, some drivers): the CPU the
-      // graphics do not need stays with the servo and disc threads.
-      const auto worked = std::chrono::steady_clock::now();
-      if (!scene.bodies.empty()) {  // the frames of a scene, not of the wait for one
-        frame_ms.push_back(std::chrono::duration<double, std::milli>(worked - frame_start).count());
-        if (shown == 0) first_shown = frame_start;
-        ++shown;
-      }
-      const auto due = last + std::chrono::microseconds(16667);
-      if (worked < due) std::this_thread::sleep_until(due);
-      last = std::chrono::steady_clock::now();
-      if (!o.screenshot.empty() && r.frames >= o.frames && clock >= o.screenshot_after_s) {
-        write_png(o.screenshot, fw, fh);
-        break;
-      }
-      glfwSwapBuffers(w);
-    }
-    double total = 0;
-    for (double ms : frame_ms) total += ms;
-    r.mean_frame_ms = frame_ms.empty() ? 0 : total / double(frame_ms.size());
-    const double span = std::chrono::duration<double>(last - first_shown).count();
-    r.rate_hz = shown > 1 && span > 0 ? (shown - 1) / span : 0;
-  } catch (...) {
-    controller.closing();
+/// The window, its GL context and Dear ImGui, torn down in reverse on every path out.
+struct Window {
+  GLFWwindow* w;
+  explicit Window(const ViewOptions& o) : w(open_window(o)) {
+    glfwSetScrollCallback(w, on_scroll);
+    IMGUI_CHECKVERSION();
+    ImGui::CreateContext();
+    ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini left behind
+    ImGui_ImplGlfw_InitForOpenGL(w, true);
+    ImGui_ImplOpenGL3_Init("#version 330 core");
+  }
+  ~Window() {
     ImGui_ImplOpenGL3_Shutdown();
     ImGui_ImplGlfw_Shutdown();
     ImGui::DestroyContext();
     glfwDestroyWindow(w);
     glfwTerminate();
-    throw;
   }
-  controller.closing();
+  Window(const Window&) = delete;
+  Window& operator=(const Window&) = delete;
+};
+
+/// The panel: what is shown, the frame time, the camera button, the controls, the controller's
+/// own contents. True when "reset camera" was pressed.
+bool draw_panel(Controller& controller, const SceneFrame& scene, double last_frame_ms,
+                const std::string& renderer, int framebuffer_width) {
+  ImGui_ImplOpenGL3_NewFrame();
+  ImGui_ImplGlfw_NewFrame();
+  ImGui::NewFrame();
+  // Top left, a third of the window wide at most: the scene is framed in the middle.
+  ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_Once);
+  ImGui::SetNextWindowSize(ImVec2(std::clamp(framebuffer_width / 3.0f, 300.0f, 460.0f), 0),
+                           ImGuiCond_Always);  // 0: the height fits the contents
+  ImGui::Begin("spinesim", nullptr, ImGuiWindowFlags_NoResize);
+  ImGui::PushTextWrapPos(0);
+  long triangles = 0;
+  for (const Body& b : scene.bodies) triangles += b.visible ? long(b.F.rows()) : 0;
+  ImGui::Text("%d bodies, %ld triangles", int(scene.bodies.size()), triangles);
+  ImGui::Text("frame %.1f ms to draw (%s)", last_frame_ms, renderer.c_str());
+  const bool reset = ImGui::Button("reset camera");
+  ImGui::TextDisabled(controller.takes_pointer()
+                          ? "cursor: probe, left/space: button, wheel: depth; right drag: "
+                            "orbit, middle: pan, shift+wheel: zoom"
+                          : "left drag: orbit, right drag: pan, wheel: zoom");
+  ImGui::Separator();
+  controller.panel();
+  ImGui::PopTextWrapPos();
+  ImGui::End();
+  ImGui::Render();
+  ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+  return reset;
+}
+
+}  // namespace
+
+ViewResult view(Controller& controller, const ViewOptions& o) {
+  check(o);
+  struct Closing {  // the controller hears of the end on every path out
+    Controller& c;
+    ~Closing() { c.closing(); }
+  } closing{controller};
+  const Window window(o);
+  GLFWwindow* w = window.w;
+  ViewResult r;
+  r.renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+  r.gl_version = reinterpret_cast<const char*>(glGetString(GL_VERSION));
+  std::vector<double> frame_ms;
+  Renderer renderer;
+  SceneFrame scene;
+  Camera cam;
+  bool framed = false;
+  Input input;
+  glEnable(GL_DEPTH_TEST);
+  const auto start = std::chrono::steady_clock::now();
+  auto last = start, first_shown = start;
+  int shown = 0;
+  const auto seconds = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
+  while (!glfwWindowShouldClose(w) && !controller.done()) {
+    const auto frame_start = std::chrono::steady_clock::now();
+    glfwPollEvents();
+    int fw = 0, fh = 0;
+    glfwGetFramebufferSize(w, &fw, &fh);
+    const float aspect = float(fw) / float(std::max(fh, 1));
+    const Projector pr{cam.view(), cam.projection(aspect), std::max(fw, 1), std::max(fh, 1)};
+    const double clock = controller.clock_s(seconds());
+    input.handle(w, cam, controller.takes_pointer(), pr, o, std::max(clock, 0.0));
+    controller.update(scene, input.pointer);
+    const auto reset = [&] {
+      Eigen::Vector3d lo, hi;
+      if (!bounds(scene, lo, hi)) return;
+      cam.frame((0.5 * (lo + hi)).cast<float>(), float(0.5 * (hi - lo).norm()));
+      cam.yaw = controller.initial_yaw();
+      framed = true;
+    };
+    if (!framed) reset();
+    glViewport(0, 0, fw, fh);
+    glClearColor(0.12f, 0.13f, 0.15f, 1.0f);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    renderer.draw(scene, cam.view(), cam.projection(aspect));
+    if (o.panel &&
+        draw_panel(controller, scene, frame_ms.empty() ? 0.0 : frame_ms.back(), r.renderer, fw))
+      reset();
+    ++r.frames;
+    const auto worked = std::chrono::steady_clock::now();
+    if (!scene.bodies.empty()) {  // the frames of a scene, not of the wait for one
+      frame_ms.push_back(std::chrono::duration<double, std::milli>(worked - frame_start).count());
+      if (shown++ == 0) first_shown = frame_start;
+    }
+    // At most 60 frames a second even without vsync (Xvfb, some drivers): the CPU the
+    // graphics do not need stays with the servo and disc threads.
+    const auto due = last + std::chrono::microseconds(16667);
+    if (worked < due) std::this_thread::sleep_until(due);
+    last = std::chrono::steady_clock::now();
+    if (!o.screenshot.empty() && r.frames >= o.frames && clock >= o.screenshot_after_s) {
+      write_png(o.screenshot, fw, fh);
+      break;
+    }
+    glfwSwapBuffers(w);
+  }
+  double total = 0;
+  for (double ms : frame_ms) total += ms;
+  r.mean_frame_ms = frame_ms.empty() ? 0 : total / double(frame_ms.size());
+  const double span = std::chrono::duration<double>(last - first_shown).count();
+  r.rate_hz = shown > 1 && span > 0 ? (shown - 1) / span : 0;
   r.p50_frame_ms = percentile(frame_ms, 0.5);
   r.p99_frame_ms = percentile(frame_ms, 0.99);
-  ImGui_ImplOpenGL3_Shutdown();
-  ImGui_ImplGlfw_Shutdown();
-  ImGui::DestroyContext();
-  glfwDestroyWindow(w);
-  glfwTerminate();
   return r;
 }
 
