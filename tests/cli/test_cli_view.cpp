@@ -230,6 +230,34 @@ TEST(CliView, TheMouseIsTheViewersDevice) {
   expect_refused(run_spinesim("view --field pressure"), "displacement, spring_strain");
 }
 
+// A device that cannot be opened: the missing library before the window opens, the vendor's
+// own error (the fake HD library finds no device) once the session has started; one line each.
+TEST(CliView, ADeviceThatCannotOpenIsOneLine) {
+  expect_refused(
+      run_spinesim("view --scene plane --device openhaptics --sdk-lib /nonexistent/libHD.so"),
+      "cannot load /nonexistent/libHD.so");
+  if (!have_xvfb()) GTEST_SKIP() << "xvfb-run missing (apt-get install xvfb)";
+  const CliRun r =
+      run_spinesim("view --scene plane --no-realtime --device openhaptics --sdk-lib '" +
+                       std::string(SPINESIM_FAKE_HD) + "' --screenshot '" + tmp("never.png") + "'",
+                   "FAKE_HAPTIC_FAIL_INIT=1 xvfb-run -a -s '-screen 0 640x480x24' ");
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_EQ(count_lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("fake HD: no device found"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(tmp("never.png")));
+}
+
+// Mesa made to offer OpenGL 3.0 only: no 3.3 core context, one line.
+TEST(CliView, AnOpenGLBelow33IsOneLine) {
+  if (!have_xvfb()) GTEST_SKIP() << "xvfb-run missing (apt-get install xvfb)";
+  const CliRun r =
+      run_spinesim("view --device none --triangles 300 --screenshot '" + tmp("old_gl.png") + "'",
+                   "MESA_GL_VERSION_OVERRIDE=3.0 xvfb-run -a -s '-screen 0 640x480x24' ");
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_EQ(count_lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("no OpenGL 3.3 core context"), std::string::npos) << r.err;
+}
+
 TEST(CliView, NoDisplayIsOneLineAndNonZero) {
   const CliRun r = run_spinesim("view --triangles 300", "env -u DISPLAY -u WAYLAND_DISPLAY ");
   EXPECT_NE(r.status, 0);

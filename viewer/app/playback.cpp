@@ -156,6 +156,7 @@ class PlaybackController final : public Controller {
     load_ms_ +=
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     ++result_.loads;
+    result_.mean_load_ms = load_ms_ / result_.loads;
     shown_time_ = at;
   }
 
@@ -212,7 +213,6 @@ PlaybackResult view_playback(const PlaybackRequest& request, const std::string& 
   PlaybackResult result;
   PlaybackController controller(request, data_dir, result);
   result.view = view(controller, options);
-  result.mean_load_ms = 0;
   return result;
 }
 
