@@ -236,17 +236,22 @@ TEST(IoVtu, MeshioReadsWhatWeWrite) {
   }
 }
 
-// A triangle surface (vertebrae in a time series): meshio reads its triangles, points and cell
-// array, in both binary encodings.
-TEST(IoVtu, MeshioReadsATriangleSurface) {
-  if (!has_meshio()) GTEST_SKIP() << "/usr/bin/python3 with meshio not available";
+/// The four faces of a tetrahedron, outward.
+TriSurface tetrahedron_surface() {
   TriSurface s;
   s.V.resize(4, 3);
   s.V << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1.5;
   s.F.resize(4, 3);
   s.F << 0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3;
-  Eigen::MatrixXd body(4, 1);
-  body << 0, 1, 2, 3;
+  return s;
+}
+
+// A triangle surface (vertebrae in a time series): meshio reads its triangles, points and cell
+// array, in both binary encodings.
+TEST(IoVtu, MeshioReadsATriangleSurface) {
+  if (!has_meshio()) GTEST_SKIP() << "/usr/bin/python3 with meshio not available";
+  const TriSurface s = tetrahedron_surface();
+  const Eigen::MatrixXd body = Eigen::Vector4d(0, 1, 2, 3);
   for (VtuEncoding enc : {VtuEncoding::binary, VtuEncoding::zlib}) {
     const std::string dir = tmp_dir(enc == VtuEncoding::zlib ? "surf_zlib" : "surf_bin");
     write_surface_vtu(dir + "/s.vtu", s, {{"height", s.V.col(2)}}, {{"body", body}}, {enc});
@@ -273,13 +278,8 @@ TEST(IoVtu, MeshioReadsATriangleSurface) {
 // arrays) in every encoding the writers have, an inverted tet included (a deformed frame);
 // mixed cell kinds are refused in one line.
 TEST(IoVtu, GridReaderReturnsWhatTheWritersWrote) {
-  TriSurface s;
-  s.V.resize(4, 3);
-  s.V << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1.5;
-  s.F.resize(4, 3);
-  s.F << 0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3;
-  Eigen::MatrixXd body(4, 1);
-  body << 0, 1, 2, 3;
+  const TriSurface s = tetrahedron_surface();
+  const Eigen::MatrixXd body = Eigen::Vector4d(0, 1, 2, 3);
   TetMesh m;
   m.V = s.V;
   m.T.resize(1, 4);
