@@ -234,7 +234,7 @@ class MouseDevice final : public Device {
     quit_ = in.quit;
     // The set-point glides towards the pointer's at the speed limit (a non-finite one is held).
     Eigen::Vector3d step = Eigen::Vector3d::Zero();
-    if (in.set_point_mm.allFinite()) {
+    if (in.active && in.set_point_mm.allFinite()) {
       step = in.set_point_mm - set_;
       const double most = speed_ * period_;
       if (step.norm() > most) step *= most / step.norm();

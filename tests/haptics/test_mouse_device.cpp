@@ -19,9 +19,6 @@ struct Rig {
   const double T = 1e-3, speed = 250;
   sh::HandModel hand;
   explicit Rig(const Eigen::Vector3d& start) {
-    sh::PointerInput p;
-    p.set_point_mm = start;
-    input.reset(p);
     device = sh::make_mouse_device(input, start, sh::device_model("touch"), T, speed, hand);
     device->open();
   }
@@ -31,7 +28,7 @@ struct Rig {
     return s;
   }
   void point(const Eigen::Vector3d& p, unsigned buttons = 0, bool quit = false) {
-    input.write({p, buttons, quit});
+    input.write({p, buttons, true, quit});
   }
 };
 
@@ -90,6 +87,9 @@ TEST(MouseDevice, TheHandPushesWithAtMostTheContinuousForce) {
 
 TEST(MouseDevice, NonFiniteSetPointIsHeldButtonsPassAndQuitFinishes) {
   Rig rig(Eigen::Vector3d(1, 2, 3));
+  // Before the pointer has given a set-point (the input's default: inactive, at the origin) the
+  // hand holds the start.
+  EXPECT_NEAR((rig.run(200).position_mm - Eigen::Vector3d(1, 2, 3)).norm(), 0, 1e-9);
   rig.point(Eigen::Vector3d(std::nan(""), 0, 0), 1);
   const auto s = rig.run(500);
   EXPECT_TRUE(s.position_mm.allFinite());

@@ -173,11 +173,7 @@ class SessionController final : public Controller {
     c.description = s.scene.description;
     c.probe_radius_mm = s.probe_radius_mm;
     c.start_mm = s.device_start_mm;
-    set_point_ = c.start_mm;
-    haptics::PointerInput in;
-    in.set_point_mm = c.start_mm;
-    pointer_.write(in);
-    setup_ = std::move(c);
+    setup_ = std::move(c);  // the window's thread takes the start from here once ready_
     ready_.store(true);
   }
 
@@ -194,6 +190,7 @@ class SessionController final : public Controller {
     haptics::PointerInput in;
     in.set_point_mm = set_point_;
     in.buttons = p.buttons;
+    in.active = true;
     pointer_.write(in);
   }
 

@@ -107,6 +107,7 @@ std::unique_ptr<Device> make_sim_device(const Trajectory& script, const DeviceCa
 struct PointerInput {
   Eigen::Vector3d set_point_mm = Eigen::Vector3d::Zero();
   unsigned buttons = 0;
+  bool active = false;  ///< false: no set-point given yet (the device holds its own)
   bool quit = false;
 };
 
