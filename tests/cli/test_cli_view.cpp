@@ -247,6 +247,28 @@ TEST(CliView, ADeviceThatCannotOpenIsOneLine) {
   EXPECT_FALSE(std::filesystem::exists(tmp("never.png")));
 }
 
+// A vendor device (the fake OpenHaptics library's scripted stylus presses the plane): the viewer
+// shows what the servo loop does — contact, the force arrow.
+TEST(CliView, AVendorDeviceShowsWhatTheLoopDoes) {
+  if (!have_xvfb()) GTEST_SKIP() << "xvfb-run missing (apt-get install xvfb)";
+  const std::string png = tmp("hd.png");
+  const CliRun r = run_spinesim(
+      "view --scene plane --no-realtime --no-panel --device openhaptics "
+      "--sdk-lib '" +
+          std::string(SPINESIM_FAKE_HD) +
+          "' --duration 2 --json --screenshot-at 1.5 --width 480 "
+          "--height 360 --screenshot '" +
+          png + "'",
+      "xvfb-run -a -s '-screen 0 640x480x24' ");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["device"], "openhaptics");
+  EXPECT_GT(j["contact_ticks"].get<int>(), 500);
+  const Image im = load_png(png);
+  ASSERT_TRUE(im.rgb);
+  EXPECT_GT(magenta_pixels(im), 20);
+}
+
 // Mesa made to offer OpenGL 3.0 only: no 3.3 core context, one line.
 TEST(CliView, AnOpenGLBelow33IsOneLine) {
   if (!have_xvfb()) GTEST_SKIP() << "xvfb-run missing (apt-get install xvfb)";

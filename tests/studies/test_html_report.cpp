@@ -107,12 +107,32 @@ std::string demo_folder(const std::string& name) {
 
 }  // namespace
 
+// The viewer's screenshots (viewer.json and its PNGs, written by the demo's front end) join the
+// figures with their captions; an entry whose PNG is missing is left out.
+TEST(HtmlReport, ViewerScreenshotsJoinTheFigures) {
+  if (!have_plotting()) GTEST_SKIP() << "/usr/bin/python3 with matplotlib and markdown missing";
+  const std::string d = demo_folder("html-report-viewer");
+  fs::create_directories(fs::path(d) / "plots");
+  write(fs::path(d) / "plots" / "view_a.png", "\x89PNG not really");
+  const nlohmann::json shots = {
+      {{"file", "view_a.png"}, {"title", "Viewer A"}, {"thesis", "HOOPS"}, {"ours", "60 Hz"}},
+      {{"file", "view_missing.png"}, {"title", "Viewer B"}, {"thesis", "-"}, {"ours", "-"}}};
+  write(fs::path(d) / "viewer.json", shots.dump());
+  const auto r = write_html_report(d);
+  ASSERT_TRUE(r.written) << r.message;
+  EXPECT_NE(r.message.find("9 figures"), std::string::npos) << r.message;
+  const std::string html = read(r.path);
+  EXPECT_NE(html.find("plots/view_a.png"), std::string::npos);
+  EXPECT_NE(html.find("Viewer A"), std::string::npos);
+  EXPECT_EQ(html.find("view_missing.png"), std::string::npos);
+}
+
 TEST(HtmlReport, WritesEveryPlotAndShowsThemInTheHtml) {
   if (!have_plotting()) GTEST_SKIP() << "/usr/bin/python3 with matplotlib and markdown missing";
   const std::string d = demo_folder("html-report");
   const auto r = write_html_report(d);
   ASSERT_TRUE(r.written) << r.message;
-  EXPECT_NE(r.message.find("8 plots"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("8 figures"), std::string::npos) << r.message;
   const std::string html = read(r.path);
   for (const char* png : {"haptic_plane.png", "calibration.png", "materials.png", "validation.png",
                           "spine_t1.png", "fusion.png", "haptic_stroke.png", "probe_test.png"}) {

@@ -95,7 +95,10 @@ class SessionController final : public Controller {
 
   void panel() override;
   // The disc is pressed at its anterior wall: look from the front right.
-  float initial_yaw() const override { return setup_.disc ? -0.785f : 0.0f; }
+  // The plane (normal +z) would be edge-on from the side: look at it obliquely from the front.
+  float initial_yaw() const override {
+    return setup_.disc ? -0.785f : request_.scene.scene == "plane" ? -1.0f : 0.0f;
+  }
   bool takes_pointer() const override { return setup_.device == "mouse" && ready_.load(); }
   double clock_s(double) const override {
     if (ended_.load()) return std::numeric_limits<double>::infinity();
