@@ -97,9 +97,11 @@ class SessionController final : public Controller {
   // The disc is pressed at its anterior wall: look from the front right.
   // The plane (normal +z) would be edge-on from the side: look at it obliquely from the front.
   float initial_yaw() const override {
-    return setup_.disc ? -0.785f : request_.scene.scene == "plane" ? -1.0f : 0.0f;
+    if (request_.scene.scene == "plane") return -1.0f;
+    return ready_.load() && setup_.disc ? -0.785f : 0.0f;
   }
-  bool takes_pointer() const override { return setup_.device == "mouse" && ready_.load(); }
+  // setup_ is the session thread's until ready_ (read ready_ first).
+  bool takes_pointer() const override { return ready_.load() && setup_.device == "mouse"; }
   double clock_s(double) const override {
     if (ended_.load()) return std::numeric_limits<double>::infinity();
     return latest_ && session_frames_.load() > 0 ? latest_->loop_time_s : -1;
