@@ -90,13 +90,13 @@ int magenta_pixels(const Image& im) {
   return n;
 }
 
-// The shipped press of the L4-L5 disc (sim hand): free at 0.3 s, pressed 2 mm at 2.5 s. Free: the
+// The shipped press of the L4-L5 disc (sim hand): free at 0.3 s, pressed 4 mm at 5 s. Free: the
 // disc is one colour (the map's lowest: nothing displaced) and there is no force arrow; pressed:
 // the faces under the probe take the map's upper colours and the arrow is there.
 TEST(CliView, PressedDiscIsColouredAndTheForceArrowShows) {
   if (!have_xvfb()) GTEST_SKIP() << "xvfb-run missing (apt-get install xvfb)";
   int high[2] = {0, 0}, arrow[2] = {0, 0};
-  const char* at[2] = {"0.3", "2.5"};
+  const char* at[2] = {"0.3", "5.0"};
   for (int k = 0; k < 2; ++k) {
     const std::string png = tmp(std::string("disc_") + at[k] + ".png");
     std::filesystem::remove(png);

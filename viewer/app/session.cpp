@@ -233,8 +233,10 @@ class SessionController final : public Controller {
     // Where the hand is held back: the rigid proxy, or the disc's own probe when pressing it.
     const Eigen::Vector3d held = s.disc_contact ? s.disc_probe_mm : s.proxy_mm;
     if (s.contact || s.disc_contact) sphere(held, r * 1.02, kProxy);
-    if (s.force_n.norm() > 0.02)
-      arrow(held, held + kForceArrowMmPerN * s.force_n, std::max(0.6, 0.3 * r), kForce);
+    if (s.force_n.norm() > 0.02) {  // from the sphere's surface, so that all of it shows
+      const Eigen::Vector3d from = held + r * s.force_n.normalized();
+      arrow(from, from + kForceArrowMmPerN * s.force_n, std::max(0.6, 0.3 * r), kForce);
+    }
     if (setup_.device == "mouse") sphere(set_point_, 0.35 * r, kSetPoint);
     if (s.hook.attached || s.hook.gain > 0) {
       sphere(s.hook.hook_mm, 0.5 * r, kHook);
