@@ -396,7 +396,8 @@ HapticsRunResult run_haptics(const HapticsRunRequest& request, const std::string
   device->close();
   if (compliant.response) finish_compliant(compliant, &result);
   if (disc.palpation) finish_disc(disc, &result);
-  if (request.stop && request.stop->load()) result.stats.stop_reason = "interrupted";
+  if (request.stop && request.stop->load())
+    result.stats.stop_reason = request.live ? "window closed" : "interrupted";
   if (result.stats.error && !device->last_error().empty())
     result.stats.stop_reason += ": " + device->last_error();
   if (record) {
