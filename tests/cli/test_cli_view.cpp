@@ -21,6 +21,12 @@ namespace {
 
 bool have_xvfb() { return std::system("command -v xvfb-run >/dev/null 2>&1") == 0; }
 
+/// The program's command line run under xvfb-run on a screen of `screen` pixels (WxH), after
+/// `env` (variables to set).
+std::string xvfb(const std::string& screen, const std::string& env = "") {
+  return env + "xvfb-run -a -s '-screen 0 " + screen + "x24' ";
+}
+
 struct Image {
   int width = 0, height = 0;
   std::unique_ptr<unsigned char, void (*)(void*)> rgb{nullptr, stbi_image_free};
@@ -41,7 +47,7 @@ TEST(CliView, ScreenshotShowsTheSpineUprightInTheMiddle) {
   const CliRun r = run_spinesim(
       "view --triangles 600 --width 400 --height 500 --no-panel --frames 2 --screenshot '" + png +
           "'",
-      "xvfb-run -a -s '-screen 0 640x600x24' ");
+      xvfb("640x600"));
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find("screenshot"), std::string::npos) << r.out;
   const Image im = load_png(png);
@@ -104,7 +110,7 @@ TEST(CliView, PressedDiscIsColouredAndTheForceArrowShows) {
         std::string("view --scene disc --device sim --disc-cell-size 4 --no-realtime --no-panel "
                     "--width 640 --height 480 --json --screenshot-at ") +
             at[k] + " --screenshot '" + png + "'",
-        "xvfb-run -a -s '-screen 0 800x600x24' ");
+        xvfb("800x600"));
     ASSERT_EQ(r.status, 0) << r.err;
     const auto j = nlohmann::json::parse(r.out);
     EXPECT_GT(j["view"]["session_frames"].get<int>(), 0);
@@ -132,7 +138,7 @@ TEST(CliView, TheMouseHooksT1AndTheSpineFollows) {
       "view --spine multirate --no-realtime --no-panel --width 400 "
       "--height 500 --json --screenshot-at 6.5 --screenshot '" +
           tmp("drag_t1.png") + "' --cursor-script '" + script + "' --record '" + rec + "'",
-      "xvfb-run -a -s '-screen 0 640x600x24' ");
+      xvfb("640x600"));
   ASSERT_EQ(r.status, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["device"], "mouse") << j["device"];
@@ -201,7 +207,7 @@ TEST(CliView, ASeriesPlaysBack) {
                                       "--field volume_change --width 320 --height 240 --no-panel "
                                       "--screenshot '" +
                                       png + "'",
-                                  "xvfb-run -a -s '-screen 0 640x480x24' ");
+                                  xvfb("640x480"));
     ASSERT_EQ(r.status, 0) << r.err;
     const auto j = nlohmann::json::parse(r.out);
     EXPECT_EQ(j["series"]["times"], 3);
@@ -240,7 +246,7 @@ TEST(CliView, ADeviceThatCannotOpenIsOneLine) {
   const CliRun r =
       run_spinesim("view --scene plane --no-realtime --device openhaptics --sdk-lib '" +
                        std::string(SPINESIM_FAKE_HD) + "' --screenshot '" + tmp("never.png") + "'",
-                   "FAKE_HAPTIC_FAIL_INIT=1 xvfb-run -a -s '-screen 0 640x480x24' ");
+                   xvfb("640x480", "FAKE_HAPTIC_FAIL_INIT=1 "));
   EXPECT_EQ(r.status, 1) << r.err;
   EXPECT_EQ(count_lines(r.err), 1) << r.err;
   EXPECT_NE(r.err.find("fake HD: no device found"), std::string::npos) << r.err;
@@ -259,7 +265,7 @@ TEST(CliView, AVendorDeviceShowsWhatTheLoopDoes) {
           "' --duration 2 --json --screenshot-at 1.5 --width 480 "
           "--height 360 --screenshot '" +
           png + "'",
-      "xvfb-run -a -s '-screen 0 640x480x24' ");
+      xvfb("640x480"));
   ASSERT_EQ(r.status, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["device"], "openhaptics");
@@ -274,7 +280,7 @@ TEST(CliView, AnOpenGLBelow33IsOneLine) {
   if (!have_xvfb()) GTEST_SKIP() << "xvfb-run missing (apt-get install xvfb)";
   const CliRun r =
       run_spinesim("view --device none --triangles 300 --screenshot '" + tmp("old_gl.png") + "'",
-                   "MESA_GL_VERSION_OVERRIDE=3.0 xvfb-run -a -s '-screen 0 640x480x24' ");
+                   xvfb("640x480", "MESA_GL_VERSION_OVERRIDE=3.0 "));
   EXPECT_EQ(r.status, 1) << r.err;
   EXPECT_EQ(count_lines(r.err), 1) << r.err;
   EXPECT_NE(r.err.find("no OpenGL 3.3 core context"), std::string::npos) << r.err;
