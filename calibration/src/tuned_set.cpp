@@ -21,7 +21,10 @@ nlohmann::json to_json(const TunedSet& set) {
 }
 
 TunedSet tuned_set_from_json(const nlohmann::json& j) {
-  if (!j.is_object() || j.value("format", "") != kSetFormat)
+  // A "format" that is not a string is not a set's (json::value would throw a type_error, which
+  // is not a one-line refusal: the fuzzer found it); the single-disc reader then names the error.
+  const auto format = j.is_object() ? j.find("format") : j.end();
+  if (format == j.end() || !format->is_string() || *format != kSetFormat)
     throw std::invalid_argument(std::string("not a tuned-disc set (\"format\": \"") + kSetFormat +
                                 "\" missing)");
   if (j.value("version", 0) != kSetVersion)
@@ -75,7 +78,10 @@ const TunedDisc& tuned_level(const TunedSet& set, const std::string& level) {
 TunedDisc read_tuned_for_mesh(const std::string& path, const mesh::TetMesh* mesh) {
   const nlohmann::json j =
       detail::read_json_file(path, "tuned-disc file");  // read once, whichever kind
-  if (!j.is_object() || j.value("format", "") != kSetFormat)
+  // A "format" that is not a string is not a set's (json::value would throw a type_error, which
+  // is not a one-line refusal: the fuzzer found it); the single-disc reader then names the error.
+  const auto format = j.is_object() ? j.find("format") : j.end();
+  if (format == j.end() || !format->is_string() || *format != kSetFormat)
     return detail::naming_file(path, [&] { return tuned_disc_from_json(j); });
   const TunedSet set = detail::naming_file(path, [&] { return tuned_set_from_json(j); });
   if (!mesh) return set.levels.begin()->second;

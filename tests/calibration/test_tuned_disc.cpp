@@ -534,5 +534,25 @@ TEST(PerSpringFile, ATunedSetRefusesIt) {
   }
 }
 
+// A file whose "format" is not a string (found by the fuzzer: the set-or-disc dispatch threw
+// nlohmann's type_error, which ended the program) is refused in one line like any bad file.
+TEST(TunedDiscRefuses, FormatThatIsNotAStringInAFile) {
+  const std::string path = temp_path("tuned_format.json");
+  for (const json format : {json(3), json::array({"x"}), json(nullptr), json::object()}) {
+    json j = to_json(sample_tuned(l4l5_mesh()));
+    j["format"] = format;
+    std::ofstream(path) << j.dump();
+    try {
+      read_tuned_for_mesh(path, nullptr);
+      ADD_FAILURE() << "accepted format " << format.dump();
+    } catch (const std::invalid_argument& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(path), std::string::npos) << what;
+      EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+    }
+  }
+  std::filesystem::remove(path);
+}
+
 }  // namespace
 }  // namespace spinesim::calibration
