@@ -31,21 +31,6 @@ struct ViewArgs {
   bool no_panel = false, json = false, quiet = false;
 };
 
-/// The scene's bodies at the reference posture, bone-coloured (the sacrum a little darker).
-std::vector<viewer::Body> bodies_of(const studies::HapticScene& s) {
-  std::vector<viewer::Body> out;
-  for (int i = 0; i < s.scene.size(); ++i) {
-    const haptics::RigidBody& b = s.scene.body(i);
-    viewer::Body v;
-    v.name = b.name;
-    v.V = b.tree.vertices();
-    v.F = b.tree.triangles();
-    if (b.name == "S1" || b.name == "sacrum") v.color = {0.72f, 0.66f, 0.56f};
-    out.push_back(std::move(v));
-  }
-  return out;
-}
-
 nlohmann::json view_json(const viewer::ViewResult& r) {
   return {
       {"frames", r.frames},
@@ -70,7 +55,7 @@ void run_still(const ViewArgs& a, viewer::ViewOptions o) {
   if (scene.scene.size() == 0)
     throw std::invalid_argument("view: the " + request.scene + " scene has no surfaces to show");
   o.title = "spinesim — " + scene.description;
-  const viewer::ViewResult r = viewer::view(bodies_of(scene), o);
+  const viewer::ViewResult r = viewer::view(viewer::bodies_of(scene.scene), o);
   if (a.json) print_json({{"view", view_json(r)}});
   report_view(a, r);
 }

@@ -254,7 +254,10 @@ TEST(CliView, ADeviceThatCannotOpenIsOneLine) {
 }
 
 // A vendor device (the fake OpenHaptics library's scripted stylus presses the plane): the viewer
-// shows what the servo loop does — contact, the force arrow.
+// shows what the servo loop does — contact, the force arrow. The fake's stylus reaches the plane
+// about 2.3 s after the device opens (z = 50 - 20 t mm, probe 4 mm), so the run lasts 4 s: at
+// 2 s it sometimes ended before contact, when the session's set-up was quick. `--view front`:
+// the stylus comes from the plane's front (+z), the side the camera looks from.
 TEST(CliView, AVendorDeviceShowsWhatTheLoopDoes) {
   if (!have_xvfb()) GTEST_SKIP() << "xvfb-run missing (apt-get install xvfb)";
   const std::string png = tmp("hd.png");
@@ -262,7 +265,7 @@ TEST(CliView, AVendorDeviceShowsWhatTheLoopDoes) {
       "view --scene plane --no-realtime --no-panel --device openhaptics "
       "--sdk-lib '" +
           std::string(SPINESIM_FAKE_HD) +
-          "' --duration 2 --json --screenshot-at 1.5 --width 480 "
+          "' --view front --duration 4 --json --screenshot-at 3.5 --width 480 "
           "--height 360 --screenshot '" +
           png + "'",
       xvfb("640x480"));

@@ -180,9 +180,8 @@ class PlaybackController final : public Controller {
         values = part.surface.from_points(a.values.rowwise().norm()), floor = 0.05;
     for (const auto& a : g.cell_data)
       if (a.name == name && a.values.cols() == 1) values = part.surface.from_cells(a.values.col(0));
-    if (values.size() == 0)
-      values = Eigen::VectorXd::Zero(
-          part.surface.from_cells(Eigen::VectorXd::Zero(g.cells.rows())).size());
+    if (values.size() == 0)  // this frame lacks the field: its lowest colour
+      values = part.surface.from_cells(Eigen::VectorXd::Zero(g.cells.rows()));
     FieldSurface::range(values, floor, lo_, hi_);
     part.surface.fill(body, g.V, values, lo_, hi_);
   }

@@ -159,15 +159,7 @@ class SessionController final : public Controller {
 
   void on_ready(const studies::HapticsLiveSetup& s) {
     Setup c;
-    for (int i = 0; i < s.scene.scene.size(); ++i) {
-      const haptics::RigidBody& b = s.scene.scene.body(i);
-      Body v;
-      v.name = b.name;
-      v.V = b.tree.vertices();
-      v.F = b.tree.triangles();
-      if (b.name == "S1" || b.name == "sacrum") v.color = {0.72f, 0.66f, 0.56f};
-      c.bodies.push_back(std::move(v));
-    }
+    c.bodies = bodies_of(s.scene.scene);
     if (s.disc) {
       c.disc.emplace(*s.disc);
       c.disc_surface = FieldSurface(s.disc->mesh().T);
@@ -294,6 +286,20 @@ void SessionController::panel() {
 }
 
 }  // namespace
+
+std::vector<Body> bodies_of(const haptics::Scene& scene) {
+  std::vector<Body> out;
+  for (int i = 0; i < scene.size(); ++i) {
+    const haptics::RigidBody& b = scene.body(i);
+    Body v;
+    v.name = b.name;
+    v.V = b.tree.vertices();
+    v.F = b.tree.triangles();
+    if (b.name == "S1" || b.name == "sacrum") v.color = {0.72f, 0.66f, 0.56f};
+    out.push_back(std::move(v));
+  }
+  return out;
+}
 
 SessionViewResult view_session(const studies::HapticsRunRequest& request,
                                const std::string& data_dir, const ViewOptions& options,

@@ -13,8 +13,12 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace spinesim::viewer {
+
+/// A haptic scene's rigid bodies at the reference posture, bone-coloured (the sacrum darker).
+std::vector<Body> bodies_of(const haptics::Scene& scene);
 
 struct SessionViewResult {
   studies::HapticsRunResult run;
