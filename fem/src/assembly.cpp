@@ -106,7 +106,8 @@ template <int NPE>
 void assemble_constrained_impl(const FeSpace& space, const Eigen::VectorXi& region,
                                const mesh::RegionMaterials& materials,
                                const std::vector<NodeRole>& roles, const Eigen::Vector3d& c,
-                               FreeBlockPattern& p, PlateCoupling& out) {
+                               FreeBlockPattern& p, PlateCoupling& out,
+                               const ElementFibres* fibres) {
   using ElementMatrix = Eigen::Matrix<double, 3 * NPE, 3 * NPE>;
   const Eigen::Index nt = space.elements.rows();
   const int* outer = p.lower.outerIndexPtr();
@@ -144,6 +145,7 @@ void assemble_constrained_impl(const FeSpace& space, const Eigen::VectorXi& regi
       element_stiffness_p1(X, lambda, mu, Ke);
     else
       element_stiffness_p2(X, lambda, mu, Ke);
+    if (fibres != nullptr) add_element_fibres(*fibres, t, X, Ke);
 
     const int* s = &p.slot[std::size_t(t) * NPE * NPE];
     for (int a = 0; a < NPE; ++a) {
@@ -182,20 +184,23 @@ PlateCoupling assemble_constrained(const FeSpace& space, const Eigen::VectorXi& 
                                    const mesh::RegionMaterials& materials,
                                    const std::vector<NodeRole>& roles,
                                    const Eigen::Vector3d& plate_center_mm,
-                                   FreeBlockPattern& pattern) {
+                                   FreeBlockPattern& pattern, const ElementFibres* fibres) {
   PlateCoupling out;
   if (space.order == 1)
-    assemble_constrained_impl<4>(space, region, materials, roles, plate_center_mm, pattern, out);
+    assemble_constrained_impl<4>(space, region, materials, roles, plate_center_mm, pattern, out,
+                                 fibres);
   else
-    assemble_constrained_impl<10>(space, region, materials, roles, plate_center_mm, pattern, out);
+    assemble_constrained_impl<10>(space, region, materials, roles, plate_center_mm, pattern, out,
+                                  fibres);
   return out;
 }
 
 Eigen::SparseMatrix<double> assemble_stiffness(const FeSpace& space, const Eigen::VectorXi& region,
-                                               const mesh::RegionMaterials& materials) {
+                                               const mesh::RegionMaterials& materials,
+                                               const ElementFibres* fibres) {
   const std::vector<NodeRole> roles(std::size_t(space.num_nodes()), NodeRole::free);
   FreeBlockPattern p = build_free_block_pattern(space, roles, FreeNodeOrder::node);
-  assemble_constrained(space, region, materials, roles, Eigen::Vector3d::Zero(), p);
+  assemble_constrained(space, region, materials, roles, Eigen::Vector3d::Zero(), p, fibres);
   Eigen::SparseMatrix<double> full = p.lower.selfadjointView<Eigen::Lower>();
   return full;
 }

@@ -8,7 +8,7 @@ namespace spinesim::fem {
 
 Eigen::VectorXd solve_dirichlet(const Eigen::SparseMatrix<double>& K, const Eigen::VectorXd& f,
                                 const std::vector<Eigen::Index>& fixed_dofs,
-                                const Eigen::VectorXd& fixed_values) {
+                                const Eigen::VectorXd& fixed_values, Factorization factorization) {
   const Eigen::Index n = K.rows();
   if (K.cols() != n || f.size() != n)
     throw std::invalid_argument("solve_dirichlet: K must be square and match f");
@@ -51,7 +51,7 @@ Eigen::VectorXd solve_dirichlet(const Eigen::SparseMatrix<double>& K, const Eige
     }
   Eigen::SparseMatrix<double> Kff(nf, nf);
   Kff.setFromTriplets(trip.begin(), trip.end());
-  CholmodSolver solver;
+  CholmodSolver solver(Ordering::automatic, factorization);
   solver.compute(Kff);
   const Eigen::VectorXd uf = solver.solve(rhs);
   for (Eigen::Index i = 0; i < n; ++i)

@@ -52,7 +52,36 @@ IsotropicMaterial parse_one(const nlohmann::json& j, const std::string& what) {
   return m;
 }
 
+FibreReinforcement parse_fibres(const nlohmann::json& j, const std::string& what) {
+  if (!j.is_object()) throw std::invalid_argument(what + ": expected a JSON object");
+  auto number = [&](const char* key) -> double {
+    if (!j.contains(key)) throw std::invalid_argument(what + ": missing '" + key + "'");
+    const auto& v = j.at(key);
+    if (!v.is_number()) throw std::invalid_argument(what + ": '" + key + "' must be a number");
+    return v.get<double>();
+  };
+  FibreReinforcement f;
+  f.modulus_inner_mpa = number("E_inner_mpa");
+  f.modulus_outer_mpa = number("E_outer_mpa");
+  f.angle_inner_deg = number("angle_inner_deg");
+  f.angle_outer_deg = number("angle_outer_deg");
+  f.source = j.value("source", std::string());
+  validate(f, what);
+  return f;
+}
+
 }  // namespace
+
+void validate(const FibreReinforcement& f, const std::string& what) {
+  for (double e : {f.modulus_inner_mpa, f.modulus_outer_mpa})
+    if (!(e > 0 && e <= 1e5))
+      throw std::invalid_argument(what + ": fibre modulus must lie in (0, 1e5] MPa (got " + fmt(e) +
+                                  ")");
+  for (double a : {f.angle_inner_deg, f.angle_outer_deg})
+    if (!(a >= 0 && a <= 90))
+      throw std::invalid_argument(what + ": fibre angle must lie in [0, 90] degrees (got " +
+                                  fmt(a) + ")");
+}
 
 void validate(const IsotropicMaterial& m, const std::string& what) {
   const double e = m.youngs_modulus_mpa, nu = m.poisson_ratio, rho = m.density_kg_m3;
@@ -91,7 +120,15 @@ RegionMaterials material_from_json(const nlohmann::json& j) {
       r.by_region[int(Region::nucleus)] =
           parse_one(j.at("nucleus"), "material '" + r.name + "' nucleus");
       r.fallback = r.by_region[int(Region::annulus)];
+      const nlohmann::json& annulus = j.at("annulus");
+      if (annulus.is_object() && annulus.contains("fibres"))
+        r.fibres[int(Region::annulus)] =
+            parse_fibres(annulus.at("fibres"), "material '" + r.name + "' annulus fibres");
     } else {
+      if (j.contains("fibres"))
+        throw std::invalid_argument(
+            "material '" + r.name +
+            "': fibres need a per-region file (they reinforce the annulus)");
       r.fallback = parse_one(j, "material '" + r.name + "'");
     }
   } catch (const nlohmann::json::exception& e) {

@@ -11,6 +11,7 @@
 
 #include "spinesim/fem/elasticity.hpp"
 #include "spinesim/fem/fe_space.hpp"
+#include "spinesim/fem/fibres.hpp"
 #include "spinesim/mesh/material.hpp"
 #include "spinesim/mesh/rigid_plate.hpp"
 
@@ -51,16 +52,19 @@ struct PlateCoupling {
 };
 
 /// Fills pattern.lower's values with K_ff and returns the plate blocks. `region` (#T) selects
-/// each tet's material via materials.at(region). `plate_center_mm` is c.
+/// each tet's material via materials.at(region). `plate_center_mm` is c. `fibres` (null or
+/// empty: none) adds each tet's fibre families (fibres.hpp).
 PlateCoupling assemble_constrained(const FeSpace& space, const Eigen::VectorXi& region,
                                    const mesh::RegionMaterials& materials,
                                    const std::vector<NodeRole>& roles,
                                    const Eigen::Vector3d& plate_center_mm,
-                                   FreeBlockPattern& pattern);
+                                   FreeBlockPattern& pattern,
+                                   const ElementFibres* fibres = nullptr);
 
 /// Full symmetric stiffness (both triangles), 3N×3N, N/mm, DOF 3·node + (x, y, z) in node order.
 Eigen::SparseMatrix<double> assemble_stiffness(const FeSpace& space, const Eigen::VectorXi& region,
-                                               const mesh::RegionMaterials& materials);
+                                               const mesh::RegionMaterials& materials,
+                                               const ElementFibres* fibres = nullptr);
 
 using VectorField = std::function<Eigen::Vector3d(const Eigen::Vector3d&)>;
 

@@ -1,6 +1,9 @@
 // Sparse Cholesky (CHOLMOD supernodal LL^T) behind one small interface: analyse the pattern
 // once, factorise (again when values change), solve. Only the lower triangle of the symmetric
-// matrix is read. Failures throw std::runtime_error with a one-line reason
+// matrix is read. `Factorization::ldlt` factorises symmetric quasi-definite matrices
+// [[A, B^T], [B, -C]] (A, C positive definite; mixed displacement–pressure systems) by CHOLMOD's
+// simplicial LDL^T without pivoting: such matrices have an LDL^T factorisation for every
+// symmetric ordering (Vanderbei 1995), so the fill-reducing ordering is free. Failures throw std::runtime_error with a one-line reason
 // ("... matrix is not positive definite ..."), non-finite input or output included.
 // CHOLMOD stays out of public headers (it is a private dependency of spinesim::fem).
 #pragma once
@@ -16,9 +19,13 @@ namespace spinesim::fem {
 /// method forced.
 enum class Ordering { automatic, amd, metis, nesdis };
 
+/// LL^T (symmetric positive definite) or LDL^T (symmetric quasi-definite).
+enum class Factorization { llt, ldlt };
+
 class CholmodSolver {
  public:
-  explicit CholmodSolver(Ordering ordering = Ordering::automatic);
+  explicit CholmodSolver(Ordering ordering = Ordering::automatic,
+                         Factorization factorization = Factorization::llt);
   ~CholmodSolver();
   CholmodSolver(CholmodSolver&&) noexcept;
   CholmodSolver& operator=(CholmodSolver&&) noexcept;
@@ -45,6 +52,7 @@ class CholmodSolver {
   std::unique_ptr<Impl> impl_;
   Eigen::Index rows_ = 0;
   bool factorized_ = false;
+  Factorization factorization_ = Factorization::llt;
 };
 
 }  // namespace spinesim::fem

@@ -32,12 +32,42 @@ struct IsotropicMaterial {
 /// Throws std::invalid_argument unless E > 0, -1 < nu < 0.5, rho > 0, all finite.
 void validate(const IsotropicMaterial& m, const std::string& what = "material");
 
+/// Linear collagen-fibre reinforcement of a region (the annulus fibrosus), added to its isotropic
+/// matrix. The annulus is a laminate of lamellae whose fibres alternate between +angle and
+/// -angle to the transverse plane, in the plane tangent to the lamella. Lamellae (0.1-0.5 mm) are
+/// thinner than the elements, so every element carries both families, each with the stiffness of
+/// half the lamellae (a cross-ply laminate, homogenised): family f adds
+///   sigma = (E_f / 2) (a_f . eps a_f) a_f (x) a_f,
+/// E_f the modulus the fibres give one lamella along its fibre direction. Angle and modulus
+/// vary linearly with the depth s in the annulus, s = 0 at the nucleus, s = 1 at the outer wall.
+/// Linear fibres also resist compression along their length (real fibres buckle): a stated
+/// limitation of a linear reference.
+struct FibreReinforcement {
+  double modulus_inner_mpa = 0, modulus_outer_mpa = 0;  ///< E_f at s = 0 and s = 1
+  double angle_inner_deg = 0, angle_outer_deg = 0;      ///< to the transverse plane
+  std::string source;
+
+  double modulus_mpa(double depth) const {
+    return modulus_inner_mpa + (modulus_outer_mpa - modulus_inner_mpa) * depth;
+  }
+  double angle_deg(double depth) const {
+    return angle_inner_deg + (angle_outer_deg - angle_inner_deg) * depth;
+  }
+};
+
+/// Throws std::invalid_argument unless 0 < E_f <= 1e5 MPa and 0 <= angle <= 90 deg, finite.
+void validate(const FibreReinforcement& f, const std::string& what = "fibres");
+
 /// A named material assignment: one material per region label (1 annulus, 2 nucleus, ...).
-/// `fallback` applies to every label not listed (the homogeneous case).
+/// `fallback` applies to every label not listed (the homogeneous case). `fibres` reinforces
+/// the regions it lists (in the files: an annulus with a "fibres" object).
 struct RegionMaterials {
   std::string name;
   IsotropicMaterial fallback;
   std::map<int, IsotropicMaterial> by_region;
+  std::map<int, FibreReinforcement> fibres;
+
+  bool has_fibres() const { return !fibres.empty(); }
 
   const IsotropicMaterial& at(int region) const {
     auto it = by_region.find(region);
@@ -46,7 +76,9 @@ struct RegionMaterials {
 };
 
 /// Parses {"name","E_mpa","nu"|"G_mpa","density_kg_m3"} or
-/// {"name","annulus":{...},"nucleus":{...}}; validates. Throws std::invalid_argument.
+/// {"name","annulus":{...},"nucleus":{...}}; the annulus may carry
+/// "fibres": {"E_inner_mpa","E_outer_mpa","angle_inner_deg","angle_outer_deg","source"}.
+/// Validates. Throws std::invalid_argument.
 RegionMaterials material_from_json(const nlohmann::json& j);
 
 /// A preset name (looked up in `data_dir`/materials/NAME.json) or a path to a JSON file.

@@ -1,0 +1,81 @@
+#include "spinesim/fem/fibres.hpp"
+
+#include "spinesim/fem/fe_space.hpp"
+#include "spinesim/mesh/annulus_frames.hpp"
+
+#include <cmath>
+#include <limits>
+
+namespace spinesim::fem {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// K_ab += k (\int h_a h_b dV) a a^T,  h = grad N . a, with the exact 4-point degree-2 rule
+// (P2: h is linear, the integrand quadratic; P1: h constant).
+template <int NPE>
+void add_family(const TetVertices& X, const Eigen::Vector3d& a, double k,
+                Eigen::Matrix<double, 3 * NPE, 3 * NPE>& Ke) {
+  static const double qa = 0.5854101966249685, qb = 0.1381966011250105;
+  double vol = 0;
+  const Eigen::Matrix<double, 4, 3> gL = barycentric_gradients(X, vol);
+  Eigen::Matrix<double, NPE, NPE> H = Eigen::Matrix<double, NPE, NPE>::Zero();
+  const int nq = NPE == 4 ? 1 : 4;
+  for (int q = 0; q < nq; ++q) {
+    Eigen::Vector4d L = Eigen::Vector4d::Constant(qb);
+    L(q) = qa;
+    const Eigen::MatrixX3d G = shape_gradients(NPE == 4 ? 1 : 2, gL, L);
+    const Eigen::Matrix<double, NPE, 1> h = G * a;
+    H.noalias() += (vol / nq) * h * h.transpose();
+  }
+  const Eigen::Matrix3d aa = k * a * a.transpose();
+  for (int i = 0; i < NPE; ++i)
+    for (int j = 0; j < NPE; ++j) Ke.template block<3, 3>(3 * i, 3 * j) += H(i, j) * aa;
+}
+
+}  // namespace
+
+Matrix6d fibre_elasticity(const Eigen::Vector3d& a, double k) {
+  Vector6d m;
+  m << a.x() * a.x(), a.y() * a.y(), a.z() * a.z(), a.y() * a.z(), a.x() * a.z(), a.x() * a.y();
+  return k * m * m.transpose();
+}
+
+void add_fibre_stiffness(const TetVertices& X, const Eigen::Vector3d& a, double k,
+                         Eigen::Matrix<double, 12, 12>& Ke) {
+  add_family<4>(X, a, k, Ke);
+}
+
+void add_fibre_stiffness(const TetVertices& X, const Eigen::Vector3d& a, double k,
+                         Eigen::Matrix<double, 30, 30>& Ke) {
+  add_family<10>(X, a, k, Ke);
+}
+
+ElementFibres fibre_field(const mesh::TetMesh& mesh, const mesh::RegionMaterials& materials) {
+  ElementFibres f;
+  if (!materials.has_fibres()) return f;
+  const mesh::AnnulusFrames frames = mesh::annulus_frames(mesh);
+  const Eigen::Index nt = mesh.num_tets();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  f.direction_1.setZero(nt, 3);
+  f.direction_2.setZero(nt, 3);
+  f.stiffness_mpa.setZero(nt);
+  f.angle_deg.setConstant(nt, nan);
+  f.depth = frames.depth;
+  for (Eigen::Index t = 0; t < nt; ++t) {
+    const auto it = materials.fibres.find(mesh.region(t));
+    if (it == materials.fibres.end() || !std::isfinite(frames.depth(t))) continue;
+    const double s = frames.depth(t);
+    const double alpha = it->second.angle_deg(s);
+    const Eigen::RowVector3d c = std::cos(alpha * kPi / 180) * frames.circumferential.row(t);
+    const Eigen::RowVector3d z = std::sin(alpha * kPi / 180) * frames.axial.row(t);
+    f.direction_1.row(t) = c + z;
+    f.direction_2.row(t) = c - z;
+    f.stiffness_mpa(t) = 0.5 * it->second.modulus_mpa(s);
+    f.angle_deg(t) = alpha;
+  }
+  return f;
+}
+
+}  // namespace spinesim::fem
