@@ -8,7 +8,8 @@
 // --motion (mm, degrees) or loaded by --wrench (N, N·mm) about --center (default: mean of the
 // superior endplate nodes). --case applies a named load case in the disc's own frame. Prints
 // the reaction wrench, the plate motion and the 6x6 disc stiffness; writes the displacement
-// field (mm) as VTU point data.
+// field (mm) as VTU point data, with the pressure (MPa, --formulation mixed) and the annulus
+// fibre field as cell vectors (fibre-reinforced materials).
 #include "cli_common.hpp"
 #include "spinesim/studies/fem_report.hpp"
 
@@ -24,6 +25,7 @@ namespace {
 
 struct FemArgs {
   std::string mesh_path, material = "real-disc", motion, wrench, load_case, center, out;
+  std::string formulation = "displacement";
   int order = 2;
   bool json = false, quiet = false;
 };
@@ -34,6 +36,9 @@ void run_fem(const FemArgs& a) {
   if (loads > 1) throw std::invalid_argument("give at most one of --motion, --wrench and --case");
   FemRunRequest rq;
   rq.order = a.order;
+  rq.formulation = parse_formulation(a.formulation);
+  if (rq.formulation == fem::Formulation::mixed && a.order != 2)
+    throw std::invalid_argument("--formulation mixed is Taylor-Hood P2-P1: it needs --order 2");
   if (!a.motion.empty())
     rq.motion =
         motion_deg_to_rad(parse_numbers(a.motion, 6, "--motion tx,ty,tz,rx,ry,rz (mm, deg)"));
@@ -55,7 +60,7 @@ void run_fem(const FemArgs& a) {
   // 3. Files and report.
   if (!a.out.empty()) {
     progress.begin("writing " + a.out);
-    mesh::write_vtu(a.out, m, {{"displacement", r.solution.displacement_mm}});
+    write_fem_vtu(a.out, m, r);
     progress.end();
   }
   nlohmann::json j = fem_run_json(r, a.mesh_path);
@@ -74,10 +79,16 @@ void register_fem(CLI::App& app) {
       "fem", "Linear FEM reference: rigid superior plate, fixed inferior endplate");
   cmd->add_option("--mesh", a->mesh_path, "Disc mesh (VTU with `surface` endplate labels)")
       ->required();
-  cmd->add_option("--material", a->material,
-                  "Preset (real-disc, annulus-nucleus, rubber, polyethylene) or JSON file")
+  cmd->add_option(
+         "--material", a->material,
+         "Preset (real-disc, annulus-nucleus, fibre-reinforced, rubber, polyethylene) or JSON "
+         "file")
       ->capture_default_str();
   cmd->add_option("--order", a->order, "Element order: 1 (P1) or 2 (P2)")->capture_default_str();
+  cmd->add_option("--formulation", a->formulation,
+                  "displacement, or mixed: Taylor-Hood P2-P1 displacement-pressure for a nearly "
+                  "incompressible nucleus (reports its pressure)")
+      ->capture_default_str();
   add_plate_load_options(cmd, a->motion, a->wrench, a->load_case, a->center);
   cmd->add_option("--out", a->out, "Write the displacement field to this VTU");
   add_output_flags(cmd, a->json, a->quiet);

@@ -1,6 +1,7 @@
 #include "spinesim/studies/fem_report.hpp"
 
 #include "spinesim/common/timer.hpp"
+#include "spinesim/mesh/io.hpp"
 
 #include "spinesim/studies/format.hpp"
 #include "spinesim/studies/json.hpp"
@@ -61,8 +62,13 @@ FemRunResult run_fem_reference(const mesh::TetMesh& m, const mesh::RegionMateria
   r.tets = m.num_tets();
   r.center = rq.center ? *rq.center : fem::DiscFem::default_plate_center(m);
 
-  hooks.begin_stage("assembling and factorising (P" + std::to_string(rq.order) + ")");
-  fem::DiscFem solver(m, materials, rq.order, r.center);
+  hooks.begin_stage(rq.formulation == fem::Formulation::mixed
+                        ? std::string("assembling and factorising (Taylor-Hood P2-P1)")
+                        : "assembling and factorising (P" + std::to_string(rq.order) + ")");
+  fem::SolverOptions options;
+  options.formulation = rq.formulation;
+  fem::DiscFem solver(m, materials, rq.order, r.center, options);
+  r.fibres = solver.fibres();
   r.stiffness = solver.stiffness_6x6();
   r.fem_nodes = solver.num_nodes();
   r.dofs = solver.num_dofs();
@@ -109,19 +115,55 @@ nlohmann::json fem_run_json(const FemRunResult& r, const std::string& mesh_label
         {"stiffness_solve_s", t.solve_s},
         {"load_solve_s", r.load_solve_s}}}};
   if (r.request.load_case) j["case"] = r.request.load_case->name;
+  j["formulation"] = formulation_name(r.request.formulation);
+  if (std::isfinite(sol.nucleus_pressure_mpa)) j["nucleus_pressure_mpa"] = sol.nucleus_pressure_mpa;
+  j["fibres"] = !r.fibres.empty();
   return j;
+}
+
+fem::Formulation parse_formulation(const std::string& name) {
+  if (name == "displacement") return fem::Formulation::displacement;
+  if (name == "mixed") return fem::Formulation::mixed;
+  throw std::invalid_argument("unknown formulation '" + name + "' (displacement, mixed)");
+}
+
+const char* formulation_name(fem::Formulation f) {
+  return f == fem::Formulation::mixed ? "mixed" : "displacement";
+}
+
+void write_fem_vtu(const std::string& path, const mesh::TetMesh& m, const FemRunResult& r) {
+  std::vector<mesh::DataArray> points{{"displacement", r.solution.displacement_mm}};
+  if (r.solution.pressure_mpa.size() == m.num_vertices())
+    points.push_back({"pressure", r.solution.pressure_mpa});
+  std::vector<mesh::DataArray> cells;
+  if (!r.fibres.empty()) {
+    // NaN outside the annulus would trouble viewers; zero vectors and -1 mark "no fibres".
+    const auto or_minus_one = [](const Eigen::VectorXd& v) {
+      return Eigen::VectorXd(v.unaryExpr([](double x) { return std::isfinite(x) ? x : -1.0; }));
+    };
+    cells = {{"fibre_direction_1", r.fibres.direction_1},
+             {"fibre_direction_2", r.fibres.direction_2},
+             {"fibre_angle_deg", or_minus_one(r.fibres.angle_deg)},
+             {"annulus_depth", or_minus_one(r.fibres.depth)}};
+  }
+  mesh::write_vtu(path, m, points, cells);
 }
 
 void print_fem_run(std::ostream& os, const FemRunResult& r, const std::string& mesh_label) {
   const auto q = motion_rad_to_deg(r.solution.plate_motion);
   const auto& w = r.solution.reaction_wrench;
-  os << std::setprecision(5) << "FEM P" << r.request.order << " on " << mesh_label << " (" << r.tets
-     << " tets, " << r.dofs << " DOF), material " << r.material << "\n"
+  os << std::setprecision(5) << "FEM "
+     << (r.request.formulation == fem::Formulation::mixed ? std::string("Taylor-Hood P2-P1")
+                                                          : "P" + std::to_string(r.request.order))
+     << " on " << mesh_label << " (" << r.tets << " tets, " << r.dofs << " DOF), material "
+     << r.material << (r.fibres.empty() ? "" : " (fibre-reinforced annulus)") << "\n"
      << "  plate centre  " << r.center.transpose() << " mm\n"
      << "  plate motion  t = " << q.head<3>().transpose() << " mm, r = " << q.tail<3>().transpose()
      << " deg\n"
      << "  reaction      F = " << w.head<3>().transpose() << " N, M = " << w.tail<3>().transpose()
      << " N·mm\n";
+  if (std::isfinite(r.solution.nucleus_pressure_mpa))
+    os << "  nucleus pressure " << r.solution.nucleus_pressure_mpa << " MPa (volume mean)\n";
   print_stiffness(os, r.stiffness);
 }
 

@@ -38,7 +38,8 @@ bool contains(const std::string& s, const std::string& part) {
 }
 
 TEST(MaterialPresets, AllLoadAndValidate) {
-  for (const char* name : {"real-disc", "annulus-nucleus", "rubber", "polyethylene"}) {
+  for (const char* name :
+       {"real-disc", "annulus-nucleus", "fibre-reinforced", "rubber", "polyethylene"}) {
     SCOPED_TRACE(name);
     const auto m = load_material(name, kData);
     EXPECT_EQ(m.name, name);
@@ -128,3 +129,41 @@ TEST(MaterialFiles, UnknownPresetListsTheKnownOnes) {
 }
 
 }  // namespace
+
+TEST(MaterialFibres, ThePresetCarriesSourcedAnnulusFibres) {
+  const auto m = load_material("fibre-reinforced", kData);
+  ASSERT_TRUE(m.has_fibres());
+  ASSERT_EQ(m.fibres.count(int(Region::annulus)), 1u);
+  const auto& f = m.fibres.at(int(Region::annulus));
+  EXPECT_DOUBLE_EQ(f.angle_inner_deg, 45);
+  EXPECT_DOUBLE_EQ(f.angle_outer_deg, 28);
+  EXPECT_DOUBLE_EQ(f.modulus_mpa(0.5), 0.5 * (59 + 136));
+  EXPECT_FALSE(f.source.empty());
+  EXPECT_EQ(m.fibres.count(int(Region::nucleus)), 0u);
+}
+
+TEST(MaterialFibres, BadFibresAreRefusedInOneLine) {
+  const auto with = [](nlohmann::json fibres) {
+    nlohmann::json j = {{"name", "f"},
+                        {"annulus", {{"E_mpa", 4.2}, {"nu", 0.45}, {"fibres", fibres}}},
+                        {"nucleus", {{"E_mpa", 1.0}, {"nu", 0.49}}}};
+    return j;
+  };
+  const nlohmann::json good = {
+      {"E_inner_mpa", 59}, {"E_outer_mpa", 136}, {"angle_inner_deg", 45}, {"angle_outer_deg", 28}};
+  EXPECT_NO_THROW(material_from_json(with(good)));
+  auto bad = good;
+  bad["angle_outer_deg"] = 95;
+  EXPECT_TRUE(contains(refusal([&] { material_from_json(with(bad)); }), "fibre angle"));
+  bad = good;
+  bad["E_inner_mpa"] = -1;
+  EXPECT_TRUE(contains(refusal([&] { material_from_json(with(bad)); }), "fibre modulus"));
+  bad = good;
+  bad.erase("E_outer_mpa");
+  EXPECT_TRUE(contains(refusal([&] { material_from_json(with(bad)); }), "E_outer_mpa"));
+  bad = good;
+  bad["angle_inner_deg"] = "steep";
+  EXPECT_TRUE(contains(refusal([&] { material_from_json(with(bad)); }), "must be a number"));
+  nlohmann::json homogeneous = {{"name", "h"}, {"E_mpa", 3}, {"nu", 0.4}, {"fibres", good}};
+  EXPECT_TRUE(contains(refusal([&] { material_from_json(homogeneous); }), "per-region"));
+}

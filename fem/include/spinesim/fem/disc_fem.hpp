@@ -22,11 +22,13 @@
 // measured per mesh size in docs/benchmarks.md ("FEM reference").
 #pragma once
 
+#include "spinesim/fem/fibres.hpp"
 #include "spinesim/mesh/material.hpp"
 #include "spinesim/mesh/tet_mesh.hpp"
 
 #include <Eigen/Core>
 
+#include <limits>
 #include <memory>
 
 namespace spinesim::fem {
@@ -48,8 +50,14 @@ struct Timings {
 /// nucleus, which slows CG.
 enum class LinearSolver { automatic, direct, p_multigrid_cg };
 
+/// `displacement`: the P1/P2 displacement form. `mixed`: Taylor–Hood P2–P1 displacement–pressure
+/// (mixed.hpp; order 2 only), for a nearly incompressible nucleus; K_ff is then quasi-definite
+/// and factorised by LDL^T (direct only).
+enum class Formulation { displacement, mixed };
+
 struct SolverOptions {
   LinearSolver solver = LinearSolver::automatic;
+  Formulation formulation = Formulation::displacement;
   Eigen::Index cg_min_dofs = 150000;
   double cg_relative_tolerance = 1e-10;  ///< per column, ||r|| <= tol ||b||
   int cg_max_iterations = 1000;
@@ -61,6 +69,11 @@ struct PlateSolution {
       node_displacement_mm;  ///< #nodes×3 at every FE node (P2: vertices, then edge nodes)
   Vector6d plate_motion;     ///< (t mm, theta rad)
   Vector6d reaction_wrench;  ///< (F N, M N·mm) the disc exerts on the plate, about c
+  /// Mixed formulation only (empty / NaN otherwise): hydrostatic pressure -tr(sigma)/3 (MPa,
+  /// positive in compression) at each mesh vertex, averaged over the regions meeting there;
+  /// and its volume average over the nucleus (region 2), the intradiscal pressure.
+  Eigen::VectorXd pressure_mpa;
+  double nucleus_pressure_mpa = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// Solver object: assembles and factorises once, then answers any number of plate loads.
@@ -90,7 +103,10 @@ class DiscFem {
   const Eigen::Vector3d& plate_center() const;  ///< c, mm
 
   int order() const;
-  Eigen::Index num_dofs() const;   ///< free displacement unknowns
+  Formulation formulation() const;
+  /// The annulus fibre field (empty when the material has no fibres), for output.
+  const ElementFibres& fibres() const;
+  Eigen::Index num_dofs() const;   ///< free unknowns (displacements, and pressures when mixed)
   Eigen::Index num_nodes() const;  ///< P1 vertices or P2 vertices + edge midpoints
   const Timings& timings() const;
 

@@ -34,6 +34,7 @@ void print_stiffness(std::ostream& os, const fem::Matrix6d& k_rad);
 /// disc-frame wrench is rotated into the mesh's frame). At most one is set; none = zero motion.
 struct FemRunRequest {
   int order = 2;
+  fem::Formulation formulation = fem::Formulation::displacement;
   std::optional<Eigen::Vector3d> center;  ///< plate centre, mm; default: DiscFem's
   std::optional<fem::Vector6d> motion;    ///< (t mm, theta rad), global
   std::optional<fem::Vector6d> wrench;    ///< (F N, M N·mm), global
@@ -50,6 +51,7 @@ struct FemRunResult {
   fem::Matrix6d stiffness = fem::Matrix6d::Zero();  ///< rows (F, M), columns (t mm, theta rad)
   fem::Timings timings;
   double load_solve_s = 0;
+  fem::ElementFibres fibres;  ///< the annulus fibre field (empty without fibres)
 };
 
 /// Assembles, factorises and solves the one load. Stages: assembly, solve (2). Throws
@@ -64,5 +66,14 @@ nlohmann::json fem_run_json(const FemRunResult& r, const std::string& mesh_label
 
 /// The readable summary: plate centre, motion, reaction and the 6x6 stiffness.
 void print_fem_run(std::ostream& os, const FemRunResult& r, const std::string& mesh_label);
+
+/// Writes the run to a VTU: point data `displacement` (mm) and, from the mixed formulation,
+/// `pressure` (MPa, hydrostatic); cell data of the fibre field when there is one:
+/// `fibre_direction_1`, `fibre_direction_2` (unit), `fibre_angle_deg`, `annulus_depth`.
+void write_fem_vtu(const std::string& path, const mesh::TetMesh& m, const FemRunResult& r);
+
+/// "displacement" or "mixed" (command-line names).
+fem::Formulation parse_formulation(const std::string& name);
+const char* formulation_name(fem::Formulation f);
 
 }  // namespace spinesim::studies
