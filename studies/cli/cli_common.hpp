@@ -40,10 +40,11 @@ void register_mss(CLI::App& app);        ///< mss, mss compare (cli_mss.cpp)
 void register_calibrate(CLI::App& app);  ///< calibrate (cli_calibrate.cpp)
 void register_study(
     CLI::App& app);  ///< study probe|drive|materials|validation|fusion|trends (cli_study.cpp)
-void register_spine(CLI::App& app);           ///< spine solve (cli_spine.cpp)
-void register_haptics(CLI::App& app);         ///< haptics run|devices (cli_haptics.cpp)
-void register_haptic_plane(CLI::App& study);  ///< study haptic-plane (cli_haptics.cpp)
-void register_haptic_drag(CLI::App& study);   ///< study haptic-drag (cli_haptics.cpp)
+void register_spine(CLI::App& app);              ///< spine solve (cli_spine.cpp)
+void register_haptics(CLI::App& app);            ///< haptics run|devices (cli_haptics.cpp)
+void register_haptic_plane(CLI::App& study);     ///< study haptic-plane (cli_haptics.cpp)
+void register_haptic_drag(CLI::App& study);      ///< study haptic-drag (cli_haptics.cpp)
+void register_disc_validation(CLI::App& study);  ///< study disc-validation (cli_study_disc.cpp)
 void register_demo(CLI::App& app);
 void register_view(CLI::App& app);
 

@@ -515,6 +515,7 @@ void register_study(CLI::App& app) {
   register_trends(*study);
   register_haptic_plane(*study);
   register_haptic_drag(*study);
+  register_disc_validation(*study);
 }
 
 }  // namespace spinesim::cli

@@ -6,6 +6,7 @@
 //                 [--width W --height H] [--screenshot FILE [--frames N] [--screenshot-at S]]
 //                 [--cursor-script CSV] [--no-panel] [--json]
 //   spinesim view --play SERIES.pvd [--recording REC.csv] [--field F] [--speed X] [--at S] [--paused]
+//   spinesim view --play RESULT.vtu [--field F] [--vectors fibre_direction_1,fibre_direction_2]
 //
 // By default the servo loop runs with the mouse as the device. A missing display, an OpenGL
 // below 3.3 core or a device that cannot be opened is one line and a non-zero exit.
@@ -17,6 +18,7 @@
 #include "spinesim/viewer/session.hpp"
 #include "spinesim/viewer/viewer.hpp"
 
+#include <cmath>
 #include <iostream>
 #include <memory>
 
@@ -28,6 +30,7 @@ struct ViewArgs {
   viewer::ViewOptions view;
   viewer::PlaybackRequest play;
   std::string cursor_script;
+  std::vector<double> camera;
   bool no_panel = false, json = false, quiet = false;
 };
 
@@ -90,7 +93,8 @@ void run_playback(const ViewArgs& a, viewer::ViewOptions o) {
                   {"first_s", r.first_s},
                   {"last_s", r.last_s},
                   {"fields", r.fields},
-                  {"frames_read", r.loads}}}});
+                  {"frames_read", r.loads},
+                  {"glyphs", r.glyphs}}}});
     return;
   }
   report_view(a, r.view);
@@ -99,6 +103,14 @@ void run_playback(const ViewArgs& a, viewer::ViewOptions o) {
 void run(ViewArgs& a) {
   viewer::ViewOptions o = a.view;
   o.panel = !a.no_panel;
+  if (!a.camera.empty()) {
+    if (a.camera.size() != 2 || !std::isfinite(a.camera[0]) || !std::isfinite(a.camera[1]) ||
+        std::abs(a.camera[1]) > 85)
+      throw std::invalid_argument(
+          "--camera YAW,PITCH: two finite angles in degrees, |pitch| <= 85");
+    o.camera_yaw_deg = a.camera[0];
+    o.camera_pitch_deg = a.camera[1];
+  }
   if (!a.cursor_script.empty()) {
     const haptics::Trajectory t = haptics::read_trajectory(a.cursor_script);
     for (std::size_t i = 0; i < t.t_s.size(); ++i)
@@ -125,7 +137,12 @@ void register_view(CLI::App& app) {
                   "Colour the discs by displacement, spring_strain or volume_change (--play: any "
                   "field the series has)")
       ->capture_default_str();
-  cmd->add_option("--play", a->play.pvd, "Play back this ParaView series (.pvd) instead");
+  cmd->add_option("--play", a->play.pvd,
+                  "Play back this ParaView series (.pvd), or show one VTU file, instead");
+  cmd->add_option("--vectors", a->play.vectors,
+                  "--play: draw these cell vector fields as rods on the surface (e.g. "
+                  "fibre_direction_1,fibre_direction_2 of a `spinesim fem` VTU)")
+      ->delimiter(',');
   cmd->add_option(
       "--recording", a->play.recording,
       "--play: the compliant-stage recording that drove the series (probe, hook, force)");
@@ -147,6 +164,10 @@ void register_view(CLI::App& app) {
                   "Move the cursor to where these scene points (CSV t_s,x_mm,y_mm,z_mm[,button]) "
                   "appear on the screen, on the session's clock (tests, demos)");
   cmd->add_flag("--no-panel", a->no_panel, "Leave out the ImGui panel");
+  cmd->add_option("--camera", a->camera,
+                  "First view as YAW,PITCH in degrees (yaw 0: from the body's right, -90: from "
+                  "the front; pitch: the eye's elevation above the horizontal)")
+      ->delimiter(',');
   add_output_flags(cmd, a->json, a->quiet);
   cmd->callback([a] { run(*a); });
 }

@@ -137,14 +137,15 @@ void write_fem_vtu(const std::string& path, const mesh::TetMesh& m, const FemRun
     points.push_back({"pressure", r.solution.pressure_mpa});
   std::vector<mesh::DataArray> cells;
   if (!r.fibres.empty()) {
-    // NaN outside the annulus would trouble viewers; zero vectors and -1 mark "no fibres".
-    const auto or_minus_one = [](const Eigen::VectorXd& v) {
-      return Eigen::VectorXd(v.unaryExpr([](double x) { return std::isfinite(x) ? x : -1.0; }));
+    // VTU files hold finite numbers only (io.hpp): cells without fibres get zero vectors, angle
+    // 0 and depth -1 (outside [0, 1]).
+    const auto finite_or = [](const Eigen::VectorXd& v, double fill) {
+      return Eigen::VectorXd(v.unaryExpr([fill](double x) { return std::isfinite(x) ? x : fill; }));
     };
     cells = {{"fibre_direction_1", r.fibres.direction_1},
              {"fibre_direction_2", r.fibres.direction_2},
-             {"fibre_angle_deg", or_minus_one(r.fibres.angle_deg)},
-             {"annulus_depth", or_minus_one(r.fibres.depth)}};
+             {"fibre_angle_deg", finite_or(r.fibres.angle_deg, 0.0)},
+             {"annulus_depth", finite_or(r.fibres.depth, -1.0)}};
   }
   mesh::write_vtu(path, m, points, cells);
 }

@@ -31,7 +31,16 @@ Eigen::VectorXd FieldSurface::from_cells(const Eigen::VectorXd& c) const {
 }
 
 void FieldSurface::range(const Eigen::VectorXd& v, double floor, double& lo, double& hi) {
-  const double a = v.size() ? v.minCoeff() : 0, b = v.size() ? v.maxCoeff() : 0;
+  // Non-finite values mean "no data" (a fibre field's nucleus): they are drawn grey and take no
+  // part in the range.
+  double a = 0, b = 0;
+  bool any = false;
+  for (double x : v)
+    if (std::isfinite(x)) {
+      a = any ? std::min(a, x) : x;
+      b = any ? std::max(b, x) : x;
+      any = true;
+    }
   if (a < 0) {
     hi = std::max({std::abs(a), std::abs(b), floor});
     lo = -hi;

@@ -33,10 +33,13 @@ class FieldSurface {
   Eigen::VectorXd from_cells(const Eigen::VectorXd& cell_values) const;
   /// The colour range for `values`: symmetric about 0 for a signed field, [0, max] otherwise,
   /// at least `floor` wide (so that a field at rest shows its lowest colour, not noise).
+  /// Non-finite values are ignored (and drawn grey).
   static void range(const Eigen::VectorXd& values, double floor, double& lo, double& hi);
   /// `body` shows the surface at `V` (#V×3) coloured by `values` on [lo, hi].
   void fill(Body& body, const Eigen::MatrixX3d& V, const Eigen::VectorXd& values, double lo,
             double hi) const;
+  const Eigen::MatrixX3i& faces() const { return F_; }
+  const Eigen::VectorXi& owners() const { return owner_; }
 
  private:
   Eigen::MatrixX3i F_;

@@ -36,6 +36,28 @@ std::vector<std::string> fields_of(const mesh::VtuGrid& g) {
   return out;
 }
 
+/// A .pvd's entries, or one .vtu as a series of one frame at t = 0.
+std::vector<mesh::PvdEntry> series(const std::string& path) {
+  const bool vtu = path.size() > 4 && path.compare(path.size() - 4, 4, ".vtu") == 0;
+  if (!vtu) return mesh::read_pvd(path);
+  mesh::PvdEntry e;
+  e.time_s = 0;
+  e.part = 0;
+  e.file = path;
+  return {e};
+}
+
+/// Three-component cell arrays.
+std::vector<std::string> vector_fields_of(const mesh::VtuGrid& g) {
+  std::vector<std::string> out;
+  for (const auto& a : g.cell_data)
+    if (a.values.cols() == 3) out.push_back(a.name);
+  return out;
+}
+
+/// Rod colours for the vector fields, in order.
+const Eigen::Vector3f kRodColors[] = {{1.0f, 0.55f, 0.1f}, {0.2f, 0.85f, 1.0f}, {1, 1, 1}};
+
 struct Part {
   std::vector<mesh::PvdEntry> entries;  ///< by time
   FieldSurface surface;                 ///< tetrahedral parts
@@ -47,7 +69,7 @@ class PlaybackController final : public Controller {
   PlaybackController(const PlaybackRequest& request, const std::string& data_dir,
                      PlaybackResult& result)
       : request_(request), result_(result), playing_(!request.paused) {
-    for (const mesh::PvdEntry& e : mesh::read_pvd(request.pvd)) {
+    for (const mesh::PvdEntry& e : series(request.pvd)) {
       parts_[e.part].entries.push_back(e);
       times_.insert(e.time_s);
     }
@@ -69,6 +91,7 @@ class PlaybackController final : public Controller {
           if (std::find(fields_.begin(), fields_.end(), f) == fields_.end()) fields_.push_back(f);
     }
     result.fields = fields_;
+    check_vectors();
     if (!fields_.empty()) {
       const auto it = std::find(fields_.begin(), fields_.end(), request.field);
       if (it == fields_.end()) {
@@ -82,6 +105,22 @@ class PlaybackController final : public Controller {
       model_ = std::make_unique<spine::SpineModel>(spine::load_spine_model(data_dir));
       recording_ = studies::read_drag_recording(request.recording, *model_);
     }
+  }
+
+  void check_vectors() {
+    std::vector<std::string> have;
+    for (auto& [k, part] : parts_) {
+      const mesh::VtuGrid g = mesh::read_vtu_grid(part.entries.front().file);
+      if (g.cell_type == 10)
+        for (const std::string& f : vector_fields_of(g)) have.push_back(f);
+    }
+    for (const std::string& v : request_.vectors)
+      if (std::find(have.begin(), have.end(), v) == have.end()) {
+        std::string list;
+        for (const auto& f : have) list += (list.empty() ? "" : ", ") + f;
+        throw std::invalid_argument("--vectors " + v + ": the series' cell vector fields are " +
+                                    (list.empty() ? std::string("none") : list));
+      }
   }
 
   void update(SceneFrame& scene, const Pointer&) override {
@@ -119,6 +158,10 @@ class PlaybackController final : public Controller {
       if (ImGui::Combo("field", &field_, names.data(), int(names.size()))) shown_time_ = -1;
       color_legend(fields_[std::size_t(field_)].c_str(), lo_, hi_);
     }
+    for (std::size_t k = 0; k < request_.vectors.size(); ++k) {
+      const Eigen::Vector3f& c = kRodColors[std::min<std::size_t>(k, 2)];
+      ImGui::TextColored(ImVec4(c.x(), c.y(), c.z(), 1), "rods: %s", request_.vectors[k].c_str());
+    }
     if (recording_)
       ImGui::Text("recording %s: probe blue, hook yellow, spine force orange",
                   recording_->complete ? "complete" : "cut short");
@@ -136,6 +179,7 @@ class PlaybackController final : public Controller {
   std::optional<std::chrono::steady_clock::time_point> last_wall_;
   std::unique_ptr<spine::SpineModel> model_;
   std::optional<studies::DragRecording> recording_;
+  std::vector<Marker> glyphs_;  ///< the vector rods of the frame shown
 
   /// The series' frame at or before `t`: each part's VTU, read when the frame changes.
   void load(SceneFrame& scene, double t) {
@@ -145,6 +189,7 @@ class PlaybackController final : public Controller {
     index_ = int(std::distance(times_.begin(), times_.upper_bound(at + 1e-12))) - 1;
     const auto start = std::chrono::steady_clock::now();
     scene.bodies.resize(parts_.size());
+    glyphs_.clear();
     std::size_t b = 0;
     for (auto& [k, part] : parts_) {
       // The part's last entry at or before `at` (a part may have fewer frames).
@@ -184,10 +229,34 @@ class PlaybackController final : public Controller {
       values = part.surface.from_cells(Eigen::VectorXd::Zero(g.cells.rows()));
     FieldSurface::range(values, floor, lo_, hi_);
     part.surface.fill(body, g.V, values, lo_, hi_);
+    add_glyphs(part, g);
+  }
+
+  /// Rods along each requested cell vector, through the centroid of every boundary face (lifted
+  /// a little off the surface), 0.7 of the face's mean edge long.
+  void add_glyphs(const Part& part, const mesh::VtuGrid& g) {
+    const Eigen::MatrixX3i& F = part.surface.faces();
+    const Eigen::VectorXi& owner = part.surface.owners();
+    for (std::size_t k = 0; k < request_.vectors.size(); ++k) {
+      const mesh::DataArray* a = g.cell_array(request_.vectors[k]);
+      if (a == nullptr || a->values.cols() != 3) continue;
+      for (Eigen::Index f = 0; f < F.rows(); ++f) {
+        const Eigen::Vector3d d = a->values.row(owner(f)).transpose();
+        if (!d.allFinite() || !(d.norm() > 1e-12)) continue;
+        const Eigen::Vector3d p0 = g.V.row(F(f, 0)), p1 = g.V.row(F(f, 1)), p2 = g.V.row(F(f, 2));
+        const Eigen::Vector3d c = (p0 + p1 + p2) / 3, n = (p1 - p0).cross(p2 - p0).normalized();
+        const double edge = ((p1 - p0).norm() + (p2 - p1).norm() + (p0 - p2).norm()) / 3;
+        const Eigen::Vector3d half = 0.35 * edge * d.normalized();
+        const Eigen::Vector3d lifted = c + 0.15 * edge * n;
+        glyphs_.push_back({Marker::Kind::rod, lifted - half, lifted + half, 0.06 * edge,
+                           kRodColors[std::min<std::size_t>(k, 2)]});
+      }
+    }
+    result_.glyphs = int(glyphs_.size());
   }
 
   void overlay(SceneFrame& scene, double t) {
-    scene.markers.clear();
+    scene.markers = glyphs_;
     if (!recording_ || recording_->frames.empty()) return;
     const auto& fr = recording_->frames;
     const auto it = std::lower_bound(

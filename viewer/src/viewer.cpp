@@ -432,8 +432,10 @@ class Renderer {
     const Eigen::Vector3d d = mk.b - mk.a;
     const double length = d.norm();
     if (!(length > 0)) return;
-    // The unit arrow is 2 long (shaft 1, head 1): the head takes min(40 %, 6 r) of the length.
-    const double head = std::min(0.4 * length, 6.0 * mk.radius_mm);
+    // The unit arrow is 2 long (shaft 1, head 1): the head takes min(40 %, 6 r) of the length;
+    // a rod is all shaft.
+    const double head =
+        mk.kind == Marker::Kind::rod ? 0.0 : std::min(0.4 * length, 6.0 * mk.radius_mm);
     const Eigen::Vector3d z = d / length;
     const Eigen::Vector3d x =
         (std::abs(z.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY())
@@ -451,6 +453,7 @@ class Renderer {
     glUniform1i(glGetUniformLocation(program_, "per_face"), 0);
     glBindVertexArray(arrow_.vao);
     glDrawArrays(GL_TRIANGLES, 0, 16 * 2 * 3);  // the shaft alone
+    if (mk.kind == Marker::Kind::rod) return;
     // The whole unit arrow scaled to `head`: its cone is the head, its shaft lies in the shaft.
     S = Eigen::Vector3d(r, r, head).asDiagonal();
     model.topLeftCorner<3, 3>() = (R * S).cast<float>();
@@ -610,7 +613,10 @@ ViewResult view(Controller& controller, const ViewOptions& o) {
       Eigen::Vector3d lo, hi;
       if (!bounds(scene, lo, hi)) return;
       cam.frame((0.5 * (lo + hi)).cast<float>(), float(0.5 * (hi - lo).norm()));
-      cam.yaw = controller.initial_yaw();
+      cam.yaw = std::isfinite(o.camera_yaw_deg) ? float(o.camera_yaw_deg * kPi / 180)
+                                                : controller.initial_yaw();
+      if (std::isfinite(o.camera_pitch_deg))  // the eye above the target: a negative pitch
+        cam.pitch = std::clamp(float(-o.camera_pitch_deg * kPi / 180), -1.5f, 1.5f);
       framed = true;
     };
     if (!framed) reset();

@@ -69,7 +69,9 @@ void print_fem_run(std::ostream& os, const FemRunResult& r, const std::string& m
 
 /// Writes the run to a VTU: point data `displacement` (mm) and, from the mixed formulation,
 /// `pressure` (MPa, hydrostatic); cell data of the fibre field when there is one:
-/// `fibre_direction_1`, `fibre_direction_2` (unit), `fibre_angle_deg`, `annulus_depth`.
+/// `fibre_direction_1`, `fibre_direction_2` (unit; zero without fibres), `fibre_angle_deg` (to the
+/// transverse plane; 0 without fibres), `annulus_depth` (0 at the nucleus, 1 at the outer wall;
+/// -1 outside the annulus).
 void write_fem_vtu(const std::string& path, const mesh::TetMesh& m, const FemRunResult& r);
 
 /// "displacement" or "mixed" (command-line names).

@@ -18,6 +18,7 @@
 #include <Eigen/Core>
 
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -36,9 +37,10 @@ struct Body {
   std::uint64_t revision = 0;
 };
 
-/// A sphere (centre `a`, `radius_mm`) or an arrow from `a` to `b` (shaft radius `radius_mm`).
+/// A sphere (centre `a`, `radius_mm`), an arrow from `a` to `b` (shaft radius `radius_mm`), or
+/// a rod from `a` to `b` (an undirected glyph: a fibre, a principal axis).
 struct Marker {
-  enum class Kind { sphere, arrow };
+  enum class Kind { sphere, arrow, rod };
   Kind kind = Kind::sphere;
   Eigen::Vector3d a = Eigen::Vector3d::Zero(), b = Eigen::Vector3d::Zero();
   double radius_mm = 1;
@@ -89,6 +91,11 @@ struct ViewOptions {
   int frames = 3;                  ///< frames before the screenshot (>= 1)
   double screenshot_after_s = 0;   ///< ... and not before this time (Controller::clock_s)
   bool panel = true;               ///< the ImGui panel
+  /// The first view's direction, degrees: yaw about the superior axis (0: from the body's right,
+  /// -45: from the front right) and the eye's elevation above the horizontal. NaN: the
+  /// controller's choice, level.
+  double camera_yaw_deg = std::numeric_limits<double>::quiet_NaN();
+  double camera_pitch_deg = std::numeric_limits<double>::quiet_NaN();
   /// Scripted pointer (tests and demos): at `t_s` (Controller::clock_s), the cursor is where
   /// the world point `point_mm` appears on the screen (linear in between), with `buttons` held
   /// and `wheel` notches turned at that step. Replaces the real cursor when not empty.

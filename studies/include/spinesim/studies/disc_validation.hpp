@@ -1,0 +1,62 @@
+// The FEM disc against in-vitro tests (`spinesim study disc-validation`): the standard loads on
+// the disc's superior plate (fem/load_cases.hpp: 500 N compression, 7.5 N·m flexion, extension,
+// lateral bending, torsion; inferior endplate fixed), the disc's stiffness in each — load over
+// plate motion in the disc frame (compression kN/mm; moments N·m/deg about the plate centre) —
+// and, with the mixed formulation, the nucleus pressure over the mean axial stress
+// (p_nucleus / (500 N / A), A = mesh volume / disc height). Each is set beside the published
+// range of `data/validation/disc_in_vitro.json` and marked MATCH (inside) or MISS.
+// Our disc has no posterior elements and rigid endplates: the targets are disc-alone tests; the
+// file's whole-segment rows are printed for scale only.
+#pragma once
+
+#include "spinesim/fem/disc_fem.hpp"
+#include "spinesim/mesh/material.hpp"
+#include "spinesim/mesh/tet_mesh.hpp"
+#include "spinesim/studies/progress.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <limits>
+#include <ostream>
+#include <string>
+#include <vector>
+
+namespace spinesim::studies {
+
+struct DiscValidationRow {
+  std::string quantity, units;                             ///< e.g. "torsion", "N m/deg"
+  double ours = std::numeric_limits<double>::quiet_NaN();  ///< NaN: not computed (see note)
+  double low = 0, high = 0;                                ///< the published window
+  std::string reported, source;                            ///< as the data file gives them
+  std::string preparation;                                 ///< "facets and ligaments removed", ...
+  std::string note;                                        ///< why `ours` is missing, if it is
+  bool match() const { return ours >= low && ours <= high; }
+};
+
+struct DiscValidationResult {
+  std::string material, formulation, mesh_label;
+  Eigen::Index tets = 0, dofs = 0;
+  double disc_height_mm = 0, disc_area_mm2 = 0;
+  double nucleus_pressure_mpa = std::numeric_limits<double>::quiet_NaN();  ///< at 500 N
+  std::vector<DiscValidationRow> rows;
+  nlohmann::json whole_segments;  ///< the file's rows for scale, as read
+  std::string source;             ///< the file's overall source
+  double solve_s = 0;             ///< assembly, factorisation and the five solves
+};
+
+/// Reads the targets file; throws std::invalid_argument (one line) when it is unusable.
+nlohmann::json read_disc_targets(const std::string& path);
+
+/// Solves the five standard loads on `m` and compares with `targets` (read_disc_targets).
+DiscValidationResult run_disc_validation(const mesh::TetMesh& m,
+                                         const mesh::RegionMaterials& materials,
+                                         fem::Formulation formulation,
+                                         const nlohmann::json& targets,
+                                         const std::string& mesh_label,
+                                         const StageHooks& hooks = StageHooks());
+
+void print_disc_validation(std::ostream& os, const DiscValidationResult& r, bool markdown = false);
+nlohmann::json disc_validation_json(const DiscValidationResult& r);
+void write_disc_validation_csv(std::ostream& os, const DiscValidationResult& r);
+
+}  // namespace spinesim::studies
