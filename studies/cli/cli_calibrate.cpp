@@ -241,8 +241,10 @@ void register_calibrate(CLI::App& app) {
                                         "With --level: CGAL cell size, mm (--level all without it: "
                                         "min(2, disc height / 5) per level)")
                             ->capture_default_str();
-  cmd->add_option("--material", a->material,
-                  "Preset (real-disc, annulus-nucleus, rubber, polyethylene) or JSON file")
+  cmd->add_option(
+         "--material", a->material,
+         "Preset (real-disc, annulus-nucleus, fibre-reinforced, rubber, polyethylene) or JSON "
+         "file")
       ->capture_default_str();
   cmd->add_option("--train", a->train, "Load cases to fit (comma-separated, or all)")
       ->capture_default_str();

@@ -323,8 +323,10 @@ void register_mss(CLI::App& app) {
   cmd->add_option("--mesh", a->mesh_path,
                   "Disc mesh (VTU with `surface` endplate labels); required");
   a->material_option =
-      cmd->add_option("--material", a->material,
-                      "Preset (real-disc, annulus-nucleus, rubber, polyethylene) or JSON file")
+      cmd->add_option(
+             "--material", a->material,
+             "Preset (real-disc, annulus-nucleus, fibre-reinforced, rubber, polyethylene) or JSON "
+             "file")
           ->capture_default_str();
   cmd->add_option("--params", a->params,
                   "Tuned disc from `spinesim calibrate` (sets terms, scales and, unless given, the "

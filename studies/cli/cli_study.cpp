@@ -213,7 +213,8 @@ void run_drive(DriveArgs a) {
 // --- study materials ---------------------------------------------------------------------------
 
 struct MaterialsArgs {
-  std::string level = "L4-L5", materials = "real-disc,annulus-nucleus,rubber,polyethylene", csv,
+  std::string level = "L4-L5",
+              materials = "real-disc,annulus-nucleus,fibre-reinforced,rubber,polyethylene", csv,
               terms = "thesis+volume";
   double cell_size_mm = mesh::MeshOptions().cell_size_mm;
   bool json = false, quiet = false;

@@ -40,7 +40,8 @@ namespace spinesim::studies {
 namespace {
 namespace fs = std::filesystem;
 
-constexpr const char* kPresets[] = {"real-disc", "annulus-nucleus", "rubber", "polyethylene"};
+constexpr const char* kPresets[] = {"real-disc", "annulus-nucleus", "fibre-reinforced", "rubber",
+                                    "polyethylene"};
 constexpr double kSpineStudyForceN = 300;  // the spine studies' default force on T1
 
 /// Block rotation of a 6x6 wrench/motion matrix into the disc frame: K_local = R^T K R.

@@ -264,6 +264,11 @@ std::string describe_material(const mesh::RegionMaterials& materials) {
   s << " MPa, nu " << a.poisson_ratio;
   if (n.poisson_ratio != a.poisson_ratio) s << "/" << n.poisson_ratio;
   if (!materials.by_region.empty()) s << " (annulus/nucleus)";
+  const auto f = materials.fibres.find(int(mesh::Region::annulus));
+  if (f != materials.fibres.end())
+    s << "; annulus fibres E_f " << f->second.modulus_inner_mpa << "-"
+      << f->second.modulus_outer_mpa << " MPa at +-" << f->second.angle_inner_deg << "-"
+      << f->second.angle_outer_deg << " deg (inner-outer)";
   return s.str();
 }
 

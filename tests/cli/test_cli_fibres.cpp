@@ -1,0 +1,140 @@
+// The fibre-reinforced disc on the command line: `fem --formulation mixed` writes the pressure
+// and the annulus fibre field; `view --vectors` draws the fibres; `study disc-validation` sets
+// the disc beside in-vitro tests; bad options are one line.
+#include "cli_runner.hpp"
+
+#include <gtest/gtest.h>
+#include <stb_image.h>
+
+#include <nlohmann/json.hpp>
+
+#include "spinesim/mesh/io.hpp"
+
+#include <cmath>
+#include <filesystem>
+#include <memory>
+
+namespace spinesim::test_cli {
+namespace {
+
+/// A structured L4-L5 disc (fast to mesh and to solve), made once.
+const std::string& disc_vtu() {
+  static const std::string path = [] {
+    const std::string p = tmp("fibre_disc.vtu");
+    const CliRun r = run_spinesim("mesh disc --level L4-L5 --structured --quiet --out '" + p + "'");
+    EXPECT_EQ(r.status, 0) << r.err;
+    return p;
+  }();
+  return path;
+}
+
+/// `fem` on it with the fibre-reinforced material, mixed, under compression; the result VTU.
+const std::string& fibre_result() {
+  static const std::string path = [] {
+    const std::string p = tmp("fibre_result.vtu");
+    const CliRun r = run_spinesim("fem --mesh '" + disc_vtu() +
+                                  "' --material fibre-reinforced --formulation mixed --case "
+                                  "compression --json --out '" +
+                                  p + "'");
+    EXPECT_EQ(r.status, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["formulation"], "mixed");
+    EXPECT_EQ(j["fibres"], true);
+    EXPECT_GT(j["nucleus_pressure_mpa"].get<double>(), 0.0);
+    return p;
+  }();
+  return path;
+}
+
+TEST(CliFibres, MixedFemWritesThePressureAndTheFibreField) {
+  std::vector<mesh::DataArray> points, cells;
+  const mesh::TetMesh m = mesh::read_vtu(fibre_result(), &points, &cells);
+  const auto find = [](const std::vector<mesh::DataArray>& v, const std::string& name) {
+    for (const auto& a : v)
+      if (a.name == name) return &a;
+    return static_cast<const mesh::DataArray*>(nullptr);
+  };
+  const mesh::DataArray* p = find(points, "pressure");
+  const mesh::DataArray* f1 = find(cells, "fibre_direction_1");
+  const mesh::DataArray* f2 = find(cells, "fibre_direction_2");
+  const mesh::DataArray* depth = find(cells, "annulus_depth");
+  ASSERT_TRUE(p && f1 && f2 && depth);
+  ASSERT_EQ(f1->values.rows(), m.num_tets());
+  for (Eigen::Index t = 0; t < m.num_tets(); ++t) {
+    if (m.region(t) == 1) {
+      EXPECT_NEAR(f1->values.row(t).norm(), 1.0, 1e-9);
+      EXPECT_NEAR(f2->values.row(t).norm(), 1.0, 1e-9);
+      EXPECT_GE(depth->values(t, 0), 0.0);
+      EXPECT_LE(depth->values(t, 0), 1.0);
+    } else {
+      EXPECT_EQ(f1->values.row(t).norm(), 0.0);
+      EXPECT_EQ(depth->values(t, 0), -1.0);
+    }
+  }
+  // The nucleus is pressurised by the compression.
+  double nucleus = 0;
+  int n = 0;
+  for (Eigen::Index t = 0; t < m.num_tets(); ++t)
+    if (m.region(t) == 2)
+      for (int a = 0; a < 4; ++a) nucleus += p->values(m.T(t, a), 0), ++n;
+  EXPECT_GT(nucleus / n, 0.0);
+}
+
+TEST(CliFibres, BadFormulationsAreOneLine) {
+  expect_refused(run_spinesim("fem --mesh '" + disc_vtu() + "' --formulation mixed --order 1"),
+                 "needs --order 2");
+  expect_refused(run_spinesim("fem --mesh '" + disc_vtu() + "' --formulation penalty"),
+                 "unknown formulation");
+  expect_refused(run_spinesim("study disc-validation --formulation penalty"),
+                 "unknown formulation");
+}
+
+bool have_xvfb() { return std::system("command -v xvfb-run >/dev/null 2>&1") == 0; }
+
+TEST(CliFibres, TheViewerDrawsTheFibresAsRods) {
+  expect_refused(run_spinesim("view --play '" + fibre_result() + "' --vectors stress"),
+                 "fibre_direction_1, fibre_direction_2");
+  expect_refused(run_spinesim("view --play '" + fibre_result() + "' --camera 10"), "--camera");
+  if (!have_xvfb()) GTEST_SKIP() << "xvfb-run missing (apt-get install xvfb)";
+  const std::string png = tmp("fibres.png");
+  std::filesystem::remove(png);
+  const CliRun r = run_spinesim(
+      "view --play '" + fibre_result() +
+          "' --field fibre_angle_deg --vectors fibre_direction_1,fibre_direction_2 --camera "
+          "-60,35 --width 480 --height 360 --no-panel --frames 2 --json --screenshot '" +
+          png + "'",
+      "xvfb-run -a -s '-screen 0 640x480x24' ");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_GT(j["series"]["glyphs"].get<int>(), 100);
+  int width = 0, height = 0, channels = 0;
+  std::unique_ptr<unsigned char, void (*)(void*)> rgb(
+      stbi_load(png.c_str(), &width, &height, &channels, 3), stbi_image_free);
+  ASSERT_TRUE(rgb);
+  int orange = 0, cyan = 0;  // the two families' rods
+  for (int i = 0; i < width * height; ++i) {
+    const unsigned char* q = rgb.get() + 3 * i;
+    orange += q[0] > 180 && q[1] > 70 && q[1] < 160 && q[2] < 80;
+    cyan += q[2] > 180 && q[1] > 140 && q[0] < 120;
+  }
+  EXPECT_GT(orange, 100);
+  EXPECT_GT(cyan, 100);
+}
+
+TEST(CliFibres, DiscValidationSetsTheDiscBesideInVitroTests) {
+  const CliRun r = run_spinesim("study disc-validation --mesh '" + disc_vtu() + "' --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["rows"].size(), 6u);
+  for (const auto& row : j["rows"]) {
+    EXPECT_TRUE(row["verdict"] == "MATCH" || row["verdict"] == "MISS") << row.dump();
+    EXPECT_FALSE(row["source"].get<std::string>().empty());
+  }
+  expect_refused(run_spinesim("study disc-validation --level L9-L10"), "L9-L10");
+  expect_refused(run_spinesim("study disc-validation --targets /nonexistent.json"),
+                 "/nonexistent.json");
+  expect_refused(run_spinesim("study disc-validation --material nothing"), "unknown material");
+}
+
+}  // namespace
+}  // namespace spinesim::test_cli
