@@ -80,13 +80,18 @@ double axis_energy(double x, double k_pos, double k_neg, double lim_pos, double 
   return E;
 }
 
-/// Joint spring energy and its gradient in θ (x flexion/extension, y torsion, z lateral bending).
+/// Joint spring energy and its gradient in θ (x flexion/extension, y torsion, z lateral bending):
+/// the diagonal springs with their range-of-motion bumps, plus a disc's off-diagonal coupling.
 double joint_energy(const SpineModel& m, const Joint& j, const Vector3d& th, Vector3d& dE) {
   const double b = m.rom_bump_factor, w = m.rom_bump_onset;
-  return axis_energy(th.x(), j.k_flexion, j.k_extension, j.rom_flexion, j.rom_extension, b, w,
-                     dE.x()) +
-         axis_energy(th.y(), j.k_torsion, j.k_torsion, j.rom_torsion, j.rom_torsion, b, w, dE.y()) +
-         axis_energy(th.z(), j.k_lateral, j.k_lateral, j.rom_lateral, j.rom_lateral, b, w, dE.z());
+  const double E =
+      axis_energy(th.x(), j.k_flexion, j.k_extension, j.rom_flexion, j.rom_extension, b, w,
+                  dE.x()) +
+      axis_energy(th.y(), j.k_torsion, j.k_torsion, j.rom_torsion, j.rom_torsion, b, w, dE.y()) +
+      axis_energy(th.z(), j.k_lateral, j.k_lateral, j.rom_lateral, j.rom_lateral, b, w, dE.z());
+  const Vector3d coupled = j.coupling * th;
+  dE += coupled;
+  return E + 0.5 * th.dot(coupled);
 }
 
 Vector3d load_point(const SpineModel& m, const ExternalLoad& l) {
@@ -392,8 +397,10 @@ bool mirrored(const Vector3d& a, const Vector3d& b) {
 bool mirror_symmetric(const SpineModel& m) {
   for (const auto& v : m.vertebrae)
     if (v.centre_mm.x() != 0) return false;
+  // A mirror-symmetric joint spring keeps flexion apart from torsion and lateral bending (θ_x is
+  // even under x -> -x, θ_y and θ_z odd).
   for (const auto& j : m.joints)
-    if (j.point_mm.x() != 0) return false;
+    if (j.point_mm.x() != 0 || j.coupling(0, 1) != 0 || j.coupling(0, 2) != 0) return false;
   if (m.has_bushing && m.bushing.point_mm.x() != 0) return false;
   auto has_twin = [](const auto& items, const auto& same) {
     for (const auto& a : items) {

@@ -5,6 +5,7 @@
 
 #include "csv_table.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -362,6 +363,7 @@ SpineModel load_spine_model(const std::string& data_dir, const ModelOptions& opt
         throw std::runtime_error(k.path + ": joint stiffness of " + name + " must be > 0");
       m.joints.push_back(j);
     }
+    if (!options.disc_joints.empty()) apply_disc_joints(m.joints, options.disc_joints, data_dir);
     for (int f : options.fused_joints) {
       if (f < 0 || f >= int(m.joints.size()))
         throw std::invalid_argument("fused joint index out of range");
@@ -391,6 +393,61 @@ SpineModel load_spine_model(const std::string& data_dir, const ModelOptions& opt
     throw std::runtime_error(config_file + ": " + e.what());
   }
   return m;
+}
+
+void apply_disc_joints(std::vector<Joint>& joints, const std::string& name_or_path,
+                       const std::string& data_dir) {
+  fs::path path(name_or_path);
+  if (!fs::exists(path)) {
+    const fs::path preset = fs::path(data_dir) / "spine" / "disc_joints" / (name_or_path + ".json");
+    if (!fs::exists(preset)) {
+      std::string known;
+      const fs::path dir = fs::path(data_dir) / "spine" / "disc_joints";
+      if (fs::is_directory(dir))
+        for (const auto& e : fs::directory_iterator(dir))
+          if (e.path().extension() == ".json")
+            known += (known.empty() ? "" : ", ") + e.path().stem().string();
+      throw std::invalid_argument("unknown disc joints '" + name_or_path +
+                                  "' (no such file; presets: " + known + ")");
+    }
+    path = preset;
+  }
+  const std::string who = "disc joints '" + path.string() + "': ";
+  const json j = read_json_file(path.string(), "disc joints file");
+  if (!j.is_object() || !j.contains("joints") || !j.at("joints").is_object())
+    throw std::invalid_argument(who + "expected a 'joints' object");
+  const std::string source = j.value("source", path.filename().string());
+  for (Joint& joint : joints) {
+    if (!j.at("joints").contains(joint.name))
+      throw std::invalid_argument(who + "no stiffness for joint " + joint.name);
+    const json& e = j.at("joints").at(joint.name);
+    const json* rows =
+        e.is_object() && e.contains("K_nmm_per_rad") ? &e.at("K_nmm_per_rad") : nullptr;
+    Eigen::Matrix3d K;
+    bool ok = rows && rows->is_array() && rows->size() == 3;
+    for (int r = 0; ok && r < 3; ++r) {
+      const json& row = rows->at(std::size_t(r));
+      ok = row.is_array() && row.size() == 3;
+      for (int c = 0; ok && c < 3; ++c) {
+        ok = row.at(std::size_t(c)).is_number();
+        if (ok) K(r, c) = row.at(std::size_t(c)).get<double>();
+      }
+    }
+    if (!ok)
+      throw std::invalid_argument(who + joint.name +
+                                  ": 'K_nmm_per_rad' must be 3 rows of 3 numbers");
+    if (!K.allFinite() || (K - K.transpose()).norm() > 1e-6 * K.norm())
+      throw std::invalid_argument(who + joint.name + ": the stiffness is not finite and symmetric");
+    const Eigen::Matrix3d sym = 0.5 * (K + K.transpose());
+    if (!(Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(sym).eigenvalues().minCoeff() > 0))
+      throw std::invalid_argument(who + joint.name + ": the stiffness is not positive definite");
+    joint.k_flexion = joint.k_extension = sym(0, 0);
+    joint.k_torsion = sym(1, 1);
+    joint.k_lateral = sym(2, 2);
+    joint.coupling = sym;
+    joint.coupling.diagonal().setZero();
+    joint.stiffness_source = source;
+  }
 }
 
 }  // namespace spinesim::spine

@@ -64,6 +64,8 @@ void resolve_haptics_run_flags(HapticsRunFlags& flags);
 void register_bench(CLI::App& app);
 void register_spine_database(
     CLI::App& spine);  ///< spine database, under `spine` (cli_spine_database.cpp)
+void register_spine_disc_joints(
+    CLI::App& spine);                        ///< spine disc-joints (cli_spine_disc_joints.cpp)
 void register_spine_discs(CLI::App& spine);  ///< spine discs, under `spine` (cli_spine_discs.cpp)
 
 }  // namespace spinesim::cli

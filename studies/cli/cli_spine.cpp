@@ -42,7 +42,7 @@ namespace {
 
 struct SpineSolveArgs {
   std::vector<std::string> forces, moments, points;
-  std::string fusion, criterion = "polynomial", csv;
+  std::string fusion, criterion = "polynomial", csv, disc_joints;
   double power = 3;
   double tolerance_nmm = spine::SolveOptions().tolerance;
   int max_iterations = spine::SolveOptions().max_iterations;
@@ -115,6 +115,7 @@ void solve(const SpineSolveArgs& a) {
   model_options.muscles = !a.no_muscles;
   model_options.trunk_muscles = !a.no_trunk_muscles;
   model_options.gravity = !a.no_gravity;
+  model_options.disc_joints = a.disc_joints;
   if (!a.csv.empty()) require_output_folder(a.csv, "--csv");
 
   // 2. Model and equilibrium (studies/spine_solve.hpp).
@@ -160,6 +161,10 @@ void register_spine(CLI::App& app) {
                 "Lumbar muscles F.8-F.19 only: leave out the restored thoracic erector spinae and "
                 "rectus abdominis");
   cmd->add_flag("--no-gravity", a->no_gravity, "No weights (vertebrae, head, arms)");
+  cmd->add_option("--disc-joints", a->disc_joints,
+                  "Joint springs from each level's disc (a data/spine/disc_joints/ preset such as "
+                  "fibre-reinforced, or a file from `spine disc-joints`) in place of the thesis's "
+                  "F.4");
   cmd->add_option("--tolerance", a->tolerance_nmm, "Newton tolerance on max |dPi/dtheta|, N·mm")
       ->capture_default_str();
   cmd->add_option("--max-iterations", a->max_iterations, "Newton iterations before giving up")
@@ -192,6 +197,7 @@ void register_spine(CLI::App& app) {
   // `spinesim spine database` (thesis 3.5) lives in cli_spine_database.cpp.
   register_spine_database(*spine_cmd);
   register_spine_discs(*spine_cmd);
+  register_spine_disc_joints(*spine_cmd);
 }
 
 }  // namespace spinesim::cli

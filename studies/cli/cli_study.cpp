@@ -362,20 +362,24 @@ void register_materials(CLI::App& study) {
 
 struct SpineStudyArgs {
   double force_n = 300;
-  std::string csv;
+  std::string csv, disc_joints;
   bool json = false, quiet = false, no_trunk_muscles = false;
   spine::ModelOptions model() const {
     spine::ModelOptions o;
     o.trunk_muscles = !no_trunk_muscles;
+    o.disc_joints = disc_joints;
     return o;
   }
 };
 
-/// A line under the title when the study runs on the lumbar muscles only.
+/// Lines under the title when the study runs on the lumbar muscles only or on disc joints.
 void print_muscle_set(const SpineStudyArgs& a) {
   if (a.no_trunk_muscles)
     std::cout << "Muscles: F.8-F.19 only (--no-trunk-muscles: no thoracic erector spinae, no "
                  "rectus abdominis)\n\n";
+  if (!a.disc_joints.empty())
+    std::cout << "Joint springs: the discs of " << a.disc_joints
+              << " (--disc-joints) in place of the thesis's F.4\n\n";
 }
 
 void add_spine_study_options(CLI::App* cmd, SpineStudyArgs& a, bool with_force) {
@@ -387,6 +391,9 @@ void add_spine_study_options(CLI::App* cmd, SpineStudyArgs& a, bool with_force) 
                 "Lumbar muscles F.8-F.19 only: leave out the restored thoracic erector spinae and "
                 "rectus abdominis");
   cmd->add_flag("--quiet", a.quiet, "No progress on stderr");
+  cmd->add_option("--disc-joints", a.disc_joints,
+                  "Joint springs from each level's disc (a data/spine/disc_joints/ preset such as "
+                  "fibre-reinforced, or a file from `spine disc-joints`) in place of F.4");
 }
 
 /// Checks shared by the spine studies before any work; returns the progress hooks.

@@ -351,3 +351,25 @@ TEST(SpineDatabaseCli, RefusesBadInput) {
       run_spinesim("spine database --check --quiet --out " + in_quotes(tmp("missing.json"))),
       "missing.json");
 }
+
+// The discs as joint springs (--disc-joints): the spine solves, stiffer or softer per level than
+// F.4, and every spine study reports both ways.
+TEST(SpineSolveCli, DiscJointsReplaceTheThesisSprings) {
+  const nlohmann::json thesis = solve_json("--force T1:0,0,200");
+  const nlohmann::json disc = solve_json("--force T1:0,0,200 --disc-joints fibre-reinforced");
+  ASSERT_FALSE(thesis.empty());
+  ASSERT_FALSE(disc.empty());
+  // The thoracic discs are softer in flexion than F.4 (297-985 against 2700 N·mm/deg): T1 moves
+  // further forward.
+  const auto t1_z = [](const nlohmann::json& j) {
+    return j["vertebrae"][0]["translation_mm"][2].get<double>();
+  };
+  EXPECT_GT(t1_z(disc), t1_z(thesis));
+  for (const char* s : {"validation", "fusion", "trends"}) {
+    const CliRun r =
+        run_spinesim(std::string("study ") + s + " --disc-joints fibre-reinforced --quiet");
+    EXPECT_EQ(r.status, 0) << s << ": " << r.err;
+    EXPECT_NE(r.out.find("Joint springs: the discs of fibre-reinforced"), std::string::npos) << s;
+  }
+  expect_refused(run_spinesim("spine solve --disc-joints nowhere"), "presets: fibre-reinforced");
+}

@@ -497,3 +497,107 @@ TEST(SpineEquilibrium, SensitivityRefusesALoadIndexOutOfRange) {
   EXPECT_THROW(sp::displacement_sensitivity(m, {force_on("T1", Vector3d(0, 0, 10))}, s, 1),
                std::invalid_argument);
 }
+
+namespace {
+
+/// A disc-joint file with the same coupled 3×3 stiffness at every joint (N·mm/rad).
+std::string disc_joint_file(const Eigen::Matrix3d& K, const std::string& name) {
+  const std::string path = std::string(SPINESIM_TEST_TMP) + "/" + name;
+  std::ofstream f(path);
+  f << "{\"source\": \"test\", \"joints\": {";
+  bool first = true;
+  for (const auto& j : sp::joint_names()) {
+    f << (first ? "" : ",") << "\"" << j << "\": {\"K_nmm_per_rad\": [";
+    for (int r = 0; r < 3; ++r)
+      f << (r ? "," : "") << "[" << K(r, 0) << "," << K(r, 1) << "," << K(r, 2) << "]";
+    f << "]}";
+    first = false;
+  }
+  f << "}}\n";
+  return path;
+}
+
+Eigen::Matrix3d coupled_stiffness() {
+  Eigen::Matrix3d K;
+  K << 90000, 12000, -20000,  //
+      12000, 400000, 15000,   //
+      -20000, 15000, 150000;
+  return K;
+}
+
+}  // namespace
+
+// A disc joint's coupled spring: a small couple on L5 over the bare spine turns L5-S1 by K⁻¹M.
+TEST(SpineEquilibrium, DiscJointCouplingGivesThetaEqualsKInverseM) {
+  sp::ModelOptions o;
+  o.gravity = o.ligaments = o.muscles = o.iap = false;
+  o.disc_joints = disc_joint_file(coupled_stiffness(), "disc_joints_test.json");
+  const sp::SpineModel m = sp::load_spine_model(SPINESIM_DATA_DIR, o);
+  const sp::Joint& j = m.joints[16];
+  EXPECT_EQ(j.stiffness_source, "test");
+  EXPECT_DOUBLE_EQ(j.k_flexion, 90000);
+  EXPECT_DOUBLE_EQ(j.k_extension, 90000);
+  EXPECT_DOUBLE_EQ(j.k_torsion, 400000);
+  EXPECT_DOUBLE_EQ(j.k_lateral, 150000);
+  EXPECT_DOUBLE_EQ(j.coupling(0, 1), 12000);
+  EXPECT_DOUBLE_EQ(j.coupling(1, 1), 0);
+  const Vector3d M(300, -500, 200);  // N·mm: well inside every range of motion
+  sp::ExternalLoad l;
+  l.vertebra = sp::vertebra_index("L5");
+  l.moment_nmm = M;
+  sp::SolveOptions tight;
+  tight.tolerance = 1e-9;
+  const sp::SpineSolution s = sp::solve_spine(m, {l}, tight);
+  const Vector3d expected = coupled_stiffness().ldlt().solve(M);
+  const Vector3d theta = s.theta.segment<3>(3 * 16);
+  EXPECT_LT((theta - expected).norm(), 1e-3 * expected.norm())
+      << theta.transpose() << " vs " << expected.transpose();
+  // The joints above carry nothing.
+  EXPECT_LT(s.theta.head(3 * 16).norm(), 1e-6 * expected.norm());
+}
+
+TEST(SpineEquilibrium, GradientMatchesFiniteDifferencesWithDiscJoints) {
+  sp::ModelOptions o;
+  o.disc_joints = disc_joint_file(coupled_stiffness(), "disc_joints_grad.json");
+  const sp::SpineModel m = sp::load_spine_model(SPINESIM_DATA_DIR, o);
+  VectorXd theta(sp::dof_count(m));
+  for (Eigen::Index i = 0; i < theta.size(); ++i) theta[i] = 0.01 * std::cos(0.7 * double(i) + 0.3);
+  const VectorXd F = VectorXd::Constant(Eigen::Index(m.muscles.size()), 25.0);
+  const std::vector<sp::ExternalLoad> loads;
+  VectorXd g;
+  sp::potential(m, loads, F, theta, &g);
+  for (Eigen::Index i : {Eigen::Index(3 * 16), Eigen::Index(3 * 16 + 1), Eigen::Index(3 * 9 + 2)}) {
+    const double h = 1e-6;
+    VectorXd a = theta, b = theta;
+    a[i] += h;
+    b[i] -= h;
+    const double fd =
+        (sp::potential(m, loads, F, a, nullptr) - sp::potential(m, loads, F, b, nullptr)) / (2 * h);
+    EXPECT_NEAR(g[i], fd, 1e-5 * std::max(1.0, std::abs(fd))) << i;
+  }
+}
+
+TEST(SpineModelDiscJoints, BadFilesAreRefusedInOneLine) {
+  const auto refusal = [](const std::string& path) {
+    sp::ModelOptions o;
+    o.disc_joints = path;
+    try {
+      sp::load_spine_model(SPINESIM_DATA_DIR, o);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(refusal("no-such-preset").find("presets: fibre-reinforced"), std::string::npos);
+  Eigen::Matrix3d indefinite = coupled_stiffness();
+  indefinite(1, 1) = -1;
+  EXPECT_NE(refusal(disc_joint_file(indefinite, "dj_bad.json")).find("positive definite"),
+            std::string::npos);
+  Eigen::Matrix3d asym = coupled_stiffness();
+  asym(0, 1) += 5000;
+  EXPECT_NE(refusal(disc_joint_file(asym, "dj_asym.json")).find("symmetric"), std::string::npos);
+  const std::string partial = std::string(SPINESIM_TEST_TMP) + "/dj_partial.json";
+  std::ofstream(partial)
+      << "{\"joints\": {\"L4-L5\": {\"K_nmm_per_rad\": [[1,0,0],[0,1,0],[0,0,1]]}}}";
+  EXPECT_NE(refusal(partial).find("no stiffness for joint T1-T2"), std::string::npos);
+}

@@ -41,12 +41,17 @@ struct Vertebra {
 
 /// Spherical joint with a rotational spring; θ (rotation vector of the upper vertebra relative
 /// to the lower one, in the lower one's axes) has components x = flexion (+) / extension (−),
-/// y = axial torsion, z = lateral bending.
+/// y = axial torsion, z = lateral bending. The spring is the thesis's F.4 (diagonal, flexion and
+/// extension apart) or a disc's 3×3 rotational stiffness about the joint point
+/// (ModelOptions::disc_joints): its diagonal in the k's, its off-diagonal in `coupling`
+/// (energy ½ θᵀ coupling θ on top of the diagonal springs).
 struct Joint {
   std::string name;
   Eigen::Vector3d point_mm;                                                     ///< table F.2
   double k_flexion = 0, k_extension = 0, k_lateral = 0, k_torsion = 0;          ///< N·mm/rad (F.4)
   double rom_flexion = 0, rom_extension = 0, rom_lateral = 0, rom_torsion = 0;  ///< rad (F.5)
+  Eigen::Matrix3d coupling = Eigen::Matrix3d::Zero();  ///< N·mm/rad, zero diagonal
+  std::string stiffness_source = "thesis F.4";
   bool fused = false;  ///< fixed joint (spinal fusion): θ ≡ 0
 };
 
@@ -107,7 +112,16 @@ struct ModelOptions {
   bool trunk_muscles = true;
   bool arms_forward = false;  ///< arms reaching forward (crate case) instead of hanging
   double body_mass_kg = 0;    ///< 0: spine_model.json's value
+  /// A disc-joint stiffness file (`spinesim spine disc-joints`; data/spine/disc_joints/): each
+  /// joint's spring becomes that level's disc 3×3 rotational stiffness about the joint point, in
+  /// place of F.4. A preset name (file stem in data/spine/disc_joints/) or a path; empty: F.4.
+  std::string disc_joints;
 };
+
+/// Reads a disc-joint file into the joints (every joint must be there, each 3×3 symmetric
+/// positive definite and finite). Throws std::invalid_argument with one line otherwise.
+void apply_disc_joints(std::vector<Joint>& joints, const std::string& name_or_path,
+                       const std::string& data_dir);
 
 struct SpineModel {
   std::vector<Vertebra> vertebrae;  ///< 17, T1…L5
