@@ -401,12 +401,14 @@ void apply_disc_joints(std::vector<Joint>& joints, const std::string& name_or_pa
   if (!fs::exists(path)) {
     const fs::path preset = fs::path(data_dir) / "spine" / "disc_joints" / (name_or_path + ".json");
     if (!fs::exists(preset)) {
-      std::string known;
+      std::vector<std::string> names;
       const fs::path dir = fs::path(data_dir) / "spine" / "disc_joints";
       if (fs::is_directory(dir))
         for (const auto& e : fs::directory_iterator(dir))
-          if (e.path().extension() == ".json")
-            known += (known.empty() ? "" : ", ") + e.path().stem().string();
+          if (e.path().extension() == ".json") names.push_back(e.path().stem().string());
+      std::sort(names.begin(), names.end());
+      std::string known;
+      for (const auto& n : names) known += (known.empty() ? "" : ", ") + n;
       throw std::invalid_argument("unknown disc joints '" + name_or_path +
                                   "' (no such file; presets: " + known + ")");
     }

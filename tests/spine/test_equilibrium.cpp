@@ -588,7 +588,7 @@ TEST(SpineModelDiscJoints, BadFilesAreRefusedInOneLine) {
     }
     return std::string();
   };
-  EXPECT_NE(refusal("no-such-preset").find("presets: fibre-reinforced"), std::string::npos);
+  EXPECT_NE(refusal("no-such-preset").find("presets: fibre-reinforced, tuned-mss"), std::string::npos);
   Eigen::Matrix3d indefinite = coupled_stiffness();
   indefinite(1, 1) = -1;
   EXPECT_NE(refusal(disc_joint_file(indefinite, "dj_bad.json")).find("positive definite"),
