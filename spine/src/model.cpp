@@ -418,7 +418,9 @@ void apply_disc_joints(std::vector<Joint>& joints, const std::string& name_or_pa
   const json j = read_json_file(path.string(), "disc joints file");
   if (!j.is_object() || !j.contains("joints") || !j.at("joints").is_object())
     throw std::invalid_argument(who + "expected a 'joints' object");
-  const std::string source = j.value("source", path.filename().string());
+  const std::string source = j.contains("source") && j.at("source").is_string()
+                                 ? j.at("source").get<std::string>()
+                                 : path.filename().string();
   for (Joint& joint : joints) {
     if (!j.at("joints").contains(joint.name))
       throw std::invalid_argument(who + "no stiffness for joint " + joint.name);

@@ -54,12 +54,26 @@ nlohmann::json read_disc_targets(const std::string& path) {
   const nlohmann::json j = read_json_file(path, "disc targets file");
   if (!j.is_object() || !j.contains("targets") || !j.at("targets").is_array())
     throw std::invalid_argument("disc targets file '" + path + "': expected a 'targets' array");
-  for (const auto& t : j.at("targets"))
+  for (const auto& t : j.at("targets")) {
     if (!t.is_object() || !t.contains("quantity") || !t.at("quantity").is_string() ||
         !t.contains("low") || !t.at("low").is_number() || !t.contains("high") ||
         !t.at("high").is_number())
       throw std::invalid_argument("disc targets file '" + path +
                                   "': every target needs 'quantity', 'low' and 'high'");
+    for (const char* key : {"units", "reported", "source"})
+      if (t.contains(key) && !t.at(key).is_string())
+        throw std::invalid_argument("disc targets file '" + path + "': '" + key +
+                                    "' must be a string");
+    for (const char* key : {"facets_removed", "ligaments_removed"})
+      if (t.contains(key) && !t.at(key).is_boolean() && !t.at(key).is_null())
+        throw std::invalid_argument("disc targets file '" + path + "': '" + key +
+                                    "' must be true, false or null");
+  }
+  if (j.contains("source") && !j.at("source").is_string())
+    throw std::invalid_argument("disc targets file '" + path + "': 'source' must be a string");
+  if (j.contains("whole_segments") && !j.at("whole_segments").is_array())
+    throw std::invalid_argument("disc targets file '" + path +
+                                "': 'whole_segments' must be an array");
   return j;
 }
 
@@ -152,9 +166,14 @@ void print_disc_validation(std::ostream& os, const DiscValidationResult& r, bool
   os << "\n  " << matches << " of " << compared << " inside the in-vitro window.\n";
   if (r.whole_segments.is_array() && !r.whole_segments.empty()) {
     os << "  Whole motion segments (posterior elements present; for scale, not targets):";
-    for (const auto& w : r.whole_segments)
-      os << " " << w.value("quantity", "") << " " << w.value("reported", "") << " "
-         << w.value("units", "") << ";";
+    for (const auto& w : r.whole_segments) {
+      const auto text = [&w](const char* key) {
+        return w.is_object() && w.contains(key) && w.at(key).is_string()
+                   ? w.at(key).get<std::string>()
+                   : std::string();
+      };
+      os << " " << text("quantity") << " " << text("reported") << " " << text("units") << ";";
+    }
     os << "\n";
   }
   os << "  Sources: data/validation/disc_in_vitro.json (each row's 'source').\n";

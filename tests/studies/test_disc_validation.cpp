@@ -9,6 +9,7 @@
 #include <Eigen/Cholesky>
 
 #include <cmath>
+#include <fstream>
 #include <stdexcept>
 
 using namespace spinesim;
@@ -83,6 +84,22 @@ TEST(DiscValidation, ABadTargetsFileIsRefusedInOneLine) {
   EXPECT_THROW(read_disc_targets("/nonexistent/targets.json"), std::invalid_argument);
   EXPECT_THROW(read_disc_targets(std::string(SPINESIM_DATA_DIR) + "/spine/spine_model.json"),
                std::invalid_argument);
+}
+
+}  // namespace
+
+namespace {
+
+TEST(DiscValidation, FieldsOfTheWrongTypeAreRefusedInOneLine) {
+  const std::string path = std::string(SPINESIM_TEST_TMP) + "/bad_targets.json";
+  for (const char* text :
+       {R"({"targets": [{"quantity": "torsion", "low": 1, "high": 2, "units": 5}]})",
+        R"({"targets": [{"quantity": "torsion", "low": 1, "high": 2, "facets_removed": "yes"}]})",
+        R"({"targets": [{"quantity": "torsion", "low": "1", "high": 2}]})",
+        R"({"source": 3, "targets": []})", R"({"targets": [], "whole_segments": {}})"}) {
+    std::ofstream(path) << text;
+    EXPECT_THROW(read_disc_targets(path), std::invalid_argument) << text;
+  }
 }
 
 }  // namespace
