@@ -152,7 +152,8 @@ def calibration(s, out_dir):
 
 def materials(s, out_dir):
     m = s["materials"]
-    names = [r["material"] for r in m]
+    # Two-word presets on two lines, so five names fit under the bars.
+    names = [r["material"].replace("-", "-\n", 1) for r in m]
     fig, axes = plt.subplots(1, 2, figsize=(10, 3.8))
     x = range(len(m))
     axes[0].bar([i - 0.2 for i in x], [100 * r["untuned"]["displacement_error"] for r in m], 0.4,
