@@ -142,21 +142,8 @@ RegionMaterials material_from_json(const nlohmann::json& j) {
 }
 
 RegionMaterials load_material(const std::string& name_or_path, const std::string& data_dir) {
-  namespace fs = std::filesystem;
-  fs::path path(name_or_path);
-  if (!fs::exists(path)) {
-    const fs::path preset = fs::path(data_dir) / "materials" / (name_or_path + ".json");
-    if (!fs::exists(preset)) {
-      std::string known;
-      if (fs::is_directory(fs::path(data_dir) / "materials"))
-        for (const auto& e : fs::directory_iterator(fs::path(data_dir) / "materials"))
-          if (e.path().extension() == ".json")
-            known += (known.empty() ? "" : ", ") + e.path().stem().string();
-      throw std::invalid_argument("unknown material '" + name_or_path +
-                                  "' (no such file; presets: " + known + ")");
-    }
-    path = preset;
-  }
+  const std::filesystem::path path = resolve_preset(
+      name_or_path, (std::filesystem::path(data_dir) / "materials").string(), "material");
   const nlohmann::json j = read_json_file(path.string(), "material file");
   try {
     return material_from_json(j);

@@ -397,23 +397,8 @@ SpineModel load_spine_model(const std::string& data_dir, const ModelOptions& opt
 
 void apply_disc_joints(std::vector<Joint>& joints, const std::string& name_or_path,
                        const std::string& data_dir) {
-  fs::path path(name_or_path);
-  if (!fs::exists(path)) {
-    const fs::path preset = fs::path(data_dir) / "spine" / "disc_joints" / (name_or_path + ".json");
-    if (!fs::exists(preset)) {
-      std::vector<std::string> names;
-      const fs::path dir = fs::path(data_dir) / "spine" / "disc_joints";
-      if (fs::is_directory(dir))
-        for (const auto& e : fs::directory_iterator(dir))
-          if (e.path().extension() == ".json") names.push_back(e.path().stem().string());
-      std::sort(names.begin(), names.end());
-      std::string known;
-      for (const auto& n : names) known += (known.empty() ? "" : ", ") + n;
-      throw std::invalid_argument("unknown disc joints '" + name_or_path +
-                                  "' (no such file; presets: " + known + ")");
-    }
-    path = preset;
-  }
+  const fs::path path = resolve_preset(
+      name_or_path, (fs::path(data_dir) / "spine" / "disc_joints").string(), "disc joints");
   const std::string who = "disc joints '" + path.string() + "': ";
   const json j = read_json_file(path.string(), "disc joints file");
   if (!j.is_object() || !j.contains("joints") || !j.at("joints").is_object())

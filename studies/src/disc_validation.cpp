@@ -8,9 +8,7 @@
 #include "spinesim/studies/table.hpp"
 
 #include <cmath>
-#include <iomanip>
 #include <map>
-#include <sstream>
 #include <stdexcept>
 
 namespace spinesim::studies {
@@ -39,13 +37,6 @@ double disc_height_mm(const mesh::TetMesh& m) {
     if (m.surface(i) == int(mesh::Surface::superior_endplate)) hi += m.V.row(i).transpose(), ++nh;
   }
   return (hi / nh - lo / nl).dot(m.frame.axes.col(1));
-}
-
-std::string number(double v, int precision = 3) {
-  if (!std::isfinite(v)) return "n/a";
-  std::ostringstream os;
-  os << std::setprecision(precision) << v;
-  return os.str();
 }
 
 }  // namespace
@@ -98,11 +89,14 @@ DiscValidationResult run_disc_validation(const mesh::TetMesh& m,
   options.formulation = formulation;
   const fem::DiscFem solver(m, materials, 2, fem::DiscFem::default_plate_center(m), options);
   r.dofs = solver.num_dofs();
-  // Stiffness of one case: its load over the plate motion along the load, disc frame.
+  // Stiffness of one case: its load over the plate motion along the load, disc frame. The
+  // compression's solution also gives the nucleus pressure.
   const Eigen::Matrix3d& axes = m.frame.axes;
+  fem::PlateSolution compression;
   const auto stiffness = [&](const char* name, int component) {
     const fem::LoadCase& c = fem::load_case(name);
     const fem::PlateSolution s = solver.solve_wrench(fem::global_wrench(c, m.frame));
+    if (component == 1) compression = s;
     const Eigen::Vector3d t = axes.transpose() * s.plate_motion.head<3>();
     const Eigen::Vector3d theta = axes.transpose() * s.plate_motion.tail<3>();
     if (component < 3) return std::abs(c.wrench_local(component) / t(component)) / 1000.0;
@@ -113,9 +107,7 @@ DiscValidationResult run_disc_validation(const mesh::TetMesh& m,
                                         {"flexion", stiffness("flexion", 3)},
                                         {"extension", stiffness("extension", 3)},
                                         {"lateral-bending", stiffness("lateral-bending", 5)}};
-  const fem::PlateSolution comp =
-      solver.solve_wrench(fem::global_wrench(fem::load_case("compression"), m.frame));
-  r.nucleus_pressure_mpa = comp.nucleus_pressure_mpa;
+  r.nucleus_pressure_mpa = compression.nucleus_pressure_mpa;
   const double mean_stress =
       std::abs(fem::load_case("compression").wrench_local(1)) / r.disc_area_mm2;
   ours["nucleus-pressure-ratio"] = r.nucleus_pressure_mpa / mean_stress;
@@ -146,9 +138,9 @@ DiscValidationResult run_disc_validation(const mesh::TetMesh& m,
 void print_disc_validation(std::ostream& os, const DiscValidationResult& r, bool markdown) {
   os << "Disc validation: " << r.mesh_label << " (" << r.tets << " tets, " << r.dofs
      << " DOF), material " << r.material << ", " << r.formulation << " formulation\n"
-     << "  disc height " << number(r.disc_height_mm) << " mm, mean cross-section "
-     << number(r.disc_area_mm2, 4) << " mm^2; nucleus pressure at 500 N "
-     << number(r.nucleus_pressure_mpa) << " MPa\n"
+     << "  disc height " << significant(r.disc_height_mm, 3) << " mm, mean cross-section "
+     << significant(r.disc_area_mm2, 4) << " mm^2; nucleus pressure at 500 N "
+     << significant(r.nucleus_pressure_mpa, 3) << " MPa\n"
      << "  stiffness = load / plate motion at 500 N and 7.5 N·m (disc frame, about the plate "
         "centre)\n\n";
   TextTable table({"quantity", "units", "ours", "in vitro", "window", "verdict", "tested as"}, 2);
@@ -157,8 +149,8 @@ void print_disc_validation(std::ostream& os, const DiscValidationResult& r, bool
     const bool have = std::isfinite(row.ours);
     compared += have;
     matches += have && row.match();
-    table.add({row.quantity, row.units, number(row.ours), row.reported,
-               number(row.low) + " - " + number(row.high),
+    table.add({row.quantity, row.units, significant(row.ours, 3), row.reported,
+               significant(row.low, 3) + " - " + significant(row.high, 3),
                have ? (row.match() ? "MATCH" : "MISS") : "n/a (" + row.note + ")",
                row.preparation});
   }
@@ -219,8 +211,9 @@ void write_disc_validation_csv(std::ostream& os, const DiscValidationResult& r) 
   os << "quantity,units,ours,low,high,verdict\n";
   for (const DiscValidationRow& row : r.rows)
     os << row.quantity << "," << row.units << ","
-       << (std::isfinite(row.ours) ? number(row.ours, 6) : "") << "," << row.low << "," << row.high
-       << "," << (std::isfinite(row.ours) ? (row.match() ? "MATCH" : "MISS") : "n/a") << "\n";
+       << (std::isfinite(row.ours) ? significant(row.ours, 6) : "") << "," << row.low << ","
+       << row.high << "," << (std::isfinite(row.ours) ? (row.match() ? "MATCH" : "MISS") : "n/a")
+       << "\n";
 }
 
 }  // namespace spinesim::studies

@@ -150,3 +150,21 @@ TEST(OutputSet, AllOrNothing) {
   EXPECT_TRUE(fs::exists(b));
   EXPECT_THROW(set.stage("/dev/null"), std::invalid_argument);
 }
+
+TEST(ResolvePreset, ThePathItselfThenTheFolderThenOneLineListingThePresets) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::path(SPINESIM_TEST_TMP) / "presets";
+  fs::create_directories(dir);
+  for (const char* n : {"zeta", "alpha"}) std::ofstream(dir / (std::string(n) + ".json")) << "{}";
+  std::ofstream(dir / "notes.txt") << "not a preset";
+  EXPECT_EQ(spinesim::resolve_preset("alpha", dir.string(), "thing"),
+            (dir / "alpha.json").string());
+  const std::string direct = (dir / "zeta.json").string();
+  EXPECT_EQ(spinesim::resolve_preset(direct, "/nonexistent", "thing"), direct);
+  try {
+    spinesim::resolve_preset("beta", dir.string(), "thing");
+    ADD_FAILURE() << "expected a refusal";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "unknown thing 'beta' (no such file; presets: alpha, zeta)");
+  }
+}

@@ -8,11 +8,14 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstddef>
 #include <cstring>
+#include <filesystem>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -119,6 +122,26 @@ inline nlohmann::json read_json_file(const std::string& path, const std::string&
     if (why.find("] ") != std::string::npos) why = why.substr(why.find("] ") + 2);
     throw std::invalid_argument(what + " '" + path + "' cannot be read: " + why);
   }
+}
+
+/// A preset name or a path: `name_or_path` itself when it exists, else `folder`/NAME.json. Neither:
+/// std::invalid_argument "unknown WHAT 'NAME' (no such file; presets: a, b)", the presets being
+/// the .json files of `folder` in name order.
+inline std::string resolve_preset(const std::string& name_or_path, const std::string& folder,
+                                  const std::string& what) {
+  namespace fs = std::filesystem;
+  if (fs::exists(name_or_path)) return name_or_path;
+  const fs::path preset = fs::path(folder) / (name_or_path + ".json");
+  if (fs::exists(preset)) return preset.string();
+  std::vector<std::string> names;
+  if (fs::is_directory(folder))
+    for (const auto& e : fs::directory_iterator(folder))
+      if (e.path().extension() == ".json") names.push_back(e.path().stem().string());
+  std::sort(names.begin(), names.end());
+  std::string known;
+  for (const auto& n : names) known += (known.empty() ? "" : ", ") + n;
+  throw std::invalid_argument("unknown " + what + " '" + name_or_path +
+                              "' (no such file; presets: " + known + ")");
 }
 
 }  // namespace spinesim
