@@ -105,11 +105,39 @@ struct State {
   BodyLoads loads;
   VectorXd ligament_t, muscle_t;
   Eigen::Matrix<double, 6, 1> bushing = Eigen::Matrix<double, 6, 1>::Zero();
+  std::vector<Vector3d> contact_f, contact_x;
   explicit State(std::size_t n) : loads(n) {}
 };
 
+/// The back's contact points: springs on the contact surface, or — when `dead` is given (one force
+/// per point) — those forces as dead loads (what the recruitment assumes the chair supplies).
+void add_contacts(const SpineModel& m, const std::vector<Vector3d>* dead, State& s) {
+  const auto& P = s.poses;
+  s.contact_f.assign(m.contacts.size(), Vector3d::Zero());
+  s.contact_x.assign(m.contacts.size(), Vector3d::Zero());
+  for (std::size_t i = 0; i < m.contacts.size(); ++i) {
+    const ContactPoint& c = m.contacts[i];
+    const Vector3d x = place(P, c.body, c.point_mm);
+    s.contact_x[i] = x;
+    if (dead) {
+      s.contact_f[i] = (*dead)[i];
+      s.energy -= (*dead)[i].dot(x - c.point_mm);
+      s.loads.add(c.body, x, (*dead)[i]);
+      continue;
+    }
+    if (!m.contact_surface) continue;
+    Vector3d grad;
+    const double depth = -m.contact_surface->level(x, grad);
+    if (!(depth > 0)) continue;
+    double dq = 0;
+    s.energy += c.k_n_per_mm * smooth_half_square(depth, kContactToeMm, dq);
+    s.contact_f[i] = c.k_n_per_mm * dq * grad;
+    s.loads.add(c.body, x, s.contact_f[i]);
+  }
+}
+
 State evaluate(const SpineModel& m, const std::vector<ExternalLoad>& ext, const VectorXd& F,
-               const VectorXd& theta) {
+               const VectorXd& theta, const std::vector<Vector3d>* dead_contacts = nullptr) {
   const std::size_t n = m.joints.size();
   State s(n);
   s.poses = vertebra_poses(m, theta);
@@ -185,6 +213,7 @@ State evaluate(const SpineModel& m, const std::vector<ExternalLoad>& ext, const 
     s.loads.couple(b.body, tau);
     s.bushing << f, tau;
   }
+  add_contacts(m, dead_contacts, s);
   return s;
 }
 
@@ -299,9 +328,9 @@ class Newton {
     return Eigen::MatrixXd(0.5 * (H + H.transpose()));
   }
 
-  /// Minimises Π from θ = 0; throws SolveError when the gradient does not reach the tolerance.
-  VectorXd solve(int& iterations, double& gradient_norm) const {
-    VectorXd theta = VectorXd::Zero(dof_count(m_)), g;
+  /// Minimises Π from `start`; throws SolveError when the gradient does not reach the tolerance.
+  VectorXd solve(const VectorXd& start, int& iterations, double& gradient_norm) const {
+    VectorXd theta = start, g;
     double E = energy_grad(theta, g);
     const double tolerance = std::max(o_.tolerance, o_.relative_tolerance * worst(g));
     int it = 0;
@@ -386,6 +415,13 @@ bool sagittal(const std::vector<ExternalLoad>& loads) {
   return true;
 }
 
+/// Only flexion/extension coordinates are non-zero.
+bool sagittal_posture(const VectorXd& theta) {
+  for (Eigen::Index k = 0; k < theta.size(); ++k)
+    if (k % 3 != 0 && theta[k] != 0) return false;
+  return true;
+}
+
 /// A point and its mirror image x → −x are the same to round-off.
 bool mirrored(const Vector3d& a, const Vector3d& b) {
   return std::abs(a.x() + b.x()) < 1e-9 && std::abs(a.y() - b.y()) < 1e-9 &&
@@ -402,6 +438,8 @@ bool mirror_symmetric(const SpineModel& m) {
   for (const auto& j : m.joints)
     if (j.point_mm.x() != 0 || j.coupling(0, 1) != 0 || j.coupling(0, 2) != 0) return false;
   if (m.has_bushing && m.bushing.point_mm.x() != 0) return false;
+  if (!m.contacts.empty() && m.contact_surface && !m.contact_surface->mirror_symmetric())
+    return false;
   auto has_twin = [](const auto& items, const auto& same) {
     for (const auto& a : items) {
       bool found = false;
@@ -423,10 +461,15 @@ bool mirror_symmetric(const SpineModel& m) {
                   [&](const Ligament& a, const Ligament& b) {
                     return line_twin(a, b) && a.k_n_per_mm == b.k_n_per_mm;
                   }) &&
-         has_twin(m.weights, [](const PointLoad& a, const PointLoad& b) {
+         has_twin(m.weights,
+                  [](const PointLoad& a, const PointLoad& b) {
+                    return a.body == b.body && mirrored(a.point_mm, b.point_mm) &&
+                           a.force_n.x() == -b.force_n.x() && a.force_n.y() == b.force_n.y() &&
+                           a.force_n.z() == b.force_n.z();
+                  }) &&
+         has_twin(m.contacts, [](const ContactPoint& a, const ContactPoint& b) {
            return a.body == b.body && mirrored(a.point_mm, b.point_mm) &&
-                  a.force_n.x() == -b.force_n.x() && a.force_n.y() == b.force_n.y() &&
-                  a.force_n.z() == b.force_n.z();
+                  a.k_n_per_mm == b.k_n_per_mm;
          });
 }
 
@@ -486,6 +529,8 @@ void report(const SpineModel& m, const State& s, SpineSolution& out) {
   out.ligament_force_n = s.ligament_t;
   out.muscle_force_n = s.muscle_t;
   out.bushing_wrench = s.bushing;
+  out.contact_force_n = s.contact_f;
+  out.contact_point_mm = s.contact_x;
 }
 
 }  // namespace
@@ -499,32 +544,45 @@ double potential(const SpineModel& m, const std::vector<ExternalLoad>& loads,
 }
 
 void recruitment_problem(const SpineModel& m, const std::vector<ExternalLoad>& loads,
-                         Eigen::MatrixXd& arm, VectorXd& load_moment_nmm,
-                         std::vector<int>& joints) {
+                         Eigen::MatrixXd& arm, VectorXd& load_moment_nmm, std::vector<int>& joints,
+                         const VectorXd& posture, const std::vector<Vector3d>* contact_forces) {
   check_loads(m, loads, nullptr);
+  const VectorXd theta = posture.size() ? posture : VectorXd::Zero(dof_count(m));
+  if (theta.size() != dof_count(m) || !theta.allFinite())
+    throw std::invalid_argument("recruitment posture: " + std::to_string(dof_count(m)) +
+                                " finite joint coordinates expected");
+  if (contact_forces && contact_forces->size() != m.contacts.size())
+    throw std::invalid_argument("recruitment contact forces: one per contact point expected");
   joints.clear();
   for (int j : m.recruited_joints)
     if (!m.joints[std::size_t(j)].fused) joints.push_back(j);
-  // Reference posture: joints, ligaments and the bushing are unloaded; gravity and the external
-  // loads (and nothing else) must be balanced by the muscles about each recruited joint.
-  const VectorXd theta0 = VectorXd::Zero(dof_count(m));
-  const State s = evaluate(m, loads, VectorXd(), theta0);
-  std::vector<Vector3d> F, M;
-  resultants_above(m, s, F, M);
+  // What the muscles and the joints' shares must balance: ∂Π/∂θ of everything but the muscles
+  // (in the reference posture, joints, ligaments and bushing are unloaded and this is minus the
+  // moment of gravity and the external loads about each joint).
+  const State s = evaluate(m, loads, VectorXd(), theta, contact_forces);
+  const VectorXd g = gradient_of(m, s, theta);
   const Eigen::Index nm = Eigen::Index(m.muscles.size());
   arm = Eigen::MatrixXd::Zero(3 * Eigen::Index(joints.size()), nm);
   load_moment_nmm.resize(3 * Eigen::Index(joints.size()));
-  for (std::size_t r = 0; r < joints.size(); ++r) {
-    const int j = joints[r];
-    const Vector3d c = m.joints[std::size_t(j)].point_mm;
-    load_moment_nmm.segment<3>(3 * Eigen::Index(r)) = -M[std::size_t(j)];
-    auto above = [j](int body) { return body != kGround && body <= j; };
-    for (Eigen::Index i = 0; i < nm; ++i) {
-      const Muscle& mu = m.muscles[std::size_t(i)];
-      if (above(mu.body_a) == above(mu.body_b)) continue;          // does not cross joint j
-      const Vector3d u = (mu.a_mm - mu.b_mm) / mu.rest_length_mm;  // unit tension pulls a towards b
+  for (std::size_t r = 0; r < joints.size(); ++r)
+    load_moment_nmm.segment<3>(3 * Eigen::Index(r)) = g.segment<3>(3 * joints[r]);
+  // A unit tension's generalised force, J_rᵀ R_kᵀ (moment about the moved joint point of its pull
+  // on the part above): the same map gradient_of() applies.
+  const auto& P = s.poses;
+  for (Eigen::Index i = 0; i < nm; ++i) {
+    const Muscle& mu = m.muscles[std::size_t(i)];
+    const Vector3d xa = place(P, mu.body_a, mu.a_mm), xb = place(P, mu.body_b, mu.b_mm);
+    const Vector3d u = (xa - xb).normalized();  // a unit tension pulls a towards b
+    for (std::size_t r = 0; r < joints.size(); ++r) {
+      const std::size_t j = std::size_t(joints[r]);
+      auto above = [j](int body) { return body != kGround && std::size_t(body) <= j; };
+      if (above(mu.body_a) == above(mu.body_b)) continue;  // does not cross joint j
+      const Vector3d c = joint_point(m, P, j);
+      const Vector3d M =
+          above(mu.body_a) ? Vector3d((xa - c).cross(-u)) : Vector3d((xb - c).cross(u));
+      const Vector3d th = theta.segment<3>(3 * Eigen::Index(j));
       arm.block<3, 1>(3 * Eigen::Index(r), i) =
-          above(mu.body_a) ? Vector3d((mu.a_mm - c).cross(-u)) : Vector3d((mu.b_mm - c).cross(u));
+          right_jacobian(th).transpose() * P[j].R.transpose() * M;
     }
   }
 }
@@ -536,6 +594,9 @@ SpineSolution solve_spine(const SpineModel& m, const std::vector<ExternalLoad>& 
   if (!(o.tolerance > 0) || o.max_iterations < 1 || !(o.fd_step > 0))
     throw std::invalid_argument(
         "solve_spine: tolerance and finite-difference step must be > 0, iterations >= 1");
+  if (o.posture.size() && (o.posture.size() != dof_count(m) || !o.posture.allFinite()))
+    throw std::invalid_argument("solve_spine: the posture needs " + std::to_string(dof_count(m)) +
+                                " finite joint coordinates");
   Timer timer;
 
   VectorXd F;  // recruited muscle forces (empty: muscles off)
@@ -543,7 +604,9 @@ SpineSolution solve_spine(const SpineModel& m, const std::vector<ExternalLoad>& 
     Eigen::MatrixXd arm;
     VectorXd b;
     std::vector<int> joints;
-    recruitment_problem(m, loads, arm, b, joints);
+    recruitment_problem(
+        m, loads, arm, b, joints, o.posture,
+        o.recruitment_contact_forces.empty() ? nullptr : &o.recruitment_contact_forces);
     out.recruitment = recruit(m, arm, b, o.recruitment);
     if (!out.recruitment.success)
       throw SolveError("muscle recruitment failed (Ipopt: " + out.recruitment.status + ")");
@@ -554,13 +617,25 @@ SpineSolution solve_spine(const SpineModel& m, const std::vector<ExternalLoad>& 
   // A symmetric model under sagittal loads has a symmetric equilibrium: solve for it in the
   // sagittal plane (deterministic; where it is unstable, which way the spine would buckle is
   // decided by round-off otherwise) and judge its stability over all coordinates.
-  out.sagittal_solve = sagittal(loads) && mirror_symmetric(m);
-  const Newton newton(m, loads, F, o, out.sagittal_solve), full(m, loads, F, o, false);
-  out.theta = newton.solve(out.iterations, out.gradient_norm);
+  // Recruited in another posture, the muscles' short-range springs rest there.
+  const SpineModel* model = &m;
+  SpineModel posed;
+  VectorXd start = VectorXd::Zero(dof_count(m));
+  if (o.posture.size()) {
+    start = o.posture;
+    posed = m;
+    const std::vector<Pose> P = vertebra_poses(m, o.posture);
+    for (Muscle& mu : posed.muscles)
+      mu.rest_length_mm = (place(P, mu.body_a, mu.a_mm) - place(P, mu.body_b, mu.b_mm)).norm();
+    model = &posed;
+  }
+  out.sagittal_solve = sagittal(loads) && mirror_symmetric(m) && sagittal_posture(start);
+  const Newton newton(*model, loads, F, o, out.sagittal_solve), full(*model, loads, F, o, false);
+  out.theta = newton.solve(start, out.iterations, out.gradient_norm);
   out.converged = true;
-  assess_stability(m, full, out.theta, out);
+  assess_stability(*model, full, out.theta, out);
   out.seconds_equilibrium = timer.seconds();
-  report(m, evaluate(m, loads, F, out.theta), out);
+  report(*model, evaluate(*model, loads, F, out.theta), out);
   return out;
 }
 

@@ -46,6 +46,14 @@ struct SolveOptions {
   double fd_step = 1e-7;  ///< rad, for the finite-difference Hessian
   bool warn_above_600n =
       true;  ///< SpineSolution::warnings names forces beyond 600 N (thesis limit)
+  /// Posture (joint coordinates, rad; 3 per joint) at which the muscles are recruited, their
+  /// short-range springs rest and Newton starts. Empty: the reference posture θ = 0. The joint
+  /// springs, ligaments and bushing keep their reference rest state, so whatever they carry in
+  /// this posture is part of what the recruitment balances (a flexed seated lumbar spine).
+  Eigen::VectorXd posture;
+  /// The model's contact forces (world axes, N, one per SpineModel::contacts) the recruitment
+  /// takes as dead loads at the contact points; empty: the contact forces at `posture`.
+  std::vector<Eigen::Vector3d> recruitment_contact_forces;
 };
 
 /// Force the lower side of a joint exerts on everything above it, and the moment it carries.
@@ -77,6 +85,9 @@ struct SpineSolution {
   Eigen::VectorXd ligament_force_n, muscle_force_n;  ///< tensions in the final posture
   Recruitment recruitment;                           ///< the recruited forces F (reference posture)
   Eigen::Matrix<double, 6, 1> bushing_wrench;  ///< IAP force (N) and moment (N·mm) on the ribs
+  /// Per SpineModel::contacts: the force the surface exerts on the back (world axes, N) and the
+  /// contact point's position (mm) in the final posture.
+  std::vector<Eigen::Vector3d> contact_force_n, contact_point_mm;
   /// Smallest eigenvalue of the tangent stiffness ∂²Π/∂θ² at the solution (N·mm/rad; ≤ 0: not
   /// stable) and the joint axis that dominates its mode.
   double min_stiffness_nmm_per_rad = 0;
@@ -136,10 +147,15 @@ double potential(const SpineModel& m, const std::vector<ExternalLoad>& loads,
                  const Eigen::VectorXd& muscle_force_n, const Eigen::VectorXd& theta,
                  Eigen::VectorXd* gradient = nullptr);
 
-/// Moment arms (3 per recruited, non-fused joint × muscles) and load moments in the reference
-/// posture, as recruit() takes them.
+/// Moment arms (3 per recruited, non-fused joint × muscles) and load moments, as recruit() takes
+/// them, at the posture `theta` (empty: the reference posture) in generalised form: arm(·, i) is
+/// −∂L_i/∂θ (the generalised force of a unit tension; at θ = 0 the moment about the joint point)
+/// and the loads are ∂Π/∂θ of everything but the muscles (at θ = 0: minus the moment of gravity
+/// and the external loads). `contact_forces` (if given, one per contact point) replaces the
+/// contact springs by those dead loads.
 void recruitment_problem(const SpineModel& m, const std::vector<ExternalLoad>& loads,
                          Eigen::MatrixXd& arm, Eigen::VectorXd& load_moment_nmm,
-                         std::vector<int>& joints);
+                         std::vector<int>& joints, const Eigen::VectorXd& theta = Eigen::VectorXd(),
+                         const std::vector<Eigen::Vector3d>* contact_forces = nullptr);
 
 }  // namespace spinesim::spine

@@ -13,6 +13,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -95,6 +96,29 @@ struct PointLoad {
   Eigen::Vector3d force_n;
 };
 
+/// A fixed surface the back can lean on (a chair's backrest), in the model's frame (the pelvis's:
+/// fixed parts are the ground): a level function φ(x) in mm, positive on the body's side and
+/// negative inside the surface, with ∇φ close to the unit normal and C¹ where the back touches.
+class ContactSurface {
+ public:
+  virtual ~ContactSurface() = default;
+  /// φ(x_mm) and its gradient.
+  virtual double level(const Eigen::Vector3d& x_mm, Eigen::Vector3d& gradient) const = 0;
+  /// Is the surface its own mirror image in x → −x? (The sagittal solve needs it.)
+  virtual bool mirror_symmetric() const { return false; }
+};
+
+/// A point of the back — on a vertebra, through the soft tissue — that presses on the contact
+/// surface: compliant, frictionless, one-sided. With penetration δ = max(−φ(x), 0):
+/// Π = ½ k δ² (its stiffness ramped in over kContactToeMm, so Π is C²), force k δ ∇φ.
+struct ContactPoint {
+  std::string name;
+  int body = kGround;
+  Eigen::Vector3d point_mm;  ///< reference posture
+  double k_n_per_mm = 0;
+};
+inline constexpr double kContactToeMm = 0.5;
+
 /// Appendix C recomputed from its inputs (never pasted).
 struct IapStiffness {
   double s_mean_mm2 = 0, h_l1l5_mm = 0, h_mm = 0, a_mm = 0, pressure_mpa = 0;
@@ -133,6 +157,9 @@ struct SpineModel {
   IapStiffness iap;
   std::vector<PointLoad>
       weights;  ///< gravity on vertebrae, head+neck, arms (empty without gravity)
+  /// The back's contact points and the surface they press on (none: no contact; seating.hpp).
+  std::vector<ContactPoint> contacts;
+  std::shared_ptr<const ContactSurface> contact_surface;
   std::vector<int> recruited_joints;  ///< joints whose equilibrium the muscles are recruited for
   double muscle_q = 10;               ///< short-range stiffness factor (k = q F / L0)
   double rom_bump_factor = 100;       ///< joint stiffness multiplier beyond the F.5 range
