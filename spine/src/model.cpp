@@ -4,6 +4,7 @@
 #include "spinesim/common/input_file.hpp"
 
 #include "csv_table.hpp"
+#include "json_fields.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <nlohmann/json.hpp>
@@ -21,7 +22,10 @@ namespace spinesim::spine {
 namespace {
 namespace fs = std::filesystem;
 using detail::CsvTable;
+using detail::number;
 using detail::read_csv;
+using detail::read_json;
+using detail::vec3;
 using Eigen::Vector3d;
 using nlohmann::json;
 
@@ -38,32 +42,6 @@ std::string joined(const std::vector<std::string>& names) {
   std::string s;
   for (const auto& n : names) s += (s.empty() ? "" : ", ") + n;
   return s;
-}
-
-json read_json(const fs::path& path) {
-  try {
-    return read_json_file(path.string(), "model file");
-  } catch (const std::invalid_argument& e) {  // broken data: the model's contract is runtime_error
-    throw std::runtime_error(e.what());
-  }
-}
-
-/// Value at `key` of `j` as a finite number; throws naming the file.
-double number(const json& j, const std::string& key, const std::string& file) {
-  if (!j.contains(key) || !j.at(key).is_number())
-    throw std::runtime_error(file + ": missing number '" + key + "'");
-  const double v = j.at(key).get<double>();
-  if (!std::isfinite(v)) throw std::runtime_error(file + ": '" + key + "' is not finite");
-  return v;
-}
-
-Vector3d vec3(const json& j, const std::string& key, const std::string& file) {
-  if (!j.contains(key) || !j.at(key).is_array() || j.at(key).size() != 3)
-    throw std::runtime_error(file + ": '" + key + "' must be an array of 3 numbers");
-  Vector3d v;
-  for (int i = 0; i < 3; ++i) v[i] = j.at(key).at(std::size_t(i)).get<double>();
-  if (!v.allFinite()) throw std::runtime_error(file + ": '" + key + "' is not finite");
-  return v;
 }
 
 Vector3d row_point(const CsvTable& t, std::size_t r, const std::string& prefix = "") {
@@ -377,7 +355,7 @@ SpineModel load_spine_model(const std::string& data_dir, const ModelOptions& opt
     if (options.muscles) load_muscles(m, data, config, options.trunk_muscles);
     m.iap = iap_from_appendix_c((thesis / "appendix_c_iap.json").string());
     if (options.iap) {
-      const json c = read_json(thesis / "appendix_c_iap.json");
+      const json c = read_json((thesis / "appendix_c_iap.json").string());
       m.has_bushing = true;
       m.bushing.body = m.ribs_body;
       m.bushing.point_mm =
