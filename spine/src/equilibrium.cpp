@@ -199,13 +199,15 @@ State evaluate(const SpineModel& m, const std::vector<ExternalLoad>& ext, const 
       s.muscle_t[Eigen::Index(i)] = T;
     }
   }
-  // IAP bushing (ribs to pelvis): ½ dᵀ K_t d + ½ φᵀ K_r φ, world axes.
+  // IAP bushing (ribs to pelvis): ½ dᵀ K_t d + ½ φᵀ K_r φ from its rest pose, world axes.
   if (m.has_bushing) {
     const Bushing& b = m.bushing;
     const Pose& pose = P[std::size_t(b.body)];
-    const Vector3d x = pose.apply(b.point_mm), d = x - b.point_mm;
+    const Vector3d x = pose.apply(b.point_mm);
+    const Vector3d d = x - (b.rest_rotation * b.point_mm + b.rest_translation_mm);
     const Vector3d f = -b.k_translation_n_per_mm.cwiseProduct(d);
-    const Vector3d phi = rotation_log(pose.R);
+    // Rotation from the rest pose: R R_restᵀ = exp(φ), so δφ is the world spin as before.
+    const Vector3d phi = rotation_log(pose.R * b.rest_rotation.transpose());
     const Vector3d Kphi = b.k_rotation_nmm_per_rad.cwiseProduct(phi);
     s.energy += 0.5 * d.dot(-f) + 0.5 * phi.dot(Kphi);
     s.loads.add(b.body, x, f);

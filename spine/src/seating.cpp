@@ -102,16 +102,23 @@ void add_back_points(const SpineModel& standing, const Sitter& sitter, SpineMode
   const std::string file = standing.data_dir + "/spine/spine_model.json";
   const nlohmann::json config = detail::read_json(file);
   const auto& lengths = config.at("ligaments").at("spinous_length_mm");
+  // The posterior elements' geometry is the ligaments' (spine_model.json): a model built without
+  // ligaments takes it from one built with them.
+  SpineModel with_ligaments;
+  const SpineModel* geometry = &standing;
+  if (standing.ligaments.empty()) {
+    with_ligaments = load_spine_model(standing.data_dir);
+    geometry = &with_ligaments;
+  }
   for (std::size_t i = 0; i < standing.vertebrae.size(); ++i) {
     const Vertebra& v = standing.vertebrae[i];
     const bool lumbar = v.name[0] == 'L';
     // The interspinous ligament leaves the vertebra halfway along its spinous process.
     double isl_z = NAN;
-    for (const Ligament& l : standing.ligaments)
+    for (const Ligament& l : geometry->ligaments)
       if (l.type == "ISL" && l.body_a == int(i)) isl_z = l.a_mm.z();
     if (std::isnan(isl_z))
-      throw std::runtime_error("seating: the back's contact points need the ligaments (ISL of " +
-                               v.name + ")");
+      throw std::runtime_error("seating: no interspinous ligament geometry for " + v.name);
     const double tip = isl_z - 0.5 * number(lengths, lumbar ? "lumbar" : "thoracic", file);
     const double tissue = lumbar ? sitter.tissue_lumbar_mm : sitter.tissue_thoracic_mm;
     m.contacts.push_back({v.name, int(i), Vector3d(0, v.centre_mm.y(), tip - tissue),
@@ -127,17 +134,6 @@ std::vector<Vector3d> contact_points_at_posture(const SeatedModel& sm) {
   std::vector<Vector3d> out;
   for (const ContactPoint& c : sm.model.contacts) out.push_back(place(P, c.body, c.point_mm));
   return out;
-}
-
-/// The smallest gap between the back and the backrest at the seated posture (mm; < 0 pressed in).
-double smallest_gap(const SeatedModel& sm) {
-  double gap = INFINITY;
-  if (!sm.model.contact_surface) return gap;
-  for (const Vector3d& x : contact_points_at_posture(sm)) {
-    Vector3d g;
-    gap = std::min(gap, sm.model.contact_surface->level(x, g));
-  }
-  return gap;
 }
 
 /// One lean: the seated equilibrium with the recruitment's contact forces iterated to the
@@ -285,6 +281,15 @@ SeatedModel seat_model(const SpineModel& standing, const Chair& chair, const Sit
   out.posture = VectorXd::Zero(dof_count(m));
   for (std::size_t k = 0; k < m.joints.size(); ++k)
     out.posture[3 * Eigen::Index(k)] = sitter.lumbar_flexion_deg * kDeg * sitter.lumbar_share[k];
+  // The IAP bushing stands for the abdomen's pressure, not for an elastic memory of standing:
+  // seated, the abdomen settles into the sitting posture and the bushing rests there (stress-free
+  // at standing, its appendix C stiffness would hold the ribs 1 kN up and 55 N·m back against the
+  // 16.6° of flattened lordosis).
+  if (m.has_bushing) {
+    const Pose ribs = vertebra_poses(m, out.posture)[std::size_t(m.bushing.body)];
+    m.bushing.rest_rotation = ribs.R;
+    m.bushing.rest_translation_mm = ribs.t;
+  }
   return out;
 }
 
@@ -305,14 +310,24 @@ void check_facing(const SeatedModel& sm) {
         "sitter; reverse the triangles' winding)");
 }
 
-/// How far in front of the seat reference point the ischia rest: the sitter slides back until
-/// the back first touches the backrest at the upright sitting tilt (never behind the seat's end).
+/// How far in front of the seat reference point the ischia rest at pelvic tilt `tilt_deg`: the
+/// sitter sits back until the back first touches the backrest (never behind the seat's end).
+/// Moving the body d along the seat moves its points by Rᵀ u d in the pelvis frame.
 double slide_back(const SpineModel& standing, const Chair& chair, const Sitter& sitter,
                   double tilt_deg) {
+  const SeatedModel sm = seat_model(standing, chair, sitter, tilt_deg, 0);
+  if (!sm.model.contact_surface) return 0;
+  const std::vector<Vector3d> points = contact_points_at_posture(sm);
+  const double a = chair.seat_angle_deg * kDeg;
+  const Vector3d shift = sm.rotation.transpose() * Vector3d(0, std::sin(a), std::cos(a));
   auto gap = [&](double d) {
-    return smallest_gap(seat_model(standing, chair, sitter, tilt_deg, d));
+    double g = INFINITY;
+    Vector3d grad;
+    for (const Vector3d& x : points)
+      g = std::min(g, sm.model.contact_surface->level(x + d * shift, grad));
+    return g;
   };
-  if (!std::isfinite(gap(0)) || gap(0) >= 0) return 0;
+  if (gap(0) >= 0) return 0;
   double lo = 0, hi = 1000;
   if (gap(hi) < 0)
     throw std::invalid_argument(
@@ -398,10 +413,13 @@ SeatedSolution solve_seated(const SpineModel& standing, const Chair& chair, cons
   SeatedSolution out;
   const double tilt0 = sitter.pelvic_tilt_deg + sitter.seat_pelvis_coupling * chair.seat_angle_deg;
   check_facing(seat_model(standing, chair, sitter, tilt0, 0));
-  out.ischia_forward_mm = slide_back(standing, chair, sitter, tilt0);
+  // The sitter sits back until the back touches the backrest, upright; then rolls back on the
+  // ischia without sliding (the seat's friction holds the pelvis). Sliding forward to keep the back
+  // just touching at every lean was tried: the backrest then carries nothing beyond what the
+  // spine's own give presses into it, and no lean up to 45° balances (docs/seating.md).
+  const double ischia = slide_back(standing, chair, sitter, tilt0);
   auto at = [&](double lean) {
-    return solve_lean(standing, chair, sitter, loads, o, tilt0 + lean, out.ischia_forward_mm,
-                      out.solves);
+    return solve_lean(standing, chair, sitter, loads, o, tilt0 + lean, ischia, out.solves);
   };
   LeanState st = at(0);
   out.contact_rounds = st.rounds;
@@ -454,6 +472,7 @@ SeatedSolution solve_seated(const SpineModel& standing, const Chair& chair, cons
   }
   out.lean_deg = lean;
   out.pelvic_tilt_deg = tilt0 + lean;
+  out.ischia_forward_mm = st.seated.ischia_world_mm.norm();
   out.lean_balanced = !backrest || std::abs(st.moment_nmm) <= o.lean_tolerance_nmm;
   std::vector<std::string> before = out.warnings;
   fill_result(st, chair, sitter, loads, out);

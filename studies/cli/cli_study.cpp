@@ -524,6 +524,7 @@ void register_study(CLI::App& app) {
   register_haptic_plane(*study);
   register_haptic_drag(*study);
   register_disc_validation(*study);
+  register_seating(*study);
 }
 
 }  // namespace spinesim::cli

@@ -36,10 +36,10 @@ std::string last_line(const std::string& text) {
 
 }  // namespace
 
-HtmlReport write_html_report(const std::string& folder) {
+HtmlReport write_html_report(const std::string& folder, const std::string& script_name) {
   HtmlReport r;
   r.path = (fs::path(folder) / "report.html").string();
-  const fs::path script = fs::path(SPINESIM_SCRIPTS_DIR) / "report.py";
+  const fs::path script = fs::path(SPINESIM_SCRIPTS_DIR) / script_name;
   if (!fs::exists(kPython)) {
     r.message = std::string("report.html not written: ") + kPython +
                 " is missing (apt-get install python3 python3-matplotlib python3-markdown)";

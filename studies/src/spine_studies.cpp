@@ -249,6 +249,10 @@ WilkeCase wilke_case(const std::string& data_dir, const spine::ModelOptions& mod
 
 }  // namespace
 
+WilkeCase run_wilke_case(const std::string& data_dir, const spine::ModelOptions& model) {
+  return wilke_case(data_dir, model, read_spine_json(data_dir));
+}
+
 ValidationStudy run_validation_study(const std::string& data_dir, const spine::ModelOptions& model,
                                      const StageHooks& hooks) {
   Timer t0;

@@ -86,6 +86,10 @@ struct Bushing {
   Eigen::Vector3d point_mm;
   Eigen::Vector3d k_translation_n_per_mm;  ///< k'x, k'y, k'z
   Eigen::Vector3d k_rotation_nmm_per_rad;  ///< M'x, M'y, M'z (appendix C gives N·mm/deg)
+  /// The body's pose (rotation and translation of the reference posture) at which the bushing is
+  /// unloaded: the reference posture (identity), or the posture the body settles into (seated).
+  Eigen::Matrix3d rest_rotation = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d rest_translation_mm = Eigen::Vector3d::Zero();
 };
 
 /// A constant (dead) force on a body, e.g. a weight.

@@ -13,8 +13,9 @@ struct HtmlReport {
   std::string message;  ///< the script's one line: what it wrote, or why it wrote nothing
 };
 
-/// Runs the report script on `folder`. Never throws for the script's own failures (a missing
+/// Runs the report script (scripts/`script`: report.py for the demo, seating_report.py for the
+/// seating studies) on `folder`. Never throws for the script's own failures (a missing
 /// python3 or plotting library, bad input): they come back as written = false and one line.
-HtmlReport write_html_report(const std::string& folder);
+HtmlReport write_html_report(const std::string& folder, const std::string& script = "report.py");
 
 }  // namespace spinesim::studies

@@ -104,6 +104,9 @@ struct WilkeCase {
   bool ok() const;  ///< joint-frame axial within target·(1 ± tolerance)
 };
 
+/// The crate case (b) alone.
+WilkeCase run_wilke_case(const std::string& data_dir, const spine::ModelOptions& model = {});
+
 struct ValidationStudy {
   McGillCase mcgill;
   WilkeCase wilke;
