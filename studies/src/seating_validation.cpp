@@ -128,8 +128,8 @@ void print_seating_sweep(std::ostream& os, const SeatingSweep& s, bool markdown)
   }
   t.print(os, markdown);
   if (!s.findings.empty()) {
-    os << "\nAgainst the literature\n";
-    print_findings(os, s.findings, markdown);
+    os << "\nAgainst the literature (in-vivo trends, data/validation/sitting_in_vivo.json)\n";
+    print_findings(os, s.findings, markdown, "literature says");
   }
 }
 

@@ -99,8 +99,9 @@ nlohmann::json findings_json(const std::vector<Finding>& findings) {
   return a;
 }
 
-void print_findings(std::ostream& os, const std::vector<Finding>& findings, bool markdown) {
-  TextTable t({"verdict", "load", "thesis says", "ours"}, 4);
+void print_findings(std::ostream& os, const std::vector<Finding>& findings, bool markdown,
+                    const std::string& says) {
+  TextTable t({"verdict", "load", says, "ours"}, 4);
   for (const auto& f : findings) t.add({f.match ? "MATCH" : "DIFFERS", f.load, f.thesis, f.ours});
   t.print(os, markdown);
 }

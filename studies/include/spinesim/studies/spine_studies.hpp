@@ -62,7 +62,9 @@ struct Finding {
   bool match = false;
 };
 nlohmann::json findings_json(const std::vector<Finding>& findings);
-void print_findings(std::ostream& os, const std::vector<Finding>& findings, bool markdown);
+/// `says` heads the statements' column ("thesis says"; "literature says" for in-vivo data).
+void print_findings(std::ostream& os, const std::vector<Finding>& findings, bool markdown,
+                    const std::string& says = "thesis says");
 
 /// Stages of each study, for StageHooks: validation 2 (McGill, Wilke), fusion 4 (one per fusion), trends 1.
 inline constexpr int kValidationStages = 2, kFusionStages = 4, kTrendsStages = 1;
