@@ -56,7 +56,7 @@ void add_scene_flags(CLI::App* cmd, studies::HapticSceneRequest& scene);
 /// `haptics run` and `view` (`viewer`: the help names the mouse device).
 struct HapticsRunFlags {
   studies::HapticsRunRequest request;
-  std::string workspace_center;
+  std::string workspace_center, chair_file;
   bool no_realtime = false;
 };
 void add_haptics_run_flags(CLI::App* cmd, HapticsRunFlags& flags, bool viewer);

@@ -10,6 +10,7 @@
 // Ctrl-C (or SIGTERM/SIGHUP/QUIT) during a run ends the loop: the force goes to zero, the device
 // is closed, the summary is printed, then the run exits by the signal.
 #include "cli_common.hpp"
+#include "spinesim/studies/seating_study.hpp"
 
 #include "spinesim/studies/haptic_drag_study.hpp"
 #include "spinesim/studies/haptic_plane_study.hpp"
@@ -225,6 +226,19 @@ void add_haptics_run_flags(CLI::App* cmd, HapticsRunFlags& f, bool viewer) {
       ->capture_default_str();
   cmd->add_flag("--no-recruit{false}", f.request.spine_recruit,
                 "--spine multirate: passive spine solves (muscles off)");
+  cmd->add_option("--posture", f.request.posture,
+                  "--spine multirate: standing, or seated in a chair (study seating's model; "
+                  "--chair, --backrest-recline, --lumbar-support)")
+      ->capture_default_str();
+  cmd->add_option("--chair", f.chair_file,
+                  "--posture seated: the backrest as a surface file (STL, OBJ; mm; see study "
+                  "seating --help)");
+  cmd->add_option("--backrest-recline", f.request.chair.backrest_recline_deg,
+                  "--posture seated: backrest angle to the horizontal, deg")
+      ->capture_default_str();
+  cmd->add_option("--lumbar-support", f.request.chair.lumbar_support_mm,
+                  "--posture seated: lumbar pad depth, mm")
+      ->capture_default_str();
 }
 
 void resolve_haptics_run_flags(HapticsRunFlags& f) {
@@ -234,6 +248,12 @@ void resolve_haptics_run_flags(HapticsRunFlags& f) {
     f.request.workspace_center_mm = Eigen::Vector3d(v[0], v[1], v[2]);
   }
   if (f.request.scene.testdata_dir.empty()) f.request.scene.testdata_dir = testdata_dir();
+  if (!f.chair_file.empty()) {
+    if (f.request.posture != "seated")
+      throw std::invalid_argument("--chair is for --posture seated");
+    f.request.chair.surface = read_chair_surface(f.chair_file);
+    f.request.chair.surface_name = f.chair_file;
+  }
 }
 
 void register_haptics(CLI::App& app) {

@@ -72,6 +72,13 @@ void check_haptics_request(const HapticsRunRequest& r) {
     throw std::invalid_argument("--script is for --device sim");
   if (!r.spine.empty() && r.spine != "multirate" && r.spine != "database")
     throw std::invalid_argument("--spine " + r.spine + ": give multirate or database");
+  if (r.posture != "standing" && r.posture != "seated")
+    throw std::invalid_argument("--posture " + r.posture + ": give standing or seated");
+  if (r.posture == "seated" && r.spine != "multirate")
+    throw std::invalid_argument(
+        "--posture seated needs --spine multirate (the displacement database is the standing "
+        "spine's)");
+  if (r.posture == "seated") spine::check_chair(r.chair);
   if (!r.spine.empty() && r.scene.scene != "spine")
     throw std::invalid_argument(
         "--spine needs --scene spine (the compliant stage drags the spine)");
@@ -186,6 +193,23 @@ struct CompliantSetup {
   std::unique_ptr<haptics::CompliantStage> stage;
 };
 
+/// The seated spine for the multirate stage: seated in the request's chair (spine::solve_seated),
+/// then every hook solve recruits in the seated posture with the chair's contact forces of that
+/// equilibrium and lets the contact springs answer the hook (one solve per update: the contact
+/// rounds and the lean are those of the unloaded sitter).
+void seat_for_haptics(const HapticsRunRequest& request, CompliantSetup& c,
+                      haptics::MultirateOptions& o) {
+  const spine::Sitter sitter = spine::load_sitter(*c.model);
+  spine::SeatingOptions so;
+  so.solve.recruit = request.spine_recruit;
+  const spine::SeatedSolution seated = spine::solve_seated(*c.model, request.chair, sitter, {}, so);
+  spine::SeatedModel sm = spine::seat_model(*c.model, request.chair, sitter, seated.pelvic_tilt_deg,
+                                            seated.ischia_forward_mm);
+  o.solve.posture = sm.posture;
+  o.solve.recruitment_contact_forces = seated.spine.contact_force_n;
+  *c.model = std::move(sm.model);
+}
+
 CompliantSetup make_compliant_stage(const HapticsRunRequest& request, const std::string& data_dir,
                                     const haptics::Scene& scene, HapticsRunResult& result) {
   CompliantSetup c;
@@ -200,6 +224,7 @@ CompliantSetup make_compliant_stage(const HapticsRunRequest& request, const std:
   } else {
     haptics::MultirateOptions o;
     o.solve.recruit = request.spine_recruit;
+    if (request.posture == "seated") seat_for_haptics(request, c, o);
     c.response = std::make_unique<haptics::MultirateSpine>(*c.model, o);
   }
   const double peak = result.capabilities.peak_force_n;
@@ -484,6 +509,7 @@ nlohmann::json haptics_run_json(const HapticsRunResult& r) {
            r.spine.empty()
                ? nlohmann::json()
                : nlohmann::json{{"spine", r.spine},
+                                {"posture", r.request.posture},
                                 {"force_scale", r.force_scale},
                                 {"coupling_stiffness_n_per_mm", r.coupling_stiffness_n_per_mm},
                                 {"spine_max_force_n", r.spine_max_force_n},
@@ -528,10 +554,11 @@ std::string haptics_run_table(const HapticsRunResult& r) {
      << "  passivity energy: min " << fixed(s.passivity_min_mj, 3) << " mJ, final "
      << fixed(s.passivity_final_mj, 3) << " mJ\n";
   if (!r.spine.empty()) {
-    os << "  spine: " << r.spine << ", force scale " << fixed(r.force_scale, 1)
-       << " (spine N per felt N), coupling " << fixed(r.coupling_stiffness_n_per_mm, 2)
-       << " N/mm; hooked " << s.hooked_ticks << " ticks, spine force max "
-       << fixed(s.max_spine_force_n, 1) << " N (clamped " << s.spine_clamped_ticks << ")\n";
+    os << "  spine: " << r.spine << " (" << r.request.posture << "), force scale "
+       << fixed(r.force_scale, 1) << " (spine N per felt N), coupling "
+       << fixed(r.coupling_stiffness_n_per_mm, 2) << " N/mm; hooked " << s.hooked_ticks
+       << " ticks, spine force max " << fixed(s.max_spine_force_n, 1) << " N (clamped "
+       << s.spine_clamped_ticks << ")\n";
     if (r.spine == "multirate")
       os << "  worker: " << r.worker_solves << " updates, " << fixed(r.worker_update_ms, 1)
          << " ms each (" << fixed(r.worker_rate_hz, 1) << " Hz), " << r.worker_failures << " failed"

@@ -7,6 +7,7 @@
 #include "spinesim/haptics/device.hpp"
 #include "spinesim/haptics/scene.hpp"
 #include "spinesim/haptics/servo.hpp"
+#include "spinesim/spine/seating.hpp"
 #include "spinesim/studies/disc_palpation_setup.hpp"
 #include "spinesim/studies/haptic_scene.hpp"
 
@@ -75,6 +76,10 @@ struct HapticsRunRequest {
   double coupling_damping_n_s_per_mm = 0;  ///< felt, relative to the hook
   double force_scale = 0;     ///< spine N per felt N (0: the spine's 600 N at the device's peak)
   bool spine_recruit = true;  ///< muscles recruited in the spine solves (as the database)
+  /// The spine's posture for --spine multirate: "standing" or "seated" (in `chair`, solved by
+  /// spine::solve_seated; the hook pushes on the seated spine leaning on the backrest).
+  std::string posture = "standing";
+  spine::Chair chair;
   /// Disc palpation (scene "disc"): the tuned parameters ("": data/tuned_discs.json) and the
   /// budget the disc's step must fit (us); the coupling is coupling_stiffness/damping.
   std::string disc_params;
