@@ -93,8 +93,7 @@ TEST(CliSeating, ABackrestFromStlOrObjMatchesTheSameParametricBackrest) {
     const json f = seating("--chair '" + file + "'");
     ASSERT_FALSE(f.empty()) << file;
     EXPECT_EQ(f["chair"]["surface"], file);
-    EXPECT_NEAR(f["sitter"]["lean_deg"].get<double>(), p["sitter"]["lean_deg"].get<double>(),
-                0.05);
+    EXPECT_NEAR(f["sitter"]["lean_deg"].get<double>(), p["sitter"]["lean_deg"].get<double>(), 0.05);
     for (int axis : {1, 2})
       EXPECT_NEAR(f["backrest_force_n"][axis].get<double>(),
                   p["backrest_force_n"][axis].get<double>(), 0.5)
@@ -138,10 +137,30 @@ TEST(CliSeating, BadChairsAreRefusedInOneLine) {
   expect_refused(
       run_spinesim("study seating --chair '" + backrest_file("away.stl", 100, false, true) + "'"),
       "does not face the back");
-  expect_refused(run_spinesim("study seating-sweep --parameter colour --values 1,2"),
-                 "not one of");
+  expect_refused(run_spinesim("study seating-sweep --parameter colour --values 1,2"), "not one of");
   expect_refused(run_spinesim("study seating-sweep --parameter seat-angle --values 1,x"),
                  "not a finite number");
   expect_refused(run_spinesim("study seating-sweep --parameter backrest-recline --values 90,170"),
                  "backrest-recline 170");
+}
+
+// The haptic loop on the seated spine: a scripted drag of T1 hooks the spine leaning on the
+// backrest; the worker solves the seated equilibrium under the hook without a failure.
+TEST(CliSeating, HapticLoopDragsTheSeatedSpine) {
+  const std::string script = std::string(SPINESIM_DATA_DIR) + "/haptics/drag_t1_sagittal.csv";
+  const auto r = run_spinesim(
+      "haptics run --scene spine --triangles 1500 --spine multirate --posture seated "
+      "--backrest-recline 105 --script '" +
+      script + "' --duration 3 --no-realtime --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = json::parse(r.out);
+  const auto& c = j["compliant_stage"];
+  EXPECT_EQ(c["posture"], "seated");
+  EXPECT_GT(c["worker_solves"].get<int>(), 3);
+  EXPECT_EQ(c["worker_failures"].get<int>(), 0) << c["worker_error"];
+  EXPECT_GT(c["max_spine_force_n"].get<double>(), 20.0);
+  EXPECT_EQ(j["non_finite_ticks"].get<long>(), 0);
+  expect_refused(run_spinesim("haptics run --scene spine --posture seated --spine database"),
+                 "--spine multirate");
+  expect_refused(run_spinesim("haptics run --scene spine --chair x.stl"), "--posture seated");
 }

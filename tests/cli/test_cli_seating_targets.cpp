@@ -16,6 +16,6 @@ TEST(SeatingTargets, StandingAndSeatedLoadsAndChairTrendsMatchTheInVivoData) {
   const json j = json::parse(r.out);
   ASSERT_GE(j["findings"].size(), 9u);
   for (const auto& f : j["findings"])
-    EXPECT_TRUE(f["match"].get<bool>()) << f["id"] << ": " << f["thesis"] << " — ours "
-                                        << f["ours"];
+    EXPECT_TRUE(f["match"].get<bool>())
+        << f["id"] << ": " << f["thesis"] << " — ours " << f["ours"];
 }
