@@ -8,11 +8,16 @@
 //                          (three axis fits superposed), shipped file
 //   DatabaseGenerate/W     every solve and fit for one loaded vertebra (T7: 72 solves +
 //                          baseline) on W threads; counter full_estimate_s = 17 × that
+//   Seated/R               solve_seated in the parametric chair with the backrest at R deg
+//                          (R = 0: a stool): one seated posture, i.e. one point of a sweep
+//   SeatedHookSolve        one seated equilibrium under a 100 N hook on T1 as the haptic
+//                          worker solves it (posture and contact forces of the seated sitter)
 // Run: build/release/bench/bench_spine [--benchmark_filter=Database]
 #include "spinesim/spine/database.hpp"
 #include "spinesim/spine/equilibrium.hpp"
 #include "spinesim/spine/model.hpp"
 #include "spinesim/spine/recruitment.hpp"
+#include "spinesim/spine/seating.hpp"
 
 #include <benchmark/benchmark.h>
 
@@ -66,6 +71,42 @@ void Recruitment(benchmark::State& state) {
   state.counters["joint_axes"] = double(arm.rows());
 }
 BENCHMARK(Recruitment)->Unit(benchmark::kMillisecond);
+
+void Seated(benchmark::State& state) {
+  const Sitter sitter = load_sitter(model());
+  Chair chair;
+  if (state.range(0) == 0)
+    chair.backrest_height_mm = 0;
+  else
+    chair.backrest_recline_deg = double(state.range(0));
+  SeatedSolution s;
+  for (auto _ : state) {
+    s = solve_seated(model(), chair, sitter);
+    benchmark::DoNotOptimize(s.spine.displacement.data());
+  }
+  state.counters["equilibria"] = s.solves;
+  state.counters["lean_steps"] = s.lean_iterations;
+  state.counters["ms_per_equilibrium"] = 1e3 * s.seconds / std::max(1, s.solves);
+}
+BENCHMARK(Seated)->Arg(0)->Arg(90)->Arg(100)->Arg(110)->Arg(120)->Unit(benchmark::kMillisecond);
+
+void SeatedHookSolve(benchmark::State& state) {
+  const Sitter sitter = load_sitter(model());
+  const Chair chair;
+  const SeatedSolution seated = solve_seated(model(), chair, sitter);
+  const SeatedModel sm =
+      seat_model(model(), chair, sitter, seated.pelvic_tilt_deg, seated.ischia_forward_mm);
+  SolveOptions o;
+  o.posture = sm.posture;
+  o.recruitment_contact_forces = seated.spine.contact_force_n;
+  auto loads = forward_on_t1();
+  loads[0].force_n = Eigen::Vector3d(0, 0, -100);  // towards the backrest
+  for (auto _ : state) {
+    const SpineSolution s = solve_spine(sm.model, loads, o);
+    benchmark::DoNotOptimize(s.displacement.data());
+  }
+}
+BENCHMARK(SeatedHookSolve)->Unit(benchmark::kMillisecond);
 
 void DatabaseEvaluate(benchmark::State& state) {
   const DisplacementDatabase& db = database();

@@ -173,6 +173,8 @@ LeanState solve_lean(const SpineModel& standing, const Chair& chair, const Sitte
   SolveOptions so = o.solve;
   so.posture = st.seated.posture;
   std::vector<Vector3d> assumed;  // first round: the contact forces of the posture itself
+  VectorXd previous;
+  double omega = o.contact_relaxation;
   for (st.rounds = 1;; ++st.rounds) {
     so.recruitment_contact_forces = assumed;
     st.spine = solve_spine(st.seated.model, loads, so);
@@ -191,10 +193,21 @@ LeanState solve_lean(const SpineModel& standing, const Chair& chair, const Sitte
     }
     if (assumed.empty()) {
       assumed = found;
-    } else {
-      for (std::size_t i = 0; i < found.size(); ++i)
-        assumed[i] += o.contact_relaxation * (found[i] - assumed[i]);
+      continue;
     }
+    // Relaxed fixed point on the contact forces, its factor adapted by Aitken's Δ² (Irons &
+    // Tuck 1969): ω ← −ω r_{k−1}·(r_k − r_{k−1}) / |r_k − r_{k−1}|², r = found − assumed.
+    VectorXd r(3 * Eigen::Index(found.size()));
+    for (std::size_t i = 0; i < found.size(); ++i)
+      r.segment<3>(3 * Eigen::Index(i)) = found[i] - assumed[i];
+    if (previous.size() == r.size()) {
+      const VectorXd dr = r - previous;
+      if (dr.squaredNorm() > 0)
+        omega = std::clamp(-omega * previous.dot(dr) / dr.squaredNorm(), 0.05, 1.0);
+    }
+    previous = r;
+    for (std::size_t i = 0; i < found.size(); ++i)
+      assumed[i] += omega * r.segment<3>(3 * Eigen::Index(i));
   }
   st.moment_nmm = moment_about_ischia(st.seated, sitter, loads, st.spine);
   return st;

@@ -66,7 +66,7 @@ struct SeatingOptions {
   SolveOptions solve;
   int max_contact_iterations = 60;
   double contact_tolerance_n = 0.5;  ///< on the largest change of a contact force between rounds
-  double contact_relaxation = 0.5;   ///< under-relaxation of the recruitment's contact forces
+  double contact_relaxation = 0.5;   ///< first relaxation factor (then Aitken's Δ²)
   double lean_tolerance_nmm = 200;   ///< on the moment about the ischia (0.2 N·m)
   int max_lean_iterations = 40;
 };
