@@ -99,9 +99,6 @@ void check_range(double v, double lo, double hi, const std::string& what) {
 /// The back's contact points: behind each vertebra's spinous-process tip by the soft tissue, and
 /// the skin over the sacrum (on the pelvis).
 void add_back_points(const SpineModel& standing, const Sitter& sitter, SpineModel& m) {
-  const std::string file = standing.data_dir + "/spine/spine_model.json";
-  const nlohmann::json config = detail::read_json(file);
-  const auto& lengths = config.at("ligaments").at("spinous_length_mm");
   // The posterior elements' geometry is the ligaments' (spine_model.json): a model built without
   // ligaments takes it from one built with them.
   SpineModel with_ligaments;
@@ -119,7 +116,8 @@ void add_back_points(const SpineModel& standing, const Sitter& sitter, SpineMode
       if (l.type == "ISL" && l.body_a == int(i)) isl_z = l.a_mm.z();
     if (std::isnan(isl_z))
       throw std::runtime_error("seating: no interspinous ligament geometry for " + v.name);
-    const double tip = isl_z - 0.5 * number(lengths, lumbar ? "lumbar" : "thoracic", file);
+    const double tip =
+        isl_z - 0.5 * (lumbar ? sitter.spinous_lumbar_mm : sitter.spinous_thoracic_mm);
     const double tissue = lumbar ? sitter.tissue_lumbar_mm : sitter.tissue_thoracic_mm;
     m.contacts.push_back({v.name, int(i), Vector3d(0, v.centre_mm.y(), tip - tissue),
                           sitter.tissue_stiffness_n_per_mm});
@@ -230,6 +228,11 @@ Sitter load_sitter(const SpineModel& model) {
   s.pelvis_mass_percent = number(j, "pelvis_mass_percent", file);
   s.pelvis_com_mm = vec3(j, "pelvis_com_mm", file);
   s.forearm_hand_percent_each = number(j, "forearm_hand_percent_each", file);
+  const std::string model_file = model.data_dir + "/spine/spine_model.json";
+  const nlohmann::json lengths =
+      detail::read_json(model_file).at("ligaments").at("spinous_length_mm");
+  s.spinous_thoracic_mm = number(lengths, "thoracic", model_file);
+  s.spinous_lumbar_mm = number(lengths, "lumbar", model_file);
   const auto& lean = j.at("lean_range_deg");
   if (!lean.is_array() || lean.size() != 2 || !lean[0].is_number() || !lean[1].is_number())
     throw std::runtime_error(file + ": lean_range_deg must be [min, max]");

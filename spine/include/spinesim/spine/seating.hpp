@@ -30,6 +30,7 @@ struct Sitter {
   double seat_pelvis_coupling = 0;   ///< fraction of the seat angle the pelvis follows
   Eigen::Vector3d ischia_mm = Eigen::Vector3d::Zero(), sacrum_back_mm = Eigen::Vector3d::Zero();
   double tissue_thoracic_mm = 0, tissue_lumbar_mm = 0, tissue_stiffness_n_per_mm = 0;
+  double spinous_thoracic_mm = 0, spinous_lumbar_mm = 0;  ///< spine_model.json's process lengths
   double pelvis_mass_percent = 0;
   Eigen::Vector3d pelvis_com_mm = Eigen::Vector3d::Zero();
   double forearm_hand_percent_each = 0;
