@@ -363,10 +363,11 @@ void register_materials(CLI::App& study) {
 struct SpineStudyArgs {
   double force_n = 300;
   std::string csv, disc_joints;
-  bool json = false, quiet = false, no_trunk_muscles = false;
+  bool json = false, quiet = false, no_trunk_muscles = false, no_ligaments = false;
   spine::ModelOptions model() const {
     spine::ModelOptions o;
     o.trunk_muscles = !no_trunk_muscles;
+    o.ligaments = !no_ligaments;
     o.disc_joints = disc_joints;
     return o;
   }
@@ -377,6 +378,7 @@ void print_muscle_set(const SpineStudyArgs& a) {
   if (a.no_trunk_muscles)
     std::cout << "Muscles: F.8-F.19 only (--no-trunk-muscles: no thoracic erector spinae, no "
                  "rectus abdominis)\n\n";
+  if (a.no_ligaments) std::cout << "Ligaments: none (--no-ligaments)\n\n";
   if (!a.disc_joints.empty())
     std::cout << "Joint springs: the discs of " << a.disc_joints
               << " (--disc-joints) in place of the thesis's F.4\n\n";
@@ -391,6 +393,9 @@ void add_spine_study_options(CLI::App* cmd, SpineStudyArgs& a, bool with_force) 
                 "Lumbar muscles F.8-F.19 only: leave out the restored thoracic erector spinae and "
                 "rectus abdominis");
   cmd->add_flag("--quiet", a.quiet, "No progress on stderr");
+  cmd->add_flag("--no-ligaments", a.no_ligaments,
+                "Without the ligaments: the F.4 joint springs alone (Schultz & Ashton-Miller's "
+                "whole-segment stiffness, which includes them)");
   cmd->add_option("--disc-joints", a.disc_joints,
                   "Joint springs from each level's disc (a data/spine/disc_joints/ preset such as "
                   "fibre-reinforced, or a file from `spine disc-joints`) in place of F.4");
