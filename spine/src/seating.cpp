@@ -143,6 +143,13 @@ struct LeanState {
   int rounds = 0;
 };
 
+/// The pelvis's weight in the pelvis frame (de Leva's lower-trunk share of the body mass).
+Vector3d pelvis_weight(const SeatedModel& sm, const Sitter& sitter) {
+  const SpineModel& m = sm.model;
+  const double n = sitter.pelvis_mass_percent / 100 * m.body_mass_kg * m.gravity_mm_s2 / 1000;
+  return sm.rotation.transpose() * Vector3d(0, -n, 0);
+}
+
 double moment_about_ischia(const SeatedModel& sm, const Sitter& sitter,
                            const std::vector<ExternalLoad>& loads, const SpineSolution& sol) {
   const SpineModel& m = sm.model;
@@ -156,10 +163,7 @@ double moment_about_ischia(const SeatedModel& sm, const Sitter& sitter,
   }
   for (std::size_t i = 0; i < m.contacts.size(); ++i)
     M += (sol.contact_point_mm[i] - I).cross(sol.contact_force_n[i]);
-  const double pelvis_n =
-      sitter.pelvis_mass_percent / 100 * m.body_mass_kg * m.gravity_mm_s2 / 1000;
-  const Vector3d pelvis_w = sm.rotation.transpose() * Vector3d(0, -pelvis_n, 0);
-  M += (m.joints.back().point_mm + sitter.pelvis_com_mm - I).cross(pelvis_w);
+  M += (m.joints.back().point_mm + sitter.pelvis_com_mm - I).cross(pelvis_weight(sm, sitter));
   return M.x();
 }
 
@@ -374,9 +378,7 @@ Vector3d seat_from_pelvis(const SeatedModel& sm, const Sitter& sitter, const Spi
   if (m.has_bushing) f -= sol.bushing_wrench.head<3>();
   for (std::size_t i = 0; i < m.contacts.size(); ++i)
     if (m.contacts[i].body == kGround) f += sol.contact_force_n[i];
-  const double pelvis_n =
-      sitter.pelvis_mass_percent / 100 * m.body_mass_kg * m.gravity_mm_s2 / 1000;
-  f += sm.rotation.transpose() * Vector3d(0, -pelvis_n, 0);
+  f += pelvis_weight(sm, sitter);
   return -(sm.rotation * f);
 }
 
@@ -406,8 +408,7 @@ void fill_result(const LeanState& st, const Chair& chair, const Sitter& sitter,
   const double forearms_n =
       chair.armrests ? 2 * sitter.forearm_hand_percent_each / 100 * m.body_mass_kg * g_n : 0;
   out.armrest_force_n = Vector3d(0, forearms_n, 0);
-  Vector3d weight =
-      Vector3d(0, -forearms_n - sitter.pelvis_mass_percent / 100 * m.body_mass_kg * g_n, 0);
+  Vector3d weight = R * pelvis_weight(sm, sitter) + Vector3d(0, -forearms_n, 0);
   for (const PointLoad& w : m.weights) weight += R * w.force_n;
   for (const ExternalLoad& l : loads) weight += R * l.force_n;  // carried like a weight
   out.body_weight_n = -weight.y();

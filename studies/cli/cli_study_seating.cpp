@@ -84,14 +84,19 @@ void resolve(SeatingArgs& a) {
   }
 }
 
-/// --out: the JSON and CSV, then the plots and report.html (scripts/seating_report.py).
-void write_out(const SeatingArgs& a, const nlohmann::json& j, const std::string& csv,
-               const std::string& stem) {
-  if (a.out.empty()) return;
-  write_text_file((fs::path(a.out) / (stem + ".json")).string(), j.dump(2) + "\n");
-  write_text_file((fs::path(a.out) / (stem + ".csv")).string(), csv);
-  const HtmlReport r = write_html_report(a.out, "seating_report.py");
-  std::cerr << (r.written ? "" : "spinesim: warning: ") << r.message << std::endl;
+/// --csv, --out (the JSON and CSV, then the plots and report.html: scripts/seating_report.py) and
+/// --json; true when the JSON went to stdout (nothing else is printed then).
+bool emit(const SeatingArgs& a, const nlohmann::json& j, const std::string& csv,
+          const std::string& stem) {
+  if (!a.csv.empty()) write_text_file(a.csv, csv);
+  if (!a.out.empty()) {
+    write_text_file((fs::path(a.out) / (stem + ".json")).string(), j.dump(2) + "\n");
+    write_text_file((fs::path(a.out) / (stem + ".csv")).string(), csv);
+    const HtmlReport r = write_html_report(a.out, "seating_report.py");
+    std::cerr << (r.written ? "" : "spinesim: warning: ") << r.message << std::endl;
+  }
+  if (a.json) print_json(j);
+  return a.json;
 }
 
 void run_one(SeatingArgs& a) {
@@ -100,14 +105,7 @@ void run_one(SeatingArgs& a) {
   progress.begin("seating the spine");
   const SeatingRun run = run_seating(data_dir(), a.request);
   progress.end(std::to_string(run.seated.solves) + " equilibria");
-  const nlohmann::json j = seating_json(run);
-  const std::string csv = seating_csv(run);
-  if (!a.csv.empty()) write_text_file(a.csv, csv);
-  write_out(a, j, csv, "seating");
-  if (a.json) {
-    print_json(j);
-    return;
-  }
+  if (emit(a, seating_json(run), seating_csv(run), "seating")) return;
   std::cout << "The spine seated in a chair (thesis 6.2)\n\n";
   print_seating(std::cout, run, a.markdown);
 }
@@ -132,14 +130,7 @@ void run_sweep(SeatingArgs& a) {
   Progress progress(int(values.size()), a.quiet || a.json);
   const SeatingSweep s =
       run_seating_sweep(data_dir(), a.parameter, values, a.request, progress.hooks());
-  const nlohmann::json j = seating_sweep_json(s);
-  const std::string csv = seating_sweep_csv(s);
-  if (!a.csv.empty()) write_text_file(a.csv, csv);
-  write_out(a, j, csv, "seating_sweep");
-  if (a.json) {
-    print_json(j);
-    return;
-  }
+  if (emit(a, seating_sweep_json(s), seating_sweep_csv(s), "seating_sweep")) return;
   std::cout << "Chair-design sweep over " << a.parameter << " (thesis 6.2)\n\n";
   print_seating_sweep(std::cout, s, a.markdown);
   std::cout << "Total " << fixed(s.seconds, 2) << " s\n";
