@@ -414,6 +414,10 @@ void fill_result(const LeanState& st, const Chair& chair, const Sitter& sitter,
   out.body_weight_n = -weight.y();
   out.seat_force_n = -(weight + out.backrest_force_n + out.armrest_force_n);
   out.force_residual_n = (seat_from_pelvis(sm, sitter, st.spine) - out.seat_force_n).norm();
+  const double a = chair.seat_angle_deg * kDeg;
+  const Vector3d across(0, std::cos(a), -std::sin(a));  // the seat pan's normal, up
+  const double pressing = out.seat_force_n.dot(across);
+  out.seat_friction_needed = (out.seat_force_n - pressing * across).norm() / pressing;
   out.hip_moment_nmm = st.moment_nmm;
   out.vertebra_angle_deg.clear();
   for (const Pose& p : st.spine.poses)

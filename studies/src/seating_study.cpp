@@ -122,7 +122,8 @@ void print_seating(std::ostream& os, const SeatingRun& run, bool markdown) {
   os << "  body weight carried " << fixed(s.body_weight_n, 1)
      << " N (trunk, head, arms, pelvis); force balance residual "
      << significant(s.force_residual_n, 2) << " N; moment left for the hips "
-     << fixed(s.hip_moment_nmm / 1000, 2) << " N·m\n\n";
+     << fixed(s.hip_moment_nmm / 1000, 2) << " N·m; the seat needs a friction coefficient of "
+     << fixed(s.seat_friction_needed, 2) << " to hold the pelvis\n\n";
   const auto& l5 = s.spine.joints.back();
   os << "L5-S1 (thesis fig. 6.8; joint frame: x lateral, y axial, z anterior)\n";
   TextTable l5s1({"", "x", "y", "z"});
@@ -190,6 +191,7 @@ json seating_json(const SeatingRun& run) {
   j["body_weight_n"] = s.body_weight_n;
   j["force_residual_n"] = s.force_residual_n;
   j["hip_moment_nmm"] = s.hip_moment_nmm;
+  j["seat_friction_needed"] = s.seat_friction_needed;
   json joints = json::array();
   for (std::size_t k = 0; k < s.spine.joints.size(); ++k) {
     json r = joint_reaction_json(s.spine.joints[k]);

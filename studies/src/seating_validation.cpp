@@ -116,7 +116,7 @@ SeatingSweep run_seating_sweep(const std::string& data_dir, const std::string& p
 void print_seating_sweep(std::ostream& os, const SeatingSweep& s, bool markdown) {
   TextTable t({s.parameter, "lean (deg)", "backrest (N)", "seat (N)", "L4-L5 comp. (N)",
                "L5-S1 comp. (N)", "L5-S1 shear AP (N)", "L5-S1 Mx (N·m)", "back muscles (N)",
-               "max back act.", "residual (N)", "time (s)"});
+               "max back act.", "seat friction", "residual (N)", "time (s)"});
   for (std::size_t i = 0; i < s.runs.size(); ++i) {
     const auto& r = s.runs[i].seated;
     const auto& l5 = r.spine.joints.back();
@@ -124,7 +124,8 @@ void print_seating_sweep(std::ostream& os, const SeatingSweep& s, bool markdown)
            fixed(r.seat_force_n.norm(), 1), fixed(l4l5(r.spine), 1), fixed(l5.axial_n, 1),
            fixed(l5.shear_ap_n, 1), fixed(l5.moment_local_nmm.x() / 1000, 2),
            fixed(s.runs[i].back_muscle_force_n, 1), fixed(s.runs[i].back_muscle_max_activation, 3),
-           significant(r.force_residual_n, 2), fixed(r.seconds, 2)});
+           fixed(r.seat_friction_needed, 2), significant(r.force_residual_n, 2),
+           fixed(r.seconds, 2)});
   }
   t.print(os, markdown);
   if (!s.findings.empty()) {
@@ -152,15 +153,15 @@ std::string seating_sweep_csv(const SeatingSweep& s) {
   os << s.parameter
      << ",lean_deg,backrest_n,seat_n,l4l5_compression_n,l5s1_compression_n,"
         "l5s1_shear_ap_n,l5s1_moment_x_nmm,back_muscle_force_n,"
-        "back_muscle_max_activation,force_residual_n,seconds\n";
+        "back_muscle_max_activation,seat_friction_needed,force_residual_n,seconds\n";
   for (std::size_t i = 0; i < s.runs.size(); ++i) {
     const auto& r = s.runs[i].seated;
     const auto& l5 = r.spine.joints.back();
     os << s.values[i] << "," << r.lean_deg << "," << r.backrest_force_n.norm() << ","
        << r.seat_force_n.norm() << "," << l4l5(r.spine) << "," << l5.axial_n << "," << l5.shear_ap_n
        << "," << l5.moment_local_nmm.x() << "," << s.runs[i].back_muscle_force_n << ","
-       << s.runs[i].back_muscle_max_activation << "," << r.force_residual_n << "," << r.seconds
-       << "\n";
+       << s.runs[i].back_muscle_max_activation << "," << r.seat_friction_needed << ","
+       << r.force_residual_n << "," << r.seconds << "\n";
   }
   return os.str();
 }

@@ -140,6 +140,9 @@ TEST(Seating, BodyWeightBalancesSeatBackrestAndArmrestsAndTheLeanBalances) {
     EXPECT_GT(back, 1.0);
     EXPECT_GT(s.seat_force_n.y(), 0);
     EXPECT_EQ(s.armrest_force_n.y() > 0, armrests);
+    // The backrest pushes forward, so the flat seat must hold the pelvis back by friction:
+    // |F_z| / F_y of the seat's reaction.
+    EXPECT_NEAR(s.seat_friction_needed, -s.seat_force_n.z() / s.seat_force_n.y(), 1e-12);
   }
 }
 
@@ -159,6 +162,7 @@ TEST(Seating, WithoutBackrestTheHipsHoldTheMomentAndNothingTouches) {
   EXPECT_EQ(s.backrest_force_n.norm(), 0);
   EXPECT_NEAR(s.seat_force_n.y(), s.body_weight_n, 1e-9);
   EXPECT_LT(s.force_residual_n, 1e-6);
+  EXPECT_NEAR(s.seat_friction_needed, 0, 1e-12);  // a flat seat under a vertical load
 }
 
 TEST(Seating, BadChairsAreRefusedInOneLine) {

@@ -96,6 +96,10 @@ struct SeatedSolution {
   /// contact): the reported forces balance to this, N.
   double force_residual_n = 0;
   double hip_moment_nmm = 0;  ///< about the ischia, what the hips hold (0 when the lean balances)
+  /// The seat's reaction along the seat pan over its reaction across it: the friction coefficient
+  /// the seat needs to hold the pelvis (the model is frictionless at the back, the pelvis fixed on
+  /// the seat). Above 1 the backrest pushes the sitter forward harder than the seat presses.
+  double seat_friction_needed = 0;
   std::vector<double>
       vertebra_angle_deg;  ///< sagittal tilt of each vertebra in the chair (+ forward)
   int contact_rounds = 0, lean_iterations = 0, solves = 0;
