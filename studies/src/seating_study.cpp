@@ -110,8 +110,8 @@ void print_seating(std::ostream& os, const SeatingRun& run, bool markdown) {
         "forward)\n";
   TextTable contacts({"level", "gap (mm)", "Fy (N)", "Fz (N)", "|F| (N)"});
   for (const auto& c : s.contacts)
-    contacts.add({c.name, fixed(c.gap_mm, 1), fixed(c.force_n.y(), 1), fixed(c.force_n.z(), 1),
-                  fixed(c.force_n.norm(), 1)});
+    contacts.add({c.name, std::isfinite(c.gap_mm) ? fixed(c.gap_mm, 1) : "-",
+                  fixed(c.force_n.y(), 1), fixed(c.force_n.z(), 1), fixed(c.force_n.norm(), 1)});
   contacts.add({"backrest", "", fixed(s.backrest_force_n.y(), 1), fixed(s.backrest_force_n.z(), 1),
                 fixed(s.backrest_force_n.norm(), 1)});
   contacts.add({"seat", "", fixed(s.seat_force_n.y(), 1), fixed(s.seat_force_n.z(), 1),
