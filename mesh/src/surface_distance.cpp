@@ -1,16 +1,16 @@
 // Signed distance to a triangle surface through a CGAL AABB tree (surface_distance.hpp).
 #include "spinesim/mesh/surface_distance.hpp"
 
+#include "spinesim/mesh/io.hpp"
+
 #include <CGAL/AABB_traits.h>
 #include <CGAL/AABB_tree.h>
 #include <CGAL/AABB_triangle_primitive.h>
-#include <CGAL/IO/polygon_soup_io.h>
 #include <CGAL/Simple_cartesian.h>
 
 #include <Eigen/Geometry>
 
 #include <cmath>
-#include <filesystem>
 #include <stdexcept>
 
 namespace spinesim::mesh {
@@ -83,23 +83,15 @@ Eigen::Vector3d SurfaceDistance::lower() const { return impl_->lo; }
 Eigen::Vector3d SurfaceDistance::upper() const { return impl_->hi; }
 
 SurfaceDistance read_surface_distance(const std::string& path) {
-  if (!std::filesystem::is_regular_file(path)) throw std::invalid_argument(path + ": no such file");
-  std::vector<K::Point_3> pts;
-  std::vector<std::vector<std::size_t>> polygons;
-  bool ok = false;
-  try {
-    ok = CGAL::IO::read_polygon_soup(path, pts, polygons, CGAL::parameters::verbose(false));
-  } catch (const std::exception& e) {
-    throw std::invalid_argument(path + ": cannot be read as a surface (" + e.what() + ")");
-  }
-  if (!ok || polygons.empty())
-    throw std::invalid_argument(path + ": not a readable STL, OBJ, OFF or PLY surface with faces");
+  // The vertebra surfaces' reader (io.hpp; fuzzed): mm, the file's own axes.
+  const TriSurface surface = read_surface(path, 1.0, UpAxis::y);
   std::vector<Eigen::Vector3d> points;
-  for (const auto& p : pts) points.push_back(to_eigen(p));
+  for (Eigen::Index i = 0; i < surface.V.rows(); ++i)
+    points.push_back(surface.V.row(i).transpose());
   std::vector<std::array<std::size_t, 3>> tris;
-  for (const auto& poly : polygons)
-    for (std::size_t k = 1; k + 1 < poly.size(); ++k)
-      tris.push_back({poly[0], poly[k], poly[k + 1]});
+  for (Eigen::Index f = 0; f < surface.F.rows(); ++f)
+    tris.push_back(
+        {std::size_t(surface.F(f, 0)), std::size_t(surface.F(f, 1)), std::size_t(surface.F(f, 2))});
   try {
     return SurfaceDistance(points, tris);
   } catch (const std::invalid_argument& e) {

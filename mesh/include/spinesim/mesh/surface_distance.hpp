@@ -33,9 +33,10 @@ class SurfaceDistance {
   std::shared_ptr<const Impl> impl_;
 };
 
-/// Reads an STL (ASCII or binary), OBJ, OFF or PLY surface (polygons split into triangle fans).
-/// Throws std::invalid_argument "PATH: problem" (one line) for a missing, unreadable, empty or
-/// non-finite file.
+/// Reads an STL (ASCII or binary), OBJ, OFF or PLY surface in mm with io.hpp's read_surface (the
+/// file's own axes; polygons split into triangle fans). Throws std::invalid_argument (one line
+/// naming the file) for a missing, unreadable, empty or non-finite file, or one without a
+/// triangle with an area.
 SurfaceDistance read_surface_distance(const std::string& path);
 
 }  // namespace spinesim::mesh
