@@ -21,6 +21,9 @@ using Primitive = CGAL::AABB_triangle_primitive<K, TriangleIt>;
 using Tree = CGAL::AABB_tree<CGAL::AABB_traits<K, Primitive>>;
 
 Eigen::Vector3d to_eigen(const K::Point_3& p) { return {p.x(), p.y(), p.z()}; }
+
+// Beyond this, distances and cross products lose all precision (and overflow far beyond it).
+constexpr double kMaxCoordinate = 1e9;
 }  // namespace
 
 struct SurfaceDistance::Impl {
@@ -38,8 +41,9 @@ SurfaceDistance::SurfaceDistance(const std::vector<Eigen::Vector3d>& points,
   impl->hi = -impl->lo;
   for (const auto& t : triangles) {
     for (std::size_t i : t)
-      if (i >= points.size() || !points[i].allFinite())
-        throw std::invalid_argument("surface: a triangle refers to a missing or non-finite point");
+      if (i >= points.size() || !(points[i].cwiseAbs().maxCoeff() <= kMaxCoordinate))
+        throw std::invalid_argument(
+            "surface: a triangle refers to a missing, non-finite or far point (beyond 1e9 mm)");
     const Eigen::Vector3d &a = points[t[0]], &b = points[t[1]], &c = points[t[2]];
     const Eigen::Vector3d n = (b - a).cross(c - a);
     if (!(n.norm() > 1e-12)) continue;
