@@ -555,6 +555,10 @@ void recruitment_problem(const SpineModel& m, const std::vector<ExternalLoad>& l
                                 " finite joint coordinates expected");
   if (contact_forces && contact_forces->size() != m.contacts.size())
     throw std::invalid_argument("recruitment contact forces: one per contact point expected");
+  if (contact_forces)
+    for (const Vector3d& f : *contact_forces)
+      if (!(f.norm() <= kMaxForceN))
+        throw std::invalid_argument("recruitment contact forces: finite and below 100 kN expected");
   joints.clear();
   for (int j : m.recruited_joints)
     if (!m.joints[std::size_t(j)].fused) joints.push_back(j);

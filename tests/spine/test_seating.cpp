@@ -117,6 +117,21 @@ TEST(Seating, RecruitmentArmsAtAPostureAreMinusTheMuscleLengthDerivatives) {
       }
 }
 
+TEST(Seating, BadPosturesAndContactForcesAreRefused) {
+  const sp::SeatedModel sm = sp::seat_model(standing(), sp::Chair(), sitter(), 18.3, 100);
+  sp::SolveOptions o;
+  o.posture = VectorXd::Zero(5);
+  EXPECT_THROW(sp::solve_spine(sm.model, {}, o), std::invalid_argument);
+  o.posture = sm.posture;
+  o.posture[3] = NAN;
+  EXPECT_THROW(sp::solve_spine(sm.model, {}, o), std::invalid_argument);
+  o.posture = sm.posture;
+  o.recruitment_contact_forces.assign(2, Vector3d::Zero());  // not one per contact point
+  EXPECT_THROW(sp::solve_spine(sm.model, {}, o), std::invalid_argument);
+  o.recruitment_contact_forces.assign(sm.model.contacts.size(), Vector3d(0, NAN, 0));
+  EXPECT_THROW(sp::solve_spine(sm.model, {}, o), std::invalid_argument);
+}
+
 TEST(Seating, BodyWeightBalancesSeatBackrestAndArmrestsAndTheLeanBalances) {
   for (bool armrests : {false, true}) {
     sp::Chair c;
