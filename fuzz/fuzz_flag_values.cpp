@@ -13,6 +13,7 @@
 #include "spinesim/mesh/disc_geometry.hpp"
 #include "spinesim/spine/model.hpp"
 
+#include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <stdexcept>
@@ -34,6 +35,7 @@ void parse(std::uint8_t which, const std::string& text) {
     }
     case 1:
       for (const std::string& item : cli::split_list(text)) check(!item.empty());
+      for (double v : cli::parse_number_list(text, "--values")) check(std::isfinite(v));
       break;
     case 2: {
       const auto [vertebra, v] = cli::parse_vertebra_vector(text, "--force", "Fx,Fy,Fz");

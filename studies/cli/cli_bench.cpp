@@ -50,12 +50,6 @@ nlohmann::json run_child(const std::string& args) {
   return nlohmann::json::parse(text);
 }
 
-std::vector<double> parse_list(const std::string& text, const std::string& what) {
-  const auto n = std::count(text.begin(), text.end(), ',') + 1;
-  const Eigen::VectorXd v = parse_numbers(text, int(n), what);
-  return std::vector<double>(v.data(), v.data() + v.size());
-}
-
 // --- one measurement per process -----------------------------------------------------------
 
 struct OneArgs {
@@ -121,7 +115,7 @@ void bench_mesh(const BenchArgs& a) {
   nlohmann::json rows = nlohmann::json::array();
   TextTable t({"cell mm", "tets", "nodes", "seconds", "min dihedral", "volume err %", "peak MB"},
               0);
-  const auto sizes = parse_list(a.cell_sizes, "--cell-sizes");
+  const auto sizes = parse_number_list(a.cell_sizes, "--cell-sizes");
   ProgressBar bar(int(sizes.size()), a.json, "runs");
   for (double h : sizes) {
     bar.update(int(rows.size()), "meshing at " + fixed(h, 2) + " mm");
@@ -152,7 +146,7 @@ void bench_fem(const BenchArgs& a) {
   TextTable t({"order", "DOF", "assembly", "analyse", "factorise", "6 solves", "6x6 total",
                "1 load", "peak MB"},
               0);
-  const auto sizes = parse_list(a.cell_sizes, "--cell-sizes");
+  const auto sizes = parse_number_list(a.cell_sizes, "--cell-sizes");
   ProgressBar bar(int(sizes.size()), a.json, "meshes");
   int done = 0;
   for (double h : sizes) {
@@ -162,7 +156,7 @@ void bench_fem(const BenchArgs& a) {
     margs << "bench-mesh-one --level " << a.level << " --cell-size " << h << " --mesh-out '"
           << mesh_path.string() << "'";
     run_child(margs.str());
-    for (double order : parse_list(a.orders, "--orders")) {
+    for (double order : parse_number_list(a.orders, "--orders")) {
       std::ostringstream fargs;
       fargs << "bench-fem-one --mesh '" << mesh_path.string() << "' --order " << int(order);
       auto r = run_child(fargs.str());

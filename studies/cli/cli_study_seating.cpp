@@ -9,7 +9,6 @@
 #include "spinesim/studies/seating_study.hpp"
 
 #include <cmath>
-#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -110,21 +109,8 @@ void run_one(SeatingArgs& a) {
   print_seating(std::cout, run, a.markdown);
 }
 
-std::vector<double> parse_values(const std::string& text) {
-  std::vector<double> out;
-  for (const std::string& item : split_list(text)) {
-    char* end = nullptr;
-    const double v = std::strtod(item.c_str(), &end);
-    if (end == item.c_str() || *end != '\0' || !std::isfinite(v))
-      throw std::invalid_argument("--values: '" + item + "' is not a finite number");
-    out.push_back(v);
-  }
-  if (out.empty()) throw std::invalid_argument("--values needs numbers, e.g. 90,100,110,120");
-  return out;
-}
-
 void run_sweep(SeatingArgs& a) {
-  const std::vector<double> values = parse_values(a.values);
+  const std::vector<double> values = parse_number_list(a.values, "--values");
   with_parameter(a.request, a.parameter, values.front());  // an unknown name fails here
   resolve(a);
   Progress progress(int(values.size()), a.quiet || a.json);

@@ -2,6 +2,7 @@
 
 #include "spinesim/spine/model.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <map>
@@ -31,6 +32,12 @@ Eigen::VectorXd parse_numbers(const std::string& text, int n, const std::string&
     throw std::invalid_argument(what + ": expected " + std::to_string(n) +
                                 " comma-separated numbers, got " + std::to_string(values.size()));
   return Eigen::Map<Eigen::VectorXd>(values.data(), n);
+}
+
+std::vector<double> parse_number_list(const std::string& text, const std::string& what) {
+  const auto n = std::count(text.begin(), text.end(), ',') + 1;
+  const Eigen::VectorXd v = parse_numbers(text, int(n), what);
+  return std::vector<double>(v.data(), v.data() + v.size());
 }
 
 std::vector<std::string> split_list(const std::string& text) {

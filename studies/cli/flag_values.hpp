@@ -19,6 +19,10 @@ namespace spinesim::cli {
 /// Parses "a,b,c" into exactly n finite numbers; throws std::invalid_argument naming `what`.
 Eigen::VectorXd parse_numbers(const std::string& text, int n, const std::string& what);
 
+/// "a,b,c" -> as many finite numbers as there are items; throws std::invalid_argument naming
+/// `what` for a non-number or an empty item.
+std::vector<double> parse_number_list(const std::string& text, const std::string& what);
+
 /// "a,b,,c" -> {"a", "b", "c"} (empty items dropped).
 std::vector<std::string> split_list(const std::string& text);
 

@@ -139,7 +139,7 @@ TEST(CliSeating, BadChairsAreRefusedInOneLine) {
       "does not face the back");
   expect_refused(run_spinesim("study seating-sweep --parameter colour --values 1,2"), "not one of");
   expect_refused(run_spinesim("study seating-sweep --parameter seat-angle --values 1,x"),
-                 "not a finite number");
+                 "--values: 'x' is not a number");
   expect_refused(run_spinesim("study seating-sweep --parameter backrest-recline --values 90,170"),
                  "backrest-recline 170");
 }
