@@ -25,6 +25,7 @@
 #include "spinesim/mss/disc_set.hpp"
 #include "spinesim/mss/model.hpp"
 #include "spinesim/mss/solver.hpp"
+#include "spinesim/mss/simulator.hpp"
 
 #include <benchmark/benchmark.h>
 

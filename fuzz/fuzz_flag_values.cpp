@@ -1,5 +1,5 @@
 // libFuzzer target: every parser that turns the text of a command-line flag into a value, on
-// arbitrary text — the command line's own (studies/cli/flag_values.hpp: numbers, vertebra
+// arbitrary text — the command line's own (app/cli/flag_values.hpp: numbers, vertebra
 // vectors, units, axes, integrators, lists) and the library parsers behind other flags (load
 // cases and case lists, fusion levels, vertebra names, disc levels, stiffness knobs). The first
 // byte picks the parser, the rest is the flag's text. Each must return a valid value or refuse

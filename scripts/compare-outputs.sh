@@ -52,6 +52,10 @@ record() {
   run study-trends study trends --json --csv trends.csv
   run spine-database spine database --quiet --vertebrae T7 --superposition-on T7 --magnitudes 300 --out db.json --json
   run spine-database-check spine database --check --quiet --vertebrae T7 --superposition-on T7 --magnitudes 300 --out db.json --json
+  run study-seating study seating --json --csv seating.csv
+  run study-seating-sweep study seating-sweep --parameter backrest-recline --values 100,120 --json
+  run mesh-vertebrae mesh vertebrae --level L3 --triangles 400 --out vertebrae-out --json
+  run haptic-plane study haptic-plane --json
   run refused-mesh mss --mesh no-such-file.vtu --case compression --json
   run refused-flag spine solve --force T7:1,2 --json
   # Readable reports (stdout without --json) of the verbs whose drivers print them.

@@ -9,4 +9,4 @@ scripts/install-deps.sh
 cmake --preset release
 cmake --build --preset release --target spinesim
 out="${1:-demo-out}"
-build/release/studies/spinesim demo --out "$out"
+build/release/app/spinesim demo --out "$out"

@@ -13,6 +13,10 @@ namespace spinesim::calibration {
 
 namespace {
 
+/// The plausible range of a fitted scale or multiplier (see read_tuned_disc).
+constexpr double kMinScale = 1e-6, kMaxScale = 1e6;
+
+
 constexpr const char* kFormat = "spinesim-tuned-disc";
 constexpr int kVersion = 1;
 
@@ -154,8 +158,12 @@ TunedDisc tuned_disc_from_json(const nlohmann::json& j) {
     for (const auto& [name, value] : j.at("scales").items()) {
       const Knob k = knob_from_name(name);
       const double s = value.get<double>();
-      if (!std::isfinite(s) || s <= 0)
-        throw std::invalid_argument("scale '" + name + "' must be finite and > 0");
+      // A scale is a factor on Van Gelder's constants, fitted within [1e-3, 1e3] by default
+      // (IpoptSettings): beyond 1e-6..1e6 the constants are not a disc's (and at 1e300 the
+      // forces overflow while the solve reports a meaningless "converged").
+      if (!std::isfinite(s) || !(s >= kMinScale && s <= kMaxScale))
+        throw std::invalid_argument("scale '" + name + "' = " + value.dump() +
+                                    ": must be a finite number in [1e-6, 1e6]");
       if (!mss::term_enabled(t.options, k.term))
         throw std::invalid_argument("scale '" + name + "' belongs to a term the file switches off");
       t.scales[name] = s;
@@ -169,8 +177,8 @@ TunedDisc tuned_disc_from_json(const nlohmann::json& j) {
       if (t.edge_multipliers.empty())
         throw std::invalid_argument("per-spring tuned-disc file has no edge_multipliers");
       for (const double mu : t.edge_multipliers)
-        if (!std::isfinite(mu) || mu <= 0)
-          throw std::invalid_argument("edge_multipliers must be finite and > 0");
+        if (!std::isfinite(mu) || !(mu >= kMinScale && mu <= kMaxScale))
+          throw std::invalid_argument("edge_multipliers must be finite numbers in [1e-6, 1e6]");
       t.edge_order = j.at("edge_order").get<std::string>();
       if (j.at("edge_springs").get<std::size_t>() != t.edge_multipliers.size())
         throw std::invalid_argument(

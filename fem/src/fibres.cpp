@@ -1,4 +1,5 @@
 #include "spinesim/fem/fibres.hpp"
+#include "spinesim/common/constants.hpp"
 
 #include "spinesim/fem/fe_space.hpp"
 #include "spinesim/mesh/annulus_frames.hpp"
@@ -10,7 +11,6 @@ namespace spinesim::fem {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 // K_ab += k (\int h_a h_b dV) a a^T,  h = grad N . a, with the exact 4-point degree-2 rule
 // (P2: h is linear, the integrand quadratic; P1: h constant).
@@ -68,8 +68,8 @@ ElementFibres fibre_field(const mesh::TetMesh& mesh, const mesh::RegionMaterials
     if (it == materials.fibres.end() || !std::isfinite(frames.depth(t))) continue;
     const double s = frames.depth(t);
     const double alpha = it->second.angle_deg(s);
-    const Eigen::RowVector3d c = std::cos(alpha * kPi / 180) * frames.circumferential.row(t);
-    const Eigen::RowVector3d z = std::sin(alpha * kPi / 180) * frames.axial.row(t);
+    const Eigen::RowVector3d c = std::cos(alpha * kRadPerDeg) * frames.circumferential.row(t);
+    const Eigen::RowVector3d z = std::sin(alpha * kRadPerDeg) * frames.axial.row(t);
     f.direction_1.row(t) = c + z;
     f.direction_2.row(t) = c - z;
     f.stiffness_mpa(t) = 0.5 * it->second.modulus_mpa(s);

@@ -1,4 +1,5 @@
 #include "spinesim/fem/quadrature.hpp"
+#include "spinesim/common/constants.hpp"
 
 #include <cmath>
 #include <stdexcept>
@@ -12,9 +13,8 @@ namespace {
 void gauss_legendre_01(int n, std::vector<double>& x, std::vector<double>& w) {
   x.assign(std::size_t(n), 0.0);
   w.assign(std::size_t(n), 0.0);
-  const double pi = 3.14159265358979323846;
   for (int i = 0; i < n; ++i) {
-    double z = std::cos(pi * (i + 0.75) / (n + 0.5));
+    double z = std::cos(kPi * (i + 0.75) / (n + 0.5));
     double dp = 1.0;
     for (int iter = 0; iter < 100; ++iter) {
       double p0 = 1.0, p1 = z;  // Legendre recurrence: P_k

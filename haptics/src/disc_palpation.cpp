@@ -1,4 +1,5 @@
 #include "spinesim/haptics/disc_palpation.hpp"
+#include "spinesim/mss/simulator.hpp"
 
 #include "spinesim/haptics/servo.hpp"
 #include "spinesim/mss/quantities.hpp"

@@ -1,4 +1,5 @@
 #include "spinesim/haptics/renderer.hpp"
+#include "spinesim/common/constants.hpp"
 
 #include <Eigen/Geometry>
 
@@ -256,7 +257,7 @@ RenderOutput GaoGibsonRenderer::render(const ProbeState& probe, const Scene& sce
     deepest = std::max(deepest, body_deepest);
   }
   if (inside == 0) return out;
-  if (p_.law == GaoGibsonLaw::eq_4_10) magnitude /= M_PI * r * r;
+  if (p_.law == GaoGibsonLaw::eq_4_10) magnitude /= kPi * r * r;
   magnitude = std::max(magnitude, 0.0);  // a surface pushes, it never pulls
   // Eq 4.11: the depth-weighted mean of the probe normals points from the probe into the
   // surface; the reaction on the probe is opposite.

@@ -1,5 +1,6 @@
 // Kidney-shaped disc cross-section and the lofted parametric disc (see disc_geometry.hpp).
 #include "spinesim/mesh/disc_geometry.hpp"
+#include "spinesim/common/constants.hpp"
 #include "spinesim/mesh/mesher.hpp"
 
 #include <algorithm>
@@ -11,7 +12,6 @@
 namespace spinesim::mesh {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 // Base curve before scaling: polar ellipse (a = 1, b = 0.75) with a posterior notch.
 constexpr double kA = 1.0, kB = 0.75, kNotchDepth = 0.3;

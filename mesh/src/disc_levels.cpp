@@ -12,7 +12,7 @@
 // All coordinates in mm, frame x lateral (body's right = -x), y superior, z anterior.
 #include "spinesim/mesh/disc_geometry.hpp"
 
-#include "csv_table.hpp"
+#include "spinesim/common/csv_table.hpp"
 
 #include <Eigen/Geometry>
 
@@ -31,12 +31,11 @@ namespace spinesim::mesh {
 namespace {
 
 namespace fs = std::filesystem;
-using detail::CsvTable;
-using detail::find_row;
-using detail::point;
-using detail::read_csv;
-using detail::to_double;
-using detail::trim;
+
+/// The x_mm, y_mm, z_mm cells of row r.
+Eigen::Vector3d point(const CsvTable& t, std::size_t r) {
+  return {t.number(r, "x_mm"), t.number(r, "y_mm"), t.number(r, "z_mm")};
+}
 
 std::string upper(std::string s) {
   for (char& c : s) c = char(std::toupper(static_cast<unsigned char>(c)));
@@ -64,10 +63,10 @@ const std::vector<std::string>& disc_levels() {
 
 DiscDimensions disc_dimensions(const std::string& level, const std::string& data_dir) {
   const std::string name = canonical_level(level);
-  const CsvTable table = read_csv(fs::path(data_dir) / "disc_morphometry.csv");
-  const auto& row = find_row(table, "level", name);
+  const CsvTable table = read_csv((fs::path(data_dir) / "disc_morphometry.csv").string());
+  const std::size_t row = table.find("level", name);
   auto value = [&](const char* column) {
-    const double v = to_double(row[table.column(column)], table.path + " " + name + " " + column);
+    const double v = table.number(row, column);
     if (!(v > 0))
       throw std::invalid_argument(table.path + ": " + name + " " + column + " must be > 0 mm");
     return v;
@@ -88,17 +87,17 @@ DiscFrame disc_frame_in_spine(const std::string& level, const std::string& data_
   const std::string inferior = name.substr(name.find('-') + 1);
 
   const fs::path thesis = fs::path(data_dir) / "thesis";
-  const CsvTable joints = read_csv(thesis / "F2_joint_markers.csv");
-  const CsvTable centres = read_csv(thesis / "F1_vertebra_cm.csv");
+  const CsvTable joints = read_csv((thesis / "F2_joint_markers.csv").string());
+  const CsvTable centres = read_csv((thesis / "F1_vertebra_cm.csv").string());
 
   DiscFrame frame;
-  frame.origin_mm = point(joints, find_row(joints, "location", name), "joint " + name);
+  frame.origin_mm = point(joints, joints.find("location", name));
 
-  const Eigen::Vector3d top = point(centres, find_row(centres, "segment", superior), superior);
+  const Eigen::Vector3d top = point(centres, centres.find("segment", superior));
   // F.1 has no sacrum: below L5 the joint point stands in for the inferior centre.
   const Eigen::Vector3d bottom =
       inferior == "S1" ? frame.origin_mm
-                       : point(centres, find_row(centres, "segment", inferior), inferior);
+                       : point(centres, centres.find("segment", inferior));
   Eigen::Vector3d y = top - bottom;
   if (!(y.norm() > 1e-9))
     throw std::invalid_argument("disc " + name + ": coincident vertebra centres");

@@ -354,6 +354,16 @@ TetMesh read_tet_mesh(const std::string& path, std::vector<DataArray>* point_dat
   if (in.gcount() == std::streamsize(sizeof head) &&
       std::string(head, sizeof head) == "# vtk DataFile Version ")
     return read_vtk_legacy(path, point_data, cell_data);
+  // Neither a legacy VTK header nor XML (its first non-blank character is '<', after an optional
+  // UTF-8 byte-order mark): name what is read rather than an XML parser's complaint.
+  std::string start(head, std::size_t(in.gcount()));
+  if (start.rfind("\xEF\xBB\xBF", 0) == 0) start.erase(0, 3);
+  const auto first = start.find_first_not_of(" \t\r\n");
+  if (first != std::string::npos && start[first] != '<')
+    detail::FileError{"read_tet_mesh", path}.fail(
+        "not a mesh file this program reads: a tetrahedral mesh is read from VTU (VTK XML "
+        "UnstructuredGrid: ascii, binary, appended, zlib or lzma) or legacy VTK (.vtk, ASCII or "
+        "binary); convert other formats with meshio (`meshio convert IN OUT.vtu`)");
   return read_vtu(path, point_data, cell_data);
 }
 

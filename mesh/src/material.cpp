@@ -21,8 +21,12 @@ std::string fmt(double v) {
   return os.str();
 }
 
-IsotropicMaterial parse_one(const nlohmann::json& j, const std::string& what) {
+IsotropicMaterial parse_one(const nlohmann::json& j, const std::string& what,
+                            std::vector<std::string> also_known = {}) {
   if (!j.is_object()) throw std::invalid_argument(what + ": expected a JSON object");
+  for (const char* k : {"E_mpa", "nu", "G_mpa", "density_kg_m3", "source", "notes"})
+    also_known.push_back(k);
+  require_known_keys(j, also_known, what);
   auto number = [&](const char* key) -> double {
     const auto& v = j.at(key);
     if (!v.is_number()) throw std::invalid_argument(what + ": '" + key + "' must be a number");
@@ -54,6 +58,10 @@ IsotropicMaterial parse_one(const nlohmann::json& j, const std::string& what) {
 
 FibreReinforcement parse_fibres(const nlohmann::json& j, const std::string& what) {
   if (!j.is_object()) throw std::invalid_argument(what + ": expected a JSON object");
+  require_known_keys(j,
+                     {"E_inner_mpa", "E_outer_mpa", "angle_inner_deg", "angle_outer_deg", "source",
+                      "notes"},
+                     what);
   auto number = [&](const char* key) -> double {
     if (!j.contains(key)) throw std::invalid_argument(what + ": missing '" + key + "'");
     const auto& v = j.at(key);
@@ -115,8 +123,10 @@ RegionMaterials material_from_json(const nlohmann::json& j) {
       if (!j.contains("annulus") || !j.contains("nucleus"))
         throw std::invalid_argument("material '" + r.name +
                                     "': per-region files need both 'annulus' and 'nucleus'");
+      require_known_keys(j, {"name", "source", "description", "notes", "annulus", "nucleus"},
+                         "material '" + r.name + "'");
       r.by_region[int(Region::annulus)] =
-          parse_one(j.at("annulus"), "material '" + r.name + "' annulus");
+          parse_one(j.at("annulus"), "material '" + r.name + "' annulus", {"fibres"});
       r.by_region[int(Region::nucleus)] =
           parse_one(j.at("nucleus"), "material '" + r.name + "' nucleus");
       r.fallback = r.by_region[int(Region::annulus)];
@@ -129,7 +139,7 @@ RegionMaterials material_from_json(const nlohmann::json& j) {
         throw std::invalid_argument(
             "material '" + r.name +
             "': fibres need a per-region file (they reinforce the annulus)");
-      r.fallback = parse_one(j, "material '" + r.name + "'");
+      r.fallback = parse_one(j, "material '" + r.name + "'", {"name", "description"});
     }
   } catch (const nlohmann::json::exception& e) {
     std::string what = e.what();  // "[json.exception.type_error.302] type must be ...": the reason

@@ -6,6 +6,7 @@
 // Optimisers run after refinement in CGAL's own order (ODT, Lloyd, perturb, exude), without
 // time limits so that a given seed always gives the same mesh.
 #include "spinesim/mesh/mesher.hpp"
+#include "spinesim/common/constants.hpp"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Labeled_mesh_domain_3.h>
@@ -140,7 +141,7 @@ TetMesh mesh_labeled_body(const LabeledBody& body, const MeshOptions& opt) {
   // Size before work: CGAL would allocate until the machine runs out (cm read as m, 1e-6 mm).
   const double volume = body.exact_volume_mm3 > 0
                             ? body.exact_volume_mm3
-                            : 4.0 / 3.0 * M_PI * std::pow(body.bounding_radius_mm, 3);
+                            : 4.0 / 3.0 * kPi * std::pow(body.bounding_radius_mm, 3);
   const double expected = expected_elements(volume, body.bounding_radius_mm, opt);
   if (!(expected <= opt.max_elements)) {
     std::ostringstream os;

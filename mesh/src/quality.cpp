@@ -1,5 +1,6 @@
 // Tet mesh quality: counts, dihedral angles, radius-edge ratio, edge lengths, volume.
 #include "spinesim/mesh/quality.hpp"
+#include "spinesim/common/constants.hpp"
 
 #include <Eigen/Geometry>
 
@@ -12,7 +13,6 @@
 namespace spinesim::mesh {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 // Circumradius of the tet (a, b, c, d): |center - a| with center from the 3x3 linear system
 // 2 (p_i - a) . x = |p_i - a|^2 (x relative to a).
@@ -47,7 +47,7 @@ std::array<double, 6> dihedral_angles_deg(const Eigen::Vector3d& a, const Eigen:
     vk -= vk.dot(u) * u;
     vl -= vl.dot(u) * u;
     const double cosang = std::clamp(vk.normalized().dot(vl.normalized()), -1.0, 1.0);
-    out[std::size_t(e)] = std::acos(cosang) * 180.0 / kPi;
+    out[std::size_t(e)] = std::acos(cosang) * kDegPerRad;
   }
   return out;
 }

@@ -1,4 +1,5 @@
 #include "spinesim/mesh/rigid_plate.hpp"
+#include "spinesim/common/skew.hpp"
 
 #include <Eigen/Geometry>
 
@@ -8,10 +9,8 @@ namespace spinesim::mesh {
 
 PlateMap plate_map(const Eigen::Vector3d& r) {
   PlateMap R;
-  // theta × r = −[r]× theta
-  R << 1, 0, 0, 0, r.z(), -r.y(),  //
-      0, 1, 0, -r.z(), 0, r.x(),   //
-      0, 0, 1, r.y(), -r.x(), 0;
+  R.leftCols<3>().setIdentity();
+  R.rightCols<3>() = -skew(r);  // theta × r = −[r]× theta
   return R;
 }
 

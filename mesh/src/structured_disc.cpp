@@ -1,5 +1,6 @@
 // Structured (sweep) disc mesh — see structured_disc.hpp for the construction.
 #include "spinesim/mesh/structured_disc.hpp"
+#include "spinesim/common/constants.hpp"
 
 #include <Eigen/Dense>
 
@@ -36,7 +37,6 @@ double cross2(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
 // polyline, inverted by linear interpolation: the points are exactly on the curve, equally
 // spaced to the accuracy of that polyline.
 std::vector<double> equal_arc_angles(const KidneyOutline& o, int sectors) {
-  constexpr double kPi = 3.14159265358979323846;
   constexpr int kChords = 4096;
   std::vector<double> arc(kChords + 1, 0.0);
   auto theta = [&](double k) { return -0.5 * kPi + 2 * kPi * k / kChords; };

@@ -23,7 +23,25 @@ double mesh_volume(const TetMesh& m) {
   return v;
 }
 
+void validate_frame(const DiscFrame& f, const std::string& what) {
+  const Eigen::Matrix3d& A = f.axes;
+  if (!A.allFinite() || !f.origin_mm.allFinite())
+    throw std::invalid_argument(what + ": non-finite axes or origin");
+  if (f.origin_mm.cwiseAbs().maxCoeff() > 1e6)
+    throw std::invalid_argument(what + ": origin beyond 1e6 mm (1 km): not in mm, or corrupt");
+  const double off = (A.transpose() * A - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+  if (!(off <= 1e-6)) {
+    std::ostringstream os;
+    os << what << ": the axes are not orthonormal (|A^T A - I| = " << off
+       << "): they must be the disc's unit lateral, axial and anterior directions";
+    throw std::invalid_argument(os.str());
+  }
+  if (!(A.determinant() > 0))
+    throw std::invalid_argument(what + ": the axes are left-handed (a mirror, not a rotation)");
+}
+
 void validate(const TetMesh& m) {
+  validate_frame(m.frame, "mesh disc_frame");
   if (m.num_vertices() == 0 || m.num_tets() == 0)
     throw std::invalid_argument("mesh is empty (no vertices or no tetrahedra)");
   if (!m.V.allFinite()) throw std::invalid_argument("mesh has non-finite vertex coordinates");

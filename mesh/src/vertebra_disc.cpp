@@ -1,6 +1,7 @@
 // Disc between two user-supplied vertebrae; the construction is described in vertebra_disc.hpp.
 // CGAL AABB trees answer the ray queries; the meshing itself goes through mesh_labeled_body.
 #include "spinesim/mesh/vertebra_disc.hpp"
+#include "spinesim/common/constants.hpp"
 #include "spinesim/mesh/vertebra_geometry.hpp"
 
 #include <CGAL/AABB_traits.h>
@@ -22,7 +23,6 @@
 namespace spinesim::mesh {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 using K = CGAL::Exact_predicates_inexact_constructions_kernel;
@@ -245,7 +245,7 @@ void DiscBetween::set_frame(const TriSurface& inf, const TriSurface& sup) {
                                 fmt(d.norm()) +
                                 " mm apart; the same vertebra twice, or the wrong --units?)");
   const Eigen::Vector3d y = d.normalized();
-  if (y.y() < std::cos(60.0 * kPi / 180.0))
+  if (y.y() < std::cos(60.0 * kRadPerDeg))
     throw std::invalid_argument(
         "the vertebrae do not face each other: the superior vertebra is not above the inferior one "
         "(centroid direction " +
@@ -296,7 +296,7 @@ std::vector<char> DiscBetween::height_fields(const TriSurface& inf, const TriSur
   s_inf_.assign(std::size_t(nu_) * std::size_t(nv_), kNaN);
   s_sup_ = s_inf_;
   std::vector<char> facing(s_inf_.size(), 0);
-  const double cos_facing = std::cos(opt.facing_angle_deg * kPi / 180.0);
+  const double cos_facing = std::cos(opt.facing_angle_deg * kRadPerDeg);
   int both_facing = 0, gap_positive = 0;
   for (int j = 0; j < nv_; ++j)
     for (int i = 0; i < nu_; ++i) {

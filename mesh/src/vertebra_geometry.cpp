@@ -1,7 +1,8 @@
 // Parametric vertebrae and the schematic sacrum (vertebra_geometry.hpp).
 #include "spinesim/mesh/vertebra_geometry.hpp"
+#include "spinesim/common/constants.hpp"
 
-#include "csv_table.hpp"
+#include "spinesim/common/csv_table.hpp"
 #include "spinesim/common/atomic_file.hpp"
 #include "spinesim/mesh/disc_geometry.hpp"
 #include "spinesim/mesh/mesher.hpp"
@@ -21,7 +22,6 @@ namespace spinesim::mesh {
 namespace {
 
 namespace fs = std::filesystem;
-constexpr double kDeg = M_PI / 180.0;
 
 // Assumptions that have no per-level column (also stated in data/vertebra_morphometry.csv):
 // the C7-T1 disc, which places T1's upper endplate, is 5 mm high (the thoracic discs of
@@ -35,7 +35,7 @@ std::string upper(std::string s) {
 }
 
 std::string canonical_body(const std::string& name) {
-  const std::string n = upper(detail::trim(name));
+  const std::string n = upper(trim(name));
   const auto& known = scene_body_names();
   if (std::find(known.begin(), known.end(), n) != known.end()) return n;
   std::string list;
@@ -104,7 +104,7 @@ std::vector<SweptBox> neural_arch(const VertebraMorphometry& m, const Parametric
     parts.push_back(swept(root, pillar, Y, pw / 2, ph / 2));                           // pedicle
     parts.push_back(swept(pillar, mid, Y, m.lamina_thickness_mm / 2, lamina_half_h));  // lamina
     // Transverse process: from the pillar, swept back and raised by the table's angles.
-    const double sweep = m.transverse_sweep_deg * kDeg, rise = m.transverse_rise_deg * kDeg;
+    const double sweep = m.transverse_sweep_deg * kRadPerDeg, rise = m.transverse_rise_deg * kRadPerDeg;
     const Eigen::Vector3d dir(side * std::cos(sweep) * std::cos(rise), std::sin(rise),
                               -std::sin(sweep) * std::cos(rise));
     const double length = std::max(m.transverse_span_mm / 2 - xp, 2.0 * m.facet_radius_mm);
@@ -122,7 +122,7 @@ std::vector<SweptBox> neural_arch(const VertebraMorphometry& m, const Parametric
     parts.push_back(swept(inf_root, inf_root + m.facet_length_mm * down.normalized(),
                           Eigen::Vector3d::UnitZ(), m.facet_radius_mm, m.facet_radius_mm));
   }
-  const double alpha = m.spinous_angle_deg * kDeg;
+  const double alpha = m.spinous_angle_deg * kRadPerDeg;
   const Eigen::Vector3d spine_dir(0, -std::sin(alpha), -std::cos(alpha));
   parts.push_back(swept(mid, mid + m.spinous_length_mm * spine_dir,
                         Eigen::Vector3d(0, std::cos(alpha), -std::sin(alpha)),
@@ -139,7 +139,7 @@ std::vector<SweptBox> sacral_parts(const ParametricVertebra& v) {
   std::vector<SweptBox> parts;
   parts.push_back(swept({-48, -0.1 * H, -0.25 * D}, {48, -0.1 * H, -0.25 * D}, Y, 12, 11));
   const Eigen::Vector3d top(0, 0, -0.45 * D);
-  const Eigen::Vector3d down_back(0, -std::cos(35 * kDeg), -std::sin(35 * kDeg));
+  const Eigen::Vector3d down_back(0, -std::cos(35 * kRadPerDeg), -std::sin(35 * kRadPerDeg));
   const Eigen::Vector3d plate_end = top + 55 * down_back;
   const Eigen::Vector3d plate_up = down_back.cross(X);  // the plate is wide along x
   parts.push_back(swept(top, plate_end, X, 9, 40));
@@ -167,11 +167,10 @@ VertebraMorphometry vertebra_morphometry(const std::string& level, const std::st
   const std::string name = canonical_body(level);
   if (name == "S1")
     throw std::invalid_argument("vertebra_morphometry: the sacrum has no row (it is schematic)");
-  const auto table = detail::read_csv(fs::path(data_dir) / "vertebra_morphometry.csv");
-  const auto& row = detail::find_row(table, "level", name);
+  const auto table = read_csv((fs::path(data_dir) / "vertebra_morphometry.csv").string());
+  const std::size_t row = table.find("level", name);
   auto num = [&](const char* column) {
-    const double x =
-        detail::to_double(row[table.column(column)], table.path + " " + name + " " + column);
+    const double x = table.number(row, column);
     if (!(x >= 0))
       throw std::invalid_argument(table.path + " " + name + " " + column + ": negative");
     return x;
@@ -288,9 +287,10 @@ ParametricVertebra parametric_vertebra(const std::string& name_in, const std::st
   v.lower_width_mm = below.upper_width_mm;
   v.lower_depth_mm = below.upper_depth_mm;
   if (i == 0) {
-    const auto joints = detail::read_csv(fs::path(data_dir) / "thesis" / "F2_joint_markers.csv");
-    const Eigen::Vector3d c7t1 =
-        detail::point(joints, detail::find_row(joints, "location", "C7-T1"), "joint C7-T1");
+    const auto joints = read_csv((fs::path(data_dir) / "thesis" / "F2_joint_markers.csv").string());
+    const std::size_t r = joints.find("location", "C7-T1");
+    const Eigen::Vector3d c7t1(joints.number(r, "x_mm"), joints.number(r, "y_mm"),
+                               joints.number(r, "z_mm"));
     const Eigen::Vector3d axis = (c7t1 - below_frame.origin_mm).normalized();
     top = c7t1 - 0.5 * kC7T1DiscHeightMm * axis;
     v.upper_width_mm = v.lower_width_mm;

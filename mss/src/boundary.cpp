@@ -1,5 +1,6 @@
 // Rigid poses of the endplates and the check of a Boundary (boundary.hpp).
 #include "spinesim/mss/boundary.hpp"
+#include "spinesim/common/skew.hpp"
 
 #include <cmath>
 #include <stdexcept>
@@ -8,14 +9,6 @@
 namespace spinesim::mss {
 
 namespace {
-
-Eigen::Matrix3d cross_matrix(const Eigen::Vector3d& w) {
-  Eigen::Matrix3d W;
-  W << 0, -w.z(), w.y(),  //
-      w.z(), 0, -w.x(),   //
-      -w.y(), w.x(), 0;
-  return W;
-}
 
 void require(bool ok, const std::string& message) {
   if (!ok) throw std::invalid_argument(message);
@@ -47,7 +40,7 @@ Eigen::Matrix3d rotation_from_vector(const Eigen::Vector3d& theta) {
     const double s = std::sin(0.5 * phi) / phi;
     b = 2.0 * s * s;
   }
-  const Eigen::Matrix3d W = cross_matrix(theta);
+  const Eigen::Matrix3d W = skew(theta);
   return Eigen::Matrix3d::Identity() + a * W + b * (W * W);
 }
 

@@ -1,4 +1,5 @@
 #include "spinesim/mss/disc_set.hpp"
+#include "spinesim/mss/simulator.hpp"
 
 #include <cmath>
 #include <stdexcept>

@@ -2,6 +2,7 @@
 // equations, units and sign conventions are in elements.hpp. These are the hot kernels (about
 // 50k calls per time step): fixed-size Eigen types, no allocation, the Hessian only when asked.
 #include "spinesim/mss/elements.hpp"
+#include "spinesim/common/skew.hpp"
 
 #include <Eigen/Geometry>
 
@@ -17,14 +18,6 @@ namespace {
 // The comparisons are written so that a NaN input falls through and propagates, not hidden.
 // Below this sin(theta) the arms are collinear and the angle's gradient direction undefined.
 constexpr double kMinSin = 1e-12;
-
-Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d S;
-  S << 0, -v.z(), v.y(),  //
-      v.z(), 0, -v.x(),   //
-      -v.y(), v.x(), 0;
-  return S;
-}
 
 // Adds scale * T to H, where T is the Hessian with respect to N arms x_i - x0 (i = 1..N) and H
 // the Hessian with respect to (x0, x1, ..., xN): d/dx_i = d/d(arm_i), d/dx0 = -sum_i d/d(arm_i).

@@ -1,6 +1,8 @@
 // MssModel: builder (mesh + material -> springs, masses) and the energy/gradient/Hessian loops.
 // Formulas and constants: model.hpp; element kernels: elements.cpp.
 #include "spinesim/mss/model.hpp"
+#include "spinesim/common/skew.hpp"
+#include "spinesim/common/constants.hpp"
 
 #include "face_angles.hpp"
 #include "hessian_pattern.hpp"
@@ -20,7 +22,6 @@
 namespace spinesim::mss {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 /// Region label -> index into the per-region stiffness parts (0 annulus, 1 nucleus).
 int region_index(int region_label) {
@@ -708,11 +709,6 @@ void MssModel::Impl::assemble_hessian(const Eigen::VectorXd& x, HessianMode mode
       mode == HessianMode::exact) {
     const double w =
         sel.disc(m.disc_k, m.disc_k_unscaled) * (m.volume_and_gradient(x, nullptr) - m.rest_volume);
-    auto skew = [](const Eigen::Vector3d& v) {
-      Eigen::Matrix3d S;
-      S << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
-      return S;
-    };
     for (Eigen::Index t = 0; t < m.mesh.num_tets(); ++t) {
       const TetPoints p = tet_points(x, m.mesh.T, static_cast<int>(t));
       const Eigen::Matrix3d Sa = skew((p.col(1) - p.col(0)) * (w / 6.0));

@@ -30,6 +30,7 @@
 // Dirichlet nodes jump to the poses of the next boundary; their velocity is the displacement
 // over dt.
 #include "spinesim/mss/solver.hpp"
+#include "spinesim/mss/simulator.hpp"
 
 #include "external_loads.hpp"
 #include "reduced_potential.hpp"

@@ -59,6 +59,26 @@ void check_static_input(const MssModel& model, const Boundary& bc, const StaticO
     throw std::invalid_argument("mss: the plate wrench is too large (its norm overflows)");
 }
 
+/// Backtracking (Armijo) line search from y along the Newton direction d (slope = r·d < 0);
+/// the accepted point is left in y_trial. False when 40 halvings find none.
+bool line_search(const MssModel& model, const ReducedSpace& space, ReducedPotential& pot,
+                 const Eigen::VectorXd& y, const Eigen::VectorXd& d, double Pi, double slope,
+                 double residual_n, Eigen::VectorXd& y_trial, Eigen::VectorXd& r_trial) {
+  double alpha = 1.0;
+  for (int ls = 0; ls < 40; ++ls, alpha *= 0.5) {
+    y_trial = y + alpha * d;
+    const double Pi_trial = pot.value(y_trial);
+    if (!std::isfinite(Pi_trial)) continue;
+    if (Pi_trial <= Pi + 1e-4 * alpha * slope) return true;
+    if (std::abs(Pi_trial - Pi) <= 1e-12 * (std::abs(Pi) + model.energy(pot.x()))) {
+      // Round-off regime: Pi cannot resolve the decrease; accept if the residual drops.
+      pot.value_and_gradient(y_trial, r_trial);
+      if (space.force_norm(r_trial) < residual_n) return true;
+    }
+  }
+  return false;
+}
+
 }  // namespace
 
 StaticResult solve_static(const MssModel& model, const Boundary& bc, const StaticOptions& options,
@@ -121,22 +141,7 @@ StaticResult solve_static(const MssModel& model, const Boundary& bc, const Stati
     }
     d = -r;
     tangent.solve_in_place(d);
-    const double slope = r.dot(d);
-    bool accepted = false;
-    double alpha = 1.0, Pi_trial = Pi;
-    for (int ls = 0; ls < 40 && !accepted; ++ls, alpha *= 0.5) {
-      y_trial = y + alpha * d;
-      Pi_trial = pot.value(y_trial);
-      if (!std::isfinite(Pi_trial)) continue;
-      if (Pi_trial <= Pi + 1e-4 * alpha * slope) {
-        accepted = true;
-      } else if (std::abs(Pi_trial - Pi) <= 1e-12 * (std::abs(Pi) + model.energy(pot.x()))) {
-        // Round-off regime: Pi cannot resolve the decrease; accept if the residual drops.
-        pot.value_and_gradient(y_trial, r_trial);
-        accepted = space.force_norm(r_trial) < res.residual_n;
-      }
-    }
-    if (!accepted) {
+    if (!line_search(model, space, pot, y, d, Pi, r.dot(d), res.residual_n, y_trial, r_trial)) {
       res.message = "line search failed at Newton iteration " + std::to_string(it) +
                     " (|r| = " + std::to_string(res.residual_n) + " N)";
       break;

@@ -1,5 +1,6 @@
 // Stable-time-step predictions of the explicit integrators (stability.hpp, solver.hpp).
 #include "stability.hpp"
+#include "spinesim/mss/simulator.hpp"
 
 #include "reduced_space.hpp"
 #include "spectrum.hpp"

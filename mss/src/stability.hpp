@@ -4,6 +4,7 @@
 
 #include "spinesim/mss/model.hpp"
 #include "spinesim/mss/solver.hpp"
+#include "spinesim/mss/simulator.hpp"
 
 #include <Eigen/SparseCore>
 

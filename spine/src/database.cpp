@@ -786,6 +786,9 @@ DisplacementDatabase DisplacementDatabase::load(const std::string& path) {
         }
       }
     }
+    // An empty database answers every force with the baseline: a check of it checks nothing.
+    if (std::none_of(db.present_.begin(), db.present_.end(), [](bool p) { return p; }))
+      throw std::runtime_error("\"fits\" is empty: the database holds no vertebra's response");
     // Every present vertebra needs all six directions, or evaluate() would silently add zeros.
     for (int v = 0; v < kDbVertebrae; ++v)
       for (int d = 0; d < kDbDirections; ++d)

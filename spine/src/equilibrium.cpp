@@ -2,6 +2,7 @@
 // coordinates, its analytic gradient by accumulating every element's force on the vertebrae
 // above each joint, and a modified Newton method with a finite-difference Hessian.
 #include "spinesim/spine/equilibrium.hpp"
+#include "spinesim/common/constants.hpp"
 
 #include "spinesim/common/timer.hpp"
 
@@ -17,7 +18,6 @@ namespace {
 using Eigen::Vector3d;
 using Eigen::VectorXd;
 
-constexpr double kRadToDeg = 180.0 / M_PI;
 constexpr double kThesisForceLimitN = 600.0;  // thesis 3.3.5: the largest force it validated
 
 /// Forces and couples on each vertebra, accumulated as the resultant force and the moment about
@@ -57,7 +57,7 @@ double bump_energy(double s, double w, double& ds) {
 // 200 iterations). The new stiffness ramps in over a band this narrow instead (so beyond it the
 // spring acts as if its zero were w/2 further on: 0.025° or 0.025 mm, below anything measured);
 // nothing changes at rest.
-constexpr double kFlexExtBlendRad = 0.05 * M_PI / 180;  // 0.05°
+constexpr double kFlexExtBlendRad = 0.05 * kRadPerDeg;  // 0.05°
 constexpr double kLigamentToeMm = 0.05;
 
 /// ½ max(x, 0)² made C²: its second derivative ramps from 0 at x = 0 to 1 at x = w.
@@ -503,7 +503,7 @@ void report(const SpineModel& m, const State& s, SpineSolution& out) {
     const Vector3d& C = m.vertebrae[i].centre_mm;
     out.displacement.row(Eigen::Index(i)).head<3>() = (s.poses[i].apply(C) - C).transpose();
     out.displacement.row(Eigen::Index(i)).tail<3>() =
-        (rotation_log(s.poses[i].R) * kRadToDeg).transpose();
+        (rotation_log(s.poses[i].R) * kDegPerRad).transpose();
   }
   std::vector<Vector3d> Fa, Ma;
   resultants_above(m, s, Fa, Ma);
@@ -700,7 +700,7 @@ DisplacementSensitivity displacement_sensitivity(const SpineModel& m,
     for (std::size_t i = 0; i < m.vertebrae.size(); ++i) {
       const Vector3d& C = m.vertebrae[i].centre_mm;
       d.segment<3>(6 * Eigen::Index(i)) = P[i].apply(C) - C;
-      d.segment<3>(6 * Eigen::Index(i) + 3) = rotation_log(P[i].R) * kRadToDeg;
+      d.segment<3>(6 * Eigen::Index(i) + 3) = rotation_log(P[i].R) * kDegPerRad;
     }
   };
   for (int a = 0; a < 3; ++a) {

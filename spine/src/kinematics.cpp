@@ -1,4 +1,5 @@
 #include "spinesim/spine/kinematics.hpp"
+#include "spinesim/common/constants.hpp"
 
 #include <cmath>
 #include <stdexcept>
@@ -26,7 +27,7 @@ Eigen::Vector3d rotation_log(const Eigen::Matrix3d& R) {
   const double a = std::acos(c);
   const Eigen::Vector3d w(R(2, 1) - R(1, 2), R(0, 2) - R(2, 0), R(1, 0) - R(0, 1));
   if (a < 1e-8) return 0.5 * w;
-  if (M_PI - a < 1e-6) throw std::domain_error("rotation_log: rotation of 180 degrees");
+  if (kPi - a < 1e-6) throw std::domain_error("rotation_log: rotation of 180 degrees");
   return a / (2 * std::sin(a)) * w;
 }
 
@@ -66,7 +67,7 @@ std::vector<Pose> vertebra_poses(const SpineModel& m, const Eigen::VectorXd& the
 Pose pose_from_displacement(const Eigen::Vector3d& centre_mm, const Eigen::Vector3d& translation_mm,
                             const Eigen::Vector3d& rotation_deg) {
   Pose p;
-  p.R = rotation_exp(rotation_deg * (M_PI / 180.0));
+  p.R = rotation_exp(rotation_deg * kRadPerDeg);
   p.t = centre_mm + translation_mm - p.R * centre_mm;
   return p;
 }

@@ -1,9 +1,10 @@
 // Builds the spine model from data/ (spine/README.md): no number of the model is in this file.
 #include "spinesim/spine/model.hpp"
+#include "spinesim/common/constants.hpp"
 
+#include "spinesim/common/csv_table.hpp"
 #include "spinesim/common/input_file.hpp"
 
-#include "csv_table.hpp"
 #include "json_fields.hpp"
 
 #include <Eigen/Eigenvalues>
@@ -21,15 +22,12 @@
 namespace spinesim::spine {
 namespace {
 namespace fs = std::filesystem;
-using detail::CsvTable;
 using detail::number;
-using detail::read_csv;
 using detail::read_json;
 using detail::vec3;
 using Eigen::Vector3d;
 using nlohmann::json;
 
-constexpr double kDeg = M_PI / 180.0;
 
 std::string upper(std::string s) {
   s.erase(std::remove_if(s.begin(), s.end(), [](unsigned char c) { return std::isspace(c); }),
@@ -291,8 +289,8 @@ IapStiffness iap_from_appendix_c(const std::string& path) {
   s.k_x = 0.5 * s.pressure_mpa * s.a_mm * s.h_mm;           // (3.10)
   s.bushing_k_xz = 4 * s.k_x;                               // (3.15)
   s.bushing_k_y = 4 * s.k_y;                                // (3.16), printed "k_y = 4k_y"
-  s.bushing_m_xz_per_deg = s.k_y * kDeg * s.a_mm * s.a_mm;  // (3.17)
-  s.bushing_m_y_per_deg = s.k_x * kDeg * s.a_mm * s.a_mm;   // (3.18)
+  s.bushing_m_xz_per_deg = s.k_y * kRadPerDeg * s.a_mm * s.a_mm;  // (3.17)
+  s.bushing_m_y_per_deg = s.k_x * kRadPerDeg * s.a_mm * s.a_mm;   // (3.18)
   return s;
 }
 
@@ -307,7 +305,7 @@ SpineModel load_spine_model(const std::string& data_dir, const ModelOptions& opt
   m.gravity_mm_s2 = number(config, "gravity_m_s2", config_file) * 1000.0;
   m.muscle_q = number(config, "muscle_short_range_stiffness_q", config_file);
   m.rom_bump_factor = number(config, "joint_rom_bump_factor", config_file);
-  m.rom_bump_onset = number(config, "joint_rom_bump_onset_deg", config_file) * kDeg;
+  m.rom_bump_onset = number(config, "joint_rom_bump_onset_deg", config_file) * kRadPerDeg;
   m.chest_front_mm = vec3(config, "chest_front_mm", config_file);
   m.ribs_body = vertebra_index(config.at("ribs").at("fixed_to").get<std::string>());
   if (!(m.muscle_q > 0) || !(m.rom_bump_factor >= 1) || !(m.rom_bump_onset > 0))
@@ -322,21 +320,20 @@ SpineModel load_spine_model(const std::string& data_dir, const ModelOptions& opt
     const CsvTable markers = read_csv((thesis / "F2_joint_markers.csv").string());
     const CsvTable k = read_csv((thesis / "F4_joint_torsional_stiffness.csv").string());
     const CsvTable rom = read_csv((thesis / "F5_range_of_motion.csv").string());
-    constexpr double kNmmPerDegToPerRad = 180.0 / M_PI;
     for (const auto& name : joint_names()) {
       Joint j;
       j.name = name;
       j.point_mm = row_point(markers, markers.find("location", name));
       const std::size_t g = k.find("level_group", stiffness_group(name));
-      j.k_flexion = k.number(g, "flexion_nmm_per_deg") * kNmmPerDegToPerRad;
-      j.k_extension = k.number(g, "extension_nmm_per_deg") * kNmmPerDegToPerRad;
-      j.k_lateral = k.number(g, "lateral_bending_nmm_per_deg") * kNmmPerDegToPerRad;
-      j.k_torsion = k.number(g, "axial_torsion_nmm_per_deg") * kNmmPerDegToPerRad;
+      j.k_flexion = k.number(g, "flexion_nmm_per_deg") * kDegPerRad;
+      j.k_extension = k.number(g, "extension_nmm_per_deg") * kDegPerRad;
+      j.k_lateral = k.number(g, "lateral_bending_nmm_per_deg") * kDegPerRad;
+      j.k_torsion = k.number(g, "axial_torsion_nmm_per_deg") * kDegPerRad;
       const std::size_t r = rom.find("level", name);
-      j.rom_flexion = rom.number(r, "flexion_deg") * kDeg;
-      j.rom_extension = rom.number(r, "extension_deg") * kDeg;
-      j.rom_lateral = rom.number(r, "lateral_bending_deg") * kDeg;
-      j.rom_torsion = rom.number(r, "torsion_deg") * kDeg;
+      j.rom_flexion = rom.number(r, "flexion_deg") * kRadPerDeg;
+      j.rom_extension = rom.number(r, "extension_deg") * kRadPerDeg;
+      j.rom_lateral = rom.number(r, "lateral_bending_deg") * kRadPerDeg;
+      j.rom_torsion = rom.number(r, "torsion_deg") * kRadPerDeg;
       if (!(j.k_flexion > 0 && j.k_extension > 0 && j.k_lateral > 0 && j.k_torsion > 0))
         throw std::runtime_error(k.path + ": joint stiffness of " + name + " must be > 0");
       m.joints.push_back(j);
@@ -365,7 +362,7 @@ SpineModel load_spine_model(const std::string& data_dir, const ModelOptions& opt
       m.bushing.k_rotation_nmm_per_rad =
           Vector3d(m.iap.bushing_m_xz_per_deg, m.iap.bushing_m_y_per_deg,
                    m.iap.bushing_m_xz_per_deg) /
-          kDeg;
+          kRadPerDeg;
     }
   } catch (const nlohmann::json::exception& e) {
     throw std::runtime_error(config_file + ": " + e.what());
@@ -381,6 +378,19 @@ void apply_disc_joints(std::vector<Joint>& joints, const std::string& name_or_pa
   const json j = read_json_file(path.string(), "disc joints file");
   if (!j.is_object() || !j.contains("joints") || !j.at("joints").is_object())
     throw std::invalid_argument(who + "expected a 'joints' object");
+  require_known_keys(j, {"formulation", "generated_by", "joints", "material", "source", "units"},
+                     who + "the file");
+  // Every level named must be one of the spine's (a typo or an "L6-L7" is not silently unused).
+  for (const auto& level : j.at("joints").items()) {
+    if (std::none_of(joints.begin(), joints.end(),
+                     [&](const Joint& jt) { return jt.name == level.key(); }))
+      throw std::invalid_argument(who + "unknown level '" + level.key() + "'");
+    require_known_keys(level.value(),
+                       {"K_nmm_per_rad", "cell_size_mm", "diagonal_nmm_per_deg", "joint_point_mm",
+                        "mesh_asymmetry_removed", "plate_center_mm", "tets",
+                        "thesis_F4_nmm_per_deg"},
+                       who + level.key());
+  }
   const std::string source = j.contains("source") && j.at("source").is_string()
                                  ? j.at("source").get<std::string>()
                                  : path.filename().string();
@@ -406,8 +416,16 @@ void apply_disc_joints(std::vector<Joint>& joints, const std::string& name_or_pa
     if (!K.allFinite() || (K - K.transpose()).norm() > 1e-6 * K.norm())
       throw std::invalid_argument(who + joint.name + ": the stiffness is not finite and symmetric");
     const Eigen::Matrix3d sym = 0.5 * (K + K.transpose());
-    if (!(Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(sym).eigenvalues().minCoeff() > 0))
+    const Eigen::Vector3d eig = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(sym).eigenvalues();
+    if (!(eig.minCoeff() > 0))
       throw std::invalid_argument(who + joint.name + ": the stiffness is not positive definite");
+    // A spinal joint's rotational stiffness is of order 1e5 N·mm/rad (F.4: 1e3-1e7 across the
+    // spine and its fusions); beyond 1 … 1e10 N·mm/rad the numbers are not a disc's.
+    if (!(eig.minCoeff() >= 1 && eig.maxCoeff() <= 1e10))
+      throw std::invalid_argument(who + joint.name +
+                                  ": the stiffness lies outside 1 … 1e10 N·mm/rad (eigenvalues " +
+                                  std::to_string(eig.minCoeff()) + " … " +
+                                  std::to_string(eig.maxCoeff()) + ")");
     joint.k_flexion = joint.k_extension = sym(0, 0);
     joint.k_torsion = sym(1, 1);
     joint.k_lateral = sym(2, 2);

@@ -1,5 +1,6 @@
 // The seated spine (seating.hpp; docs/seating.md).
 #include "spinesim/spine/seating.hpp"
+#include "spinesim/common/constants.hpp"
 
 #include "spinesim/common/timer.hpp"
 #include "spinesim/spine/kinematics.hpp"
@@ -22,11 +23,10 @@ using Eigen::Matrix3d;
 using Eigen::Vector3d;
 using Eigen::VectorXd;
 
-constexpr double kDeg = M_PI / 180.0;
 constexpr double kTopRadiusMm = 50;  // the parametric backrest's rounded top edge
 
 /// Posterior pelvic tilt by `deg`: rotation about x carrying superior (y) towards posterior (−z).
-Matrix3d tilt(double deg) { return Eigen::AngleAxisd(-deg * kDeg, Vector3d::UnitX()).matrix(); }
+Matrix3d tilt(double deg) { return Eigen::AngleAxisd(-deg * kRadPerDeg, Vector3d::UnitX()).matrix(); }
 
 bool lumbar_joint(const std::string& name) {
   return name == "L1-L2" || name == "L2-L3" || name == "L3-L4" || name == "L4-L5" ||
@@ -39,8 +39,8 @@ bool lumbar_joint(const std::string& name) {
 class ParametricBackrest : public ContactSurface {
  public:
   explicit ParametricBackrest(const Chair& c)
-      : t_(0, std::sin(c.backrest_recline_deg * kDeg), std::cos(c.backrest_recline_deg * kDeg)),
-        n_(0, -std::cos(c.backrest_recline_deg * kDeg), std::sin(c.backrest_recline_deg * kDeg)),
+      : t_(0, std::sin(c.backrest_recline_deg * kRadPerDeg), std::cos(c.backrest_recline_deg * kRadPerDeg)),
+        n_(0, -std::cos(c.backrest_recline_deg * kRadPerDeg), std::sin(c.backrest_recline_deg * kRadPerDeg)),
         height_(c.backrest_height_mm),
         depth_(c.lumbar_support_mm),
         centre_(c.lumbar_support_height_mm),
@@ -51,9 +51,9 @@ class ParametricBackrest : public ContactSurface {
     double phi = n_.dot(x);
     grad = n_;
     if (depth_ > 0 && std::abs(s - centre_) < half_) {  // the pad stands out of the plane
-      const double a = M_PI * (s - centre_) / half_;
+      const double a = kPi * (s - centre_) / half_;
       phi -= 0.5 * depth_ * (1 + std::cos(a));
-      grad += 0.5 * depth_ * std::sin(a) * (M_PI / half_) * t_;
+      grad += 0.5 * depth_ * std::sin(a) * (kPi / half_) * t_;
     }
     if (s > height_) {  // above the top the surface curves away behind
       phi += (s - height_) * (s - height_) / (2 * kTopRadiusMm);
@@ -99,23 +99,15 @@ void check_range(double v, double lo, double hi, const std::string& what) {
 /// The back's contact points: behind each vertebra's spinous-process tip by the soft tissue, and
 /// the skin over the sacrum (on the pelvis).
 void add_back_points(const SpineModel& standing, const Sitter& sitter, SpineModel& m) {
-  // The posterior elements' geometry is the ligaments' (spine_model.json): a model built without
-  // ligaments takes it from one built with them.
-  SpineModel with_ligaments;
-  const SpineModel* geometry = &standing;
-  if (standing.ligaments.empty()) {
-    with_ligaments = load_spine_model(standing.data_dir);
-    geometry = &with_ligaments;
-  }
+  if (sitter.interspinous_z_mm.size() != standing.vertebrae.size())
+    throw std::invalid_argument("seating: the sitter's posterior-element geometry is for " +
+                                std::to_string(sitter.interspinous_z_mm.size()) +
+                                " vertebrae, the model has " +
+                                std::to_string(standing.vertebrae.size()));
   for (std::size_t i = 0; i < standing.vertebrae.size(); ++i) {
     const Vertebra& v = standing.vertebrae[i];
     const bool lumbar = v.name[0] == 'L';
-    // The interspinous ligament leaves the vertebra halfway along its spinous process.
-    double isl_z = NAN;
-    for (const Ligament& l : geometry->ligaments)
-      if (l.type == "ISL" && l.body_a == int(i)) isl_z = l.a_mm.z();
-    if (std::isnan(isl_z))
-      throw std::runtime_error("seating: no interspinous ligament geometry for " + v.name);
+    const double isl_z = sitter.interspinous_z_mm[i];
     const double tip =
         isl_z - 0.5 * (lumbar ? sitter.spinous_lumbar_mm : sitter.spinous_thoracic_mm);
     const double tissue = lumbar ? sitter.tissue_lumbar_mm : sitter.tissue_thoracic_mm;
@@ -237,6 +229,24 @@ Sitter load_sitter(const SpineModel& model) {
       detail::read_json(model_file).at("ligaments").at("spinous_length_mm");
   s.spinous_thoracic_mm = number(lengths, "thoracic", model_file);
   s.spinous_lumbar_mm = number(lengths, "lumbar", model_file);
+  // The posterior elements' geometry is the ligaments' (spine_model.json): a model built without
+  // ligaments takes it from one built with them.
+  SpineModel with_ligaments;
+  const SpineModel* geometry = &model;
+  if (model.ligaments.empty()) {
+    with_ligaments = load_spine_model(model.data_dir);
+    geometry = &with_ligaments;
+  }
+  for (std::size_t i = 0; i < model.vertebrae.size(); ++i) {
+    // The interspinous ligament leaves the vertebra halfway along its spinous process.
+    double isl_z = NAN;
+    for (const Ligament& l : geometry->ligaments)
+      if (l.type == "ISL" && l.body_a == int(i)) isl_z = l.a_mm.z();
+    if (std::isnan(isl_z))
+      throw std::runtime_error("seating: no interspinous ligament geometry for " +
+                               model.vertebrae[i].name);
+    s.interspinous_z_mm.push_back(isl_z);
+  }
   const auto& lean = j.at("lean_range_deg");
   if (!lean.is_array() || lean.size() != 2 || !lean[0].is_number() || !lean[1].is_number())
     throw std::runtime_error(file + ": lean_range_deg must be [min, max]");
@@ -280,7 +290,7 @@ SeatedModel seat_model(const SpineModel& standing, const Chair& chair, const Sit
   out.model = standing;
   SpineModel& m = out.model;
   out.rotation = tilt(tilt_deg);
-  const double a = chair.seat_angle_deg * kDeg;
+  const double a = chair.seat_angle_deg * kRadPerDeg;
   out.ischia_world_mm = ischia_forward_mm * Vector3d(0, std::sin(a), std::cos(a));
   const Vector3d I = standing.joints.back().point_mm + sitter.ischia_mm;
   // Gravity keeps pointing down in the chair: in the pelvis frame it turns with the tilt.
@@ -300,7 +310,7 @@ SeatedModel seat_model(const SpineModel& standing, const Chair& chair, const Sit
     m.contact_surface = std::make_shared<PlacedSurface>(back, out.rotation, I, out.ischia_world_mm);
   out.posture = VectorXd::Zero(dof_count(m));
   for (std::size_t k = 0; k < m.joints.size(); ++k)
-    out.posture[3 * Eigen::Index(k)] = sitter.lumbar_flexion_deg * kDeg * sitter.lumbar_share[k];
+    out.posture[3 * Eigen::Index(k)] = sitter.lumbar_flexion_deg * kRadPerDeg * sitter.lumbar_share[k];
   // The IAP bushing stands for the abdomen's pressure, not for an elastic memory of standing:
   // seated, the abdomen settles into the sitting posture and the bushing rests there (stress-free
   // at standing, its appendix C stiffness would hold the ribs 1 kN up and 55 N·m back against the
@@ -338,7 +348,7 @@ double slide_back(const SpineModel& standing, const Chair& chair, const Sitter& 
   const SeatedModel sm = seat_model(standing, chair, sitter, tilt_deg, 0);
   if (!sm.model.contact_surface) return 0;
   const std::vector<Vector3d> points = contact_points_at_posture(sm);
-  const double a = chair.seat_angle_deg * kDeg;
+  const double a = chair.seat_angle_deg * kRadPerDeg;
   const Vector3d shift = sm.rotation.transpose() * Vector3d(0, std::sin(a), std::cos(a));
   auto gap = [&](double d) {
     double g = INFINITY;
@@ -414,14 +424,14 @@ void fill_result(const LeanState& st, const Chair& chair, const Sitter& sitter,
   out.body_weight_n = -weight.y();
   out.seat_force_n = -(weight + out.backrest_force_n + out.armrest_force_n);
   out.force_residual_n = (seat_from_pelvis(sm, sitter, st.spine) - out.seat_force_n).norm();
-  const double a = chair.seat_angle_deg * kDeg;
+  const double a = chair.seat_angle_deg * kRadPerDeg;
   const Vector3d across(0, std::cos(a), -std::sin(a));  // the seat pan's normal, up
   const double pressing = out.seat_force_n.dot(across);
   out.seat_friction_needed = (out.seat_force_n - pressing * across).norm() / pressing;
   out.hip_moment_nmm = st.moment_nmm;
   out.vertebra_angle_deg.clear();
   for (const Pose& p : st.spine.poses)
-    out.vertebra_angle_deg.push_back(rotation_log(R * p.R).x() / kDeg);
+    out.vertebra_angle_deg.push_back(rotation_log(R * p.R).x() / kRadPerDeg);
   out.warnings = st.spine.warnings;
 }
 

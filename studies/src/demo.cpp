@@ -1,4 +1,5 @@
 #include "spinesim/studies/demo.hpp"
+#include "spinesim/common/constants.hpp"
 
 #include "spinesim/studies/haptic_plane_study.hpp"
 #include "spinesim/studies/haptics_run.hpp"
@@ -13,7 +14,7 @@
 #include "spinesim/mesh/mesher.hpp"
 #include "spinesim/mesh/quality.hpp"
 #include "spinesim/mss/model.hpp"
-#include "spinesim/studies/calibration_report.hpp"
+#include "spinesim/studies/calibration_summary.hpp"
 #include "spinesim/studies/comparison_report.hpp"
 #include "spinesim/studies/data.hpp"
 #include "spinesim/studies/disc_level.hpp"
@@ -43,14 +44,6 @@ namespace fs = std::filesystem;
 constexpr const char* kPresets[] = {"real-disc", "annulus-nucleus", "fibre-reinforced", "rubber",
                                     "polyethylene"};
 constexpr double kSpineStudyForceN = 300;  // the spine studies' default force on T1
-
-/// Block rotation of a 6x6 wrench/motion matrix into the disc frame: K_local = R^T K R.
-fem::Matrix6d to_disc_frame(const fem::Matrix6d& k, const mesh::DiscFrame& f) {
-  fem::Matrix6d r = fem::Matrix6d::Zero();
-  r.topLeftCorner<3, 3>() = f.axes;
-  r.bottomRightCorner<3, 3>() = f.axes;
-  return r.transpose() * k * r;
-}
 
 /// The four training and four held-out cases of the demo's calibration.
 CalibrationRequest demo_calibration_request() {
@@ -152,7 +145,7 @@ void Demo::fem_load_cases() {
     fields.push_back({"displacement_" + c.name, sol.displacement_mm});
     const Eigen::Vector3d t_local = m.frame.axes.transpose() * sol.plate_motion.head<3>();
     const Eigen::Vector3d r_local =
-        m.frame.axes.transpose() * sol.plate_motion.tail<3>() * 180.0 / M_PI;
+        m.frame.axes.transpose() * sol.plate_motion.tail<3>() * kDegPerRad;
     const double umax = sol.displacement_mm.rowwise().norm().maxCoeff();
     cases.push_back({{"name", c.name},
                      {"wrench_local", to_json(c.wrench_local)},
@@ -273,7 +266,7 @@ void Demo::haptics() {
 
 // 8. The report.
 std::string Demo::report() const {
-  const fem::Matrix6d k_local = to_disc_frame(k6, m.frame);
+  const fem::Matrix6d k_local = fem::to_disc_frame(k6, m.frame);
   std::ostringstream report;
   report << "# spinesim demo — " << dims.level << " disc\n\n"
          << "## Mesh (CGAL Mesh_3, cell size " << rq.cell_size_mm << " mm)\n\n```\n";
@@ -366,7 +359,7 @@ std::string Demo::haptics_section() const {
 }
 
 nlohmann::json Demo::summary(const std::string& report_path) const {
-  const fem::Matrix6d k_local = to_disc_frame(k6, m.frame);
+  const fem::Matrix6d k_local = fem::to_disc_frame(k6, m.frame);
   return {{"level", dims.level},
           {"mesh", quality_json(quality)},
           {"mesh_seconds", mesh_seconds},
@@ -398,10 +391,58 @@ int demo_stages() {
          kTrendsStages;
 }
 
+namespace {
+
+/// A number at `pointer` in `j` ("n/a" when absent), with `digits` significant digits.
+std::string at(const nlohmann::json& j, const std::string& pointer, int digits = 4) {
+  const nlohmann::json::json_pointer p(pointer);
+  if (!j.contains(p) || !j.at(p).is_number()) return "n/a";
+  const double v = j.at(p).get<double>();
+  // Counts (tets, DOF, ticks) in full; measured numbers to `digits` significant digits.
+  if (j.at(p).is_number_integer() || (v == std::round(v) && std::abs(v) >= 1e3 && std::abs(v) < 1e15))
+    return fixed(std::round(v), 0);
+  return significant(v, digits);
+}
+
+/// Mean of `key` over the rows of `rows` (NaN when none).
+double mean_of(const nlohmann::json& rows, const char* key) {
+  double sum = 0;
+  int n = 0;
+  for (const auto& r : rows)
+    if (r.contains(key) && r.at(key).is_number()) sum += r.at(key).get<double>(), ++n;
+  return n ? sum / n : std::nan("");
+}
+
+}  // namespace
+
+std::string demo_summary(const DemoResult& r) {
+  const nlohmann::json& s = r.summary;
+  const nlohmann::json holdout = s.contains("calibration") ? s["calibration"].value("holdout", nlohmann::json::array())
+                                                           : nlohmann::json::array();
+  std::ostringstream os;
+  os << "spinesim demo: " << s.value("level", std::string("?")) << "\n"
+     << "  mesh         " << at(s, "/mesh/tets") << " tets, " << at(s, "/mesh/nodes") << " nodes, min dihedral "
+     << at(s, "/mesh/min_dihedral_deg", 3) << " deg\n"
+     << "  FEM P" << at(s, "/fem_order", 1) << "       " << at(s, "/fem_dofs") << " DOF, axial stiffness "
+     << at(s, "/stiffness_6x6_disc_frame/1/1") << " N/mm\n"
+     << "  MSS vs FEM   held-out displacement error untuned " << percent(mean_of(holdout, "untuned_error"))
+     << ", tuned " << percent(mean_of(holdout, "tuned_error")) << " (mean of "
+     << holdout.size() << " cases)\n"
+     << "  spine        L5-S1 " << at(s, "/spine_validation/mcgill/axial_n") << " N (McGill & Norman), L4-L5 "
+     << at(s, "/spine_validation/wilke/axial_n") << " N (Wilke: "
+     << at(s, "/spine_validation/wilke/target/axial_n") << " N)\n"
+     << "  haptics      " << at(s, "/haptics_run/rate_hz") << " Hz, "
+     << at(s, "/haptics_run/missed_deadlines") << " missed deadlines of "
+     << at(s, "/haptics_run/ticks", 6) << " ticks\n"
+     << "Report: " << r.report_path << " (markdown), summary.json beside it\n"
+     << (r.html.written ? "" : "note: ") << r.html.message << "\n";
+  return os.str();
+}
+
 DemoResult run_demo(const DemoRequest& rq, const StageHooks& hooks) {
   if (rq.fem_order != 1 && rq.fem_order != 2)
     throw std::invalid_argument("the FEM order must be 1 or 2");
-  fs::create_directories(rq.out);
+  prepare_output_folder(rq.out, "--out");
   Demo demo(rq, hooks);
   demo.mesh_disc();
   demo.fem_reference();

@@ -1,4 +1,5 @@
 #include "spinesim/studies/disc_joints.hpp"
+#include "spinesim/common/constants.hpp"
 
 #include "spinesim/calibration/linear_mss.hpp"
 #include "spinesim/calibration/tuned_set.hpp"
@@ -6,6 +7,7 @@
 #include "spinesim/mesh/disc_geometry.hpp"
 #include "spinesim/spine/model.hpp"
 #include "spinesim/studies/disc_level.hpp"
+#include "spinesim/fem/plate_stiffness.hpp"
 #include "spinesim/studies/fem_report.hpp"
 #include "spinesim/studies/format.hpp"
 #include "spinesim/studies/table.hpp"
@@ -16,13 +18,6 @@
 namespace spinesim::studies {
 namespace {
 
-constexpr double kDegPerRad = 180.0 / 3.14159265358979323846;
-
-Eigen::Matrix3d cross_matrix(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d m;
-  m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
-  return m;
-}
 
 /// The parametric disc is mirror-symmetric about the sagittal plane, its CGAL mesh only nearly:
 /// under x -> -x, θ_x is even and θ_y, θ_z odd, so the exact disc has no flexion-torsion or
@@ -50,15 +45,6 @@ bool wanted(const std::vector<std::string>& levels, const std::string& level) {
 
 }  // namespace
 
-Eigen::Matrix3d joint_stiffness_about(const fem::Matrix6d& K6, const Eigen::Vector3d& c,
-                                      const Eigen::Vector3d& J) {
-  Eigen::Matrix<double, 6, 3> T;
-  T.topRows<3>() = -cross_matrix(c - J);  // θ × (c − J) = −[c − J]× θ
-  T.bottomRows<3>().setIdentity();
-  const Eigen::Matrix3d K = T.transpose() * K6 * T;
-  return 0.5 * (K + K.transpose());
-}
-
 DiscJointSet compute_disc_joints(const std::string& data_dir,
                                  const mesh::RegionMaterials& materials,
                                  fem::Formulation formulation,
@@ -79,7 +65,7 @@ DiscJointSet compute_disc_joints(const std::string& data_dir,
     options.formulation = formulation;
     const fem::DiscFem solver(m, materials, 2, d.plate_center_mm, options);
     set_mirror_symmetric(
-        d, joint_stiffness_about(solver.stiffness_6x6(), d.plate_center_mm, d.joint_point_mm));
+        d, fem::joint_stiffness_about(solver.stiffness_6x6(), d.plate_center_mm, d.joint_point_mm));
     hooks.end_stage(std::to_string(d.tets) + " tets");
     set.joints.push_back(d);
   }
@@ -121,7 +107,7 @@ DiscJointSet compute_tuned_disc_joints(const std::string& data_dir, const std::s
                                                    td.edge_multipliers.data(),
                                                    Eigen::Index(td.edge_multipliers.size())))
                         : linear.solve(scales);
-    set_mirror_symmetric(d, joint_stiffness_about(state.k6, d.plate_center_mm, d.joint_point_mm));
+    set_mirror_symmetric(d, fem::joint_stiffness_about(state.k6, d.plate_center_mm, d.joint_point_mm));
     hooks.end_stage(std::to_string(d.tets) + " tets");
     set.joints.push_back(d);
   }

@@ -1,4 +1,5 @@
 #include "spinesim/studies/disc_validation.hpp"
+#include "spinesim/common/constants.hpp"
 
 #include "spinesim/common/input_file.hpp"
 #include "spinesim/common/timer.hpp"
@@ -14,7 +15,6 @@
 namespace spinesim::studies {
 namespace {
 
-constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
 
 std::string preparation_of(const nlohmann::json& t) {
   const auto flag = [&](const char* key) -> int {
@@ -100,7 +100,7 @@ DiscValidationResult run_disc_validation(const mesh::TetMesh& m,
     const Eigen::Vector3d t = axes.transpose() * s.plate_motion.head<3>();
     const Eigen::Vector3d theta = axes.transpose() * s.plate_motion.tail<3>();
     if (component < 3) return std::abs(c.wrench_local(component) / t(component)) / 1000.0;
-    return std::abs(c.wrench_local(component) / 1000.0 / (theta(component - 3) * kRadToDeg));
+    return std::abs(c.wrench_local(component) / 1000.0 / (theta(component - 3) * kDegPerRad));
   };
   std::map<std::string, double> ours = {{"compression", stiffness("compression", 1)},
                                         {"torsion", stiffness("torsion", 4)},

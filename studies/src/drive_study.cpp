@@ -1,4 +1,6 @@
 #include "spinesim/studies/drive_study.hpp"
+#include "spinesim/mss/simulator.hpp"
+#include "spinesim/common/constants.hpp"
 
 #include "spinesim/fem/disc_fem.hpp"
 #include "spinesim/mss/boundary.hpp"
@@ -32,7 +34,7 @@ mss::Vector6d schedule_motion(const std::vector<Keyframe>& keys, double t) {
   const double w = std::clamp((t - k0.time_s) / (k1.time_s - k0.time_s), 0.0, 1.0);
   mss::Vector6d q = mss::Vector6d::Zero();
   q(1) = k0.axial_mm + w * (k1.axial_mm - k0.axial_mm);
-  q(3) = (k0.flexion_deg + w * (k1.flexion_deg - k0.flexion_deg)) * M_PI / 180.0;
+  q(3) = (k0.flexion_deg + w * (k1.flexion_deg - k0.flexion_deg)) * kRadPerDeg;
   return q;
 }
 
@@ -152,7 +154,7 @@ DriveStudyResult run_drive_study(const mesh::TetMesh& m, const DriveStudyRequest
                                  const StageHooks& hooks) {
   check(request);
   const SteppedStudyOptions& o = request.stepping;
-  fs::create_directories(o.out);
+  prepare_output_folder(o.out, "--out");
   DriveStudyResult r;
   r.request = request;
   r.schedule = drive_schedule(request.compression_mm, request.flexion_deg, request.time_scale);

@@ -1,4 +1,5 @@
 #include "spinesim/studies/fem_report.hpp"
+#include "spinesim/common/constants.hpp"
 
 #include "spinesim/common/timer.hpp"
 #include "spinesim/mesh/io.hpp"
@@ -16,25 +17,6 @@
 namespace spinesim::studies {
 
 namespace {
-constexpr double kDegToRad = M_PI / 180.0;
-}
-
-fem::Vector6d motion_deg_to_rad(const fem::Vector6d& q_deg) {
-  fem::Vector6d q = q_deg;
-  q.tail<3>() *= kDegToRad;
-  return q;
-}
-
-fem::Vector6d motion_rad_to_deg(const fem::Vector6d& q_rad) {
-  fem::Vector6d q = q_rad;
-  q.tail<3>() /= kDegToRad;
-  return q;
-}
-
-fem::Matrix6d stiffness_per_degree(const fem::Matrix6d& k_rad) {
-  fem::Matrix6d k = k_rad;
-  k.rightCols<3>() *= kDegToRad;
-  return k;
 }
 
 void print_stiffness(std::ostream& os, const fem::Matrix6d& k_rad) {

@@ -1,4 +1,5 @@
 #include "spinesim/studies/files.hpp"
+#include "spinesim/mss/simulator.hpp"
 
 #include "spinesim/common/atomic_file.hpp"
 #include "spinesim/mss/quantities.hpp"
@@ -6,6 +7,7 @@
 #include <cctype>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <set>
 #include <stdexcept>
 
@@ -25,6 +27,30 @@ void require_output_folder(const std::string& path, const std::string& option) {
     throw std::invalid_argument(option + " " + path + ": folder " + dir.string() +
                                 " does not exist");
   require_replaceable(option, path);  // a device, FIFO or link is refused before the work
+}
+
+void prepare_output_folder(const std::string& path, const std::string& option) {
+  if (path.empty()) throw std::invalid_argument(option + ": give an output folder");
+  const fs::path dir(path);
+  std::error_code ec;
+  if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
+    throw std::invalid_argument(option + " " + path + ": exists and is not a folder");
+  fs::create_directories(dir, ec);
+  if (ec || !fs::is_directory(dir))
+    throw std::invalid_argument(option + " " + path + ": cannot create the folder (" +
+                                (ec ? ec.message() : std::string("not a folder")) + ")");
+  // Writable? A probe file, made and removed (permissions, read-only mounts).
+  const fs::path probe = dir / (".spinesim-write-probe-" + std::to_string(::getpid()));
+  {
+    std::ofstream os(probe);
+    os << "probe";
+    os.flush();
+    if (!os) {
+      fs::remove(probe, ec);
+      throw std::invalid_argument(option + " " + path + ": the folder cannot be written");
+    }
+  }
+  fs::remove(probe, ec);
 }
 
 namespace {

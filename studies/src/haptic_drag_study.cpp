@@ -1,4 +1,5 @@
 #include "spinesim/studies/haptic_drag_study.hpp"
+#include "spinesim/common/constants.hpp"
 
 #include "spinesim/common/timer.hpp"
 #include "spinesim/spine/database.hpp"
@@ -20,7 +21,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr double kRadToDeg = 180.0 / M_PI;
 constexpr int kVertebrae = 17;
 
 ErrorPercentiles percentiles_of(std::vector<double> v) {
@@ -93,7 +93,7 @@ void measure_pose_error(const spine::SpineModel& m, const DragRecording& rec,
       const spine::Pose r = f.pose(m, i);
       const double e = (r.apply(c) - d.apply(c)).norm();
       et[std::size_t(i)].push_back(e);
-      er[std::size_t(i)].push_back(spine::rotation_log(r.R * d.R.transpose()).norm() * kRadToDeg);
+      er[std::size_t(i)].push_back(spine::rotation_log(r.R * d.R.transpose()).norm() * kDegPerRad);
     }
     ++out.samples;
   }
@@ -128,7 +128,7 @@ std::string pairs_csv(const spine::SpineModel& m, const DragRecording& rec) {
       const Eigen::Vector3d cu = m.vertebrae[std::size_t(i)].centre_mm;
       const Eigen::Vector3d cl = m.vertebrae[std::size_t(i + 1)].centre_mm;
       const Eigen::Vector3d d = low.R.transpose() * (up.apply(cu) - low.apply(cl)) - (cu - cl);
-      const Eigen::Vector3d r = spine::rotation_log(low.R.transpose() * up.R) * kRadToDeg;
+      const Eigen::Vector3d r = spine::rotation_log(low.R.transpose() * up.R) * kDegPerRad;
       char line[256];
       std::snprintf(line, sizeof line, "%.3f,%s-%s,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f\n", f.t_s,
                     names[std::size_t(i)].c_str(), names[std::size_t(i + 1)].c_str(), d.x(), d.y(),
@@ -150,10 +150,9 @@ HapticDragResult run_haptic_drag_study(const HapticDragRequest& request,
   for (const auto& m : request.methods)
     if (m != "multirate" && m != "database")
       throw std::invalid_argument("method " + m + ": give multirate or database");
-  if (request.out.empty() || !fs::is_directory(request.out))
-    throw std::invalid_argument("--out " + request.out + ": not an existing folder");
   if (!(request.sample_every_s > 0))
     throw std::invalid_argument("the sampling interval must be > 0 s");
+  prepare_output_folder(request.out, "--out");
   Timer timer;
   HapticDragResult result;
   result.request = request;

@@ -1,4 +1,5 @@
 #include "spinesim/studies/haptic_plane_study.hpp"
+#include "spinesim/common/constants.hpp"
 
 #include "spinesim/common/timer.hpp"
 #include "spinesim/haptics/renderer.hpp"
@@ -15,7 +16,7 @@ namespace {
 // ∫ (r − |p − c|) dA over the plane's part inside the ball of radius r centred at height h.
 double depth_integral(double r, double h) {
   if (std::abs(h) >= r) return 0;
-  return M_PI * r * (r * r - h * h) - 2.0 * M_PI / 3.0 * (r * r * r - std::pow(std::abs(h), 3));
+  return kPi * r * (r * r - h * h) - 2.0 * kPi / 3.0 * (r * r * r - std::pow(std::abs(h), 3));
 }
 
 }  // namespace
@@ -34,7 +35,7 @@ HapticPlaneResult run_haptic_plane_study(const HapticPlaneRequest& req) {
   out.request = req;
   const double k410 = req.stiffness_eq410_n_per_mm;
   const double k49 =
-      req.stiffness_eq49_n_per_mm3 > 0 ? req.stiffness_eq49_n_per_mm3 : k410 / (M_PI * r * r);
+      req.stiffness_eq49_n_per_mm3 > 0 ? req.stiffness_eq49_n_per_mm3 : k410 / (kPi * r * r);
   out.stiffness_eq49 = k49;
 
   haptics::Scene scene;
@@ -72,8 +73,8 @@ HapticPlaneResult run_haptic_plane_study(const HapticPlaneRequest& req) {
     row.large_eq410_n = force(large410, R, d);
     row.small_eq49_exact_n = k49 * depth_integral(r, r - d);
     row.large_eq49_exact_n = k49 * depth_integral(R, R - d);
-    row.small_eq410_exact_n = k410 * depth_integral(r, r - d) / (M_PI * r * r);
-    row.large_eq410_exact_n = k410 * depth_integral(R, R - d) / (M_PI * R * R);
+    row.small_eq410_exact_n = k410 * depth_integral(r, r - d) / (kPi * r * r);
+    row.large_eq410_exact_n = k410 * depth_integral(R, R - d) / (kPi * R * R);
     if (row.small_eq49_n > small_peak) {
       small_peak = row.small_eq49_n;
       out.small_peak_depth_eq49_mm = d;

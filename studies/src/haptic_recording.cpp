@@ -1,6 +1,8 @@
 #include "spinesim/studies/haptic_recording.hpp"
+#include "spinesim/common/constants.hpp"
 
 #include "spinesim/common/input_file.hpp"
+#include "spinesim/studies/format.hpp"
 #include "spinesim/spine/equilibrium.hpp"
 #include "spinesim/spine/kinematics.hpp"
 
@@ -17,7 +19,6 @@ namespace spinesim::studies {
 
 namespace {
 
-constexpr double kRadToDeg = 180.0 / M_PI;
 constexpr int kCommonColumns = 13, kHookColumns = 11, kVertebrae = 17;
 constexpr int kDragColumns = kCommonColumns + kHookColumns + 6 * kVertebrae;
 
@@ -106,7 +107,7 @@ void HapticRecordingWriter::append(const haptics::TickRecord* rows, std::size_t 
       for (std::size_t v = 0; v < centres_.size(); ++v) {
         const Eigen::Matrix3d R = r.R[v].cast<double>();
         const Eigen::Vector3d d = R * centres_[v] + r.t[v].cast<double>() - centres_[v];
-        const Eigen::Vector3d rot = spine::rotation_log(R) * kRadToDeg;
+        const Eigen::Vector3d rot = spine::rotation_log(R) * kDegPerRad;
         std::fprintf(file_, ",%.5f,%.5f,%.5f,%.5f,%.5f,%.5f", d.x(), d.y(), d.z(), rot.x(), rot.y(),
                      rot.z());
       }
@@ -118,14 +119,22 @@ void HapticRecordingWriter::append(const haptics::TickRecord* rows, std::size_t 
   if (std::fflush(file_) != 0 || ::fdatasync(::fileno(file_)) != 0) failed_ = true;
 }
 
-void HapticRecordingWriter::finish() {
+void HapticRecordingWriter::finish(const std::string& stopped_early) {
   if (!file_) return;
-  std::fprintf(file_, "# end: %lld ticks\n", static_cast<long long>(rows_));
+  if (stopped_early.empty())
+    std::fprintf(file_, "%s%lld ticks\n", kEndLine, static_cast<long long>(rows_));
+  else
+    std::fprintf(file_, "%s%lld ticks; stopped early: %s\n", kEndLine,
+                 static_cast<long long>(rows_), one_line(stopped_early).c_str());
   const bool ok = std::fflush(file_) == 0 && ::fdatasync(::fileno(file_)) == 0;
   const bool closed = std::fclose(file_) == 0;
   file_ = nullptr;
-  if (failed_ || !ok || !closed)
-    throw std::runtime_error("--record " + path_ + ": write failed (disk full?)");
+  if (failed_ || !ok || !closed) {
+    // A write that failed (a full disk) leaves no half file under the output's name: what is
+    // on disk ends mid-row and its rows are not all the run's.
+    std::remove(path_.c_str());
+    throw std::runtime_error("--record " + path_ + ": write failed (disk full?); nothing kept");
+  }
 }
 
 spine::Pose DragFrame::pose(const spine::SpineModel& m, int i) const {
@@ -180,19 +189,20 @@ bool parse_row(const std::string& line, DragFrame& f, std::string& why) {
 }  // namespace
 
 DragRecording read_drag_recording(const std::string& path, const spine::SpineModel& model) {
-  const std::string text = read_regular_file(path, "the recording");
+  // Streamed: a recording near the size limit is never held in memory as text besides its rows.
+  std::ifstream in = open_regular_file(path, "the recording");
   DragRecording rec;
   rec.path = path;
-  std::istringstream in(text);
   std::string line;
   int line_no = 0;
   bool header = false;
+  std::string end_line;
   const std::string ours = spine_model_fingerprint(model);
   while (std::getline(in, line)) {
     ++line_no;
     const std::string where = path + ":" + std::to_string(line_no);
     // A last line without its newline is a row the killed run did not finish: dropped.
-    if (in.eof() && !text.empty() && text.back() != '\n') break;
+    if (in.eof()) break;
     if (line.rfind("# spine model ", 0) == 0) {
       std::istringstream h(line.substr(14));
       h >> rec.fingerprint;
@@ -205,8 +215,8 @@ DragRecording read_drag_recording(const std::string& path, const spine::SpineMod
                                     rec.fingerprint + ", this model " + ours + ")");
       continue;
     }
-    if (line.rfind("# end:", 0) == 0) {
-      rec.complete = true;
+    if (line.rfind(kEndLine, 0) == 0) {
+      end_line = line;
       continue;
     }
     if (line.empty() || line[0] == '#') continue;
@@ -230,13 +240,34 @@ DragRecording read_drag_recording(const std::string& path, const spine::SpineMod
                                   " N, more than the spine solve accepts");
     if (f.hook_vertebra < -1 || f.hook_vertebra >= kVertebrae)
       throw std::invalid_argument(where + ": hook vertebra out of range");
+    // A vertebra moved beyond any spine's reach is a corrupt row, not a posture.
+    const double shift = f.motion.leftCols<3>().rowwise().norm().maxCoeff(),
+                 turn = f.motion.rightCols<3>().rowwise().norm().maxCoeff();
+    if (!(shift <= kMaxVertebraShiftMm) || !(turn <= kMaxVertebraTurnDeg))
+      throw std::invalid_argument(where + ": a vertebra moved " + significant(shift, 3) +
+                                  " mm / turned " + significant(turn, 3) + " deg, beyond " +
+                                  fixed(kMaxVertebraShiftMm, 0) + " mm / " +
+                                  fixed(kMaxVertebraTurnDeg, 0) + " deg");
     rec.frames.push_back(f);
   }
   if (rec.fingerprint.empty())
     throw std::invalid_argument(path +
                                 ": not a compliant-stage recording (no spine model line: "
                                 "record with haptics run --spine …)");
-  if (rec.frames.empty()) throw std::invalid_argument(path + ": no recorded ticks");
+  if (rec.frames.size() < 2)
+    throw std::invalid_argument(path + ": " + std::to_string(rec.frames.size()) +
+                                " recorded tick(s): at least two are needed to step between");
+  // Whole only when the end line counts exactly the rows read and the run ended by itself.
+  const std::string clean = kEndLine + std::to_string(rec.frames.size()) + " ticks";
+  if (end_line.empty())
+    rec.incomplete_reason = "no end line (the run was killed, or the file cut)";
+  else if (end_line.rfind(clean, 0) != 0 ||
+           (end_line.size() > clean.size() && end_line.compare(clean.size(), 2, "; ") != 0))
+    rec.incomplete_reason = "the end line (\"" + end_line + "\") does not count the " +
+                            std::to_string(rec.frames.size()) + " rows read";
+  else if (end_line.size() > clean.size())
+    rec.incomplete_reason = end_line.substr(clean.size() + 2);
+  rec.complete = rec.incomplete_reason.empty();
   return rec;
 }
 

@@ -426,7 +426,9 @@ HapticsRunResult run_haptics(const HapticsRunRequest& request, const std::string
   if (result.stats.error && !device->last_error().empty())
     result.stats.stop_reason += ": " + device->last_error();
   if (record) {
-    record->finish();
+    const std::string& why = result.stats.stop_reason;
+    const bool clean = why == "duration" || why == "device finished" || why == "window closed";
+    record->finish(clean ? "" : why);
     result.recorded_rows = record->rows();
   }
   return result;
@@ -582,6 +584,17 @@ std::string haptics_run_table(const HapticsRunResult& r) {
   if (!r.request.record.empty())
     os << "  recorded " << r.recorded_rows << " ticks to " << r.request.record << "\n";
   return os.str();
+}
+
+std::string missed_deadlines_warning(const HapticsRunResult& r, double max_missed_percent) {
+  const auto& s = r.stats;
+  if (s.ticks <= 0) return "";
+  const double percent = 100.0 * double(s.missed_deadlines) / double(s.ticks);
+  if (!(percent > max_missed_percent)) return "";
+  return std::to_string(s.missed_deadlines) + " of " + std::to_string(s.ticks) +
+         " deadlines missed (" + fixed(percent, 2) + " %, more than the " +
+         fixed(max_missed_percent, 2) + " % allowed): the loop did not hold its rate here (" +
+         fixed(s.rate_hz, 1) + " Hz)";
 }
 
 nlohmann::json haptic_devices_json(const std::string& openhaptics_lib, const std::string& dhd_lib) {

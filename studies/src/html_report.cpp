@@ -1,6 +1,7 @@
 #include "spinesim/studies/html_report.hpp"
 
 #include <array>
+#include <sys/wait.h>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -59,6 +60,7 @@ HtmlReport write_html_report(const std::string& folder, const std::string& scrip
     while (std::fgets(buffer.data(), int(buffer.size()), pipe)) output += buffer.data();
     const int status = ::pclose(pipe);
     r.written = status == 0 && fs::exists(r.path);
+    r.failed = !r.written && !(WIFEXITED(status) && WEXITSTATUS(status) == 2);
   }
   r.message = last_line(output);
   if (r.message.empty()) r.message = "report.html not written: the report script said nothing";

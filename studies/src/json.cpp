@@ -4,6 +4,15 @@
 
 namespace spinesim::studies {
 
-void print_json(const nlohmann::json& j) { std::cout << j.dump(2) << std::endl; }
+namespace {
+bool g_json_printed = false;
+}  // namespace
+
+void print_json(const nlohmann::json& j) {
+  std::cout << j.dump(2) << std::endl;
+  g_json_printed = true;
+}
+
+bool json_printed() { return g_json_printed; }
 
 }  // namespace spinesim::studies

@@ -26,12 +26,9 @@ namespace {
 const char* kTrainCases = "compression,shear-ap,flexion,torsion";
 
 /// 6x6 plate stiffness (global frame, rotations in rad) -> its disc-frame diagonal, N/mm and
-/// N·mm/deg: K_local = R^T K R with R = diag(axes, axes).
+/// N·mm/deg.
 fem::Vector6d disc_frame_diagonal(const fem::Matrix6d& k, const mesh::DiscFrame& frame) {
-  fem::Matrix6d r = fem::Matrix6d::Zero();
-  r.topLeftCorner<3, 3>() = frame.axes;
-  r.bottomRightCorner<3, 3>() = frame.axes;
-  return stiffness_per_degree(r.transpose() * k * r).diagonal();
+  return fem::stiffness_per_degree(fem::to_disc_frame(k, frame)).diagonal();
 }
 
 /// Disc-frame axial (y) component of a global plate translation, mm.

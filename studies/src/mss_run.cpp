@@ -1,4 +1,5 @@
 #include "spinesim/studies/mss_run.hpp"
+#include "spinesim/mss/simulator.hpp"
 
 #include "spinesim/calibration/tuned_disc.hpp"
 #include "spinesim/common/timer.hpp"

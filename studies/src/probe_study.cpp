@@ -1,4 +1,5 @@
 #include "spinesim/studies/probe_study.hpp"
+#include "spinesim/mss/simulator.hpp"
 
 #include "spinesim/mesh/io.hpp"
 #include "spinesim/mss/boundary.hpp"
@@ -183,7 +184,7 @@ ProbeStudyResult run_probe_study(const mesh::TetMesh& m, const mesh::RegionMater
   // 1. The model and the probe sites.
   check(rq);
   const SteppedStudyOptions& o = rq.stepping;
-  fs::create_directories(o.out);
+  prepare_output_folder(o.out, "--out");
   ProbeStudyResult r;
   r.request = rq;
   hooks.begin_stage("building the mass-spring model (" + o.model_variant + ")");

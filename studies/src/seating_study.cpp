@@ -64,19 +64,20 @@ std::shared_ptr<const spine::ContactSurface> read_chair_surface(const std::strin
   return std::make_shared<FileSurface>(std::move(d));
 }
 
+void check_seating_request(const SeatingRequest& request) {
+  spine::check_chair(request.chair);
+  if (request.pelvic_tilt_deg && !(std::abs(*request.pelvic_tilt_deg) <= 60))
+    throw std::invalid_argument("--pelvic-tilt must be a number within -60 … 60 deg");
+}
+
 SeatingRun run_seating(const std::string& data_dir, const SeatingRequest& request) {
   Timer timer;
   SeatingRun run;
   run.request = request;
-  spine::check_chair(request.chair);
+  check_seating_request(request);
   const spine::SpineModel standing = spine::load_spine_model(data_dir, request.model);
   run.sitter = spine::load_sitter(standing);
-  if (request.pelvic_tilt_deg) {
-    const double t = *request.pelvic_tilt_deg;
-    if (!(std::abs(t) <= 60))
-      throw std::invalid_argument("--pelvic-tilt must be a number within -60 … 60 deg");
-    run.sitter.pelvic_tilt_deg = t;
-  }
+  if (request.pelvic_tilt_deg) run.sitter.pelvic_tilt_deg = *request.pelvic_tilt_deg;
   try {
     run.seated = spine::solve_seated(standing, request.chair, run.sitter);
   } catch (const spine::SolveError& e) {

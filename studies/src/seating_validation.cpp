@@ -94,7 +94,14 @@ SeatingSweep run_seating_sweep(const std::string& data_dir, const std::string& p
   if (values.empty()) throw std::invalid_argument("--values needs at least one number");
   for (double v : values)
     if (!std::isfinite(v)) throw std::invalid_argument("--values must be finite numbers");
-  with_parameter(base, parameter, values.front());  // an unknown parameter fails before any work
+  // An unknown parameter or a value no chair can have fails before any work.
+  for (double v : values) {
+    try {
+      check_seating_request(with_parameter(base, parameter, v));
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(parameter + " " + significant(v, 4) + ": " + e.what());
+    }
+  }
   SeatingSweep s;
   s.parameter = parameter;
   s.values = values;

@@ -1,10 +1,13 @@
 #include "spinesim/studies/spine_discs.hpp"
+#include "spinesim/common/constants.hpp"
 
 #include "spinesim/common/timer.hpp"
+#include "spinesim/haptics/hybrid_spine.hpp"
 #include "spinesim/mesh/disc_geometry.hpp"
 #include "spinesim/mss/boundary.hpp"
 #include "spinesim/mss/quantities.hpp"
 #include "spinesim/mss/solver.hpp"
+#include "spinesim/mss/simulator.hpp"
 #include "spinesim/spine/kinematics.hpp"
 #include "spinesim/studies/disc_level.hpp"
 #include "spinesim/studies/files.hpp"
@@ -24,7 +27,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr double kRadToDeg = 180.0 / M_PI;
 
 int vertebra_index(const spine::SpineModel& model, const std::string& name) {
   for (std::size_t i = 0; i < model.vertebrae.size(); ++i)
@@ -36,63 +38,23 @@ std::string mesh_label(const calibration::MeshFingerprint& f) {
   return std::to_string(f.tets) + " tets, fingerprint " + f.hash;
 }
 
-/// The pose of vertebra `i` in a frame (the sacrum, i < 0, does not move).
-mss::RigidPose vertebra_pose(const spine::SpineModel& m, const DragFrame& f, int i) {
-  mss::RigidPose p;
-  if (i < 0) return p;
-  const spine::Pose q = f.pose(m, i);
-  p.rotation = q.R;
-  p.translation_mm = q.t;
-  return p;
+using haptics::HybridDisc;
+using haptics::SegmentState;
+
+/// The poses of the 17 vertebrae T1 … L5 in a recorded frame.
+std::vector<spine::Pose> frame_poses(const spine::SpineModel& m, const DragFrame& f) {
+  std::vector<spine::Pose> poses(m.vertebrae.size());
+  for (std::size_t i = 0; i < poses.size(); ++i) poses[i] = f.pose(m, int(i));
+  return poses;
 }
 
-/// What a disc's step tells the table: its plates' relative motion, volume and reaction.
-struct DiscSample {
-  Eigen::Vector3d shift_mm, rotation_deg, force_n, moment_nmm;  ///< in the disc's axes
-  double volume_change = 0;
-  long inverted = 0;
-};
-
-/// Everything one disc needs per step: its model, plate centre and boundary.
-struct DiscRun {
-  const mss::MssModel* model = nullptr;
-  Eigen::Vector3d centre;  ///< the superior plate's centre at the reference posture
-  int upper = 0, lower = -1;
-};
-
-mss::Boundary disc_boundary(const spine::SpineModel& m, const DiscRun& d, const DragFrame& f) {
-  mss::Boundary bc;
-  bc.inferior = vertebra_pose(m, f, d.lower);
-  bc.superior = vertebra_pose(m, f, d.upper);
-  bc.plate_center_mm = d.centre;
-  return bc;
-}
-
-DiscSample sample(const DiscRun& d, const mss::Boundary& bc, const Eigen::VectorXd& x) {
-  // The upper plate relative to the lower vertebra, in the disc's axes carried by the lower one.
-  const Eigen::Matrix3d& A = d.model->mesh().frame.axes;
-  const Eigen::Matrix3d Rl = bc.inferior.rotation, Ru = bc.superior.rotation;
-  const Eigen::Vector3d moved =
-      Rl.transpose() * (bc.superior.apply(d.centre) - bc.inferior.translation_mm);
-  DiscSample s;
-  s.shift_mm = A.transpose() * (moved - d.centre);
-  s.rotation_deg = A.transpose() * spine::rotation_log(Rl.transpose() * Ru) * kRadToDeg;
-  const mss::Vector6d w = mss::plate_reaction(*d.model, x, bc.superior.apply(d.centre));
-  const Eigen::Matrix3d to_disc = (Rl * A).transpose();
-  s.force_n = to_disc * w.head<3>();
-  s.moment_nmm = to_disc * w.tail<3>();
-  s.volume_change = mss::volume_change(*d.model, x);
-  s.inverted = long(d.model->inverted_tets(x));
-  return s;
-}
-
-void add_to_peaks(const DiscSample& s, DiscPeaks& p) {
+void add_to_peaks(const SegmentState& s, DiscPeaks& p) {
   p.compression_mm = std::max(p.compression_mm, -s.shift_mm.y());
   p.shear_mm = std::max(p.shear_mm, std::hypot(s.shift_mm.x(), s.shift_mm.z()));
   p.rotation_deg = std::max(p.rotation_deg, s.rotation_deg.norm());
   p.volume_change_min = std::min(p.volume_change_min, s.volume_change);
   p.volume_change_max = std::max(p.volume_change_max, s.volume_change);
-  p.inverted_tets = std::max(p.inverted_tets, s.inverted);
+  p.inverted_tets = std::max(p.inverted_tets, s.inverted_tets);
   p.force_n = std::max(p.force_n, s.force_n.norm());
   p.moment_nmm = std::max(p.moment_nmm, s.moment_nmm.norm());
 }
@@ -174,9 +136,9 @@ CombinedVertebrae combine(const VertebraSurfacesResult& s, const spine::SpineMod
 }
 
 void write_vertebrae_frame(const std::string& path, CombinedVertebrae& c,
-                           const spine::SpineModel& m, const DragFrame& f) {
+                           const std::vector<spine::Pose>& poses) {
   for (std::size_t b = 0; b < c.vertebra.size(); ++b) {
-    const mss::RigidPose p = vertebra_pose(m, f, c.vertebra[b]);
+    const spine::Pose p = c.vertebra[b] < 0 ? spine::Pose() : poses[std::size_t(c.vertebra[b])];
     for (Eigen::Index k = c.first[b]; k < c.first[b] + c.count[b]; ++k)
       c.moved.V.row(k) = p.apply(c.rest.V.row(k).transpose()).transpose();
   }
@@ -197,7 +159,9 @@ void add_frame(VtuSeries& series, CombinedDiscs& discs, const mss::DiscSet& set,
                CombinedVertebrae* vertebrae, const spine::SpineModel& m, const DragFrame& f) {
   series.add(f.t_s, 0, [&](const std::string& p) { write_discs_frame(p, discs, set); });
   if (vertebrae)
-    series.add(f.t_s, 1, [&](const std::string& p) { write_vertebrae_frame(p, *vertebrae, m, f); });
+    series.add(f.t_s, 1, [&](const std::string& p) {
+      write_vertebrae_frame(p, *vertebrae, frame_poses(m, f));
+    });
 }
 
 void check(const SpineDiscsRequest& r) {
@@ -212,21 +176,14 @@ void check(const SpineDiscsRequest& r) {
   if (r.newton_iterations < 1 || r.newton_iterations > 50)
     throw std::invalid_argument("--newton-iterations must be 1 to 50");
   if (r.out.empty()) throw std::invalid_argument("--out: give an output folder");
-  fs::path parent = fs::path(r.out).parent_path();
-  if (parent.empty()) parent = ".";
-  if (!fs::is_directory(parent))
-    throw std::invalid_argument("--out " + r.out + ": folder " + parent.string() +
-                                " does not exist");
-  if (fs::exists(r.out) && !fs::is_directory(r.out))
-    throw std::invalid_argument("--out " + r.out + " exists and is not a folder");
 }
 
 /// Starts every disc at its static equilibrium at the first recorded posture.
-void start_at_equilibrium(const spine::SpineModel& m, const std::vector<DiscRun>& runs,
+void start_at_equilibrium(const spine::SpineModel& m, const std::vector<HybridDisc>& runs,
                           const SpineDiscs& discs, const DragFrame& first, mss::DiscSet& set) {
   for (std::size_t i = 0; i < runs.size(); ++i) {
     const mss::StaticResult eq =
-        mss::solve_static(*runs[i].model, disc_boundary(m, runs[i], first));
+        mss::solve_static(*runs[i].model, haptics::disc_boundary(runs[i], frame_poses(m, first)));
     if (!eq.converged || !eq.x_mm.allFinite())
       throw std::runtime_error(discs.levels[i] +
                                ": no static equilibrium at the first recorded posture (" +
@@ -239,12 +196,38 @@ void start_at_equilibrium(const spine::SpineModel& m, const std::vector<DiscRun>
   }
 }
 
-void motion_row(std::ostream& os, double t, const std::string& level, const DiscSample& s) {
+/// The implicit Euler of the offline discs: one recorded tick a step.
+mss::DynamicsOptions disc_dynamics(const SpineDiscsRequest& request) {
+  mss::DynamicsOptions dyn;
+  dyn.integrator = mss::Integrator::implicit_euler;
+  dyn.dt_s = 1e-3;  // one recorded tick
+  dyn.newton_iterations = request.newton_iterations;
+  dyn.matrix_update =
+      request.refactorize ? mss::MatrixUpdate::every_iteration : mss::MatrixUpdate::frozen;
+  return dyn;
+}
+
+/// The discs added to `set`, coupled to their vertebrae; the result's per-disc rows begun.
+std::vector<HybridDisc> add_discs(const SpineDiscs& discs, const mss::DynamicsOptions& dyn,
+                                  mss::DiscSet& set, SpineDiscsResult& r) {
+  std::vector<HybridDisc> runs;
+  for (std::size_t i = 0; i < discs.models.size(); ++i) set.add(discs.models[i], dyn);
+  for (int i = 0; i < set.size(); ++i) {
+    runs.push_back({&set.model(i), mss::default_plate_center(set.model(i).mesh()),
+                    discs.upper[std::size_t(i)], discs.lower[std::size_t(i)]});
+    r.tets += long(set.model(i).mesh().num_tets());
+    r.peaks.push_back({});
+    r.peaks.back().level = discs.levels[std::size_t(i)];
+  }
+  return runs;
+}
+
+void motion_row(std::ostream& os, double t, const std::string& level, const SegmentState& s) {
   char line[512];
   std::snprintf(line, sizeof line,
                 "%.3f,%s,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,%.6f,%ld,%.4f,%.4f,%.4f,%.3f,%.3f,%.3f\n", t,
                 level.c_str(), s.shift_mm.x(), s.shift_mm.y(), s.shift_mm.z(), s.rotation_deg.x(),
-                s.rotation_deg.y(), s.rotation_deg.z(), s.volume_change, s.inverted, s.force_n.x(),
+                s.rotation_deg.y(), s.rotation_deg.z(), s.volume_change, s.inverted_tets, s.force_n.x(),
                 s.force_n.y(), s.force_n.z(), s.moment_nmm.x(), s.moment_nmm.y(), s.moment_nmm.z());
   os << line;
 }
@@ -302,6 +285,7 @@ SpineDiscsResult run_spine_discs(const SpineDiscsRequest& request, const std::st
   const DragRecording rec = read_drag_recording(request.recording, model);
   r.fingerprint = rec.fingerprint;
   r.recording_complete = rec.complete;
+  r.recording_incomplete = rec.incomplete_reason;
   const std::string tuned_path = request.tuned.empty()
                                      ? (fs::path(data_dir) / "tuned_structured_discs.json").string()
                                      : request.tuned;
@@ -313,30 +297,18 @@ SpineDiscsResult run_spine_discs(const SpineDiscsRequest& request, const std::st
     surfaces = make_vertebra_surfaces(vs, data_dir);
   }
 
+  prepare_output_folder(request.out, "--out");  // made once every input is read and checked
+
   // 2. The discs, started at equilibrium.
-  mss::DynamicsOptions dyn;
-  dyn.integrator = mss::Integrator::implicit_euler;
-  dyn.dt_s = 1e-3;  // one recorded tick
-  dyn.newton_iterations = request.newton_iterations;
-  dyn.matrix_update =
-      request.refactorize ? mss::MatrixUpdate::every_iteration : mss::MatrixUpdate::frozen;
+  const mss::DynamicsOptions dyn = disc_dynamics(request);
   if (r.request.threads == 0)
     r.request.threads = int(std::max(1u, std::min(17u, std::thread::hardware_concurrency())));
   mss::DiscSet set(r.request.threads);
-  std::vector<DiscRun> runs;
-  for (std::size_t i = 0; i < discs.models.size(); ++i) set.add(discs.models[i], dyn);
-  for (int i = 0; i < set.size(); ++i) {
-    runs.push_back({&set.model(i), mss::default_plate_center(set.model(i).mesh()),
-                    discs.upper[std::size_t(i)], discs.lower[std::size_t(i)]});
-    r.tets += long(set.model(i).mesh().num_tets());
-    r.peaks.push_back({});
-    r.peaks.back().level = discs.levels[std::size_t(i)];
-  }
+  const std::vector<HybridDisc> runs = add_discs(discs, dyn, set, r);
   r.discs = set.size();
   start_at_equilibrium(model, runs, discs, rec.frames.front(), set);
 
   // 3. Step through the recording; frames and rows every frame period.
-  fs::create_directories(request.out);
   r.pvd = (fs::path(request.out) / "spine.pvd").string();
   VtuSeries series(r.pvd);
   CombinedDiscs all_discs = combine(discs);
@@ -344,12 +316,13 @@ SpineDiscsResult run_spine_discs(const SpineDiscsRequest& request, const std::st
   std::ostringstream motion;
   motion << motion_header(request.recording);
   std::vector<mss::Boundary> bcs(runs.size());
-  std::vector<DiscSample> samples(runs.size());
+  std::vector<SegmentState> samples(runs.size());
   double next_frame = -INFINITY;
   const int n = int(rec.frames.size());
   for (int k = 0; k < n; ++k) {
     const DragFrame& f = rec.frames[std::size_t(k)];
-    for (std::size_t i = 0; i < runs.size(); ++i) bcs[i] = disc_boundary(model, runs[i], f);
+    const std::vector<spine::Pose> poses = frame_poses(model, f);
+    for (std::size_t i = 0; i < runs.size(); ++i) bcs[i] = haptics::disc_boundary(runs[i], poses);
     if (k > 0) {
       Timer step;
       const std::vector<mss::StepReport>& reports = set.step(bcs);
@@ -362,7 +335,7 @@ SpineDiscsResult run_spine_discs(const SpineDiscsRequest& request, const std::st
     Timer measuring;
     set.for_each([&](int i) {
       samples[std::size_t(i)] =
-          sample(runs[std::size_t(i)], bcs[std::size_t(i)], set.state(i).x_mm);
+          haptics::segment_state(runs[std::size_t(i)], bcs[std::size_t(i)], set.state(i).x_mm);
     });
     for (std::size_t i = 0; i < runs.size(); ++i) {
       add_to_peaks(samples[i], r.peaks[i]);
@@ -387,8 +360,23 @@ SpineDiscsResult run_spine_discs(const SpineDiscsRequest& request, const std::st
   write_text_file(r.table_csv, table_csv(r));
   write_text_file(r.motion_csv, motion.str());
   r.total_s = total.seconds();
+  r.diverged = spine_discs_diverged(r);
   write_text_file(r.json, spine_discs_json(r).dump(1) + "\n");
   return r;
+}
+
+std::string spine_discs_diverged(const SpineDiscsResult& r) {
+  // No disc reacts with more than a body's weight many times over; 1e5 N is far beyond any.
+  constexpr double kMaxPhysicalForceN = 1e5;
+  for (const DiscPeaks& p : r.peaks) {
+    if (p.rejected_steps > 0)
+      return p.level + ": " + std::to_string(p.rejected_steps) + " steps rejected (diverged)";
+    if (p.inverted_tets > 0)
+      return p.level + ": " + std::to_string(p.inverted_tets) + " tetrahedra inside out";
+    if (!(p.force_n <= kMaxPhysicalForceN) || !std::isfinite(p.moment_nmm))
+      return p.level + ": a reaction of " + significant(p.force_n, 3) + " N, beyond any disc's";
+  }
+  return "";
 }
 
 nlohmann::json spine_discs_json(const SpineDiscsResult& r) {
@@ -406,6 +394,9 @@ nlohmann::json spine_discs_json(const SpineDiscsResult& r) {
                      {"rejected_steps", p.rejected_steps}});
   return {{"recording", r.request.recording},
           {"recording_complete", r.recording_complete},
+          {"recording_incomplete", r.recording_incomplete},
+          {"diverged", !r.diverged.empty()},
+          {"diverged_reason", r.diverged},
           {"spine_model", r.fingerprint},
           {"tuned", r.request.tuned.empty() ? "data/tuned_structured_discs.json" : r.request.tuned},
           {"integrator", "implicit Euler"},
@@ -433,7 +424,7 @@ std::string spine_discs_table(const SpineDiscsResult& r) {
   std::ostringstream os;
   os << "The hybrid spine offline: " << r.discs << " tuned structured discs (" << r.tets
      << " tets), implicit Euler at 1 ms, " << r.steps << " steps of " << r.request.recording
-     << (r.recording_complete ? "" : " (cut short: a killed run, read to its last row)") << "\n"
+     << (r.recording_complete ? "" : " (not whole: " + r.recording_incomplete + ")") << "\n"
      << "stepping " << fixed(r.stepping_s, 2) << " s for " << fixed(r.simulated_s, 2)
      << " s simulated: " << fixed(r.speedup(), 2) << "x real time ("
      << (r.request.refactorize ? "refactorised" : "frozen matrix") << ", " << r.request.threads

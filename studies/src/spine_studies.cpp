@@ -1,6 +1,7 @@
 // The spine studies: validation (thesis 3.4), fusion (6.1), trends (6.3–6.4). Protocols and
 // definitions are in spine_studies.hpp.
 #include "spinesim/studies/spine_studies.hpp"
+#include "spinesim/common/constants.hpp"
 
 #include "spinesim/common/input_file.hpp"
 
@@ -31,7 +32,6 @@ using spine::SpineSolution;
 
 namespace {
 
-constexpr double kDeg = 180.0 / M_PI;
 const double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 void begin(const StageHooks& h, const std::string& what) {
@@ -533,7 +533,7 @@ FusionStudy run_fusion_study(const std::string& data_dir, double force_n,
       r.t1_translation_mm =
           sol.poses[std::size_t(t1)].apply(c) - base.poses[std::size_t(t1)].apply(c);
       r.t1_total_translation_mm = sol.poses[std::size_t(t1)].apply(c) - c;
-      r.t1_rotation_deg = kDeg * spine::rotation_log(sol.poses[std::size_t(t1)].R *
+      r.t1_rotation_deg = kDegPerRad * spine::rotation_log(sol.poses[std::size_t(t1)].R *
                                                      base.poses[std::size_t(t1)].R.transpose());
       r.l2l3 = sol.joints[l2l3];
       r.l5s1 = sol.joints[l5s1];
@@ -899,7 +899,7 @@ TrendsStudy run_trends_study(const std::string& data_dir, double force_n,
     r.resize(n_pairs, 3);
     for (int i = 0; i < n_pairs; ++i) {
       t.row(i) = sol.displacement.row(i).head<3>() - sol.displacement.row(i + 1).head<3>();
-      r.row(i) = kDeg * sol.theta.segment<3>(3 * i).transpose();
+      r.row(i) = kDegPerRad * sol.theta.segment<3>(3 * i).transpose();
     }
   };
   Eigen::MatrixX3d base_t, base_r;

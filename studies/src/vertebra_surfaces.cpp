@@ -25,12 +25,7 @@ VertebraSurfacesResult make_vertebra_surfaces(const VertebraSurfacesRequest& req
   if (!request.out_dir.empty()) {
     namespace fs = std::filesystem;
     const fs::path dir(request.out_dir);
-    std::error_code ec;
-    if (!fs::exists(dir, ec)) fs::create_directory(dir, ec);
-    if (!fs::is_directory(dir, ec))
-      throw std::invalid_argument("--out " + request.out_dir +
-                                  ": not a folder, and cannot be made one" +
-                                  (ec ? " (" + ec.message() + ")" : std::string()));
+    prepare_output_folder(request.out_dir, "--out");
     for (const auto& v : solids) require_output_folder((dir / (v.name + ".obj")).string(), "--out");
   }
 

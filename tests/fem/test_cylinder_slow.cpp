@@ -13,6 +13,7 @@
 // F_y > 0 and a positive twist theta_y gives M_y < 0.
 // Slow (CGAL meshing + three 55k-DOF P2 solves, ~20 s), hence the _slow label.
 #include "spinesim/fem/disc_fem.hpp"
+#include "spinesim/common/constants.hpp"
 #include "spinesim/mesh/mesher.hpp"
 
 #include <gtest/gtest.h>
@@ -25,7 +26,6 @@ using namespace spinesim::fem;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kR = 5.0, kL = 10.0;  // mm
 
 const mesh::TetMesh& cylinder() {

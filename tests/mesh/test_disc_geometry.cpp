@@ -1,6 +1,7 @@
 // Kidney outline and lofted parametric disc: extents, area, 40 % nucleus, posterior concavity,
 // loft volume — each checked by an independent computation.
 #include "spinesim/mesh/disc_geometry.hpp"
+#include "spinesim/common/constants.hpp"
 #include "spinesim/mesh/mesher.hpp"
 
 #include <gtest/gtest.h>
@@ -9,9 +10,9 @@
 #include <random>
 
 using namespace spinesim::mesh;
+using spinesim::kPi;
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
 
 // Shoelace area and centroid of a closed polygon in (x, z).
 void polygon_area_centroid(const std::vector<Eigen::Vector2d>& p, double& area,

@@ -5,6 +5,7 @@
 #include "io_fixtures.hpp"
 
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 
 #include <cmath>
 #include <cstdio>
@@ -677,4 +678,51 @@ TEST(IoVtu, LegacyCountsBeyondTheFileAreRefused) {
     test::expect_one_line_refusal([&] { read_tet_mesh(path); }, path,
                                   name == "suffix" ? "is not a count" : "can hold");
   }
+}
+
+// A disc frame that is not a rotation would turn every load case into another load (zero axes:
+// no load; axes x1000: a 1000-fold load; skewed axes: a sideways one): the reader refuses it.
+TEST(IoVtu, ADiscFrameThatIsNotARotationIsRefused) {
+  const std::string dir = tmp_dir("bad_frames");
+  const std::vector<std::pair<std::string, Eigen::Matrix3d>> bad = {
+      {"zero", Eigen::Matrix3d::Zero()},
+      {"tiny", 1e-300 * Eigen::Matrix3d::Identity()},
+      {"large", 1000 * Eigen::Matrix3d::Identity()},
+      {"skewed", (Eigen::Matrix3d() << 1, 0.3, 0, 0, 1, 0, 0, 0, 1).finished()},
+      {"mirror", Eigen::Vector3d(-1, 1, 1).asDiagonal().toDenseMatrix()}};
+  for (const auto& [name, axes] : bad) {
+    SCOPED_TRACE(name);
+    DiscFrame f;
+    f.axes = axes;
+    EXPECT_THROW(validate_frame(f), std::invalid_argument);
+    // Written by hand (the writer is not the guard), read back through the reader.
+    TetMesh m = cube_mesh();
+    write_vtu(dir + "/ok.vtu", m, {}, {}, {VtuEncoding::ascii});
+    std::string text;
+    {
+      std::ifstream in(dir + "/ok.vtu");
+      text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    }
+    const auto at = text.find("Name=\"disc_frame\"");
+    ASSERT_NE(at, std::string::npos);
+    const auto open = text.find('>', at) + 1, close = text.find("</DataArray>", open);
+    std::ostringstream numbers;
+    numbers.precision(17);
+    numbers << "1.5 -2.25 1e-7";
+    for (int c = 0; c < 3; ++c)
+      for (int i = 0; i < 3; ++i) numbers << ' ' << axes(i, c);
+    text.replace(open, close - open, numbers.str());
+    std::ofstream(dir + "/" + name + ".vtu") << text;
+    try {
+      read_tet_mesh(dir + "/" + name + ".vtu");
+      ADD_FAILURE() << "read";
+    } catch (const std::invalid_argument& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("disc_frame"), std::string::npos) << what;
+      EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+    }
+  }
+  DiscFrame rotated;
+  rotated.axes = Eigen::AngleAxisd(1.0, Eigen::Vector3d(1, 1, 0).normalized()).toRotationMatrix();
+  EXPECT_NO_THROW(validate_frame(rotated));
 }

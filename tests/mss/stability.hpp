@@ -3,6 +3,7 @@
 #pragma once
 
 #include "spinesim/mss/solver.hpp"
+#include "spinesim/mss/simulator.hpp"
 
 #include <gtest/gtest.h>
 

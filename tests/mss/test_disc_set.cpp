@@ -1,6 +1,7 @@
 // DiscSet: stepping discs together, serially or in parallel, gives each disc exactly the
 // result of stepping it alone.
 #include "spinesim/mss/disc_set.hpp"
+#include "spinesim/mss/simulator.hpp"
 
 #include "solver_fixtures.hpp"
 

@@ -4,6 +4,7 @@
 // (frozen and refreshed matrices), dynamic runs under a constant motion, wrench or probe
 // converging to solve_static, moving endplates, and rejected steps.
 #include "spinesim/mss/solver.hpp"
+#include "spinesim/mss/simulator.hpp"
 
 #include "solver_fixtures.hpp"
 #include "stability.hpp"

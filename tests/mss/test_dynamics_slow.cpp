@@ -6,6 +6,7 @@
 // Timings are printed, never asserted (shared 2-core machines); each is the best of 5 batches.
 // Run with OPENBLAS_NUM_THREADS=1 for the one-core numbers.
 #include "spinesim/mss/solver.hpp"
+#include "spinesim/mss/simulator.hpp"
 
 #include "solver_fixtures.hpp"
 #include "stability.hpp"

@@ -3,6 +3,7 @@
 // rigid-motion invariance, and the two places where we depart from the thesis: the apex force
 // that (5.13) omits and the barycentre reaction that (5.4) omits.
 #include "spinesim/mss/elements.hpp"
+#include "spinesim/common/constants.hpp"
 
 #include <gtest/gtest.h>
 
@@ -15,6 +16,7 @@
 #include <random>
 
 using namespace spinesim::mss;
+using spinesim::kPi;
 
 namespace {
 
@@ -23,7 +25,6 @@ using Vec = Eigen::Matrix<double, N, 1>;
 template <int N>
 using Mat = Eigen::Matrix<double, N, N>;
 
-constexpr double kPi = 3.14159265358979323846;
 
 // Central differences with step h on mm-sized configurations: truncation h^2 |E'''|/6 ~ 1e-12
 // and roundoff eps |E| / h ~ 1e-10, both relative to the derivative's scale, so 1e-6 relative

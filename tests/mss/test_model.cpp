@@ -3,6 +3,7 @@
 // invariance, the Hessian's rigid null space, and closed-form energies under a uniform
 // dilation that check the constants (5.1), (5.2), (5.8) without looking inside.
 #include "spinesim/mss/model.hpp"
+#include "spinesim/common/constants.hpp"
 
 #include "spinesim/mss/elements.hpp"
 
@@ -19,7 +20,6 @@
 namespace spinesim::mss {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 using spinesim::mesh::box_mesh;
 

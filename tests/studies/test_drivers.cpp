@@ -13,7 +13,7 @@
 #include "spinesim/mss/plate_stiffness.hpp"
 #include "spinesim/mss/quantities.hpp"
 #include "spinesim/mss/solver.hpp"
-#include "spinesim/studies/calibration_report.hpp"
+#include "spinesim/studies/calibration_summary.hpp"
 #include "spinesim/studies/disc_level.hpp"
 #include "spinesim/studies/spine_studies.hpp"
 

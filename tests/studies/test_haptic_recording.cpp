@@ -149,3 +149,48 @@ TEST(HapticRecording, BadRecordingsAreRefusedInOneLine) {
   std::ofstream(bad, std::ios::trunc) << text;
   expect_refused(bad, "not a finite number");
 }
+
+// A recording is whole only when its end line counts exactly the rows read and the run ended by
+// itself: a stopped run, a cut file or a lying end line is read, but not as whole.
+TEST(HapticRecording, WholeOnlyWhenTheEndLineMatchesItsRowsAndTheStopWasClean) {
+  const auto rows = ticks(30);
+  const std::string whole = write_recording("whole.csv", rows);
+  EXPECT_TRUE(st::read_drag_recording(whole, model()).complete);
+  // An end line that does not count the rows (1,500 rows, "99999 ticks").
+  std::string text = slurp(whole);
+  const std::string end = "# end: 30 ticks";
+  ASSERT_NE(text.find(end), std::string::npos);
+  text.replace(text.find(end), end.size(), "# end: 99999 ticks");
+  const std::string lying = (scratch() / "lying.csv").string();
+  std::ofstream(lying, std::ios::trunc) << text;
+  st::DragRecording rec = st::read_drag_recording(lying, model());
+  EXPECT_FALSE(rec.complete);
+  EXPECT_NE(rec.incomplete_reason.find("does not count the 30 rows"), std::string::npos)
+      << rec.incomplete_reason;
+  // A run stopped by a signal says so in its end line.
+  const std::string stopped = (scratch() / "stopped.csv").string();
+  {
+    st::HapticRecordingWriter w(stopped, "test", &model(), "multirate");
+    w.append(rows.data(), rows.size());
+    w.finish("interrupted");
+  }
+  EXPECT_NE(slurp(stopped).find("# end: 30 ticks; stopped early: interrupted"), std::string::npos);
+  rec = st::read_drag_recording(stopped, model());
+  EXPECT_FALSE(rec.complete);
+  EXPECT_EQ(rec.incomplete_reason, "stopped early: interrupted");
+  EXPECT_EQ(rec.frames.size(), 30u);
+  // No end line at all.
+  rec = st::read_drag_recording(write_recording("no_end.csv", rows, false), model());
+  EXPECT_FALSE(rec.complete);
+  EXPECT_NE(rec.incomplete_reason.find("no end line"), std::string::npos);
+}
+
+TEST(HapticRecording, ARecordingThatCannotBeSteppedOrMovesAVertebraAwayIsRefused) {
+  expect_refused(write_recording("one.csv", ticks(1)), "at least two are needed");
+  // A vertebra 1e6 mm away (a corrupt row), and 1e308: refused naming the line.
+  for (const double far : {1e6, 1e308}) {
+    auto rows = ticks(10);
+    rows[5].t[3] = Eigen::Vector3f(float(std::min(far, 1e30)), 0, 0);
+    expect_refused(write_recording("far.csv", rows), "a vertebra moved");
+  }
+}

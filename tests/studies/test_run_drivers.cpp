@@ -6,6 +6,7 @@
 #include "spinesim/mesh/rigid_plate.hpp"
 #include "spinesim/mss/model.hpp"
 #include "spinesim/mss/solver.hpp"
+#include "spinesim/mss/simulator.hpp"
 #include "spinesim/spine/model.hpp"
 #include "spinesim/studies/disc_level.hpp"
 #include "spinesim/studies/drive_study.hpp"

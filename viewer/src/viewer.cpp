@@ -1,4 +1,5 @@
 #include "spinesim/viewer/viewer.hpp"
+#include "spinesim/common/constants.hpp"
 
 #include <GL/glcorearb.h>
 #include <GLFW/glfw3.h>
@@ -23,7 +24,6 @@ namespace spinesim::viewer {
 
 namespace {
 
-constexpr float kPi = 3.14159265358979f;
 
 const char* kVertexShader = R"(#version 330 core
 layout(location = 0) in vec3 position;
@@ -198,7 +198,7 @@ Eigen::MatrixX3d arrow_vertices(Eigen::MatrixX3i& F) {
 /// Orbit camera about a target: yaw about the superior (y) axis, pitch above the horizontal.
 struct Camera {
   Eigen::Vector3f target = Eigen::Vector3f::Zero();
-  float distance = 1000, yaw = 0, pitch = 0, fov = 35.0f * kPi / 180.0f;
+  float distance = 1000, yaw = 0, pitch = 0, fov = float(35.0 * kRadPerDeg);
 
   Eigen::Vector3f eye() const {
     const Eigen::Vector3f dir(std::cos(pitch) * std::cos(yaw), std::sin(pitch),
@@ -613,10 +613,10 @@ ViewResult view(Controller& controller, const ViewOptions& o) {
       Eigen::Vector3d lo, hi;
       if (!bounds(scene, lo, hi)) return;
       cam.frame((0.5 * (lo + hi)).cast<float>(), float(0.5 * (hi - lo).norm()));
-      cam.yaw = std::isfinite(o.camera_yaw_deg) ? float(o.camera_yaw_deg * kPi / 180)
+      cam.yaw = std::isfinite(o.camera_yaw_deg) ? float(o.camera_yaw_deg * kRadPerDeg)
                                                 : controller.initial_yaw();
       if (std::isfinite(o.camera_pitch_deg))  // the eye above the target: a negative pitch
-        cam.pitch = std::clamp(float(-o.camera_pitch_deg * kPi / 180), -1.5f, 1.5f);
+        cam.pitch = std::clamp(float(-o.camera_pitch_deg * kRadPerDeg), -1.5f, 1.5f);
       framed = true;
     };
     if (!framed) reset();

@@ -3,7 +3,7 @@
 // error names the file and the real cause in one line. JSON inputs (materials, tuned discs, the
 // spine model, databases) are also bounded in nesting depth, so a hostile file cannot exhaust the
 // stack of the parser or of the value's destructor, and are parsed strictly (nothing after the
-// value). Every JSON file the project reads goes through read_json_file.
+// value, no key twice in one object; require_known_keys refuses fields a reader does not know). Every JSON file the project reads goes through read_json_file.
 #pragma once
 
 #include <nlohmann/json.hpp>
@@ -13,6 +13,7 @@
 #include <cstddef>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -76,6 +77,25 @@ inline std::string read_regular_file(const std::string& path, const std::string&
   return text;
 }
 
+/// The regular file `path` opened for reading line by line (a large input is streamed, not held
+/// twice in memory), after the checks of read_regular_file: no such file, not a regular file
+/// (named), too large. Throws std::invalid_argument "cannot read <what> '<path>': <cause>".
+inline std::ifstream open_regular_file(const std::string& path, const std::string& what,
+                                       const InputLimits& limits = InputLimits()) {
+  const auto refuse = [&](const std::string& cause) {
+    return std::invalid_argument("cannot read " + what + " '" + path + "': " + cause);
+  };
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) throw refuse(errno == ENOENT ? "no such file" : std::strerror(errno));
+  if (!S_ISREG(st.st_mode)) throw refuse("it is " + path_kind(path) + ", not a regular file");
+  if (std::size_t(st.st_size) > limits.max_bytes)
+    throw refuse("it has " + std::to_string(st.st_size) + " bytes, more than the limit of " +
+                 std::to_string(limits.max_bytes));
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw refuse(std::strerror(errno));
+  return in;
+}
+
 /// The deepest nesting of arrays and objects in JSON text (brackets inside strings ignored).
 inline int json_depth(const std::string& text) {
   int depth = 0, deepest = 0;
@@ -112,8 +132,30 @@ inline nlohmann::json read_json_file(const std::string& path, const std::string&
     throw std::invalid_argument(what + " '" + path + "' is nested " + std::to_string(depth) +
                                 " levels deep (the limit is " +
                                 std::to_string(limits.max_json_depth) + "): not a file of ours");
+  // Strict: a key given twice in one object is refused (nlohmann keeps the last silently, so a
+  // file could say two things and mean one).
+  std::vector<std::vector<std::string>> keys;  // per open object
+  std::string duplicate;
+  const auto strict = [&](int, nlohmann::json::parse_event_t event, nlohmann::json& parsed) {
+    using E = nlohmann::json::parse_event_t;
+    if (event == E::object_start) keys.emplace_back();
+    if (event == E::object_end && !keys.empty()) keys.pop_back();
+    if (event == E::key && !keys.empty() && duplicate.empty()) {
+      const std::string key = parsed.get<std::string>();
+      auto& seen = keys.back();
+      if (std::find(seen.begin(), seen.end(), key) != seen.end())
+        duplicate = key;
+      else
+        seen.push_back(key);
+    }
+    return true;
+  };
   try {
-    return nlohmann::json::parse(text);
+    nlohmann::json j = nlohmann::json::parse(text, strict);
+    if (!duplicate.empty())
+      throw std::invalid_argument(what + " '" + path + "' gives the key \"" + duplicate +
+                                  "\" twice in one object");
+    return j;
   } catch (const nlohmann::json::parse_error& e) {
     throw std::invalid_argument(what + " '" + path + "' is not valid JSON (byte " +
                                 std::to_string(e.byte) + ")");
@@ -122,6 +164,20 @@ inline nlohmann::json read_json_file(const std::string& path, const std::string&
     if (why.find("] ") != std::string::npos) why = why.substr(why.find("] ") + 2);
     throw std::invalid_argument(what + " '" + path + "' cannot be read: " + why);
   }
+}
+
+/// Refuses (std::invalid_argument naming `where` and the key) a key of the object `j` that is not
+/// one of `known`: a misspelt or misplaced field is an error, not a silently ignored line.
+inline void require_known_keys(const nlohmann::json& j, const std::vector<std::string>& known,
+                               const std::string& where) {
+  if (!j.is_object()) return;
+  for (const auto& item : j.items())
+    if (std::find(known.begin(), known.end(), item.key()) == known.end()) {
+      std::string list;
+      for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
+      throw std::invalid_argument(where + ": unknown field \"" + item.key() + "\" (known: " +
+                                  list + ")");
+    }
 }
 
 /// A preset name or a path: `name_or_path` itself when it exists, else `folder`/NAME.json. Neither:

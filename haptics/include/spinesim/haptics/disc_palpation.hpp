@@ -28,6 +28,7 @@
 #include "spinesim/haptics/triple_buffer.hpp"
 #include "spinesim/mss/model.hpp"
 #include "spinesim/mss/solver.hpp"
+#include "spinesim/mss/simulator.hpp"
 
 #include <Eigen/Core>
 

@@ -6,6 +6,7 @@
 
 #include "spinesim/mss/model.hpp"
 #include "spinesim/mss/solver.hpp"
+#include "spinesim/mss/simulator.hpp"
 
 #include <functional>
 #include <memory>

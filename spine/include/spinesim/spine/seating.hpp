@@ -31,14 +31,18 @@ struct Sitter {
   Eigen::Vector3d ischia_mm = Eigen::Vector3d::Zero(), sacrum_back_mm = Eigen::Vector3d::Zero();
   double tissue_thoracic_mm = 0, tissue_lumbar_mm = 0, tissue_stiffness_n_per_mm = 0;
   double spinous_thoracic_mm = 0, spinous_lumbar_mm = 0;  ///< spine_model.json's process lengths
+  /// Per vertebra (T1 … L5): z of the interspinous ligament's origin, halfway along the spinous
+  /// process (the ligaments' geometry, spine_model.json), mm. Read once here: no solve reads files.
+  std::vector<double> interspinous_z_mm;
   double pelvis_mass_percent = 0;
   Eigen::Vector3d pelvis_com_mm = Eigen::Vector3d::Zero();
   double forearm_hand_percent_each = 0;
   double lean_min_deg = -10, lean_max_deg = 45;
 };
 
-/// Reads data/spine/seating.json for `model` (the lumbar shares use its F.5 ranges). Throws
-/// std::runtime_error naming the file and field for missing or malformed data.
+/// Reads data/spine/seating.json for `model` (the lumbar shares use its F.5 ranges; the posterior
+/// elements' geometry its ligaments, or those of the model with ligaments when it has none).
+/// Throws std::runtime_error naming the file and field for missing or malformed data.
 Sitter load_sitter(const SpineModel& model);
 
 /// A chair. The backrest is parametric (a plane at `backrest_recline_deg` to the horizontal with

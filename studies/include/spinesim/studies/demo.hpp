@@ -5,7 +5,7 @@
 // 3. the material study (materials_study.hpp, thesis fig. 5.9); 4. the untuned mass-spring disc
 // against that FEM on all eight cases (calibration/compare.hpp), and the probe test of thesis 5.3
 // (probe_study.hpp, fig. 5.8) into <out>/probe; 5. the calibration protocol
-// (calibration_report.hpp): Ipopt on four training cases, four held out; 6. the spine
+// (calibration/protocol.hpp): Ipopt on four training cases, four held out; 6. the spine
 // (spine_studies.hpp): validation (3.4), fusion (6.1) and trends (6.3-6.4); 7. VTU results,
 // report.md and summary.json in the output folder; 8. report.html with plots (html_report.hpp).
 #pragma once
@@ -46,5 +46,9 @@ struct DemoResult {
 /// Runs the steps above; throws std::invalid_argument for a bad request (unknown level, bad
 /// order), std::runtime_error when a file cannot be written.
 DemoResult run_demo(const DemoRequest& request, const StageHooks& hooks = StageHooks());
+
+/// What the program prints when the demo is done (the report itself is in the files): the
+/// headline numbers of each step — a dozen lines — and where the report is.
+std::string demo_summary(const DemoResult& r);
 
 }  // namespace spinesim::studies

@@ -1,7 +1,8 @@
 // Disc-joint stiffness for the spine model (`spinesim spine disc-joints`): each level's FEM disc,
 // condensed onto its superior plate (6×6 about the plate centre c) and restricted to rotations of
 // the upper vertebra about the spine's joint point J (thesis F.2, mid-disc):
-//   plate motion q = T θ,  T = [ −[c − J]× ; I ]  (6×3)   →   K_J = Tᵀ K6 T  (3×3, N·mm/rad),
+//   plate motion q = T θ,  T = [ −[c − J]× ; I ]  (6×3)   →   K_J = Tᵀ K6 T  (3×3, N·mm/rad;
+//   fem::joint_stiffness_about),
 // the disc's rotational stiffness as the spherical joint sees it (the joint holds J in place, so
 // the disc's translational stiffness acts only through the lever c − J). The spine model reads
 // the file through ModelOptions::disc_joints in place of the thesis's F.4 joint springs.
@@ -22,11 +23,6 @@
 #include <vector>
 
 namespace spinesim::studies {
-
-/// K_J = Tᵀ K6 T for a plate centre c and joint point J (mm).
-Eigen::Matrix3d joint_stiffness_about(const fem::Matrix6d& K6,
-                                      const Eigen::Vector3d& plate_center_mm,
-                                      const Eigen::Vector3d& joint_point_mm);
 
 struct DiscJoint {
   std::string level;

@@ -5,6 +5,7 @@
 
 #include "spinesim/fem/disc_fem.hpp"
 #include "spinesim/fem/load_cases.hpp"
+#include "spinesim/fem/plate_stiffness.hpp"
 #include "spinesim/mesh/material.hpp"
 #include "spinesim/mesh/tet_mesh.hpp"
 #include "spinesim/studies/progress.hpp"
@@ -17,13 +18,10 @@
 
 namespace spinesim::studies {
 
-/// (t mm, theta deg) -> (t mm, theta rad), and back.
-fem::Vector6d motion_deg_to_rad(const fem::Vector6d& q_deg);
-fem::Vector6d motion_rad_to_deg(const fem::Vector6d& q_rad);
-
-/// The 6x6 stiffness with rotation columns per degree: rows (F N, M N·mm), columns
-/// (t mm, theta deg).
-fem::Matrix6d stiffness_per_degree(const fem::Matrix6d& k_rad);
+// The degree units of the program's plate motions and stiffnesses (fem/plate_stiffness.hpp).
+using fem::motion_deg_to_rad;
+using fem::motion_rad_to_deg;
+using fem::stiffness_per_degree;
 
 inline constexpr const char* kStiffnessUnits =
     "rows Fx,Fy,Fz [N], Mx,My,Mz [N·mm]; columns tx,ty,tz [mm], rx,ry,rz [deg]";

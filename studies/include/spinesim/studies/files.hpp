@@ -22,6 +22,12 @@ void write_text_file(const std::string& path, const std::string& text);
 /// folder exists (checked before long runs, so nothing is lost at the end).
 void require_output_folder(const std::string& path, const std::string& option);
 
+/// The one rule of every folder output (`--out DIR`): the folder is made, parents and all, before
+/// the work starts; refused (std::invalid_argument "<option> <path>: …", one line) only when it
+/// cannot be: a file, a device or a link to one is in the way, or the system says no (no
+/// permission, a read-only or full file system — checked by making and removing a probe file).
+void prepare_output_folder(const std::string& path, const std::string& option);
+
 /// A VTU time series of MSS states: frames `<stem>/<stem>_NNNNNN.vtu` next to `<stem>.pvd`
 /// (the PVD lists them relative to its folder). Frames are written as they come (each
 /// atomically) into a staging folder `<stem>.staged-PID/` beside the PVD; finish() moves them

@@ -37,8 +37,10 @@ class HapticRecordingWriter {
   ~HapticRecordingWriter();
   /// Appends rows, flushes and syncs them (the loop's writer thread).
   void append(const haptics::TickRecord* rows, std::size_t n);
-  /// Appends the end line and closes; throws std::runtime_error on a failed write.
-  void finish();
+  /// Appends the end line — "# end: N ticks", and "; stopped early: WHY" when `stopped_early`
+  /// says why the run did not end by itself (a signal, an error) — and closes. Throws
+  /// std::runtime_error on a failed write, after removing the file.
+  void finish(const std::string& stopped_early = "");
   std::int64_t rows() const { return rows_; }
 
  private:
@@ -67,13 +69,22 @@ struct DragFrame {
 struct DragRecording {
   std::string path, fingerprint, response;
   std::vector<DragFrame> frames;
-  bool complete = false;  ///< the end line is there (false: a killed run, read to its last row)
+  /// The run ended by itself and its end line counts exactly the rows read (false: a killed or
+  /// stopped run, read to its last whole row; incomplete_reason says which).
+  bool complete = false;
+  std::string incomplete_reason;
 };
+
+/// The end line's start, and the bounds of a recorded vertebra motion (a corrupt row beyond them
+/// is refused): no spine moves a vertebra half a metre or turns it past half a turn.
+inline constexpr const char* kEndLine = "# end: ";
+inline constexpr double kMaxVertebraShiftMm = 500, kMaxVertebraTurnDeg = 180;
 
 /// Reads a compliant-stage recording for `model`. Throws std::invalid_argument with one line for
 /// a file that is not one (no spine columns), one from another spine model, missing ticks (a
 /// gap in the tick numbers), a bad number, a hook force beyond what the spine solve accepts
-/// (spine::kMaxForceN) or no rows. A last line cut off mid-row (a killed run) is dropped.
+/// (spine::kMaxForceN), a vertebra beyond the bounds above, or fewer than two rows. A last line
+/// cut off mid-row (a killed run) is dropped.
 DragRecording read_drag_recording(const std::string& path, const spine::SpineModel& model);
 
 }  // namespace spinesim::studies

@@ -9,7 +9,7 @@
 #include "spinesim/haptics/servo.hpp"
 #include "spinesim/spine/seating.hpp"
 #include "spinesim/studies/disc_palpation_setup.hpp"
-#include "spinesim/studies/haptic_scene.hpp"
+#include "spinesim/haptics/scene_builder.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -24,6 +24,14 @@ class MssModel;
 }
 
 namespace spinesim::studies {
+
+// The rigid scene is built by the haptics library (haptics/scene_builder.hpp).
+using haptics::build_haptic_scene;
+using haptics::check_scene_name;
+using haptics::HapticScene;
+using haptics::HapticSceneRequest;
+using haptics::Registration;
+using haptics::registration_json;
 
 /// What a viewer gets once a session is set up (on the session's thread, before the loop
 /// starts; the references are valid only during the call: copy what is needed).
@@ -143,5 +151,10 @@ nlohmann::json haptic_devices_json(const std::string& openhaptics_lib = "",
                                    const std::string& dhd_lib = "");
 std::string haptic_devices_table(const std::string& openhaptics_lib = "",
                                  const std::string& dhd_lib = "");
+
+/// The deadlines a run missed, judged: empty when at most `max_missed_percent` % of its ticks
+/// missed theirs, else one line saying how many, of how many, against what limit. A shared
+/// machine misses some (compare `cyclictest` in the same minute, docs/benchmarks.md).
+std::string missed_deadlines_warning(const HapticsRunResult& r, double max_missed_percent);
 
 }  // namespace spinesim::studies

@@ -11,6 +11,9 @@ struct HtmlReport {
   bool written = false;
   std::string path;     ///< <folder>/report.html
   std::string message;  ///< the script's one line: what it wrote, or why it wrote nothing
+  /// The script ran and failed (not a missing tool, which it reports with status 2): a write
+  /// that did not happen (a full disk) — the plots asked for are not all there, an error.
+  bool failed = false;
 };
 
 /// Runs the report script (scripts/`script`: report.py for the demo, seating_report.py for the

@@ -35,5 +35,8 @@ inline nlohmann::json path_or_null(const std::string& path) {
 
 /// Prints `j` as the only thing on stdout (pretty, one object).
 void print_json(const nlohmann::json& j);
+/// Whether print_json has printed (the program's last word with --json: a run that failed
+/// after its work began still prints one object, saying so).
+bool json_printed();
 
 }  // namespace spinesim::studies

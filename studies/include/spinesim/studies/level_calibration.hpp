@@ -4,7 +4,7 @@
 // that is only complete when every level succeeded.
 #pragma once
 
-#include "spinesim/studies/calibration_report.hpp"
+#include "spinesim/studies/calibration_summary.hpp"
 
 #include "spinesim/calibration/tuned_set.hpp"
 #include "spinesim/mesh/mesher.hpp"

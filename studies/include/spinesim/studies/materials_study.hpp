@@ -7,7 +7,7 @@
 // vertices; inferior endplate fixed, superior endplate a rigid plate):
 //   1. FEM P2 on the mesh: the 6x6 plate stiffness K6, and the `compression` case
 //      (fem/load_cases.hpp: F_y = -500 N in the disc frame, the thesis's fig. 5.9 load), linear.
-//   2. calibrate_disc (calibration_report.hpp): Ipopt fits the per-region stiffness scales of the
+//   2. calibrate_disc (calibration/protocol.hpp): Ipopt fits the per-region stiffness scales of the
 //      chosen terms (default thesis+volume, as `spinesim calibrate`) to the FEM on the training
 //      cases compression, shear-ap, flexion, torsion; no nonlinear check. It returns the linear
 //      K6 of the untuned and the tuned MSS (rest Hessian condensed onto the plate's 6 DOF).
@@ -29,7 +29,7 @@
 //                      compression (as `spinesim mss compare`; compression is a training case).
 #pragma once
 
-#include "spinesim/studies/calibration_report.hpp"
+#include "spinesim/studies/calibration_summary.hpp"
 #include "spinesim/studies/progress.hpp"
 
 #include "spinesim/fem/disc_fem.hpp"

@@ -11,6 +11,7 @@
 #include "spinesim/mss/boundary.hpp"
 #include "spinesim/mss/model.hpp"
 #include "spinesim/mss/solver.hpp"
+#include "spinesim/mss/simulator.hpp"
 #include "spinesim/studies/progress.hpp"
 
 #include <nlohmann/json.hpp>

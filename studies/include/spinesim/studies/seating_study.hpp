@@ -46,6 +46,10 @@ std::shared_ptr<const spine::ContactSurface> read_chair_surface(const std::strin
 /// equilibrium does not converge.
 SeatingRun run_seating(const std::string& data_dir, const SeatingRequest& request);
 
+/// The checks run_seating makes before any work (the chair, the pelvic tilt); one-line
+/// std::invalid_argument. A sweep checks every value with it before its first point.
+void check_seating_request(const SeatingRequest& request);
+
 void print_seating(std::ostream& os, const SeatingRun& run, bool markdown);
 nlohmann::json seating_json(const SeatingRun& run);
 /// One row per level T1 … L5 and the sacrum: contact force, gap, the joint below's reaction.

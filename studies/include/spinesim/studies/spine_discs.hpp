@@ -82,6 +82,10 @@ struct SpineDiscsResult {
   SpineDiscsRequest request;
   std::string fingerprint;  ///< the spine model's
   bool recording_complete = false;
+  std::string recording_incomplete;  ///< why the recording is not whole (empty when it is)
+  /// Why the discs' answer means nothing (empty when it holds): a rejected step, a tet turned
+  /// inside out, a reaction beyond any physical one. The files are still written, to look at.
+  std::string diverged;
   int steps = 0, frames = 0, discs = 0;
   long tets = 0;
   /// Simulated time; wall-clock of the steps alone, of the per-step measurements (reactions,
@@ -100,6 +104,9 @@ struct SpineDiscsResult {
 /// later removes the half-written series. `progress(done, total)` every 100 steps.
 SpineDiscsResult run_spine_discs(const SpineDiscsRequest& request, const std::string& data_dir,
                                  const std::function<void(int, int)>& progress = {});
+
+/// The result's verdict: empty when every disc stepped and stayed physical, else why not.
+std::string spine_discs_diverged(const SpineDiscsResult& r);
 
 nlohmann::json spine_discs_json(const SpineDiscsResult& r);
 std::string spine_discs_table(const SpineDiscsResult& r);

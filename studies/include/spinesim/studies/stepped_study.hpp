@@ -6,6 +6,7 @@
 #include "spinesim/mesh/tet_mesh.hpp"
 #include "spinesim/mss/model.hpp"
 #include "spinesim/mss/solver.hpp"
+#include "spinesim/mss/simulator.hpp"
 #include "spinesim/studies/files.hpp"
 #include "spinesim/studies/mss_run.hpp"
 

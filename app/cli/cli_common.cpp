@@ -1,0 +1,50 @@
+#include "cli_common.hpp"
+
+#include "spinesim/common/numbers.hpp"
+
+#include <cmath>
+#include <cstdlib>
+#include <iostream>
+#include <sstream>
+#include <stdexcept>
+
+namespace spinesim::cli {
+
+void require_plain_numbers(CLI::App& app) {
+  for (CLI::Option* opt : app.get_options()) {
+    const std::string type = opt->get_type_name();
+    const bool integer = type.rfind("INT", 0) == 0 || type.rfind("UINT", 0) == 0;
+    if (!integer && type.rfind("FLOAT", 0) != 0) continue;
+    opt->check(CLI::Validator(
+        [integer](std::string& text) -> std::string {
+          if (integer ? is_plain_number(text, true) : is_plain_number(text)) {
+            if (integer || std::isfinite(std::strtod(text.c_str(), nullptr))) return "";
+          }
+          return "'" + text + "' is not " +
+                 (integer ? "a whole number" : "a finite number in plain decimal notation");
+        },
+        ""));
+  }
+  for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; }))
+    require_plain_numbers(*sub);
+}
+
+void add_output_flags(CLI::App* cmd, bool& json, bool& quiet, const std::string& what) {
+  cmd->add_flag("--json", json, "Print " + what + " on stdout");
+  cmd->add_flag("--quiet", quiet, "No progress on stderr");
+}
+
+void add_plate_load_options(CLI::App* cmd, std::string& motion, std::string& wrench,
+                            std::string& load_case, std::string& center) {
+  cmd->add_option("--motion", motion, "Plate motion tx,ty,tz,rx,ry,rz (mm, degrees)");
+  cmd->add_option("--wrench", wrench,
+                  "Applied wrench Fx,Fy,Fz,Mx,My,Mz (N, N·mm) about the centre");
+  cmd->add_option(
+      "--case", load_case,
+      "Named load case in the disc frame: compression, tension, shear-ap, shear-lat, flexion, "
+      "extension, lateral-bending, torsion");
+  cmd->add_option("--center", center,
+                  "Plate centre x,y,z (mm); default: mean of the superior endplate nodes");
+}
+
+}  // namespace spinesim::cli

@@ -1,0 +1,81 @@
+// Shared pieces of the `spinesim` command line: value parsing with clear errors and the verbs'
+// registration. Everything else a verb needs (drivers, reports, tables, progress, files) is in
+// the studies library (spinesim/studies/).
+#pragma once
+
+#include "flag_values.hpp"
+
+#include "spinesim/studies/data.hpp"
+#include "spinesim/studies/files.hpp"
+#include "spinesim/studies/format.hpp"
+#include "spinesim/haptics/scene_builder.hpp"
+#include "spinesim/studies/haptics_run.hpp"
+#include "spinesim/studies/json.hpp"
+#include "spinesim/studies/progress.hpp"
+#include "spinesim/studies/table.hpp"
+
+#include <CLI/CLI.hpp>
+#include <Eigen/Core>
+
+#include <string>
+#include <vector>
+
+namespace spinesim::cli {
+
+using namespace spinesim::studies;  // the command line is a thin layer over the studies library
+
+/// Every number-valued flag of `app` and its sub-commands read as every number is
+/// (spinesim/common/numbers.hpp): "nan", "", "0x10" or "1,5" are refused, not read as the
+/// default, 0, 16 or 1.
+void require_plain_numbers(CLI::App& app);
+
+/// --json (one JSON object on stdout; `what` says which) and --quiet (no progress on stderr).
+void add_output_flags(CLI::App* cmd, bool& json, bool& quiet,
+                      const std::string& what = "a JSON summary");
+
+/// The plate load options of `fem` and `mss`: --motion, --wrench, --case, --center.
+void add_plate_load_options(CLI::App* cmd, std::string& motion, std::string& wrench,
+                            std::string& load_case, std::string& center);
+
+// Sub-command registration; each lives in its own cli_<verb>.cpp.
+void register_mesh(CLI::App& app);
+void register_mesh_vertebrae(CLI::App& mesh);  ///< mesh vertebrae, under `mesh`
+void register_fem(CLI::App& app);
+void register_mss(CLI::App& app);        ///< mss, mss compare (cli_mss.cpp)
+void register_calibrate(CLI::App& app);  ///< calibrate (cli_calibrate.cpp)
+void register_study(
+    CLI::App& app);  ///< study probe|drive|materials|validation|fusion|trends (cli_study.cpp)
+void register_spine(CLI::App& app);              ///< spine solve (cli_spine.cpp)
+void register_haptics(CLI::App& app);            ///< haptics run|devices (cli_haptics.cpp)
+void register_haptic_plane(CLI::App& study);     ///< study haptic-plane (cli_haptics.cpp)
+void register_haptic_drag(CLI::App& study);      ///< study haptic-drag (cli_haptics.cpp)
+void register_disc_validation(CLI::App& study);  ///< study disc-validation (cli_study_disc.cpp)
+void register_seating(CLI::App& study);          ///< study seating|seating-sweep|seating-validation
+void register_demo(CLI::App& app);
+void register_view(CLI::App& app);
+
+/// --scene, --vertebrae, --testdata, --triangles: the haptic scene's flags (haptics run, view).
+void add_scene_flags(CLI::App* cmd, haptics::HapticSceneRequest& scene);
+
+/// A haptic session's flags (scene, disc, device, renderer, compliant stage …), shared by
+/// `haptics run` and `view` (`viewer`: the help names the mouse device).
+struct HapticsRunFlags {
+  studies::HapticsRunRequest request;
+  std::string workspace_center, chair_file;
+  bool no_realtime = false;
+  /// A run that misses more than this share of its deadlines ends with a warning (--strict: an
+  /// error, exit status 1).
+  double max_missed_percent = 1.0;
+  bool strict = false;
+};
+void add_haptics_run_flags(CLI::App* cmd, HapticsRunFlags& flags, bool viewer);
+/// After parsing: --workspace-center, --no-realtime and the test-data folder into the request.
+void resolve_haptics_run_flags(HapticsRunFlags& flags);
+void register_bench(CLI::App& app);
+void register_spine_database(
+    CLI::App& spine);  ///< spine database, under `spine` (cli_spine_database.cpp)
+void register_spine_disc_joints(
+    CLI::App& spine);                        ///< spine disc-joints (cli_spine_disc_joints.cpp)
+void register_spine_discs(CLI::App& spine);  ///< spine discs, under `spine` (cli_spine_discs.cpp)
+
+}  // namespace spinesim::cli

@@ -1,0 +1,34 @@
+// A calibration as the program shows it: the tuned model a file gives on a mesh, and the
+// readable summary of a calibration (calibration/protocol.hpp runs it).
+#pragma once
+
+#include "spinesim/studies/comparison_report.hpp"
+#include "spinesim/studies/mss_run.hpp"
+
+#include "spinesim/calibration/protocol.hpp"
+
+#include <ostream>
+
+namespace spinesim::studies {
+
+using calibration::calibrate_disc;
+using calibration::CalibrationOutcome;
+using calibration::CalibrationRequest;
+using calibration::parse_term_set;
+using calibration::StatusLine;
+using calibration::term_set_name;
+using calibration::term_set_options;
+using calibration::TermSet;
+using calibration::TransferCheck;
+
+/// Builds the MSS for `mesh` from a tuned file, after check_applies (one-line refusal otherwise);
+/// prints check_applies's note to stderr unless quiet.
+mss::MssModel tuned_model(const calibration::TunedDisc& tuned, const mesh::TetMesh& mesh,
+                          const mesh::RegionMaterials& materials, bool quiet);
+
+/// Readable summary: every case untuned vs tuned (nonlinear and linear; region-only beside
+/// per-spring when that stage ran), K6 diagonals, Ipopt.
+void print_calibration(std::ostream& os, const CalibrationOutcome& o,
+                       const CalibrationRequest& request);
+
+}  // namespace spinesim::studies

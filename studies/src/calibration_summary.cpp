@@ -1,0 +1,113 @@
+#include "spinesim/studies/calibration_summary.hpp"
+
+#include "spinesim/studies/format.hpp"
+#include "spinesim/studies/table.hpp"
+
+#include <iomanip>
+#include <iostream>
+
+namespace spinesim::studies {
+namespace {
+
+std::string pct(double e) { return percent(e); }
+
+}  // namespace
+
+mss::MssModel tuned_model(const calibration::TunedDisc& tuned, const mesh::TetMesh& mesh,
+                          const mesh::RegionMaterials& materials, bool quiet) {
+  const std::string note = calibration::check_applies(tuned, mesh, materials);
+  if (!note.empty() && !quiet) std::cerr << "spinesim: note: " << note << "\n";
+  return calibration::build_tuned_model(tuned, mesh, materials);
+}
+
+void print_calibration(std::ostream& os, const CalibrationOutcome& o,
+                       const CalibrationRequest& rq) {
+  const auto& rep = o.tuned.report;
+  const bool ps = o.per_spring_ran;
+  os << "Calibration of " << (o.tuned.level.empty() ? "disc" : o.tuned.level) << " ("
+     << rep["nodes"] << " nodes, " << rep["tets"] << " tets), material " << o.tuned.material_name
+     << ", terms " << term_set_name(rq.terms) << ", FEM P" << rq.fem_order
+     << (ps ? ", region scales then per-spring multipliers" : "") << "\n"
+     << "Ipopt" << (ps ? " (region scales)" : "") << ": " << o.result.status << " after "
+     << o.result.iterations << " iterations, " << o.result.evaluations << " evaluations, "
+     << std::fixed << std::setprecision(2) << o.result.seconds << " s (" << std::setprecision(1)
+     << 1e3 * rep["ipopt"]["seconds_per_evaluation"].get<double>()
+     << " ms per objective + gradient + Hessian)\n";
+  if (ps) {
+    const auto& p = rep["per_spring"];
+    os << "Ipopt (per-spring, " << p["edge_springs"] << " multipliers in [" << std::defaultfloat
+       << std::setprecision(6) << rq.per_spring_ipopt.lower_scale << ", "
+       << rq.per_spring_ipopt.upper_scale << "], smoothness weight "
+       << rq.per_spring_weights.smoothness << ", limited-memory BFGS): " << o.per_spring.status
+       << " after " << o.per_spring.iterations << " iterations, " << o.per_spring.evaluations
+       << " evaluations, " << std::fixed << std::setprecision(2) << o.per_spring.seconds << " s; J "
+       << std::setprecision(3) << std::scientific << o.per_spring.start.value << " -> "
+       << o.per_spring.final.value << std::fixed
+       << (o.per_spring.kept_start ? " (Ipopt ended higher: the region fit is kept)" : "")
+       << "; multipliers " << std::setprecision(2) << p["multipliers"]["min"].get<double>()
+       << " .. " << p["multipliers"]["max"].get<double>() << ", median "
+       << p["multipliers"]["median"].get<double>() << "\n";
+  }
+  os << "\n"
+     << (rq.nonlinear_check
+             ? "Relative nodal displacement error vs FEM (nonlinear MSS at the case loads x " +
+                   std::to_string(rq.check_load_scale).substr(0, 4) +
+                   "; linearised in brackets):\n\n"
+             : "Relative nodal displacement error vs FEM (linearised MSS only: --no-check):\n\n");
+  std::vector<std::string> head{"case", "set", "untuned (Van Gelder)"};
+  if (ps) head.push_back("region scales");
+  head.push_back(ps ? "per-spring" : "tuned");
+  TextTable cases(head, 2);
+  for (const char* set : {"train", "holdout"})
+    for (const auto& r : rep[set]) {
+      const auto cell = [&](const char* nl, const char* lin) {
+        return pct(r[nl].get<double>()) + " (" + pct(r[lin].get<double>()) + ")";
+      };
+      std::vector<std::string> row{r["name"].get<std::string>(), set,
+                                   cell("untuned_error", "untuned_error_linear")};
+      if (ps) row.push_back(cell("region_error", "region_error_linear"));
+      row.push_back(cell("tuned_error", "tuned_error_linear"));
+      cases.add(row);
+    }
+  cases.print(os, false);
+  static const char* dof[] = {"tx [N/mm]",     "ty [N/mm]",     "tz [N/mm]",
+                              "rx [N·mm/deg]", "ry [N·mm/deg]", "rz [N·mm/deg]"};
+  const auto& kd = rep["stiffness_diagonal"];
+  os << "\n6x6 plate stiffness diagonal (linear), MSS / FEM:\n\n";
+  std::vector<std::string> khead{"DOF", "FEM", "untuned"};
+  if (ps) khead.push_back("region");
+  khead.push_back(ps ? "per-spring" : "tuned");
+  TextTable k6(khead);
+  for (std::size_t i = 0; i < 6; ++i) {
+    std::vector<std::string> row{dof[i], significant(kd["fem"][i].get<double>(), 4),
+                                 fixed(kd["ratio_untuned"][i].get<double>(), 3)};
+    if (ps) row.push_back(fixed(kd["ratio_region"][i].get<double>(), 3));
+    row.push_back(fixed(kd["ratio_tuned"][i].get<double>(), 3));
+    k6.add(row);
+  }
+  k6.print(os, false);
+  for (const auto& tr : rep["transfer"]) {
+    os << "\n"
+       << (ps ? "Region-level scales" : "Same scales")
+       << " on another mesh: " << tr["mesh"].get<std::string>() << " (" << tr["tets"]
+       << " tets), vs the FEM there"
+       << (ps ? " (per-spring multipliers do not transfer to another mesh)" : "") << ":\n\n";
+    TextTable t({"case", "untuned", ps ? "region scales" : "tuned"});
+    for (const auto& c : tr["cases"])
+      t.add({c["name"].get<std::string>(), pct(c["untuned_error"].get<double>()),
+             pct(c["tuned_error"].get<double>())});
+    t.print(os, false);
+    os << "  6x6 diagonal MSS/FEM, tuned:";
+    for (const auto& r : tr["stiffness_ratio_tuned"]) os << " " << fixed(r.get<double>(), 3);
+    os << "\n";
+  }
+  os << "\nTuned " << (ps ? "region " : "") << "scales (x Van Gelder constants):";
+  for (const auto& [name, s] : o.tuned.scales)
+    os << "  " << name << " " << std::setprecision(3) << s;
+  os << std::defaultfloat << "\n";
+  if (ps)
+    os << "Per-spring multipliers: " << o.tuned.edge_multipliers.size()
+       << " (this mesh only: `mss --params` refuses the file on any other mesh)\n";
+}
+
+}  // namespace spinesim::studies

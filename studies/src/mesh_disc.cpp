@@ -1,0 +1,137 @@
+#include "spinesim/studies/mesh_disc.hpp"
+
+#include "spinesim/common/atomic_file.hpp"
+#include "spinesim/common/timer.hpp"
+#include "spinesim/mesh/disc_geometry.hpp"
+#include "spinesim/mesh/vertebra_disc.hpp"
+#include "spinesim/studies/files.hpp"
+#include "spinesim/studies/format.hpp"
+#include "spinesim/studies/mesh_report.hpp"
+
+#include <stdexcept>
+
+namespace spinesim::studies {
+namespace {
+
+void check(const MeshDiscRequest& r) {
+  const bool from_vertebrae = !r.inferior.empty() || !r.superior.empty();
+  if (from_vertebrae == !r.level.empty())
+    throw std::invalid_argument("give either --level or both --inferior and --superior");
+  if (from_vertebrae && (r.inferior.empty() || r.superior.empty()))
+    throw std::invalid_argument("a disc between vertebrae needs both --inferior and --superior");
+  if (r.structured) mesh::validate(r.structured_options);
+  if (r.out.empty()) throw std::invalid_argument("--out: give the output VTU");
+  require_output_folder(r.out, "--out");  // a device, FIFO or link is refused before meshing
+  if (!r.medit.empty()) require_output_folder(r.medit, "--medit");
+}
+
+nlohmann::json options_json(const MeshDiscRequest& r) {
+  if (r.structured)
+    return {{"mesher", "structured"},
+            {"sectors", r.structured_options.sectors},
+            {"rings", r.structured_options.rings},
+            {"layers", r.structured_options.layers},
+            {"match_area", r.structured_options.match_area}};
+  const mesh::MeshOptions& o = r.cgal;
+  return {{"mesher", "cgal"},
+          {"cell_size_mm", o.cell_size_mm},
+          {"facet_distance_mm", o.facet_distance_mm},
+          {"facet_size_mm", o.facet_size_mm},
+          {"radius_edge_ratio", o.radius_edge_ratio},
+          {"odt", o.odt},
+          {"lloyd", o.lloyd},
+          {"perturb", o.perturb},
+          {"exude", o.exude},
+          {"seed", o.seed}};
+}
+
+/// The disc between two vertebra surfaces; returns the exact volume (the gap's quadrature).
+double mesh_between_vertebrae(const MeshDiscRequest& r, const StageHooks& hooks,
+                              MeshDiscResult& out) {
+  hooks.begin_stage("reading vertebra surfaces");
+  const auto inferior = mesh::read_surface(r.inferior, r.surface_mm_per_unit, r.up);
+  const auto superior = mesh::read_surface(r.superior, r.surface_mm_per_unit, r.up);
+  hooks.end_stage(std::to_string(inferior.F.rows()) + " + " + std::to_string(superior.F.rows()) +
+                  " triangles");
+  hooks.begin_stage("meshing the disc between the facing endplates");
+  const Timer t;
+  mesh::VertebraDiscInfo info;
+  out.mesh = mesh::mesh_disc_between_vertebrae(inferior, superior, r.cgal,
+                                               mesh::VertebraDiscOptions(), &info);
+  out.mesh_seconds = t.seconds();
+  hooks.end_stage(std::to_string(out.mesh.num_tets()) + " tets");
+  if (info.filled_columns > 0)
+    out.warning = "the endplates have holes: " + std::to_string(info.filled_columns) +
+                  " columns (" + fixed(info.filled_area_mm2, 2) +
+                  " mm^2) of the disc's footprint got endplate heights interpolated from around "
+                  "them";
+  out.disc = {{"inferior", r.inferior},
+              {"superior", r.superior},
+              {"disc",
+               {{"filled_columns", info.filled_columns},
+                {"filled_area_mm2", info.filled_area_mm2},
+                {"footprint_area_mm2", info.footprint_area_mm2},
+                {"center_height_mm", info.center_height_mm},
+                {"min_height_mm", info.min_height_mm},
+                {"max_height_mm", info.max_height_mm},
+                {"width_mm", info.width_mm},
+                {"depth_mm", info.depth_mm}}}};
+  return info.volume_mm3;
+}
+
+/// A parametric level, CGAL or structured; returns the exact volume of the parametric disc.
+double mesh_level(const MeshDiscRequest& r, const std::string& data_dir, const StageHooks& hooks,
+                  MeshDiscResult& out) {
+  const auto dims = mesh::disc_dimensions(r.level, data_dir);
+  const Timer t;
+  if (r.structured) {
+    const mesh::StructuredDiscOptions& so = r.structured_options;
+    hooks.begin_stage("meshing " + dims.level + " (structured, " + std::to_string(so.sectors) +
+                      " sectors, " + std::to_string(so.rings) + " rings, " +
+                      std::to_string(so.layers) + " layers)");
+    out.mesh = mesh_structured_level(dims.level, so, r.placement);
+  } else {
+    hooks.begin_stage("meshing " + dims.level + " (cell size " +
+                      std::to_string(r.cgal.cell_size_mm).substr(0, 4) + " mm)");
+    out.mesh = mesh_disc_level(dims.level, r.cgal, r.placement);
+  }
+  out.mesh_seconds = t.seconds();
+  hooks.end_stage(std::to_string(out.mesh.num_tets()) + " tets");
+  out.disc = {{"level", dims.level},
+              {"placement", r.placement == DiscPlacement::spine ? "spine" : "local"}};
+  return mesh::parametric_disc_volume(dims);
+}
+
+}  // namespace
+
+int mesh_disc_stages(const MeshDiscRequest& r) { return r.level.empty() ? 3 : 2; }
+
+MeshDiscResult run_mesh_disc(const MeshDiscRequest& request, const std::string& data_dir,
+                             const StageHooks& hooks) {
+  check(request);
+  MeshDiscResult r;
+  r.request = request;
+  const double exact_volume = request.level.empty()
+                                  ? mesh_between_vertebrae(request, hooks, r)
+                                  : mesh_level(request, data_dir, hooks, r);
+  r.quality = mesh::quality_report(r.mesh, exact_volume);
+  hooks.begin_stage("writing " + request.out);
+  OutputSet outputs("mesh disc");  // the VTU and the Medit copy: both or neither
+  mesh::write_vtu(outputs.stage(request.out), r.mesh);
+  if (!request.medit.empty()) mesh::write_medit(outputs.stage(request.medit), r.mesh);
+  outputs.commit();
+  hooks.end_stage();
+  return r;
+}
+
+nlohmann::json mesh_disc_json(const MeshDiscResult& r) {
+  nlohmann::json j = r.disc;
+  j.update(quality_json(r.quality));
+  j["mesh_seconds"] = r.mesh_seconds;
+  j["out"] = r.request.out;
+  if (!r.request.medit.empty()) j["medit"] = r.request.medit;
+  j["options"] = options_json(r.request);
+  return j;
+}
+
+}  // namespace spinesim::studies
