@@ -3,7 +3,7 @@
 // must be read or refused with std::invalid_argument; an accepted recording must have at least two
 // frames with finite, bounded vertebra motions. Anything else is a finding.
 #include "fuzz_input.hpp"
-#include "spinesim/studies/haptic_recording.hpp"
+#include "spinesim/haptics/recording.hpp"
 
 #include <cstdint>
 #include <cstdlib>
@@ -14,7 +14,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   static const spinesim::spine::SpineModel model =
       spinesim::spine::load_spine_model(SPINESIM_DATA_DIR);
   const std::string path = spinesim::fuzz::input_file("recording", data, size, ".csv");
-  namespace st = spinesim::studies;
+  namespace st = spinesim::haptics;
   try {
     const st::DragRecording r = st::read_drag_recording(path, model);
     if (r.frames.size() < 2 || r.complete != r.incomplete_reason.empty()) std::abort();

@@ -21,11 +21,13 @@ SEES = {
     "mss": {"common", "mesh", "mss"},
     "calibration": {"common", "mesh", "fem", "mss", "calibration"},
     "spine": {"common", "spine"},
-    "haptics": {"common", "mesh", "mss", "spine", "haptics"},
+    "output": {"common", "mesh", "mss", "output"},
+    "haptics": {"common", "mesh", "mss", "spine", "output", "haptics"},
     "viewer": {"common", "viewer"},
-    "studies": {"common", "mesh", "fem", "mss", "calibration", "spine", "haptics", "studies"},
-    "app": {"common", "mesh", "fem", "mss", "calibration", "spine", "haptics", "viewer", "studies",
-            "app"},
+    "studies": {"common", "mesh", "fem", "mss", "calibration", "spine", "output", "haptics",
+                "studies"},
+    "app": {"common", "mesh", "fem", "mss", "calibration", "spine", "output", "haptics", "viewer",
+            "studies", "app"},
 }
 INCLUDE = re.compile(r'^\s*#\s*include\s*"([^"]+)"')
 

@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <memory>
@@ -24,15 +25,28 @@ namespace {
 
 std::string self_exe() { return std::filesystem::read_symlink("/proc/self/exe").string(); }
 
-/// Runs this program with `args` and parses the one JSON object it prints.
+/// Runs this program with `args` and parses the one JSON object it prints; a run that fails is
+/// an error naming the run and the child's own error line.
 nlohmann::json run_child(const std::string& args) {
-  const std::string cmd = "'" + self_exe() + "' " + args + " 2>/dev/null";
+  const std::string err = std::filesystem::temp_directory_path().string() + "/spinesim-bench-" +
+                          std::to_string(getpid()) + ".stderr";
+  const std::string cmd = "'" + self_exe() + "' " + args + " 2>'" + err + "'";
   FILE* pipe = popen(cmd.c_str(), "r");
   if (!pipe) throw std::runtime_error("bench: cannot start " + cmd);
   std::string text;
   char buf[4096];
   while (std::size_t n = fread(buf, 1, sizeof buf, pipe)) text.append(buf, n);
-  if (pclose(pipe) != 0) throw std::runtime_error("bench: child run failed: " + args);
+  const int status = pclose(pipe);
+  std::string why;
+  {
+    std::ifstream in(err);
+    for (std::string line; std::getline(in, line);)
+      if (!line.empty()) why = line;
+  }
+  std::remove(err.c_str());
+  if (status != 0)
+    throw std::runtime_error("bench: the run `" + args + "` failed" +
+                             (why.empty() ? std::string() : ": " + why));
   return nlohmann::json::parse(text);
 }
 

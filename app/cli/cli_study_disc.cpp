@@ -58,7 +58,7 @@ void run_disc_validation(const DiscValidationArgs& a) {
   }
   progress.end(std::to_string(m.num_tets()) + " tets");
   const DiscValidationResult r =
-      run_disc_validation(m, materials, formulation, targets, label, progress.hooks());
+      studies::run_disc_validation(m, materials, formulation, targets, label, progress.hooks());
 
   // 3. Output.
   if (!a.csv.empty()) {

@@ -5,7 +5,8 @@
 //   spinesim study seating-sweep --parameter backrest-recline --values 90,100,110,120 [...]
 //   spinesim study seating-validation [--csv FILE] [--json]
 #include "cli_common.hpp"
-#include "spinesim/studies/html_report.hpp"
+#include "spinesim/output/html_report.hpp"
+#include "spinesim/studies/toolkit.hpp"
 #include "spinesim/studies/seating_study.hpp"
 
 #include <cmath>

@@ -4,7 +4,7 @@
 
 #include "spinesim/mesh/io.hpp"
 #include "spinesim/spine/model.hpp"
-#include "spinesim/studies/haptic_recording.hpp"
+#include "spinesim/haptics/recording.hpp"
 
 #include <imgui.h>
 
@@ -103,7 +103,7 @@ class PlaybackController final : public Controller {
     }
     if (!request.recording.empty()) {
       model_ = std::make_unique<spine::SpineModel>(spine::load_spine_model(data_dir));
-      recording_ = studies::read_drag_recording(request.recording, *model_);
+      recording_ = haptics::read_drag_recording(request.recording, *model_);
     }
   }
 
@@ -178,7 +178,7 @@ class PlaybackController final : public Controller {
   double time_ = 0, shown_time_ = -1, lo_ = 0, hi_ = 0, load_ms_ = 0;
   std::optional<std::chrono::steady_clock::time_point> last_wall_;
   std::unique_ptr<spine::SpineModel> model_;
-  std::optional<studies::DragRecording> recording_;
+  std::optional<haptics::DragRecording> recording_;
   std::vector<Marker> glyphs_;  ///< the vector rods of the frame shown
 
   /// The series' frame at or before `t`: each part's VTU, read when the frame changes.
@@ -260,8 +260,8 @@ class PlaybackController final : public Controller {
     if (!recording_ || recording_->frames.empty()) return;
     const auto& fr = recording_->frames;
     const auto it = std::lower_bound(
-        fr.begin(), fr.end(), t, [](const studies::DragFrame& f, double x) { return f.t_s < x; });
-    const studies::DragFrame& f = it == fr.end() ? fr.back() : *it;
+        fr.begin(), fr.end(), t, [](const haptics::DragFrame& f, double x) { return f.t_s < x; });
+    const haptics::DragFrame& f = it == fr.end() ? fr.back() : *it;
     scene.markers.push_back({Marker::Kind::sphere, f.probe_mm, f.probe_mm, 4, {0.35f, 0.65f, 1}});
     if (f.attached) {
       scene.markers.push_back({Marker::Kind::sphere, f.hook_mm, f.hook_mm, 2, {1, 0.85f, 0.1f}});

@@ -36,8 +36,6 @@ void validate_frame(const DiscFrame& f, const std::string& what) {
        << "): they must be the disc's unit lateral, axial and anterior directions";
     throw std::invalid_argument(os.str());
   }
-  if (!(A.determinant() > 0))
-    throw std::invalid_argument(what + ": the axes are left-handed (a mirror, not a rotation)");
 }
 
 void validate(const TetMesh& m) {

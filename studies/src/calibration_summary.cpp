@@ -1,7 +1,8 @@
 #include "spinesim/studies/calibration_summary.hpp"
 
-#include "spinesim/studies/format.hpp"
-#include "spinesim/studies/table.hpp"
+#include "spinesim/output/format.hpp"
+#include "spinesim/studies/toolkit.hpp"
+#include "spinesim/output/table.hpp"
 
 #include <iomanip>
 #include <iostream>

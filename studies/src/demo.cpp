@@ -19,14 +19,15 @@
 #include "spinesim/studies/data.hpp"
 #include "spinesim/studies/disc_level.hpp"
 #include "spinesim/studies/fem_report.hpp"
-#include "spinesim/studies/files.hpp"
-#include "spinesim/studies/format.hpp"
-#include "spinesim/studies/json.hpp"
+#include "spinesim/output/files.hpp"
+#include "spinesim/studies/toolkit.hpp"
+#include "spinesim/output/format.hpp"
+#include "spinesim/output/json.hpp"
 #include "spinesim/studies/materials_study.hpp"
 #include "spinesim/studies/mesh_report.hpp"
 #include "spinesim/studies/probe_study.hpp"
 #include "spinesim/studies/spine_studies.hpp"
-#include "spinesim/studies/table.hpp"
+#include "spinesim/output/table.hpp"
 
 #include <cmath>
 #include <filesystem>

@@ -9,8 +9,9 @@
 #include "spinesim/studies/disc_level.hpp"
 #include "spinesim/fem/plate_stiffness.hpp"
 #include "spinesim/studies/fem_report.hpp"
-#include "spinesim/studies/format.hpp"
-#include "spinesim/studies/table.hpp"
+#include "spinesim/output/format.hpp"
+#include "spinesim/studies/toolkit.hpp"
+#include "spinesim/output/table.hpp"
 
 #include <algorithm>
 #include <cmath>

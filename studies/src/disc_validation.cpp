@@ -5,8 +5,9 @@
 #include "spinesim/common/timer.hpp"
 #include "spinesim/fem/load_cases.hpp"
 #include "spinesim/studies/fem_report.hpp"
-#include "spinesim/studies/format.hpp"
-#include "spinesim/studies/table.hpp"
+#include "spinesim/output/format.hpp"
+#include "spinesim/studies/toolkit.hpp"
+#include "spinesim/output/table.hpp"
 
 #include <cmath>
 #include <map>

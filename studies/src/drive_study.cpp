@@ -6,9 +6,10 @@
 #include "spinesim/mss/boundary.hpp"
 #include "spinesim/mss/quantities.hpp"
 #include "spinesim/studies/fem_report.hpp"
-#include "spinesim/studies/files.hpp"
-#include "spinesim/studies/format.hpp"
-#include "spinesim/studies/table.hpp"
+#include "spinesim/output/files.hpp"
+#include "spinesim/studies/toolkit.hpp"
+#include "spinesim/output/format.hpp"
+#include "spinesim/output/table.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -4,9 +4,10 @@
 #include "spinesim/common/timer.hpp"
 #include "spinesim/mesh/io.hpp"
 
-#include "spinesim/studies/format.hpp"
-#include "spinesim/studies/json.hpp"
-#include "spinesim/studies/table.hpp"
+#include "spinesim/output/format.hpp"
+#include "spinesim/studies/toolkit.hpp"
+#include "spinesim/output/json.hpp"
+#include "spinesim/output/table.hpp"
 
 #include <cmath>
 #include <iomanip>

@@ -4,10 +4,11 @@
 #include "spinesim/common/timer.hpp"
 #include "spinesim/spine/database.hpp"
 #include "spinesim/spine/kinematics.hpp"
-#include "spinesim/studies/files.hpp"
-#include "spinesim/studies/format.hpp"
-#include "spinesim/studies/haptic_recording.hpp"
-#include "spinesim/studies/table.hpp"
+#include "spinesim/output/files.hpp"
+#include "spinesim/studies/toolkit.hpp"
+#include "spinesim/output/format.hpp"
+#include "spinesim/haptics/recording.hpp"
+#include "spinesim/output/table.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -16,6 +17,10 @@
 #include <stdexcept>
 
 namespace spinesim::studies {
+
+using haptics::DragFrame;
+using haptics::DragRecording;
+using haptics::read_drag_recording;
 
 namespace fs = std::filesystem;
 

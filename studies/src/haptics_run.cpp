@@ -1,4 +1,5 @@
 #include "spinesim/studies/haptics_run.hpp"
+#include "spinesim/studies/spine_database.hpp"
 
 #include "spinesim/common/atomic_file.hpp"
 #include "spinesim/common/machine.hpp"
@@ -8,10 +9,11 @@
 #include "spinesim/haptics/renderer.hpp"
 #include "spinesim/mesh/vertebra_geometry.hpp"
 #include "spinesim/studies/disc_palpation_setup.hpp"
-#include "spinesim/studies/files.hpp"
-#include "spinesim/studies/format.hpp"
-#include "spinesim/studies/haptic_recording.hpp"
-#include "spinesim/studies/table.hpp"
+#include "spinesim/output/files.hpp"
+#include "spinesim/studies/toolkit.hpp"
+#include "spinesim/output/format.hpp"
+#include "spinesim/haptics/recording.hpp"
+#include "spinesim/output/table.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -219,7 +221,7 @@ CompliantSetup make_compliant_stage(const HapticsRunRequest& request, const std:
                                  ? (fs::path(data_dir) / "spine" / "displacement_db.json").string()
                                  : request.database;
     c.database =
-        std::make_unique<spine::DisplacementDatabase>(spine::DisplacementDatabase::load(path));
+        std::make_unique<spine::DisplacementDatabase>(read_database(path));
     c.response = std::make_unique<haptics::DatabaseResponse>(*c.database);
   } else {
     haptics::MultirateOptions o;
@@ -315,7 +317,7 @@ void finish_disc(DiscSetup& d, HapticsRunResult* result) {
 }
 
 // The --record file, fed by the loop's writer thread (null without --record).
-std::unique_ptr<HapticRecordingWriter> start_recording(const HapticsRunRequest& request,
+std::unique_ptr<haptics::HapticRecordingWriter> start_recording(const HapticsRunRequest& request,
                                                        const HapticsRunResult& result,
                                                        const spine::SpineModel* model, bool disc,
                                                        haptics::ServoLoop& loop) {
@@ -326,9 +328,9 @@ std::unique_ptr<HapticRecordingWriter> start_recording(const HapticsRunRequest& 
   if (disc)
     what << "; disc " << result.disc_level << " (" << result.disc_tets << " tets, "
          << result.disc_tuned_file << ")";
-  auto record = std::make_unique<HapticRecordingWriter>(request.record, what.str(), model,
+  auto record = std::make_unique<haptics::HapticRecordingWriter>(request.record, what.str(), model,
                                                         request.spine, disc);
-  HapticRecordingWriter* sink = record.get();
+  haptics::HapticRecordingWriter* sink = record.get();
   loop.record_to([sink](const haptics::TickRecord* rows, std::size_t n) { sink->append(rows, n); },
                  1 << 13);
   return record;
@@ -395,7 +397,7 @@ HapticsRunResult run_haptics(const HapticsRunRequest& request, const std::string
     loop.set_compliant_stage(compliant.stage.get());
     compliant.response->start();
   }
-  const std::unique_ptr<HapticRecordingWriter> record =
+  const std::unique_ptr<haptics::HapticRecordingWriter> record =
       start_recording(request, result, compliant.model.get(), disc.palpation != nullptr, loop);
 
   if (request.live && request.live->ready)

@@ -3,8 +3,9 @@
 #include "spinesim/mesh/disc_geometry.hpp"
 #include "spinesim/studies/data.hpp"
 #include "spinesim/studies/disc_level.hpp"
-#include "spinesim/studies/format.hpp"
-#include "spinesim/studies/table.hpp"
+#include "spinesim/output/format.hpp"
+#include "spinesim/studies/toolkit.hpp"
+#include "spinesim/output/table.hpp"
 
 #include <algorithm>
 #include <iomanip>

@@ -4,8 +4,9 @@
 #include "spinesim/common/timer.hpp"
 #include "spinesim/mesh/disc_geometry.hpp"
 #include "spinesim/mesh/vertebra_disc.hpp"
-#include "spinesim/studies/files.hpp"
-#include "spinesim/studies/format.hpp"
+#include "spinesim/output/files.hpp"
+#include "spinesim/studies/toolkit.hpp"
+#include "spinesim/output/format.hpp"
 #include "spinesim/studies/mesh_report.hpp"
 
 #include <stdexcept>

@@ -5,9 +5,10 @@
 #include "spinesim/common/timer.hpp"
 #include "spinesim/mss/quantities.hpp"
 #include "spinesim/studies/fem_report.hpp"
-#include "spinesim/studies/files.hpp"
-#include "spinesim/studies/format.hpp"
-#include "spinesim/studies/json.hpp"
+#include "spinesim/output/files.hpp"
+#include "spinesim/studies/toolkit.hpp"
+#include "spinesim/output/format.hpp"
+#include "spinesim/output/json.hpp"
 
 #include <algorithm>
 #include <cmath>

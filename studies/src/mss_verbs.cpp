@@ -7,8 +7,9 @@
 #include "spinesim/common/timer.hpp"
 #include "spinesim/mss/quantities.hpp"
 #include "spinesim/studies/calibration_summary.hpp"
-#include "spinesim/studies/files.hpp"
-#include "spinesim/studies/json.hpp"
+#include "spinesim/output/files.hpp"
+#include "spinesim/studies/toolkit.hpp"
+#include "spinesim/output/json.hpp"
 
 #include <filesystem>
 #include <ostream>

@@ -4,9 +4,10 @@
 #include "spinesim/mesh/io.hpp"
 #include "spinesim/mss/boundary.hpp"
 #include "spinesim/mss/quantities.hpp"
-#include "spinesim/studies/files.hpp"
-#include "spinesim/studies/format.hpp"
-#include "spinesim/studies/json.hpp"
+#include "spinesim/output/files.hpp"
+#include "spinesim/studies/toolkit.hpp"
+#include "spinesim/output/format.hpp"
+#include "spinesim/output/json.hpp"
 
 #include <algorithm>
 #include <array>

@@ -4,8 +4,9 @@
 #include "spinesim/common/input_file.hpp"
 #include "spinesim/common/timer.hpp"
 #include "spinesim/mesh/surface_distance.hpp"
-#include "spinesim/studies/format.hpp"
-#include "spinesim/studies/table.hpp"
+#include "spinesim/output/format.hpp"
+#include "spinesim/studies/toolkit.hpp"
+#include "spinesim/output/table.hpp"
 
 #include <algorithm>
 #include <cmath>

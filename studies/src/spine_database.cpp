@@ -1,7 +1,8 @@
 #include "spinesim/studies/spine_database.hpp"
 
-#include "spinesim/studies/format.hpp"
-#include "spinesim/studies/table.hpp"
+#include "spinesim/output/format.hpp"
+#include "spinesim/studies/toolkit.hpp"
+#include "spinesim/output/table.hpp"
 
 #include <algorithm>
 #include <stdexcept>
@@ -130,6 +131,14 @@ std::vector<GridRow> grid_rows(const std::vector<sp::SuperpositionCase>& cases, 
 
 }  // namespace
 
+spine::DisplacementDatabase read_database(const std::string& path) {
+  try {
+    return spine::DisplacementDatabase::load(path);
+  } catch (const std::runtime_error& e) {  // load's contract for a bad file: runtime_error
+    throw std::invalid_argument(e.what());
+  }
+}
+
 DatabaseCheck check_database(const std::string& data_dir, const std::string& path,
                              const std::vector<int>& superposition_on,
                              const std::vector<double>& magnitudes_n, int workers,
@@ -137,7 +146,7 @@ DatabaseCheck check_database(const std::string& data_dir, const std::string& pat
   DatabaseCheck c;
   c.path = path;
   hooks.begin_stage("loading " + path + " and its model");
-  const sp::DisplacementDatabase db = sp::DisplacementDatabase::load(path);
+  const sp::DisplacementDatabase db = read_database(path);
   const sp::SpineModel model = sp::load_spine_model(data_dir, db.info.model);
   const sp::SolveOptions& so = db.info.solve;
   c.generated_by = db.info.generated_by;

@@ -10,9 +10,10 @@
 #include "spinesim/mss/simulator.hpp"
 #include "spinesim/spine/kinematics.hpp"
 #include "spinesim/studies/disc_level.hpp"
-#include "spinesim/studies/files.hpp"
-#include "spinesim/studies/format.hpp"
-#include "spinesim/studies/table.hpp"
+#include "spinesim/output/files.hpp"
+#include "spinesim/studies/toolkit.hpp"
+#include "spinesim/output/format.hpp"
+#include "spinesim/output/table.hpp"
 #include "spinesim/studies/vertebra_surfaces.hpp"
 
 #include <cmath>

@@ -1,10 +1,11 @@
 #include "spinesim/studies/spine_solve.hpp"
 
 #include "spinesim/common/timer.hpp"
-#include "spinesim/studies/format.hpp"
-#include "spinesim/studies/json.hpp"
+#include "spinesim/output/format.hpp"
+#include "spinesim/studies/toolkit.hpp"
+#include "spinesim/output/json.hpp"
 #include "spinesim/studies/spine_studies.hpp"
-#include "spinesim/studies/table.hpp"
+#include "spinesim/output/table.hpp"
 
 #include <algorithm>
 #include <iomanip>

@@ -6,9 +6,10 @@
 #include "spinesim/common/input_file.hpp"
 
 #include "spinesim/common/timer.hpp"
-#include "spinesim/studies/format.hpp"
-#include "spinesim/studies/json.hpp"
-#include "spinesim/studies/table.hpp"
+#include "spinesim/output/format.hpp"
+#include "spinesim/studies/toolkit.hpp"
+#include "spinesim/output/json.hpp"
+#include "spinesim/output/table.hpp"
 
 #include "spinesim/spine/kinematics.hpp"
 #include "spinesim/spine/model.hpp"

@@ -1,9 +1,10 @@
 #include "spinesim/studies/vertebra_surfaces.hpp"
 
 #include "spinesim/common/timer.hpp"
-#include "spinesim/studies/files.hpp"
-#include "spinesim/studies/format.hpp"
-#include "spinesim/studies/table.hpp"
+#include "spinesim/output/files.hpp"
+#include "spinesim/studies/toolkit.hpp"
+#include "spinesim/output/format.hpp"
+#include "spinesim/output/table.hpp"
 
 #include <filesystem>
 #include <sstream>

@@ -454,7 +454,9 @@ TEST(PerSpringFile, RefusesBadMultipliers) {
   expect_per_spring_refused([](json& j) { j["edge_multipliers"] = json::array(); },
                             "no edge_multipliers");
   for (const double bad : {0.0, -1.0, std::numeric_limits<double>::infinity()})
-    expect_per_spring_refused([bad](json& j) { j["edge_multipliers"][3] = bad; }, "finite and > 0");
+    expect_per_spring_refused([bad](json& j) { j["edge_multipliers"][3] = bad; },
+                              "finite numbers in [1e-6, 1e6]");
+  expect_per_spring_refused([](json& j) { j["edge_multipliers"][3] = 1e300; }, "[1e-6, 1e6]");
   expect_per_spring_refused([](json& j) { j["edge_multipliers"][3] = nullptr; },
                             "malformed");  // a NaN written to text
   expect_per_spring_refused([](json& j) { j["edge_multipliers"][3] = "1"; }, "malformed");

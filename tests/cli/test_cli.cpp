@@ -108,7 +108,7 @@ TEST_F(CliTest, BadLoadsAreRefusedWithoutOutput) {
   const std::string out = tmp("cli-bad.vtu");
   expect_refused(
       run_spinesim("fem --mesh '" + disc_ + "' --wrench 0,nan,0,0,0,0 --out '" + out + "'"),
-      "non-finite");
+      "not a finite number");
   expect_refused(run_spinesim("fem --mesh '" + disc_ + "' --motion 0,-0.1,0 --out '" + out + "'"),
                  "expected 6");
   expect_refused(run_spinesim("fem --mesh '" + disc_ +

@@ -233,7 +233,7 @@ TEST_F(MssCli, BadInputIsRefusedInOneLineWithoutOutput) {
   expect_refused(run_spinesim(mss + "--case compression --dt 0 --steps 5" + o), "--dt");
   expect_refused(run_spinesim(mss + "--case compression --dt -1e-3 --steps 5" + o), "--dt");
   expect_refused(run_spinesim(mss + "--case compression --dt nan --steps 5" + o), "--dt");
-  expect_refused(run_spinesim(mss + "--motion 0,nan,0,0,0,0" + o), "non-finite");
+  expect_refused(run_spinesim(mss + "--motion 0,nan,0,0,0,0" + o), "not a finite number");
   expect_refused(run_spinesim(mss + "--wrench 0,-500,0" + o), "expected 6");
   expect_refused(run_spinesim(mss + "--case compression --steps 0" + o), "--steps");
   expect_refused(run_spinesim(mss + "--case compression --dt abc --steps 5" + o),

@@ -126,7 +126,7 @@ TEST(CliSeating, SweepWritesOneRowPerValueItsPlotsAndTheLiteratureTrends) {
 TEST(CliSeating, BadChairsAreRefusedInOneLine) {
   expect_refused(run_spinesim("study seating --lumbar-support -5"), "lumbar support depth");
   expect_refused(run_spinesim("study seating --backrest-recline 200"), "backrest recline");
-  expect_refused(run_spinesim("study seating --seat-angle nan"), "seat angle");
+  expect_refused(run_spinesim("study seating --seat-angle nan"), "--seat-angle");
   expect_refused(run_spinesim("study seating --lumbar-support 30 --lumbar-height 900"),
                  "above the backrest");
   expect_refused(run_spinesim("study seating --pelvic-tilt 80"), "--pelvic-tilt");
@@ -139,7 +139,7 @@ TEST(CliSeating, BadChairsAreRefusedInOneLine) {
       "does not face the back");
   expect_refused(run_spinesim("study seating-sweep --parameter colour --values 1,2"), "not one of");
   expect_refused(run_spinesim("study seating-sweep --parameter seat-angle --values 1,x"),
-                 "--values: 'x' is not a number");
+                 "--values: 'x' is not a finite number");
   expect_refused(run_spinesim("study seating-sweep --parameter backrest-recline --values 90,170"),
                  "backrest-recline 170");
 }

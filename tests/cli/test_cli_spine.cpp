@@ -145,10 +145,10 @@ TEST(SpineSolveCli, ForceBeyond600NIsSolvedWithAWarning) {
 
 TEST(SpineSolveCliRefuses, BadLoads) {
   expect_refused(run_spinesim("spine solve --force X9:0,0,1"), "X9");
-  expect_refused(run_spinesim("spine solve --force T7:nan,0,0"), "non-finite");
-  expect_refused(run_spinesim("spine solve --force T7:inf,0,0"), "non-finite");
+  expect_refused(run_spinesim("spine solve --force T7:nan,0,0"), "not a finite number");
+  expect_refused(run_spinesim("spine solve --force T7:inf,0,0"), "not a finite number");
   expect_refused(run_spinesim("spine solve --force T7:1,2"), "3 comma-separated");
-  expect_refused(run_spinesim("spine solve --force T7:1,2,abc"), "not a number");
+  expect_refused(run_spinesim("spine solve --force T7:1,2,abc"), "not a finite number");
   expect_refused(run_spinesim("spine solve --force T7"), "VERTEBRA:");
   expect_refused(run_spinesim("spine solve --moment S1:0,0,1"), "S1");
   expect_refused(run_spinesim("spine solve --force T7:0,0,1 --at 0,1"), "--at");

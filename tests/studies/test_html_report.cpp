@@ -1,7 +1,8 @@
 // The demo's HTML report (studies/html_report.hpp, scripts/report.py) on a small demo folder made
 // here: every plot is written and shown in report.html; a missing or broken input is one line and
 // no report.html. Needs Debian's python3 with matplotlib and markdown (scripts/install-deps.sh).
-#include "spinesim/studies/html_report.hpp"
+#include "spinesim/output/html_report.hpp"
+#include "spinesim/studies/toolkit.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>

@@ -6,7 +6,7 @@
 #include "spinesim/mss/boundary.hpp"
 #include "spinesim/mss/solver.hpp"
 #include "spinesim/spine/kinematics.hpp"
-#include "spinesim/studies/haptic_recording.hpp"
+#include "spinesim/haptics/recording.hpp"
 #include "spinesim/studies/spine_discs.hpp"
 
 #include <gtest/gtest.h>
@@ -62,7 +62,7 @@ std::string recording(const std::string& name, int n, int moved, Shift shift) {
     }
   }
   const std::string path = scratch(name).string();
-  st::HapticRecordingWriter w(path, "test", &model(), "multirate");
+  spinesim::haptics::HapticRecordingWriter w(path, "test", &model(), "multirate");
   w.append(rows.data(), rows.size());
   w.finish();
   return path;
@@ -214,7 +214,8 @@ TEST(SpineDiscs, BadRequestsAreRefusedBeforeAnythingIsWritten) {
   bad = rq;
   bad.tuned = std::string(SPINESIM_DATA_DIR) + "/tuned_discs.json";
   refused(bad, "fitted on another mesh");
-  bad = rq;
-  bad.out = "/nonexistent-parent/out";
-  refused(bad, "does not exist");
+  bad = rq;  // a folder that cannot be made: a file is in the way
+  std::ofstream(scratch("a-file")) << "x";
+  bad.out = (scratch("a-file") / "out").string();
+  refused(bad, "cannot create the folder");
 }

@@ -52,14 +52,14 @@ double mesh_volume(const TetMesh& m);
 
 /// Throws std::invalid_argument with a one-line message when the mesh is unusable:
 /// empty, index out of range, non-finite coordinates, inverted or zero-volume tets
-/// (relative to the mean edge length cubed), label arrays of the wrong size, a disc frame that
-/// is not a rotation (validate_frame).
+/// (relative to the mean edge length cubed), label arrays of the wrong size, a disc frame whose
+/// axes are not orthonormal (validate_frame).
 void validate(const TetMesh& m);
 
-/// Throws std::invalid_argument (one line, naming `what`) unless the frame's axes are a rotation
-/// — orthonormal to 1e-6 and right-handed — and its origin finite and within 1e6 mm. A frame of
-/// zero, scaled or skewed axes would turn every load case into another load (a zero load, a
-/// 1000-fold one, a sideways one) without an error.
+/// Throws std::invalid_argument (one line, naming `what`) unless the frame's axes are orthonormal
+/// to 1e-6 (a rotation, or a mirror for a mirrored disc) and its origin finite and within 1e6 mm.
+/// A frame of zero, scaled or skewed axes would turn every load case into another load (a zero
+/// load, a 1000-fold one, a sideways one) without an error.
 void validate_frame(const DiscFrame& frame, const std::string& what = "disc frame");
 
 /// The boundary of tetrahedra `T` (#T×4): the faces used by exactly one tet, oriented outward

@@ -11,8 +11,9 @@
 #pragma once
 
 #include "spinesim/mesh/mesher.hpp"
-#include "spinesim/studies/html_report.hpp"
-#include "spinesim/studies/progress.hpp"
+#include "spinesim/output/html_report.hpp"
+#include "spinesim/studies/toolkit.hpp"
+#include "spinesim/output/progress.hpp"
 
 #include <nlohmann/json.hpp>
 

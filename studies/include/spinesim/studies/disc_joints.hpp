@@ -14,7 +14,8 @@
 
 #include "spinesim/fem/disc_fem.hpp"
 #include "spinesim/mesh/material.hpp"
-#include "spinesim/studies/progress.hpp"
+#include "spinesim/output/progress.hpp"
+#include "spinesim/studies/toolkit.hpp"
 
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>

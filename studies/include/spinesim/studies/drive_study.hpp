@@ -8,7 +8,8 @@
 
 #include "spinesim/mesh/material.hpp"
 #include "spinesim/mesh/tet_mesh.hpp"
-#include "spinesim/studies/progress.hpp"
+#include "spinesim/output/progress.hpp"
+#include "spinesim/studies/toolkit.hpp"
 #include "spinesim/studies/stepped_study.hpp"
 
 #include <nlohmann/json.hpp>

@@ -30,7 +30,8 @@
 #pragma once
 
 #include "spinesim/studies/calibration_summary.hpp"
-#include "spinesim/studies/progress.hpp"
+#include "spinesim/output/progress.hpp"
+#include "spinesim/studies/toolkit.hpp"
 
 #include "spinesim/fem/disc_fem.hpp"
 #include "spinesim/mesh/material.hpp"

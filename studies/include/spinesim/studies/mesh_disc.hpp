@@ -8,7 +8,8 @@
 #include "spinesim/mesh/quality.hpp"
 #include "spinesim/mesh/structured_disc.hpp"
 #include "spinesim/studies/disc_level.hpp"
-#include "spinesim/studies/progress.hpp"
+#include "spinesim/output/progress.hpp"
+#include "spinesim/studies/toolkit.hpp"
 
 #include <nlohmann/json.hpp>
 

@@ -12,14 +12,21 @@
 #include "spinesim/mss/model.hpp"
 #include "spinesim/mss/solver.hpp"
 #include "spinesim/mss/simulator.hpp"
-#include "spinesim/studies/progress.hpp"
+#include "spinesim/output/progress.hpp"
+#include "spinesim/studies/toolkit.hpp"
 
 #include <nlohmann/json.hpp>
 
 #include <ostream>
 #include <string>
 
+namespace spinesim::output {
+class VtuSeries;
+}  // namespace spinesim::output
+
 namespace spinesim::studies {
+
+using output::VtuSeries;
 
 /// One stepped run's wall-clock statistics and its first rejected step.
 struct StepStats {
@@ -59,7 +66,6 @@ struct MssRunRequest {
   int frame_every = 0;  ///< dynamic: a frame every K steps (0: about 100 frames)
 };
 
-class VtuSeries;
 
 struct MssRunResult {
   MssRunRequest request;

@@ -10,7 +10,8 @@
 #include "spinesim/mss/model.hpp"
 #include "spinesim/studies/comparison_report.hpp"
 #include "spinesim/studies/mss_run.hpp"
-#include "spinesim/studies/progress.hpp"
+#include "spinesim/output/progress.hpp"
+#include "spinesim/studies/toolkit.hpp"
 
 #include <nlohmann/json.hpp>
 

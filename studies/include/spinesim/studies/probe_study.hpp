@@ -11,7 +11,8 @@
 #include "spinesim/mss/model.hpp"
 #include "spinesim/mss/solver.hpp"
 #include "spinesim/studies/mss_run.hpp"
-#include "spinesim/studies/progress.hpp"
+#include "spinesim/output/progress.hpp"
+#include "spinesim/studies/toolkit.hpp"
 #include "spinesim/studies/stepped_study.hpp"
 
 #include <Eigen/Core>

@@ -9,7 +9,8 @@
 #pragma once
 
 #include "spinesim/spine/seating.hpp"
-#include "spinesim/studies/progress.hpp"
+#include "spinesim/output/progress.hpp"
+#include "spinesim/studies/toolkit.hpp"
 #include "spinesim/studies/spine_studies.hpp"
 
 #include <nlohmann/json.hpp>

@@ -9,7 +9,8 @@
 #include "spinesim/spine/database.hpp"
 #include "spinesim/spine/equilibrium.hpp"
 #include "spinesim/spine/model.hpp"
-#include "spinesim/studies/progress.hpp"
+#include "spinesim/output/progress.hpp"
+#include "spinesim/studies/toolkit.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -19,6 +20,12 @@
 #include <vector>
 
 namespace spinesim::studies {
+
+/// A displacement database the user gives (`--check --out`, `haptics run --database`): the file
+/// is input, so a malformed one — or one with no fits, which would answer every force with the
+/// baseline — is refused with std::invalid_argument (one line), not reported as a failed run.
+spine::DisplacementDatabase read_database(const std::string& path);
+
 
 /// The `source` recorded in a generated file: the model, the solver and the protocol.
 extern const char* const kDatabaseSource;

@@ -28,7 +28,7 @@
 #include "spinesim/mesh/structured_disc.hpp"
 #include "spinesim/mss/disc_set.hpp"
 #include "spinesim/spine/model.hpp"
-#include "spinesim/studies/haptic_recording.hpp"
+#include "spinesim/haptics/recording.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -37,6 +37,11 @@
 #include <vector>
 
 namespace spinesim::studies {
+
+// The recording format is the haptic loop's (haptics/recording.hpp).
+using haptics::DragFrame;
+using haptics::DragRecording;
+using haptics::read_drag_recording;
 
 /// The 17 discs of the spine, each its level's structured disc with its tuned parameters.
 struct SpineDiscs {

@@ -40,7 +40,8 @@
 #pragma once
 
 #include "spinesim/spine/equilibrium.hpp"
-#include "spinesim/studies/progress.hpp"
+#include "spinesim/output/progress.hpp"
+#include "spinesim/studies/toolkit.hpp"
 
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>

@@ -7,7 +7,8 @@
 #include "spinesim/mss/model.hpp"
 #include "spinesim/mss/solver.hpp"
 #include "spinesim/mss/simulator.hpp"
-#include "spinesim/studies/files.hpp"
+#include "spinesim/output/files.hpp"
+#include "spinesim/studies/toolkit.hpp"
 #include "spinesim/studies/mss_run.hpp"
 
 #include <nlohmann/json.hpp>

@@ -20,7 +20,7 @@
 #include <string>
 #include <vector>
 
-namespace spinesim::studies {
+namespace spinesim::haptics {
 
 /// 16 hex digits (FNV-1a) over the model's vertebra centres, joint points and fused joints.
 std::string spine_model_fingerprint(const spine::SpineModel& m);
@@ -87,4 +87,4 @@ inline constexpr double kMaxVertebraShiftMm = 500, kMaxVertebraTurnDeg = 180;
 /// cut off mid-row (a killed run) is dropped.
 DragRecording read_drag_recording(const std::string& path, const spine::SpineModel& model);
 
-}  // namespace spinesim::studies
+}  // namespace spinesim::haptics

@@ -1,10 +1,10 @@
 // The VTU time series: a series replaces an earlier one of the same name only when it is
 // complete, and then wholly (no frame of the earlier one left beside it); one that fails leaves
 // the earlier series as it was and no staging folder.
-#include "spinesim/studies/files.hpp"
+#include "spinesim/output/files.hpp"
 
-#include "studies_fixtures.hpp"
-
+#include "spinesim/mesh/disc_geometry.hpp"
+#include "spinesim/mesh/structured_disc.hpp"
 #include "spinesim/mss/model.hpp"
 
 #include <gtest/gtest.h>
@@ -20,6 +20,13 @@ namespace fs = std::filesystem;
 using namespace spinesim;
 
 namespace {
+
+/// The structured T7-T8 disc (no CGAL), made once.
+const spinesim::mesh::TetMesh& t7_t8() {
+  static const spinesim::mesh::TetMesh m = spinesim::mesh::mesh_structured_disc(
+      spinesim::mesh::disc_dimensions("T7-T8", SPINESIM_DATA_DIR));
+  return m;
+}
 
 std::string fresh_dir(const std::string& name) {
   const fs::path dir =
@@ -43,8 +50,8 @@ std::string slurp(const std::string& path) {
 }
 
 /// Writes `frames` frames of the disc at rest (displaced by `shift` mm) into `series`.
-void fill(studies::VtuSeries& series, int frames, double shift) {
-  const mss::MssModel model(test::structured("T7-T8"), test::material("real-disc"));
+void fill(output::VtuSeries& series, int frames, double shift) {
+  const mss::MssModel model(t7_t8(), mesh::load_material("real-disc", SPINESIM_DATA_DIR));
   Eigen::VectorXd x = model.rest_positions_mm();
   x.array() += shift;
   for (int k = 0; k < frames; ++k) series.add(1e-3 * k, model, x);
@@ -55,14 +62,14 @@ void fill(studies::VtuSeries& series, int frames, double shift) {
 TEST(VtuSeries, AFinishedSeriesReplacesAnEarlierOneWhole) {
   const std::string dir = fresh_dir("replace"), pvd = dir + "/run.pvd";
   {
-    studies::VtuSeries first(pvd);
+    output::VtuSeries first(pvd);
     fill(first, 5, 0.0);
     first.finish();
   }
   EXPECT_EQ(names_in(dir + "/run").size(), 5u);
   std::ofstream(dir + "/run/notes.txt") << "the user's";  // not a frame: never touched
   {
-    studies::VtuSeries second(pvd);
+    output::VtuSeries second(pvd);
     fill(second, 3, 1.0);
     // Until it finishes, the earlier series is whole.
     EXPECT_EQ(names_in(dir + "/run").size(), 6u);
@@ -79,13 +86,13 @@ TEST(VtuSeries, AFinishedSeriesReplacesAnEarlierOneWhole) {
 TEST(VtuSeries, AnUnfinishedSeriesLeavesTheEarlierOneAsItWas) {
   const std::string dir = fresh_dir("unfinished"), pvd = dir + "/run.pvd";
   {
-    studies::VtuSeries first(pvd);
+    output::VtuSeries first(pvd);
     fill(first, 4, 0.0);
     first.finish();
   }
   const std::string pvd_before = slurp(pvd), frame_before = slurp(dir + "/run/run_000001.vtu");
   {
-    studies::VtuSeries failed(pvd);
+    output::VtuSeries failed(pvd);
     fill(failed, 2, 1.0);  // then an exception, as from a full disk: destroyed unfinished
   }
   EXPECT_EQ(slurp(pvd), pvd_before);
@@ -97,6 +104,6 @@ TEST(VtuSeries, AnUnfinishedSeriesLeavesTheEarlierOneAsItWas) {
 TEST(VtuSeries, AFrameFolderThatIsNotAFolderIsRefused) {
   const std::string dir = fresh_dir("not-a-folder");
   std::ofstream(dir + "/run") << "a file where the frames would go";
-  EXPECT_THROW(studies::VtuSeries(dir + "/run.pvd"), std::invalid_argument);
+  EXPECT_THROW(output::VtuSeries(dir + "/run.pvd"), std::invalid_argument);
   EXPECT_EQ(slurp(dir + "/run"), "a file where the frames would go");
 }

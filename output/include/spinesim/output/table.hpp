@@ -7,7 +7,7 @@
 #include <utility>
 #include <vector>
 
-namespace spinesim::studies {
+namespace spinesim::output {
 
 /// A plain table. The first `text_columns` columns are left-aligned, the rest (numbers)
 /// right-aligned; in markdown a '|' inside a cell is escaped and number columns are marked
@@ -35,4 +35,4 @@ class TextTable {
   std::vector<std::vector<std::string>> rows_;
 };
 
-}  // namespace spinesim::studies
+}  // namespace spinesim::output

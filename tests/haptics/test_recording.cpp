@@ -1,9 +1,9 @@
-// The haptic recording: what the writer writes the reader reads back (poses to 0.1 µm, 1e-5°);
+// The haptic recording (haptics/recording.hpp): what the writer writes the reader reads back (poses to 0.1 µm, 1e-5°);
 // a row cut off by a kill is dropped and the file still reads; another spine model, missing
 // ticks, a hook force beyond the spine solve's range and a file without the spine's columns are
 // refused in one line.
 #include "spinesim/spine/kinematics.hpp"
-#include "spinesim/studies/haptic_recording.hpp"
+#include "spinesim/haptics/recording.hpp"
 
 #include <gtest/gtest.h>
 
@@ -11,7 +11,7 @@
 #include <fstream>
 #include <sstream>
 
-namespace st = spinesim::studies;
+namespace st = spinesim::haptics;
 namespace sp = spinesim::spine;
 namespace sh = spinesim::haptics;
 namespace fs = std::filesystem;

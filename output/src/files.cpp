@@ -1,4 +1,4 @@
-#include "spinesim/studies/files.hpp"
+#include "spinesim/output/files.hpp"
 #include "spinesim/mss/simulator.hpp"
 
 #include "spinesim/common/atomic_file.hpp"
@@ -13,7 +13,7 @@
 
 #include <unistd.h>
 
-namespace spinesim::studies {
+namespace spinesim::output {
 namespace fs = std::filesystem;
 
 void write_text_file(const std::string& path, const std::string& text) {
@@ -151,4 +151,4 @@ std::vector<std::string> VtuSeries::frame_paths() const {
   return out;
 }
 
-}  // namespace spinesim::studies
+}  // namespace spinesim::output

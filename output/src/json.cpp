@@ -1,8 +1,8 @@
-#include "spinesim/studies/json.hpp"
+#include "spinesim/output/json.hpp"
 
 #include <iostream>
 
-namespace spinesim::studies {
+namespace spinesim::output {
 
 namespace {
 bool g_json_printed = false;
@@ -15,4 +15,4 @@ void print_json(const nlohmann::json& j) {
 
 bool json_printed() { return g_json_printed; }
 
-}  // namespace spinesim::studies
+}  // namespace spinesim::output

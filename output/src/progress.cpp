@@ -1,6 +1,6 @@
-#include "spinesim/studies/progress.hpp"
+#include "spinesim/output/progress.hpp"
 
-#include "spinesim/studies/format.hpp"
+#include "spinesim/output/format.hpp"
 
 #include <unistd.h>
 
@@ -9,7 +9,7 @@
 #include <iostream>
 #include <sstream>
 
-namespace spinesim::studies {
+namespace spinesim::output {
 
 bool stderr_is_terminal() { return isatty(STDERR_FILENO) != 0; }
 
@@ -90,4 +90,4 @@ std::function<void(int, int)> ProgressBar::callback() {
   };
 }
 
-}  // namespace spinesim::studies
+}  // namespace spinesim::output

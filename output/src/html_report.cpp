@@ -1,4 +1,4 @@
-#include "spinesim/studies/html_report.hpp"
+#include "spinesim/output/html_report.hpp"
 
 #include <array>
 #include <sys/wait.h>
@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <string>
 
-namespace spinesim::studies {
+namespace spinesim::output {
 
 namespace {
 
@@ -67,4 +67,4 @@ HtmlReport write_html_report(const std::string& folder, const std::string& scrip
   return r;
 }
 
-}  // namespace spinesim::studies
+}  // namespace spinesim::output

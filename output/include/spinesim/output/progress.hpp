@@ -11,7 +11,7 @@
 #include <functional>
 #include <string>
 
-namespace spinesim::studies {
+namespace spinesim::output {
 
 /// True when stderr is a terminal (progress may be drawn).
 bool stderr_is_terminal();
@@ -74,4 +74,4 @@ class ProgressBar {
   bool drawn_ = false;
 };
 
-}  // namespace spinesim::studies
+}  // namespace spinesim::output

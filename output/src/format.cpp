@@ -1,11 +1,11 @@
-#include "spinesim/studies/format.hpp"
+#include "spinesim/output/format.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
 #include <sstream>
 
-namespace spinesim::studies {
+namespace spinesim::output {
 
 std::string fixed(double v, int decimals) {
   if (std::isnan(v)) return "n/a";
@@ -45,4 +45,4 @@ std::string pad(const std::string& s, std::size_t width, bool left) {
   return left ? s + fill : fill + s;
 }
 
-}  // namespace spinesim::studies
+}  // namespace spinesim::output

@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-namespace spinesim::studies {
+namespace spinesim::output {
 
 /// Writes `text` to `path` completely or not at all (spinesim/common/atomic_file.hpp). Throws
 /// std::runtime_error naming the file when the system refuses.
@@ -64,4 +64,4 @@ class VtuSeries {
   bool finished_ = false;
 };
 
-}  // namespace spinesim::studies
+}  // namespace spinesim::output

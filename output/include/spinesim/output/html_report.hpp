@@ -5,7 +5,7 @@
 
 #include <string>
 
-namespace spinesim::studies {
+namespace spinesim::output {
 
 struct HtmlReport {
   bool written = false;
@@ -21,4 +21,4 @@ struct HtmlReport {
 /// python3 or plotting library, bad input): they come back as written = false and one line.
 HtmlReport write_html_report(const std::string& folder, const std::string& script = "report.py");
 
-}  // namespace spinesim::studies
+}  // namespace spinesim::output

@@ -1,10 +1,10 @@
-#include "spinesim/studies/table.hpp"
+#include "spinesim/output/table.hpp"
 
-#include "spinesim/studies/format.hpp"
+#include "spinesim/output/format.hpp"
 
 #include <algorithm>
 
-namespace spinesim::studies {
+namespace spinesim::output {
 
 void TextTable::set_min_width(std::size_t i, std::size_t width) {
   if (min_width_.size() <= i) min_width_.resize(i + 1, 0);
@@ -54,4 +54,4 @@ void TextTable::print(std::ostream& os, bool markdown, const std::string& indent
   for (const auto& r : rows_) line(r);
 }
 
-}  // namespace spinesim::studies
+}  // namespace spinesim::output

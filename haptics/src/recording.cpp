@@ -1,8 +1,8 @@
-#include "spinesim/studies/haptic_recording.hpp"
+#include "spinesim/haptics/recording.hpp"
 #include "spinesim/common/constants.hpp"
 
 #include "spinesim/common/input_file.hpp"
-#include "spinesim/studies/format.hpp"
+#include "spinesim/output/format.hpp"
 #include "spinesim/spine/equilibrium.hpp"
 #include "spinesim/spine/kinematics.hpp"
 
@@ -15,7 +15,11 @@
 #include <sstream>
 #include <stdexcept>
 
-namespace spinesim::studies {
+namespace spinesim::haptics {
+
+using output::fixed;
+using output::one_line;
+using output::significant;
 
 namespace {
 
@@ -271,4 +275,4 @@ DragRecording read_drag_recording(const std::string& path, const spine::SpineMod
   return rec;
 }
 
-}  // namespace spinesim::studies
+}  // namespace spinesim::haptics

@@ -7,7 +7,7 @@
 
 #include <string>
 
-namespace spinesim::studies {
+namespace spinesim::output {
 
 /// `v` with `decimals` digits after the point ("n/a" for NaN, "inf"/"-inf" for infinities).
 std::string fixed(double v, int decimals);
@@ -27,4 +27,4 @@ std::size_t display_width(const std::string& s);
 /// `s` padded with spaces to `width` display columns, right-aligned (or left when `left`).
 std::string pad(const std::string& s, std::size_t width, bool left = false);
 
-}  // namespace spinesim::studies
+}  // namespace spinesim::output

@@ -5,7 +5,7 @@
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>
 
-namespace spinesim::studies {
+namespace spinesim::output {
 
 /// Row-major nested arrays [[m00, m01, …], …], also for a matrix with one row or column.
 template <class Derived>
@@ -39,4 +39,4 @@ void print_json(const nlohmann::json& j);
 /// after its work began still prints one object, saying so).
 bool json_printed();
 
-}  // namespace spinesim::studies
+}  // namespace spinesim::output
