@@ -24,8 +24,8 @@
 #include "spinesim/mesh/structured_disc.hpp"
 #include "spinesim/mss/disc_set.hpp"
 #include "spinesim/mss/model.hpp"
-#include "spinesim/mss/solver.hpp"
 #include "spinesim/mss/simulator.hpp"
+#include "spinesim/mss/solver.hpp"
 
 #include <benchmark/benchmark.h>
 

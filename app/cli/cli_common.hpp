@@ -5,15 +5,15 @@
 
 #include "flag_values.hpp"
 
-#include "spinesim/studies/data.hpp"
-#include "spinesim/output/files.hpp"
-#include "spinesim/studies/toolkit.hpp"
-#include "spinesim/output/format.hpp"
 #include "spinesim/haptics/scene_builder.hpp"
-#include "spinesim/studies/haptics_run.hpp"
+#include "spinesim/output/files.hpp"
+#include "spinesim/output/format.hpp"
 #include "spinesim/output/json.hpp"
 #include "spinesim/output/progress.hpp"
 #include "spinesim/output/table.hpp"
+#include "spinesim/studies/data.hpp"
+#include "spinesim/studies/haptics_run.hpp"
+#include "spinesim/studies/toolkit.hpp"
 
 #include <CLI/CLI.hpp>
 #include <Eigen/Core>

@@ -49,8 +49,8 @@
 #include "spinesim/mesh/mesher.hpp"
 #include "spinesim/mss/boundary.hpp"
 #include "spinesim/mss/model.hpp"
-#include "spinesim/mss/solver.hpp"
 #include "spinesim/mss/simulator.hpp"
+#include "spinesim/mss/solver.hpp"
 
 #include <unistd.h>
 

@@ -6,8 +6,8 @@
 //   spinesim study seating-validation [--csv FILE] [--json]
 #include "cli_common.hpp"
 #include "spinesim/output/html_report.hpp"
-#include "spinesim/studies/toolkit.hpp"
 #include "spinesim/studies/seating_study.hpp"
+#include "spinesim/studies/toolkit.hpp"
 
 #include <cmath>
 #include <filesystem>

@@ -12,10 +12,10 @@
 // below 3.3 core or a device that cannot be opened is one line and a non-zero exit.
 #include "cli_common.hpp"
 
-#include "spinesim/haptics/device.hpp"
-#include "spinesim/haptics/scene_builder.hpp"
 #include "playback.hpp"
 #include "session.hpp"
+#include "spinesim/haptics/device.hpp"
+#include "spinesim/haptics/scene_builder.hpp"
 #include "spinesim/viewer/viewer.hpp"
 
 #include <cmath>

@@ -6,8 +6,8 @@
 #pragma once
 
 #include "spinesim/mesh/io.hpp"
-#include "spinesim/mss/solver.hpp"
 #include "spinesim/mss/simulator.hpp"
+#include "spinesim/mss/solver.hpp"
 
 #include <Eigen/Core>
 

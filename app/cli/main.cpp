@@ -71,7 +71,8 @@ int main(int argc, char** argv) {
     // One line and status 1, like every other error (CLI11's own exit() adds a second line
     // and uses codes such as 104 for a bad number).
     // A mistyped verb or flag gets the nearest valid one.
-    const std::string hint = spinesim::cli::suggest(app, std::vector<std::string>(argv + 1, argv + argc));
+    const std::string hint =
+        spinesim::cli::suggest(app, std::vector<std::string>(argv + 1, argv + argc));
     std::cerr << "spinesim: error: " << spinesim::studies::one_line(hint.empty() ? e.what() : hint)
               << " (see --help)" << std::endl;
     return 1;

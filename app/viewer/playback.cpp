@@ -2,9 +2,9 @@
 
 #include "field_surface.hpp"
 
+#include "spinesim/haptics/recording.hpp"
 #include "spinesim/mesh/io.hpp"
 #include "spinesim/spine/model.hpp"
-#include "spinesim/haptics/recording.hpp"
 
 #include <imgui.h>
 

@@ -28,8 +28,7 @@ nlohmann::json evaluation_json(const Evaluation& e) {
           {"regularisation", e.regularisation}};
 }
 
-const CaseError& case_error(const Evaluation& e,
-                                         const std::string& name) {
+const CaseError& case_error(const Evaluation& e, const std::string& name) {
   for (const auto& c : e.cases)
     if (c.name == name) return c;
   throw std::logic_error("calibration report: case " + name + " missing");
@@ -146,8 +145,7 @@ mss::MssOptions fill_tuned_file(CalibrationOutcome& out, const mesh::TetMesh& m,
   t.fem_order = rq.fem_order;
   t.options = options;
   for (std::size_t j = 0; j < lin.knobs().size(); ++j)
-    t.scales[knob_name(lin.knobs()[j])] =
-        std::exp(out.result.log_scales(Eigen::Index(j)));
+    t.scales[knob_name(lin.knobs()[j])] = std::exp(out.result.log_scales(Eigen::Index(j)));
   const mss::MssOptions region_options = t.mss_options();  // before the multipliers: what transfers
   if (out.per_spring_ran) {
     const Eigen::VectorXd mu = out.per_spring.log_multipliers.array().exp();
@@ -168,7 +166,7 @@ void run_nonlinear_checks(CalibrationOutcome& out, const fem::DiscFem& fem,
   const Timer t0;
   const auto compare = [&](const fem::DiscFem& f, const mss::MssModel& model) {
     return compare_mss_fem(f, model, all, materials.name, mss::StaticOptions(),
-                                        rq.check_load_scale);
+                           rq.check_load_scale);
   };
   out.untuned_check = compare(fem, thesis_model);
   out.tuned_check = compare(fem, mss::MssModel(m, materials, out.tuned.mss_options()));
@@ -192,12 +190,11 @@ void run_transfer_checks(CalibrationOutcome& out, const mesh::RegionMaterials& m
                                  fem::DiscFem::default_plate_center(other));
     TransferCheck tc;
     tc.label = label;
-    tc.untuned = compare_mss_fem(
-        other_fem, mss::MssModel(other, materials, term_set_options(TermSet::thesis)), all,
-        materials.name, mss::StaticOptions(), rq.check_load_scale);
-    tc.tuned = compare_mss_fem(
-        other_fem, mss::MssModel(other, materials, region_options), all, materials.name,
-        mss::StaticOptions(), rq.check_load_scale);
+    tc.untuned = compare_mss_fem(other_fem,
+                                 mss::MssModel(other, materials, term_set_options(TermSet::thesis)),
+                                 all, materials.name, mss::StaticOptions(), rq.check_load_scale);
+    tc.tuned = compare_mss_fem(other_fem, mss::MssModel(other, materials, region_options), all,
+                               materials.name, mss::StaticOptions(), rq.check_load_scale);
     tc.seconds = t0.seconds();
     out.transfer.push_back(std::move(tc));
   }
@@ -220,8 +217,7 @@ nlohmann::json case_rows(const CalibrationOutcome& out, const FemReference& ref,
                         {"tuned_reaction_error_linear", f.reaction_error}};
     for (const auto& ref_case : ref.cases)
       if (ref_case.name == lc.name)
-        r["fem_plate_rotation_deg"] =
-            ref_case.plate_motion.tail<3>().norm() * kDegPerRad;
+        r["fem_plate_rotation_deg"] = ref_case.plate_motion.tail<3>().norm() * kDegPerRad;
     if (out.per_spring_ran) {  // the region-only fit beside the per-spring one
       const auto& g = case_error(out.result.final, lc.name);
       r["region_error_linear"] = g.displacement_error;
@@ -386,8 +382,7 @@ CalibrationOutcome calibrate_disc(const mesh::TetMesh& m, const mesh::RegionMate
   say("linearising the mass-spring model at rest");
   t0.restart();
   const mss::MssModel thesis_model(m, materials, term_set_options(TermSet::thesis));
-  LinearMss thesis_lin(thesis_model,
-                                    available_knobs(thesis_model.options()), c);
+  LinearMss thesis_lin(thesis_model, available_knobs(thesis_model.options()), c);
   Objective thesis_obj(thesis_lin, ref, names(rq.train), rq.weights);
   out.untuned_linear =
       thesis_obj.evaluate(Eigen::VectorXd::Zero(Eigen::Index(thesis_lin.knobs().size())), false);
@@ -401,8 +396,8 @@ CalibrationOutcome calibrate_disc(const mesh::TetMesh& m, const mesh::RegionMate
   // 3. Ipopt from Van Gelder (all scales 1).
   say("Ipopt: " + std::to_string(lin.knobs().size()) + " stiffness scales, " +
       std::to_string(rq.train.size()) + " training cases");
-  out.result = calibrate(obj, Eigen::VectorXd::Zero(Eigen::Index(lin.knobs().size())),
-                                      rq.ipopt, ipopt_progress(say, ""));
+  out.result = calibrate(obj, Eigen::VectorXd::Zero(Eigen::Index(lin.knobs().size())), rq.ipopt,
+                         ipopt_progress(say, ""));
   out.k6_region = out.k6_tuned = out.result.final.k6;
   out.success = out.result.success;
 
@@ -413,8 +408,8 @@ CalibrationOutcome calibrate_disc(const mesh::TetMesh& m, const mesh::RegionMate
     PerSpringWeights w = rq.per_spring_weights;
     w.prior = rq.weights.regularisation;
     PerSpringObjective ps(obj, model, out.result.log_scales, w);
-    out.per_spring = calibrate_per_spring(ps, rq.per_spring_ipopt,
-                                                       ipopt_progress(say, "per-spring "));
+    out.per_spring =
+        calibrate_per_spring(ps, rq.per_spring_ipopt, ipopt_progress(say, "per-spring "));
     out.per_spring_ran = true;
     out.k6_tuned = out.per_spring.final.data.k6;
     out.success = out.per_spring.success;

@@ -16,7 +16,6 @@ namespace {
 /// The plausible range of a fitted scale or multiplier (see read_tuned_disc).
 constexpr double kMinScale = 1e-6, kMaxScale = 1e6;
 
-
 constexpr const char* kFormat = "spinesim-tuned-disc";
 constexpr int kVersion = 1;
 

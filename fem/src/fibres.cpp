@@ -11,7 +11,6 @@ namespace spinesim::fem {
 
 namespace {
 
-
 // K_ab += k (\int h_a h_b dV) a a^T,  h = grad N . a, with the exact 4-point degree-2 rule
 // (P2: h is linear, the integrand quadratic; P1: h constant).
 template <int NPE>

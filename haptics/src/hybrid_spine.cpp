@@ -37,7 +37,8 @@ SegmentState segment_state(const HybridDisc& disc, const mss::Boundary& bc,
   const Eigen::Matrix3d& A = disc.model->mesh().frame.axes;
   const Eigen::Matrix3d Rl = bc.inferior.rotation, Ru = bc.superior.rotation;
   const Eigen::Vector3d c = disc.centre_mm;
-  const Eigen::Vector3d moved = Rl.transpose() * (bc.superior.apply(c) - bc.inferior.translation_mm);
+  const Eigen::Vector3d moved =
+      Rl.transpose() * (bc.superior.apply(c) - bc.inferior.translation_mm);
   SegmentState s;
   s.shift_mm = A.transpose() * (moved - c);
   s.rotation_deg = A.transpose() * spine::rotation_log(Rl.transpose() * Ru) * kDegPerRad;

@@ -12,7 +12,6 @@
 namespace spinesim::mesh {
 namespace {
 
-
 // Base curve before scaling: polar ellipse (a = 1, b = 0.75) with a posterior notch.
 constexpr double kA = 1.0, kB = 0.75, kNotchDepth = 0.3;
 constexpr int kNotchPower = 16;

@@ -96,8 +96,7 @@ DiscFrame disc_frame_in_spine(const std::string& level, const std::string& data_
   const Eigen::Vector3d top = point(centres, centres.find("segment", superior));
   // F.1 has no sacrum: below L5 the joint point stands in for the inferior centre.
   const Eigen::Vector3d bottom =
-      inferior == "S1" ? frame.origin_mm
-                       : point(centres, centres.find("segment", inferior));
+      inferior == "S1" ? frame.origin_mm : point(centres, centres.find("segment", inferior));
   Eigen::Vector3d y = top - bottom;
   if (!(y.norm() > 1e-9))
     throw std::invalid_argument("disc " + name + ": coincident vertebra centres");

@@ -58,10 +58,9 @@ IsotropicMaterial parse_one(const nlohmann::json& j, const std::string& what,
 
 FibreReinforcement parse_fibres(const nlohmann::json& j, const std::string& what) {
   if (!j.is_object()) throw std::invalid_argument(what + ": expected a JSON object");
-  require_known_keys(j,
-                     {"E_inner_mpa", "E_outer_mpa", "angle_inner_deg", "angle_outer_deg", "source",
-                      "notes"},
-                     what);
+  require_known_keys(
+      j, {"E_inner_mpa", "E_outer_mpa", "angle_inner_deg", "angle_outer_deg", "source", "notes"},
+      what);
   auto number = [&](const char* key) -> double {
     if (!j.contains(key)) throw std::invalid_argument(what + ": missing '" + key + "'");
     const auto& v = j.at(key);

@@ -13,7 +13,6 @@
 namespace spinesim::mesh {
 namespace {
 
-
 // Circumradius of the tet (a, b, c, d): |center - a| with center from the 3x3 linear system
 // 2 (p_i - a) . x = |p_i - a|^2 (x relative to a).
 double circumradius(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,

@@ -2,8 +2,8 @@
 #include "spinesim/mesh/vertebra_geometry.hpp"
 #include "spinesim/common/constants.hpp"
 
-#include "spinesim/common/csv_table.hpp"
 #include "spinesim/common/atomic_file.hpp"
+#include "spinesim/common/csv_table.hpp"
 #include "spinesim/mesh/disc_geometry.hpp"
 #include "spinesim/mesh/mesher.hpp"
 
@@ -104,7 +104,8 @@ std::vector<SweptBox> neural_arch(const VertebraMorphometry& m, const Parametric
     parts.push_back(swept(root, pillar, Y, pw / 2, ph / 2));                           // pedicle
     parts.push_back(swept(pillar, mid, Y, m.lamina_thickness_mm / 2, lamina_half_h));  // lamina
     // Transverse process: from the pillar, swept back and raised by the table's angles.
-    const double sweep = m.transverse_sweep_deg * kRadPerDeg, rise = m.transverse_rise_deg * kRadPerDeg;
+    const double sweep = m.transverse_sweep_deg * kRadPerDeg,
+                 rise = m.transverse_rise_deg * kRadPerDeg;
     const Eigen::Vector3d dir(side * std::cos(sweep) * std::cos(rise), std::sin(rise),
                               -std::sin(sweep) * std::cos(rise));
     const double length = std::max(m.transverse_span_mm / 2 - xp, 2.0 * m.facet_radius_mm);

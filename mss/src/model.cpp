@@ -1,8 +1,8 @@
 // MssModel: builder (mesh + material -> springs, masses) and the energy/gradient/Hessian loops.
 // Formulas and constants: model.hpp; element kernels: elements.cpp.
 #include "spinesim/mss/model.hpp"
-#include "spinesim/common/skew.hpp"
 #include "spinesim/common/constants.hpp"
+#include "spinesim/common/skew.hpp"
 
 #include "face_angles.hpp"
 #include "hessian_pattern.hpp"
@@ -21,7 +21,6 @@
 
 namespace spinesim::mss {
 namespace {
-
 
 /// Region label -> index into the per-region stiffness parts (0 annulus, 1 nucleus).
 int region_index(int region_label) {

@@ -29,8 +29,8 @@
 // O(n) per step with the frozen factor, never a refactorisation.
 // Dirichlet nodes jump to the poses of the next boundary; their velocity is the displacement
 // over dt.
-#include "spinesim/mss/solver.hpp"
 #include "spinesim/mss/simulator.hpp"
+#include "spinesim/mss/solver.hpp"
 
 #include "external_loads.hpp"
 #include "reduced_potential.hpp"

@@ -1,7 +1,7 @@
 #include "spinesim/output/html_report.hpp"
 
-#include <array>
 #include <sys/wait.h>
+#include <array>
 #include <cstdio>
 #include <filesystem>
 #include <string>

@@ -28,7 +28,6 @@ using detail::vec3;
 using Eigen::Vector3d;
 using nlohmann::json;
 
-
 std::string upper(std::string s) {
   s.erase(std::remove_if(s.begin(), s.end(), [](unsigned char c) { return std::isspace(c); }),
           s.end());
@@ -285,10 +284,10 @@ IapStiffness iap_from_appendix_c(const std::string& path) {
   // P = ρ_Hg g h: mmHg → Pa → MPa.
   s.pressure_mpa = number(c, "mercury_density_kg_m3", path) * number(c, "gravity_m_s2", path) *
                    number(c, "iap_mmhg", path) * 1e-3 * 1e-6;
-  s.k_y = 0.5 * s.pressure_mpa * s.a_mm * s.a_mm;           // (3.9), "N/mm" as the thesis writes it
-  s.k_x = 0.5 * s.pressure_mpa * s.a_mm * s.h_mm;           // (3.10)
-  s.bushing_k_xz = 4 * s.k_x;                               // (3.15)
-  s.bushing_k_y = 4 * s.k_y;                                // (3.16), printed "k_y = 4k_y"
+  s.k_y = 0.5 * s.pressure_mpa * s.a_mm * s.a_mm;  // (3.9), "N/mm" as the thesis writes it
+  s.k_x = 0.5 * s.pressure_mpa * s.a_mm * s.h_mm;  // (3.10)
+  s.bushing_k_xz = 4 * s.k_x;                      // (3.15)
+  s.bushing_k_y = 4 * s.k_y;                       // (3.16), printed "k_y = 4k_y"
   s.bushing_m_xz_per_deg = s.k_y * kRadPerDeg * s.a_mm * s.a_mm;  // (3.17)
   s.bushing_m_y_per_deg = s.k_x * kRadPerDeg * s.a_mm * s.a_mm;   // (3.18)
   return s;
@@ -385,11 +384,11 @@ void apply_disc_joints(std::vector<Joint>& joints, const std::string& name_or_pa
     if (std::none_of(joints.begin(), joints.end(),
                      [&](const Joint& jt) { return jt.name == level.key(); }))
       throw std::invalid_argument(who + "unknown level '" + level.key() + "'");
-    require_known_keys(level.value(),
-                       {"K_nmm_per_rad", "cell_size_mm", "diagonal_nmm_per_deg", "joint_point_mm",
-                        "mesh_asymmetry_removed", "plate_center_mm", "tets",
-                        "thesis_F4_nmm_per_deg"},
-                       who + level.key());
+    require_known_keys(
+        level.value(),
+        {"K_nmm_per_rad", "cell_size_mm", "diagonal_nmm_per_deg", "joint_point_mm",
+         "mesh_asymmetry_removed", "plate_center_mm", "tets", "thesis_F4_nmm_per_deg"},
+        who + level.key());
   }
   const std::string source = j.contains("source") && j.at("source").is_string()
                                  ? j.at("source").get<std::string>()
@@ -422,10 +421,9 @@ void apply_disc_joints(std::vector<Joint>& joints, const std::string& name_or_pa
     // A spinal joint's rotational stiffness is of order 1e5 N·mm/rad (F.4: 1e3-1e7 across the
     // spine and its fusions); beyond 1 … 1e10 N·mm/rad the numbers are not a disc's.
     if (!(eig.minCoeff() >= 1 && eig.maxCoeff() <= 1e10))
-      throw std::invalid_argument(who + joint.name +
-                                  ": the stiffness lies outside 1 … 1e10 N·mm/rad (eigenvalues " +
-                                  std::to_string(eig.minCoeff()) + " … " +
-                                  std::to_string(eig.maxCoeff()) + ")");
+      throw std::invalid_argument(
+          who + joint.name + ": the stiffness lies outside 1 … 1e10 N·mm/rad (eigenvalues " +
+          std::to_string(eig.minCoeff()) + " … " + std::to_string(eig.maxCoeff()) + ")");
     joint.k_flexion = joint.k_extension = sym(0, 0);
     joint.k_torsion = sym(1, 1);
     joint.k_lateral = sym(2, 2);

@@ -26,7 +26,9 @@ using Eigen::VectorXd;
 constexpr double kTopRadiusMm = 50;  // the parametric backrest's rounded top edge
 
 /// Posterior pelvic tilt by `deg`: rotation about x carrying superior (y) towards posterior (−z).
-Matrix3d tilt(double deg) { return Eigen::AngleAxisd(-deg * kRadPerDeg, Vector3d::UnitX()).matrix(); }
+Matrix3d tilt(double deg) {
+  return Eigen::AngleAxisd(-deg * kRadPerDeg, Vector3d::UnitX()).matrix();
+}
 
 bool lumbar_joint(const std::string& name) {
   return name == "L1-L2" || name == "L2-L3" || name == "L3-L4" || name == "L4-L5" ||
@@ -39,8 +41,10 @@ bool lumbar_joint(const std::string& name) {
 class ParametricBackrest : public ContactSurface {
  public:
   explicit ParametricBackrest(const Chair& c)
-      : t_(0, std::sin(c.backrest_recline_deg * kRadPerDeg), std::cos(c.backrest_recline_deg * kRadPerDeg)),
-        n_(0, -std::cos(c.backrest_recline_deg * kRadPerDeg), std::sin(c.backrest_recline_deg * kRadPerDeg)),
+      : t_(0, std::sin(c.backrest_recline_deg * kRadPerDeg),
+           std::cos(c.backrest_recline_deg * kRadPerDeg)),
+        n_(0, -std::cos(c.backrest_recline_deg * kRadPerDeg),
+           std::sin(c.backrest_recline_deg * kRadPerDeg)),
         height_(c.backrest_height_mm),
         depth_(c.lumbar_support_mm),
         centre_(c.lumbar_support_height_mm),
@@ -310,7 +314,8 @@ SeatedModel seat_model(const SpineModel& standing, const Chair& chair, const Sit
     m.contact_surface = std::make_shared<PlacedSurface>(back, out.rotation, I, out.ischia_world_mm);
   out.posture = VectorXd::Zero(dof_count(m));
   for (std::size_t k = 0; k < m.joints.size(); ++k)
-    out.posture[3 * Eigen::Index(k)] = sitter.lumbar_flexion_deg * kRadPerDeg * sitter.lumbar_share[k];
+    out.posture[3 * Eigen::Index(k)] =
+        sitter.lumbar_flexion_deg * kRadPerDeg * sitter.lumbar_share[k];
   // The IAP bushing stands for the abdomen's pressure, not for an elastic memory of standing:
   // seated, the abdomen settles into the sitting posture and the bushing rests there (stress-free
   // at standing, its appendix C stiffness would hold the ribs 1 kN up and 55 N·m back against the

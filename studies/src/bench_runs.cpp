@@ -41,7 +41,8 @@ nlohmann::json bench_mesh_once(const std::string& level, double cell_size_mm,
           {"peak_rss_mb", peak_rss_mb()}};
 }
 
-nlohmann::json bench_fem_once(const std::string& mesh_path, int order, const std::string& data_dir) {
+nlohmann::json bench_fem_once(const std::string& mesh_path, int order,
+                              const std::string& data_dir) {
   const auto m = mesh::read_tet_mesh(mesh_path);
   const double rss_mesh = peak_rss_mb();
   const auto mat = mesh::load_material("real-disc", data_dir);

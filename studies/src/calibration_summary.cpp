@@ -1,8 +1,8 @@
 #include "spinesim/studies/calibration_summary.hpp"
 
 #include "spinesim/output/format.hpp"
-#include "spinesim/studies/toolkit.hpp"
 #include "spinesim/output/table.hpp"
+#include "spinesim/studies/toolkit.hpp"
 
 #include <iomanip>
 #include <iostream>

@@ -1,10 +1,10 @@
 #include "spinesim/studies/comparison_report.hpp"
 
-#include "spinesim/studies/fem_report.hpp"
 #include "spinesim/output/format.hpp"
-#include "spinesim/studies/toolkit.hpp"
 #include "spinesim/output/json.hpp"
 #include "spinesim/output/table.hpp"
+#include "spinesim/studies/fem_report.hpp"
+#include "spinesim/studies/toolkit.hpp"
 
 #include <iomanip>
 #include <sstream>

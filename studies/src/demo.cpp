@@ -14,20 +14,20 @@
 #include "spinesim/mesh/mesher.hpp"
 #include "spinesim/mesh/quality.hpp"
 #include "spinesim/mss/model.hpp"
+#include "spinesim/output/files.hpp"
+#include "spinesim/output/format.hpp"
+#include "spinesim/output/json.hpp"
+#include "spinesim/output/table.hpp"
 #include "spinesim/studies/calibration_summary.hpp"
 #include "spinesim/studies/comparison_report.hpp"
 #include "spinesim/studies/data.hpp"
 #include "spinesim/studies/disc_level.hpp"
 #include "spinesim/studies/fem_report.hpp"
-#include "spinesim/output/files.hpp"
-#include "spinesim/studies/toolkit.hpp"
-#include "spinesim/output/format.hpp"
-#include "spinesim/output/json.hpp"
 #include "spinesim/studies/materials_study.hpp"
 #include "spinesim/studies/mesh_report.hpp"
 #include "spinesim/studies/probe_study.hpp"
 #include "spinesim/studies/spine_studies.hpp"
-#include "spinesim/output/table.hpp"
+#include "spinesim/studies/toolkit.hpp"
 
 #include <cmath>
 #include <filesystem>
@@ -400,7 +400,8 @@ std::string at(const nlohmann::json& j, const std::string& pointer, int digits =
   if (!j.contains(p) || !j.at(p).is_number()) return "n/a";
   const double v = j.at(p).get<double>();
   // Counts (tets, DOF, ticks) in full; measured numbers to `digits` significant digits.
-  if (j.at(p).is_number_integer() || (v == std::round(v) && std::abs(v) >= 1e3 && std::abs(v) < 1e15))
+  if (j.at(p).is_number_integer() ||
+      (v == std::round(v) && std::abs(v) >= 1e3 && std::abs(v) < 1e15))
     return fixed(std::round(v), 0);
   return significant(v, digits);
 }
@@ -418,20 +419,21 @@ double mean_of(const nlohmann::json& rows, const char* key) {
 
 std::string demo_summary(const DemoResult& r) {
   const nlohmann::json& s = r.summary;
-  const nlohmann::json holdout = s.contains("calibration") ? s["calibration"].value("holdout", nlohmann::json::array())
-                                                           : nlohmann::json::array();
+  const nlohmann::json holdout = s.contains("calibration")
+                                     ? s["calibration"].value("holdout", nlohmann::json::array())
+                                     : nlohmann::json::array();
   std::ostringstream os;
   os << "spinesim demo: " << s.value("level", std::string("?")) << "\n"
-     << "  mesh         " << at(s, "/mesh/tets") << " tets, " << at(s, "/mesh/nodes") << " nodes, min dihedral "
-     << at(s, "/mesh/min_dihedral_deg", 3) << " deg\n"
-     << "  FEM P" << at(s, "/fem_order", 1) << "       " << at(s, "/fem_dofs") << " DOF, axial stiffness "
-     << at(s, "/stiffness_6x6_disc_frame/1/1") << " N/mm\n"
-     << "  MSS vs FEM   held-out displacement error untuned " << percent(mean_of(holdout, "untuned_error"))
-     << ", tuned " << percent(mean_of(holdout, "tuned_error")) << " (mean of "
-     << holdout.size() << " cases)\n"
-     << "  spine        L5-S1 " << at(s, "/spine_validation/mcgill/axial_n") << " N (McGill & Norman), L4-L5 "
-     << at(s, "/spine_validation/wilke/axial_n") << " N (Wilke: "
-     << at(s, "/spine_validation/wilke/target/axial_n") << " N)\n"
+     << "  mesh         " << at(s, "/mesh/tets") << " tets, " << at(s, "/mesh/nodes")
+     << " nodes, min dihedral " << at(s, "/mesh/min_dihedral_deg", 3) << " deg\n"
+     << "  FEM P" << at(s, "/fem_order", 1) << "       " << at(s, "/fem_dofs")
+     << " DOF, axial stiffness " << at(s, "/stiffness_6x6_disc_frame/1/1") << " N/mm\n"
+     << "  MSS vs FEM   held-out displacement error untuned "
+     << percent(mean_of(holdout, "untuned_error")) << ", tuned "
+     << percent(mean_of(holdout, "tuned_error")) << " (mean of " << holdout.size() << " cases)\n"
+     << "  spine        L5-S1 " << at(s, "/spine_validation/mcgill/axial_n")
+     << " N (McGill & Norman), L4-L5 " << at(s, "/spine_validation/wilke/axial_n")
+     << " N (Wilke: " << at(s, "/spine_validation/wilke/target/axial_n") << " N)\n"
      << "  haptics      " << at(s, "/haptics_run/rate_hz") << " Hz, "
      << at(s, "/haptics_run/missed_deadlines") << " missed deadlines of "
      << at(s, "/haptics_run/ticks", 6) << " ticks\n"

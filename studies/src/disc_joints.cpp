@@ -4,21 +4,20 @@
 #include "spinesim/calibration/linear_mss.hpp"
 #include "spinesim/calibration/tuned_set.hpp"
 #include "spinesim/common/timer.hpp"
+#include "spinesim/fem/plate_stiffness.hpp"
 #include "spinesim/mesh/disc_geometry.hpp"
+#include "spinesim/output/format.hpp"
+#include "spinesim/output/table.hpp"
 #include "spinesim/spine/model.hpp"
 #include "spinesim/studies/disc_level.hpp"
-#include "spinesim/fem/plate_stiffness.hpp"
 #include "spinesim/studies/fem_report.hpp"
-#include "spinesim/output/format.hpp"
 #include "spinesim/studies/toolkit.hpp"
-#include "spinesim/output/table.hpp"
 
 #include <algorithm>
 #include <cmath>
 
 namespace spinesim::studies {
 namespace {
-
 
 /// The parametric disc is mirror-symmetric about the sagittal plane, its CGAL mesh only nearly:
 /// under x -> -x, θ_x is even and θ_y, θ_z odd, so the exact disc has no flexion-torsion or
@@ -108,7 +107,8 @@ DiscJointSet compute_tuned_disc_joints(const std::string& data_dir, const std::s
                                                    td.edge_multipliers.data(),
                                                    Eigen::Index(td.edge_multipliers.size())))
                         : linear.solve(scales);
-    set_mirror_symmetric(d, fem::joint_stiffness_about(state.k6, d.plate_center_mm, d.joint_point_mm));
+    set_mirror_symmetric(d,
+                         fem::joint_stiffness_about(state.k6, d.plate_center_mm, d.joint_point_mm));
     hooks.end_stage(std::to_string(d.tets) + " tets");
     set.joints.push_back(d);
   }

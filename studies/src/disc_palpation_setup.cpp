@@ -2,8 +2,8 @@
 
 #include "spinesim/calibration/tuned_set.hpp"
 #include "spinesim/mss/boundary.hpp"
-#include "spinesim/studies/disc_level.hpp"
 #include "spinesim/output/format.hpp"
+#include "spinesim/studies/disc_level.hpp"
 #include "spinesim/studies/toolkit.hpp"
 
 #include <filesystem>

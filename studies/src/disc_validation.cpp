@@ -4,10 +4,10 @@
 #include "spinesim/common/input_file.hpp"
 #include "spinesim/common/timer.hpp"
 #include "spinesim/fem/load_cases.hpp"
-#include "spinesim/studies/fem_report.hpp"
 #include "spinesim/output/format.hpp"
-#include "spinesim/studies/toolkit.hpp"
 #include "spinesim/output/table.hpp"
+#include "spinesim/studies/fem_report.hpp"
+#include "spinesim/studies/toolkit.hpp"
 
 #include <cmath>
 #include <map>
@@ -15,7 +15,6 @@
 
 namespace spinesim::studies {
 namespace {
-
 
 std::string preparation_of(const nlohmann::json& t) {
   const auto flag = [&](const char* key) -> int {

@@ -1,15 +1,15 @@
 #include "spinesim/studies/drive_study.hpp"
-#include "spinesim/mss/simulator.hpp"
 #include "spinesim/common/constants.hpp"
+#include "spinesim/mss/simulator.hpp"
 
 #include "spinesim/fem/disc_fem.hpp"
 #include "spinesim/mss/boundary.hpp"
 #include "spinesim/mss/quantities.hpp"
-#include "spinesim/studies/fem_report.hpp"
 #include "spinesim/output/files.hpp"
-#include "spinesim/studies/toolkit.hpp"
 #include "spinesim/output/format.hpp"
 #include "spinesim/output/table.hpp"
+#include "spinesim/studies/fem_report.hpp"
+#include "spinesim/studies/toolkit.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -5,9 +5,9 @@
 #include "spinesim/mesh/io.hpp"
 
 #include "spinesim/output/format.hpp"
-#include "spinesim/studies/toolkit.hpp"
 #include "spinesim/output/json.hpp"
 #include "spinesim/output/table.hpp"
+#include "spinesim/studies/toolkit.hpp"
 
 #include <cmath>
 #include <iomanip>
@@ -17,8 +17,7 @@
 
 namespace spinesim::studies {
 
-namespace {
-}
+namespace {}
 
 void print_stiffness(std::ostream& os, const fem::Matrix6d& k_rad) {
   const fem::Matrix6d k = stiffness_per_degree(k_rad);

@@ -6,14 +6,14 @@
 #include "spinesim/common/timer.hpp"
 #include "spinesim/haptics/compliant_stage.hpp"
 #include "spinesim/haptics/disc_palpation.hpp"
+#include "spinesim/haptics/recording.hpp"
 #include "spinesim/haptics/renderer.hpp"
 #include "spinesim/mesh/vertebra_geometry.hpp"
-#include "spinesim/studies/disc_palpation_setup.hpp"
 #include "spinesim/output/files.hpp"
-#include "spinesim/studies/toolkit.hpp"
 #include "spinesim/output/format.hpp"
-#include "spinesim/haptics/recording.hpp"
 #include "spinesim/output/table.hpp"
+#include "spinesim/studies/disc_palpation_setup.hpp"
+#include "spinesim/studies/toolkit.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -220,8 +220,7 @@ CompliantSetup make_compliant_stage(const HapticsRunRequest& request, const std:
     const std::string path = request.database.empty()
                                  ? (fs::path(data_dir) / "spine" / "displacement_db.json").string()
                                  : request.database;
-    c.database =
-        std::make_unique<spine::DisplacementDatabase>(read_database(path));
+    c.database = std::make_unique<spine::DisplacementDatabase>(read_database(path));
     c.response = std::make_unique<haptics::DatabaseResponse>(*c.database);
   } else {
     haptics::MultirateOptions o;
@@ -318,9 +317,10 @@ void finish_disc(DiscSetup& d, HapticsRunResult* result) {
 
 // The --record file, fed by the loop's writer thread (null without --record).
 std::unique_ptr<haptics::HapticRecordingWriter> start_recording(const HapticsRunRequest& request,
-                                                       const HapticsRunResult& result,
-                                                       const spine::SpineModel* model, bool disc,
-                                                       haptics::ServoLoop& loop) {
+                                                                const HapticsRunResult& result,
+                                                                const spine::SpineModel* model,
+                                                                bool disc,
+                                                                haptics::ServoLoop& loop) {
   if (request.record.empty()) return nullptr;
   std::ostringstream what;
   what << "device " << request.device << ", renderer " << request.renderer << ", probe radius "
@@ -329,7 +329,7 @@ std::unique_ptr<haptics::HapticRecordingWriter> start_recording(const HapticsRun
     what << "; disc " << result.disc_level << " (" << result.disc_tets << " tets, "
          << result.disc_tuned_file << ")";
   auto record = std::make_unique<haptics::HapticRecordingWriter>(request.record, what.str(), model,
-                                                        request.spine, disc);
+                                                                 request.spine, disc);
   haptics::HapticRecordingWriter* sink = record.get();
   loop.record_to([sink](const haptics::TickRecord* rows, std::size_t n) { sink->append(rows, n); },
                  1 << 13);

@@ -1,11 +1,11 @@
 #include "spinesim/studies/level_calibration.hpp"
 
 #include "spinesim/mesh/disc_geometry.hpp"
+#include "spinesim/output/format.hpp"
+#include "spinesim/output/table.hpp"
 #include "spinesim/studies/data.hpp"
 #include "spinesim/studies/disc_level.hpp"
-#include "spinesim/output/format.hpp"
 #include "spinesim/studies/toolkit.hpp"
-#include "spinesim/output/table.hpp"
 
 #include <algorithm>
 #include <iomanip>

@@ -1,12 +1,12 @@
 #include "spinesim/studies/materials_study.hpp"
 
 #include "spinesim/common/timer.hpp"
+#include "spinesim/output/json.hpp"
 #include "spinesim/studies/comparison_report.hpp"
 #include "spinesim/studies/fem_report.hpp"
-#include "spinesim/output/json.hpp"
-#include "spinesim/studies/toolkit.hpp"
 #include "spinesim/studies/mss_run.hpp"
 #include "spinesim/studies/stepped_study.hpp"
+#include "spinesim/studies/toolkit.hpp"
 
 #include "spinesim/fem/load_cases.hpp"
 #include "spinesim/mss/model.hpp"

@@ -5,9 +5,9 @@
 #include "spinesim/mesh/disc_geometry.hpp"
 #include "spinesim/mesh/vertebra_disc.hpp"
 #include "spinesim/output/files.hpp"
-#include "spinesim/studies/toolkit.hpp"
 #include "spinesim/output/format.hpp"
 #include "spinesim/studies/mesh_report.hpp"
+#include "spinesim/studies/toolkit.hpp"
 
 #include <stdexcept>
 
@@ -112,9 +112,8 @@ MeshDiscResult run_mesh_disc(const MeshDiscRequest& request, const std::string& 
   check(request);
   MeshDiscResult r;
   r.request = request;
-  const double exact_volume = request.level.empty()
-                                  ? mesh_between_vertebrae(request, hooks, r)
-                                  : mesh_level(request, data_dir, hooks, r);
+  const double exact_volume = request.level.empty() ? mesh_between_vertebrae(request, hooks, r)
+                                                    : mesh_level(request, data_dir, hooks, r);
   r.quality = mesh::quality_report(r.mesh, exact_volume);
   hooks.begin_stage("writing " + request.out);
   OutputSet outputs("mesh disc");  // the VTU and the Medit copy: both or neither

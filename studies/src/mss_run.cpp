@@ -4,11 +4,11 @@
 #include "spinesim/calibration/tuned_disc.hpp"
 #include "spinesim/common/timer.hpp"
 #include "spinesim/mss/quantities.hpp"
-#include "spinesim/studies/fem_report.hpp"
 #include "spinesim/output/files.hpp"
-#include "spinesim/studies/toolkit.hpp"
 #include "spinesim/output/format.hpp"
 #include "spinesim/output/json.hpp"
+#include "spinesim/studies/fem_report.hpp"
+#include "spinesim/studies/toolkit.hpp"
 
 #include <algorithm>
 #include <cmath>

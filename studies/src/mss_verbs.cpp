@@ -2,14 +2,14 @@
 
 #include "spinesim/calibration/compare.hpp"
 #include "spinesim/calibration/tuned_set.hpp"
+#include "spinesim/common/timer.hpp"
 #include "spinesim/fem/disc_fem.hpp"
 #include "spinesim/mesh/io.hpp"
-#include "spinesim/common/timer.hpp"
 #include "spinesim/mss/quantities.hpp"
-#include "spinesim/studies/calibration_summary.hpp"
 #include "spinesim/output/files.hpp"
-#include "spinesim/studies/toolkit.hpp"
 #include "spinesim/output/json.hpp"
+#include "spinesim/studies/calibration_summary.hpp"
+#include "spinesim/studies/toolkit.hpp"
 
 #include <filesystem>
 #include <ostream>
@@ -187,8 +187,8 @@ MssCompareResult run_mss_compare(const MssCompareRequest& rq, const std::string&
 
 void print_mss_compare(std::ostream& os, const MssCompareRequest& rq, const MssCompareResult& r) {
   os << "MSS (" << r.choice.constants << ", " << r.choice.variant << ") vs FEM P" << rq.order
-     << " on " << rq.mesh_path << " (" << r.nodes << " nodes, " << r.tets
-     << " tets), material " << r.choice.materials.name
+     << " on " << rq.mesh_path << " (" << r.nodes << " nodes, " << r.tets << " tets), material "
+     << r.choice.materials.name
      << (rq.load_scale != 1.0 ? ", loads x " + std::to_string(rq.load_scale) : std::string())
      << "\n\n";
   print_comparison(os, r.comparison, false);

@@ -5,9 +5,9 @@
 #include "spinesim/mss/boundary.hpp"
 #include "spinesim/mss/quantities.hpp"
 #include "spinesim/output/files.hpp"
-#include "spinesim/studies/toolkit.hpp"
 #include "spinesim/output/format.hpp"
 #include "spinesim/output/json.hpp"
+#include "spinesim/studies/toolkit.hpp"
 
 #include <algorithm>
 #include <array>

@@ -5,8 +5,8 @@
 #include "spinesim/common/timer.hpp"
 #include "spinesim/mesh/surface_distance.hpp"
 #include "spinesim/output/format.hpp"
-#include "spinesim/studies/toolkit.hpp"
 #include "spinesim/output/table.hpp"
+#include "spinesim/studies/toolkit.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -2,9 +2,9 @@
 #include "spinesim/common/input_file.hpp"
 #include "spinesim/common/timer.hpp"
 #include "spinesim/output/format.hpp"
-#include "spinesim/studies/toolkit.hpp"
-#include "spinesim/studies/seating_study.hpp"
 #include "spinesim/output/table.hpp"
+#include "spinesim/studies/seating_study.hpp"
+#include "spinesim/studies/toolkit.hpp"
 
 #include <cmath>
 #include <numeric>

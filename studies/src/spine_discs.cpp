@@ -6,14 +6,14 @@
 #include "spinesim/mesh/disc_geometry.hpp"
 #include "spinesim/mss/boundary.hpp"
 #include "spinesim/mss/quantities.hpp"
-#include "spinesim/mss/solver.hpp"
 #include "spinesim/mss/simulator.hpp"
-#include "spinesim/spine/kinematics.hpp"
-#include "spinesim/studies/disc_level.hpp"
+#include "spinesim/mss/solver.hpp"
 #include "spinesim/output/files.hpp"
-#include "spinesim/studies/toolkit.hpp"
 #include "spinesim/output/format.hpp"
 #include "spinesim/output/table.hpp"
+#include "spinesim/spine/kinematics.hpp"
+#include "spinesim/studies/disc_level.hpp"
+#include "spinesim/studies/toolkit.hpp"
 #include "spinesim/studies/vertebra_surfaces.hpp"
 
 #include <cmath>
@@ -27,7 +27,6 @@ namespace spinesim::studies {
 namespace fs = std::filesystem;
 
 namespace {
-
 
 int vertebra_index(const spine::SpineModel& model, const std::string& name) {
   for (std::size_t i = 0; i < model.vertebrae.size(); ++i)
@@ -228,8 +227,9 @@ void motion_row(std::ostream& os, double t, const std::string& level, const Segm
   std::snprintf(line, sizeof line,
                 "%.3f,%s,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,%.6f,%ld,%.4f,%.4f,%.4f,%.3f,%.3f,%.3f\n", t,
                 level.c_str(), s.shift_mm.x(), s.shift_mm.y(), s.shift_mm.z(), s.rotation_deg.x(),
-                s.rotation_deg.y(), s.rotation_deg.z(), s.volume_change, s.inverted_tets, s.force_n.x(),
-                s.force_n.y(), s.force_n.z(), s.moment_nmm.x(), s.moment_nmm.y(), s.moment_nmm.z());
+                s.rotation_deg.y(), s.rotation_deg.z(), s.volume_change, s.inverted_tets,
+                s.force_n.x(), s.force_n.y(), s.force_n.z(), s.moment_nmm.x(), s.moment_nmm.y(),
+                s.moment_nmm.z());
   os << line;
 }
 

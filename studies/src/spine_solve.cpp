@@ -2,10 +2,10 @@
 
 #include "spinesim/common/timer.hpp"
 #include "spinesim/output/format.hpp"
-#include "spinesim/studies/toolkit.hpp"
 #include "spinesim/output/json.hpp"
-#include "spinesim/studies/spine_studies.hpp"
 #include "spinesim/output/table.hpp"
+#include "spinesim/studies/spine_studies.hpp"
+#include "spinesim/studies/toolkit.hpp"
 
 #include <algorithm>
 #include <iomanip>

@@ -7,9 +7,9 @@
 
 #include "spinesim/common/timer.hpp"
 #include "spinesim/output/format.hpp"
-#include "spinesim/studies/toolkit.hpp"
 #include "spinesim/output/json.hpp"
 #include "spinesim/output/table.hpp"
+#include "spinesim/studies/toolkit.hpp"
 
 #include "spinesim/spine/kinematics.hpp"
 #include "spinesim/spine/model.hpp"
@@ -534,8 +534,9 @@ FusionStudy run_fusion_study(const std::string& data_dir, double force_n,
       r.t1_translation_mm =
           sol.poses[std::size_t(t1)].apply(c) - base.poses[std::size_t(t1)].apply(c);
       r.t1_total_translation_mm = sol.poses[std::size_t(t1)].apply(c) - c;
-      r.t1_rotation_deg = kDegPerRad * spine::rotation_log(sol.poses[std::size_t(t1)].R *
-                                                     base.poses[std::size_t(t1)].R.transpose());
+      r.t1_rotation_deg =
+          kDegPerRad * spine::rotation_log(sol.poses[std::size_t(t1)].R *
+                                           base.poses[std::size_t(t1)].R.transpose());
       r.l2l3 = sol.joints[l2l3];
       r.l5s1 = sol.joints[l5s1];
       r.iterations = sol.iterations;

@@ -2,9 +2,9 @@
 
 #include "spinesim/common/timer.hpp"
 #include "spinesim/output/files.hpp"
-#include "spinesim/studies/toolkit.hpp"
 #include "spinesim/output/format.hpp"
 #include "spinesim/output/table.hpp"
+#include "spinesim/studies/toolkit.hpp"
 
 #include <filesystem>
 #include <sstream>

@@ -63,9 +63,9 @@ std::string text_file(const std::string& name, const std::string& text) {
 }
 
 struct Hole {
-  std::string what;                          ///< the reproducer, in words
-  std::function<std::string()> args;        ///< the command line (files made when called)
-  std::string cause;                         ///< the refusal names this
+  std::string what;                   ///< the reproducer, in words
+  std::function<std::string()> args;  ///< the command line (files made when called)
+  std::string cause;                  ///< the refusal names this
 };
 
 const std::string kData = SPINESIM_DATA_DIR;
@@ -77,25 +77,35 @@ std::vector<Hole> input_holes() {
   return {
       // Disc frames that are not rotations: a zero, a 500 N sideways or a 5e5 N load before.
       {"fem on a disc whose disc_frame axes are all zero",
-       [] { return "fem --mesh " + q(disc_with_axes("zero.vtu", "0 0 0 0 0 0 0 0 0")) +
-                   " --case compression --json"; },
+       [] {
+         return "fem --mesh " + q(disc_with_axes("zero.vtu", "0 0 0 0 0 0 0 0 0")) +
+                " --case compression --json";
+       },
        "not orthonormal"},
       {"fem on a disc whose disc_frame axes are 1e-300",
-       [] { return "fem --mesh " + q(disc_with_axes("tiny.vtu", "1e-300 0 0 0 1e-300 0 0 0 1e-300")) +
-                   " --case compression --json"; },
+       [] {
+         return "fem --mesh " + q(disc_with_axes("tiny.vtu", "1e-300 0 0 0 1e-300 0 0 0 1e-300")) +
+                " --case compression --json";
+       },
        "not orthonormal"},
       {"fem on a disc whose disc_frame axes are not orthogonal",
-       [] { return "fem --mesh " + q(disc_with_axes("skew.vtu", "1 0 0 0.7 0.7 0 0 0 1")) +
-                   " --case compression --json"; },
+       [] {
+         return "fem --mesh " + q(disc_with_axes("skew.vtu", "1 0 0 0.7 0.7 0 0 0 1")) +
+                " --case compression --json";
+       },
        "not orthonormal"},
       {"fem on a disc whose disc_frame axes are x1000",
-       [] { return "fem --mesh " + q(disc_with_axes("big.vtu", "1000 0 0 0 1000 0 0 0 1000")) +
-                   " --case compression --json"; },
+       [] {
+         return "fem --mesh " + q(disc_with_axes("big.vtu", "1000 0 0 0 1000 0 0 0 1000")) +
+                " --case compression --json";
+       },
        "not orthonormal"},
       {"a database check of a database with no fits",
-       [] { return "spine database --check --json --out " +
-                   q(edited_json(kData + "/spine/displacement_db.json", "empty_db.json",
-                                 [](nlohmann::json& j) { j["fits"] = nlohmann::json::array(); })); },
+       [] {
+         return "spine database --check --json --out " +
+                q(edited_json(kData + "/spine/displacement_db.json", "empty_db.json",
+                              [](nlohmann::json& j) { j["fits"] = nlohmann::json::array(); }));
+       },
        "\"fits\" is empty"},
       {"a mistyped verb", [] { return std::string("mesh dsic"); }, "did you mean 'disc'?"},
       {"a mistyped study", [] { return std::string("study validatoin"); },
@@ -114,11 +124,13 @@ std::vector<Hole> input_holes() {
 std::vector<Hole> file_holes() {
   return {
       {"mss with a tuned scale of 1e300",
-       [] { return "mss --mesh " + q(disc()) + " --case compression --json --params " +
-                   q(edited_json(kData + "/tuned_structured_discs.json", "scale.json",
-                                 [](nlohmann::json& j) {
-                                   j["levels"]["T7-T8"]["scales"]["main.annulus"] = 1e300;
-                                 })); },
+       [] {
+         return "mss --mesh " + q(disc()) + " --case compression --json --params " +
+                q(edited_json(kData + "/tuned_structured_discs.json", "scale.json",
+                              [](nlohmann::json& j) {
+                                j["levels"]["T7-T8"]["scales"]["main.annulus"] = 1e300;
+                              }));
+       },
        "[1e-6, 1e6]"},
       {"mss with no load at all", [] { return "mss --mesh " + q(disc()) + " --json"; },
        "give a load"},
@@ -134,49 +146,63 @@ std::vector<Hole> file_holes() {
       {"the viewer's camera at 1e308 degrees",
        [] { return "view --play " + q(disc()) + " --camera 1e308,0 --screenshot x.png"; },
        "|yaw| <= 360"},
-      {"a screenshot into a folder", [] {
-         return "view --play " + q(disc()) + " --screenshot " + q(tmp_dir().string());
-       },
+      {"a screenshot into a folder",
+       [] { return "view --play " + q(disc()) + " --screenshot " + q(tmp_dir().string()); },
        "a directory, not a regular file"},
       {"a FEM result into /dev/full",
        [] { return "fem --mesh " + q(disc()) + " --case compression --out /dev/full"; },
        "not a regular file"},
       {"a chair sweep whose third value no chair can have",
-       [] { return std::string("study seating-sweep --parameter backrest-recline --values 100,110,500"); },
+       [] {
+         return std::string(
+             "study seating-sweep --parameter backrest-recline --values 100,110,500");
+       },
        "backrest-recline 500"},
       {"disc joints of 1e300 N·mm/rad",
-       [] { return "spine solve --json --disc-joints " +
-                   q(edited_json(kData + "/spine/disc_joints/fibre-reinforced.json", "k.json",
-                                 [](nlohmann::json& j) {
-                                   auto& K = j["joints"]["L4-L5"]["K_nmm_per_rad"];
-                                   for (int i = 0; i < 3; ++i)
-                                     for (int k = 0; k < 3; ++k) K[i][k] = i == k ? 1e300 : 0.0;
-                                 })); },
+       [] {
+         return "spine solve --json --disc-joints " +
+                q(edited_json(kData + "/spine/disc_joints/fibre-reinforced.json", "k.json",
+                              [](nlohmann::json& j) {
+                                auto& K = j["joints"]["L4-L5"]["K_nmm_per_rad"];
+                                for (int i = 0; i < 3; ++i)
+                                  for (int k = 0; k < 3; ++k) K[i][k] = i == k ? 1e300 : 0.0;
+                              }));
+       },
        "outside 1 … 1e10"},
       {"disc joints of 1e-300 N·mm/rad",
-       [] { return "spine solve --json --disc-joints " +
-                   q(edited_json(kData + "/spine/disc_joints/fibre-reinforced.json", "k2.json",
-                                 [](nlohmann::json& j) {
-                                   auto& K = j["joints"]["L4-L5"]["K_nmm_per_rad"];
-                                   for (int i = 0; i < 3; ++i)
-                                     for (int k = 0; k < 3; ++k) K[i][k] = i == k ? 1e-300 : 0.0;
-                                 })); },
+       [] {
+         return "spine solve --json --disc-joints " +
+                q(edited_json(kData + "/spine/disc_joints/fibre-reinforced.json", "k2.json",
+                              [](nlohmann::json& j) {
+                                auto& K = j["joints"]["L4-L5"]["K_nmm_per_rad"];
+                                for (int i = 0; i < 3; ++i)
+                                  for (int k = 0; k < 3; ++k) K[i][k] = i == k ? 1e-300 : 0.0;
+                              }));
+       },
        "outside 1 … 1e10"},
       {"disc joints for a level L6-L7",
-       [] { return "spine solve --json --disc-joints " +
-                   q(edited_json(kData + "/spine/disc_joints/fibre-reinforced.json", "l6.json",
-                                 [](nlohmann::json& j) { j["joints"]["L6-L7"] = j["joints"]["L4-L5"]; })); },
+       [] {
+         return "spine solve --json --disc-joints " +
+                q(edited_json(
+                    kData + "/spine/disc_joints/fibre-reinforced.json", "l6.json",
+                    [](nlohmann::json& j) { j["joints"]["L6-L7"] = j["joints"]["L4-L5"]; }));
+       },
        "unknown level 'L6-L7'"},
       {"a material whose fibres have a direction field",
-       [] { return "fem --mesh " + q(disc()) + " --material " +
-                   q(edited_json(kData + "/materials/fibre-reinforced.json", "dir.json",
-                                 [](nlohmann::json& j) {
-                                   j["annulus"]["fibres"]["direction"] = {0, 0, 0};
-                                 })); },
+       [] {
+         return "fem --mesh " + q(disc()) + " --material " +
+                q(edited_json(kData + "/materials/fibre-reinforced.json", "dir.json",
+                              [](nlohmann::json& j) {
+                                j["annulus"]["fibres"]["direction"] = {0, 0, 0};
+                              }));
+       },
        "unknown field \"direction\""},
       {"a material that gives E_mpa twice",
-       [] { return "fem --mesh " + q(disc()) + " --material " +
-                   q(text_file("twice.json", R"({"name": "x", "E_mpa": 1, "nu": 0.3, "E_mpa": 1000})")); },
+       [] {
+         return "fem --mesh " + q(disc()) + " --material " +
+                q(text_file("twice.json",
+                            R"({"name": "x", "E_mpa": 1, "nu": 0.3, "E_mpa": 1000})"));
+       },
        "\"E_mpa\" twice"},
   };
 }

@@ -63,8 +63,9 @@ TEST(HostileInput, FifoAndFolderInputsAreNamedNotWaitedOn) {
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
   expect_refused_cleanly("fem --mesh " + quoted(disc()) + " --material " + quoted(fifo),
                          "a FIFO, not a regular file");
-  expect_refused_cleanly("mss --mesh " + quoted(disc()) + " --case compression --params " + quoted(fifo),
-                         "a FIFO, not a regular file");
+  expect_refused_cleanly(
+      "mss --mesh " + quoted(disc()) + " --case compression --params " + quoted(fifo),
+      "a FIFO, not a regular file");
   expect_refused_cleanly("fem --mesh " + quoted(fifo), "a FIFO, not a regular file");
   expect_refused_cleanly("fem --mesh " + quoted(tmp_dir().string()),
                          "a directory, not a regular file");

@@ -9,10 +9,10 @@
 #include <gtest/gtest.h>
 #include <Eigen/Geometry>
 
+#include <unistd.h>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <unistd.h>
 
 namespace fs = std::filesystem;
 
@@ -33,8 +33,8 @@ TEST(Numbers, PlainDecimalNotationOnly) {
   }
   // What strtod or std::stod would have read as something else: hex, nan, inf, blanks, an empty
   // text, a partial number.
-  for (const char* bad : {"", " 1", "1 ", "0x10", "nan", "NaN", "inf", "-inf", "1e", "e3", ".",
-                          "-", "1,5", "1.2.3", "12abc", "1e400"}) {
+  for (const char* bad : {"", " 1", "1 ", "0x10", "nan", "NaN", "inf", "-inf", "1e", "e3", ".", "-",
+                          "1,5", "1.2.3", "12abc", "1e400"}) {
     EXPECT_THROW(spinesim::to_double(bad, "the flag"), std::invalid_argument) << bad;
   }
   try {

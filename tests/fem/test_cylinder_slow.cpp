@@ -12,8 +12,8 @@
 // Reaction convention: the wrench the cylinder exerts on the top plate, so compression gives
 // F_y > 0 and a positive twist theta_y gives M_y < 0.
 // Slow (CGAL meshing + three 55k-DOF P2 solves, ~20 s), hence the _slow label.
-#include "spinesim/fem/disc_fem.hpp"
 #include "spinesim/common/constants.hpp"
+#include "spinesim/fem/disc_fem.hpp"
 #include "spinesim/mesh/mesher.hpp"
 
 #include <gtest/gtest.h>

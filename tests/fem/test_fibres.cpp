@@ -1,7 +1,7 @@
 // Linear fibre families (fibres.hpp): the element term against the fibre energy and against an
 // independent B^T D_f B quadrature; the patch test with fibres; the annulus fibre field.
-#include "spinesim/fem/assembly.hpp"
 #include "spinesim/common/constants.hpp"
+#include "spinesim/fem/assembly.hpp"
 #include "spinesim/fem/dirichlet.hpp"
 #include "spinesim/fem/fibres.hpp"
 #include "spinesim/fem/mixed.hpp"
@@ -21,7 +21,6 @@ using namespace spinesim;
 using namespace spinesim::fem;
 
 namespace {
-
 
 TetVertices sample_tet() {
   TetVertices X;

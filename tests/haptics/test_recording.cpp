@@ -2,8 +2,8 @@
 // a row cut off by a kill is dropped and the file still reads; another spine model, missing
 // ticks, a hook force beyond the spine solve's range and a file without the spine's columns are
 // refused in one line.
-#include "spinesim/spine/kinematics.hpp"
 #include "spinesim/haptics/recording.hpp"
+#include "spinesim/spine/kinematics.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,8 +1,8 @@
 // The haptic scene's sources (haptics/scene_builder.hpp): a user's scene file (surfaces in their vertebra's frame) lands
 // where the model puts that vertebra; bad scene files are refused in one line; the real
 // ArtiSynth vertebrae register to the model's lumbar frames (skipped without the test data).
-#include "spinesim/mesh/vertebra_geometry.hpp"
 #include "spinesim/haptics/scene_builder.hpp"
+#include "spinesim/mesh/vertebra_geometry.hpp"
 
 #include <gtest/gtest.h>
 

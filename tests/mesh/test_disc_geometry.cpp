@@ -1,7 +1,7 @@
 // Kidney outline and lofted parametric disc: extents, area, 40 % nucleus, posterior concavity,
 // loft volume — each checked by an independent computation.
-#include "spinesim/mesh/disc_geometry.hpp"
 #include "spinesim/common/constants.hpp"
+#include "spinesim/mesh/disc_geometry.hpp"
 #include "spinesim/mesh/mesher.hpp"
 
 #include <gtest/gtest.h>

@@ -2,8 +2,8 @@
 // run from a perturbed rest state with both endplates fixed and watch the total energy.
 #pragma once
 
-#include "spinesim/mss/solver.hpp"
 #include "spinesim/mss/simulator.hpp"
+#include "spinesim/mss/solver.hpp"
 
 #include <gtest/gtest.h>
 

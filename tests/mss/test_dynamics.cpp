@@ -3,8 +3,8 @@
 // against predicted_stable_dt_s, implicit Euler at 1 ms converging to the static equilibrium
 // (frozen and refreshed matrices), dynamic runs under a constant motion, wrench or probe
 // converging to solve_static, moving endplates, and rejected steps.
-#include "spinesim/mss/solver.hpp"
 #include "spinesim/mss/simulator.hpp"
+#include "spinesim/mss/solver.hpp"
 
 #include "solver_fixtures.hpp"
 #include "stability.hpp"

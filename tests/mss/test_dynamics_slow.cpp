@@ -5,8 +5,8 @@
 //     tetrahedron count (the per-step solve of each Cholesky backend is bench/bench_mss_cholesky).
 // Timings are printed, never asserted (shared 2-core machines); each is the best of 5 batches.
 // Run with OPENBLAS_NUM_THREADS=1 for the one-core numbers.
-#include "spinesim/mss/solver.hpp"
 #include "spinesim/mss/simulator.hpp"
+#include "spinesim/mss/solver.hpp"
 
 #include "solver_fixtures.hpp"
 #include "stability.hpp"

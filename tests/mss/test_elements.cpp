@@ -2,8 +2,8 @@
 // symmetry and positive semi-definiteness, rest states, momentum (zero net force and moment),
 // rigid-motion invariance, and the two places where we depart from the thesis: the apex force
 // that (5.13) omits and the barycentre reaction that (5.4) omits.
-#include "spinesim/mss/elements.hpp"
 #include "spinesim/common/constants.hpp"
+#include "spinesim/mss/elements.hpp"
 
 #include <gtest/gtest.h>
 
@@ -24,7 +24,6 @@ template <int N>
 using Vec = Eigen::Matrix<double, N, 1>;
 template <int N>
 using Mat = Eigen::Matrix<double, N, N>;
-
 
 // Central differences with step h on mm-sized configurations: truncation h^2 |E'''|/6 ~ 1e-12
 // and roundoff eps |E| / h ~ 1e-10, both relative to the derivative's scale, so 1e-6 relative

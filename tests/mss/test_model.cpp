@@ -2,8 +2,8 @@
 // Properties: finite differences of the assembled gradient/Hessian, momentum balance, rigid
 // invariance, the Hessian's rigid null space, and closed-form energies under a uniform
 // dilation that check the constants (5.1), (5.2), (5.8) without looking inside.
-#include "spinesim/mss/model.hpp"
 #include "spinesim/common/constants.hpp"
+#include "spinesim/mss/model.hpp"
 
 #include "spinesim/mss/elements.hpp"
 
@@ -19,7 +19,6 @@
 
 namespace spinesim::mss {
 namespace {
-
 
 using spinesim::mesh::box_mesh;
 

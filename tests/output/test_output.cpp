@@ -69,7 +69,7 @@ TEST(Files, AnOutputFolderIsMadeOrRefusedInOneLine) {
   const fs::path nested = root / "a" / "b" / "c";
   spinesim::output::prepare_output_folder(nested.string(), "--out");
   EXPECT_TRUE(fs::is_directory(nested));
-  EXPECT_TRUE(fs::is_empty(nested));  // the write probe is gone
+  EXPECT_TRUE(fs::is_empty(nested));                                  // the write probe is gone
   spinesim::output::prepare_output_folder(nested.string(), "--out");  // exists: fine
   std::ofstream(root / "file") << "x";
   const auto refused = [](const std::string& path, const std::string& needle) {

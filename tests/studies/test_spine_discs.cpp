@@ -3,10 +3,10 @@
 // T1 down moves only the T1-T2 disc, by the recorded amount, and its reaction matches a static
 // solve of that disc; the ParaView series has a disc and a vertebra part per frame.
 #include "spinesim/calibration/tuned_set.hpp"
+#include "spinesim/haptics/recording.hpp"
 #include "spinesim/mss/boundary.hpp"
 #include "spinesim/mss/solver.hpp"
 #include "spinesim/spine/kinematics.hpp"
-#include "spinesim/haptics/recording.hpp"
 #include "spinesim/studies/spine_discs.hpp"
 
 #include <gtest/gtest.h>

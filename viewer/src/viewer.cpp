@@ -24,7 +24,6 @@ namespace spinesim::viewer {
 
 namespace {
 
-
 const char* kVertexShader = R"(#version 330 core
 layout(location = 0) in vec3 position;
 layout(location = 1) in vec3 normal;

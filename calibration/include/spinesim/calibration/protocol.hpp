@@ -63,11 +63,10 @@ struct TransferCheck {
 };
 
 struct CalibrationOutcome {
-  TunedDisc tuned;           ///< report filled; written only if `success`
-  bool success = false;                   ///< every requested stage succeeded
-  CalibrationResult result;  ///< the region fit
-  PerSpringResult
-      per_spring;  ///< the per-spring stage (if requested and the region fit succeeded)
+  TunedDisc tuned;             ///< report filled; written only if `success`
+  bool success = false;        ///< every requested stage succeeded
+  CalibrationResult result;    ///< the region fit
+  PerSpringResult per_spring;  ///< the per-spring stage (if requested and the region fit succeeded)
   bool per_spring_ran = false;
   Evaluation untuned_linear;  ///< thesis model, scales 1, linearised
   /// k6_tuned: the tuned file's model (per-spring when that stage ran); k6_region: the region fit.

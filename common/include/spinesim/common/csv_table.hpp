@@ -41,7 +41,8 @@ struct CsvTable {
   }
   /// Number in row r (0 = the first data row), column `name`; throws naming file, row, column.
   double number(std::size_t r, const std::string& name) const {
-    return to_double(text(r, name), path + ": row " + std::to_string(r + 1) + " column '" + name + "'");
+    return to_double(text(r, name),
+                     path + ": row " + std::to_string(r + 1) + " column '" + name + "'");
   }
   /// Index of the row whose `key_column` equals `key` (exact match); throws when absent.
   std::size_t find(const std::string& key_column, const std::string& key) const {

@@ -86,7 +86,8 @@ inline std::ifstream open_regular_file(const std::string& path, const std::strin
     return std::invalid_argument("cannot read " + what + " '" + path + "': " + cause);
   };
   struct stat st {};
-  if (::stat(path.c_str(), &st) != 0) throw refuse(errno == ENOENT ? "no such file" : std::strerror(errno));
+  if (::stat(path.c_str(), &st) != 0)
+    throw refuse(errno == ENOENT ? "no such file" : std::strerror(errno));
   if (!S_ISREG(st.st_mode)) throw refuse("it is " + path_kind(path) + ", not a regular file");
   if (std::size_t(st.st_size) > limits.max_bytes)
     throw refuse("it has " + std::to_string(st.st_size) + " bytes, more than the limit of " +
@@ -175,8 +176,8 @@ inline void require_known_keys(const nlohmann::json& j, const std::vector<std::s
     if (std::find(known.begin(), known.end(), item.key()) == known.end()) {
       std::string list;
       for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
-      throw std::invalid_argument(where + ": unknown field \"" + item.key() + "\" (known: " +
-                                  list + ")");
+      throw std::invalid_argument(where + ": unknown field \"" + item.key() + "\" (known: " + list +
+                                  ")");
     }
 }
 

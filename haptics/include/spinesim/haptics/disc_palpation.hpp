@@ -27,8 +27,8 @@
 #include "spinesim/haptics/renderer.hpp"
 #include "spinesim/haptics/triple_buffer.hpp"
 #include "spinesim/mss/model.hpp"
-#include "spinesim/mss/solver.hpp"
 #include "spinesim/mss/simulator.hpp"
+#include "spinesim/mss/solver.hpp"
 
 #include <Eigen/Core>
 

@@ -5,8 +5,8 @@
 #pragma once
 
 #include "spinesim/mss/model.hpp"
-#include "spinesim/mss/solver.hpp"
 #include "spinesim/mss/simulator.hpp"
+#include "spinesim/mss/solver.hpp"
 
 #include <functional>
 #include <memory>

@@ -12,8 +12,8 @@
 
 #include "spinesim/mesh/mesher.hpp"
 #include "spinesim/output/html_report.hpp"
-#include "spinesim/studies/toolkit.hpp"
 #include "spinesim/output/progress.hpp"
+#include "spinesim/studies/toolkit.hpp"
 
 #include <nlohmann/json.hpp>
 

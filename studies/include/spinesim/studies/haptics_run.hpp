@@ -6,10 +6,10 @@
 
 #include "spinesim/haptics/device.hpp"
 #include "spinesim/haptics/scene.hpp"
+#include "spinesim/haptics/scene_builder.hpp"
 #include "spinesim/haptics/servo.hpp"
 #include "spinesim/spine/seating.hpp"
 #include "spinesim/studies/disc_palpation_setup.hpp"
-#include "spinesim/haptics/scene_builder.hpp"
 
 #include <nlohmann/json.hpp>
 

@@ -29,8 +29,8 @@
 //                      compression (as `spinesim mss compare`; compression is a training case).
 #pragma once
 
-#include "spinesim/studies/calibration_summary.hpp"
 #include "spinesim/output/progress.hpp"
+#include "spinesim/studies/calibration_summary.hpp"
 #include "spinesim/studies/toolkit.hpp"
 
 #include "spinesim/fem/disc_fem.hpp"

@@ -10,8 +10,8 @@
 #include "spinesim/mesh/material.hpp"
 #include "spinesim/mss/boundary.hpp"
 #include "spinesim/mss/model.hpp"
-#include "spinesim/mss/solver.hpp"
 #include "spinesim/mss/simulator.hpp"
+#include "spinesim/mss/solver.hpp"
 #include "spinesim/output/progress.hpp"
 #include "spinesim/studies/toolkit.hpp"
 
@@ -65,7 +65,6 @@ struct MssRunRequest {
   int steps = 0;        ///< dynamic: number of steps (>= 1)
   int frame_every = 0;  ///< dynamic: a frame every K steps (0: about 100 frames)
 };
-
 
 struct MssRunResult {
   MssRunRequest request;

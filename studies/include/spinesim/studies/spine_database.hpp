@@ -6,10 +6,10 @@
 // solves of the model it names.
 #pragma once
 
+#include "spinesim/output/progress.hpp"
 #include "spinesim/spine/database.hpp"
 #include "spinesim/spine/equilibrium.hpp"
 #include "spinesim/spine/model.hpp"
-#include "spinesim/output/progress.hpp"
 #include "spinesim/studies/toolkit.hpp"
 
 #include <nlohmann/json.hpp>
@@ -25,7 +25,6 @@ namespace spinesim::studies {
 /// is input, so a malformed one — or one with no fits, which would answer every force with the
 /// baseline — is refused with std::invalid_argument (one line), not reported as a failed run.
 spine::DisplacementDatabase read_database(const std::string& path);
-
 
 /// The `source` recorded in a generated file: the model, the solver and the protocol.
 extern const char* const kDatabaseSource;

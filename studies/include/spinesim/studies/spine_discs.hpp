@@ -25,10 +25,10 @@
 #pragma once
 
 #include "spinesim/calibration/tuned_set.hpp"
+#include "spinesim/haptics/recording.hpp"
 #include "spinesim/mesh/structured_disc.hpp"
 #include "spinesim/mss/disc_set.hpp"
 #include "spinesim/spine/model.hpp"
-#include "spinesim/haptics/recording.hpp"
 
 #include <nlohmann/json.hpp>
 

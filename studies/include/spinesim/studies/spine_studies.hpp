@@ -39,8 +39,8 @@
 //   checked: MATCH or DIFFERS with our numbers.
 #pragma once
 
-#include "spinesim/spine/equilibrium.hpp"
 #include "spinesim/output/progress.hpp"
+#include "spinesim/spine/equilibrium.hpp"
 #include "spinesim/studies/toolkit.hpp"
 
 #include <Eigen/Core>

@@ -5,11 +5,11 @@
 
 #include "spinesim/mesh/tet_mesh.hpp"
 #include "spinesim/mss/model.hpp"
-#include "spinesim/mss/solver.hpp"
 #include "spinesim/mss/simulator.hpp"
+#include "spinesim/mss/solver.hpp"
 #include "spinesim/output/files.hpp"
-#include "spinesim/studies/toolkit.hpp"
 #include "spinesim/studies/mss_run.hpp"
+#include "spinesim/studies/toolkit.hpp"
 
 #include <nlohmann/json.hpp>
 
