@@ -11,7 +11,7 @@
 // field (mm) as VTU point data, with the pressure (MPa, --formulation mixed) and the annulus
 // fibre field as cell vectors (fibre-reinforced materials).
 #include "cli_common.hpp"
-#include "spinesim/studies/fem_report.hpp"
+#include "spinesim/studies/fem_reference.hpp"
 
 #include "spinesim/fem/load_cases.hpp"
 #include "spinesim/mesh/io.hpp"
@@ -48,7 +48,7 @@ void run_fem(const FemArgs& a) {
   const auto materials = mesh::load_material(a.material, data_dir());
   if (!a.out.empty()) require_output_folder(a.out, "--out");  // a device or FIFO before the solve
 
-  // 2. The mesh, then the driver (studies/fem_report.hpp).
+  // 2. The mesh, then the driver (studies/fem_reference.hpp).
   Progress progress(3 + int(!a.out.empty()), a.quiet || a.json);
   progress.begin("reading " + a.mesh_path);
   const mesh::TetMesh m = mesh::read_tet_mesh(a.mesh_path);

@@ -22,7 +22,7 @@
 #include "cli_common.hpp"
 #include "model_flags.hpp"
 
-#include "spinesim/studies/fem_report.hpp"
+#include "spinesim/studies/fem_reference.hpp"
 #include "spinesim/studies/mss_verbs.hpp"
 
 #include "spinesim/fem/load_cases.hpp"

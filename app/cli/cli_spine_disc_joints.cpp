@@ -5,7 +5,7 @@
 //   spinesim spine disc-joints --tuned shipped --out data/spine/disc_joints/tuned-mss.json
 #include "cli_common.hpp"
 #include "spinesim/studies/disc_joints.hpp"
-#include "spinesim/studies/fem_report.hpp"
+#include "spinesim/studies/fem_reference.hpp"
 
 #include "spinesim/calibration/tuned_set.hpp"
 #include "spinesim/mesh/material.hpp"

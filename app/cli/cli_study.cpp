@@ -37,7 +37,7 @@
 #include "model_flags.hpp"
 #include "spinesim/common/timer.hpp"
 #include "spinesim/studies/comparison_report.hpp"
-#include "spinesim/studies/fem_report.hpp"
+#include "spinesim/studies/fem_reference.hpp"
 #include "spinesim/studies/materials_study.hpp"
 #include "spinesim/studies/mss_run.hpp"
 #include "spinesim/studies/spine_studies.hpp"

@@ -5,7 +5,7 @@
 #include "cli_common.hpp"
 #include "spinesim/studies/disc_level.hpp"
 #include "spinesim/studies/disc_validation.hpp"
-#include "spinesim/studies/fem_report.hpp"
+#include "spinesim/studies/fem_reference.hpp"
 
 #include "spinesim/mesh/disc_geometry.hpp"
 #include "spinesim/mesh/io.hpp"

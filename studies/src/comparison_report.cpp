@@ -3,7 +3,7 @@
 #include "spinesim/output/format.hpp"
 #include "spinesim/output/json.hpp"
 #include "spinesim/output/table.hpp"
-#include "spinesim/studies/fem_report.hpp"
+#include "spinesim/studies/fem_reference.hpp"
 #include "spinesim/studies/toolkit.hpp"
 
 #include <iomanip>

@@ -22,7 +22,7 @@
 #include "spinesim/studies/comparison_report.hpp"
 #include "spinesim/studies/data.hpp"
 #include "spinesim/studies/disc_level.hpp"
-#include "spinesim/studies/fem_report.hpp"
+#include "spinesim/studies/fem_reference.hpp"
 #include "spinesim/studies/materials_study.hpp"
 #include "spinesim/studies/mesh_report.hpp"
 #include "spinesim/studies/probe_study.hpp"

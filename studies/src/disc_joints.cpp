@@ -10,7 +10,7 @@
 #include "spinesim/output/table.hpp"
 #include "spinesim/spine/model.hpp"
 #include "spinesim/studies/disc_level.hpp"
-#include "spinesim/studies/fem_report.hpp"
+#include "spinesim/studies/fem_reference.hpp"
 #include "spinesim/studies/toolkit.hpp"
 
 #include <algorithm>

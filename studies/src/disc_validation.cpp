@@ -6,7 +6,7 @@
 #include "spinesim/fem/load_cases.hpp"
 #include "spinesim/output/format.hpp"
 #include "spinesim/output/table.hpp"
-#include "spinesim/studies/fem_report.hpp"
+#include "spinesim/studies/fem_reference.hpp"
 #include "spinesim/studies/toolkit.hpp"
 
 #include <cmath>

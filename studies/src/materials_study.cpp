@@ -3,7 +3,7 @@
 #include "spinesim/common/timer.hpp"
 #include "spinesim/output/json.hpp"
 #include "spinesim/studies/comparison_report.hpp"
-#include "spinesim/studies/fem_report.hpp"
+#include "spinesim/studies/fem_reference.hpp"
 #include "spinesim/studies/mss_run.hpp"
 #include "spinesim/studies/stepped_study.hpp"
 #include "spinesim/studies/toolkit.hpp"

@@ -11,7 +11,7 @@
 #include "spinesim/spine/model.hpp"
 #include "spinesim/studies/disc_level.hpp"
 #include "spinesim/studies/drive_study.hpp"
-#include "spinesim/studies/fem_report.hpp"
+#include "spinesim/studies/fem_reference.hpp"
 #include "spinesim/studies/level_calibration.hpp"
 #include "spinesim/studies/mss_run.hpp"
 #include "spinesim/studies/spine_database.hpp"

@@ -1,4 +1,4 @@
-#include "spinesim/studies/fem_report.hpp"
+#include "spinesim/studies/fem_reference.hpp"
 #include "spinesim/common/constants.hpp"
 
 #include "spinesim/common/timer.hpp"
