@@ -18,9 +18,12 @@ import os
 import sys
 
 
-def fail(message):
+def fail(message, status=1):
+    """Exit 2 for a missing tool (the program warns and goes on), 1 for anything else (a read or
+    a write that failed, e.g. a full disk: the program fails, the figures it promised are not
+    all there)."""
     print(f"report: {message}; report.html not written", file=sys.stderr)
-    sys.exit(2)
+    sys.exit(status)
 
 
 try:
@@ -29,11 +32,11 @@ try:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 except ImportError:
-    fail("python3-matplotlib is missing (apt-get install python3-matplotlib)")
+    fail("python3-matplotlib is missing (apt-get install python3-matplotlib)", 2)
 try:
     import markdown
 except ImportError:
-    fail("python3-markdown is missing (apt-get install python3-markdown)")
+    fail("python3-markdown is missing (apt-get install python3-markdown)", 2)
 
 
 class Figure:
@@ -356,9 +359,11 @@ def main(argv):
         figures.append(fusion(d, s, d))
         figures.append(haptic_stroke(d, d))
         figures += viewer_screenshots(d)
-    except (OSError, ValueError, KeyError, TypeError, ZeroDivisionError) as e:
+        write_html(d, figures, report_md)
+    except OSError as e:  # a file that cannot be read or written (a full disk)
+        fail(f"cannot read or write in {d}: {e}")
+    except (ValueError, KeyError, TypeError, ZeroDivisionError) as e:
         fail(f"bad input in {d}: {type(e).__name__} {e}")
-    write_html(d, figures, report_md)
     print(f"report: {os.path.join(d, 'report.html')} with {len(figures)} figures in "
           f"{os.path.join(d, 'plots')}")
     return 0

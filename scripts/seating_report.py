@@ -17,9 +17,12 @@ import os
 import sys
 
 
-def fail(message):
+def fail(message, status=1):
+    """Exit 2 for a missing tool (the program warns and goes on), 1 for anything else (a read or
+    a write that failed, e.g. a full disk: the program fails, the figures it promised are not
+    all there)."""
     print(f"seating report: {message}; report.html not written", file=sys.stderr)
-    sys.exit(2)
+    sys.exit(status)
 
 
 try:
@@ -28,7 +31,7 @@ try:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 except ImportError:
-    fail("python3-matplotlib is missing (apt-get install python3-matplotlib)")
+    fail("python3-matplotlib is missing (apt-get install python3-matplotlib)", 2)
 
 
 def save(fig, d, name):
@@ -146,7 +149,9 @@ def main(argv):
             title = f"The spine in a chair: {chair_text(s)}"
             figures = [contacts(s, d), l5s1(s, d)]
             extra = ""
-    except (OSError, ValueError, KeyError, TypeError, IndexError) as e:
+    except OSError as e:  # a file that cannot be read or written (a full disk)
+        fail(f"cannot read or write in {d}: {e}")
+    except (ValueError, KeyError, TypeError, IndexError) as e:
         fail(f"bad input in {d}: {type(e).__name__} {e}")
     parts = ["<!DOCTYPE html><html><head><meta charset='utf-8'>",
              f"<title>{html.escape(title)}</title><style>body{{font-family:sans-serif;"
@@ -155,8 +160,11 @@ def main(argv):
              f"<h1>{html.escape(title)}</h1>"]
     parts += [f"<figure><img src='plots/{n}' alt='{n}'></figure>" for n in figures]
     parts.append(extra + "</body></html>")
-    with open(os.path.join(d, "report.html"), "w") as f:
-        f.write("\n".join(parts))
+    try:
+        with open(os.path.join(d, "report.html"), "w") as f:
+            f.write("\n".join(parts))
+    except OSError as e:
+        fail(f"cannot write in {d}: {e}")
     print(f"seating report: {os.path.join(d, 'report.html')} with {len(figures)} figures in "
           f"{os.path.join(d, 'plots')}")
     return 0

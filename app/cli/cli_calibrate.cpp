@@ -18,9 +18,6 @@
 #include "cli_common.hpp"
 #include "spinesim/studies/calibration_summary.hpp"
 
-#include "spinesim/studies/disc_level.hpp"
-#include "spinesim/studies/level_calibration.hpp"
-
 #include "spinesim/calibration/tuned_set.hpp"
 #include "spinesim/mesh/disc_geometry.hpp"
 #include "spinesim/mesh/io.hpp"
@@ -34,6 +31,7 @@
 #include <iomanip>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 namespace spinesim::cli {
@@ -70,10 +68,11 @@ std::vector<fem::LoadCase> other_cases(const std::vector<fem::LoadCase>& train) 
 }
 
 /// --level all: every level's parametric disc, one tuned set file (tuned_set.hpp), written only
-/// when every level succeeded (studies/level_calibration.hpp).
+/// when every level succeeded (calibration/levels.hpp).
 void run_all_levels(const CalibrateArgs& a, const CalibrationRequest& rq,
                     const mesh::RegionMaterials& materials) {
   AllLevelsRequest all;
+  all.data_dir = data_dir();
   all.calibration = rq;
   if (a.cell_size_option->count()) all.cell_size_mm = a.cell_size_mm;
   all.transfer = !a.no_transfer;
@@ -184,22 +183,14 @@ void run_calibrate(const CalibrateArgs& a) {
   if (!a.mesh_path.empty()) {
     status("reading " + a.mesh_path);
     m = mesh::read_tet_mesh(a.mesh_path);
-  } else if (a.structured) {
-    status("meshing " + a.level + " (structured)");
-    m = mesh_structured_level(a.level, mesh::StructuredDiscOptions());
-    mesh::StructuredDiscOptions finer;
-    finer.sectors += 4;
-    if (!a.no_transfer && a.transfer_meshes.empty())
-      rq.transfer_meshes.emplace_back("structured, " + std::to_string(finer.sectors) + " sectors",
-                                      mesh_structured_level(a.level, finer));
-  } else {
-    mesh::MeshOptions opt;
-    opt.cell_size_mm = a.cell_size_mm;
-    status("meshing " + a.level + " (cell size " + std::to_string(a.cell_size_mm).substr(0, 4) +
-           " mm)");
-    m = mesh_disc_level(a.level, opt);  // as `mesh disc --level`
-    if (!a.no_transfer && a.transfer_meshes.empty())
-      rq.transfer_meshes.push_back(coarser_level_mesh(a.level, opt, status));
+  } else {  // as `mesh disc --level [--structured]`
+    std::optional<mesh::StructuredDiscOptions> structured;
+    if (a.structured) structured.emplace();
+    calibration::LevelMeshes meshes =
+        calibration::mesh_level(a.level, structured, a.cell_size_mm,
+                                !a.no_transfer && a.transfer_meshes.empty(), data_dir(), status);
+    m = std::move(meshes.mesh);
+    for (auto& t : meshes.transfer) rq.transfer_meshes.push_back(std::move(t));
   }
 
   // 3. Calibrate, report, write only a successful result.

@@ -89,7 +89,7 @@ void run_mesh_disc(const MeshArgs& a) {
   }
   if (a.placement != "spine" && a.placement != "local")
     throw std::invalid_argument("--placement must be 'spine' or 'local'");
-  rq.placement = a.placement == "spine" ? DiscPlacement::spine : DiscPlacement::local;
+  rq.placement = a.placement == "spine" ? mesh::DiscPlacement::spine : mesh::DiscPlacement::local;
   rq.structured = a.structured;
   rq.structured_options = a.structured_opt;
   rq.structured_options.max_elements = a.max_elements;

@@ -28,7 +28,7 @@
 // function below, and add one line to register_study() at the end of this file.
 #include "cli_common.hpp"
 
-#include "spinesim/studies/disc_level.hpp"
+#include "spinesim/mesh/disc_level.hpp"
 #include "spinesim/studies/drive_study.hpp"
 #include "spinesim/studies/probe_study.hpp"
 
@@ -130,7 +130,7 @@ mesh::TetMesh study_mesh(const StudyCommon& c, Progress& progress) {
   mesh::MeshOptions opt;
   opt.cell_size_mm = c.cell_size_mm;
   progress.begin("meshing the " + dims.level + " disc");
-  mesh::TetMesh m = mesh_disc_level(dims.level, opt);
+  mesh::TetMesh m = mesh::mesh_disc_level(dims.level, opt, data_dir());
   progress.end(std::to_string(m.num_tets()) + " tets");
   return m;
 }

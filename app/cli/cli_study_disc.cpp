@@ -3,7 +3,7 @@
 //   spinesim study disc-validation [--level L4-L5] [--material fibre-reinforced]
 //       [--formulation mixed] [--mesh disc.vtu] [--cell-size 2] [--csv FILE] [--json]
 #include "cli_common.hpp"
-#include "spinesim/studies/disc_level.hpp"
+#include "spinesim/mesh/disc_level.hpp"
 #include "spinesim/studies/disc_validation.hpp"
 #include "spinesim/studies/fem_reference.hpp"
 
@@ -52,7 +52,7 @@ void run_disc_validation(const DiscValidationArgs& a) {
     label = a.mesh_path;
   } else {
     progress.begin("meshing the " + a.level + " disc");
-    m = mesh_disc_level(a.level, a.cell_size_mm);
+    m = mesh::mesh_disc_level(a.level, a.cell_size_mm, data_dir());
     label = a.level + " parametric disc, cell size " + std::to_string(a.cell_size_mm).substr(0, 4) +
             " mm";
   }

@@ -4,6 +4,7 @@
 #include "spinesim/output/table.hpp"
 #include "spinesim/studies/toolkit.hpp"
 
+#include <cmath>
 #include <iomanip>
 #include <iostream>
 
@@ -109,6 +110,27 @@ void print_calibration(std::ostream& os, const CalibrationOutcome& o,
   if (ps)
     os << "Per-spring multipliers: " << o.tuned.edge_multipliers.size()
        << " (this mesh only: `mss --params` refuses the file on any other mesh)\n";
+}
+
+void print_all_levels(std::ostream& os, const AllLevelsResult& r, const std::string& terms,
+                      double check_load_scale) {
+  TextTable table({"level", "tets", "train max (untuned>tuned)", "holdout max (untuned>tuned)",
+                   "K6 diag ratio (tuned, min-max)", "Ipopt its", "time (s)"});
+  const auto pair = [](double u, double t) {
+    return fixed(100 * u, 0) + ">" + fixed(100 * t, 1) + "%";
+  };
+  for (const auto& l : r.levels) {
+    if (!l.success) continue;
+    table.add({l.level, std::to_string(l.tets), pair(l.train_untuned, l.train_tuned),
+               std::isnan(l.holdout_untuned) ? std::string("-")
+                                             : pair(l.holdout_untuned, l.holdout_tuned),
+               fixed(l.k6_ratio_min, 3) + "-" + fixed(l.k6_ratio_max, 3),
+               std::to_string(l.iterations), fixed(l.seconds, 1)});
+  }
+  os << "Calibration of all " << r.set.levels.size() << " levels, material " << r.set.material_name
+     << ", terms " << terms << " (errors: relative nodal displacement, nonlinear check at loads x "
+     << check_load_scale << ")\n\n";
+  table.print(os, false);
 }
 
 }  // namespace spinesim::studies

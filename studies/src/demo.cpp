@@ -9,6 +9,7 @@
 #include "spinesim/fem/disc_fem.hpp"
 #include "spinesim/fem/load_cases.hpp"
 #include "spinesim/mesh/disc_geometry.hpp"
+#include "spinesim/mesh/disc_level.hpp"
 #include "spinesim/mesh/io.hpp"
 #include "spinesim/mesh/material.hpp"
 #include "spinesim/mesh/mesher.hpp"
@@ -21,7 +22,6 @@
 #include "spinesim/studies/calibration_summary.hpp"
 #include "spinesim/studies/comparison_report.hpp"
 #include "spinesim/studies/data.hpp"
-#include "spinesim/studies/disc_level.hpp"
 #include "spinesim/studies/fem_reference.hpp"
 #include "spinesim/studies/materials_study.hpp"
 #include "spinesim/studies/mesh_report.hpp"
@@ -114,7 +114,7 @@ void Demo::mesh_disc() {
   dims = mesh::disc_dimensions(rq.level, data_dir());
   hooks.begin_stage("meshing the " + dims.level + " disc");
   const Timer t;
-  m = mesh_disc_level(rq.level, rq.cell_size_mm);
+  m = mesh::mesh_disc_level(rq.level, rq.cell_size_mm, data_dir());
   mesh_seconds = t.seconds();
   hooks.end_stage(std::to_string(m.num_tets()) + " tets");
   quality = mesh::quality_report(m, mesh::parametric_disc_volume(dims));

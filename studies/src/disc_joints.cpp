@@ -6,10 +6,10 @@
 #include "spinesim/common/timer.hpp"
 #include "spinesim/fem/plate_stiffness.hpp"
 #include "spinesim/mesh/disc_geometry.hpp"
+#include "spinesim/mesh/disc_level.hpp"
 #include "spinesim/output/format.hpp"
 #include "spinesim/output/table.hpp"
 #include "spinesim/spine/model.hpp"
-#include "spinesim/studies/disc_level.hpp"
 #include "spinesim/studies/fem_reference.hpp"
 #include "spinesim/studies/toolkit.hpp"
 
@@ -58,7 +58,7 @@ DiscJointSet compute_disc_joints(const std::string& data_dir,
     if (!wanted(levels, joint.name)) continue;
     DiscJoint d = joint_entry(joint, data_dir);
     hooks.begin_stage(joint.name + " disc (cell " + fixed(d.cell_size_mm, 2) + " mm)");
-    const mesh::TetMesh m = mesh_disc_level(joint.name, d.cell_size_mm);
+    const mesh::TetMesh m = mesh::mesh_disc_level(joint.name, d.cell_size_mm, data_dir);
     d.tets = m.num_tets();
     d.plate_center_mm = fem::DiscFem::default_plate_center(m);
     fem::SolverOptions options;
@@ -91,7 +91,7 @@ DiscJointSet compute_tuned_disc_joints(const std::string& data_dir, const std::s
         tuned.settings["cell_size_mm"].contains(joint.name))
       d.cell_size_mm = tuned.settings["cell_size_mm"][joint.name].get<double>();
     hooks.begin_stage(joint.name + " tuned MSS (cell " + fixed(d.cell_size_mm, 2) + " mm)");
-    const mesh::TetMesh m = mesh_disc_level(joint.name, d.cell_size_mm);
+    const mesh::TetMesh m = mesh::mesh_disc_level(joint.name, d.cell_size_mm, data_dir);
     d.tets = m.num_tets();
     d.plate_center_mm = fem::DiscFem::default_plate_center(m);
     const mss::MssModel mss = calibration::build_tuned_model(td, m, td.materials());

@@ -1,9 +1,9 @@
 #include "spinesim/studies/disc_palpation_setup.hpp"
 
 #include "spinesim/calibration/tuned_set.hpp"
+#include "spinesim/mesh/disc_level.hpp"
 #include "spinesim/mss/boundary.hpp"
 #include "spinesim/output/format.hpp"
-#include "spinesim/studies/disc_level.hpp"
 #include "spinesim/studies/toolkit.hpp"
 
 #include <filesystem>
@@ -76,7 +76,7 @@ DiscSetup make_disc_setup(const DiscSceneRequest& request, const std::string& da
     if (stage) stage("meshing " + request.level + " at " + fixed(cell, 1) + " mm, timing its step");
     mesh::MeshOptions mo;
     mo.cell_size_mm = cell;
-    const mesh::TetMesh m = mesh_disc_level(request.level, mo);
+    const mesh::TetMesh m = mesh::mesh_disc_level(request.level, mo, data_dir);
     const calibration::TunedDisc tuned = calibration::read_tuned_for_mesh(s.tuned_file, &m);
     auto model = std::make_unique<mss::MssModel>(
         calibration::build_tuned_model(tuned, m, tuned.materials()));

@@ -90,16 +90,16 @@ double mesh_level(const MeshDiscRequest& r, const std::string& data_dir, const S
     hooks.begin_stage("meshing " + dims.level + " (structured, " + std::to_string(so.sectors) +
                       " sectors, " + std::to_string(so.rings) + " rings, " +
                       std::to_string(so.layers) + " layers)");
-    out.mesh = mesh_structured_level(dims.level, so, r.placement);
+    out.mesh = mesh::mesh_structured_level(dims.level, so, data_dir, r.placement);
   } else {
     hooks.begin_stage("meshing " + dims.level + " (cell size " +
                       std::to_string(r.cgal.cell_size_mm).substr(0, 4) + " mm)");
-    out.mesh = mesh_disc_level(dims.level, r.cgal, r.placement);
+    out.mesh = mesh::mesh_disc_level(dims.level, r.cgal, data_dir, r.placement);
   }
   out.mesh_seconds = t.seconds();
   hooks.end_stage(std::to_string(out.mesh.num_tets()) + " tets");
   out.disc = {{"level", dims.level},
-              {"placement", r.placement == DiscPlacement::spine ? "spine" : "local"}};
+              {"placement", r.placement == mesh::DiscPlacement::spine ? "spine" : "local"}};
   return mesh::parametric_disc_volume(dims);
 }
 

@@ -4,6 +4,7 @@
 #include "spinesim/common/timer.hpp"
 #include "spinesim/haptics/hybrid_spine.hpp"
 #include "spinesim/mesh/disc_geometry.hpp"
+#include "spinesim/mesh/disc_level.hpp"
 #include "spinesim/mss/boundary.hpp"
 #include "spinesim/mss/quantities.hpp"
 #include "spinesim/mss/simulator.hpp"
@@ -12,7 +13,7 @@
 #include "spinesim/output/format.hpp"
 #include "spinesim/output/table.hpp"
 #include "spinesim/spine/kinematics.hpp"
-#include "spinesim/studies/disc_level.hpp"
+#include "spinesim/studies/data.hpp"
 #include "spinesim/studies/toolkit.hpp"
 #include "spinesim/studies/vertebra_surfaces.hpp"
 
@@ -257,7 +258,7 @@ SpineDiscs build_spine_discs(const spine::SpineModel& model, const calibration::
   SpineDiscs d;
   for (const std::string& level : mesh::disc_levels()) {
     const calibration::TunedDisc& entry = calibration::tuned_level(tuned, level);
-    const mesh::TetMesh m = mesh_structured_level(level, options);
+    const mesh::TetMesh m = mesh::mesh_structured_level(level, options, studies::data_dir());
     const calibration::MeshFingerprint here = calibration::fingerprint(m);
     if (!(entry.mesh == here))
       throw std::invalid_argument(

@@ -288,3 +288,45 @@ TEST(ContractHoles, StrictRealTimeRunsFailOnMissedDeadlines) {
   expect_refused(run_spinesim("haptics run --scene plane --device null --max-missed 101"),
                  "--max-missed");
 }
+
+// A full disk, made for one process: its files may not grow past 16 KiB (sh's ulimit -f counts
+// 512-byte blocks; SIGXFSZ ignored, so that a write past the limit fails with EFBIG as one past a
+// full disk does).
+const char* const kFullDisk = "trap '' XFSZ; ulimit -f 32; ";
+
+// A recording that cannot be written whole is not kept under the output's name: the run fails
+// and names the recording, and no half file (ending mid-row) is left for `spine discs` to read.
+TEST(ContractHoles, ARecordingOnAFullDiskFailsAndLeavesNoHalfFile) {
+  const std::string rec = tmp("full-disk-rec.csv");
+  std::remove(rec.c_str());
+  const CliRun r = run_spinesim(
+      "haptics run --scene plane --device sim --duration 2 --no-realtime "
+      "--record " +
+          q(rec),
+      kFullDisk);
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_NE(r.err.find("--record " + rec), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("nothing kept"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(rec));
+  // The same run with room to write keeps a whole recording.
+  const CliRun ok = run_spinesim(
+      "haptics run --scene plane --device sim --duration 2 --no-realtime --record " + q(rec));
+  ASSERT_EQ(ok.status, 0) << ok.err;
+  EXPECT_GT(fs::file_size(rec), 16u * 1024);
+}
+
+// Plots that cannot be written fail the study's --out (the figures are part of what it
+// promises); the JSON and CSV, written first, are whole.
+TEST(ContractHoles, SeatingPlotsOnAFullDiskFailTheRun) {
+  const std::string out = tmp("full-disk-seating");
+  fs::remove_all(out);
+  // 40 KiB: the JSON (~34 kB) fits, the L5-S1 figure (~50 kB) does not.
+  const CliRun r =
+      run_spinesim("study seating --quiet --out " + q(out), "trap '' XFSZ; ulimit -f 80; ");
+  if (r.status == 0 && r.err.find("warning") != std::string::npos)
+    GTEST_SKIP() << "no plotting here (python3-matplotlib): " << r.err;
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_NE(r.err.find("--out " + out), std::string::npos) << r.err;
+  ASSERT_TRUE(fs::exists(fs::path(out) / "seating.json"));
+  EXPECT_NO_THROW(nlohmann::json::parse(slurp((fs::path(out) / "seating.json").string())));
+}

@@ -1,11 +1,13 @@
 // The 17 disc levels: sourced dimensions from data/disc_morphometry.csv and the disc frames
 // placed in the thesis spine (tables F.1/F.2).
 #include "spinesim/mesh/disc_geometry.hpp"
+#include "spinesim/mesh/disc_level.hpp"
 
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -135,3 +137,23 @@ TEST(DiscFrame, AxisRunsFromInferiorToSuperiorCentre) {
 }
 
 }  // namespace
+
+// A level meshed in the spine is the same mesh as the upright one, carried by the level's frame.
+TEST(DiscLevels, ALevelMeshedInTheSpineIsTheUprightMeshInItsFrame) {
+  using spinesim::mesh::DiscPlacement;
+  const auto local =
+      spinesim::mesh::mesh_structured_level("T12-L1", {}, kData, DiscPlacement::local);
+  const auto placed = spinesim::mesh::mesh_structured_level("T12-L1", {}, kData);
+  const auto frame = disc_frame_in_spine("T12-L1", kData);
+  ASSERT_EQ(local.num_vertices(), placed.num_vertices());
+  ASSERT_TRUE((local.T.array() == placed.T.array()).all());
+  double worst = 0;
+  for (Eigen::Index i = 0; i < local.num_vertices(); ++i) {
+    const Eigen::Vector3d mapped = frame.origin_mm + frame.axes * local.V.row(i).transpose();
+    worst = std::max(worst, (mapped - placed.V.row(i).transpose()).norm());
+  }
+  EXPECT_LT(worst, 1e-9);
+  EXPECT_TRUE(local.frame.axes.isIdentity());
+  EXPECT_TRUE(placed.frame.axes.isApprox(frame.axes));
+  EXPECT_THROW(spinesim::mesh::disc_level_frame("T12-L2", kData), std::invalid_argument);
+}

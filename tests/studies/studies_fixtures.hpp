@@ -2,9 +2,9 @@
 // per level and test program) and material presets.
 #pragma once
 
+#include "spinesim/mesh/disc_level.hpp"
 #include "spinesim/mesh/material.hpp"
 #include "spinesim/mesh/tet_mesh.hpp"
-#include "spinesim/studies/disc_level.hpp"
 
 #include <map>
 #include <string>
@@ -15,7 +15,8 @@ namespace spinesim::test {
 inline const mesh::TetMesh& structured(const std::string& level) {
   static std::map<std::string, mesh::TetMesh> cache;
   auto it = cache.find(level);
-  if (it == cache.end()) it = cache.emplace(level, studies::mesh_structured_level(level, {})).first;
+  if (it == cache.end())
+    it = cache.emplace(level, mesh::mesh_structured_level(level, {}, SPINESIM_DATA_DIR)).first;
   return it->second;
 }
 

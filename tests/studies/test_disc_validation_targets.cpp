@@ -1,7 +1,7 @@
 // In-vitro disc behaviour the fibre-reinforced FEM disc does NOT reproduce yet (measured, not
 // loosened; `spinesim study disc-validation`, docs/disc-model.md "Validation"). Label `targets`:
 // left out of the default run; `ctest --test-dir build/release -L targets`.
-#include "spinesim/studies/disc_level.hpp"
+#include "spinesim/mesh/disc_level.hpp"
 #include "spinesim/studies/disc_validation.hpp"
 #include "studies_fixtures.hpp"
 
@@ -11,7 +11,7 @@ using namespace spinesim;
 using namespace spinesim::studies;
 
 TEST(DiscValidationTargets, L4L5FibreReinforcedDiscInsideEveryInVitroWindow) {
-  const mesh::TetMesh m = mesh_disc_level("L4-L5", 2.0);
+  const mesh::TetMesh m = mesh::mesh_disc_level("L4-L5", 2.0, SPINESIM_DATA_DIR);
   const DiscValidationResult r = run_disc_validation(
       m, test::material("fibre-reinforced"), fem::Formulation::mixed,
       read_disc_targets(std::string(SPINESIM_DATA_DIR) + "/validation/disc_in_vitro.json"),

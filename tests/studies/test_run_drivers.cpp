@@ -2,6 +2,7 @@
 // called directly: their results against independent solves and physical expectations.
 #include "spinesim/fem/disc_fem.hpp"
 #include "spinesim/fem/load_cases.hpp"
+#include "spinesim/mesh/disc_level.hpp"
 #include "spinesim/mesh/material.hpp"
 #include "spinesim/mesh/rigid_plate.hpp"
 #include "spinesim/mss/model.hpp"
@@ -9,10 +10,8 @@
 #include "spinesim/mss/solver.hpp"
 #include "spinesim/output/files.hpp"
 #include "spinesim/spine/model.hpp"
-#include "spinesim/studies/disc_level.hpp"
 #include "spinesim/studies/drive_study.hpp"
 #include "spinesim/studies/fem_reference.hpp"
-#include "spinesim/studies/level_calibration.hpp"
 #include "spinesim/studies/mss_run.hpp"
 #include "spinesim/studies/spine_database.hpp"
 #include "spinesim/studies/toolkit.hpp"
@@ -217,53 +216,6 @@ TEST(DriveStudyDriver, PolyethyleneResistsMoreThanTheDiscAndTheFilesMatchTheRun)
   studies::DriveStudyRequest none = rq;
   none.materials.clear();
   EXPECT_THROW(studies::run_drive_study(m, none), std::invalid_argument);
-}
-
-// --- calibration of every level ------------------------------------------------------------------
-
-TEST(LevelCalibrationDriver, OneLevelGoesIntoTheSetWithItsSettings) {
-  studies::AllLevelsRequest rq;
-  rq.levels = {"T7-T8"};
-  rq.cell_size_mm = 3.0;
-  rq.transfer = false;
-  rq.calibration.train = {fem::load_case("compression"), fem::load_case("flexion")};
-  rq.calibration.holdout = {fem::load_case("torsion")};
-  rq.calibration.fem_order = 1;
-  rq.calibration.nonlinear_check = false;
-  rq.generated_by = "test";
-  int reports = 0;
-  const studies::AllLevelsResult r = studies::calibrate_all_levels(
-      material("real-disc"), rq, [&reports](int, const std::string&) { ++reports; });
-  ASSERT_EQ(r.failed(), "");
-  ASSERT_EQ(r.levels.size(), 1u);
-  EXPECT_GT(reports, 0);
-  const auto& row = r.levels[0];
-  EXPECT_TRUE(row.success);
-  EXPECT_GT(row.tets, 0);
-  EXPECT_EQ(row.cell_size_mm, 3.0);
-  EXPECT_LT(row.train_tuned, row.train_untuned);
-  EXPECT_LE(row.k6_ratio_min, row.k6_ratio_max);
-  ASSERT_EQ(r.set.levels.count("T7-T8"), 1u);
-  EXPECT_EQ(r.set.settings["cell_size_mm"]["T7-T8"].get<double>(), 3.0);
-  EXPECT_EQ(r.set.settings["cell_size_rule"], "as given");
-  EXPECT_EQ(r.set.generated_by, "test");
-  EXPECT_EQ(r.set.material_name, "real-disc");
-
-  studies::AllLevelsRequest unknown = rq;
-  unknown.levels = {"T7-T9"};
-  EXPECT_THROW(studies::calibrate_all_levels(material("real-disc"), unknown),
-               std::invalid_argument);
-  studies::AllLevelsRequest per_spring = rq;
-  per_spring.calibration.per_spring = true;
-  EXPECT_THROW(studies::calibrate_all_levels(material("real-disc"), per_spring),
-               std::invalid_argument);
-}
-
-TEST(LevelCalibrationDriver, DefaultCellSizeGivesThinDiscsFiveCellsThroughTheirHeight) {
-  for (const std::string& level : {"T1-T2", "T7-T8", "L4-L5"}) {
-    const double h = mesh::disc_dimensions(level, SPINESIM_DATA_DIR).height_mm;
-    EXPECT_DOUBLE_EQ(studies::default_level_cell_size_mm(level), std::min(2.0, h / 5));
-  }
 }
 
 // --- the displacement-force database -------------------------------------------------------------

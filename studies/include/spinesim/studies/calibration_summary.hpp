@@ -5,12 +5,16 @@
 #include "spinesim/studies/comparison_report.hpp"
 #include "spinesim/studies/mss_run.hpp"
 
+#include "spinesim/calibration/levels.hpp"
 #include "spinesim/calibration/protocol.hpp"
 
 #include <ostream>
 
 namespace spinesim::studies {
 
+using calibration::AllLevelsRequest;
+using calibration::AllLevelsResult;
+using calibration::calibrate_all_levels;
 using calibration::calibrate_disc;
 using calibration::CalibrationOutcome;
 using calibration::CalibrationRequest;
@@ -30,5 +34,10 @@ mss::MssModel tuned_model(const calibration::TunedDisc& tuned, const mesh::TetMe
 /// per-spring when that stage ran), K6 diagonals, Ipopt.
 void print_calibration(std::ostream& os, const CalibrationOutcome& o,
                        const CalibrationRequest& request);
+
+/// The table of `calibrate --level all`: tets, train and held-out worst errors (untuned >
+/// tuned), K6 ratio range, Ipopt iterations and time per level.
+void print_all_levels(std::ostream& os, const AllLevelsResult& r, const std::string& terms,
+                      double check_load_scale);
 
 }  // namespace spinesim::studies

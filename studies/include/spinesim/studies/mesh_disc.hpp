@@ -3,12 +3,12 @@
 // the VTU (with an optional Medit copy) written both or neither.
 #pragma once
 
+#include "spinesim/mesh/disc_level.hpp"
 #include "spinesim/mesh/io.hpp"
 #include "spinesim/mesh/mesher.hpp"
 #include "spinesim/mesh/quality.hpp"
 #include "spinesim/mesh/structured_disc.hpp"
 #include "spinesim/output/progress.hpp"
-#include "spinesim/studies/disc_level.hpp"
 #include "spinesim/studies/toolkit.hpp"
 
 #include <nlohmann/json.hpp>
@@ -22,8 +22,8 @@ struct MeshDiscRequest {
   std::string inferior, superior;  ///< two vertebra (or endplate) surface files
   double surface_mm_per_unit = 1;  ///< the surface files' length unit, mm
   mesh::UpAxis up = mesh::UpAxis::y;
-  DiscPlacement placement = DiscPlacement::spine;  ///< of a parametric level
-  bool structured = false;                         ///< the structured sweep, not CGAL
+  mesh::DiscPlacement placement = mesh::DiscPlacement::spine;  ///< of a parametric level
+  bool structured = false;                                     ///< the structured sweep, not CGAL
   mesh::StructuredDiscOptions structured_options;
   mesh::MeshOptions cgal;
   std::string out, medit;  ///< the VTU, and an optional Medit copy

@@ -33,9 +33,6 @@ struct SpineSolveRun {
   double model_seconds = 0, total_seconds = 0;
 };
 
-/// One line per load beyond the validated 600 N (to warn before solving).
-std::vector<std::string> force_warnings(const std::vector<spine::ExternalLoad>& loads);
-
 /// Loads the model and solves. Throws std::runtime_error "the spine did not reach equilibrium: …"
 /// (one line) when Newton fails; the solution's own warnings are in solution.warnings.
 SpineSolveRun run_spine_solve(const std::string& data_dir, const SpineSolveRequest& request);

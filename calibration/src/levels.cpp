@@ -1,33 +1,55 @@
-#include "spinesim/studies/level_calibration.hpp"
+#include "spinesim/calibration/levels.hpp"
 
 #include "spinesim/mesh/disc_geometry.hpp"
-#include "spinesim/output/format.hpp"
-#include "spinesim/output/table.hpp"
-#include "spinesim/studies/data.hpp"
-#include "spinesim/studies/disc_level.hpp"
-#include "spinesim/studies/toolkit.hpp"
+#include "spinesim/mesh/disc_level.hpp"
 
 #include <algorithm>
 #include <iomanip>
 #include <sstream>
 #include <stdexcept>
 
-namespace spinesim::studies {
+namespace spinesim::calibration {
 
 std::pair<std::string, mesh::TetMesh> coarser_level_mesh(const std::string& level,
                                                          mesh::MeshOptions options,
+                                                         const std::string& data_dir,
                                                          const StatusLine& status) {
-  const mesh::DiscDimensions dims = mesh::disc_dimensions(level, data_dir());
+  const mesh::DiscDimensions dims = mesh::disc_dimensions(level, data_dir);
   options.cell_size_mm *= 1.5;
   std::ostringstream label;
   label << "parametric " << dims.level << ", cell size " << std::setprecision(3)
         << options.cell_size_mm << " mm";
   if (status) status("meshing the second resolution: " + label.str());
-  return {label.str(), mesh_disc_level(dims.level, options)};
+  return {label.str(), mesh::mesh_disc_level(dims.level, options, data_dir)};
 }
 
-double default_level_cell_size_mm(const std::string& level) {
-  return std::min(2.0, mesh::disc_dimensions(level, data_dir()).height_mm / 5.0);
+double default_level_cell_size_mm(const std::string& level, const std::string& data_dir) {
+  return std::min(2.0, mesh::disc_dimensions(level, data_dir).height_mm / 5.0);
+}
+
+LevelMeshes mesh_level(const std::string& level,
+                       const std::optional<mesh::StructuredDiscOptions>& structured,
+                       double cell_size_mm, bool transfer, const std::string& data_dir,
+                       const StatusLine& status) {
+  LevelMeshes out;
+  if (structured) {
+    if (status) status("meshing " + level + " (structured)");
+    out.mesh = mesh::mesh_structured_level(level, *structured, data_dir);
+    mesh::StructuredDiscOptions finer = *structured;
+    finer.sectors += 4;
+    if (transfer)
+      out.transfer.emplace_back("structured, " + std::to_string(finer.sectors) + " sectors",
+                                mesh::mesh_structured_level(level, finer, data_dir));
+    return out;
+  }
+  mesh::MeshOptions options;
+  options.cell_size_mm = cell_size_mm;
+  if (status)
+    status("meshing " + level + " (cell size " + std::to_string(cell_size_mm).substr(0, 4) +
+           " mm)");
+  out.mesh = mesh::mesh_disc_level(level, options, data_dir);
+  if (transfer) out.transfer.push_back(coarser_level_mesh(level, options, data_dir, status));
+  return out;
 }
 
 std::string AllLevelsResult::failed() const {
@@ -82,7 +104,8 @@ AllLevelsResult calibrate_all_levels(const mesh::RegionMaterials& materials,
         "other meshes");
   const std::vector<std::string>& levels =
       request.levels.empty() ? mesh::disc_levels() : request.levels;
-  for (const auto& level : levels) mesh::disc_dimensions(level, data_dir());  // known levels
+  const std::string& data_dir = request.data_dir;
+  for (const auto& level : levels) mesh::disc_dimensions(level, data_dir);  // known levels
 
   AllLevelsResult r;
   r.set.material_name = materials.name;
@@ -111,29 +134,17 @@ AllLevelsResult calibrate_all_levels(const mesh::RegionMaterials& materials,
     const StatusLine status = [&](const std::string& s) {
       if (progress) progress(done, level + ": " + s);
     };
-    CalibrationRequest level_rq = rq;
-    mesh::TetMesh m;
     LevelCalibration row;
-    if (request.structured) {
-      status("meshing (structured)");
-      m = mesh_structured_level(level, *request.structured);
-      mesh::StructuredDiscOptions finer = *request.structured;
-      finer.sectors += 4;
-      if (request.transfer)
-        level_rq.transfer_meshes.emplace_back(
-            "structured, " + std::to_string(finer.sectors) + " sectors",
-            mesh_structured_level(level, finer));
-    } else {
-      mesh::MeshOptions opt;
-      opt.cell_size_mm =
-          request.cell_size_mm ? *request.cell_size_mm : default_level_cell_size_mm(level);
-      cell_by_level[level] = opt.cell_size_mm;
-      row.cell_size_mm = opt.cell_size_mm;
-      status("meshing (cell size " + std::to_string(opt.cell_size_mm).substr(0, 4) + " mm)");
-      m = mesh_disc_level(level, opt);
-      if (request.transfer)
-        level_rq.transfer_meshes.push_back(coarser_level_mesh(level, opt, status));
+    if (!request.structured) {
+      row.cell_size_mm = request.cell_size_mm ? *request.cell_size_mm
+                                              : default_level_cell_size_mm(level, data_dir);
+      cell_by_level[level] = row.cell_size_mm;
     }
+    LevelMeshes meshes =
+        mesh_level(level, request.structured, row.cell_size_mm, request.transfer, data_dir, status);
+    const mesh::TetMesh& m = meshes.mesh;
+    CalibrationRequest level_rq = rq;
+    level_rq.transfer_meshes = std::move(meshes.transfer);
     const CalibrationOutcome o = calibrate_disc(m, materials, level_rq, status);
     ++done;
     row.level = level;
@@ -146,25 +157,4 @@ AllLevelsResult calibrate_all_levels(const mesh::RegionMaterials& materials,
   return r;
 }
 
-void print_all_levels(std::ostream& os, const AllLevelsResult& r, const std::string& terms,
-                      double check_load_scale) {
-  TextTable table({"level", "tets", "train max (untuned>tuned)", "holdout max (untuned>tuned)",
-                   "K6 diag ratio (tuned, min-max)", "Ipopt its", "time (s)"});
-  const auto pair = [](double u, double t) {
-    return fixed(100 * u, 0) + ">" + fixed(100 * t, 1) + "%";
-  };
-  for (const auto& l : r.levels) {
-    if (!l.success) continue;
-    table.add({l.level, std::to_string(l.tets), pair(l.train_untuned, l.train_tuned),
-               std::isnan(l.holdout_untuned) ? std::string("-")
-                                             : pair(l.holdout_untuned, l.holdout_tuned),
-               fixed(l.k6_ratio_min, 3) + "-" + fixed(l.k6_ratio_max, 3),
-               std::to_string(l.iterations), fixed(l.seconds, 1)});
-  }
-  os << "Calibration of all " << r.set.levels.size() << " levels, material " << r.set.material_name
-     << ", terms " << terms << " (errors: relative nodal displacement, nonlinear check at loads x "
-     << check_load_scale << ")\n\n";
-  table.print(os, false);
-}
-
-}  // namespace spinesim::studies
+}  // namespace spinesim::calibration

@@ -1,36 +1,49 @@
-// Calibrating every disc level of the spine (`spinesim calibrate --level all`): each level's
-// parametric disc meshed as `mesh disc --level` does, calibrated by calibrate_disc, checked on a
-// second resolution (1.5x the cell size), gathered into one tuned set (calibration/tuned_set.hpp)
-// that is only complete when every level succeeded.
+// The calibration protocol over every disc level of the spine (`spinesim calibrate --level all`):
+// each level's parametric disc meshed as `mesh disc --level` does (mesh/disc_level.hpp),
+// calibrated by calibrate_disc, checked on a second resolution (1.5x the cell size), gathered into
+// one tuned set (tuned_set.hpp) that is only complete when every level succeeded.
 #pragma once
 
-#include "spinesim/studies/calibration_summary.hpp"
-
+#include "spinesim/calibration/protocol.hpp"
 #include "spinesim/calibration/tuned_set.hpp"
 #include "spinesim/mesh/mesher.hpp"
 #include "spinesim/mesh/structured_disc.hpp"
 
 #include <functional>
 #include <optional>
-#include <ostream>
 #include <string>
 #include <utility>
 #include <vector>
 
-namespace spinesim::studies {
+namespace spinesim::calibration {
 
 /// The protocol's second mesh resolution for a level's parametric disc: the same disc at 1.5x
 /// `options`' cell size, with a label naming it.
 std::pair<std::string, mesh::TetMesh> coarser_level_mesh(const std::string& level,
                                                          mesh::MeshOptions options,
+                                                         const std::string& data_dir,
                                                          const StatusLine& status = StatusLine());
 
 /// The cell size of a level's disc when none is given: min(2 mm, disc height / 5), so that the
 /// thin thoracic discs (4.5-7 mm) get at least five cells through their height (at 2 mm the
 /// fitted MSS stays much further off the FEM there: calibration/README.md).
-double default_level_cell_size_mm(const std::string& level);
+double default_level_cell_size_mm(const std::string& level, const std::string& data_dir);
+
+/// A level's disc as the protocol meshes it, and its second resolution for the transfer check.
+struct LevelMeshes {
+  mesh::TetMesh mesh;
+  std::vector<std::pair<std::string, mesh::TetMesh>> transfer;  ///< empty unless asked for
+};
+
+/// The structured disc of `structured` (second resolution: 4 more sectors) when set, else the
+/// CGAL disc at `cell_size_mm` (second resolution: coarser_level_mesh).
+LevelMeshes mesh_level(const std::string& level,
+                       const std::optional<mesh::StructuredDiscOptions>& structured,
+                       double cell_size_mm, bool transfer, const std::string& data_dir,
+                       const StatusLine& status = StatusLine());
 
 struct AllLevelsRequest {
+  std::string data_dir;                ///< the morphometry's folder (disc_morphometry.csv)
   CalibrationRequest calibration;      ///< per level; its transfer_meshes must be empty
   std::optional<double> cell_size_mm;  ///< every level's; default: default_level_cell_size_mm
   bool transfer = true;                ///< check each level on its second resolution
@@ -57,7 +70,7 @@ struct LevelCalibration {
 };
 
 struct AllLevelsResult {
-  calibration::TunedSet set;  ///< the successful levels
+  TunedSet set;  ///< the successful levels
   std::vector<LevelCalibration> levels;
   /// "T7-T8 (Maximum_Iterations_Exceeded), ..."; empty when every level succeeded.
   std::string failed() const;
@@ -71,9 +84,4 @@ AllLevelsResult calibrate_all_levels(const mesh::RegionMaterials& materials,
                                      const AllLevelsRequest& request,
                                      const LevelProgress& progress = LevelProgress());
 
-/// The table: tets, train and held-out worst errors (untuned > tuned), K6 ratio range, Ipopt
-/// iterations and time per level.
-void print_all_levels(std::ostream& os, const AllLevelsResult& r, const std::string& terms,
-                      double check_load_scale);
-
-}  // namespace spinesim::studies
+}  // namespace spinesim::calibration
