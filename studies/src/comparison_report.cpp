@@ -1,8 +1,5 @@
 #include "spinesim/studies/comparison_report.hpp"
 
-#include "spinesim/output/format.hpp"
-#include "spinesim/output/json.hpp"
-#include "spinesim/output/table.hpp"
 #include "spinesim/studies/fem_reference.hpp"
 #include "spinesim/studies/toolkit.hpp"
 

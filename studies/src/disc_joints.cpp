@@ -7,8 +7,6 @@
 #include "spinesim/fem/plate_stiffness.hpp"
 #include "spinesim/mesh/disc_geometry.hpp"
 #include "spinesim/mesh/disc_level.hpp"
-#include "spinesim/output/format.hpp"
-#include "spinesim/output/table.hpp"
 #include "spinesim/spine/model.hpp"
 #include "spinesim/studies/fem_reference.hpp"
 #include "spinesim/studies/toolkit.hpp"

@@ -3,7 +3,6 @@
 #include "spinesim/calibration/tuned_set.hpp"
 #include "spinesim/mesh/disc_level.hpp"
 #include "spinesim/mss/boundary.hpp"
-#include "spinesim/output/format.hpp"
 #include "spinesim/studies/toolkit.hpp"
 
 #include <filesystem>

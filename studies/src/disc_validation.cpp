@@ -4,8 +4,6 @@
 #include "spinesim/common/input_file.hpp"
 #include "spinesim/common/timer.hpp"
 #include "spinesim/fem/load_cases.hpp"
-#include "spinesim/output/format.hpp"
-#include "spinesim/output/table.hpp"
 #include "spinesim/studies/fem_reference.hpp"
 #include "spinesim/studies/toolkit.hpp"
 

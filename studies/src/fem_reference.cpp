@@ -4,9 +4,6 @@
 #include "spinesim/common/timer.hpp"
 #include "spinesim/mesh/io.hpp"
 
-#include "spinesim/output/format.hpp"
-#include "spinesim/output/json.hpp"
-#include "spinesim/output/table.hpp"
 #include "spinesim/studies/toolkit.hpp"
 
 #include <cmath>

@@ -3,9 +3,6 @@
 
 #include "spinesim/common/timer.hpp"
 #include "spinesim/haptics/recording.hpp"
-#include "spinesim/output/files.hpp"
-#include "spinesim/output/format.hpp"
-#include "spinesim/output/table.hpp"
 #include "spinesim/spine/database.hpp"
 #include "spinesim/spine/kinematics.hpp"
 #include "spinesim/studies/toolkit.hpp"

@@ -3,7 +3,6 @@
 
 #include "spinesim/common/timer.hpp"
 #include "spinesim/haptics/renderer.hpp"
-#include "spinesim/output/format.hpp"
 #include "spinesim/studies/toolkit.hpp"
 
 #include <cmath>

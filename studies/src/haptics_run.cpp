@@ -9,9 +9,6 @@
 #include "spinesim/haptics/recording.hpp"
 #include "spinesim/haptics/renderer.hpp"
 #include "spinesim/mesh/vertebra_geometry.hpp"
-#include "spinesim/output/files.hpp"
-#include "spinesim/output/format.hpp"
-#include "spinesim/output/table.hpp"
 #include "spinesim/studies/disc_palpation_setup.hpp"
 #include "spinesim/studies/toolkit.hpp"
 

@@ -1,7 +1,6 @@
 #include "spinesim/studies/materials_study.hpp"
 
 #include "spinesim/common/timer.hpp"
-#include "spinesim/output/json.hpp"
 #include "spinesim/studies/comparison_report.hpp"
 #include "spinesim/studies/fem_reference.hpp"
 #include "spinesim/studies/mss_run.hpp"

@@ -4,8 +4,6 @@
 #include "spinesim/common/timer.hpp"
 #include "spinesim/mesh/disc_geometry.hpp"
 #include "spinesim/mesh/vertebra_disc.hpp"
-#include "spinesim/output/files.hpp"
-#include "spinesim/output/format.hpp"
 #include "spinesim/studies/mesh_report.hpp"
 #include "spinesim/studies/toolkit.hpp"
 

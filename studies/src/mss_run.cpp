@@ -4,9 +4,6 @@
 #include "spinesim/calibration/tuned_disc.hpp"
 #include "spinesim/common/timer.hpp"
 #include "spinesim/mss/quantities.hpp"
-#include "spinesim/output/files.hpp"
-#include "spinesim/output/format.hpp"
-#include "spinesim/output/json.hpp"
 #include "spinesim/studies/fem_reference.hpp"
 #include "spinesim/studies/toolkit.hpp"
 

@@ -6,8 +6,6 @@
 #include "spinesim/fem/disc_fem.hpp"
 #include "spinesim/mesh/io.hpp"
 #include "spinesim/mss/quantities.hpp"
-#include "spinesim/output/files.hpp"
-#include "spinesim/output/json.hpp"
 #include "spinesim/studies/calibration_summary.hpp"
 #include "spinesim/studies/toolkit.hpp"
 

@@ -4,9 +4,6 @@
 #include "spinesim/mesh/io.hpp"
 #include "spinesim/mss/boundary.hpp"
 #include "spinesim/mss/quantities.hpp"
-#include "spinesim/output/files.hpp"
-#include "spinesim/output/format.hpp"
-#include "spinesim/output/json.hpp"
 #include "spinesim/studies/toolkit.hpp"
 
 #include <algorithm>

@@ -1,8 +1,6 @@
 // The seating sweep and the seated spine beside in-vivo data (seating_study.hpp; docs/seating.md).
 #include "spinesim/common/input_file.hpp"
 #include "spinesim/common/timer.hpp"
-#include "spinesim/output/format.hpp"
-#include "spinesim/output/table.hpp"
 #include "spinesim/studies/seating_study.hpp"
 #include "spinesim/studies/toolkit.hpp"
 

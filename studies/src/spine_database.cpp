@@ -1,7 +1,5 @@
 #include "spinesim/studies/spine_database.hpp"
 
-#include "spinesim/output/format.hpp"
-#include "spinesim/output/table.hpp"
 #include "spinesim/studies/toolkit.hpp"
 
 #include <algorithm>

@@ -9,9 +9,6 @@
 #include "spinesim/mss/quantities.hpp"
 #include "spinesim/mss/simulator.hpp"
 #include "spinesim/mss/solver.hpp"
-#include "spinesim/output/files.hpp"
-#include "spinesim/output/format.hpp"
-#include "spinesim/output/table.hpp"
 #include "spinesim/spine/kinematics.hpp"
 #include "spinesim/studies/data.hpp"
 #include "spinesim/studies/toolkit.hpp"
@@ -157,12 +154,11 @@ std::string motion_header(const std::string& recording) {
 
 /// One frame of the series: the discs (part 0) and, if given, the vertebrae (part 1).
 void add_frame(VtuSeries& series, CombinedDiscs& discs, const mss::DiscSet& set,
-               CombinedVertebrae* vertebrae, const spine::SpineModel& m, const DragFrame& f) {
-  series.add(f.t_s, 0, [&](const std::string& p) { write_discs_frame(p, discs, set); });
+               CombinedVertebrae* vertebrae, double t_s, const std::vector<spine::Pose>& poses) {
+  series.add(t_s, 0, [&](const std::string& p) { write_discs_frame(p, discs, set); });
   if (vertebrae)
-    series.add(f.t_s, 1, [&](const std::string& p) {
-      write_vertebrae_frame(p, *vertebrae, frame_poses(m, f));
-    });
+    series.add(t_s, 1,
+               [&](const std::string& p) { write_vertebrae_frame(p, *vertebrae, poses); });
 }
 
 void check(const SpineDiscsRequest& r) {
@@ -347,7 +343,7 @@ SpineDiscsResult run_spine_discs(const SpineDiscsRequest& request, const std::st
     if (frame) {
       next_frame = f.t_s + request.frame_period_s;
       add_frame(series, all_discs, set, request.vertebra_triangles > 0 ? &all_vertebrae : nullptr,
-                model, f);
+                f.t_s, poses);
       ++r.frames;
     }
     if (progress && (k % 100 == 0 || k == n - 1)) progress(k + 1, n);

@@ -1,9 +1,6 @@
 #include "spinesim/studies/spine_solve.hpp"
 
 #include "spinesim/common/timer.hpp"
-#include "spinesim/output/format.hpp"
-#include "spinesim/output/json.hpp"
-#include "spinesim/output/table.hpp"
 #include "spinesim/studies/spine_studies.hpp"
 #include "spinesim/studies/toolkit.hpp"
 

@@ -6,9 +6,6 @@
 #include "spinesim/common/input_file.hpp"
 
 #include "spinesim/common/timer.hpp"
-#include "spinesim/output/format.hpp"
-#include "spinesim/output/json.hpp"
-#include "spinesim/output/table.hpp"
 #include "spinesim/studies/toolkit.hpp"
 
 #include "spinesim/spine/kinematics.hpp"

@@ -1,9 +1,6 @@
 #include "spinesim/studies/vertebra_surfaces.hpp"
 
 #include "spinesim/common/timer.hpp"
-#include "spinesim/output/files.hpp"
-#include "spinesim/output/format.hpp"
-#include "spinesim/output/table.hpp"
 #include "spinesim/studies/toolkit.hpp"
 
 #include <filesystem>

@@ -11,8 +11,6 @@
 #pragma once
 
 #include "spinesim/mesh/mesher.hpp"
-#include "spinesim/output/html_report.hpp"
-#include "spinesim/output/progress.hpp"
 #include "spinesim/studies/toolkit.hpp"
 
 #include <nlohmann/json.hpp>

@@ -14,7 +14,6 @@
 
 #include "spinesim/fem/disc_fem.hpp"
 #include "spinesim/mesh/material.hpp"
-#include "spinesim/output/progress.hpp"
 #include "spinesim/studies/toolkit.hpp"
 
 #include <Eigen/Core>

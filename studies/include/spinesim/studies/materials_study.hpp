@@ -29,7 +29,6 @@
 //                      compression (as `spinesim mss compare`; compression is a training case).
 #pragma once
 
-#include "spinesim/output/progress.hpp"
 #include "spinesim/studies/calibration_summary.hpp"
 #include "spinesim/studies/toolkit.hpp"
 

@@ -8,7 +8,6 @@
 #include "spinesim/mesh/mesher.hpp"
 #include "spinesim/mesh/quality.hpp"
 #include "spinesim/mesh/structured_disc.hpp"
-#include "spinesim/output/progress.hpp"
 #include "spinesim/studies/toolkit.hpp"
 
 #include <nlohmann/json.hpp>

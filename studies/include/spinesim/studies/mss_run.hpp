@@ -12,7 +12,6 @@
 #include "spinesim/mss/model.hpp"
 #include "spinesim/mss/simulator.hpp"
 #include "spinesim/mss/solver.hpp"
-#include "spinesim/output/progress.hpp"
 #include "spinesim/studies/toolkit.hpp"
 
 #include <nlohmann/json.hpp>

@@ -8,7 +8,6 @@
 #include "spinesim/mesh/material.hpp"
 #include "spinesim/mesh/tet_mesh.hpp"
 #include "spinesim/mss/model.hpp"
-#include "spinesim/output/progress.hpp"
 #include "spinesim/studies/comparison_report.hpp"
 #include "spinesim/studies/mss_run.hpp"
 #include "spinesim/studies/toolkit.hpp"

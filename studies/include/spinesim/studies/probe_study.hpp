@@ -10,7 +10,6 @@
 #include "spinesim/mesh/tet_mesh.hpp"
 #include "spinesim/mss/model.hpp"
 #include "spinesim/mss/solver.hpp"
-#include "spinesim/output/progress.hpp"
 #include "spinesim/studies/mss_run.hpp"
 #include "spinesim/studies/stepped_study.hpp"
 #include "spinesim/studies/toolkit.hpp"

@@ -8,7 +8,6 @@
 // in the lower vertebra's axes (the thesis's joint frame); units N, N·m, mm, degrees.
 #pragma once
 
-#include "spinesim/output/progress.hpp"
 #include "spinesim/spine/seating.hpp"
 #include "spinesim/studies/spine_studies.hpp"
 #include "spinesim/studies/toolkit.hpp"

@@ -6,7 +6,6 @@
 // solves of the model it names.
 #pragma once
 
-#include "spinesim/output/progress.hpp"
 #include "spinesim/spine/database.hpp"
 #include "spinesim/spine/equilibrium.hpp"
 #include "spinesim/spine/model.hpp"

@@ -39,7 +39,6 @@
 //   checked: MATCH or DIFFERS with our numbers.
 #pragma once
 
-#include "spinesim/output/progress.hpp"
 #include "spinesim/spine/equilibrium.hpp"
 #include "spinesim/studies/toolkit.hpp"
 

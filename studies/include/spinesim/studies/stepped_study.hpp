@@ -7,7 +7,6 @@
 #include "spinesim/mss/model.hpp"
 #include "spinesim/mss/simulator.hpp"
 #include "spinesim/mss/solver.hpp"
-#include "spinesim/output/files.hpp"
 #include "spinesim/studies/mss_run.hpp"
 #include "spinesim/studies/toolkit.hpp"
 
