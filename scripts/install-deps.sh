@@ -14,6 +14,7 @@ packages=(
   zlib1g-dev liblzma-dev   # compressed VTU files (VTK's zlib and LZMA compressors)
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-meshio python3-numpy   # independent VTU reader used by the tests
+  calculix-ccx             # CalculiX 2.20: the independent FEM reference of the tests
   python3-matplotlib python3-markdown    # the demo's report.html and its plots (scripts/report.py)
   libglfw3-dev libimgui-dev libstb-dev libgl-dev   # `spinesim view` (GLFW, Dear ImGui, PNG)
   libgl1-mesa-dri xvfb xauth             # Mesa's software OpenGL and a virtual X server (view tests)
