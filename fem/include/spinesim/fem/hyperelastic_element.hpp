@@ -1,0 +1,32 @@
+// The total Lagrangian element of the nonlinear disc: a straight P1 or P2 tetrahedron of the
+// material of hyperelastic.hpp, its energy, internal force and tangent at nodal displacements u.
+//
+//   F = I + Σ_a u_a ⊗ ∇N_a          (∇N_a: shape-function gradients in the reference configuration)
+//   δE = Σ_a B_a δu_a,  B_a (6×3):  row jj: F_ij ∂_j N_a;  row jk (engineering): F_ij ∂_k N_a + F_ik ∂_j N_a
+//   f_a = ∫ B_aᵀ S dV₀                                     (internal force, N)
+//   K_ab = ∫ B_aᵀ ℂ B_b + (∇N_a · S ∇N_b) I dV₀             (material + geometric stiffness, N/mm)
+//
+// (Bonet & Wood, Nonlinear Continuum Mechanics for Finite Element Analysis, ch. 7; Voigt order
+// and units as elasticity.hpp.) Quadrature: one point for P1 (F is constant), the symmetric
+// 4-point rule for P2 (as CalculiX's C3D10). DOF order node-major, (x, y, z) per node.
+#pragma once
+
+#include "spinesim/fem/elasticity.hpp"
+#include "spinesim/fem/hyperelastic.hpp"
+
+#include <Eigen/Core>
+
+namespace spinesim::fem {
+
+struct HyperelasticElement {
+  double energy = 0;        ///< ∫ W dV₀, mJ (N·mm); NaN when a point has no valid state
+  Eigen::VectorXd force;    ///< 3·npe internal force, N
+  Eigen::MatrixXd tangent;  ///< 3·npe × 3·npe, N/mm (empty unless asked for)
+  int inverted_points = 0;  ///< quadrature points with det F <= 0
+};
+
+/// `u` is npe×3 (4 or 10 nodes), mm; X the 4 vertices in the reference configuration.
+HyperelasticElement hyperelastic_element(int order, const TetVertices& X, const Eigen::MatrixX3d& u,
+                                         const FibreHyperelastic& m, bool with_tangent = true);
+
+}  // namespace spinesim::fem
