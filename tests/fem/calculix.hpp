@@ -5,11 +5,14 @@
 
 #include <gtest/gtest.h>
 
+#include "spinesim/fem/hyperelastic.hpp"
+
 #include <Eigen/Core>
 
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -38,6 +41,23 @@ inline std::string run_calculix(const std::string& name, const std::string& inp)
   std::stringstream ss;
   ss << in.rdbuf();
   return ss.str();
+}
+
+/// The material cards of `m` as CalculiX's ELASTIC_FIBER: C10, D1, then per family a_x, a_y,
+/// k1, k2, with a_z = +√(1 − a_x² − a_y²) (a family's sign does not matter, so a direction with
+/// a_z < 0 is given reversed); eight constants a line.
+inline std::string elastic_fiber_material(const fem::FibreHyperelastic& m) {
+  std::vector<double> c{m.c10_mpa, m.d1_per_mpa};
+  for (const fem::FibreFamily& f : m.fibres) {
+    const Eigen::Vector3d a = f.direction.z() < 0 ? Eigen::Vector3d(-f.direction) : f.direction;
+    c.insert(c.end(), {a.x(), a.y(), f.k1_mpa, f.k2});
+  }
+  std::ostringstream os;
+  os << std::setprecision(13)
+     << "*MATERIAL,NAME=ELASTIC_FIBER\n*USER MATERIAL,CONSTANTS=" << c.size() << "\n";
+  for (std::size_t k = 0; k < c.size(); ++k)
+    os << c[k] << ((k + 1) % 8 == 0 || k + 1 == c.size() ? ",\n" : ",");
+  return os.str();
 }
 
 /// The rows of the last block whose header starts with `header` (e.g. " stresses", " forces"),

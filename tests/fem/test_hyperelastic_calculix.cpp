@@ -26,23 +26,14 @@ using test::run_calculix;
 const Eigen::Matrix<double, 4, 3> kNodes =
     (Eigen::Matrix<double, 4, 3>() << 0, 0, 0, 2, 0, 0, 0, 1.5, 0, 0.2, 0.1, 1.8).finished();
 
-/// The deck: one C3D4, material ELASTIC_FIBER (C10, D1, then per family a_x, a_y, k1, k2 with
-/// a_z = +√(1 − a_x² − a_y²): a family's sign does not matter), every node moved to F X.
+/// The deck: one C3D4 of material ELASTIC_FIBER, every node moved to F X.
 std::string deck(const FibreHyperelastic& m, const Eigen::Matrix3d& F) {
   std::ostringstream os;
   os << std::setprecision(13);  // CalculiX reads fields of at most 20 characters
   os << "*NODE,NSET=NALL\n";
   for (int a = 0; a < 4; ++a)
     os << a + 1 << "," << kNodes(a, 0) << "," << kNodes(a, 1) << "," << kNodes(a, 2) << "\n";
-  os << "*ELEMENT,TYPE=C3D4,ELSET=EALL\n1,1,2,3,4\n*MATERIAL,NAME=ELASTIC_FIBER\n"
-     << "*USER MATERIAL,CONSTANTS=" << 2 + 4 * m.fibres.size() << "\n";
-  std::vector<double> c{m.c10_mpa, m.d1_per_mpa};
-  for (const FibreFamily& f : m.fibres) {
-    const Eigen::Vector3d a = f.direction.z() < 0 ? Eigen::Vector3d(-f.direction) : f.direction;
-    c.insert(c.end(), {a.x(), a.y(), f.k1_mpa, f.k2});
-  }
-  for (std::size_t k = 0; k < c.size(); ++k)
-    os << c[k] << ((k + 1) % 8 == 0 || k + 1 == c.size() ? ",\n" : ",");
+  os << "*ELEMENT,TYPE=C3D4,ELSET=EALL\n1,1,2,3,4\n" << test::elastic_fiber_material(m);
   os << "*SOLID SECTION,ELSET=EALL,MATERIAL=ELASTIC_FIBER\n*STEP,NLGEOM,INC=1000\n*STATIC\n"
      << "0.05,1.0\n*BOUNDARY\n";
   for (int a = 0; a < 4; ++a) {

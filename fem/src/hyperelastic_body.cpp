@@ -1,0 +1,260 @@
+#include "spinesim/fem/hyperelastic_body.hpp"
+
+#include "spinesim/common/timer.hpp"
+#include "spinesim/fem/cholmod_solver.hpp"
+#include "spinesim/fem/hyperelastic_element.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+namespace spinesim::fem {
+
+HyperelasticBody::HyperelasticBody(FeSpace space, std::vector<FibreHyperelastic> element_materials)
+    : space_(std::move(space)), materials_(std::move(element_materials)) {
+  if (Eigen::Index(materials_.size()) != space_.elements.rows())
+    throw std::invalid_argument("hyperelastic body: " + std::to_string(materials_.size()) +
+                                " materials for " + std::to_string(space_.elements.rows()) +
+                                " elements");
+  for (const FibreHyperelastic& m : materials_) validate(m, "hyperelastic body");
+}
+
+HyperelasticBody::Evaluation HyperelasticBody::evaluate(const Eigen::VectorXd& u,
+                                                        bool with_tangent) const {
+  const Eigen::Index n = space_.num_nodes();
+  if (u.size() != 3 * n) throw std::invalid_argument("hyperelastic body: wrong displacement size");
+  const int npe = space_.nodes_per_element();
+  Evaluation out;
+  out.force = Eigen::VectorXd::Zero(3 * n);
+  std::vector<Eigen::Triplet<double>> triplets;
+  if (with_tangent) triplets.reserve(std::size_t(space_.elements.rows()) * 9 * npe * (npe + 1) / 2);
+  Eigen::MatrixX3d ue(npe, 3);
+  for (Eigen::Index t = 0; t < space_.elements.rows(); ++t) {
+    TetVertices X;
+    for (int a = 0; a < 4; ++a) X.row(a) = space_.X.row(space_.elements(t, a));
+    for (int a = 0; a < npe; ++a) ue.row(a) = u.segment<3>(3 * space_.elements(t, a)).transpose();
+    const HyperelasticElement e =
+        hyperelastic_element(space_.order, X, ue, materials_[std::size_t(t)], with_tangent);
+    out.energy += e.energy;
+    out.inverted += e.inverted_points;
+    for (int a = 0; a < npe; ++a) {
+      const Eigen::Index A = space_.elements(t, a);
+      out.force.segment<3>(3 * A) += e.force.segment<3>(3 * a);
+      if (!with_tangent) continue;
+      for (int b = 0; b < npe; ++b) {
+        const Eigen::Index B = space_.elements(t, b);
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j)
+            if (3 * A + i >= 3 * B + j)
+              triplets.emplace_back(3 * A + i, 3 * B + j, e.tangent(3 * a + i, 3 * b + j));
+      }
+    }
+  }
+  if (with_tangent) {
+    out.tangent_lower.resize(3 * n, 3 * n);
+    out.tangent_lower.setFromTriplets(triplets.begin(), triplets.end());
+  }
+  return out;
+}
+
+namespace {
+
+/// The free/prescribed split of the DOF and the blocks of a lower-triangular tangent.
+struct Split {
+  std::vector<Eigen::Index> free_index;  ///< per DOF: index among the free DOF, −1 if prescribed
+  std::vector<Eigen::Index> free_dofs, prescribed_dofs;
+  Eigen::VectorXd prescribed_values;  ///< per prescribed DOF, the full value
+
+  Eigen::VectorXd free_part(const Eigen::VectorXd& v) const {
+    Eigen::VectorXd out(Eigen::Index(free_dofs.size()));
+    for (std::size_t k = 0; k < free_dofs.size(); ++k) out(Eigen::Index(k)) = v(free_dofs[k]);
+    return out;
+  }
+  /// K_ff (lower) and K_fp d_p (d_p: a change of the prescribed DOF, full-size vector).
+  Eigen::SparseMatrix<double> free_block(const Eigen::SparseMatrix<double>& lower) const {
+    std::vector<Eigen::Triplet<double>> t;
+    t.reserve(std::size_t(lower.nonZeros()));
+    for (Eigen::Index c = 0; c < lower.outerSize(); ++c)
+      for (Eigen::SparseMatrix<double>::InnerIterator it(lower, c); it; ++it) {
+        const Eigen::Index fr = free_index[std::size_t(it.row())],
+                           fc = free_index[std::size_t(it.col())];
+        if (fr >= 0 && fc >= 0) t.emplace_back(fr, fc, it.value());
+      }
+    const auto nf = Eigen::Index(free_dofs.size());
+    Eigen::SparseMatrix<double> K(nf, nf);
+    K.setFromTriplets(t.begin(), t.end());
+    return K;
+  }
+};
+
+Split split_dofs(Eigen::Index num_dofs, const std::vector<PrescribedDisplacement>& prescribed) {
+  Split s;
+  s.free_index.assign(std::size_t(num_dofs), 0);
+  std::vector<double> value(std::size_t(num_dofs), 0.0);
+  for (const PrescribedDisplacement& p : prescribed) {
+    if (p.node < 0 || 3 * p.node >= num_dofs || p.dof < 0 || p.dof > 2)
+      throw std::invalid_argument("prescribed displacement: node " + std::to_string(p.node) +
+                                  " dof " + std::to_string(p.dof) + " is not in the body");
+    if (!std::isfinite(p.value_mm))
+      throw std::invalid_argument("prescribed displacement: not a finite number");
+    const std::size_t d = std::size_t(3 * p.node + p.dof);
+    if (s.free_index[d] < 0)
+      throw std::invalid_argument("prescribed displacement: node " + std::to_string(p.node) +
+                                  " dof " + std::to_string(p.dof) + " given twice");
+    s.free_index[d] = -1;
+    value[d] = p.value_mm;
+  }
+  for (Eigen::Index d = 0; d < num_dofs; ++d) {
+    if (s.free_index[std::size_t(d)] < 0) {
+      s.prescribed_dofs.push_back(d);
+      continue;
+    }
+    s.free_index[std::size_t(d)] = Eigen::Index(s.free_dofs.size());
+    s.free_dofs.push_back(d);
+  }
+  s.prescribed_values.resize(Eigen::Index(s.prescribed_dofs.size()));
+  for (std::size_t k = 0; k < s.prescribed_dofs.size(); ++k)
+    s.prescribed_values(Eigen::Index(k)) = value[std::size_t(s.prescribed_dofs[k])];
+  return s;
+}
+
+/// K d for a symmetric K stored as its lower triangle.
+Eigen::VectorXd symmetric_product(const Eigen::SparseMatrix<double>& lower,
+                                  const Eigen::VectorXd& d) {
+  return lower * d + lower.transpose() * d - lower.diagonal().cwiseProduct(d);
+}
+
+}  // namespace
+
+namespace {
+
+/// One solve's Newton state: the converged displacement, the factorisation (pattern analysed
+/// once) and the counts.
+struct NewtonRun {
+  const HyperelasticBody& body;
+  const Split& split;
+  const NewtonOptions& options;
+  HyperelasticSolution& sol;
+  Eigen::VectorXd u;  ///< the last converged state
+  CholmodSolver cholesky;
+  bool analysed = false;
+
+  /// Factorises K_ff of `ev`; false when it is not positive definite.
+  bool factorize(const HyperelasticBody::Evaluation& ev) {
+    const Eigen::SparseMatrix<double> Kff = split.free_block(ev.tangent_lower);
+    if (!analysed) cholesky.analyze(Kff), analysed = true;
+    try {
+      cholesky.factorize(Kff);
+    } catch (const std::runtime_error&) {
+      return false;
+    }
+    ++sol.factorisations;
+    return true;
+  }
+
+  Eigen::VectorXd moved(const Eigen::VectorXd& x, const Eigen::VectorXd& step, double alpha) const {
+    Eigen::VectorXd y = x;
+    for (std::size_t k = 0; k < split.free_dofs.size(); ++k)
+      y(split.free_dofs[k]) += alpha * step(Eigen::Index(k));
+    return y;
+  }
+
+  /// The prescribed DOF set to fraction `to`, the free DOF carried along by the last tangent
+  /// (halved until no element inverts); false when no such state is found.
+  bool predict(double to, Eigen::VectorXd& trial) {
+    trial = u;
+    for (std::size_t k = 0; k < split.prescribed_dofs.size(); ++k)
+      trial(split.prescribed_dofs[k]) = to * split.prescribed_values(Eigen::Index(k));
+    const HyperelasticBody::Evaluation ev = body.evaluate(u, true);
+    if (!factorize(ev)) return false;
+    const Eigen::VectorXd du =
+        cholesky.solve(-split.free_part(ev.force) -
+                       split.free_part(symmetric_product(ev.tangent_lower, trial - u)));
+    for (double alpha = 1.0; alpha >= 1e-6; alpha *= 0.5) {
+      const Eigen::VectorXd x = moved(trial, du, alpha);
+      if (body.evaluate(x, false).inverted == 0) {
+        trial = x;
+        return true;
+      }
+    }
+    return false;
+  }
+
+  /// Newton iterations from `trial` with an Armijo line search on the energy; on convergence
+  /// the state becomes u.
+  bool correct(Eigen::VectorXd trial) {
+    for (int it = 0; it < options.max_iterations; ++it) {
+      const HyperelasticBody::Evaluation ev = body.evaluate(trial, true);
+      ++sol.newton_iterations;
+      const Eigen::VectorXd r = split.free_part(ev.force);
+      double reaction = 0;
+      for (const Eigen::Index d : split.prescribed_dofs) reaction += ev.force(d) * ev.force(d);
+      if (!factorize(ev)) return false;
+      const Eigen::VectorXd step = cholesky.solve(-r);
+      sol.residual_n = r.norm();
+      if (r.norm() <= options.tolerance * std::max(std::sqrt(reaction), 1.0) &&
+          step.cwiseAbs().maxCoeff() <=
+              options.tolerance * std::max(trial.cwiseAbs().maxCoeff(), 1.0)) {
+        u = trial;
+        return true;
+      }
+      const double slope = r.dot(step);  // dE/dα at α = 0 (< 0 for a descent direction)
+      bool stepped = false;
+      for (double alpha = 1.0; alpha >= 1e-8 && !stepped; alpha *= 0.5) {
+        const Eigen::VectorXd x = moved(trial, step, alpha);
+        const double e = body.evaluate(x, false).energy;
+        if (std::isfinite(e) && (slope >= 0 || e <= ev.energy + 1e-4 * alpha * slope))
+          trial = x, stepped = true;
+      }
+      if (!stepped) return false;
+    }
+    return false;
+  }
+};
+
+}  // namespace
+
+HyperelasticSolution HyperelasticBody::solve(const std::vector<PrescribedDisplacement>& prescribed,
+                                             const NewtonOptions& options) const {
+  if (options.load_increments < 1 || options.max_iterations < 1 || !(options.tolerance > 0))
+    throw std::invalid_argument("Newton options: increments, iterations >= 1, tolerance > 0");
+  Timer timer;
+  const Eigen::Index ndof = 3 * space_.num_nodes();
+  const Split split = split_dofs(ndof, prescribed);
+  HyperelasticSolution sol;
+  NewtonRun run{*this, split, options, sol, Eigen::VectorXd::Zero(ndof), CholmodSolver(), false};
+  double done = 0, size = 1.0 / options.load_increments;
+  int cuts_in_a_row = 0;
+  while (done < 1.0 - 1e-12) {
+    const double to = std::min(1.0, done + size);
+    Eigen::VectorXd trial;
+    if (run.predict(to, trial) && run.correct(trial)) {
+      ++sol.increments;
+      done = to;
+      cuts_in_a_row = 0;
+      continue;
+    }
+    if (++cuts_in_a_row > options.max_cutbacks) {
+      sol.failure = "Newton did not converge from " + std::to_string(done) + " to " +
+                    std::to_string(to) + " of the load after " +
+                    std::to_string(options.max_cutbacks) + " halvings of the increment (residual " +
+                    std::to_string(sol.residual_n) + " N)";
+      break;
+    }
+    ++sol.cutbacks;
+    size *= 0.5;
+  }
+  sol.converged = sol.failure.empty();
+  const Evaluation last = evaluate(run.u, false);
+  sol.energy_mj = last.energy;
+  sol.displacement_mm = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(
+      run.u.data(), space_.num_nodes(), 3);
+  sol.reaction_n = Eigen::MatrixX3d::Zero(space_.num_nodes(), 3);
+  for (const Eigen::Index d : split.prescribed_dofs) sol.reaction_n(d / 3, d % 3) = last.force(d);
+  sol.seconds = timer.seconds();
+  return sol;
+}
+
+}  // namespace spinesim::fem
