@@ -1,0 +1,58 @@
+// The nonlinear disc reference: the disc problem of disc_fem.hpp (inferior endplate fixed,
+// superior endplate on a rigid plate driven by a motion q = (t mm, θ rad)) with the material of
+// hyperelastic.hpp, finite strain and a finite plate rotation:
+//
+//   plate nodes:  x = c + t + R(θ) (X − c),  R(θ) the rotation by the vector θ (axis θ/|θ|,
+//                 angle |θ|), which is t + θ × (X − c) to first order (mesh/rigid_plate.hpp);
+//
+// solved by hyperelastic_body.hpp (load increments, Newton, line search). The reaction is the
+// wrench the disc exerts on the plate, force and moment about the moved centre c + t (N, N·mm),
+// the sign convention of disc_fem.hpp: a compressive motion gives F_y > 0. At small motions it
+// is the linear FEM's −K6 q (tested).
+#pragma once
+
+#include "spinesim/fem/hyperelastic.hpp"
+#include "spinesim/fem/hyperelastic_body.hpp"
+#include "spinesim/mesh/material.hpp"
+#include "spinesim/mesh/tet_mesh.hpp"
+
+#include <Eigen/Core>
+
+#include <vector>
+
+namespace spinesim::fem {
+
+/// Each tet's material from `materials`: its region's matrix with the small-strain moduli of
+/// its (E, ν) (neo_hookean_from_linear), and in a fibre-reinforced region the two families of
+/// fibre_field (fibres.hpp) with k1 = k/4 — the tension stiffness of the linear fibres at small
+/// isochoric strain (hyperelastic.hpp) — and the toe exponent `fibre_k2`.
+std::vector<FibreHyperelastic> disc_element_materials(const mesh::TetMesh& mesh,
+                                                      const mesh::RegionMaterials& materials,
+                                                      double fibre_k2);
+
+struct NonlinearPlateSolution {
+  HyperelasticSolution body;  ///< nodal displacements, reactions, Newton counts, convergence
+  Eigen::Matrix<double, 6, 1> plate_motion;     ///< (t mm, θ rad)
+  Eigen::Matrix<double, 6, 1> reaction_wrench;  ///< (F N, M N·mm about c + t)
+};
+
+class NonlinearDisc {
+ public:
+  /// Throws std::invalid_argument for a mesh without endplate labels, a bad order or material
+  /// count.
+  NonlinearDisc(const mesh::TetMesh& mesh, std::vector<FibreHyperelastic> element_materials,
+                int order, const Eigen::Vector3d& plate_center_mm);
+
+  NonlinearPlateSolution solve_motion(const Eigen::Matrix<double, 6, 1>& motion,
+                                      const NewtonOptions& options = NewtonOptions()) const;
+
+  const Eigen::Vector3d& plate_center() const { return center_; }
+  const HyperelasticBody& body() const { return body_; }
+
+ private:
+  Eigen::VectorXi labels_;
+  HyperelasticBody body_;
+  Eigen::Vector3d center_;
+};
+
+}  // namespace spinesim::fem

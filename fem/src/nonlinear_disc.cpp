@@ -1,0 +1,88 @@
+#include "spinesim/fem/nonlinear_disc.hpp"
+
+#include "spinesim/fem/fe_space.hpp"
+#include "spinesim/fem/fibres.hpp"
+
+#include <Eigen/Geometry>
+
+#include <stdexcept>
+#include <utility>
+
+namespace spinesim::fem {
+
+std::vector<FibreHyperelastic> disc_element_materials(const mesh::TetMesh& mesh,
+                                                      const mesh::RegionMaterials& materials,
+                                                      double fibre_k2) {
+  const ElementFibres fibres = fibre_field(mesh, materials);
+  std::vector<FibreHyperelastic> out;
+  out.reserve(std::size_t(mesh.num_tets()));
+  for (Eigen::Index t = 0; t < mesh.num_tets(); ++t) {
+    const mesh::IsotropicMaterial& m = materials.at(mesh.region(t));
+    FibreHyperelastic h = neo_hookean_from_linear(m.youngs_modulus_mpa, m.poisson_ratio);
+    if (!fibres.empty() && fibres.stiffness_mpa(t) > 0) {
+      const double k1 = fibres.stiffness_mpa(t) / 4.0;
+      h.fibres.push_back({fibres.direction_1.row(t).transpose().normalized(), k1, fibre_k2});
+      h.fibres.push_back({fibres.direction_2.row(t).transpose().normalized(), k1, fibre_k2});
+    }
+    out.push_back(std::move(h));
+  }
+  return out;
+}
+
+namespace {
+
+HyperelasticBody make_body(const mesh::TetMesh& mesh, std::vector<FibreHyperelastic> materials,
+                           int order) {
+  mesh::require_endplate_labels(mesh);
+  return HyperelasticBody(make_fe_space(mesh, order), std::move(materials));
+}
+
+}  // namespace
+
+NonlinearDisc::NonlinearDisc(const mesh::TetMesh& mesh,
+                             std::vector<FibreHyperelastic> element_materials, int order,
+                             const Eigen::Vector3d& plate_center_mm)
+    : body_(make_body(mesh, std::move(element_materials), order)), center_(plate_center_mm) {
+  labels_ = node_surface_labels(body_.space(), mesh);
+  if (!center_.allFinite()) throw std::invalid_argument("plate centre: not finite");
+}
+
+NonlinearPlateSolution NonlinearDisc::solve_motion(const Eigen::Matrix<double, 6, 1>& motion,
+                                                   const NewtonOptions& options) const {
+  if (!motion.allFinite()) throw std::invalid_argument("plate motion: not finite");
+  const Eigen::Vector3d t = motion.head<3>(), theta = motion.tail<3>();
+  const double angle = theta.norm();
+  const Eigen::Matrix3d R = angle > 0 ? Eigen::AngleAxisd(angle, theta / angle).toRotationMatrix()
+                                      : Eigen::Matrix3d::Identity();
+  const FeSpace& s = body_.space();
+  std::vector<PrescribedDisplacement> bc;
+  for (Eigen::Index i = 0; i < s.num_nodes(); ++i) {
+    const int label = labels_(i);
+    if (label != int(mesh::Surface::inferior_endplate) &&
+        label != int(mesh::Surface::superior_endplate))
+      continue;
+    Eigen::Vector3d u = Eigen::Vector3d::Zero();
+    if (label == int(mesh::Surface::superior_endplate)) {
+      const Eigen::Vector3d arm = s.X.row(i).transpose() - center_;
+      u = t + R * arm - arm;
+    }
+    for (int d = 0; d < 3; ++d) bc.push_back({i, d, u(d)});
+  }
+  NonlinearPlateSolution out;
+  out.plate_motion = motion;
+  out.body = body_.solve(bc, options);
+  // The disc pushes on the plate with −f at each plate node (f its internal force there).
+  Eigen::Vector3d F = Eigen::Vector3d::Zero(), M = Eigen::Vector3d::Zero();
+  const Eigen::Vector3d moved_center = center_ + t;
+  for (Eigen::Index i = 0; i < s.num_nodes(); ++i) {
+    if (labels_(i) != int(mesh::Surface::superior_endplate)) continue;
+    const Eigen::Vector3d f = -out.body.reaction_n.row(i).transpose();
+    const Eigen::Vector3d x = s.X.row(i).transpose() + out.body.displacement_mm.row(i).transpose();
+    F += f;
+    M += (x - moved_center).cross(f);
+  }
+  out.reaction_wrench << F, M;
+  return out;
+}
+
+}  // namespace spinesim::fem
