@@ -45,16 +45,18 @@ inline std::string run_calculix(const std::string& name, const std::string& inp)
 
 /// The material cards of `m` as CalculiX's ELASTIC_FIBER: C10, D1, then per family a_x, a_y,
 /// k1, k2, with a_z = +√(1 − a_x² − a_y²) (a family's sign does not matter, so a direction with
-/// a_z < 0 is given reversed); eight constants a line.
-inline std::string elastic_fiber_material(const fem::FibreHyperelastic& m) {
+/// a_z < 0 is given reversed); eight constants a line. CalculiX picks the law by the name's first
+/// 13 letters, so `name` must start with ELASTIC_FIBER.
+inline std::string elastic_fiber_material(const fem::FibreHyperelastic& m,
+                                          const std::string& name = "ELASTIC_FIBER") {
   std::vector<double> c{m.c10_mpa, m.d1_per_mpa};
   for (const fem::FibreFamily& f : m.fibres) {
     const Eigen::Vector3d a = f.direction.z() < 0 ? Eigen::Vector3d(-f.direction) : f.direction;
     c.insert(c.end(), {a.x(), a.y(), f.k1_mpa, f.k2});
   }
   std::ostringstream os;
-  os << std::setprecision(13)
-     << "*MATERIAL,NAME=ELASTIC_FIBER\n*USER MATERIAL,CONSTANTS=" << c.size() << "\n";
+  os << std::setprecision(13) << "*MATERIAL,NAME=" << name
+     << "\n*USER MATERIAL,CONSTANTS=" << c.size() << "\n";
   for (std::size_t k = 0; k < c.size(); ++k)
     os << c[k] << ((k + 1) % 8 == 0 || k + 1 == c.size() ? ",\n" : ",");
   return os.str();
