@@ -3,6 +3,8 @@
 #include "spinesim/fem/fe_space.hpp"
 #include "spinesim/fem/fibres.hpp"
 
+#include "plate_newton.hpp"
+
 #include <Eigen/Geometry>
 
 #include <stdexcept>
@@ -71,17 +73,43 @@ NonlinearPlateSolution NonlinearDisc::solve_motion(const Eigen::Matrix<double, 6
   NonlinearPlateSolution out;
   out.plate_motion = motion;
   out.body = body_.solve(bc, options);
+  out.reaction_wrench = plate_reaction(out.body, motion.head<3>());
+  return out;
+}
+
+Eigen::Matrix<double, 6, 1> NonlinearDisc::plate_reaction(const HyperelasticSolution& body,
+                                                          const Eigen::Vector3d& t) const {
   // The disc pushes on the plate with −f at each plate node (f its internal force there).
+  const FeSpace& s = body_.space();
   Eigen::Vector3d F = Eigen::Vector3d::Zero(), M = Eigen::Vector3d::Zero();
   const Eigen::Vector3d moved_center = center_ + t;
   for (Eigen::Index i = 0; i < s.num_nodes(); ++i) {
     if (labels_(i) != int(mesh::Surface::superior_endplate)) continue;
-    const Eigen::Vector3d f = -out.body.reaction_n.row(i).transpose();
-    const Eigen::Vector3d x = s.X.row(i).transpose() + out.body.displacement_mm.row(i).transpose();
+    const Eigen::Vector3d f = -body.reaction_n.row(i).transpose();
+    const Eigen::Vector3d x = s.X.row(i).transpose() + body.displacement_mm.row(i).transpose();
     F += f;
     M += (x - moved_center).cross(f);
   }
-  out.reaction_wrench << F, M;
+  Eigen::Matrix<double, 6, 1> w;
+  w << F, M;
+  return w;
+}
+
+NonlinearPlateSolution NonlinearDisc::solve(const PlateLoad& load,
+                                            const NewtonOptions& options) const {
+  detail::PlateProblem pr;
+  pr.center = center_;
+  pr.motion_given = load.motion_given;
+  pr.value = load.value;
+  for (Eigen::Index i = 0; i < labels_.size(); ++i) {
+    if (labels_(i) == int(mesh::Surface::inferior_endplate)) pr.fixed_nodes.push_back(i);
+    if (labels_(i) == int(mesh::Surface::superior_endplate)) pr.plate_nodes.push_back(i);
+  }
+  detail::PlateNewtonResult r = detail::solve_plate_problem(body_, pr, options);
+  NonlinearPlateSolution out;
+  out.body = std::move(r.body);
+  out.plate_motion = r.plate;
+  out.reaction_wrench = plate_reaction(out.body, r.plate.head<3>());
   return out;
 }
 

@@ -18,6 +18,7 @@
 
 #include <Eigen/Core>
 
+#include <array>
 #include <vector>
 
 namespace spinesim::fem {
@@ -29,6 +30,15 @@ namespace spinesim::fem {
 std::vector<FibreHyperelastic> disc_element_materials(const mesh::TetMesh& mesh,
                                                       const mesh::RegionMaterials& materials,
                                                       double fibre_k2);
+
+/// What drives the plate, per DOF (t_x, t_y, t_z, θ_x, θ_y, θ_z): a motion (mm, rad) or a load
+/// the plate applies to the disc (N, N·mm about the moved centre). A moment does the work M·θ
+/// (θ the rotation vector): exact for a rotation about the moment's axis, as in the in-vitro
+/// tests; a second-order approximation of a fixed-direction moment otherwise.
+struct PlateLoad {
+  std::array<bool, 6> motion_given{};  ///< true: `value` is the motion; false: the load
+  Eigen::Matrix<double, 6, 1> value = Eigen::Matrix<double, 6, 1>::Zero();
+};
 
 struct NonlinearPlateSolution {
   HyperelasticSolution body;  ///< nodal displacements, reactions, Newton counts, convergence
@@ -46,10 +56,17 @@ class NonlinearDisc {
   NonlinearPlateSolution solve_motion(const Eigen::Matrix<double, 6, 1>& motion,
                                       const NewtonOptions& options = NewtonOptions()) const;
 
+  /// The plate driven and loaded per DOF (the plate's six unknowns solved with the disc).
+  NonlinearPlateSolution solve(const PlateLoad& load,
+                               const NewtonOptions& options = NewtonOptions()) const;
+
   const Eigen::Vector3d& plate_center() const { return center_; }
   const HyperelasticBody& body() const { return body_; }
 
  private:
+  Eigen::Matrix<double, 6, 1> plate_reaction(const HyperelasticSolution& body,
+                                             const Eigen::Vector3d& t) const;
+
   Eigen::VectorXi labels_;
   HyperelasticBody body_;
   Eigen::Vector3d center_;
