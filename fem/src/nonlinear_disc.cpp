@@ -1,5 +1,6 @@
 #include "spinesim/fem/nonlinear_disc.hpp"
 
+#include "spinesim/common/rotation.hpp"
 #include "spinesim/fem/fe_space.hpp"
 #include "spinesim/fem/fibres.hpp"
 
@@ -53,9 +54,7 @@ NonlinearPlateSolution NonlinearDisc::solve_motion(const Eigen::Matrix<double, 6
                                                    const NewtonOptions& options) const {
   if (!motion.allFinite()) throw std::invalid_argument("plate motion: not finite");
   const Eigen::Vector3d t = motion.head<3>(), theta = motion.tail<3>();
-  const double angle = theta.norm();
-  const Eigen::Matrix3d R = angle > 0 ? Eigen::AngleAxisd(angle, theta / angle).toRotationMatrix()
-                                      : Eigen::Matrix3d::Identity();
+  const Eigen::Matrix3d R = rotation_exp(theta);
   const FeSpace& s = body_.space();
   std::vector<PrescribedDisplacement> bc;
   for (Eigen::Index i = 0; i < s.num_nodes(); ++i) {

@@ -1,5 +1,6 @@
 #include "plate_newton.hpp"
 
+#include "spinesim/common/rotation.hpp"
 #include "spinesim/common/skew.hpp"
 #include "spinesim/common/timer.hpp"
 #include "spinesim/fem/cholmod_solver.hpp"
@@ -13,27 +14,8 @@
 
 namespace spinesim::fem::detail {
 
-Eigen::Matrix3d rotation(const Eigen::Vector3d& theta) {
-  const double phi = theta.norm();
-  return phi > 0 ? Eigen::AngleAxisd(phi, theta / phi).toRotationMatrix()
-                 : Eigen::Matrix3d::Identity();
-}
-
-namespace {
-
-/// The right Jacobian of SO(3): R(θ + δθ) ≈ R(θ) exp([J_r(θ) δθ]×).
-Eigen::Matrix3d right_jacobian(const Eigen::Vector3d& theta) {
-  const double phi = theta.norm();
-  const Eigen::Matrix3d K = skew(theta);
-  if (phi < 1e-6) return Eigen::Matrix3d::Identity() - 0.5 * K + K * K / 6.0;
-  return Eigen::Matrix3d::Identity() - (1 - std::cos(phi)) / (phi * phi) * K +
-         (phi - std::sin(phi)) / (phi * phi * phi) * K * K;
-}
-
-}  // namespace
-
 Eigen::Matrix3d rotated_arm_jacobian(const Eigen::Vector3d& theta, const Eigen::Vector3d& arm) {
-  return -rotation(theta) * skew(arm) * right_jacobian(theta);
+  return -rotation_exp(theta) * skew(arm) * right_jacobian(theta);
 }
 
 namespace {
@@ -130,7 +112,7 @@ class PlateNewton {
   Eigen::VectorXd full(const Eigen::VectorXd& uf, const Vector6& p) const {
     Eigen::VectorXd u = Eigen::VectorXd::Zero(3 * body_.space().num_nodes());
     for (std::size_t k = 0; k < free_dofs_.size(); ++k) u(free_dofs_[k]) = uf(Eigen::Index(k));
-    const Eigen::Matrix3d R = rotation(p.tail<3>());
+    const Eigen::Matrix3d R = rotation_exp(p.tail<3>());
     for (std::size_t k = 0; k < pr_.plate_nodes.size(); ++k)
       u.segment<3>(3 * pr_.plate_nodes[k]) = p.head<3>() + R * arm_[k] - arm_[k];
     return u;

@@ -24,11 +24,8 @@ namespace spinesim::fem::detail {
 
 using Vector6 = Eigen::Matrix<double, 6, 1>;
 
-/// ∂(R(θ) a)/∂θ (3×3), R(θ) the rotation by the vector θ.
+/// ∂(R(θ) a)/∂θ (3×3), R(θ) = rotation_exp(θ) (common/rotation.hpp).
 Eigen::Matrix3d rotated_arm_jacobian(const Eigen::Vector3d& theta, const Eigen::Vector3d& arm);
-
-/// R(θ).
-Eigen::Matrix3d rotation(const Eigen::Vector3d& theta);
 
 struct PlateProblem {
   std::vector<Eigen::Index> fixed_nodes, plate_nodes;

@@ -2,6 +2,8 @@
 // private to fem/): ∂(R(θ) a)/∂θ against central differences, at rest and at large rotations.
 #include "plate_newton.hpp"
 
+#include "spinesim/common/rotation.hpp"
+
 #include <gtest/gtest.h>
 
 namespace spinesim::fem::detail {
@@ -17,15 +19,15 @@ TEST(PlateKinematics, RotatedArmJacobianIsTheDerivativeOfTheRotation) {
     for (int d = 0; d < 3; ++d) {
       Eigen::Vector3d tp = theta, tm = theta;
       tp(d) += h, tm(d) -= h;
-      const Eigen::Vector3d fd = (rotation(tp) * arm - rotation(tm) * arm) / (2 * h);
+      const Eigen::Vector3d fd = (rotation_exp(tp) * arm - rotation_exp(tm) * arm) / (2 * h);
       EXPECT_LE((fd - J.col(d)).norm(), 1e-8 * arm.norm()) << "theta " << theta.transpose();
     }
   }
   // R(θ) is the rotation by |θ| about θ: it keeps the axis and turns the arm by |θ|.
   const Eigen::Vector3d axis_turn(0, 0.5, 0);
-  EXPECT_LE((rotation(axis_turn) * Eigen::Vector3d::UnitY() - Eigen::Vector3d::UnitY()).norm(),
+  EXPECT_LE((rotation_exp(axis_turn) * Eigen::Vector3d::UnitY() - Eigen::Vector3d::UnitY()).norm(),
             1e-15);
-  EXPECT_NEAR((rotation(axis_turn) * Eigen::Vector3d::UnitX()).dot(Eigen::Vector3d::UnitX()),
+  EXPECT_NEAR((rotation_exp(axis_turn) * Eigen::Vector3d::UnitX()).dot(Eigen::Vector3d::UnitX()),
               std::cos(0.5), 1e-15);
 }
 

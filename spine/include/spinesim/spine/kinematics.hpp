@@ -3,6 +3,7 @@
 // joint point; the sacrum (below L5-S1) is fixed. Translations at the joints are constrained.
 #pragma once
 
+#include "spinesim/common/rotation.hpp"
 #include "spinesim/spine/model.hpp"
 
 #include <Eigen/Core>
@@ -18,13 +19,11 @@ struct Pose {
   Eigen::Vector3d apply(const Eigen::Vector3d& X) const { return R * X + t; }
 };
 
-/// exp: rotation vector (rad) → rotation matrix; log: the inverse (|φ| < π).
-Eigen::Matrix3d rotation_exp(const Eigen::Vector3d& phi);
-Eigen::Vector3d rotation_log(const Eigen::Matrix3d& R);
-/// Right Jacobian of exp (exp(φ+δ) ≈ exp(φ)·exp(J_r(φ)δ)) and the inverse of the left Jacobian
-/// (log(exp(δ)R) ≈ log(R) + J_l^{-1}(log R) δ).
-Eigen::Matrix3d right_jacobian(const Eigen::Vector3d& phi);
-Eigen::Matrix3d left_jacobian_inverse(const Eigen::Vector3d& phi);
+/// The rotation-vector maps (common/rotation.hpp), as the spine names them.
+using spinesim::left_jacobian_inverse;
+using spinesim::right_jacobian;
+using spinesim::rotation_exp;
+using spinesim::rotation_log;
 
 /// The rigid motion that moves `centre_mm` by `translation_mm` and turns about it by the
 /// rotation vector `rotation_deg` (SpineSolution::displacement's row as a pose).
