@@ -4,6 +4,8 @@
 // closed forms of simple shear and of an isochoric stretch along a fibre.
 #include "spinesim/fem/hyperelastic.hpp"
 
+#include "hyperelastic_fixtures.hpp"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/LU>
@@ -14,16 +16,7 @@
 namespace spinesim::fem {
 namespace {
 
-/// Annulus-like parameters: a soft matrix, two families at ±30° in the x-y plane.
-FibreHyperelastic annulus() {
-  FibreHyperelastic m;
-  m.c10_mpa = 0.35;
-  m.d1_per_mpa = 0.3;
-  const double a = 30.0 * M_PI / 180.0;
-  m.fibres.push_back({Eigen::Vector3d(std::cos(a), std::sin(a), 0), 3.0, 45.0});
-  m.fibres.push_back({Eigen::Vector3d(std::cos(a), -std::sin(a), 0), 3.0, 45.0});
-  return m;
-}
+using fixtures::annulus;
 
 /// A deformation with one family stretched and the other shortened.
 Eigen::Matrix3d deformation() {

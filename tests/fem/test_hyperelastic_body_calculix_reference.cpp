@@ -9,6 +9,8 @@
 
 #include "calculix.hpp"
 
+#include "hyperelastic_fixtures.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -24,16 +26,7 @@ using test::have_calculix;
 using test::last_block;
 using test::run_calculix;
 
-FibreHyperelastic fibre_block() {
-  FibreHyperelastic m;
-  m.c10_mpa = 0.35;
-  m.d1_per_mpa = 0.3;
-  const double a = 30.0 * M_PI / 180.0;
-  // Families in the x-y plane (CalculiX: a_z = +√(1 − a_x² − a_y²) = 0).
-  m.fibres.push_back({Eigen::Vector3d(std::cos(a), std::sin(a), 0), 3.0, 45.0});
-  m.fibres.push_back({Eigen::Vector3d(std::cos(a), -std::sin(a), 0), 3.0, 45.0});
-  return m;
-}
+using fixtures::annulus;
 
 /// The base (surface 1) held, the top (surface 2) moved by `top` mm.
 std::vector<PrescribedDisplacement> held_and_moved(const FeSpace& s, const Eigen::VectorXi& labels,
@@ -78,7 +71,7 @@ TEST_P(BodyAgainstCalculix, SameDisplacementsAndReactions) {
   const mesh::TetMesh box = mesh::box_mesh(3, 2, 3, 6.0, 4.0, 6.0);
   const FeSpace space = make_fe_space(box, order);
   const Eigen::VectorXi labels = node_surface_labels(space, box);
-  const FibreHyperelastic m = fibre_block();
+  const FibreHyperelastic m = annulus();
   const auto bc = held_and_moved(space, labels, Eigen::Vector3d(0.4, -0.5, 0.0));
 
   const HyperelasticBody body(space,

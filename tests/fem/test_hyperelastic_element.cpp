@@ -3,6 +3,8 @@
 // a rigid rotation costs nothing and rotates the forces, and at rest it is the linear element.
 #include "spinesim/fem/hyperelastic_element.hpp"
 
+#include "hyperelastic_fixtures.hpp"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -15,15 +17,7 @@ namespace {
 const TetVertices kX =
     (TetVertices() << 0, 0, 0, 2, 0.1, 0, 0.2, 1.5, 0.1, 0.3, 0.2, 1.8).finished();
 
-FibreHyperelastic annulus() {
-  FibreHyperelastic m;
-  m.c10_mpa = 0.35;
-  m.d1_per_mpa = 0.3;
-  const double a = 30.0 * M_PI / 180.0;
-  m.fibres.push_back({Eigen::Vector3d(std::cos(a), std::sin(a), 0), 3.0, 45.0});
-  m.fibres.push_back({Eigen::Vector3d(std::cos(a), -std::sin(a), 0), 3.0, 45.0});
-  return m;
-}
+using fixtures::annulus;
 
 /// A displacement with one fibre family stretched: a shear plus a smooth wrinkle (P2 nodes
 /// are the vertices, then the edge midpoints).
