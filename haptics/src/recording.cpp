@@ -175,6 +175,17 @@ bool parse_row(const std::string& line, DragFrame& f, std::string& why) {
     why = "more than " + std::to_string(kDragColumns) + " columns";
     return false;
   }
+  // Counts become integers only when they are whole numbers in range (a cast of 1e40 is
+  // undefined behaviour).
+  if (!(v[12] >= 0 && v[12] <= 9007199254740992.0 && v[12] == std::floor(v[12]))) {
+    why = "the tick (column 13) is not a whole number from 0 to 2^53";
+    return false;
+  }
+  if (!(v[14] >= -1 && v[14] < kVertebrae && v[14] == std::floor(v[14]))) {
+    why = "the hooked vertebra (column 15) is not -1 or a vertebra index 0.." +
+          std::to_string(kVertebrae - 1);
+    return false;
+  }
   f.t_s = v[0];
   f.probe_mm = Eigen::Vector3d(v[1], v[2], v[3]);
   f.hand_force_n = Eigen::Vector3d(v[5], v[6], v[7]);

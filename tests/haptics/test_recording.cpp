@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <tuple>
 
 namespace st = spinesim::haptics;
 namespace sp = spinesim::spine;
@@ -148,6 +149,20 @@ TEST(HapticRecording, BadRecordingsAreRefusedInOneLine) {
   const std::string bad = (scratch() / "nan.csv").string();
   std::ofstream(bad, std::ios::trunc) << text;
   expect_refused(bad, "not a finite number");
+  // Counts out of range (the fuzzer's 2.6e39 ticks, a hooked vertebra 1e12): refused, not cast.
+  for (const auto& [column, value, needle] :
+       {std::tuple<int, const char*, const char*>{12, "2.6e39", "tick"},
+        std::tuple<int, const char*, const char*>{12, "3.5", "tick"},
+        std::tuple<int, const char*, const char*>{14, "1e12", "hooked vertebra"}}) {
+    text = slurp(write_recording("count.csv", ticks(5)));
+    const auto row = text.find("\n0.003000,") + 1;
+    std::size_t cell = row;
+    for (int k = 0; k < column; ++k) cell = text.find(',', cell) + 1;
+    text.replace(cell, text.find(',', cell) - cell, value);
+    const std::string counted = (scratch() / "count.csv").string();
+    std::ofstream(counted, std::ios::trunc) << text;
+    expect_refused(counted, needle);
+  }
 }
 
 // A recording is whole only when its end line counts exactly the rows read and the run ended by
