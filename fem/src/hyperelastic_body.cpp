@@ -4,6 +4,8 @@
 #include "spinesim/fem/cholmod_solver.hpp"
 #include "spinesim/fem/hyperelastic_element.hpp"
 
+#include "newton_steps.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -201,14 +203,13 @@ struct NewtonRun {
         return true;
       }
       const double slope = r.dot(step);  // dE/dα at α = 0 (< 0 for a descent direction)
-      bool stepped = false;
-      for (double alpha = 1.0; alpha >= 1e-8 && !stepped; alpha *= 0.5) {
-        const Eigen::VectorXd x = moved(trial, step, alpha);
-        const double e = body.evaluate(x, false).energy;
-        if (std::isfinite(e) && (slope >= 0 || e <= ev.energy + 1e-4 * alpha * slope))
-          trial = x, stepped = true;
-      }
-      if (!stepped) return false;
+      const double alpha =
+          detail::backtrack({ev.energy, r.norm()}, slope, ev.energy, [&](double a) {
+            const HyperelasticBody::Evaluation e = body.evaluate(moved(trial, step, a), false);
+            return detail::TrialPoint{e.energy, split.free_part(e.force).norm()};
+          });
+      if (alpha == 0) return false;
+      trial = moved(trial, step, alpha);
     }
     return false;
   }
@@ -225,27 +226,10 @@ HyperelasticSolution HyperelasticBody::solve(const std::vector<PrescribedDisplac
   const Split split = split_dofs(ndof, prescribed);
   HyperelasticSolution sol;
   NewtonRun run{*this, split, options, sol, Eigen::VectorXd::Zero(ndof), CholmodSolver(), false};
-  double done = 0, size = 1.0 / options.load_increments;
-  int cuts_in_a_row = 0;
-  while (done < 1.0 - 1e-12) {
-    const double to = std::min(1.0, done + size);
+  sol.failure = detail::ramp(options, sol, "the load", [&](double to) {
     Eigen::VectorXd trial;
-    if (run.predict(to, trial) && run.correct(trial)) {
-      ++sol.increments;
-      done = to;
-      cuts_in_a_row = 0;
-      continue;
-    }
-    if (++cuts_in_a_row > options.max_cutbacks) {
-      sol.failure = "Newton did not converge from " + std::to_string(done) + " to " +
-                    std::to_string(to) + " of the load after " +
-                    std::to_string(options.max_cutbacks) + " halvings of the increment (residual " +
-                    std::to_string(sol.residual_n) + " N)";
-      break;
-    }
-    ++sol.cutbacks;
-    size *= 0.5;
-  }
+    return run.predict(to, trial) && run.correct(trial);
+  });
   sol.converged = sol.failure.empty();
   const Evaluation last = evaluate(run.u, false);
   sol.energy_mj = last.energy;

@@ -5,6 +5,8 @@
 #include "spinesim/common/timer.hpp"
 #include "spinesim/fem/cholmod_solver.hpp"
 
+#include "newton_steps.hpp"
+
 #include <Eigen/Cholesky>
 #include <Eigen/Geometry>
 
@@ -63,23 +65,7 @@ class PlateNewton {
 
   /// Ramps the plate values in increments, halving failing ones; fills the solution.
   Vector6 run() {
-    double done = 0, size = 1.0 / o_.load_increments;
-    int cuts = 0;
-    while (done < 1.0 - 1e-12) {
-      const double to = std::min(1.0, done + size);
-      if (increment(to)) {
-        ++sol_.increments, done = to, cuts = 0;
-        continue;
-      }
-      if (++cuts > o_.max_cutbacks) {
-        sol_.failure = "Newton did not converge from " + std::to_string(done) + " to " +
-                       std::to_string(to) + " of the plate load after " +
-                       std::to_string(o_.max_cutbacks) + " halvings of the increment (residual " +
-                       std::to_string(sol_.residual_n) + ")";
-        break;
-      }
-      ++sol_.cutbacks, size *= 0.5;
-    }
+    sol_.failure = ramp(o_, sol_, "the plate load", [this](double to) { return increment(to); });
     sol_.converged = sol_.failure.empty();
     const Eigen::VectorXd u = full(uf_, p_);
     const HyperelasticBody::Evaluation ev = body_.evaluate(u, false);
@@ -142,6 +128,16 @@ class PlateNewton {
     double work = 0;
     for (const int k : loaded_) work += lambda * pr_.value(k) * p(k);
     return energy - work;
+  }
+
+  /// Π and the residual norm ‖(r_f, g_P − λ w)‖ at a state.
+  TrialPoint trial_point(const Eigen::VectorXd& uf, const Vector6& p, double lambda) const {
+    const HyperelasticBody::Evaluation ev = body_.evaluate(full(uf, p), false);
+    double r2 = 0;
+    for (std::size_t k = 0; k < free_dofs_.size(); ++k) r2 += std::pow(ev.force(free_dofs_[k]), 2);
+    const Vector6 g = plate_force(p, ev.force);
+    for (const int k : loaded_) r2 += std::pow(g(k) - lambda * pr_.value(k), 2);
+    return {potential(ev.energy, p, lambda), std::sqrt(r2)};
   }
 
   bool factorize(const Linearised& L) {
@@ -275,18 +271,14 @@ bool PlateNewton::increment(double to) {
       uf_ = uf, p_ = p;
       return true;
     }
-    const double pi0 = potential(L.energy, p, to);
     double slope = L.r_f.dot(du);
     for (const int k : loaded_) slope += (L.g_p(k) - to * pr_.value(k)) * dp(k);
-    bool stepped = false;
-    for (double alpha = 1.0; alpha >= 1e-8 && !stepped; alpha *= 0.5) {
-      const Vector6 tp = p + alpha * dp;
-      const double e = body_.evaluate(full(uf + alpha * du, tp), false).energy;
-      const double pi = potential(e, tp, to);
-      if (std::isfinite(pi) && (slope >= 0 || pi <= pi0 + 1e-4 * alpha * slope))
-        uf += alpha * du, p = tp, stepped = true;
-    }
-    if (!stepped) return false;
+    const double pi0 = potential(L.energy, p, to), work = L.energy - pi0;
+    const double alpha =
+        backtrack({pi0, r.norm()}, slope, std::max(L.energy, std::abs(work)),
+                  [&](double a) { return trial_point(uf + a * du, p + a * dp, to); });
+    if (alpha == 0) return false;
+    uf += alpha * du, p += alpha * dp;
   }
   return false;
 }
