@@ -106,35 +106,51 @@ FibreHyperelastic neo_hookean_from_linear(double young_mpa, double poisson) {
   return m;
 }
 
-MaterialPointState fibre_hyperelastic_point(const Eigen::Matrix3d& C, const FibreHyperelastic& m,
-                                            bool with_tangent) {
-  MaterialPointState out;
-  const double det = C.determinant();
-  if (!(det > 0) || !C.allFinite()) {
-    out.energy = std::numeric_limits<double>::quiet_NaN();
-    return out;
-  }
-  const double J = std::sqrt(det), j23 = std::pow(J, -2.0 / 3.0);
-  const Eigen::Matrix3d Ci = C.inverse();
-  Matrix6d dCi, CiCi;
-  if (with_tangent) {
-    dCi = inverse_derivative(Ci);
-    CiCi = outer(Ci, Ci);
-  }
-  const Matrix6d* pdCi = with_tangent ? &dCi : nullptr;
-  const Matrix6d* pCiCi = with_tangent ? &CiCi : nullptr;
+namespace {
 
+/// C⁻¹, J and the Voigt tensors of C⁻¹ a material point needs; false when det C <= 0.
+struct Kinematics {
+  double J = 0;
+  Eigen::Matrix3d Ci;
+  Matrix6d dCi, CiCi;  ///< −∂C⁻¹/∂C and C⁻¹ ⊗ C⁻¹ (only with the tangent)
+};
+
+bool kinematics(const Eigen::Matrix3d& C, bool with_tangent, Kinematics& k) {
+  const double det = C.determinant();
+  if (!(det > 0) || !C.allFinite()) return false;
+  k.J = std::sqrt(det);
+  k.Ci = C.inverse();
+  if (with_tangent) k.dCi = inverse_derivative(k.Ci), k.CiCi = outer(k.Ci, k.Ci);
+  return true;
+}
+
+MaterialPointState invalid_state() {
+  MaterialPointState out;
+  out.energy = std::numeric_limits<double>::quiet_NaN();
+  return out;
+}
+
+MaterialPointState checked(MaterialPointState out) {
+  if (!std::isfinite(out.energy) || !out.S.allFinite() || !out.tangent.allFinite())
+    out.energy = std::numeric_limits<double>::quiet_NaN();
+  return out;
+}
+
+MaterialPointState isochoric_part(const Eigen::Matrix3d& C, const FibreHyperelastic& m,
+                                  const Kinematics& k, bool with_tangent) {
+  MaterialPointState out;
+  const double j23 = std::pow(k.J, -2.0 / 3.0);
+  const Matrix6d* pdCi = with_tangent ? &k.dCi : nullptr;
+  const Matrix6d* pCiCi = with_tangent ? &k.CiCi : nullptr;
   // ∂W/∂C, term by term; S = 2 ∂W/∂C, ℂ = 4 ∂²W/∂C².
-  const IsochoricInvariant i1 = isochoric(Eigen::Matrix3d::Identity(), C, Ci, j23, pdCi, pCiCi);
-  out.energy = m.c10_mpa * (i1.value - 3.0) + (J - 1.0) * (J - 1.0) / m.d1_per_mpa;
-  Eigen::Matrix3d dW = m.c10_mpa * i1.first + (J * J - J) / m.d1_per_mpa * Ci;
+  const IsochoricInvariant i1 = isochoric(Eigen::Matrix3d::Identity(), C, k.Ci, j23, pdCi, pCiCi);
+  out.energy = m.c10_mpa * (i1.value - 3.0);
+  Eigen::Matrix3d dW = m.c10_mpa * i1.first;
   Matrix6d d2W = Matrix6d::Zero();
-  if (with_tangent)
-    d2W = m.c10_mpa * i1.second +
-          ((2.0 * J - 1.0) * J / 2.0 * CiCi - (J * J - J) * dCi) / m.d1_per_mpa;
+  if (with_tangent) d2W = m.c10_mpa * i1.second;
   for (const FibreFamily& f : m.fibres) {
     const Eigen::Matrix3d A = f.direction * f.direction.transpose();
-    const IsochoricInvariant i4 = isochoric(A, C, Ci, j23, pdCi, pCiCi);
+    const IsochoricInvariant i4 = isochoric(A, C, k.Ci, j23, pdCi, pCiCi);
     const FibreLaw law = fibre_law(f, i4.value);
     if (i4.value > 1.0) ++out.fibres_in_tension;
     if (i4.value < 1.0) continue;
@@ -144,9 +160,48 @@ MaterialPointState fibre_hyperelastic_point(const Eigen::Matrix3d& C, const Fibr
   }
   out.S = 2.0 * dW;
   out.tangent = 4.0 * d2W;
-  if (!std::isfinite(out.energy) || !out.S.allFinite() || !out.tangent.allFinite())
-    out.energy = std::numeric_limits<double>::quiet_NaN();
   return out;
+}
+
+/// S = p J C⁻¹ and ℂ = 2 ∂S/∂C at fixed p = p J (C⁻¹ ⊗ C⁻¹ − 2 (−∂C⁻¹/∂C)).
+void add_pressure(double p, const Kinematics& k, bool with_tangent, MaterialPointState& out) {
+  out.S += p * k.J * k.Ci;
+  if (with_tangent) out.tangent += p * k.J * (k.CiCi - 2.0 * k.dCi);
+}
+
+}  // namespace
+
+VolumetricEnergy volumetric_energy(double J, const FibreHyperelastic& m) {
+  return {(J - 1.0) * (J - 1.0) / m.d1_per_mpa, 2.0 * (J - 1.0) / m.d1_per_mpa, 2.0 / m.d1_per_mpa};
+}
+
+MaterialPointState fibre_hyperelastic_point(const Eigen::Matrix3d& C, const FibreHyperelastic& m,
+                                            bool with_tangent) {
+  Kinematics k;
+  if (!kinematics(C, with_tangent, k)) return invalid_state();
+  MaterialPointState out = isochoric_part(C, m, k, with_tangent);
+  // U(J) with ∂J/∂C = J C⁻¹/2: S gains U'(J) J C⁻¹, ℂ the fixed-pressure part and U'' J² C⁻¹⊗C⁻¹.
+  const VolumetricEnergy U = volumetric_energy(k.J, m);
+  out.energy += U.value;
+  add_pressure(U.first, k, with_tangent, out);
+  if (with_tangent) out.tangent += U.second * k.J * k.J * k.CiCi;
+  return checked(out);
+}
+
+MaterialPointState isochoric_point(const Eigen::Matrix3d& C, const FibreHyperelastic& m,
+                                   bool with_tangent) {
+  Kinematics k;
+  if (!kinematics(C, with_tangent, k)) return invalid_state();
+  return checked(isochoric_part(C, m, k, with_tangent));
+}
+
+MaterialPointState pressure_point(const Eigen::Matrix3d& C, double pressure_mpa,
+                                  bool with_tangent) {
+  Kinematics k;
+  if (!kinematics(C, with_tangent, k)) return invalid_state();
+  MaterialPointState out;
+  add_pressure(pressure_mpa, k, with_tangent, out);
+  return checked(out);
 }
 
 Eigen::Matrix3d cauchy_stress(const Eigen::Matrix3d& F, const FibreHyperelastic& m) {

@@ -14,8 +14,9 @@
 
 namespace spinesim::fem {
 
-HyperelasticBody::HyperelasticBody(FeSpace space, std::vector<FibreHyperelastic> element_materials)
-    : space_(std::move(space)), materials_(std::move(element_materials)) {
+HyperelasticBody::HyperelasticBody(FeSpace space, std::vector<FibreHyperelastic> element_materials,
+                                   VolumetricForm form)
+    : space_(std::move(space)), materials_(std::move(element_materials)), form_(form) {
   if (Eigen::Index(materials_.size()) != space_.elements.rows())
     throw std::invalid_argument("hyperelastic body: " + std::to_string(materials_.size()) +
                                 " materials for " + std::to_string(space_.elements.rows()) +
@@ -38,7 +39,7 @@ HyperelasticBody::Evaluation HyperelasticBody::evaluate(const Eigen::VectorXd& u
     for (int a = 0; a < 4; ++a) X.row(a) = space_.X.row(space_.elements(t, a));
     for (int a = 0; a < npe; ++a) ue.row(a) = u.segment<3>(3 * space_.elements(t, a)).transpose();
     const HyperelasticElement e =
-        hyperelastic_element(space_.order, X, ue, materials_[std::size_t(t)], with_tangent);
+        hyperelastic_element(space_.order, X, ue, materials_[std::size_t(t)], with_tangent, form_);
     out.energy += e.energy;
     out.inverted += e.inverted_points;
     for (int a = 0; a < npe; ++a) {

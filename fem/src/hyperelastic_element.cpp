@@ -4,8 +4,10 @@
 
 #include <Eigen/LU>
 
+#include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <vector>
 
 namespace spinesim::fem {
 
@@ -28,13 +30,10 @@ Eigen::Matrix<double, 6, 3> strain_displacement(const Eigen::Matrix3d& F,
 
 }  // namespace
 
-HyperelasticElement hyperelastic_element(int order, const TetVertices& X, const Eigen::MatrixX3d& u,
-                                         const FibreHyperelastic& m, bool with_tangent) {
-  if (order != 1 && order != 2) throw std::invalid_argument("element order must be 1 or 2");
-  const int npe = order == 1 ? 4 : 10;
-  if (u.rows() != npe) throw std::invalid_argument("element displacements: wrong node count");
-  double volume = 0;
-  const Eigen::Matrix<double, 4, 3> gL = barycentric_gradients(X, volume);
+namespace {
+
+/// The quadrature rule of an element order: one point for P1, the symmetric 4-point rule for P2.
+const TetQuadrature& element_rule(int order) {
   static const TetQuadrature p1 = [] {
     TetQuadrature q;
     q.barycentric = Eigen::RowVector4d::Constant(0.25);
@@ -42,40 +41,88 @@ HyperelasticElement hyperelastic_element(int order, const TetVertices& X, const 
     return q;
   }();
   static const TetQuadrature p2 = tet_rule_degree2();
-  const TetQuadrature& rule = order == 1 ? p1 : p2;
+  return order == 1 ? p1 : p2;
+}
+
+/// Adds one point's ∫ Bᵀ S and ∫ Bᵀ ℂ B + (∇N_a · S ∇N_b) I (weight dV) to the element.
+void add_point(const Eigen::Matrix3d& F, const Eigen::MatrixX3d& G, const MaterialPointState& p,
+               double dV, bool with_tangent, HyperelasticElement& out) {
+  const auto npe = int(G.rows());
+  std::vector<Eigen::Matrix<double, 6, 3>> B(static_cast<std::size_t>(npe));
+  const Vector6d S = to_voigt(p.S);
+  for (int a = 0; a < npe; ++a) {
+    B[std::size_t(a)] = strain_displacement(F, G.row(a).transpose());
+    out.force.segment<3>(3 * a) += dV * B[std::size_t(a)].transpose() * S;
+  }
+  if (!with_tangent) return;
+  for (int a = 0; a < npe; ++a) {
+    const Eigen::Matrix<double, 3, 6> BaC = B[std::size_t(a)].transpose() * p.tangent;
+    const Eigen::RowVector3d gSa = G.row(a) * p.S;
+    for (int b = 0; b <= a; ++b) {
+      Eigen::Matrix3d k = BaC * B[std::size_t(b)];
+      k.diagonal().array() += gSa.dot(G.row(b));
+      out.tangent.block<3, 3>(3 * a, 3 * b) += dV * k;
+      if (b != a) out.tangent.block<3, 3>(3 * b, 3 * a) += dV * k.transpose();
+    }
+  }
+}
+
+}  // namespace
+
+HyperelasticElement hyperelastic_element(int order, const TetVertices& X, const Eigen::MatrixX3d& u,
+                                         const FibreHyperelastic& m, bool with_tangent,
+                                         VolumetricForm form) {
+  if (order != 1 && order != 2) throw std::invalid_argument("element order must be 1 or 2");
+  const int npe = order == 1 ? 4 : 10;
+  if (u.rows() != npe) throw std::invalid_argument("element displacements: wrong node count");
+  double volume = 0;
+  const Eigen::Matrix<double, 4, 3> gL = barycentric_gradients(X, volume);
+  const TetQuadrature& rule = element_rule(order);
+  const auto nq = rule.weights.size();
 
   HyperelasticElement out;
   out.force = Eigen::VectorXd::Zero(3 * npe);
   if (with_tangent) out.tangent = Eigen::MatrixXd::Zero(3 * npe, 3 * npe);
-  std::vector<Eigen::Matrix<double, 6, 3>> B(static_cast<std::size_t>(npe));
-  for (Eigen::Index q = 0; q < rule.weights.size(); ++q) {
-    const Eigen::Vector4d L = rule.barycentric.row(q).transpose();
-    const Eigen::MatrixX3d G = shape_gradients(order, gL, L);
-    const Eigen::Matrix3d F = Eigen::Matrix3d::Identity() + u.transpose() * G;
-    const double dV = rule.weights(q) * volume;
-    if (!(F.determinant() > 0)) {
+  std::vector<Eigen::MatrixX3d> G(static_cast<std::size_t>(nq));
+  std::vector<Eigen::Matrix3d> F(static_cast<std::size_t>(nq));
+  // The element's mean dilatation J̄ = ∫ J dV₀ / V₀ and d = ∂J̄/∂u (∂J/∂u_a = J F⁻ᵀ ∇N_a).
+  double J_mean = 0;
+  Eigen::VectorXd d = Eigen::VectorXd::Zero(3 * npe);
+  for (Eigen::Index q = 0; q < nq; ++q) {
+    const std::size_t k = std::size_t(q);
+    G[k] = shape_gradients(order, gL, rule.barycentric.row(q).transpose());
+    F[k] = Eigen::Matrix3d::Identity() + u.transpose() * G[k];
+    const double J = F[k].determinant();
+    if (!(J > 0)) {
       ++out.inverted_points;
-      out.energy = std::numeric_limits<double>::quiet_NaN();
       continue;
     }
-    const MaterialPointState p = fibre_hyperelastic_point(F.transpose() * F, m, with_tangent);
-    out.energy += dV * p.energy;
-    const Vector6d S = to_voigt(p.S);
-    for (int a = 0; a < npe; ++a) {
-      B[std::size_t(a)] = strain_displacement(F, G.row(a).transpose());
-      out.force.segment<3>(3 * a) += dV * B[std::size_t(a)].transpose() * S;
+    J_mean += rule.weights(q) * J;
+    const Eigen::Matrix3d FiT = F[k].inverse().transpose();
+    for (int a = 0; a < npe; ++a)
+      d.segment<3>(3 * a) += rule.weights(q) * J * FiT * G[k].row(a).transpose();
+  }
+  if (out.inverted_points > 0) {
+    out.energy = std::numeric_limits<double>::quiet_NaN();
+    return out;
+  }
+  const bool mean = form == VolumetricForm::mean_dilatation;
+  const VolumetricEnergy U = volumetric_energy(J_mean, m);
+  for (Eigen::Index q = 0; q < nq; ++q) {
+    const std::size_t k = std::size_t(q);
+    const Eigen::Matrix3d C = F[k].transpose() * F[k];
+    MaterialPointState p =
+        mean ? isochoric_point(C, m, with_tangent) : fibre_hyperelastic_point(C, m, with_tangent);
+    if (mean && std::isfinite(p.energy)) {
+      const MaterialPointState v = pressure_point(C, U.first, with_tangent);
+      p.S += v.S, p.tangent += v.tangent;
     }
-    if (!with_tangent) continue;
-    for (int a = 0; a < npe; ++a) {
-      const Eigen::Matrix<double, 3, 6> BaC = B[std::size_t(a)].transpose() * p.tangent;
-      const Eigen::RowVector3d gSa = G.row(a) * p.S;
-      for (int b = 0; b <= a; ++b) {
-        Eigen::Matrix3d k = BaC * B[std::size_t(b)];
-        k.diagonal().array() += gSa.dot(G.row(b));
-        out.tangent.block<3, 3>(3 * a, 3 * b) += dV * k;
-        if (b != a) out.tangent.block<3, 3>(3 * b, 3 * a) += dV * k.transpose();
-      }
-    }
+    out.energy += rule.weights(q) * volume * p.energy;
+    add_point(F[k], G[k], p, rule.weights(q) * volume, with_tangent, out);
+  }
+  if (mean) {
+    out.energy += volume * U.value;
+    if (with_tangent) out.tangent += volume * U.second * d * d.transpose();
   }
   return out;
 }

@@ -35,17 +35,17 @@ std::vector<FibreHyperelastic> disc_element_materials(const mesh::TetMesh& mesh,
 namespace {
 
 HyperelasticBody make_body(const mesh::TetMesh& mesh, std::vector<FibreHyperelastic> materials,
-                           int order) {
+                           int order, VolumetricForm form) {
   mesh::require_endplate_labels(mesh);
-  return HyperelasticBody(make_fe_space(mesh, order), std::move(materials));
+  return HyperelasticBody(make_fe_space(mesh, order), std::move(materials), form);
 }
 
 }  // namespace
 
 NonlinearDisc::NonlinearDisc(const mesh::TetMesh& mesh,
                              std::vector<FibreHyperelastic> element_materials, int order,
-                             const Eigen::Vector3d& plate_center_mm)
-    : body_(make_body(mesh, std::move(element_materials), order)), center_(plate_center_mm) {
+                             const Eigen::Vector3d& plate_center_mm, VolumetricForm form)
+    : body_(make_body(mesh, std::move(element_materials), order, form)), center_(plate_center_mm) {
   labels_ = node_surface_labels(body_.space(), mesh);
   if (!center_.allFinite()) throw std::invalid_argument("plate centre: not finite");
 }

@@ -67,6 +67,42 @@ TEST(FibreHyperelastic, TangentIsTheStresssDerivative) {
   EXPECT_LE((p.tangent - p.tangent.transpose()).norm(), 1e-12 * p.tangent.norm());
 }
 
+// The split the mean-dilatation element uses: W̄ has no volumetric stress (S̄ : C = 0, the
+// isochoric part is deviatoric in the sense of C), the pressure part at fixed p is p J C⁻¹ with
+// the fixed-p tangent (central differences), and the parts sum to the whole point.
+TEST(FibreHyperelastic, IsochoricAndPressurePartsSumToThePoint) {
+  const FibreHyperelastic m = annulus();
+  const Eigen::Matrix3d F = deformation(), C = F.transpose() * F;
+  const double J = F.determinant();
+  const MaterialPointState whole = fibre_hyperelastic_point(C, m);
+  const MaterialPointState iso = isochoric_point(C, m);
+  EXPECT_NEAR((iso.S * C).trace(), 0, 1e-12 * iso.S.norm());
+  const VolumetricEnergy U = volumetric_energy(J, m);
+  EXPECT_NEAR(U.value, (J - 1) * (J - 1) / m.d1_per_mpa, 1e-15);
+  const double h = 1e-6;
+  EXPECT_NEAR(U.first,
+              (volumetric_energy(J + h, m).value - volumetric_energy(J - h, m).value) / (2 * h),
+              1e-8);
+  const MaterialPointState vol = pressure_point(C, U.first);
+  EXPECT_NEAR(vol.energy, 0, 0);
+  EXPECT_LE((vol.S - U.first * J * C.inverse()).norm(), 1e-14 * vol.S.norm());
+  for (int K = 0; K < 6; ++K) {
+    const Vector6d dS = (to_voigt(pressure_point(C + h * unit(K), U.first, false).S) -
+                         to_voigt(pressure_point(C - h * unit(K), U.first, false).S)) /
+                        (2 * h);
+    EXPECT_LE((dS - vol.tangent.col(K) * (K < 3 ? 0.5 : 1.0)).norm(), 1e-6 * vol.tangent.norm());
+  }
+  const Eigen::Matrix3d Ci = C.inverse();
+  Matrix6d CiCi;
+  for (int I = 0; I < 6; ++I)
+    for (int K = 0; K < 6; ++K) CiCi(I, K) = to_voigt(Ci)(I) * to_voigt(Ci)(K);
+  EXPECT_NEAR(whole.energy, iso.energy + U.value, 1e-14 * whole.energy);
+  EXPECT_LE((whole.S - iso.S - vol.S).norm(), 1e-13 * whole.S.norm());
+  EXPECT_LE((whole.tangent - iso.tangent - vol.tangent - U.second * J * J * CiCi).norm(),
+            1e-12 * whole.tangent.norm());
+  EXPECT_EQ(iso.fibres_in_tension, whole.fibres_in_tension);
+}
+
 TEST(FibreHyperelastic, AtRestTheMatrixIsTheLinearIsotropicMaterial) {
   const mesh::IsotropicMaterial lin{4.2, 0.45, 1200.0};
   const FibreHyperelastic m = neo_hookean_from_linear(lin.youngs_modulus_mpa, lin.poisson_ratio);

@@ -65,7 +65,7 @@ TEST_P(DiscAgainstCalculix, SameDisplacementsAndWrench) {
   const auto materials =
       disc_element_materials(m, mesh::load_material("fibre-reinforced", SPINESIM_DATA_DIR), 10.0);
   const Eigen::Vector3d c = DiscFem::default_plate_center(m);
-  const NonlinearDisc d(m, materials, order, c);
+  const NonlinearDisc d(m, materials, order, c, VolumetricForm::pointwise);
   Vector6 q = Vector6::Zero();
   q(1) = -0.3;
   q(4) = 6.0 * M_PI / 180.0;

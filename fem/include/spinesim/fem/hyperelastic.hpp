@@ -62,6 +62,23 @@ struct MaterialPointState {
 MaterialPointState fibre_hyperelastic_point(const Eigen::Matrix3d& C, const FibreHyperelastic& m,
                                             bool with_tangent = true);
 
+/// The split W = W̄(C) + U(J) the mean-dilatation element (hyperelastic_element.hpp) needs:
+/// U(J) = (J − 1)²/D1 and its first two derivatives (MPa) ...
+struct VolumetricEnergy {
+  double value = 0, first = 0, second = 0;
+};
+VolumetricEnergy volumetric_energy(double J, const FibreHyperelastic& m);
+
+/// ... W̄ alone — the matrix's Ī1 term and the fibres, with its S and ℂ ...
+MaterialPointState isochoric_point(const Eigen::Matrix3d& C, const FibreHyperelastic& m,
+                                   bool with_tangent = true);
+
+/// ... and the volumetric stress at a pressure p held fixed: S = p J C⁻¹, ℂ = 2 ∂S/∂C at fixed p
+/// (energy 0). fibre_hyperelastic_point is isochoric_point + pressure_point(U'(J)) + U''(J) J²
+/// C⁻¹ ⊗ C⁻¹ in ℂ.
+MaterialPointState pressure_point(const Eigen::Matrix3d& C, double pressure_mpa,
+                                  bool with_tangent = true);
+
 /// The Cauchy stress σ = J⁻¹ F S Fᵀ (MPa) of the deformation gradient F.
 Eigen::Matrix3d cauchy_stress(const Eigen::Matrix3d& F, const FibreHyperelastic& m);
 

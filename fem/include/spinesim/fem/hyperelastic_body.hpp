@@ -15,6 +15,7 @@
 
 #include "spinesim/fem/fe_space.hpp"
 #include "spinesim/fem/hyperelastic.hpp"
+#include "spinesim/fem/hyperelastic_element.hpp"
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
@@ -52,7 +53,8 @@ class HyperelasticBody {
  public:
   /// One material per tet (validated). Throws std::invalid_argument for a count that does not
   /// match the elements or a bad material.
-  HyperelasticBody(FeSpace space, std::vector<FibreHyperelastic> element_materials);
+  HyperelasticBody(FeSpace space, std::vector<FibreHyperelastic> element_materials,
+                   VolumetricForm form = VolumetricForm::pointwise);
 
   /// Energy, internal force (3·#nodes) and, if asked, the full tangent (lower triangle) at the
   /// nodal displacements u (3·#nodes, node-major). `inverted` counts quadrature points with
@@ -71,10 +73,12 @@ class HyperelasticBody {
                              const NewtonOptions& options = NewtonOptions()) const;
 
   const FeSpace& space() const { return space_; }
+  VolumetricForm form() const { return form_; }
 
  private:
   FeSpace space_;
   std::vector<FibreHyperelastic> materials_;
+  VolumetricForm form_ = VolumetricForm::pointwise;
 };
 
 }  // namespace spinesim::fem

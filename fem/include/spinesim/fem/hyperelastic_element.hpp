@@ -7,7 +7,10 @@
 //   K_ab = ∫ B_aᵀ ℂ B_b + (∇N_a · S ∇N_b) I dV₀             (material + geometric stiffness, N/mm)
 //
 // (Bonet & Wood, Nonlinear Continuum Mechanics for Finite Element Analysis, ch. 7; Voigt order
-// and units as elasticity.hpp.) Quadrature: one point for P1 (F is constant), the symmetric
+// and units as elasticity.hpp.) With VolumetricForm::mean_dilatation, ∫ U(J) dV₀ becomes V₀ U(J̄):
+//   f += V₀ U'(J̄) ∂J̄/∂u (through S = p J C⁻¹ at each point, p = U'(J̄)),
+//   K += V₀ U''(J̄) d dᵀ, d = ∂J̄/∂u = ∫ J F⁻ᵀ∇N_a dV₀ / V₀.
+// Quadrature: one point for P1 (F is constant), the symmetric
 // 4-point rule for P2 (as CalculiX's C3D10). DOF order node-major, (x, y, z) per node.
 #pragma once
 
@@ -18,6 +21,16 @@
 
 namespace spinesim::fem {
 
+/// How the element integrates the volumetric energy U(J):
+/// - pointwise: U(J) at each quadrature point — the standard displacement element, as CalculiX's
+///   C3D4/C3D10; it locks when K ≫ μ (a nearly incompressible nucleus);
+/// - mean_dilatation: V₀ U(J̄) with J̄ = ∫ J dV₀ / V₀, the element's mean dilatation (a constant
+///   pressure p = U'(J̄) per element, condensed exactly; Nagtegaal, Parks & Rice 1974; Simo, Taylor
+///   & Pister 1985). The isochoric part W̄ stays pointwise. The tangent is symmetric and, for a
+///   stable state, positive definite — one Cholesky per Newton step. On P1 J is constant and the
+///   two forms coincide; on P2 (P2/P0) it relieves the locking.
+enum class VolumetricForm { pointwise, mean_dilatation };
+
 struct HyperelasticElement {
   double energy = 0;        ///< ∫ W dV₀, mJ (N·mm); NaN when a point has no valid state
   Eigen::VectorXd force;    ///< 3·npe internal force, N
@@ -27,6 +40,7 @@ struct HyperelasticElement {
 
 /// `u` is npe×3 (4 or 10 nodes), mm; X the 4 vertices in the reference configuration.
 HyperelasticElement hyperelastic_element(int order, const TetVertices& X, const Eigen::MatrixX3d& u,
-                                         const FibreHyperelastic& m, bool with_tangent = true);
+                                         const FibreHyperelastic& m, bool with_tangent = true,
+                                         VolumetricForm form = VolumetricForm::pointwise);
 
 }  // namespace spinesim::fem

@@ -50,8 +50,11 @@ class NonlinearDisc {
  public:
   /// Throws std::invalid_argument for a mesh without endplate labels, a bad order or material
   /// count.
+  /// `form`: how the elements take the volume change (hyperelastic_element.hpp); the mean
+  /// dilatation keeps a nearly incompressible nucleus from locking on P2.
   NonlinearDisc(const mesh::TetMesh& mesh, std::vector<FibreHyperelastic> element_materials,
-                int order, const Eigen::Vector3d& plate_center_mm);
+                int order, const Eigen::Vector3d& plate_center_mm,
+                VolumetricForm form = VolumetricForm::pointwise);
 
   NonlinearPlateSolution solve_motion(const Eigen::Matrix<double, 6, 1>& motion,
                                       const NewtonOptions& options = NewtonOptions()) const;
