@@ -6,6 +6,8 @@
 
 #include "newton_steps.hpp"
 
+#include <Eigen/LU>
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -13,6 +15,169 @@
 #include <utility>
 
 namespace spinesim::fem {
+
+namespace {
+
+using Triplets = std::vector<Eigen::Triplet<double>>;
+
+/// Σ over the tets of `element_at(t, X, u_e)`: energy, inverted points, nodal forces, and the
+/// tangent's lower-triangle entries appended to `triplets` (with_tangent).
+template <class ElementAt>
+HyperelasticBody::Evaluation assemble(const FeSpace& space, const Eigen::VectorXd& u,
+                                      bool with_tangent, Triplets& triplets,
+                                      ElementAt&& element_at) {
+  const int npe = space.nodes_per_element();
+  HyperelasticBody::Evaluation out;
+  out.force = Eigen::VectorXd::Zero(3 * space.num_nodes());
+  if (with_tangent) triplets.reserve(std::size_t(space.elements.rows()) * 9 * npe * (npe + 1) / 2);
+  Eigen::MatrixX3d ue(npe, 3);
+  for (Eigen::Index t = 0; t < space.elements.rows(); ++t) {
+    TetVertices X;
+    for (int a = 0; a < 4; ++a) X.row(a) = space.X.row(space.elements(t, a));
+    for (int a = 0; a < npe; ++a) ue.row(a) = u.segment<3>(3 * space.elements(t, a)).transpose();
+    const HyperelasticElement e = element_at(t, X, ue);
+    out.energy += e.energy;
+    out.inverted += e.inverted_points;
+    for (int a = 0; a < npe; ++a) {
+      const Eigen::Index A = space.elements(t, a);
+      out.force.segment<3>(3 * A) += e.force.segment<3>(3 * a);
+      if (!with_tangent) continue;
+      for (int b = 0; b < npe; ++b) {
+        const Eigen::Index B = space.elements(t, b);
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j)
+            if (3 * A + i >= 3 * B + j)
+              triplets.emplace_back(3 * A + i, 3 * B + j, e.tangent(3 * a + i, 3 * b + j));
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+/// The nodal-average volumetric form on P1 (hyperelastic_element.hpp, VolumetricForm): nodes
+/// carry one volume per bulk modulus met around them, so that a region interface (nucleus and
+/// annulus) does not average an incompressible region with a compressible one. The volumes come
+/// from J = det(I + ∇u) of each tet, not from the moved vertices: differences of positions tens
+/// of millimetres from the origin lose ~|X|/h of the digits of J − 1, and with a bulk modulus
+/// thousands of times the shear modulus that rounding becomes a residual Newton cannot remove.
+namespace detail {
+
+class NodalVolumes {
+ public:
+  NodalVolumes(const FeSpace& space, const std::vector<FibreHyperelastic>& materials)
+      : group_(materials.size()) {
+    if (space.order != 1)
+      throw std::invalid_argument("hyperelastic body: the nodal-average volume needs P1 elements");
+    std::vector<double> d1s;
+    for (std::size_t t = 0; t < materials.size(); ++t) {
+      const auto it = std::find(d1s.begin(), d1s.end(), materials[t].d1_per_mpa);
+      group_[t] = int(it - d1s.begin());
+      if (it == d1s.end()) d1s.push_back(materials[t].d1_per_mpa);
+    }
+    groups_ = int(d1s.size());
+    slots_.resize(space.elements.rows(), 4);
+    gradients_.resize(materials.size());
+    tet_volume_.resize(space.elements.rows());
+    reference_ = Eigen::VectorXd::Zero(space.num_nodes() * groups_);
+    group_material_.resize(d1s.size());
+    for (std::size_t g = 0; g < d1s.size(); ++g) group_material_[g].d1_per_mpa = d1s[g];
+    for (Eigen::Index t = 0; t < space.elements.rows(); ++t) {
+      TetVertices X;
+      for (int a = 0; a < 4; ++a) X.row(a) = space.X.row(space.elements(t, a));
+      gradients_[std::size_t(t)] = barycentric_gradients(X, tet_volume_(t));
+      for (int a = 0; a < 4; ++a) {
+        slots_(t, a) = space.elements(t, a) * groups_ + group_[std::size_t(t)];
+        reference_(slots_(t, a)) += tet_volume_(t) / 4.0;
+      }
+    }
+  }
+
+  HyperelasticBody::Evaluation evaluate(const FeSpace& space,
+                                        const std::vector<FibreHyperelastic>& materials,
+                                        const Eigen::VectorXd& u, bool with_tangent) const {
+    const Eigen::VectorXd v = volumes(space, u);
+    // Nodal pressures p = U'(v/V), and per tet the mean of its four.
+    Eigen::VectorXd p = Eigen::VectorXd::Zero(v.size());
+    double volumetric_energy_mj = 0;
+    for (Eigen::Index k = 0; k < v.size(); ++k) {
+      if (reference_(k) == 0) continue;  // no tet of this group at this node
+      const VolumetricEnergy U = volumetric_energy(v(k) / reference_(k), material(k));
+      p(k) = U.first;
+      volumetric_energy_mj += reference_(k) * U.value;
+    }
+    Triplets triplets;
+    std::vector<Eigen::VectorXd> gradient(materials.size());
+    HyperelasticBody::Evaluation out =
+        assemble(space, u, with_tangent, triplets,
+                 [&](Eigen::Index t, const TetVertices& X, const Eigen::MatrixX3d& ue) {
+                   double mean = 0;
+                   for (int a = 0; a < 4; ++a) mean += 0.25 * p(slots_(t, a));
+                   HyperelasticElement e = hyperelastic_element_at_pressure(
+                       1, X, ue, materials[std::size_t(t)], mean, with_tangent);
+                   gradient[std::size_t(t)] = std::move(e.volume_gradient);
+                   return e;
+                 });
+    out.energy += volumetric_energy_mj;
+    if (with_tangent) {
+      const Eigen::Index n = 3 * space.num_nodes();
+      out.tangent_lower.resize(n, n);
+      out.tangent_lower.setFromTriplets(triplets.begin(), triplets.end());
+      if (out.inverted == 0) out.tangent_lower += volume_stiffness(space, v, gradient);
+    }
+    return out;
+  }
+
+ private:
+  std::vector<int> group_;  ///< per tet: its bulk-modulus group
+  int groups_ = 0;
+  Eigen::MatrixX4i slots_;  ///< per tet and vertex: the (node, group) slot
+  std::vector<Eigen::Matrix<double, 4, 3>> gradients_;
+  Eigen::VectorXd tet_volume_;
+  Eigen::VectorXd reference_;                      ///< V per slot
+  std::vector<FibreHyperelastic> group_material_;  ///< per group: its D1 (the rest unused)
+
+  const FibreHyperelastic& material(Eigen::Index slot) const {
+    return group_material_[std::size_t(slot % groups_)];
+  }
+
+  /// A quarter of each tet's current volume V J, summed per slot.
+  Eigen::VectorXd volumes(const FeSpace& space, const Eigen::VectorXd& u) const {
+    Eigen::VectorXd v = Eigen::VectorXd::Zero(reference_.size());
+    for (Eigen::Index t = 0; t < space.elements.rows(); ++t) {
+      Eigen::Matrix3d F = Eigen::Matrix3d::Identity();
+      for (int a = 0; a < 4; ++a)
+        F += u.segment<3>(3 * space.elements(t, a)) * gradients_[std::size_t(t)].row(a);
+      for (int a = 0; a < 4; ++a) v(slots_(t, a)) += tet_volume_(t) * F.determinant() / 4.0;
+    }
+    return v;
+  }
+
+  /// Σ_n U''(J_n)/V_n g_n g_nᵀ = Gᵀ diag(U''/V) G, with the rows of G the slots' volume
+  /// gradients g_n = ∂v_n/∂u = Σ over the tets at n of ¼ ∂v_e/∂u; lower triangle.
+  Eigen::SparseMatrix<double> volume_stiffness(const FeSpace& space, const Eigen::VectorXd& v,
+                                               const std::vector<Eigen::VectorXd>& gradient) const {
+    Triplets t;
+    t.reserve(std::size_t(space.elements.rows()) * 48);
+    for (Eigen::Index e = 0; e < space.elements.rows(); ++e)
+      for (int a = 0; a < 4; ++a)
+        for (int b = 0; b < 4; ++b)
+          for (int i = 0; i < 3; ++i)
+            t.emplace_back(slots_(e, a), 3 * space.elements(e, b) + i,
+                           0.25 * gradient[std::size_t(e)](3 * b + i));
+    Eigen::SparseMatrix<double> G(v.size(), 3 * space.num_nodes());
+    G.setFromTriplets(t.begin(), t.end());
+    Eigen::VectorXd scale = Eigen::VectorXd::Zero(v.size());
+    for (Eigen::Index k = 0; k < v.size(); ++k)
+      if (reference_(k) > 0)
+        scale(k) = volumetric_energy(v(k) / reference_(k), material(k)).second / reference_(k);
+    const Eigen::SparseMatrix<double> H = G.transpose() * scale.asDiagonal() * G;
+    return H.triangularView<Eigen::Lower>();
+  }
+};
+
+}  // namespace detail
 
 HyperelasticBody::HyperelasticBody(FeSpace space, std::vector<FibreHyperelastic> element_materials,
                                    VolumetricForm form)
@@ -22,39 +187,22 @@ HyperelasticBody::HyperelasticBody(FeSpace space, std::vector<FibreHyperelastic>
                                 " materials for " + std::to_string(space_.elements.rows()) +
                                 " elements");
   for (const FibreHyperelastic& m : materials_) validate(m, "hyperelastic body");
+  if (form_ == VolumetricForm::nodal_average)
+    nodal_ = std::make_shared<const detail::NodalVolumes>(space_, materials_);
 }
 
 HyperelasticBody::Evaluation HyperelasticBody::evaluate(const Eigen::VectorXd& u,
                                                         bool with_tangent) const {
   const Eigen::Index n = space_.num_nodes();
   if (u.size() != 3 * n) throw std::invalid_argument("hyperelastic body: wrong displacement size");
-  const int npe = space_.nodes_per_element();
-  Evaluation out;
-  out.force = Eigen::VectorXd::Zero(3 * n);
-  std::vector<Eigen::Triplet<double>> triplets;
-  if (with_tangent) triplets.reserve(std::size_t(space_.elements.rows()) * 9 * npe * (npe + 1) / 2);
-  Eigen::MatrixX3d ue(npe, 3);
-  for (Eigen::Index t = 0; t < space_.elements.rows(); ++t) {
-    TetVertices X;
-    for (int a = 0; a < 4; ++a) X.row(a) = space_.X.row(space_.elements(t, a));
-    for (int a = 0; a < npe; ++a) ue.row(a) = u.segment<3>(3 * space_.elements(t, a)).transpose();
-    const HyperelasticElement e =
-        hyperelastic_element(space_.order, X, ue, materials_[std::size_t(t)], with_tangent, form_);
-    out.energy += e.energy;
-    out.inverted += e.inverted_points;
-    for (int a = 0; a < npe; ++a) {
-      const Eigen::Index A = space_.elements(t, a);
-      out.force.segment<3>(3 * A) += e.force.segment<3>(3 * a);
-      if (!with_tangent) continue;
-      for (int b = 0; b < npe; ++b) {
-        const Eigen::Index B = space_.elements(t, b);
-        for (int i = 0; i < 3; ++i)
-          for (int j = 0; j < 3; ++j)
-            if (3 * A + i >= 3 * B + j)
-              triplets.emplace_back(3 * A + i, 3 * B + j, e.tangent(3 * a + i, 3 * b + j));
-      }
-    }
-  }
+  if (nodal_) return nodal_->evaluate(space_, materials_, u, with_tangent);
+  Triplets triplets;
+  Evaluation out =
+      assemble(space_, u, with_tangent, triplets,
+               [&](Eigen::Index t, const TetVertices& X, const Eigen::MatrixX3d& ue) {
+                 return hyperelastic_element(space_.order, X, ue, materials_[std::size_t(t)],
+                                             with_tangent, form_);
+               });
   if (with_tangent) {
     out.tangent_lower.resize(3 * n, 3 * n);
     out.tangent_lower.setFromTriplets(triplets.begin(), triplets.end());
@@ -197,9 +345,8 @@ struct NewtonRun {
       if (!factorize(ev)) return false;
       const Eigen::VectorXd step = cholesky.solve(-r);
       sol.residual_n = r.norm();
-      if (r.norm() <= options.tolerance * std::max(std::sqrt(reaction), 1.0) &&
-          step.cwiseAbs().maxCoeff() <=
-              options.tolerance * std::max(trial.cwiseAbs().maxCoeff(), 1.0)) {
+      if (detail::increment_converged(r.norm(), std::sqrt(reaction), step.cwiseAbs().maxCoeff(),
+                                      trial.cwiseAbs().maxCoeff(), options.tolerance)) {
         u = trial;
         return true;
       }

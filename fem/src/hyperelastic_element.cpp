@@ -69,9 +69,15 @@ void add_point(const Eigen::Matrix3d& F, const Eigen::MatrixX3d& G, const Materi
 
 }  // namespace
 
-HyperelasticElement hyperelastic_element(int order, const TetVertices& X, const Eigen::MatrixX3d& u,
-                                         const FibreHyperelastic& m, bool with_tangent,
-                                         VolumetricForm form) {
+namespace {
+
+/// The element; `pressure`: none (pointwise U), U'(J̄) of the element (mean dilatation, with
+/// V₀ U(J̄) and its U'' term added), or a given value held fixed (no volumetric energy).
+enum class Pressure { pointwise, mean, given };
+
+HyperelasticElement element(int order, const TetVertices& X, const Eigen::MatrixX3d& u,
+                            const FibreHyperelastic& m, bool with_tangent, Pressure pressure,
+                            double given_mpa) {
   if (order != 1 && order != 2) throw std::invalid_argument("element order must be 1 or 2");
   const int npe = order == 1 ? 4 : 10;
   if (u.rows() != npe) throw std::invalid_argument("element displacements: wrong node count");
@@ -82,49 +88,73 @@ HyperelasticElement hyperelastic_element(int order, const TetVertices& X, const 
 
   HyperelasticElement out;
   out.force = Eigen::VectorXd::Zero(3 * npe);
+  out.volume_gradient = Eigen::VectorXd::Zero(3 * npe);
   if (with_tangent) out.tangent = Eigen::MatrixXd::Zero(3 * npe, 3 * npe);
   std::vector<Eigen::MatrixX3d> G(static_cast<std::size_t>(nq));
   std::vector<Eigen::Matrix3d> F(static_cast<std::size_t>(nq));
-  // The element's mean dilatation J̄ = ∫ J dV₀ / V₀ and d = ∂J̄/∂u (∂J/∂u_a = J F⁻ᵀ ∇N_a).
-  double J_mean = 0;
-  Eigen::VectorXd d = Eigen::VectorXd::Zero(3 * npe);
+  // The current volume v = ∫ J dV₀ and ∂v/∂u (∂J/∂u_a = J F⁻ᵀ ∇N_a).
   for (Eigen::Index q = 0; q < nq; ++q) {
     const std::size_t k = std::size_t(q);
     G[k] = shape_gradients(order, gL, rule.barycentric.row(q).transpose());
     F[k] = Eigen::Matrix3d::Identity() + u.transpose() * G[k];
-    const double J = F[k].determinant();
+    const double J = F[k].determinant(), dV = rule.weights(q) * volume;
     if (!(J > 0)) {
       ++out.inverted_points;
       continue;
     }
-    J_mean += rule.weights(q) * J;
+    out.volume_mm3 += dV * J;
     const Eigen::Matrix3d FiT = F[k].inverse().transpose();
     for (int a = 0; a < npe; ++a)
-      d.segment<3>(3 * a) += rule.weights(q) * J * FiT * G[k].row(a).transpose();
+      out.volume_gradient.segment<3>(3 * a) += dV * J * FiT * G[k].row(a).transpose();
   }
   if (out.inverted_points > 0) {
     out.energy = std::numeric_limits<double>::quiet_NaN();
     return out;
   }
-  const bool mean = form == VolumetricForm::mean_dilatation;
-  const VolumetricEnergy U = volumetric_energy(J_mean, m);
+  const VolumetricEnergy U = volumetric_energy(out.volume_mm3 / volume, m);
+  const double p_fixed = pressure == Pressure::mean ? U.first : given_mpa;
   for (Eigen::Index q = 0; q < nq; ++q) {
     const std::size_t k = std::size_t(q);
     const Eigen::Matrix3d C = F[k].transpose() * F[k];
-    MaterialPointState p =
-        mean ? isochoric_point(C, m, with_tangent) : fibre_hyperelastic_point(C, m, with_tangent);
-    if (mean && std::isfinite(p.energy)) {
-      const MaterialPointState v = pressure_point(C, U.first, with_tangent);
+    MaterialPointState p = pressure == Pressure::pointwise
+                               ? fibre_hyperelastic_point(C, m, with_tangent)
+                               : isochoric_point(C, m, with_tangent);
+    if (pressure != Pressure::pointwise && std::isfinite(p.energy)) {
+      const MaterialPointState v = pressure_point(C, p_fixed, with_tangent);
       p.S += v.S, p.tangent += v.tangent;
     }
     out.energy += rule.weights(q) * volume * p.energy;
     add_point(F[k], G[k], p, rule.weights(q) * volume, with_tangent, out);
   }
-  if (mean) {
+  if (pressure == Pressure::mean) {
+    // V₀ U(J̄), J̄ = v/V₀: its gradient is in the forces above; its second derivative
+    // V₀ U'' ∂J̄ ∂J̄ᵀ = U''/V₀ ∂v ∂vᵀ.
     out.energy += volume * U.value;
-    if (with_tangent) out.tangent += volume * U.second * d * d.transpose();
+    if (with_tangent)
+      out.tangent += U.second / volume * out.volume_gradient * out.volume_gradient.transpose();
   }
   return out;
+}
+
+}  // namespace
+
+HyperelasticElement hyperelastic_element(int order, const TetVertices& X, const Eigen::MatrixX3d& u,
+                                         const FibreHyperelastic& m, bool with_tangent,
+                                         VolumetricForm form) {
+  if (form == VolumetricForm::nodal_average)
+    throw std::invalid_argument(
+        "the nodal-average volume is a property of a body (hyperelastic_body.hpp), not of one "
+        "element");
+  return element(order, X, u, m, with_tangent,
+                 form == VolumetricForm::pointwise ? Pressure::pointwise : Pressure::mean, 0.0);
+}
+
+HyperelasticElement hyperelastic_element_at_pressure(int order, const TetVertices& X,
+                                                     const Eigen::MatrixX3d& u,
+                                                     const FibreHyperelastic& m,
+                                                     double pressure_mpa, bool with_tangent) {
+  if (!std::isfinite(pressure_mpa)) throw std::invalid_argument("element pressure: not finite");
+  return element(order, X, u, m, with_tangent, Pressure::given, pressure_mpa);
 }
 
 }  // namespace spinesim::fem

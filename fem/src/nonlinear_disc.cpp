@@ -44,8 +44,12 @@ HyperelasticBody make_body(const mesh::TetMesh& mesh, std::vector<FibreHyperelas
 
 NonlinearDisc::NonlinearDisc(const mesh::TetMesh& mesh,
                              std::vector<FibreHyperelastic> element_materials, int order,
-                             const Eigen::Vector3d& plate_center_mm, VolumetricForm form)
-    : body_(make_body(mesh, std::move(element_materials), order, form)), center_(plate_center_mm) {
+                             const Eigen::Vector3d& plate_center_mm,
+                             std::optional<VolumetricForm> form)
+    : body_(make_body(mesh, std::move(element_materials), order,
+                      form.value_or(order == 1 ? VolumetricForm::nodal_average
+                                               : VolumetricForm::mean_dilatation))),
+      center_(plate_center_mm) {
   labels_ = node_surface_labels(body_.space(), mesh);
   if (!center_.allFinite()) throw std::invalid_argument("plate centre: not finite");
 }
@@ -54,7 +58,7 @@ NonlinearPlateSolution NonlinearDisc::solve_motion(const Eigen::Matrix<double, 6
                                                    const NewtonOptions& options) const {
   if (!motion.allFinite()) throw std::invalid_argument("plate motion: not finite");
   const Eigen::Vector3d t = motion.head<3>(), theta = motion.tail<3>();
-  const Eigen::Matrix3d R = rotation_exp(theta);
+  const Eigen::Matrix3d R_minus_I = rotation_exp_minus_identity(theta);
   const FeSpace& s = body_.space();
   std::vector<PrescribedDisplacement> bc;
   for (Eigen::Index i = 0; i < s.num_nodes(); ++i) {
@@ -65,7 +69,7 @@ NonlinearPlateSolution NonlinearDisc::solve_motion(const Eigen::Matrix<double, 6
     Eigen::Vector3d u = Eigen::Vector3d::Zero();
     if (label == int(mesh::Surface::superior_endplate)) {
       const Eigen::Vector3d arm = s.X.row(i).transpose() - center_;
-      u = t + R * arm - arm;
+      u = t + R_minus_I * arm;
     }
     for (int d = 0; d < 3; ++d) bc.push_back({i, d, u(d)});
   }

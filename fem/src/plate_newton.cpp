@@ -98,9 +98,9 @@ class PlateNewton {
   Eigen::VectorXd full(const Eigen::VectorXd& uf, const Vector6& p) const {
     Eigen::VectorXd u = Eigen::VectorXd::Zero(3 * body_.space().num_nodes());
     for (std::size_t k = 0; k < free_dofs_.size(); ++k) u(free_dofs_[k]) = uf(Eigen::Index(k));
-    const Eigen::Matrix3d R = rotation_exp(p.tail<3>());
+    const Eigen::Matrix3d R_minus_I = rotation_exp_minus_identity(p.tail<3>());
     for (std::size_t k = 0; k < pr_.plate_nodes.size(); ++k)
-      u.segment<3>(3 * pr_.plate_nodes[k]) = p.head<3>() + R * arm_[k] - arm_[k];
+      u.segment<3>(3 * pr_.plate_nodes[k]) = p.head<3>() + R_minus_I * arm_[k];
     return u;
   }
 
@@ -266,8 +266,8 @@ bool PlateNewton::increment(double to) {
     double step_max = du.size() ? du.cwiseAbs().maxCoeff() : 0.0;
     step_max = std::max(step_max, dp.cwiseAbs().maxCoeff());
     const double scale =
-        std::max({uf.size() ? uf.cwiseAbs().maxCoeff() : 0.0, p.cwiseAbs().maxCoeff(), 1.0});
-    if (r.norm() <= o_.tolerance * std::max(L.reaction, 1.0) && step_max <= o_.tolerance * scale) {
+        std::max(uf.size() ? uf.cwiseAbs().maxCoeff() : 0.0, p.cwiseAbs().maxCoeff());
+    if (increment_converged(r.norm(), L.reaction, step_max, scale, o_.tolerance)) {
       uf_ = uf, p_ = p;
       return true;
     }

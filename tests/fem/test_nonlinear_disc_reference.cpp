@@ -31,7 +31,8 @@ TEST_P(SmallMotion, TheReactionIsTheLinearFemsAtSmallMotions) {
   const mesh::RegionMaterials mat = mesh::load_material("real-disc", SPINESIM_DATA_DIR);
   const Eigen::Vector3d c = DiscFem::default_plate_center(m);
   const DiscFem linear(m, mat, order, c);
-  const NonlinearDisc nonlinear(m, disc_element_materials(m, mat, 0.0), order, c);
+  const NonlinearDisc nonlinear(m, disc_element_materials(m, mat, 0.0), order, c,
+                                VolumetricForm::pointwise);
   const Vector6 q = (Vector6() << 0.02, -0.05, 0.01, 0.004, -0.003, 0.002).finished();
   double gaps[2];
   for (int k = 0; k < 2; ++k) {

@@ -54,6 +54,19 @@ TEST(LineSearch, ThePotentialDecidesUnlessItsRoundingSwampsTheSlope) {
   EXPECT_EQ(backtrack({0.0, 1.0}, -1.0, 1.0, inverted_beyond_half), 0.5);
 }
 
+// The convergence test: both the correction and the residual within tolerance, or — once the
+// correction is at rounding — the residual within its rounding floor, a thousand times that.
+TEST(IncrementConverged, NeedsASmallCorrectionAndAResidualAtTolerance) {
+  const double tol = 1e-10;
+  EXPECT_TRUE(increment_converged(0.5e-10, 0.5, 1e-11, 1e-3, tol));  // both within
+  EXPECT_FALSE(increment_converged(2e-10, 0.5, 1e-11, 1e-3, tol));   // residual above, step not
+                                                                     // at rounding
+  EXPECT_TRUE(increment_converged(2e-10, 0.5, 1e-14, 1e-3, tol));    // residual at its floor
+  EXPECT_FALSE(increment_converged(2e-7, 0.5, 1e-14, 1e-3, tol));    // far above the floor
+  EXPECT_FALSE(increment_converged(1e-12, 0.5, 2e-10, 1e-3, tol));   // correction too large
+  EXPECT_TRUE(increment_converged(5e-8, 1000.0, 1e-9, 50.0, tol));   // scales with f and u
+}
+
 // The ramp: a failing increment is halved, the counts kept, and after too many halvings in a row
 // the failure names where the ramp stopped.
 TEST(LoadRamp, FailingIncrementsAreHalvedAndAStuckRampSaysWhere) {

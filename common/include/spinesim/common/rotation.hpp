@@ -24,6 +24,18 @@ inline Eigen::Matrix3d rotation_exp(const Eigen::Vector3d& phi) {
   return Eigen::Matrix3d::Identity() + std::sin(a) / a * K + (1 - std::cos(a)) / (a * a) * K * K;
 }
 
+/// exp(φ) − I formed directly, without subtracting I from exp(φ): the displacement (exp(φ) − I) a
+/// of a point at arm a then keeps its relative precision at small angles, where R a − a loses
+/// |a| ε absolutely (about 4e-15 mm at 20 mm — enough, through a nearly incompressible nucleus,
+/// to hold a Newton residual above its tolerance). 1 − cos a = 2 sin²(a/2).
+inline Eigen::Matrix3d rotation_exp_minus_identity(const Eigen::Vector3d& phi) {
+  const double a = phi.norm();
+  const Eigen::Matrix3d K = skew(phi);
+  if (a < 1e-8) return K + 0.5 * K * K;
+  const double s = std::sin(0.5 * a);
+  return std::sin(a) / a * K + 2 * s * s / (a * a) * K * K;
+}
+
 /// Throws std::domain_error for a rotation of 180° (its axis is not defined by R − Rᵀ).
 inline Eigen::Vector3d rotation_log(const Eigen::Matrix3d& R) {
   const double c = std::clamp(0.5 * (R.trace() - 1), -1.0, 1.0);

@@ -3,13 +3,16 @@
 //
 //   the prescribed values are ramped in load increments; in each, Newton on the free DOF
 //   (K_ff Δu = −r_f, K_ff the tangent, CHOLMOD LLᵀ on the pattern analysed once) with a
-//   backtracking line search on the total energy (Armijo; a state with an inverted quadrature
-//   point has no energy and is stepped back from); an increment that does not converge is
-//   halved, at most `max_cutbacks` times in a row, and then the solve fails with the reason —
-//   a failed solve never reports `converged`.
+//   backtracking line search on the total energy (Armijo; near the solution, where the energy's
+//   rounding hides the predicted decrease, on the residual norm — fem/src/newton_steps.hpp; a
+//   state with an inverted quadrature point has no energy and is stepped back from); an
+//   increment that does not converge is halved, at most `max_cutbacks` times in a row, and then
+//   the solve fails with the reason — a failed solve never reports `converged`.
 //
-// Convergence of an increment: ‖r_f‖ ≤ tolerance · max(‖f‖, 1 N) (f the internal force of the
-// prescribed DOF, i.e. the reaction) and the last correction ‖Δu‖∞ ≤ tolerance · max(‖u‖∞, 1 mm).
+// Convergence of an increment: the last correction ‖Δu‖∞ ≤ tolerance · max(‖u‖∞, 1 mm) and
+// ‖r_f‖ ≤ tolerance · max(‖f‖, 1 N) (f the internal force of the prescribed DOF, i.e. the
+// reaction), or ‖r_f‖ within a thousand times that once the correction is at rounding (the
+// residual's floor with a nearly incompressible region; newton_steps.hpp measures it).
 // Units: mm, N, mJ (N·mm).
 #pragma once
 
@@ -20,10 +23,15 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
+#include <memory>
 #include <string>
 #include <vector>
 
 namespace spinesim::fem {
+
+namespace detail {
+class NodalVolumes;
+}
 
 struct PrescribedDisplacement {
   Eigen::Index node = 0;
@@ -79,6 +87,7 @@ class HyperelasticBody {
   FeSpace space_;
   std::vector<FibreHyperelastic> materials_;
   VolumetricForm form_ = VolumetricForm::pointwise;
+  std::shared_ptr<const detail::NodalVolumes> nodal_;  ///< the nodal-average form's fixed data
 };
 
 }  // namespace spinesim::fem

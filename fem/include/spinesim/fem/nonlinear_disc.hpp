@@ -19,6 +19,7 @@
 #include <Eigen/Core>
 
 #include <array>
+#include <optional>
 #include <vector>
 
 namespace spinesim::fem {
@@ -50,11 +51,12 @@ class NonlinearDisc {
  public:
   /// Throws std::invalid_argument for a mesh without endplate labels, a bad order or material
   /// count.
-  /// `form`: how the elements take the volume change (hyperelastic_element.hpp); the mean
-  /// dilatation keeps a nearly incompressible nucleus from locking on P2.
+  /// `form`: how the elements take the volume change (hyperelastic_element.hpp); by default
+  /// the one that keeps a nearly incompressible nucleus from locking on that order —
+  /// nodal_average on P1, mean_dilatation on P2. `pointwise` is CalculiX's C3D4/C3D10.
   NonlinearDisc(const mesh::TetMesh& mesh, std::vector<FibreHyperelastic> element_materials,
                 int order, const Eigen::Vector3d& plate_center_mm,
-                VolumetricForm form = VolumetricForm::pointwise);
+                std::optional<VolumetricForm> form = std::nullopt);
 
   NonlinearPlateSolution solve_motion(const Eigen::Matrix<double, 6, 1>& motion,
                                       const NewtonOptions& options = NewtonOptions()) const;
