@@ -94,6 +94,18 @@ class NodalVolumes {
     }
   }
 
+  /// Per tet, minus the mean of its four nodal pressures U'(v_n / V_n).
+  Eigen::VectorXd element_pressures(const FeSpace& space, const Eigen::VectorXd& u) const {
+    const Eigen::VectorXd v = volumes(space, u);
+    Eigen::VectorXd out = Eigen::VectorXd::Zero(space.elements.rows());
+    for (Eigen::Index t = 0; t < space.elements.rows(); ++t)
+      for (int a = 0; a < 4; ++a) {
+        const Eigen::Index k = slots_(t, a);
+        out(t) -= 0.25 * volumetric_energy(v(k) / reference_(k), material(k)).first;
+      }
+    return out;
+  }
+
   HyperelasticBody::Evaluation evaluate(const FeSpace& space,
                                         const std::vector<FibreHyperelastic>& materials,
                                         const Eigen::VectorXd& u, bool with_tangent) const {
@@ -206,6 +218,26 @@ HyperelasticBody::Evaluation HyperelasticBody::evaluate(const Eigen::VectorXd& u
   if (with_tangent) {
     out.tangent_lower.resize(3 * n, 3 * n);
     out.tangent_lower.setFromTriplets(triplets.begin(), triplets.end());
+  }
+  return out;
+}
+
+Eigen::VectorXd HyperelasticBody::element_pressures_mpa(const Eigen::VectorXd& u) const {
+  if (u.size() != 3 * space_.num_nodes())
+    throw std::invalid_argument("hyperelastic body: wrong displacement size");
+  if (nodal_) return nodal_->element_pressures(space_, u);
+  const int npe = space_.nodes_per_element();
+  Eigen::VectorXd out(space_.elements.rows());
+  Eigen::MatrixX3d ue(npe, 3);
+  for (Eigen::Index t = 0; t < space_.elements.rows(); ++t) {
+    TetVertices X;
+    for (int a = 0; a < 4; ++a) X.row(a) = space_.X.row(space_.elements(t, a));
+    for (int a = 0; a < npe; ++a) ue.row(a) = u.segment<3>(3 * space_.elements(t, a)).transpose();
+    double volume = 0;
+    barycentric_gradients(X, volume);
+    const HyperelasticElement e =
+        hyperelastic_element(space_.order, X, ue, materials_[std::size_t(t)], false, form_);
+    out(t) = -volumetric_energy(e.volume_mm3 / volume, materials_[std::size_t(t)]).first;
   }
   return out;
 }

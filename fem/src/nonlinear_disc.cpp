@@ -51,6 +51,7 @@ NonlinearDisc::NonlinearDisc(const mesh::TetMesh& mesh,
                                                : VolumetricForm::mean_dilatation))),
       center_(plate_center_mm) {
   labels_ = node_surface_labels(body_.space(), mesh);
+  region_ = mesh.region;
   if (!center_.allFinite()) throw std::invalid_argument("plate centre: not finite");
 }
 
@@ -77,6 +78,7 @@ NonlinearPlateSolution NonlinearDisc::solve_motion(const Eigen::Matrix<double, 6
   out.plate_motion = motion;
   out.body = body_.solve(bc, options);
   out.reaction_wrench = plate_reaction(out.body, motion.head<3>());
+  out.nucleus_pressure_mpa = nucleus_pressure(out.body);
   return out;
 }
 
@@ -113,7 +115,27 @@ NonlinearPlateSolution NonlinearDisc::solve(const PlateLoad& load,
   out.body = std::move(r.body);
   out.plate_motion = r.plate;
   out.reaction_wrench = plate_reaction(out.body, r.plate.head<3>());
+  out.nucleus_pressure_mpa = nucleus_pressure(out.body);
+  for (const auto& [fraction, plate] : r.path) out.path.push_back({fraction, plate});
   return out;
+}
+
+double NonlinearDisc::nucleus_pressure(const HyperelasticSolution& body) const {
+  const FeSpace& s = body_.space();
+  Eigen::VectorXd u(3 * s.num_nodes());
+  for (Eigen::Index i = 0; i < s.num_nodes(); ++i)
+    u.segment<3>(3 * i) = body.displacement_mm.row(i).transpose();
+  const Eigen::VectorXd p = body_.element_pressures_mpa(u);
+  double sum = 0, volume = 0;
+  for (Eigen::Index t = 0; t < s.elements.rows(); ++t) {
+    if (region_.size() != s.elements.rows() || region_(t) != int(mesh::Region::nucleus)) continue;
+    TetVertices X;
+    for (int a = 0; a < 4; ++a) X.row(a) = s.X.row(s.elements(t, a));
+    double v = 0;
+    barycentric_gradients(X, v);
+    sum += v * p(t), volume += v;
+  }
+  return volume > 0 ? sum / volume : std::numeric_limits<double>::quiet_NaN();
 }
 
 }  // namespace spinesim::fem

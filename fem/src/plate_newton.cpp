@@ -39,8 +39,8 @@ struct Linearised {
 class PlateNewton {
  public:
   PlateNewton(const HyperelasticBody& body, const PlateProblem& pr, const NewtonOptions& o,
-              HyperelasticSolution& sol)
-      : body_(body), pr_(pr), o_(o), sol_(sol) {
+              HyperelasticSolution& sol, std::vector<std::pair<double, Vector6>>& path)
+      : body_(body), pr_(pr), o_(o), sol_(sol), path_(path) {
     const Eigen::Index n = body.space().num_nodes();
     role_.assign(std::size_t(n), 0);
     for (const Eigen::Index i : pr.fixed_nodes) role_[std::size_t(i)] = 1;
@@ -65,7 +65,11 @@ class PlateNewton {
 
   /// Ramps the plate values in increments, halving failing ones; fills the solution.
   Vector6 run() {
-    sol_.failure = ramp(o_, sol_, "the plate load", [this](double to) { return increment(to); });
+    sol_.failure = ramp(o_, sol_, "the plate load", [this](double to) {
+      if (!increment(to)) return false;
+      path_.emplace_back(to, p_);
+      return true;
+    });
     sol_.converged = sol_.failure.empty();
     const Eigen::VectorXd u = full(uf_, p_);
     const HyperelasticBody::Evaluation ev = body_.evaluate(u, false);
@@ -86,6 +90,7 @@ class PlateNewton {
   const PlateProblem& pr_;
   const NewtonOptions& o_;
   HyperelasticSolution& sol_;
+  std::vector<std::pair<double, Vector6>>& path_;
   std::vector<int> role_, slot_;  ///< per node: 0 free, 1 held, 2 plate; plate index
   std::vector<Eigen::Vector3d> arm_;
   std::vector<Eigen::Index> free_index_, free_dofs_;
@@ -292,7 +297,7 @@ PlateNewtonResult solve_plate_problem(const HyperelasticBody& body, const PlateP
   if (!problem.value.allFinite()) throw std::invalid_argument("plate load: not finite");
   Timer timer;
   PlateNewtonResult out;
-  PlateNewton newton(body, problem, options, out.body);
+  PlateNewton newton(body, problem, options, out.body, out.path);
   out.plate = newton.run();
   out.body.seconds = timer.seconds();
   return out;

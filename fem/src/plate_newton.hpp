@@ -18,6 +18,7 @@
 #include <Eigen/Core>
 
 #include <array>
+#include <utility>
 #include <vector>
 
 namespace spinesim::fem::detail {
@@ -36,7 +37,8 @@ struct PlateProblem {
 
 struct PlateNewtonResult {
   HyperelasticSolution body;
-  Vector6 plate = Vector6::Zero();  ///< p at the end
+  Vector6 plate = Vector6::Zero();               ///< p at the end
+  std::vector<std::pair<double, Vector6>> path;  ///< (load fraction, p) per converged increment
 };
 
 PlateNewtonResult solve_plate_problem(const HyperelasticBody& body, const PlateProblem& problem,

@@ -121,6 +121,29 @@ TEST(NodalVolume, ANearlyIncompressibleCantileverDoesNotLock) {
   EXPECT_LT(last_error, 0.4);
 }
 
+// Element pressures under a homogeneous dilatation J of the two-material block: −U'(J) of each
+// tet's material, which is −tr σ / 3 of the Cauchy stress, for every volumetric form and order.
+TEST(ElementPressures, AHomogeneousDilatationGivesMinusTheTraceOfTheStress) {
+  const TwoMaterialBlock b;
+  const double J = 0.97, stretch = std::cbrt(J);
+  for (const auto& [order, form] :
+       {std::pair{1, VolumetricForm::pointwise}, std::pair{1, VolumetricForm::nodal_average},
+        std::pair{2, VolumetricForm::pointwise}, std::pair{2, VolumetricForm::mean_dilatation}}) {
+    const FeSpace space = make_fe_space(b.mesh, order);
+    const HyperelasticBody body(space, b.materials, form);
+    Eigen::VectorXd u(3 * space.num_nodes());
+    for (Eigen::Index i = 0; i < space.num_nodes(); ++i)
+      u.segment<3>(3 * i) = (stretch - 1) * space.X.row(i).transpose();
+    const Eigen::VectorXd p = body.element_pressures_mpa(u);
+    for (Eigen::Index t = 0; t < p.size(); ++t) {
+      const FibreHyperelastic& m = b.materials[std::size_t(t)];
+      const Eigen::Matrix3d sigma = cauchy_stress(stretch * Eigen::Matrix3d::Identity(), m);
+      EXPECT_NEAR(p(t), -sigma.trace() / 3, 1e-9 * std::abs(p(t))) << "P" << order << " tet " << t;
+      EXPECT_GT(p(t), 0);  // compressed
+    }
+  }
+}
+
 TEST(NodalVolume, IsRefusedOnP2AndOnOneElement) {
   const mesh::TetMesh m = mesh::box_mesh(1, 1, 1, 1.0, 1.0, 1.0);
   EXPECT_THROW(

@@ -5,6 +5,7 @@
 #include "spinesim/fem/disc_fem.hpp"
 #include "spinesim/fem/fe_space.hpp"
 #include "spinesim/fem/fibres.hpp"
+#include "spinesim/fem/load_cases.hpp"
 #include "spinesim/fem/nonlinear_disc.hpp"
 #include "spinesim/mesh/disc_level.hpp"
 #include "spinesim/mesh/material.hpp"
@@ -15,6 +16,7 @@
 
 #include <cmath>
 #include <string>
+#include <tuple>
 
 namespace spinesim::fem {
 namespace {
@@ -97,6 +99,40 @@ TEST(NonlinearDisc, PureMomentsFromATenthToTenNewtonMetresConvergeInFewSteps) {
       last = s.plate_motion(axis);
     }
   }
+}
+
+// The nucleus pressure of a small compression, fibres left out so that the nonlinear disc is a
+// linear one up to its volumetric form, against the linear Taylor–Hood mixed disc's, on the CGAL
+// L4-L5 disc at 3 mm cells. Measured: P2 mean dilatation 0.97 (0.97 at 2 mm), P1 nodal average
+// 1.16 (1.03 at 2 mm); the pointwise P1 tet, locked, is far off. The load path has one point per
+// increment.
+TEST(NonlinearDisc, ASmallCompressionsNucleusPressureIsTheMixedDiscs) {
+  mesh::MeshOptions coarse;
+  coarse.cell_size_mm = 3.0;
+  const mesh::TetMesh m = mesh::mesh_disc_level("L4-L5", coarse, SPINESIM_DATA_DIR);
+  mesh::RegionMaterials mat = mesh::load_material("fibre-reinforced", SPINESIM_DATA_DIR);
+  mat.fibres.clear();  // nucleus ν 0.4999
+  const Eigen::Vector3d c = DiscFem::default_plate_center(m);
+  SolverOptions mixed;
+  mixed.formulation = Formulation::mixed;
+  mixed.solver = LinearSolver::direct;
+  const Vector6 w = fem::global_wrench(fem::load_case("compression"), m.frame) / 100.0;  // 5 N
+  const double reference = DiscFem(m, mat, 2, c, mixed).solve_wrench(w).nucleus_pressure_mpa;
+  ASSERT_GT(reference, 0);
+  PlateLoad load;
+  load.value = w;
+  const auto ratio = [&](int order, VolumetricForm form) {
+    const NonlinearPlateSolution s =
+        NonlinearDisc(m, disc_element_materials(m, mat, 10.0), order, c, form).solve(load);
+    EXPECT_TRUE(s.body.converged) << s.body.failure;
+    EXPECT_EQ(int(s.path.size()), s.body.increments);
+    EXPECT_DOUBLE_EQ(s.path.back().load_fraction, 1.0);
+    EXPECT_EQ(s.path.back().plate_motion, s.plate_motion);
+    return s.nucleus_pressure_mpa / reference;
+  };
+  EXPECT_NEAR(ratio(2, VolumetricForm::mean_dilatation), 1.0, 0.05);
+  EXPECT_NEAR(ratio(1, VolumetricForm::nodal_average), 1.0, 0.2);
+  EXPECT_GT(std::abs(ratio(1, VolumetricForm::pointwise) - 1.0), 0.5);
 }
 
 // The plate driven in all six DOF through the plate Newton is the nodal-Dirichlet solve; loaded

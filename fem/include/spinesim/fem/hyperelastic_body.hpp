@@ -75,6 +75,13 @@ class HyperelasticBody {
   };
   Evaluation evaluate(const Eigen::VectorXd& u, bool with_tangent) const;
 
+  /// Per tet, the hydrostatic pressure −tr σ / 3 (MPa, positive in compression) at nodal
+  /// displacements u, as the volumetric form takes it: −U'(J̄) with J̄ the tet's mean dilatation
+  /// (pointwise and mean dilatation: U is quadratic, so the mean of −U'(J) over the points is
+  /// −U'(J̄)), the mean of its nodes' −U'(J_n) for the nodal average. The isochoric part adds
+  /// nothing to the trace (S̄ : C = 0).
+  Eigen::VectorXd element_pressures_mpa(const Eigen::VectorXd& u) const;
+
   /// Equilibrium with the prescribed DOF (each at most once; throws std::invalid_argument
   /// otherwise or for a node out of range).
   HyperelasticSolution solve(const std::vector<PrescribedDisplacement>& prescribed,

@@ -19,6 +19,7 @@
 #include <Eigen/Core>
 
 #include <array>
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -41,10 +42,21 @@ struct PlateLoad {
   Eigen::Matrix<double, 6, 1> value = Eigen::Matrix<double, 6, 1>::Zero();
 };
 
+/// One converged load increment of a plate solve: the fraction of the load (or motion) reached
+/// and the plate motion there — the load–displacement path, e.g. a moment–rotation curve.
+struct PlatePathPoint {
+  double load_fraction = 0;
+  Eigen::Matrix<double, 6, 1> plate_motion;  ///< (t mm, θ rad)
+};
+
 struct NonlinearPlateSolution {
   HyperelasticSolution body;  ///< nodal displacements, reactions, Newton counts, convergence
   Eigen::Matrix<double, 6, 1> plate_motion;     ///< (t mm, θ rad)
   Eigen::Matrix<double, 6, 1> reaction_wrench;  ///< (F N, M N·mm about c + t)
+  std::vector<PlatePathPoint> path;  ///< solve(): every converged increment, from the first
+  /// Volume mean (reference volumes) of the hydrostatic pressure over the nucleus tets (region
+  /// 2), MPa, positive in compression; NaN without a nucleus.
+  double nucleus_pressure_mpa = std::numeric_limits<double>::quiet_NaN();
 };
 
 class NonlinearDisc {
@@ -71,8 +83,10 @@ class NonlinearDisc {
  private:
   Eigen::Matrix<double, 6, 1> plate_reaction(const HyperelasticSolution& body,
                                              const Eigen::Vector3d& t) const;
+  double nucleus_pressure(const HyperelasticSolution& body) const;
 
   Eigen::VectorXi labels_;
+  Eigen::VectorXi region_;  ///< per tet
   HyperelasticBody body_;
   Eigen::Vector3d center_;
 };
