@@ -2,6 +2,7 @@
 //
 //   spinesim study disc-validation [--level L4-L5] [--material fibre-reinforced]
 //       [--formulation mixed] [--mesh disc.vtu] [--cell-size 2] [--csv FILE] [--json]
+//       [--model nonlinear [--order 1] [--fibre-k2 10] [--increments 10] [--paths FILE]]
 #include "cli_common.hpp"
 #include "spinesim/mesh/disc_level.hpp"
 #include "spinesim/studies/disc_validation.hpp"
@@ -22,14 +23,34 @@ namespace {
 
 struct DiscValidationArgs {
   std::string level = "L4-L5", mesh_path, material = "fibre-reinforced", formulation = "mixed",
-              targets, csv;
+              targets, csv, model = "linear", paths;
   double cell_size_mm = mesh::MeshOptions().cell_size_mm;
+  studies::NonlinearDiscOptions nonlinear;
   bool json = false, quiet = false, markdown = false;
+  bool formulation_given = false, nonlinear_flag_given = false;
 };
 
 void run_disc_validation(const DiscValidationArgs& a) {
   // 1. Every option checked before any work.
+  if (a.model != "linear" && a.model != "nonlinear")
+    throw std::invalid_argument("--model must be linear or nonlinear, not '" + a.model + "'");
+  const bool nonlinear = a.model == "nonlinear";
+  if (nonlinear && a.formulation_given)
+    throw std::invalid_argument(
+        "--formulation is for --model linear (the nonlinear disc takes "
+        "its volume by --order)");
+  if (!nonlinear && a.nonlinear_flag_given)
+    throw std::invalid_argument(
+        "--order, --fibre-k2, --increments and --paths need --model nonlinear");
   const fem::Formulation formulation = parse_formulation(a.formulation);
+  if (nonlinear) {
+    if (a.nonlinear.order != 1 && a.nonlinear.order != 2)
+      throw std::invalid_argument("--order must be 1 or 2");
+    if (!std::isfinite(a.nonlinear.fibre_k2) || a.nonlinear.fibre_k2 < 0)
+      throw std::invalid_argument("--fibre-k2 must be a finite number >= 0");
+    if (a.nonlinear.load_increments < 1 || a.nonlinear.load_increments > 1000)
+      throw std::invalid_argument("--increments must be 1 to 1000");
+  }
   const mesh::RegionMaterials materials = mesh::load_material(a.material, data_dir());
   const std::string targets_path =
       a.targets.empty() ? data_dir() + "/validation/disc_in_vitro.json" : a.targets;
@@ -40,9 +61,10 @@ void run_disc_validation(const DiscValidationArgs& a) {
       throw std::invalid_argument("--cell-size must be a finite number > 0 mm");
   }
   if (!a.csv.empty()) require_output_folder(a.csv, "--csv");
+  if (!a.paths.empty()) require_output_folder(a.paths, "--paths");
 
   // 2. The disc, then the study (studies/disc_validation.hpp).
-  Progress progress(2, a.quiet || a.json);
+  Progress progress(nonlinear ? 6 : 2, a.quiet || a.json);
   mesh::TetMesh m;
   std::string label;
   if (!a.mesh_path.empty()) {
@@ -58,13 +80,21 @@ void run_disc_validation(const DiscValidationArgs& a) {
   }
   progress.end(std::to_string(m.num_tets()) + " tets");
   const DiscValidationResult r =
-      studies::run_disc_validation(m, materials, formulation, targets, label, progress.hooks());
+      nonlinear ? studies::run_nonlinear_disc_validation(m, materials, a.nonlinear, targets, label,
+                                                         progress.hooks())
+                : studies::run_disc_validation(m, materials, formulation, targets, label,
+                                               progress.hooks());
 
   // 3. Output.
   if (!a.csv.empty()) {
     std::ofstream f(a.csv);
     write_disc_validation_csv(f, r);
     if (!f) throw std::runtime_error("--csv " + a.csv + ": could not write the file");
+  }
+  if (!a.paths.empty()) {
+    std::ofstream f(a.paths);
+    write_disc_paths_csv(f, r);
+    if (!f) throw std::runtime_error("--paths " + a.paths + ": could not write the file");
   }
   if (a.json)
     print_json(disc_validation_json(r));
@@ -86,7 +116,28 @@ void register_disc_validation(CLI::App& study) {
   cmd->add_option("--material", a->material, "Preset or JSON file")->capture_default_str();
   cmd->add_option("--formulation", a->formulation,
                   "mixed (Taylor-Hood P2-P1: gives the nucleus pressure) or displacement (P2)")
+      ->capture_default_str()
+      ->each([a](const std::string&) { a->formulation_given = true; });
+  cmd->add_option("--model", a->model,
+                  "linear (the linear FEM) or nonlinear (tension-only fibres, finite strain, "
+                  "the plate loaded and free)")
       ->capture_default_str();
+  const auto nonlinear_flag = [a](const std::string&) { a->nonlinear_flag_given = true; };
+  cmd->add_option("--order", a->nonlinear.order,
+                  "Nonlinear disc: 1 (P1, nodal-average volume) or 2 (P2, mean dilatation)")
+      ->capture_default_str()
+      ->each(nonlinear_flag);
+  cmd->add_option("--fibre-k2", a->nonlinear.fibre_k2,
+                  "Nonlinear disc: the fibres' toe exponent k2 (k1 = k/4 of the preset)")
+      ->capture_default_str()
+      ->each(nonlinear_flag);
+  cmd->add_option("--increments", a->nonlinear.load_increments,
+                  "Nonlinear disc: load increments, the points of each path")
+      ->capture_default_str()
+      ->each(nonlinear_flag);
+  cmd->add_option("--paths", a->paths,
+                  "Nonlinear disc: write each case's load-motion path (moment-rotation) as CSV")
+      ->each(nonlinear_flag);
   cmd->add_option("--targets", a->targets,
                   "In-vitro targets file (default: data/validation/disc_in_vitro.json)");
   cmd->add_option("--csv", a->csv, "Write the comparison as CSV");
@@ -99,7 +150,10 @@ void register_disc_validation(CLI::App& study) {
       "of its nodes.\n"
       "Stiffness = load / plate motion along it (kN/mm, N·m/deg). Nucleus pressure ratio = "
       "volume-mean\n"
-      "nucleus pressure / (500 N / A), A = mesh volume / disc height (mixed formulation only).");
+      "nucleus pressure / (500 N / A), A = mesh volume / disc height (mixed formulation or the "
+      "nonlinear disc).\n"
+      "The nonlinear disc: secant stiffness at the standard load; a case that does not converge "
+      "gives no number.");
   cmd->callback([a] { run_disc_validation(*a); });
 }
 

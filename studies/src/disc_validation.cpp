@@ -4,6 +4,7 @@
 #include "spinesim/common/input_file.hpp"
 #include "spinesim/common/timer.hpp"
 #include "spinesim/fem/load_cases.hpp"
+#include "spinesim/fem/nonlinear_disc.hpp"
 #include "spinesim/studies/fem_reference.hpp"
 #include "spinesim/studies/toolkit.hpp"
 
@@ -35,6 +36,43 @@ double disc_height_mm(const mesh::TetMesh& m) {
     if (m.surface(i) == int(mesh::Surface::superior_endplate)) hi += m.V.row(i).transpose(), ++nh;
   }
   return (hi / nh - lo / nl).dot(m.frame.axes.col(1));
+}
+
+/// The file's targets beside `ours` (quantity → value; NaN or absent: not computed).
+void fill_rows(const nlohmann::json& targets, const std::map<std::string, double>& ours,
+               DiscValidationResult& r, const std::map<std::string, std::string>& notes = {}) {
+  for (const auto& t : targets.at("targets")) {
+    DiscValidationRow row;
+    row.quantity = t.at("quantity").get<std::string>();
+    row.units = t.value("units", std::string());
+    row.low = t.at("low").get<double>();
+    row.high = t.at("high").get<double>();
+    row.reported = t.value("reported", std::string());
+    row.source = t.value("source", std::string());
+    row.preparation = preparation_of(t);
+    const auto it = ours.find(row.quantity);
+    if (it == ours.end())
+      row.note = "not a quantity this study computes";
+    else
+      row.ours = it->second;
+    if (const auto n = notes.find(row.quantity); n != notes.end() && !std::isfinite(row.ours))
+      row.note = n->second;
+    r.rows.push_back(row);
+  }
+}
+
+/// The study's frame-independent facts of the disc.
+DiscValidationResult describe(const mesh::TetMesh& m, const mesh::RegionMaterials& materials,
+                              const nlohmann::json& targets, const std::string& mesh_label) {
+  DiscValidationResult r;
+  r.material = materials.name;
+  r.mesh_label = mesh_label;
+  r.tets = m.num_tets();
+  r.source = targets.value("source", std::string());
+  r.whole_segments = targets.value("whole_segments", nlohmann::json::array());
+  r.disc_height_mm = disc_height_mm(m);
+  r.disc_area_mm2 = mesh::mesh_volume(m) / r.disc_height_mm;
+  return r;
 }
 
 }  // namespace
@@ -71,15 +109,8 @@ DiscValidationResult run_disc_validation(const mesh::TetMesh& m,
                                          fem::Formulation formulation,
                                          const nlohmann::json& targets,
                                          const std::string& mesh_label, const StageHooks& hooks) {
-  DiscValidationResult r;
-  r.material = materials.name;
+  DiscValidationResult r = describe(m, materials, targets, mesh_label);
   r.formulation = formulation_name(formulation);
-  r.mesh_label = mesh_label;
-  r.tets = m.num_tets();
-  r.source = targets.value("source", std::string());
-  r.whole_segments = targets.value("whole_segments", nlohmann::json::array());
-  r.disc_height_mm = disc_height_mm(m);
-  r.disc_area_mm2 = mesh::mesh_volume(m) / r.disc_height_mm;
 
   hooks.begin_stage(std::string("FEM ") + r.formulation + ", " + materials.name);
   const Timer timer;
@@ -112,30 +143,88 @@ DiscValidationResult run_disc_validation(const mesh::TetMesh& m,
   r.solve_s = timer.seconds();
   hooks.end_stage(std::to_string(r.dofs) + " DOF");
 
-  for (const auto& t : targets.at("targets")) {
-    DiscValidationRow row;
-    row.quantity = t.at("quantity").get<std::string>();
-    row.units = t.value("units", std::string());
-    row.low = t.at("low").get<double>();
-    row.high = t.at("high").get<double>();
-    row.reported = t.value("reported", std::string());
-    row.source = t.value("source", std::string());
-    row.preparation = preparation_of(t);
-    const auto it = ours.find(row.quantity);
-    if (it == ours.end())
-      row.note = "not a quantity this study computes";
-    else
-      row.ours = it->second;
-    if (row.quantity == "nucleus-pressure-ratio" && !std::isfinite(row.ours))
-      row.note = "needs --formulation mixed";
-    r.rows.push_back(row);
-  }
+  fill_rows(targets, ours, r, {{"nucleus-pressure-ratio", "needs --formulation mixed"}});
   return r;
+}
+
+DiscValidationResult run_nonlinear_disc_validation(const mesh::TetMesh& m,
+                                                   const mesh::RegionMaterials& materials,
+                                                   const NonlinearDiscOptions& options,
+                                                   const nlohmann::json& targets,
+                                                   const std::string& mesh_label,
+                                                   const StageHooks& hooks) {
+  if (options.order != 1 && options.order != 2)
+    throw std::invalid_argument("nonlinear disc: order must be 1 or 2");
+  if (!std::isfinite(options.fibre_k2) || options.fibre_k2 < 0)
+    throw std::invalid_argument("nonlinear disc: the fibre toe exponent k2 must be >= 0");
+  if (options.load_increments < 1 || options.load_increments > 1000)
+    throw std::invalid_argument("nonlinear disc: load increments must be 1 to 1000");
+  DiscValidationResult r = describe(m, materials, targets, mesh_label);
+  r.formulation = std::string("nonlinear P") + std::to_string(options.order) +
+                  (options.order == 1 ? ", nodal-average volume" : ", mean dilatation") +
+                  "; tension-only fibres, k1 = k/4, k2 = " + significant(options.fibre_k2, 3);
+  const Timer timer;
+  const fem::NonlinearDisc disc(m, fem::disc_element_materials(m, materials, options.fibre_k2),
+                                options.order, fem::DiscFem::default_plate_center(m));
+  r.dofs = 3 * disc.body().space().num_nodes();
+  fem::NewtonOptions newton;
+  newton.load_increments = options.load_increments;
+  const Eigen::Matrix3d& axes = m.frame.axes;
+  std::map<std::string, double> ours;
+  std::map<std::string, std::string> notes;
+  const std::vector<std::pair<const char*, int>> cases = {
+      {"compression", 1}, {"torsion", 4}, {"flexion", 3}, {"extension", 3}, {"lateral-bending", 5}};
+  for (const auto& [name, component] : cases) {
+    hooks.begin_stage(std::string("nonlinear disc, ") + name);
+    const fem::LoadCase& c = fem::load_case(name);
+    fem::PlateLoad load;
+    load.value = fem::global_wrench(c, m.frame);
+    const fem::NonlinearPlateSolution s = disc.solve(load, newton);
+    // Motion along the case's component, disc frame: mm, or degrees.
+    const auto along = [&](const Eigen::Matrix<double, 6, 1>& q) {
+      return component < 3 ? (axes.transpose() * q.head<3>())(component)
+                           : (axes.transpose() * q.tail<3>())(component - 3) * kDegPerRad;
+    };
+    const double load_value =
+        component < 3 ? c.wrench_local(component) : c.wrench_local(component) / 1000.0;
+    DiscLoadPath path{name, component < 3 ? "N" : "N m", component < 3 ? "mm" : "deg", {}, {}};
+    for (const fem::PlatePathPoint& p : s.path) {
+      path.load.push_back(std::abs(p.load_fraction * load_value));
+      path.motion.push_back(std::abs(along(p.plate_motion)));
+    }
+    r.paths.push_back(path);
+    if (!s.body.converged) {
+      notes[name] = "did not converge: " + s.body.failure;
+      hooks.end_stage("did not converge");
+      continue;
+    }
+    ours[name] = std::abs(load_value / along(s.plate_motion)) / (component < 3 ? 1000.0 : 1.0);
+    if (component == 1) {
+      r.nucleus_pressure_mpa = s.nucleus_pressure_mpa;
+      ours["nucleus-pressure-ratio"] =
+          s.nucleus_pressure_mpa / (std::abs(c.wrench_local(1)) / r.disc_area_mm2);
+    }
+    hooks.end_stage(std::to_string(s.body.newton_iterations) + " Newton iterations");
+  }
+  if (!ours.count("compression"))
+    notes["nucleus-pressure-ratio"] = "the compression did not converge";
+  r.solve_s = timer.seconds();
+  fill_rows(targets, ours, r, notes);
+  return r;
+}
+
+void write_disc_paths_csv(std::ostream& os, const DiscValidationResult& r) {
+  os << "load_case,load,load_units,motion,motion_units\n";
+  for (const DiscLoadPath& p : r.paths)
+    for (std::size_t k = 0; k < p.load.size(); ++k)
+      os << p.load_case << "," << significant(p.load[k], 6) << "," << p.load_units << ","
+         << significant(p.motion[k], 6) << "," << p.motion_units << "\n";
 }
 
 void print_disc_validation(std::ostream& os, const DiscValidationResult& r, bool markdown) {
   os << "Disc validation: " << r.mesh_label << " (" << r.tets << " tets, " << r.dofs
-     << " DOF), material " << r.material << ", " << r.formulation << " formulation\n"
+     << " DOF), material " << r.material << ", " << r.formulation
+     << (r.paths.empty() ? " formulation" : "") << "\n"
      << "  disc height " << significant(r.disc_height_mm, 3) << " mm, mean cross-section "
      << significant(r.disc_area_mm2, 4) << " mm^2; nucleus pressure at 500 N "
      << significant(r.nucleus_pressure_mpa, 3) << " MPa\n"

@@ -12,6 +12,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <memory>
 
 namespace spinesim::test_cli {
@@ -134,6 +135,38 @@ TEST(CliFibres, DiscValidationSetsTheDiscBesideInVitroTests) {
   expect_refused(run_spinesim("study disc-validation --targets /nonexistent.json"),
                  "/nonexistent.json");
   expect_refused(run_spinesim("study disc-validation --material nothing"), "unknown material");
+}
+
+// The nonlinear disc in the study: six rows and the load paths as CSV; its options refused with
+// the linear model, a bad value refused, and nothing written.
+TEST(CliFibres, DiscValidationRunsTheNonlinearDisc) {
+  const std::string paths = tmp("paths.csv");
+  std::filesystem::remove(paths);
+  const CliRun r =
+      run_spinesim("study disc-validation --mesh '" + disc_vtu() +
+                   "' --model nonlinear --increments 3 --paths '" + paths + "' --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["rows"].size(), 6u);
+  for (const auto& row : j["rows"]) EXPECT_TRUE(row["ours"].is_number()) << row.dump();
+  std::ifstream f(paths);
+  std::string line;
+  int lines = 0;
+  while (std::getline(f, line)) ++lines;
+  EXPECT_EQ(lines, 1 + 5 * 3);
+
+  const std::string unwritten = tmp("unwritten.csv");
+  std::filesystem::remove(unwritten);
+  expect_refused(
+      run_spinesim("study disc-validation --model nonlinear --order 3 --paths '" + unwritten + "'"),
+      "--order must be 1 or 2");
+  expect_refused(run_spinesim("study disc-validation --model nonlinear --fibre-k2 -1"),
+                 "--fibre-k2");
+  expect_refused(run_spinesim("study disc-validation --order 2"), "need --model nonlinear");
+  expect_refused(run_spinesim("study disc-validation --model nonlinear --formulation mixed"),
+                 "--formulation is for --model linear");
+  expect_refused(run_spinesim("study disc-validation --model quadratic"), "--model must be");
+  EXPECT_FALSE(std::filesystem::exists(unwritten));
 }
 
 }  // namespace

@@ -8,8 +8,10 @@
 #include <gtest/gtest.h>
 #include <Eigen/Cholesky>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <sstream>
 #include <stdexcept>
 
 using namespace spinesim;
@@ -100,6 +102,40 @@ TEST(DiscValidation, FieldsOfTheWrongTypeAreRefusedInOneLine) {
     std::ofstream(path) << text;
     EXPECT_THROW(read_disc_targets(path), std::invalid_argument) << text;
   }
+}
+
+// The nonlinear disc in the same study: every quantity computed from a converged solve, each
+// stiffness the load over the last point of its path, each path rising from the first increment
+// to the standard load; options out of range are refused before any work.
+TEST(DiscValidation, TheNonlinearDiscGivesEveryRowAndItsLoadPaths) {
+  const mesh::TetMesh& m = test::structured("L4-L5");
+  const auto mat = test::material("fibre-reinforced");
+  NonlinearDiscOptions o;
+  o.load_increments = 5;
+  const DiscValidationResult r =
+      run_nonlinear_disc_validation(m, mat, o, targets(), "structured L4-L5");
+  ASSERT_EQ(r.paths.size(), 5u);
+  for (const DiscLoadPath& p : r.paths) {
+    ASSERT_EQ(p.load.size(), 5u) << p.load_case;
+    for (std::size_t k = 1; k < p.load.size(); ++k) {
+      EXPECT_GT(p.load[k], p.load[k - 1]) << p.load_case;
+      EXPECT_GT(p.motion[k], p.motion[k - 1]) << p.load_case;
+    }
+    const double stiffness = p.load.back() / p.motion.back() / (p.load_units == "N" ? 1000 : 1);
+    EXPECT_NEAR(row(r, p.load_case).ours, stiffness, 1e-9 * stiffness) << p.load_case;
+  }
+  EXPECT_NEAR(row(r, "compression").ours * 1000, 500.0 / r.paths[0].motion.back(), 1e-6);
+  EXPECT_GT(r.nucleus_pressure_mpa, 0);
+  EXPECT_NEAR(row(r, "nucleus-pressure-ratio").ours,
+              r.nucleus_pressure_mpa / (500.0 / r.disc_area_mm2), 1e-12);
+  std::ostringstream csv;
+  write_disc_paths_csv(csv, r);
+  const std::string text = csv.str();
+  EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 1 + 5 * 5);
+
+  for (const auto& bad : {NonlinearDiscOptions{3, 10.0, 4}, NonlinearDiscOptions{1, -1.0, 4},
+                          NonlinearDiscOptions{1, 10.0, 0}})
+    EXPECT_THROW(run_nonlinear_disc_validation(m, mat, bad, targets(), "x"), std::invalid_argument);
 }
 
 }  // namespace

@@ -5,6 +5,10 @@
 // and, with the mixed formulation, the nucleus pressure over the mean axial stress
 // (p_nucleus / (500 N / A), A = mesh volume / disc height). Each is set beside the published
 // range of `data/validation/disc_in_vitro.json` and marked MATCH (inside) or MISS.
+// With the nonlinear disc (fem/nonlinear_disc.hpp: tension-only fibres, finite strain, the plate
+// loaded by the wrench and free to turn) the stiffness is the secant one at the standard load,
+// and every load case's moment–rotation (force–displacement) path is kept, one point per load
+// increment. A case that does not converge gives no number, and says why.
 // Our disc has no posterior elements and rigid endplates: the targets are disc-alone tests; the
 // file's whole-segment rows are printed for scale only.
 #pragma once
@@ -33,15 +37,30 @@ struct DiscValidationRow {
   bool match() const { return ours >= low && ours <= high; }
 };
 
+/// One standard load case's path on the nonlinear disc: the load along the case's own component
+/// (N or N·m) against the plate motion along it (mm or deg), from the first increment to the full
+/// load.
+struct DiscLoadPath {
+  std::string load_case, load_units, motion_units;
+  std::vector<double> load, motion;
+};
+
+struct NonlinearDiscOptions {
+  int order = 1;             ///< 1 (nodal-average volume) or 2 (mean dilatation)
+  double fibre_k2 = 10.0;    ///< the fibres' toe exponent (>= 0)
+  int load_increments = 10;  ///< points per path (>= 1)
+};
+
 struct DiscValidationResult {
   std::string material, formulation, mesh_label;
   Eigen::Index tets = 0, dofs = 0;
   double disc_height_mm = 0, disc_area_mm2 = 0;
   double nucleus_pressure_mpa = std::numeric_limits<double>::quiet_NaN();  ///< at 500 N
   std::vector<DiscValidationRow> rows;
-  nlohmann::json whole_segments;  ///< the file's rows for scale, as read
-  std::string source;             ///< the file's overall source
-  double solve_s = 0;             ///< assembly, factorisation and the five solves
+  nlohmann::json whole_segments;    ///< the file's rows for scale, as read
+  std::string source;               ///< the file's overall source
+  double solve_s = 0;               ///< assembly, factorisation and the five solves
+  std::vector<DiscLoadPath> paths;  ///< nonlinear disc only
 };
 
 /// Reads the targets file; throws std::invalid_argument (one line) when it is unusable.
@@ -54,6 +73,17 @@ DiscValidationResult run_disc_validation(const mesh::TetMesh& m,
                                          const nlohmann::json& targets,
                                          const std::string& mesh_label,
                                          const StageHooks& hooks = StageHooks());
+
+/// The same with the nonlinear disc. Throws std::invalid_argument for options out of range.
+DiscValidationResult run_nonlinear_disc_validation(const mesh::TetMesh& m,
+                                                   const mesh::RegionMaterials& materials,
+                                                   const NonlinearDiscOptions& options,
+                                                   const nlohmann::json& targets,
+                                                   const std::string& mesh_label,
+                                                   const StageHooks& hooks = StageHooks());
+
+/// The paths as CSV: load_case, load, load_units, motion, motion_units.
+void write_disc_paths_csv(std::ostream& os, const DiscValidationResult& r);
 
 void print_disc_validation(std::ostream& os, const DiscValidationResult& r, bool markdown = false);
 nlohmann::json disc_validation_json(const DiscValidationResult& r);
