@@ -3,8 +3,11 @@
 //   spinesim study disc-validation [--level L4-L5] [--material fibre-reinforced]
 //       [--formulation mixed] [--mesh disc.vtu] [--cell-size 2] [--csv FILE] [--json]
 //       [--model nonlinear [--order 1] [--fibre-k2 10] [--increments 10] [--paths FILE]]
+//       [--out DIR]
 #include "cli_common.hpp"
 #include "spinesim/mesh/disc_level.hpp"
+#include "spinesim/output/files.hpp"
+#include "spinesim/output/html_report.hpp"
 #include "spinesim/studies/disc_validation.hpp"
 #include "spinesim/studies/fem_reference.hpp"
 
@@ -17,18 +20,37 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <sstream>
 
 namespace spinesim::cli {
 namespace {
 
 struct DiscValidationArgs {
   std::string level = "L4-L5", mesh_path, material = "fibre-reinforced", formulation = "mixed",
-              targets, csv, model = "linear", paths;
+              targets, csv, model = "linear", paths, out;
   double cell_size_mm = mesh::MeshOptions().cell_size_mm;
   studies::NonlinearDiscOptions nonlinear;
   bool json = false, quiet = false, markdown = false;
   bool formulation_given = false, nonlinear_flag_given = false;
 };
+
+/// --out: the JSON, the comparison and (nonlinear) the paths as CSV, then the figure and
+/// report.html (scripts/disc_report.py).
+void write_out_folder(const std::string& out, const DiscValidationResult& r) {
+  namespace fs = std::filesystem;
+  output::write_text_file((fs::path(out) / "disc_validation.json").string(),
+                          disc_validation_json(r).dump(2) + "\n");
+  std::ostringstream rows, paths;
+  write_disc_validation_csv(rows, r);
+  output::write_text_file((fs::path(out) / "disc_validation.csv").string(), rows.str());
+  if (!r.paths.empty()) {
+    write_disc_paths_csv(paths, r);
+    output::write_text_file((fs::path(out) / "disc_paths.csv").string(), paths.str());
+  }
+  const output::HtmlReport report = output::write_html_report(out, "disc_report.py");
+  if (report.failed) throw std::runtime_error("--out " + out + ": " + report.message);
+  std::cerr << (report.written ? "" : "spinesim: warning: ") << report.message << std::endl;
+}
 
 void run_disc_validation(const DiscValidationArgs& a) {
   // 1. Every option checked before any work.
@@ -62,6 +84,7 @@ void run_disc_validation(const DiscValidationArgs& a) {
   }
   if (!a.csv.empty()) require_output_folder(a.csv, "--csv");
   if (!a.paths.empty()) require_output_folder(a.paths, "--paths");
+  if (!a.out.empty()) output::prepare_output_folder(a.out, "--out");
 
   // 2. The disc, then the study (studies/disc_validation.hpp).
   Progress progress(nonlinear ? 6 : 2, a.quiet || a.json);
@@ -96,6 +119,7 @@ void run_disc_validation(const DiscValidationArgs& a) {
     write_disc_paths_csv(f, r);
     if (!f) throw std::runtime_error("--paths " + a.paths + ": could not write the file");
   }
+  if (!a.out.empty()) write_out_folder(a.out, r);
   if (a.json)
     print_json(disc_validation_json(r));
   else
@@ -141,6 +165,8 @@ void register_disc_validation(CLI::App& study) {
   cmd->add_option("--targets", a->targets,
                   "In-vitro targets file (default: data/validation/disc_in_vitro.json)");
   cmd->add_option("--csv", a->csv, "Write the comparison as CSV");
+  cmd->add_option("--out", a->out,
+                  "Write the JSON, CSV, the load paths' figure and report.html into this folder");
   cmd->add_flag("--markdown", a->markdown, "Print the table as markdown");
   add_output_flags(cmd, a->json, a->quiet, "the JSON summary");
   cmd->footer(

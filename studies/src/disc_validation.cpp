@@ -288,6 +288,16 @@ nlohmann::json disc_validation_json(const DiscValidationResult& r) {
                       {"rows", rows},
                       {"whole_segments", r.whole_segments},
                       {"solve_s", r.solve_s}};
+  if (!r.paths.empty()) {
+    nlohmann::json paths = nlohmann::json::array();
+    for (const DiscLoadPath& p : r.paths)
+      paths.push_back({{"load_case", p.load_case},
+                       {"load_units", p.load_units},
+                       {"motion_units", p.motion_units},
+                       {"load", p.load},
+                       {"motion", p.motion}});
+    j["paths"] = paths;
+  }
   j["nucleus_pressure_mpa"] = std::isfinite(r.nucleus_pressure_mpa)
                                   ? nlohmann::json(r.nucleus_pressure_mpa)
                                   : nlohmann::json(nullptr);

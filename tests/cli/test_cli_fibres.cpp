@@ -137,14 +137,17 @@ TEST(CliFibres, DiscValidationSetsTheDiscBesideInVitroTests) {
   expect_refused(run_spinesim("study disc-validation --material nothing"), "unknown material");
 }
 
-// The nonlinear disc in the study: six rows and the load paths as CSV; its options refused with
-// the linear model, a bad value refused, and nothing written.
+// The nonlinear disc in the study: six rows, the load paths as CSV, and with --out the JSON, the
+// figure and report.html; its options refused with the linear model, a bad value refused, and
+// nothing written.
 TEST(CliFibres, DiscValidationRunsTheNonlinearDisc) {
   const std::string paths = tmp("paths.csv");
   std::filesystem::remove(paths);
-  const CliRun r =
-      run_spinesim("study disc-validation --mesh '" + disc_vtu() +
-                   "' --model nonlinear --increments 3 --paths '" + paths + "' --json");
+  const std::string out = tmp("disc-validation-out");
+  std::filesystem::remove_all(out);
+  const CliRun r = run_spinesim("study disc-validation --mesh '" + disc_vtu() +
+                                "' --model nonlinear --increments 3 --paths '" + paths +
+                                "' --out '" + out + "' --json");
   ASSERT_EQ(r.status, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   ASSERT_EQ(j["rows"].size(), 6u);
@@ -154,6 +157,9 @@ TEST(CliFibres, DiscValidationRunsTheNonlinearDisc) {
   int lines = 0;
   while (std::getline(f, line)) ++lines;
   EXPECT_EQ(lines, 1 + 5 * 3);
+  for (const char* file : {"disc_validation.json", "disc_validation.csv", "disc_paths.csv",
+                           "report.html", "plots/disc_paths.png"})
+    EXPECT_TRUE(std::filesystem::exists(out + "/" + file)) << file << "\n" << r.err;
 
   const std::string unwritten = tmp("unwritten.csv");
   std::filesystem::remove(unwritten);
