@@ -17,20 +17,10 @@ import json
 import os
 import sys
 
+from report_tools import failer, pyplot
 
-def fail(message, status=1):
-    """Exit 2 for a missing tool (the program warns and goes on), 1 for anything else."""
-    print(f"disc report: {message}; report.html not written", file=sys.stderr)
-    sys.exit(status)
-
-
-try:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-except ImportError:
-    fail("python3-matplotlib is missing (apt-get install python3-matplotlib)", 2)
+fail = failer("disc report")
+plt = pyplot(fail)
 
 # Stiffness units of the targets → load units per motion unit of the paths.
 TO_PATH_UNITS = {"kN/mm": 1000.0, "N m/deg": 1.0}

@@ -16,22 +16,10 @@ import json
 import os
 import sys
 
+from report_tools import failer, pyplot
 
-def fail(message, status=1):
-    """Exit 2 for a missing tool (the program warns and goes on), 1 for anything else (a read or
-    a write that failed, e.g. a full disk: the program fails, the figures it promised are not
-    all there)."""
-    print(f"seating report: {message}; report.html not written", file=sys.stderr)
-    sys.exit(status)
-
-
-try:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-except ImportError:
-    fail("python3-matplotlib is missing (apt-get install python3-matplotlib)", 2)
+fail = failer("seating report")
+plt = pyplot(fail)
 
 
 def save(fig, d, name):
