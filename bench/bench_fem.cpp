@@ -12,6 +12,7 @@
 // Counters: DOF (free unknowns), peak_rss_MB (process peak resident set, getrusage; it only
 // grows, so read it in the order the benchmarks run: smaller meshes first).
 // Run: build/h-fem/bench/bench_fem [--benchmark_filter=Full6x6]
+#include "spinesim/common/memory.hpp"
 #include "spinesim/fem/assembly.hpp"
 #include "spinesim/fem/cholmod_solver.hpp"
 #include "spinesim/fem/disc_fem.hpp"
@@ -353,4 +354,12 @@ BENCHMARK(BM_NearlyIncompressibleDisc)
     ->UseRealTime()
     ->Iterations(1);
 
-BENCHMARK_MAIN();
+// As the spinesim program runs: freed memory kept in the process (common/memory.hpp).
+int main(int argc, char** argv) {
+  spinesim::keep_freed_memory();
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

@@ -12,6 +12,7 @@
 #include "cli_common.hpp"
 #include "suggest.hpp"
 
+#include "spinesim/common/memory.hpp"
 #include "spinesim/common/pending_output.hpp"
 
 #include <cstdlib>
@@ -40,6 +41,7 @@ bool asked_for_json(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  spinesim::keep_freed_memory();  // Newton's large temporaries, reused (common/memory.hpp)
   // A run killed by Ctrl-C, SIGTERM or SIGHUP removes what it had not finished writing.
   spinesim::remove_pending_outputs_on_signals();
   if (openblas_set_num_threads && !std::getenv("OPENBLAS_NUM_THREADS")) openblas_set_num_threads(1);
