@@ -17,7 +17,7 @@ import json
 import os
 import sys
 
-from report_tools import failer, pyplot
+from report_tools import failer, folder_argument, guarded, pyplot
 
 fail = failer("disc report")
 plt = pyplot(fail)
@@ -81,37 +81,35 @@ def table_html(s):
     return head + "".join(body) + "</table>"
 
 
+def write_report(d):
+    """The figure and report.html from DIR/disc_validation.json; the figures' names."""
+    with open(os.path.join(d, "disc_validation.json")) as f:
+        s = json.load(f)
+    os.makedirs(os.path.join(d, "plots"), exist_ok=True)
+    figures = [paths_figure(s, d)] if s.get("paths") else []
+    title = f"The disc beside in-vitro tests: {s['mesh']}"
+    parts = ["<!DOCTYPE html><html><head><meta charset='utf-8'>",
+             f"<title>{html.escape(title)}</title><style>body{{font-family:sans-serif;"
+             "max-width:1400px;margin:2em auto}img{max-width:100%}"
+             "table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:2px 6px}"
+             "</style></head><body>", f"<h1>{html.escape(title)}</h1>",
+             f"<p>Material {html.escape(s['material'])}; {html.escape(s['formulation'])}; "
+             f"{s['tets']} tets, {s['dofs']} DOF. Stiffness = load / plate motion at the "
+             "standard load (500 N, 7.5 N·m), disc frame.</p>"]
+    parts += [f"<figure><img src='plots/{n}' alt='{n}'><figcaption>Load against plate "
+              "motion per increment; the shaded wedge spans the in-vitro window's secant "
+              "stiffnesses.</figcaption></figure>" for n in figures]
+    if not figures:
+        parts.append("<p>The load paths need <code>--model nonlinear</code>.</p>")
+    parts.append(table_html(s) + "</body></html>")
+    with open(os.path.join(d, "report.html"), "w") as f:
+        f.write("\n".join(parts))
+    return figures
+
+
 def main(argv):
-    if len(argv) != 2 or argv[1] in ("-h", "--help"):
-        print(__doc__.strip())
-        return 0 if len(argv) == 2 else 2
-    d = argv[1]
-    try:
-        with open(os.path.join(d, "disc_validation.json")) as f:
-            s = json.load(f)
-        os.makedirs(os.path.join(d, "plots"), exist_ok=True)
-        figures = [paths_figure(s, d)] if s.get("paths") else []
-        title = f"The disc beside in-vitro tests: {s['mesh']}"
-        parts = ["<!DOCTYPE html><html><head><meta charset='utf-8'>",
-                 f"<title>{html.escape(title)}</title><style>body{{font-family:sans-serif;"
-                 "max-width:1400px;margin:2em auto}img{max-width:100%}"
-                 "table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:2px 6px}"
-                 "</style></head><body>", f"<h1>{html.escape(title)}</h1>",
-                 f"<p>Material {html.escape(s['material'])}; {html.escape(s['formulation'])}; "
-                 f"{s['tets']} tets, {s['dofs']} DOF. Stiffness = load / plate motion at the "
-                 "standard load (500 N, 7.5 N·m), disc frame.</p>"]
-        parts += [f"<figure><img src='plots/{n}' alt='{n}'><figcaption>Load against plate "
-                  "motion per increment; the shaded wedge spans the in-vitro window's secant "
-                  "stiffnesses.</figcaption></figure>" for n in figures]
-        if not figures:
-            parts.append("<p>The load paths need <code>--model nonlinear</code>.</p>")
-        parts.append(table_html(s) + "</body></html>")
-        with open(os.path.join(d, "report.html"), "w") as f:
-            f.write("\n".join(parts))
-    except OSError as e:  # a file that cannot be read or written (a full disk)
-        fail(f"cannot read or write in {d}: {e}")
-    except (ValueError, KeyError, TypeError, IndexError) as e:
-        fail(f"bad input in {d}: {type(e).__name__} {e}")
+    d = folder_argument(argv, __doc__)
+    figures = guarded(fail, d, lambda: write_report(d))
     print(f"report: {os.path.join(d, 'report.html')} with {len(figures)} figure(s) in "
           f"{os.path.join(d, 'plots')}")
     return 0

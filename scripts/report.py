@@ -17,7 +17,7 @@ import json
 import os
 import sys
 
-from report_tools import failer, pyplot
+from report_tools import failer, folder_argument, guarded, pyplot
 
 fail = failer("report")
 plt = pyplot(fail)
@@ -323,11 +323,24 @@ def write_html(d, figures, report_md):
         f.write("\n".join(parts))
 
 
+def figures_and_html(d, s, report_md):
+    """Every figure, then report.html; the figures' names."""
+    figures = []
+    figures.append(haptic_plane(d, d))
+    figures.append(probe_test(d, d))
+    figures.append(calibration(s, d))
+    figures.append(materials(s, d))
+    figures.append(validation(s, d))
+    figures.append(spine_t1(d, s, d))
+    figures.append(fusion(d, s, d))
+    figures.append(haptic_stroke(d, d))
+    figures += viewer_screenshots(d)
+    write_html(d, figures, report_md)
+    return figures
+
+
 def main(argv):
-    if len(argv) != 2 or argv[1] in ("-h", "--help"):
-        print(__doc__.strip())
-        return 0 if len(argv) == 2 else 2
-    d = argv[1]
+    d = folder_argument(argv, __doc__)
     summary_path = os.path.join(d, "summary.json")
     try:
         with open(summary_path) as f:
@@ -337,22 +350,7 @@ def main(argv):
     except (OSError, ValueError) as e:
         fail(f"cannot read the demo's output in {d}: {e}")
     os.makedirs(os.path.join(d, "plots"), exist_ok=True)
-    figures = []
-    try:
-        figures.append(haptic_plane(d, d))
-        figures.append(probe_test(d, d))
-        figures.append(calibration(s, d))
-        figures.append(materials(s, d))
-        figures.append(validation(s, d))
-        figures.append(spine_t1(d, s, d))
-        figures.append(fusion(d, s, d))
-        figures.append(haptic_stroke(d, d))
-        figures += viewer_screenshots(d)
-        write_html(d, figures, report_md)
-    except OSError as e:  # a file that cannot be read or written (a full disk)
-        fail(f"cannot read or write in {d}: {e}")
-    except (ValueError, KeyError, TypeError, ZeroDivisionError) as e:
-        fail(f"bad input in {d}: {type(e).__name__} {e}")
+    figures = guarded(fail, d, lambda: figures_and_html(d, s, report_md))
     print(f"report: {os.path.join(d, 'report.html')} with {len(figures)} figures in "
           f"{os.path.join(d, 'plots')}")
     return 0

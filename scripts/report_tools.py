@@ -25,3 +25,22 @@ def pyplot(fail):
     except ImportError:
         fail("python3-matplotlib is missing (apt-get install python3-matplotlib)", 2)
     return plt
+
+
+def guarded(fail, d, work):
+    """work(), with a read or write that failed (a full disk) or bad input in the folder d turned
+    into one line through fail."""
+    try:
+        return work()
+    except OSError as e:
+        fail(f"cannot read or write in {d}: {e}")
+    except (ValueError, KeyError, TypeError, IndexError, ZeroDivisionError) as e:
+        fail(f"bad input in {d}: {type(e).__name__} {e}")
+
+
+def folder_argument(argv, doc):
+    """The one argument DIR; --help (or no argument) prints the script's doc and exits."""
+    if len(argv) != 2 or argv[1] in ("-h", "--help"):
+        print(doc.strip())
+        sys.exit(0 if len(argv) == 2 else 2)
+    return argv[1]

@@ -16,7 +16,7 @@ import json
 import os
 import sys
 
-from report_tools import failer, pyplot
+from report_tools import failer, folder_argument, guarded, pyplot
 
 fail = failer("seating report")
 plt = pyplot(fail)
@@ -117,30 +117,28 @@ def findings_html(findings):
             f"{rows}</table>")
 
 
+def read_and_draw(d, one, many):
+    """The run's JSON and its figures: (title, figure names, extra HTML)."""
+    if os.path.exists(many):
+        with open(many) as f:
+            s = json.load(f)
+        title = f"Chair-design sweep over {s['parameter']}"
+        figures = [sweep(s, d)]
+        extra = findings_html(s["findings"])
+    else:
+        with open(one) as f:
+            s = json.load(f)
+        title = f"The spine in a chair: {chair_text(s)}"
+        figures = [contacts(s, d), l5s1(s, d)]
+        extra = ""
+    return title, figures, extra
+
+
 def main(argv):
-    if len(argv) != 2 or argv[1] in ("-h", "--help"):
-        print(__doc__.strip())
-        return 0 if len(argv) == 2 else 2
-    d = argv[1]
+    d = folder_argument(argv, __doc__)
     one, many = os.path.join(d, "seating.json"), os.path.join(d, "seating_sweep.json")
     os.makedirs(os.path.join(d, "plots"), exist_ok=True)
-    try:
-        if os.path.exists(many):
-            with open(many) as f:
-                s = json.load(f)
-            title = f"Chair-design sweep over {s['parameter']}"
-            figures = [sweep(s, d)]
-            extra = findings_html(s["findings"])
-        else:
-            with open(one) as f:
-                s = json.load(f)
-            title = f"The spine in a chair: {chair_text(s)}"
-            figures = [contacts(s, d), l5s1(s, d)]
-            extra = ""
-    except OSError as e:  # a file that cannot be read or written (a full disk)
-        fail(f"cannot read or write in {d}: {e}")
-    except (ValueError, KeyError, TypeError, IndexError) as e:
-        fail(f"bad input in {d}: {type(e).__name__} {e}")
+    title, figures, extra = guarded(fail, d, lambda: read_and_draw(d, one, many))
     parts = ["<!DOCTYPE html><html><head><meta charset='utf-8'>",
              f"<title>{html.escape(title)}</title><style>body{{font-family:sans-serif;"
              "max-width:1100px;margin:2em auto}img{max-width:100%}table{border-collapse:collapse}"
