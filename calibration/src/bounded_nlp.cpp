@@ -61,10 +61,13 @@ const char* status_name(Ipopt::ApplicationReturnStatus s) {
 /// min f(p), ln lower <= p <= ln upper, for Ipopt.
 class BoundedNlp : public Ipopt::TNLP {
  public:
-  BoundedNlp(const NlpFunction& f, Eigen::VectorXd start, HessianKind hessian,
-             const IpoptSettings& settings, const Progress& progress)
+  BoundedNlp(const NlpFunction& f, Eigen::VectorXd start, Eigen::VectorXd lower,
+             Eigen::VectorXd upper, HessianKind hessian, const IpoptSettings& settings,
+             const Progress& progress)
       : f_(f),
         start_(std::move(start)),
+        lower_(std::move(lower)),
+        upper_(std::move(upper)),
         hessian_(hessian),
         settings_(settings),
         progress_(progress) {}
@@ -79,10 +82,7 @@ class BoundedNlp : public Ipopt::TNLP {
   }
   bool get_bounds_info(Ipopt::Index n, Ipopt::Number* x_l, Ipopt::Number* x_u, Ipopt::Index,
                        Ipopt::Number*, Ipopt::Number*) override {
-    for (Ipopt::Index i = 0; i < n; ++i) {
-      x_l[i] = std::log(settings_.lower_scale);
-      x_u[i] = std::log(settings_.upper_scale);
-    }
+    for (Ipopt::Index i = 0; i < n; ++i) x_l[i] = lower_(i), x_u[i] = upper_(i);
     return true;
   }
   bool get_starting_point(Ipopt::Index n, bool init_x, Ipopt::Number* x, bool init_z,
@@ -164,7 +164,7 @@ class BoundedNlp : public Ipopt::TNLP {
   }
 
   const NlpFunction& f_;
-  Eigen::VectorXd start_, final_, last_p_;
+  Eigen::VectorXd start_, lower_, upper_, final_, last_p_;
   HessianKind hessian_;
   IpoptSettings settings_;
   Progress progress_;
@@ -179,8 +179,19 @@ class BoundedNlp : public Ipopt::TNLP {
 NlpRun run_bounded_nlp(const NlpFunction& f, const Eigen::VectorXd& start, HessianKind hessian,
                        const IpoptSettings& settings, const Progress& progress,
                        double objective_scaling) {
+  const Eigen::Index n = start.size();
+  return run_bounded_nlp(f, start, Eigen::VectorXd::Constant(n, std::log(settings.lower_scale)),
+                         Eigen::VectorXd::Constant(n, std::log(settings.upper_scale)), hessian,
+                         settings, progress, objective_scaling);
+}
+
+NlpRun run_bounded_nlp(const NlpFunction& f, const Eigen::VectorXd& start,
+                       const Eigen::VectorXd& lower, const Eigen::VectorXd& upper,
+                       HessianKind hessian, const IpoptSettings& settings,
+                       const Progress& progress, double objective_scaling) {
   NlpRun out;
-  Ipopt::SmartPtr<BoundedNlp> nlp = new BoundedNlp(f, start, hessian, settings, progress);
+  Ipopt::SmartPtr<BoundedNlp> nlp =
+      new BoundedNlp(f, start, lower, upper, hessian, settings, progress);
   Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
   app->Options()->SetStringValue("hessian_approximation",
                                  hessian == HessianKind::dense ? "exact" : "limited-memory");

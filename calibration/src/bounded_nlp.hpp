@@ -1,5 +1,5 @@
-// Private: Ipopt on a bound-constrained problem  min f(p), lower <= p_i <= upper  (the same
-// bounds for every unknown), shared by the region fit (calibrate.cpp: dense Gauss–Newton
+// Private: Ipopt on a bound-constrained problem  min f(p), lower_i <= p_i <= upper_i (by default
+// the same bounds for every unknown), shared by the region fit (calibrate.cpp: dense Gauss–Newton
 // Hessian) and the per-spring stage (per_spring.cpp: thousands of unknowns, limited-memory
 // BFGS). Ipopt's C++ TNLP interface stays inside bounded_nlp.cpp.
 #pragma once
@@ -39,5 +39,12 @@ struct NlpRun {
 NlpRun run_bounded_nlp(const NlpFunction& f, const Eigen::VectorXd& start, HessianKind hessian,
                        const IpoptSettings& settings, const Progress& progress,
                        double objective_scaling = 1.0);
+
+/// The same with a bound pair per unknown (lower(i) < upper(i), in the unknowns' own space);
+/// settings.lower_scale and upper_scale are not used.
+NlpRun run_bounded_nlp(const NlpFunction& f, const Eigen::VectorXd& start,
+                       const Eigen::VectorXd& lower, const Eigen::VectorXd& upper,
+                       HessianKind hessian, const IpoptSettings& settings,
+                       const Progress& progress, double objective_scaling = 1.0);
 
 }  // namespace spinesim::calibration::detail
