@@ -2,7 +2,7 @@
 //
 //   spinesim study disc-validation [--level L4-L5] [--material fibre-reinforced]
 //       [--formulation mixed] [--mesh disc.vtu] [--cell-size 2] [--csv FILE] [--json]
-//       [--model nonlinear [--order 1] [--fibre-k2 10] [--increments 10] [--paths FILE]]
+//       [--model nonlinear [--order 1] [--fibre-k2 K2] [--increments 10] [--paths FILE]]
 //       [--out DIR]
 #include "cli_common.hpp"
 #include "spinesim/mesh/disc_level.hpp"
@@ -68,7 +68,8 @@ void run_disc_validation(const DiscValidationArgs& a) {
   if (nonlinear) {
     if (a.nonlinear.order != 1 && a.nonlinear.order != 2)
       throw std::invalid_argument("--order must be 1 or 2");
-    if (!std::isfinite(a.nonlinear.fibre_k2) || a.nonlinear.fibre_k2 < 0)
+    if (a.nonlinear.fibre_k2 &&
+        !(std::isfinite(*a.nonlinear.fibre_k2) && *a.nonlinear.fibre_k2 >= 0))
       throw std::invalid_argument("--fibre-k2 must be a finite number >= 0");
     if (a.nonlinear.load_increments < 1 || a.nonlinear.load_increments > 1000)
       throw std::invalid_argument("--increments must be 1 to 1000");
@@ -151,10 +152,14 @@ void register_disc_validation(CLI::App& study) {
                   "Nonlinear disc: 1 (P1, nodal-average volume) or 2 (P2, mean dilatation)")
       ->capture_default_str()
       ->each(nonlinear_flag);
-  cmd->add_option("--fibre-k2", a->nonlinear.fibre_k2,
-                  "Nonlinear disc: the fibres' toe exponent k2 (k1 = k/4 of the preset)")
-      ->capture_default_str()
-      ->each(nonlinear_flag);
+  cmd->add_option_function<double>(
+      "--fibre-k2",
+      [a](double k2) {
+        a->nonlinear.fibre_k2 = k2;
+        a->nonlinear_flag_given = true;
+      },
+      "Nonlinear disc: the fibres' toe exponent k2 (default: the material's \"k2\", else 10; "
+      "k1 = k/4 of the preset)");
   cmd->add_option("--increments", a->nonlinear.load_increments,
                   "Nonlinear disc: load increments, the points of each path")
       ->capture_default_str()

@@ -187,8 +187,8 @@ NlpRun run_bounded_nlp(const NlpFunction& f, const Eigen::VectorXd& start, Hessi
 
 NlpRun run_bounded_nlp(const NlpFunction& f, const Eigen::VectorXd& start,
                        const Eigen::VectorXd& lower, const Eigen::VectorXd& upper,
-                       HessianKind hessian, const IpoptSettings& settings,
-                       const Progress& progress, double objective_scaling) {
+                       HessianKind hessian, const IpoptSettings& settings, const Progress& progress,
+                       double objective_scaling) {
   NlpRun out;
   Ipopt::SmartPtr<BoundedNlp> nlp =
       new BoundedNlp(f, start, lower, upper, hessian, settings, progress);

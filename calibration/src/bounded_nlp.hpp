@@ -44,7 +44,7 @@ NlpRun run_bounded_nlp(const NlpFunction& f, const Eigen::VectorXd& start, Hessi
 /// settings.lower_scale and upper_scale are not used.
 NlpRun run_bounded_nlp(const NlpFunction& f, const Eigen::VectorXd& start,
                        const Eigen::VectorXd& lower, const Eigen::VectorXd& upper,
-                       HessianKind hessian, const IpoptSettings& settings,
-                       const Progress& progress, double objective_scaling = 1.0);
+                       HessianKind hessian, const IpoptSettings& settings, const Progress& progress,
+                       double objective_scaling = 1.0);
 
 }  // namespace spinesim::calibration::detail

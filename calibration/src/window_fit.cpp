@@ -19,8 +19,7 @@ void check(const std::vector<FitParameter>& parameters, const std::vector<Window
            const std::vector<bool>& used, const WindowFitOptions& options) {
   if (parameters.empty()) throw std::invalid_argument("identification: no parameter to fit");
   for (const FitParameter& p : parameters) {
-    const bool finite =
-        std::isfinite(p.lower) && std::isfinite(p.upper) && std::isfinite(p.start);
+    const bool finite = std::isfinite(p.lower) && std::isfinite(p.upper) && std::isfinite(p.start);
     if (!finite || !(p.lower > 0) || !(p.lower < p.upper))
       throw std::invalid_argument("identification: parameter '" + p.name +
                                   "' needs finite bounds 0 < lower < upper");
@@ -43,8 +42,7 @@ void check(const std::vector<FitParameter>& parameters, const std::vector<Window
 
 /// The model at each column of `points` (ln p), on `threads` threads.
 std::vector<Eigen::VectorXd> evaluate_all(const QuantityModel& model,
-                                          const std::vector<Eigen::VectorXd>& points,
-                                          int threads) {
+                                          const std::vector<Eigen::VectorXd>& points, int threads) {
   std::vector<Eigen::VectorXd> out(points.size());
   std::atomic<std::size_t> next{0};
   const auto work = [&] {
@@ -110,9 +108,8 @@ WindowFit fit_to_windows(const QuantityModel& model, const std::vector<FitParame
     v.hessian = jac.transpose() * jac;
     return v;
   };
-  const detail::NlpRun run = detail::run_bounded_nlp(f, start, lower, upper,
-                                                     detail::HessianKind::dense, options.ipopt,
-                                                     progress);
+  const detail::NlpRun run = detail::run_bounded_nlp(
+      f, start, lower, upper, detail::HessianKind::dense, options.ipopt, progress);
   WindowFit out;
   out.success = run.success && run.final_point.size() == n;
   out.status = run.status;
@@ -141,8 +138,7 @@ WindowFit fit_to_windows(const QuantityModel& model, const std::vector<FitParame
 std::vector<WindowFit> leave_one_out(const QuantityModel& model,
                                      const std::vector<FitParameter>& parameters,
                                      const std::vector<WindowTarget>& targets,
-                                     const std::vector<bool>& used,
-                                     const WindowFitOptions& options,
+                                     const std::vector<bool>& used, const WindowFitOptions& options,
                                      const std::function<void(int target)>& on_start) {
   std::vector<WindowFit> out(targets.size());
   for (std::size_t i = 0; i < targets.size(); ++i) {

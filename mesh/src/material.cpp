@@ -59,7 +59,8 @@ IsotropicMaterial parse_one(const nlohmann::json& j, const std::string& what,
 FibreReinforcement parse_fibres(const nlohmann::json& j, const std::string& what) {
   if (!j.is_object()) throw std::invalid_argument(what + ": expected a JSON object");
   require_known_keys(
-      j, {"E_inner_mpa", "E_outer_mpa", "angle_inner_deg", "angle_outer_deg", "source", "notes"},
+      j,
+      {"E_inner_mpa", "E_outer_mpa", "angle_inner_deg", "angle_outer_deg", "k2", "source", "notes"},
       what);
   auto number = [&](const char* key) -> double {
     if (!j.contains(key)) throw std::invalid_argument(what + ": missing '" + key + "'");
@@ -72,6 +73,7 @@ FibreReinforcement parse_fibres(const nlohmann::json& j, const std::string& what
   f.modulus_outer_mpa = number("E_outer_mpa");
   f.angle_inner_deg = number("angle_inner_deg");
   f.angle_outer_deg = number("angle_outer_deg");
+  if (j.contains("k2")) f.toe_k2 = number("k2");
   f.source = j.value("source", std::string());
   validate(f, what);
   return f;
@@ -88,6 +90,9 @@ void validate(const FibreReinforcement& f, const std::string& what) {
     if (!(a >= 0 && a <= 90))
       throw std::invalid_argument(what + ": fibre angle must lie in [0, 90] degrees (got " +
                                   fmt(a) + ")");
+  if (!(f.toe_k2 >= 0 && f.toe_k2 <= 1000))
+    throw std::invalid_argument(what + ": the fibres' toe exponent k2 must lie in [0, 1000] (got " +
+                                fmt(f.toe_k2) + ")");
 }
 
 void validate(const IsotropicMaterial& m, const std::string& what) {

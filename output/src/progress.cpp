@@ -8,6 +8,7 @@
 #include <cmath>
 #include <iostream>
 #include <sstream>
+#include <string>
 
 namespace spinesim::output {
 
@@ -20,7 +21,8 @@ void Progress::begin(const std::string& what) {
   ++current_;
   timer_.restart();
   if (!quiet_)
-    std::cerr << "[" << current_ << "/" << stages_ << "] " << what << " ..." << std::flush;
+    std::cerr << "[" << current_ << (stages_ > 0 ? "/" + std::to_string(stages_) : "") << "] "
+              << what << " ..." << std::flush;
 }
 
 double Progress::end(const std::string& detail) {

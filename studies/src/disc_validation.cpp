@@ -15,18 +15,6 @@
 namespace spinesim::studies {
 namespace {
 
-std::string preparation_of(const nlohmann::json& t) {
-  const auto flag = [&](const char* key) -> int {
-    if (!t.contains(key) || t.at(key).is_null()) return -1;
-    return t.at(key).get<bool>() ? 1 : 0;
-  };
-  const int facets = flag("facets_removed"), ligaments = flag("ligaments_removed");
-  if (facets < 0 || ligaments < 0) return "not stated in what we read";
-  if (facets && ligaments) return "facets and ligaments removed";
-  if (facets) return "facets removed, ligaments kept";
-  return "posterior elements present";
-}
-
 /// Mean distance between the endplates along the disc axis, mm.
 double disc_height_mm(const mesh::TetMesh& m) {
   Eigen::Vector3d lo = Eigen::Vector3d::Zero(), hi = Eigen::Vector3d::Zero();
@@ -49,7 +37,7 @@ void fill_rows(const nlohmann::json& targets, const std::map<std::string, double
     row.high = t.at("high").get<double>();
     row.reported = t.value("reported", std::string());
     row.source = t.value("source", std::string());
-    row.preparation = preparation_of(t);
+    row.preparation = disc_target_preparation(t);
     const auto it = ours.find(row.quantity);
     if (it == ours.end())
       row.note = "not a quantity this study computes";
@@ -76,6 +64,24 @@ DiscValidationResult describe(const mesh::TetMesh& m, const mesh::RegionMaterial
 }
 
 }  // namespace
+
+std::string disc_target_preparation(const nlohmann::json& t) {
+  const auto flag = [&](const char* key) -> int {
+    if (!t.contains(key) || t.at(key).is_null()) return -1;
+    return t.at(key).get<bool>() ? 1 : 0;
+  };
+  const int facets = flag("facets_removed"), ligaments = flag("ligaments_removed");
+  if (facets < 0 || ligaments < 0) return "not stated in what we read";
+  if (facets && ligaments) return "facets and ligaments removed";
+  if (facets) return "facets removed, ligaments kept";
+  return "posterior elements present";
+}
+
+const std::vector<std::pair<const char*, int>>& nonlinear_disc_cases() {
+  static const std::vector<std::pair<const char*, int>> cases = {
+      {"compression", 1}, {"torsion", 4}, {"flexion", 3}, {"extension", 3}, {"lateral-bending", 5}};
+  return cases;
+}
 
 nlohmann::json read_disc_targets(const std::string& path) {
   const nlohmann::json j = read_json_file(path, "disc targets file");
@@ -147,34 +153,28 @@ DiscValidationResult run_disc_validation(const mesh::TetMesh& m,
   return r;
 }
 
-DiscValidationResult run_nonlinear_disc_validation(const mesh::TetMesh& m,
-                                                   const mesh::RegionMaterials& materials,
-                                                   const NonlinearDiscOptions& options,
-                                                   const nlohmann::json& targets,
-                                                   const std::string& mesh_label,
-                                                   const StageHooks& hooks) {
+NonlinearDiscQuantities nonlinear_disc_quantities(const mesh::TetMesh& m,
+                                                  const mesh::RegionMaterials& materials,
+                                                  const NonlinearDiscOptions& options,
+                                                  const StageHooks& hooks) {
   if (options.order != 1 && options.order != 2)
     throw std::invalid_argument("nonlinear disc: order must be 1 or 2");
-  if (!std::isfinite(options.fibre_k2) || options.fibre_k2 < 0)
+  const double k2 = options.fibre_k2.value_or(
+      materials.has_fibres() ? materials.fibres.begin()->second.toe_k2 : 10.0);
+  if (!std::isfinite(k2) || k2 < 0)
     throw std::invalid_argument("nonlinear disc: the fibre toe exponent k2 must be >= 0");
   if (options.load_increments < 1 || options.load_increments > 1000)
     throw std::invalid_argument("nonlinear disc: load increments must be 1 to 1000");
-  DiscValidationResult r = describe(m, materials, targets, mesh_label);
-  r.formulation = std::string("nonlinear P") + std::to_string(options.order) +
-                  (options.order == 1 ? ", nodal-average volume" : ", mean dilatation") +
-                  "; tension-only fibres, k1 = k/4, k2 = " + significant(options.fibre_k2, 3);
-  const Timer timer;
-  const fem::NonlinearDisc disc(m, fem::disc_element_materials(m, materials, options.fibre_k2),
-                                options.order, fem::DiscFem::default_plate_center(m));
-  r.dofs = 3 * disc.body().space().num_nodes();
+  NonlinearDiscQuantities out;
+  out.fibre_k2 = k2;
+  const double area_mm2 = mesh::mesh_volume(m) / disc_height_mm(m);
+  const fem::NonlinearDisc disc(m, fem::disc_element_materials(m, materials, k2), options.order,
+                                fem::DiscFem::default_plate_center(m));
+  out.dofs = 3 * disc.body().space().num_nodes();
   fem::NewtonOptions newton;
   newton.load_increments = options.load_increments;
   const Eigen::Matrix3d& axes = m.frame.axes;
-  std::map<std::string, double> ours;
-  std::map<std::string, std::string> notes;
-  const std::vector<std::pair<const char*, int>> cases = {
-      {"compression", 1}, {"torsion", 4}, {"flexion", 3}, {"extension", 3}, {"lateral-bending", 5}};
-  for (const auto& [name, component] : cases) {
+  for (const auto& [name, component] : nonlinear_disc_cases()) {
     hooks.begin_stage(std::string("nonlinear disc, ") + name);
     const fem::LoadCase& c = fem::load_case(name);
     fem::PlateLoad load;
@@ -192,24 +192,44 @@ DiscValidationResult run_nonlinear_disc_validation(const mesh::TetMesh& m,
       path.load.push_back(std::abs(p.load_fraction * load_value));
       path.motion.push_back(std::abs(along(p.plate_motion)));
     }
-    r.paths.push_back(path);
+    out.paths.push_back(path);
+    out.newton_iterations += s.body.newton_iterations;
     if (!s.body.converged) {
-      notes[name] = "did not converge: " + s.body.failure;
+      out.notes[name] = "did not converge: " + s.body.failure;
       hooks.end_stage("did not converge");
       continue;
     }
-    ours[name] = std::abs(load_value / along(s.plate_motion)) / (component < 3 ? 1000.0 : 1.0);
+    out.values[name] =
+        std::abs(load_value / along(s.plate_motion)) / (component < 3 ? 1000.0 : 1.0);
     if (component == 1) {
-      r.nucleus_pressure_mpa = s.nucleus_pressure_mpa;
-      ours["nucleus-pressure-ratio"] =
-          s.nucleus_pressure_mpa / (std::abs(c.wrench_local(1)) / r.disc_area_mm2);
+      out.nucleus_pressure_mpa = s.nucleus_pressure_mpa;
+      out.values["nucleus-pressure-ratio"] =
+          s.nucleus_pressure_mpa / (std::abs(c.wrench_local(1)) / area_mm2);
     }
     hooks.end_stage(std::to_string(s.body.newton_iterations) + " Newton iterations");
   }
-  if (!ours.count("compression"))
-    notes["nucleus-pressure-ratio"] = "the compression did not converge";
+  if (!out.values.count("compression"))
+    out.notes["nucleus-pressure-ratio"] = "the compression did not converge";
+  return out;
+}
+
+DiscValidationResult run_nonlinear_disc_validation(const mesh::TetMesh& m,
+                                                   const mesh::RegionMaterials& materials,
+                                                   const NonlinearDiscOptions& options,
+                                                   const nlohmann::json& targets,
+                                                   const std::string& mesh_label,
+                                                   const StageHooks& hooks) {
+  DiscValidationResult r = describe(m, materials, targets, mesh_label);
+  const Timer timer;
+  const NonlinearDiscQuantities q = nonlinear_disc_quantities(m, materials, options, hooks);
+  r.formulation = std::string("nonlinear P") + std::to_string(options.order) +
+                  (options.order == 1 ? ", nodal-average volume" : ", mean dilatation") +
+                  "; tension-only fibres, k1 = k/4, k2 = " + significant(q.fibre_k2, 3);
+  r.dofs = q.dofs;
+  r.paths = q.paths;
+  r.nucleus_pressure_mpa = q.nucleus_pressure_mpa;
   r.solve_s = timer.seconds();
-  fill_rows(targets, ours, r, notes);
+  fill_rows(targets, q.values, r, q.notes);
   return r;
 }
 

@@ -113,8 +113,8 @@ TEST(LeaveOneOut, OnAConsistentModelEachLeftOutQuantityIsPredictedWhereItWasMeas
 TEST(LeaveOneOut, SkipsTargetsNotInUse) {
   Eigen::VectorXd truth(3);
   truth << 2.5, 0.4, 3.0;
-  const std::vector<WindowFit> loo = leave_one_out(power_model, three_parameters(),
-                                                   windows_around(truth), {true, true, true, false});
+  const std::vector<WindowFit> loo = leave_one_out(
+      power_model, three_parameters(), windows_around(truth), {true, true, true, false});
   EXPECT_FALSE(loo[3].success);
   EXPECT_EQ(loo[3].parameters.size(), 0);
   EXPECT_TRUE(loo[0].success);

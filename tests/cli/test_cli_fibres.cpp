@@ -175,5 +175,46 @@ TEST(CliFibres, DiscValidationRunsTheNonlinearDisc) {
   EXPECT_FALSE(std::filesystem::exists(unwritten));
 }
 
+// The identification on the small structured disc (fine = coarse, no leave-one-out: seconds):
+// parameters with bounds and sources, six rows with the disc's values, the held-out rows, the
+// folder's files and a preset that the material reader takes. Bad input: one line, nothing
+// written.
+TEST(CliFibres, DiscIdentifyFitsTheMaterialAndWritesAPreset) {
+  const std::string out = tmp("disc-identify-out");
+  std::filesystem::remove_all(out);
+  const CliRun r =
+      run_spinesim("study disc-identify --mesh '" + disc_vtu() +
+                   "' --fine-order 1 --increments 2 --no-leave-one-out --out '" + out + "' --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_TRUE(j["success"].get<bool>());
+  ASSERT_EQ(j["parameters"].size(), 4u);
+  for (const auto& p : j["parameters"]) {
+    EXPECT_GE(p["identified"].get<double>(), p["lower"].get<double>()) << p.dump();
+    EXPECT_LE(p["identified"].get<double>(), p["upper"].get<double>()) << p.dump();
+    EXPECT_FALSE(p["bounds_source"].get<std::string>().empty());
+  }
+  ASSERT_EQ(j["targets"].size(), 6u);
+  for (const auto& row : j["targets"]) EXPECT_TRUE(row["identified"].is_number()) << row.dump();
+  EXPECT_EQ(j["held_out"].size(), 4u);
+  for (const char* file :
+       {"disc_identification.json", "disc_identification.md", "disc-identified.json"})
+    EXPECT_TRUE(std::filesystem::exists(out + "/" + file)) << file;
+  const CliRun v =
+      run_spinesim("study disc-validation --mesh '" + disc_vtu() + "' --material '" + out +
+                   "/disc-identified.json' --model nonlinear --increments 2 --json");
+  EXPECT_EQ(v.status, 0) << v.err;
+
+  const std::string unwritten = tmp("unwritten-preset.json");
+  std::filesystem::remove(unwritten);
+  expect_refused(run_spinesim("study disc-identify --fine-order 3 --preset '" + unwritten + "'"),
+                 "orders must be 1 or 2");
+  expect_refused(run_spinesim("study disc-identify --material annulus-nucleus"),
+                 "needs an annulus with fibres and a nucleus");
+  expect_refused(run_spinesim("study disc-identify --level L9-L10"), "L9-L10");
+  expect_refused(run_spinesim("study disc-identify --cell-size -1"), "--cell-size");
+  EXPECT_FALSE(std::filesystem::exists(unwritten));
+}
+
 }  // namespace
 }  // namespace spinesim::test_cli

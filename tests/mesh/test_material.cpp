@@ -162,6 +162,12 @@ TEST(MaterialFibres, BadFibresAreRefusedInOneLine) {
   bad.erase("E_outer_mpa");
   EXPECT_TRUE(contains(refusal([&] { material_from_json(with(bad)); }), "E_outer_mpa"));
   bad = good;
+  bad["k2"] = -0.5;
+  EXPECT_TRUE(contains(refusal([&] { material_from_json(with(bad)); }), "toe exponent k2"));
+  bad["k2"] = 12.5;
+  EXPECT_DOUBLE_EQ(material_from_json(with(bad)).fibres.at(int(Region::annulus)).toe_k2, 12.5);
+  EXPECT_DOUBLE_EQ(material_from_json(with(good)).fibres.at(int(Region::annulus)).toe_k2, 10.0);
+  bad = good;
   bad["angle_inner_deg"] = "steep";
   EXPECT_TRUE(contains(refusal([&] { material_from_json(with(bad)); }), "must be a number"));
   nlohmann::json homogeneous = {{"name", "h"}, {"E_mpa", 3}, {"nu", 0.4}, {"fibres", good}};

@@ -38,9 +38,9 @@ struct FitParameter {
 using QuantityModel = std::function<Eigen::VectorXd(const Eigen::VectorXd& parameters)>;
 
 struct WindowFitOptions {
-  IpoptSettings ipopt;         ///< lower_scale/upper_scale unused: each parameter has its bounds
-  double log_step = 1e-3;      ///< forward-difference step in ln p
-  int threads = 1;             ///< model evaluations run side by side
+  IpoptSettings ipopt;            ///< lower_scale/upper_scale unused: each parameter has its bounds
+  double log_step = 1e-3;         ///< forward-difference step in ln p
+  int threads = 1;                ///< model evaluations run side by side
   double bound_tolerance = 1e-4;  ///< |ln p - ln bound| below this: the bound is active
 };
 
@@ -49,10 +49,10 @@ struct WindowFit {
   std::string status;  ///< Ipopt's
   int iterations = 0, model_evaluations = 0;
   double seconds = 0;
-  Eigen::VectorXd parameters;  ///< p at the end
-  Eigen::VectorXd quantities;  ///< the model there, every target (used or not)
-  Eigen::VectorXd residuals;   ///< r_i there, every target
-  double objective = 0;        ///< ½ Σ r_i² over the targets in use
+  Eigen::VectorXd parameters;              ///< p at the end
+  Eigen::VectorXd quantities;              ///< the model there, every target (used or not)
+  Eigen::VectorXd residuals;               ///< r_i there, every target
+  double objective = 0;                    ///< ½ Σ r_i² over the targets in use
   std::vector<std::string> active_bounds;  ///< e.g. "annulus-E at upper (4.2 MPa)"
 };
 

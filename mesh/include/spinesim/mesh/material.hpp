@@ -45,6 +45,9 @@ void validate(const IsotropicMaterial& m, const std::string& what = "material");
 struct FibreReinforcement {
   double modulus_inner_mpa = 0, modulus_outer_mpa = 0;  ///< E_f at s = 0 and s = 1
   double angle_inner_deg = 0, angle_outer_deg = 0;      ///< to the transverse plane
+  /// The nonlinear disc's toe exponent k2 (fem/hyperelastic.hpp: tension-only exponential
+  /// fibres), dimensionless, >= 0; the linear FEM does not use it. Files: optional "k2".
+  double toe_k2 = 10.0;
   std::string source;
 
   double modulus_mpa(double depth) const {
@@ -55,7 +58,8 @@ struct FibreReinforcement {
   }
 };
 
-/// Throws std::invalid_argument unless 0 < E_f <= 1e5 MPa and 0 <= angle <= 90 deg, finite.
+/// Throws std::invalid_argument unless 0 < E_f <= 1e5 MPa, 0 <= angle <= 90 deg and
+/// 0 <= k2 <= 1000, finite.
 void validate(const FibreReinforcement& f, const std::string& what = "fibres");
 
 /// A named material assignment: one material per region label (1 annulus, 2 nucleus, ...).
@@ -77,7 +81,8 @@ struct RegionMaterials {
 
 /// Parses {"name","E_mpa","nu"|"G_mpa","density_kg_m3"} or
 /// {"name","annulus":{...},"nucleus":{...}}; the annulus may carry
-/// "fibres": {"E_inner_mpa","E_outer_mpa","angle_inner_deg","angle_outer_deg","source"}.
+/// "fibres": {"E_inner_mpa","E_outer_mpa","angle_inner_deg","angle_outer_deg","source"} and
+/// optionally "k2".
 /// Validates. Throws std::invalid_argument.
 RegionMaterials material_from_json(const nlohmann::json& j);
 

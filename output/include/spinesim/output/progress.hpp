@@ -31,7 +31,8 @@ struct StageHooks {
 
 class Progress {
  public:
-  /// Prints only when not quiet and stderr is a terminal.
+  /// Prints only when not quiet and stderr is a terminal. `stages` <= 0: a count not known
+  /// ahead (an iteration that stops when it settles), numbered without a total.
   Progress(int stages, bool quiet);
   void begin(const std::string& what);
   double end(const std::string& detail = "");  ///< returns the stage's seconds

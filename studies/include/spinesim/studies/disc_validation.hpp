@@ -21,8 +21,11 @@
 #include <nlohmann/json.hpp>
 
 #include <limits>
+#include <map>
+#include <optional>
 #include <ostream>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace spinesim::studies {
@@ -46,9 +49,9 @@ struct DiscLoadPath {
 };
 
 struct NonlinearDiscOptions {
-  int order = 1;             ///< 1 (nodal-average volume) or 2 (mean dilatation)
-  double fibre_k2 = 10.0;    ///< the fibres' toe exponent (>= 0)
-  int load_increments = 10;  ///< points per path (>= 1)
+  int order = 1;                   ///< 1 (nodal-average volume) or 2 (mean dilatation)
+  std::optional<double> fibre_k2;  ///< the fibres' toe exponent (>= 0); default the material's
+  int load_increments = 10;        ///< points per path (>= 1)
 };
 
 struct DiscValidationResult {
@@ -63,6 +66,9 @@ struct DiscValidationResult {
   std::vector<DiscLoadPath> paths;  ///< nonlinear disc only
 };
 
+/// A target's specimen preparation in words ("facets and ligaments removed", ...).
+std::string disc_target_preparation(const nlohmann::json& target);
+
 /// Reads the targets file; throws std::invalid_argument (one line) when it is unusable.
 nlohmann::json read_disc_targets(const std::string& path);
 
@@ -73,6 +79,28 @@ DiscValidationResult run_disc_validation(const mesh::TetMesh& m,
                                          const nlohmann::json& targets,
                                          const std::string& mesh_label,
                                          const StageHooks& hooks = StageHooks());
+
+/// The standard load cases of the nonlinear disc in order, each with the component of the disc
+/// frame's (t, θ) it is measured along: compression 1, torsion 4, flexion and extension 3,
+/// lateral bending 5.
+const std::vector<std::pair<const char*, int>>& nonlinear_disc_cases();
+
+/// The nonlinear disc's in-vitro quantities under the standard loads, keyed as the targets
+/// file's ("compression", …, "nucleus-pressure-ratio"): absent where a case did not converge
+/// (`notes` says why). Throws std::invalid_argument for options out of range.
+struct NonlinearDiscQuantities {
+  std::map<std::string, double> values;
+  std::map<std::string, std::string> notes;
+  std::vector<DiscLoadPath> paths;
+  double nucleus_pressure_mpa = std::numeric_limits<double>::quiet_NaN();
+  double fibre_k2 = 0;  ///< the toe exponent used
+  Eigen::Index dofs = 0;
+  int newton_iterations = 0;  ///< over the five cases
+};
+NonlinearDiscQuantities nonlinear_disc_quantities(const mesh::TetMesh& m,
+                                                  const mesh::RegionMaterials& materials,
+                                                  const NonlinearDiscOptions& options,
+                                                  const StageHooks& hooks = StageHooks());
 
 /// The same with the nonlinear disc. Throws std::invalid_argument for options out of range.
 DiscValidationResult run_nonlinear_disc_validation(const mesh::TetMesh& m,
