@@ -2,7 +2,8 @@
 //
 //   spinesim study disc-validation [--level L4-L5] [--material fibre-reinforced]
 //       [--formulation mixed] [--mesh disc.vtu] [--cell-size 2] [--csv FILE] [--json]
-//       [--model nonlinear [--order 1] [--fibre-k2 K2] [--increments 10] [--paths FILE]]
+//       [--model nonlinear [--order 1] [--fibre-k2 K2] [--preload N] [--increments 10]
+//        [--paths FILE]]
 //       [--out DIR]
 #include "cli_common.hpp"
 #include "spinesim/mesh/disc_level.hpp"
@@ -63,7 +64,7 @@ void run_disc_validation(const DiscValidationArgs& a) {
         "its volume by --order)");
   if (!nonlinear && a.nonlinear_flag_given)
     throw std::invalid_argument(
-        "--order, --fibre-k2, --increments and --paths need --model nonlinear");
+        "--order, --fibre-k2, --preload, --increments and --paths need --model nonlinear");
   const fem::Formulation formulation = parse_formulation(a.formulation);
   if (nonlinear) {
     if (a.nonlinear.order != 1 && a.nonlinear.order != 2)
@@ -73,6 +74,9 @@ void run_disc_validation(const DiscValidationArgs& a) {
       throw std::invalid_argument("--fibre-k2 must be a finite number >= 0");
     if (a.nonlinear.load_increments < 1 || a.nonlinear.load_increments > 1000)
       throw std::invalid_argument("--increments must be 1 to 1000");
+    if (!std::isfinite(a.nonlinear.preload_n) || a.nonlinear.preload_n < 0 ||
+        a.nonlinear.preload_n > 1e4)
+      throw std::invalid_argument("--preload: the preload must be 0 to 10000 N");
   }
   const mesh::RegionMaterials materials = mesh::load_material(a.material, data_dir());
   const std::string targets_path =
@@ -160,6 +164,11 @@ void register_disc_validation(CLI::App& study) {
       },
       "Nonlinear disc: the fibres' toe exponent k2 (default: the material's \"k2\", else 10; "
       "k1 = k/4 of the preset)");
+  cmd->add_option("--preload", a->nonlinear.preload_n,
+                  "Nonlinear disc: axial compression (N) applied with each moment, the rotation "
+                  "measured from the preloaded state")
+      ->capture_default_str()
+      ->each(nonlinear_flag);
   cmd->add_option("--increments", a->nonlinear.load_increments,
                   "Nonlinear disc: load increments, the points of each path")
       ->capture_default_str()

@@ -328,7 +328,10 @@ DiscIdentificationResult identify_disc_material(
 
 nlohmann::json identified_material_json(const DiscIdentificationResult& r,
                                         const mesh::RegionMaterials& base) {
-  const mesh::RegionMaterials m = disc_material_at(base, r.identified, "disc-identified");
+  // Six significant digits: exp(ln p) leaves rounding in the last places (100.00000000000004).
+  Eigen::VectorXd p = r.identified;
+  for (Eigen::Index j = 0; j < p.size(); ++j) p(j) = std::stod(significant(p(j), 6));
+  const mesh::RegionMaterials m = disc_material_at(base, p, "disc-identified");
   const mesh::IsotropicMaterial& a = m.at(kAnnulus);
   const mesh::IsotropicMaterial& n = m.at(kNucleus);
   const mesh::FibreReinforcement& f = m.fibres.at(kAnnulus);
@@ -355,7 +358,7 @@ nlohmann::json identified_material_json(const DiscIdentificationResult& r,
           {"angle_inner_deg", f.angle_inner_deg},
           {"angle_outer_deg", f.angle_outer_deg},
           {"k2", f.toe_k2},
-          {"source", "moduli and k2 identified; angles: " + f.source}}}}},
+          {"source", "moduli and k2 identified; the starting preset's fibres: " + f.source}}}}},
       {"nucleus",
        {{"E_mpa", n.youngs_modulus_mpa},
         {"nu", n.poisson_ratio},

@@ -165,6 +165,8 @@ NonlinearDiscQuantities nonlinear_disc_quantities(const mesh::TetMesh& m,
     throw std::invalid_argument("nonlinear disc: the fibre toe exponent k2 must be >= 0");
   if (options.load_increments < 1 || options.load_increments > 1000)
     throw std::invalid_argument("nonlinear disc: load increments must be 1 to 1000");
+  if (!std::isfinite(options.preload_n) || options.preload_n < 0 || options.preload_n > 1e4)
+    throw std::invalid_argument("nonlinear disc: the preload must be 0 to 10000 N");
   NonlinearDiscQuantities out;
   out.fibre_k2 = k2;
   const double area_mm2 = mesh::mesh_volume(m) / disc_height_mm(m);
@@ -174,12 +176,31 @@ NonlinearDiscQuantities nonlinear_disc_quantities(const mesh::TetMesh& m,
   fem::NewtonOptions newton;
   newton.load_increments = options.load_increments;
   const Eigen::Matrix3d& axes = m.frame.axes;
+  // The preload alone: the state the moment cases' rotations are measured from.
+  const fem::LoadCase& compression = fem::load_case("compression");
+  fem::PlateLoad preload;
+  preload.value = fem::global_wrench(compression, m.frame) *
+                  (options.preload_n / std::abs(compression.wrench_local(1)));
+  Eigen::Matrix<double, 6, 1> preloaded = Eigen::Matrix<double, 6, 1>::Zero();
+  if (options.preload_n > 0) {
+    hooks.begin_stage("nonlinear disc, preload " + significant(options.preload_n, 4) + " N");
+    const fem::NonlinearPlateSolution s = disc.solve(preload, newton);
+    if (!s.body.converged)
+      throw std::runtime_error("nonlinear disc: the preload did not converge: " + s.body.failure);
+    preloaded = s.plate_motion;
+    hooks.end_stage(std::to_string(s.body.newton_iterations) + " Newton iterations");
+  }
   for (const auto& [name, component] : nonlinear_disc_cases()) {
     hooks.begin_stage(std::string("nonlinear disc, ") + name);
     const fem::LoadCase& c = fem::load_case(name);
+    const bool moment = component >= 3;
     fem::PlateLoad load;
-    load.value = fem::global_wrench(c, m.frame);
-    const fem::NonlinearPlateSolution s = disc.solve(load, newton);
+    load.value = fem::global_wrench(c, m.frame) + (moment ? preload.value : 0 * preload.value);
+    fem::NonlinearPlateSolution s = disc.solve(load, newton);
+    if (moment) {
+      s.plate_motion -= preloaded;
+      for (fem::PlatePathPoint& p : s.path) p.plate_motion -= p.load_fraction * preloaded;
+    }
     // Motion along the case's component, disc frame: mm, or degrees.
     const auto along = [&](const Eigen::Matrix<double, 6, 1>& q) {
       return component < 3 ? (axes.transpose() * q.head<3>())(component)

@@ -169,6 +169,9 @@ TEST(CliFibres, DiscValidationRunsTheNonlinearDisc) {
   expect_refused(run_spinesim("study disc-validation --model nonlinear --fibre-k2 -1"),
                  "--fibre-k2");
   expect_refused(run_spinesim("study disc-validation --order 2"), "need --model nonlinear");
+  expect_refused(run_spinesim("study disc-validation --preload 500"), "need --model nonlinear");
+  expect_refused(run_spinesim("study disc-validation --model nonlinear --preload -5"),
+                 "preload must be 0 to 10000 N");
   expect_refused(run_spinesim("study disc-validation --model nonlinear --formulation mixed"),
                  "--formulation is for --model linear");
   expect_refused(run_spinesim("study disc-validation --model quadratic"), "--model must be");

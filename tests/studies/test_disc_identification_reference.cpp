@@ -1,6 +1,7 @@
 // The disc identification on a disc (label reference): windows that the disc itself makes at
 // known parameters are met by those parameters — the fit finds the material it was shown, on
 // one thread or two alike, and a fine disc equal to the coarse one settles in one round.
+#include "spinesim/common/memory.hpp"
 #include "spinesim/studies/disc_identification.hpp"
 #include "studies_fixtures.hpp"
 
@@ -29,6 +30,7 @@ nlohmann::json windows_made_by(const mesh::TetMesh& m, const mesh::RegionMateria
 }  // namespace
 
 TEST(DiscIdentificationReference, FindsTheMaterialWhoseQuantitiesCentreTheWindows) {
+  keep_freed_memory();  // as the program does: Newton's temporaries stay mapped
   const mesh::TetMesh& m = test::structured("L4-L5");
   const auto base = test::material("fibre-reinforced");
   Eigen::VectorXd truth(4);
@@ -50,4 +52,25 @@ TEST(DiscIdentificationReference, FindsTheMaterialWhoseQuantitiesCentreTheWindow
         << r.parameters[size_t(j)].fit.name;
   for (const IdentifiedRow& row : r.fit_rows) EXPECT_TRUE(row.match()) << row.quantity;
   EXPECT_TRUE(r.active_bounds.empty());
+}
+
+// A compressive preload tensions the fibres through the nucleus pressure: every moment case is
+// stiffer under it, and the rotation is measured from the preloaded state (so a preload of
+// zero gives the unloaded numbers exactly).
+TEST(DiscIdentificationReference, APreloadStiffensEveryMomentCase) {
+  keep_freed_memory();
+  const mesh::TetMesh& m = test::structured("L4-L5");
+  const auto material = test::material("fibre-reinforced");
+  NonlinearDiscOptions o;
+  o.load_increments = 2;
+  const NonlinearDiscQuantities free = nonlinear_disc_quantities(m, material, o);
+  o.preload_n = 0.0;
+  EXPECT_EQ(nonlinear_disc_quantities(m, material, o).values, free.values);
+  o.preload_n = 500.0;
+  const NonlinearDiscQuantities loaded = nonlinear_disc_quantities(m, material, o);
+  for (const char* name : {"torsion", "flexion", "extension", "lateral-bending"})
+    EXPECT_GT(loaded.values.at(name), free.values.at(name)) << name;
+  EXPECT_EQ(loaded.values.at("compression"), free.values.at("compression"));
+  o.preload_n = -1.0;
+  EXPECT_THROW(nonlinear_disc_quantities(m, material, o), std::invalid_argument);
 }

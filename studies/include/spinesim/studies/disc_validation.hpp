@@ -52,6 +52,11 @@ struct NonlinearDiscOptions {
   int order = 1;                   ///< 1 (nodal-average volume) or 2 (mean dilatation)
   std::optional<double> fibre_k2;  ///< the fibres' toe exponent (>= 0); default the material's
   int load_increments = 10;        ///< points per path (>= 1)
+  /// Axial compression (N, >= 0) applied with each moment case, as in-vitro tests under a
+  /// preload: the rotation is measured from the state under the preload alone. Both loads grow
+  /// together along the path (the end state of a hyperelastic disc does not depend on the
+  /// order), so a path's intermediate points are not a moment at constant preload.
+  double preload_n = 0;
 };
 
 struct DiscValidationResult {
