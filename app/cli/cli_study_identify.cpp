@@ -9,6 +9,7 @@
 #include "spinesim/mesh/io.hpp"
 #include "spinesim/mesh/material.hpp"
 #include "spinesim/output/files.hpp"
+#include "spinesim/output/html_report.hpp"
 #include "spinesim/studies/disc_identification.hpp"
 
 #include <cmath>
@@ -91,6 +92,9 @@ void run_disc_identify(const DiscIdentifyArgs& a) {
     if (r.success)
       output::write_text_file((fs::path(a.out) / "disc-identified.json").string(),
                               preset.dump(2) + "\n");
+    const output::HtmlReport report = output::write_html_report(a.out, "identify_report.py");
+    if (report.failed) throw std::runtime_error("--out " + a.out + ": " + report.message);
+    std::cerr << (report.written ? "" : "spinesim: warning: ") << report.message << std::endl;
   }
   if (a.json)
     print_json(studies::disc_identification_json(r));
@@ -137,8 +141,8 @@ void register_disc_identify(CLI::App& study) {
                   "Held-out tests (default: data/validation/disc_in_vitro_held_out.json)");
   cmd->add_option("--preset", a->preset, "Write the identified material as a preset file");
   cmd->add_option("--out", a->out,
-                  "Write the JSON, the tables (markdown) and the identified preset into this "
-                  "folder");
+                  "Write the JSON, the tables (markdown), the identified preset, the figure and "
+                  "report.html into this folder");
   cmd->add_flag("--markdown", a->markdown, "Print the tables as markdown");
   add_output_flags(cmd, a->json, a->quiet, "the JSON summary");
   cmd->footer(

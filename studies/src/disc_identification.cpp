@@ -226,7 +226,7 @@ calibration::WindowFit map_and_fit(const Identification& id, Eigen::VectorXd& p,
     }
     if (moved < id.options.mapping_tolerance) {
       r.success = true;
-      r.status = "converged in " + std::to_string(round) + " rounds";
+      r.status = "converged in " + std::to_string(round) + (round == 1 ? " round" : " rounds");
       return f;
     }
   }

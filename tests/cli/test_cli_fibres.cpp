@@ -200,8 +200,8 @@ TEST(CliFibres, DiscIdentifyFitsTheMaterialAndWritesAPreset) {
   ASSERT_EQ(j["targets"].size(), 6u);
   for (const auto& row : j["targets"]) EXPECT_TRUE(row["identified"].is_number()) << row.dump();
   EXPECT_EQ(j["held_out"].size(), 4u);
-  for (const char* file :
-       {"disc_identification.json", "disc_identification.md", "disc-identified.json"})
+  for (const char* file : {"disc_identification.json", "disc_identification.md",
+                           "disc-identified.json", "report.html", "plots/disc_identification.png"})
     EXPECT_TRUE(std::filesystem::exists(out + "/" + file)) << file;
   const CliRun v =
       run_spinesim("study disc-validation --mesh '" + disc_vtu() + "' --material '" + out +
