@@ -17,7 +17,7 @@ import json
 import os
 import sys
 
-from report_tools import failer, folder_argument, guarded, pyplot
+from report_tools import failer, page_head, pyplot, report_main
 
 fail = failer("disc report")
 plt = pyplot(fail)
@@ -88,11 +88,7 @@ def write_report(d):
     os.makedirs(os.path.join(d, "plots"), exist_ok=True)
     figures = [paths_figure(s, d)] if s.get("paths") else []
     title = f"The disc beside in-vitro tests: {s['mesh']}"
-    parts = ["<!DOCTYPE html><html><head><meta charset='utf-8'>",
-             f"<title>{html.escape(title)}</title><style>body{{font-family:sans-serif;"
-             "max-width:1400px;margin:2em auto}img{max-width:100%}"
-             "table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:2px 6px}"
-             "</style></head><body>", f"<h1>{html.escape(title)}</h1>",
+    parts = [page_head(title),
              f"<p>Material {html.escape(s['material'])}; {html.escape(s['formulation'])}; "
              f"{s['tets']} tets, {s['dofs']} DOF. Stiffness = load / plate motion at the "
              "standard load (500 N, 7.5 N·m), disc frame.</p>"]
@@ -108,11 +104,7 @@ def write_report(d):
 
 
 def main(argv):
-    d = folder_argument(argv, __doc__)
-    figures = guarded(fail, d, lambda: write_report(d))
-    print(f"report: {os.path.join(d, 'report.html')} with {len(figures)} figure(s) in "
-          f"{os.path.join(d, 'plots')}")
-    return 0
+    return report_main(argv, __doc__, fail, write_report)
 
 
 if __name__ == "__main__":

@@ -18,7 +18,7 @@ import math
 import os
 import sys
 
-from report_tools import failer, folder_argument, guarded, pyplot
+from report_tools import failer, page_head, pyplot, report_main
 
 fail = failer("identification report")
 plt = pyplot(fail)
@@ -122,11 +122,7 @@ def write_report(d):
     os.makedirs(os.path.join(d, "plots"), exist_ok=True)
     name = figure(s, d)
     title = "The disc material identified from in-vitro tests"
-    parts = ["<!DOCTYPE html><html><head><meta charset='utf-8'>",
-             f"<title>{title}</title><style>body{{font-family:sans-serif;max-width:1400px;"
-             "margin:2em auto}img{max-width:100%}table{border-collapse:collapse}"
-             "td,th{border:1px solid #ccc;padding:2px 6px}</style></head><body>",
-             f"<h1>{title}</h1>",
+    parts = [page_head(title),
              f"<p>Start: {html.escape(s['material'])}. Fitted on {html.escape(s['coarse_disc'])}, "
              f"corrected to and reported on {html.escape(s['fine_disc'])}. "
              f"{html.escape(s['status'])}. Active bounds: "
@@ -157,11 +153,7 @@ def write_report(d):
 
 
 def main(argv):
-    d = folder_argument(argv, __doc__)
-    figures = guarded(fail, d, lambda: write_report(d))
-    print(f"report: {os.path.join(d, 'report.html')} with {len(figures)} figure(s) in "
-          f"{os.path.join(d, 'plots')}")
-    return 0
+    return report_main(argv, __doc__, fail, write_report)
 
 
 if __name__ == "__main__":

@@ -1,5 +1,8 @@
-"""What the report scripts share (report.py, seating_report.py, disc_report.py): the one-line
-failure with its exit status, and matplotlib without a display."""
+"""What the report scripts share (report.py, seating_report.py, disc_report.py,
+identify_report.py): the one-line failure with its exit status, matplotlib without a display, the
+page's head and the main of a one-folder report."""
+import html
+import os
 import sys
 
 
@@ -44,3 +47,22 @@ def folder_argument(argv, doc):
         print(doc.strip())
         sys.exit(0 if len(argv) == 2 else 2)
     return argv[1]
+
+
+def page_head(title, width=1400):
+    """The report page's opening: doctype, title, the plain table and figure style, <h1>."""
+    t = html.escape(title)
+    return (f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{t}</title><style>"
+            f"body{{font-family:sans-serif;max-width:{width}px;margin:2em auto}}"
+            "img{max-width:100%}table{border-collapse:collapse}"
+            f"td,th{{border:1px solid #ccc;padding:2px 6px}}</style></head><body><h1>{t}</h1>")
+
+
+def report_main(argv, doc, fail, write_report):
+    """The report scripts' main: the folder argument, write_report(d) → figure names, guarded,
+    and the one line that says what was written."""
+    d = folder_argument(argv, doc)
+    figures = guarded(fail, d, lambda: write_report(d))
+    print(f"report: {os.path.join(d, 'report.html')} with {len(figures)} figure(s) in "
+          f"{os.path.join(d, 'plots')}")
+    return 0

@@ -20,14 +20,7 @@ std::vector<IdentifiedRow> rows_of(const nlohmann::json& targets) {
   std::vector<IdentifiedRow> rows;
   for (const auto& t : targets.value("targets", nlohmann::json::array())) {
     IdentifiedRow row;
-    row.quantity = t.at("quantity").get<std::string>();
-    row.units = t.value("units", std::string());
-    row.low = t.at("low").get<double>();
-    row.high = t.at("high").get<double>();
-    row.reported = t.value("reported", std::string());
-    row.source = t.value("source", std::string());
-    row.preparation = disc_target_preparation(t);
-    row.preset = row.identified = row.loo_prediction = kNaN;
+    static_cast<DiscValidationRow&>(row) = disc_target_row(t);
     if (!(row.low > 0 && row.low < row.high))
       throw std::invalid_argument("disc identification: target '" + row.quantity +
                                   "' needs a window 0 < low < high");
@@ -307,7 +300,7 @@ DiscIdentificationResult identify_disc_material(
   const Eigen::VectorXd& q = r.rounds.back().fine;
   for (std::size_t i = 0; i < rows.size(); ++i) {
     r.fit_rows[i].preset = preset_fine(Eigen::Index(i));
-    r.fit_rows[i].identified = q(Eigen::Index(i));
+    r.fit_rows[i].ours = q(Eigen::Index(i));
   }
   if (r.success && options.leave_one_out) leave_one_out(id, p, ratio, r);
 
@@ -315,7 +308,7 @@ DiscIdentificationResult identify_disc_material(
   for (IdentifiedRow row : held) {
     for (std::size_t i = 0; i < rows.size(); ++i)
       if (rows[i].quantity == row.quantity)
-        row.preset = preset_fine(Eigen::Index(i)), row.identified = q(Eigen::Index(i));
+        row.preset = preset_fine(Eigen::Index(i)), row.ours = q(Eigen::Index(i));
     r.held_out_rows.push_back(row);
   }
   r.coarse_evaluations = coarse_n;
@@ -385,7 +378,7 @@ nlohmann::json rows_json(const std::vector<IdentifiedRow>& rows) {
                    {"low", row.low},
                    {"high", row.high},
                    {"preset", json_number(row.preset)},
-                   {"identified", json_number(row.identified)},
+                   {"identified", json_number(row.ours)},
                    {"leave_one_out", json_number(row.loo_prediction)},
                    {"match", row.match()},
                    {"reported", row.reported},
@@ -461,18 +454,18 @@ void print_disc_identification(std::ostream& os, const DiscIdentificationResult&
                              : (v >= row.low && v <= row.high ? "MATCH" : "MISS");
   };
   for (const IdentifiedRow& row : r.fit_rows)
-    fit.add({row.quantity, row.units, significant(row.preset, 3), significant(row.identified, 3),
-             significant(row.low, 3) + " - " + significant(row.high, 3),
-             verdict(row.identified, row), significant(row.loo_prediction, 3),
-             verdict(row.loo_prediction, row), row.preparation});
+    fit.add({row.quantity, row.units, significant(row.preset, 3), significant(row.ours, 3),
+             significant(row.low, 3) + " - " + significant(row.high, 3), verdict(row.ours, row),
+             significant(row.loo_prediction, 3), verdict(row.loo_prediction, row),
+             row.preparation});
   fit.print(os, markdown);
   if (!r.held_out_rows.empty()) {
     os << "\n  Held out (other laboratories; predicted, not fitted):\n";
     TextTable held({"quantity", "units", "identified", "window", "verdict", "source"}, 2);
     for (const IdentifiedRow& row : r.held_out_rows)
-      held.add({row.quantity, row.units, significant(row.identified, 3),
-                significant(row.low, 3) + " - " + significant(row.high, 3),
-                verdict(row.identified, row), row.source});
+      held.add({row.quantity, row.units, significant(row.ours, 3),
+                significant(row.low, 3) + " - " + significant(row.high, 3), verdict(row.ours, row),
+                row.source});
     held.print(os, markdown);
   }
   os << "\n  Cost: " << significant(r.seconds, 3) << " s; " << r.coarse_evaluations

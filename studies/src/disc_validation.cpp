@@ -30,14 +30,7 @@ double disc_height_mm(const mesh::TetMesh& m) {
 void fill_rows(const nlohmann::json& targets, const std::map<std::string, double>& ours,
                DiscValidationResult& r, const std::map<std::string, std::string>& notes = {}) {
   for (const auto& t : targets.at("targets")) {
-    DiscValidationRow row;
-    row.quantity = t.at("quantity").get<std::string>();
-    row.units = t.value("units", std::string());
-    row.low = t.at("low").get<double>();
-    row.high = t.at("high").get<double>();
-    row.reported = t.value("reported", std::string());
-    row.source = t.value("source", std::string());
-    row.preparation = disc_target_preparation(t);
+    DiscValidationRow row = disc_target_row(t);
     const auto it = ours.find(row.quantity);
     if (it == ours.end())
       row.note = "not a quantity this study computes";
@@ -75,6 +68,18 @@ std::string disc_target_preparation(const nlohmann::json& t) {
   if (facets && ligaments) return "facets and ligaments removed";
   if (facets) return "facets removed, ligaments kept";
   return "posterior elements present";
+}
+
+DiscValidationRow disc_target_row(const nlohmann::json& t) {
+  DiscValidationRow row;
+  row.quantity = t.at("quantity").get<std::string>();
+  row.units = t.value("units", std::string());
+  row.low = t.at("low").get<double>();
+  row.high = t.at("high").get<double>();
+  row.reported = t.value("reported", std::string());
+  row.source = t.value("source", std::string());
+  row.preparation = disc_target_preparation(t);
+  return row;
 }
 
 const std::vector<std::pair<const char*, int>>& nonlinear_disc_cases() {

@@ -157,8 +157,7 @@ void add_frame(VtuSeries& series, CombinedDiscs& discs, const mss::DiscSet& set,
                CombinedVertebrae* vertebrae, double t_s, const std::vector<spine::Pose>& poses) {
   series.add(t_s, 0, [&](const std::string& p) { write_discs_frame(p, discs, set); });
   if (vertebrae)
-    series.add(t_s, 1,
-               [&](const std::string& p) { write_vertebrae_frame(p, *vertebrae, poses); });
+    series.add(t_s, 1, [&](const std::string& p) { write_vertebrae_frame(p, *vertebrae, poses); });
 }
 
 void check(const SpineDiscsRequest& r) {

@@ -10,16 +10,24 @@
 using namespace spinesim;
 using namespace spinesim::studies;
 
+namespace {
+
+void expect_every_row_inside(const DiscValidationResult& r) {
+  for (const auto& row : r.rows)
+    EXPECT_TRUE(row.match()) << row.quantity << ": ours " << row.ours << " " << row.units
+                             << ", in vitro " << row.low << " - " << row.high << " (" << row.source
+                             << ")";
+}
+
+}  // namespace
+
 TEST(DiscValidationTargets, L4L5FibreReinforcedDiscInsideEveryInVitroWindow) {
   const mesh::TetMesh m = mesh::mesh_disc_level("L4-L5", 2.0, SPINESIM_DATA_DIR);
   const DiscValidationResult r = run_disc_validation(
       m, test::material("fibre-reinforced"), fem::Formulation::mixed,
       read_disc_targets(std::string(SPINESIM_DATA_DIR) + "/validation/disc_in_vitro.json"),
       "L4-L5");
-  for (const auto& row : r.rows)
-    EXPECT_TRUE(row.match()) << row.quantity << ": ours " << row.ours << " " << row.units
-                             << ", in vitro " << row.low << " - " << row.high << " (" << row.source
-                             << ")";
+  expect_every_row_inside(r);
 }
 
 // The identified material (data/materials/disc-identified.json, `spinesim study disc-identify`)
@@ -33,8 +41,5 @@ TEST(DiscValidationTargets, L4L5IdentifiedNonlinearDiscInsideEveryInVitroWindow)
       m, test::material("disc-identified"), o,
       read_disc_targets(std::string(SPINESIM_DATA_DIR) + "/validation/disc_in_vitro.json"),
       "L4-L5");
-  for (const auto& row : r.rows)
-    EXPECT_TRUE(row.match()) << row.quantity << ": ours " << row.ours << " " << row.units
-                             << ", in vitro " << row.low << " - " << row.high << " (" << row.source
-                             << ")";
+  expect_every_row_inside(r);
 }

@@ -24,6 +24,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <limits>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -67,13 +68,12 @@ struct DiscIdentificationOptions {
 /// Throws std::invalid_argument (one line) for options out of range.
 void validate(const DiscIdentificationOptions& options);
 
-/// One quantity against one window (a fit target or a held-out row).
-struct IdentifiedRow {
-  std::string quantity, units, reported, source, preparation;
-  double low = 0, high = 0;
-  double preset = 0, identified = 0;  ///< the fine disc's, NaN when it did not converge
-  double loo_prediction = 0;          ///< fine disc at the fit without this row (fit rows only)
-  bool match() const { return identified >= low && identified <= high; }
+/// One quantity against one window (a fit target or a held-out row): `ours` is the identified
+/// fine disc's value (NaN where it did not converge), `match()` says whether it is inside.
+struct IdentifiedRow : DiscValidationRow {
+  double preset = std::numeric_limits<double>::quiet_NaN();  ///< the fine disc with the preset
+  /// The fine disc at the fit without this row (fit rows only).
+  double loo_prediction = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct MappingRound {

@@ -74,6 +74,9 @@ struct DiscValidationResult {
 /// A target's specimen preparation in words ("facets and ligaments removed", ...).
 std::string disc_target_preparation(const nlohmann::json& target);
 
+/// One target of a targets file (read_disc_targets) as a row, `ours` not yet known.
+DiscValidationRow disc_target_row(const nlohmann::json& target);
+
 /// Reads the targets file; throws std::invalid_argument (one line) when it is unusable.
 nlohmann::json read_disc_targets(const std::string& path);
 
