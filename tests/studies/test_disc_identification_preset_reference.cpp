@@ -3,7 +3,6 @@
 // windows — the sum of squared window residuals (calibration/window_fit.hpp) is smaller — and
 // its parameters lie inside the identification's bounds.
 #include "spinesim/calibration/window_fit.hpp"
-#include "spinesim/common/memory.hpp"
 #include "spinesim/mesh/disc_level.hpp"
 #include "spinesim/studies/disc_identification.hpp"
 #include "studies_fixtures.hpp"
@@ -34,7 +33,6 @@ double squared_residuals(const mesh::TetMesh& m, const mesh::RegionMaterials& ma
 }  // namespace
 
 TEST(DiscIdentificationPreset, IsNearerTheInVitroWindowsThanThePresetItStartedFrom) {
-  keep_freed_memory();  // as the program does: Newton's temporaries stay mapped
   const mesh::TetMesh m = mesh::mesh_disc_level("L4-L5", 3.0, SPINESIM_DATA_DIR);
   const nlohmann::json targets =
       read_disc_targets(std::string(SPINESIM_DATA_DIR) + "/validation/disc_in_vitro.json");

@@ -1,7 +1,6 @@
 // The disc identification on a disc (label reference): windows that the disc itself makes at
 // known parameters are met by those parameters — the fit finds the material it was shown, on
 // one thread or two alike, and a fine disc equal to the coarse one settles in one round.
-#include "spinesim/common/memory.hpp"
 #include "spinesim/studies/disc_identification.hpp"
 #include "studies_fixtures.hpp"
 
@@ -30,7 +29,6 @@ nlohmann::json windows_made_by(const mesh::TetMesh& m, const mesh::RegionMateria
 }  // namespace
 
 TEST(DiscIdentificationReference, FindsTheMaterialWhoseQuantitiesCentreTheWindows) {
-  keep_freed_memory();  // as the program does: Newton's temporaries stay mapped
   const mesh::TetMesh& m = test::structured("L4-L5");
   const auto base = test::material("fibre-reinforced");
   Eigen::VectorXd truth(4);
@@ -58,7 +56,6 @@ TEST(DiscIdentificationReference, FindsTheMaterialWhoseQuantitiesCentreTheWindow
 // stiffer under it, and the rotation is measured from the preloaded state (so a preload of
 // zero gives the unloaded numbers exactly).
 TEST(DiscIdentificationReference, APreloadStiffensEveryMomentCase) {
-  keep_freed_memory();
   const mesh::TetMesh& m = test::structured("L4-L5");
   const auto material = test::material("fibre-reinforced");
   NonlinearDiscOptions o;
