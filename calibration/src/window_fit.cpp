@@ -1,5 +1,6 @@
 #include "spinesim/calibration/window_fit.hpp"
 
+#include "spinesim/common/parallel.hpp"
 #include "spinesim/common/timer.hpp"
 
 #include "bounded_nlp.hpp"
@@ -9,7 +10,6 @@
 #include <limits>
 #include <sstream>
 #include <stdexcept>
-#include <thread>
 
 namespace spinesim::calibration {
 
@@ -40,20 +40,12 @@ void check(const std::vector<FitParameter>& parameters, const std::vector<Window
     throw std::invalid_argument("identification: step in (0, 1) and threads >= 1 expected");
 }
 
-/// The model at each column of `points` (ln p), on `threads` threads.
+/// The model at each of `points` (ln p), on `threads` threads.
 std::vector<Eigen::VectorXd> evaluate_all(const QuantityModel& model,
                                           const std::vector<Eigen::VectorXd>& points, int threads) {
   std::vector<Eigen::VectorXd> out(points.size());
-  std::atomic<std::size_t> next{0};
-  const auto work = [&] {
-    for (std::size_t k = next++; k < points.size(); k = next++)
-      out[k] = model(points[k].array().exp().matrix());
-  };
-  std::vector<std::thread> pool;
-  const int extra = std::min<int>(threads, int(points.size())) - 1;
-  for (int t = 0; t < extra; ++t) pool.emplace_back(work);
-  work();
-  for (std::thread& t : pool) t.join();
+  parallel_for(points.size(), threads,
+               [&](std::size_t k) { out[k] = model(points[k].array().exp().matrix()); });
   return out;
 }
 

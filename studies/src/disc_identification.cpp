@@ -1,5 +1,6 @@
 #include "spinesim/studies/disc_identification.hpp"
 
+#include "spinesim/common/parallel.hpp"
 #include "spinesim/common/timer.hpp"
 
 #include <algorithm>
@@ -7,7 +8,6 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
-#include <thread>
 
 namespace spinesim::studies {
 namespace {
@@ -60,14 +60,7 @@ std::vector<Eigen::VectorXd> map_points(
     const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& f,
     const std::vector<Eigen::VectorXd>& points, int threads) {
   std::vector<Eigen::VectorXd> out(points.size());
-  std::atomic<std::size_t> next{0};
-  const auto work = [&] {
-    for (std::size_t k = next++; k < points.size(); k = next++) out[k] = f(points[k]);
-  };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < std::min<int>(threads, int(points.size())); ++t) pool.emplace_back(work);
-  work();
-  for (std::thread& t : pool) t.join();
+  parallel_for(points.size(), threads, [&](std::size_t k) { out[k] = f(points[k]); });
   return out;
 }
 
@@ -281,13 +274,12 @@ DiscIdentificationResult identify_disc_material(
     p(Eigen::Index(j)) = r.parameters[j].fit.start;
   hooks.begin_stage("the preset on the coarse and the fine disc");
   Eigen::VectorXd preset_coarse, preset_fine;
-  if (options.threads > 1) {
-    std::thread beside([&] { preset_fine = id.fine(p); });
-    preset_coarse = id.coarse(p);
-    beside.join();
-  } else {
-    preset_coarse = id.coarse(p), preset_fine = id.fine(p);
-  }
+  parallel_for(2, options.threads, [&](std::size_t k) {
+    if (k == 0)
+      preset_coarse = id.coarse(p);
+    else
+      preset_fine = id.fine(p);
+  });
   hooks.end_stage();
   Eigen::VectorXd ratio = preset_fine.cwiseQuotient(preset_coarse);
   if (!ratio.allFinite())

@@ -95,6 +95,22 @@ TEST(WindowFit, StepsAroundWhereTheModelGivesNoValue) {
   EXPECT_NEAR(fit.parameters(0) / truth(0), 1.0, 1e-5);
 }
 
+TEST(WindowFit, StepsAroundAModelThatThrowsThereEvenOnTwoThreads) {
+  Eigen::VectorXd truth(3);
+  truth << 2.5, 0.4, 3.0;
+  // A solver that throws (no convergence) for a > 4, inside a worker thread.
+  const QuantityModel throwing = [](const Eigen::VectorXd& p) -> Eigen::VectorXd {
+    if (p(0) > 4.0) throw std::runtime_error("did not converge");
+    return power_model(p);
+  };
+  WindowFitOptions two;
+  two.threads = 2;
+  const WindowFit fit = fit_to_windows(throwing, three_parameters(3.9), windows_around(truth),
+                                       {true, true, true, true}, two);
+  ASSERT_TRUE(fit.success) << fit.status;
+  EXPECT_NEAR(fit.parameters(0) / truth(0), 1.0, 1e-5);
+}
+
 TEST(LeaveOneOut, OnAConsistentModelEachLeftOutQuantityIsPredictedWhereItWasMeasured) {
   Eigen::VectorXd truth(3);
   truth << 2.5, 0.4, 3.0;
