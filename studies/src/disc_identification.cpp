@@ -127,13 +127,14 @@ std::vector<DiscParameter> disc_parameters(const mesh::RegionMaterials& base) {
        "ours, an assumption: a factor 2 either way on the single-lamella moduli of Skaggs et al. "
        "1994 (" +
            significant(f.modulus_inner_mpa, 3) + "-" + significant(f.modulus_outer_mpa, 3) +
-           " MPa), which their spread between specimens and sites spans"},
+           " MPa), not a published range"},
       {{"fibre-k2", "", f.toe_k2, 1.0, 100.0},
        "ours, an assumption: the toe exponent of the exponential fibre law from nearly quadratic "
        "(1) to a toe that ends within a few per cent strain (100)"},
       {{"nucleus-E", "MPa", base.at(kNucleus).youngs_modulus_mpa, 0.72, 1.26},
-       "lower: nucleus neo-Hookean C10 0.12 MPa (BMC Musculoskelet Disord 2015, 16:222, "
-       "Table 1, grade 0), E = 6 C10; upper: Mooney-Rivlin C10 0.12, C01 0.09 MPa (BMC "
+       "lower: nucleus neo-Hookean C10 0.12 MPa (BMC Musculoskelet Disord 2015, doi "
+       "10.1186/s12891-015-0686-z, Table 1, grade 0), E = 6 C10; upper: Mooney-Rivlin C10 0.12, "
+       "C01 0.09 MPa (BMC "
        "Musculoskelet Disord 2024;25:639, Table 1), E = 6(C10 + C01)"}};
 }
 
