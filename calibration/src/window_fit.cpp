@@ -5,6 +5,7 @@
 
 #include "bounded_nlp.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <limits>
@@ -131,17 +132,17 @@ std::vector<WindowFit> leave_one_out(const QuantityModel& model,
                                      const std::vector<FitParameter>& parameters,
                                      const std::vector<WindowTarget>& targets,
                                      const std::vector<bool>& used, const WindowFitOptions& options,
-                                     const std::function<void(int target)>& on_start) {
+                                     const std::function<void(int target)>& before,
+                                     const std::function<void(int, const WindowFit&)>& after) {
   std::vector<WindowFit> out(targets.size());
-  for (std::size_t i = 0; i < targets.size(); ++i) {
+  for (std::size_t i = 0; i < targets.size() && i < used.size(); ++i) {
     if (!used[i]) continue;
     std::vector<bool> others = used;
     others[i] = false;
-    bool any = false;
-    for (bool u : others) any = any || u;
-    if (!any) continue;  // one target in use: nothing to predict it from
-    if (on_start) on_start(int(i));
+    if (std::find(others.begin(), others.end(), true) == others.end()) continue;  // nothing left
+    if (before) before(int(i));
     out[i] = fit_to_windows(model, parameters, targets, others, options);
+    if (after) after(int(i), out[i]);
   }
   return out;
 }

@@ -169,15 +169,24 @@ struct Identification {
     };
   }
 
-  calibration::WindowFit fit(const Eigen::VectorXd& ratio, const Eigen::VectorXd& start,
-                             const std::vector<bool>& used, const std::string& what) const {
+  calibration::WindowFitOptions fit_options() const {
     calibration::WindowFitOptions o;
     o.ipopt = options.ipopt;
     o.threads = options.threads;
+    return o;
+  }
+
+  static std::string summary(const calibration::WindowFit& f) {
+    return std::to_string(f.iterations) + " Ipopt iterations, " + f.status;
+  }
+
+  calibration::WindowFit fit(const Eigen::VectorXd& ratio, const Eigen::VectorXd& start,
+                             const std::string& what) const {
     hooks.begin_stage(what);
     calibration::WindowFit f = calibration::fit_to_windows(
-        corrected(ratio), fit_parameters(parameters, start), windows(rows), used, o);
-    hooks.end_stage(std::to_string(f.iterations) + " Ipopt iterations, " + f.status);
+        corrected(ratio), fit_parameters(parameters, start), windows(rows),
+        std::vector<bool>(rows.size(), true), fit_options());
+    hooks.end_stage(summary(f));
     return f;
   }
 };
@@ -186,10 +195,9 @@ struct Identification {
 /// fit's full record and leaves the ratios in `ratio`.
 calibration::WindowFit map_and_fit(const Identification& id, Eigen::VectorXd& p,
                                    Eigen::VectorXd& ratio, DiscIdentificationResult& r) {
-  const std::vector<bool> all(id.rows.size(), true);
   calibration::WindowFit f;
   for (int round = 1; round <= id.options.max_mapping_rounds; ++round) {
-    f = id.fit(ratio, p, all, "fit " + std::to_string(round) + " (coarse disc, corrected)");
+    f = id.fit(ratio, p, "fit " + std::to_string(round) + " (coarse disc, corrected)");
     p = f.parameters;
     id.hooks.begin_stage("fine disc at fit " + std::to_string(round));
     MappingRound m;
@@ -225,16 +233,20 @@ calibration::WindowFit map_and_fit(const Identification& id, Eigen::VectorXd& p,
 /// Each row's prediction by the fit to the others, evaluated on the fine disc.
 void leave_one_out(const Identification& id, const Eigen::VectorXd& p, const Eigen::VectorXd& ratio,
                    DiscIdentificationResult& r) {
-  std::vector<Eigen::VectorXd> loo;
-  for (std::size_t i = 0; i < id.rows.size(); ++i) {
-    std::vector<bool> others(id.rows.size(), true);
-    others[i] = false;
-    loo.push_back(id.fit(ratio, p, others, "fit without " + id.rows[i].quantity).parameters);
-  }
-  id.hooks.begin_stage("fine disc at the " + std::to_string(loo.size()) + " leave-one-out fits");
-  const std::vector<Eigen::VectorXd> q = map_points(id.fine, loo, id.options.threads);
-  for (std::size_t i = 0; i < loo.size(); ++i) r.fit_rows[i].loo_prediction = q[i](Eigen::Index(i));
-  r.loo_parameters = loo;
+  const std::vector<calibration::WindowFit> fits = calibration::leave_one_out(
+      id.corrected(ratio), fit_parameters(id.parameters, p), windows(id.rows),
+      std::vector<bool>(id.rows.size(), true), id.fit_options(),
+      [&](int i) { id.hooks.begin_stage("fit without " + id.rows[std::size_t(i)].quantity); },
+      [&](int, const calibration::WindowFit& f) { id.hooks.end_stage(id.summary(f)); });
+  std::vector<std::size_t> rows;
+  for (std::size_t i = 0; i < fits.size(); ++i)
+    if (fits[i].parameters.size())
+      rows.push_back(i), r.loo_parameters.push_back(fits[i].parameters);
+  if (rows.empty()) return;  // one target: nothing to predict it from
+  id.hooks.begin_stage("fine disc at the " + std::to_string(rows.size()) + " leave-one-out fits");
+  const std::vector<Eigen::VectorXd> q = map_points(id.fine, r.loo_parameters, id.options.threads);
+  for (std::size_t k = 0; k < rows.size(); ++k)
+    r.fit_rows[rows[k]].loo_prediction = q[k](Eigen::Index(rows[k]));
   id.hooks.end_stage();
 }
 

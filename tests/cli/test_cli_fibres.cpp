@@ -178,7 +178,8 @@ TEST(CliFibres, DiscValidationRunsTheNonlinearDisc) {
   EXPECT_FALSE(std::filesystem::exists(unwritten));
 }
 
-// The identification on the small structured disc (fine = coarse, no leave-one-out: seconds):
+// The identification on the small structured disc (fine = coarse: seconds), and its
+// leave-one-out on two targets:
 // parameters with bounds and sources, six rows with the disc's values, the held-out rows, the
 // folder's files and a preset that the material reader takes. Bad input: one line, nothing
 // written.
@@ -198,7 +199,22 @@ TEST(CliFibres, DiscIdentifyFitsTheMaterialAndWritesAPreset) {
     EXPECT_FALSE(p["bounds_source"].get<std::string>().empty());
   }
   ASSERT_EQ(j["targets"].size(), 6u);
-  for (const auto& row : j["targets"]) EXPECT_TRUE(row["identified"].is_number()) << row.dump();
+  for (const auto& row : j["targets"]) {
+    EXPECT_TRUE(row["identified"].is_number()) << row.dump();
+    EXPECT_TRUE(row["leave_one_out"].is_null()) << row.dump();
+  }
+
+  // Leave-one-out on two targets (two quick fits): each row predicted by the fit to the other.
+  const std::string two = tmp("two_targets.json");
+  std::ofstream(two) << R"({"targets": [
+      {"quantity": "torsion", "units": "N m/deg", "low": 2.29, "high": 4.07},
+      {"quantity": "flexion", "units": "N m/deg", "low": 2.3, "high": 3.3}]})";
+  const CliRun l = run_spinesim("study disc-identify --mesh '" + disc_vtu() + "' --targets '" +
+                                two + "' --fine-order 1 --increments 2 --json");
+  ASSERT_EQ(l.status, 0) << l.err;
+  const auto lj = nlohmann::json::parse(l.out);
+  for (const auto& row : lj["targets"]) EXPECT_TRUE(row["leave_one_out"].is_number()) << row.dump();
+  for (const auto& p : lj["parameters"]) EXPECT_EQ(p["leave_one_out"].size(), 2u) << p.dump();
   EXPECT_EQ(j["held_out"].size(), 4u);
   for (const char* file : {"disc_identification.json", "disc_identification.md",
                            "disc-identified.json", "report.html", "plots/disc_identification.png"})

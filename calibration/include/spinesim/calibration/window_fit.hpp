@@ -66,14 +66,15 @@ WindowFit fit_to_windows(const QuantityModel& model, const std::vector<FitParame
                          const WindowFitOptions& options = WindowFitOptions(),
                          const Progress& progress = Progress());
 
-/// Leave-one-out: for each target in use, the fit to the others (started from `start`, e.g.
-/// the full fit's parameters); entry i is that fit, or empty (success false, no parameters)
-/// for a target not in use.
-std::vector<WindowFit> leave_one_out(const QuantityModel& model,
-                                     const std::vector<FitParameter>& parameters,
-                                     const std::vector<WindowTarget>& targets,
-                                     const std::vector<bool>& used,
-                                     const WindowFitOptions& options = WindowFitOptions(),
-                                     const std::function<void(int target)>& on_start = {});
+/// Leave-one-out: for each target in use, the fit to the others (started from each parameter's
+/// `start`, e.g. the full fit's values); entry i is that fit, or empty (success false, no
+/// parameters) for a target not in use or the only one in use. `before` and `after` are called
+/// around each fit (progress).
+std::vector<WindowFit> leave_one_out(
+    const QuantityModel& model, const std::vector<FitParameter>& parameters,
+    const std::vector<WindowTarget>& targets, const std::vector<bool>& used,
+    const WindowFitOptions& options = WindowFitOptions(),
+    const std::function<void(int target)>& before = {},
+    const std::function<void(int target, const WindowFit& fit)>& after = {});
 
 }  // namespace spinesim::calibration

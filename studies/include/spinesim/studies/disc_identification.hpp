@@ -88,7 +88,7 @@ struct DiscIdentificationResult {
   Eigen::VectorXd identified;  ///< p
   std::vector<std::string> active_bounds;
   std::vector<IdentifiedRow> fit_rows, held_out_rows;
-  std::vector<Eigen::VectorXd> loo_parameters;  ///< per fit row
+  std::vector<Eigen::VectorXd> loo_parameters;  ///< per fit row (none with a single row)
   std::vector<MappingRound> rounds;
   bool success = false;  ///< every fit solved and the ratios settled
   std::string status;
