@@ -51,7 +51,8 @@ void register_haptics(CLI::App& app);            ///< haptics run|devices (cli_h
 void register_haptic_plane(CLI::App& study);     ///< study haptic-plane (cli_haptics.cpp)
 void register_haptic_drag(CLI::App& study);      ///< study haptic-drag (cli_haptics.cpp)
 void register_disc_validation(CLI::App& study);  ///< study disc-validation (cli_study_disc.cpp)
-void register_disc_identify(CLI::App& study);  ///< study disc-identify (cli_study_identify.cpp)
+void register_disc_identify(CLI::App& study);    ///< study disc-identify (cli_study_identify.cpp)
+void register_mss_fibres(CLI::App& study);       ///< study mss-fibres (cli_study_mss_fibres.cpp)
 void register_seating(CLI::App& study);          ///< study seating|seating-sweep|seating-validation
 void register_demo(CLI::App& app);
 void register_view(CLI::App& app);

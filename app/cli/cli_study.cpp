@@ -531,6 +531,7 @@ void register_study(CLI::App& app) {
   register_haptic_drag(*study);
   register_disc_validation(*study);
   register_disc_identify(*study);
+  register_mss_fibres(*study);
   register_seating(*study);
 }
 

@@ -25,14 +25,19 @@ const char* term_name(mss::Term t) {
       return "volume";
     case mss::Term::disc_volume:
       return "disc_volume";
+    case mss::Term::fibre:
+      return "fibre";
   }
   return "?";
 }
 
+/// Terms with one knob (region index 0): the whole-disc volume and the annulus's fibres.
+bool single_knob(mss::Term t) { return t == mss::Term::disc_volume || t == mss::Term::fibre; }
+
 }  // namespace
 
 std::string knob_name(const Knob& k) {
-  if (k.term == mss::Term::disc_volume) return "disc_volume";
+  if (single_knob(k.term)) return term_name(k.term);
   return std::string(term_name(k.term)) + (k.region == 0 ? ".annulus" : ".nucleus");
 }
 
@@ -40,11 +45,12 @@ Knob knob_from_name(const std::string& name) {
   for (int t = 0; t < mss::kNumTerms; ++t)
     for (int r = 0; r < 2; ++r) {
       const Knob k{static_cast<mss::Term>(t), r};
-      if (k.term == mss::Term::disc_volume && r == 1) continue;
+      if (single_knob(k.term) && r == 1) continue;
       if (knob_name(k) == name) return k;
     }
-  throw std::invalid_argument("unknown stiffness knob '" + name +
-                              "' (main|radial|torsion|volume .annulus|.nucleus, disc_volume)");
+  throw std::invalid_argument(
+      "unknown stiffness knob '" + name +
+      "' (main|radial|torsion|volume .annulus|.nucleus, disc_volume, fibre)");
 }
 
 std::vector<Knob> available_knobs(const mss::MssOptions& o) {
@@ -53,7 +59,7 @@ std::vector<Knob> available_knobs(const mss::MssOptions& o) {
     const auto term = static_cast<mss::Term>(t);
     if (!mss::term_enabled(o, term)) continue;
     out.push_back({term, 0});
-    if (term != mss::Term::disc_volume) out.push_back({term, 1});
+    if (!single_knob(term)) out.push_back({term, 1});
   }
   return out;
 }

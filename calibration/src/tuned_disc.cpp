@@ -95,7 +95,8 @@ nlohmann::json terms_json(const mss::MssOptions& o) {
           {"disc_volume_term", o.disc_volume_term},
           {"radial_factor", o.radial_factor},
           {"volume_factor", o.volume_factor},
-          {"disc_volume_factor", o.disc_volume_factor}};
+          {"disc_volume_factor", o.disc_volume_factor},
+          {"fibre_springs", o.fibre_springs}};
 }
 
 nlohmann::json to_json(const TunedDisc& t) {
@@ -147,6 +148,10 @@ TunedDisc tuned_disc_from_json(const nlohmann::json& j) {
     t.options.torsion_springs = terms.at("torsion_springs").get<bool>();
     t.options.volume_term = terms.at("volume_term").get<bool>();
     t.options.disc_volume_term = terms.at("disc_volume_term").get<bool>();
+    t.options.fibre_springs = terms.value("fibre_springs", false);  // files before fibre springs
+    if (t.options.fibre_springs && !t.materials().has_fibres())
+      throw std::invalid_argument(
+          "fibre springs in a tuned-disc file whose material has no fibres");
     t.options.radial_factor = terms.at("radial_factor").get<double>();
     t.options.volume_factor = terms.at("volume_factor").get<double>();
     t.options.disc_volume_factor = terms.at("disc_volume_factor").get<double>();

@@ -16,8 +16,8 @@ namespace spinesim::calibration {
 
 namespace {
 
-void check(const std::vector<FitParameter>& parameters, const std::vector<WindowTarget>& targets,
-           const std::vector<bool>& used, const WindowFitOptions& options) {
+void check_parameters(const std::vector<FitParameter>& parameters,
+                      const WindowFitOptions& options) {
   if (parameters.empty()) throw std::invalid_argument("identification: no parameter to fit");
   for (const FitParameter& p : parameters) {
     const bool finite = std::isfinite(p.lower) && std::isfinite(p.upper) && std::isfinite(p.start);
@@ -28,6 +28,13 @@ void check(const std::vector<FitParameter>& parameters, const std::vector<Window
       throw std::invalid_argument("identification: parameter '" + p.name +
                                   "' starts outside its bounds");
   }
+  if (!(options.log_step > 0) || !(options.log_step < 1) || options.threads < 1)
+    throw std::invalid_argument("identification: step in (0, 1) and threads >= 1 expected");
+}
+
+void check(const std::vector<FitParameter>& parameters, const std::vector<WindowTarget>& targets,
+           const std::vector<bool>& used, const WindowFitOptions& options) {
+  check_parameters(parameters, options);
   for (const WindowTarget& t : targets)
     if (!std::isfinite(t.low) || !std::isfinite(t.high) || !(t.low > 0) || !(t.low < t.high))
       throw std::invalid_argument("identification: target '" + t.name +
@@ -37,12 +44,10 @@ void check(const std::vector<FitParameter>& parameters, const std::vector<Window
   bool any = false;
   for (bool u : used) any = any || u;
   if (!any) throw std::invalid_argument("identification: no target in use (empty data set)");
-  if (!(options.log_step > 0) || !(options.log_step < 1) || options.threads < 1)
-    throw std::invalid_argument("identification: step in (0, 1) and threads >= 1 expected");
 }
 
 /// The model at each of `points` (ln p), on `threads` threads.
-std::vector<Eigen::VectorXd> evaluate_all(const QuantityModel& model,
+std::vector<Eigen::VectorXd> evaluate_all(const ResidualModel& model,
                                           const std::vector<Eigen::VectorXd>& points, int threads) {
   std::vector<Eigen::VectorXd> out(points.size());
   parallel_for(points.size(), threads,
@@ -63,10 +68,14 @@ double window_residual(double quantity, const WindowTarget& t) {
   return std::log(quantity / std::sqrt(t.low * t.high)) / (0.5 * std::log(t.high / t.low));
 }
 
-WindowFit fit_to_windows(const QuantityModel& model, const std::vector<FitParameter>& parameters,
-                         const std::vector<WindowTarget>& targets, const std::vector<bool>& used,
-                         const WindowFitOptions& options, const Progress& progress) {
-  check(parameters, targets, used, options);
+namespace {
+
+/// fit_least_squares, with the final residuals left to the caller when `residuals_at_end` is
+/// false (fit_to_windows evaluates its model there itself).
+LeastSquaresFit least_squares(const ResidualModel& model,
+                              const std::vector<FitParameter>& parameters,
+                              const WindowFitOptions& options, const Progress& progress,
+                              bool residuals_at_end) {
   const Timer timer;
   const Eigen::Index n = Eigen::Index(parameters.size());
   Eigen::VectorXd lower(n), upper(n), start(n);
@@ -75,9 +84,6 @@ WindowFit fit_to_windows(const QuantityModel& model, const std::vector<FitParame
     upper(j) = std::log(parameters[size_t(j)].upper);
     start(j) = std::log(parameters[size_t(j)].start);
   }
-  Eigen::VectorXd mask(Eigen::Index(targets.size()));
-  for (std::size_t i = 0; i < targets.size(); ++i) mask(Eigen::Index(i)) = used[i] ? 1.0 : 0.0;
-
   std::atomic<int> evaluations{0};
   const detail::NlpFunction f = [&](const Eigen::VectorXd& y) {
     // The point and one forward step per unknown, inward where y sits on its upper bound.
@@ -87,12 +93,15 @@ WindowFit fit_to_windows(const QuantityModel& model, const std::vector<FitParame
       step(j) = y(j) + options.log_step > upper(j) ? -options.log_step : options.log_step;
       points[std::size_t(j + 1)](j) += step(j);
     }
-    const std::vector<Eigen::VectorXd> q = evaluate_all(model, points, options.threads);
+    const std::vector<Eigen::VectorXd> r = evaluate_all(model, points, options.threads);
     evaluations += int(points.size());
-    const Eigen::VectorXd r0 = residuals(q[0], targets).cwiseProduct(mask);
+    const Eigen::VectorXd& r0 = r[0];
     Eigen::MatrixXd jac(r0.size(), n);
-    for (Eigen::Index j = 0; j < n; ++j)
-      jac.col(j) = (residuals(q[std::size_t(j + 1)], targets).cwiseProduct(mask) - r0) / step(j);
+    for (Eigen::Index j = 0; j < n; ++j) {
+      if (r[std::size_t(j + 1)].size() != r0.size())
+        throw std::logic_error("least squares: the model's residual changed length");
+      jac.col(j) = (r[std::size_t(j + 1)] - r0) / step(j);
+    }
     if (!r0.allFinite() || !jac.allFinite())
       throw std::runtime_error("the model gives no value here");  // Ipopt shortens the step
     detail::NlpValues v;
@@ -103,16 +112,18 @@ WindowFit fit_to_windows(const QuantityModel& model, const std::vector<FitParame
   };
   const detail::NlpRun run = detail::run_bounded_nlp(
       f, start, lower, upper, detail::HessianKind::dense, options.ipopt, progress);
-  WindowFit out;
+  LeastSquaresFit out;
   out.success = run.success && run.final_point.size() == n;
   out.status = run.status;
   out.iterations = run.iterations;
   const Eigen::VectorXd y = run.final_point.size() == n ? run.final_point : start;
   out.parameters = y.array().exp().matrix();
-  out.quantities = model(out.parameters);
-  out.model_evaluations = evaluations + 1;
-  out.residuals = residuals(out.quantities, targets);
-  out.objective = 0.5 * out.residuals.cwiseProduct(mask).squaredNorm();
+  out.model_evaluations = evaluations;
+  if (residuals_at_end) {
+    out.residuals = model(out.parameters);
+    out.model_evaluations += 1;
+    out.objective = 0.5 * out.residuals.squaredNorm();
+  }
   for (Eigen::Index j = 0; j < n; ++j) {
     const FitParameter& p = parameters[size_t(j)];
     const auto say = [&](const char* side, double bound) {
@@ -125,6 +136,39 @@ WindowFit fit_to_windows(const QuantityModel& model, const std::vector<FitParame
     if (upper(j) - y(j) < options.bound_tolerance) say("upper", p.upper);
   }
   out.seconds = timer.seconds();
+  return out;
+}
+
+}  // namespace
+
+LeastSquaresFit fit_least_squares(const ResidualModel& model,
+                                  const std::vector<FitParameter>& parameters,
+                                  const WindowFitOptions& options, const Progress& progress) {
+  check_parameters(parameters, options);
+  return least_squares(model, parameters, options, progress, true);
+}
+
+WindowFit fit_to_windows(const QuantityModel& model, const std::vector<FitParameter>& parameters,
+                         const std::vector<WindowTarget>& targets, const std::vector<bool>& used,
+                         const WindowFitOptions& options, const Progress& progress) {
+  check(parameters, targets, used, options);
+  Eigen::VectorXd mask(Eigen::Index(targets.size()));
+  for (std::size_t i = 0; i < targets.size(); ++i) mask(Eigen::Index(i)) = used[i] ? 1.0 : 0.0;
+  const ResidualModel masked = [&](const Eigen::VectorXd& p) -> Eigen::VectorXd {
+    return residuals(model(p), targets).cwiseProduct(mask);
+  };
+  const LeastSquaresFit fit = least_squares(masked, parameters, options, progress, false);
+  WindowFit out;
+  out.success = fit.success;
+  out.status = fit.status;
+  out.iterations = fit.iterations;
+  out.parameters = fit.parameters;
+  out.quantities = model(out.parameters);
+  out.model_evaluations = fit.model_evaluations + 1;
+  out.residuals = residuals(out.quantities, targets);
+  out.objective = 0.5 * out.residuals.cwiseProduct(mask).squaredNorm();
+  out.active_bounds = fit.active_bounds;
+  out.seconds = fit.seconds;  // without the last model run, as before
   return out;
 }
 

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 namespace spinesim::mss {
 
@@ -346,6 +347,46 @@ double probe_contact(const Eigen::Vector3d& x, const Eigen::Vector3d& center_mm,
   // E = 1/2 k (dist - r)^2 is an edge spring of rest length r to the centre, always compressed
   // inside: the projected Hessian is k nn^T.
   if (hess) *hess = stretch_stiffness(n, k_p_n_per_mm, 1.0 - radius_mm / dist, mode);
+  return energy;
+}
+
+Eigen::Vector4d fibre_coefficients(const TetPoints& rest, const Eigen::Vector3d& direction) {
+  Eigen::Matrix3d D;
+  for (int k = 0; k < 3; ++k) D.col(k) = rest.col(k + 1) - rest.col(0);
+  const double det = D.determinant();
+  if (!(std::abs(det) > 1e-300) || !std::isfinite(det))
+    throw std::invalid_argument("mss: fibre spring in a degenerate tetrahedron");
+  // Barycentric coordinates 1..3 are D^{-1} (X - x0): their gradients are the rows of D^{-1}.
+  const Eigen::Vector3d tail = D.inverse() * direction;
+  Eigen::Vector4d c;
+  c << -tail.sum(), tail;
+  return c;
+}
+
+double fibre_spring(const TetPoints& x, const Eigen::Vector4d& c, double V0, double k1, double k2,
+                    Vector12d* grad, Matrix12d* hess, double rest_i4) {
+  // I4 = |d|^2 / rest_i4: dividing by the rest value as rounded puts the rest state exactly at
+  // the kink (|X c|^2 = 1 only to round-off, and half the springs would be "in tension").
+  const Eigen::Vector3d d = x * c;
+  const double excess = (d.squaredNorm() - rest_i4) / rest_i4;  // I4 - 1
+  if (grad) grad->setZero();
+  if (hess) hess->setZero();
+  if (!(excess > 0.0)) return excess == excess ? 0.0 : excess;  // compression; NaN propagates
+  const double e = std::exp(k2 * excess * excess);
+  const double energy =
+      k2 > 0.0 ? V0 * k1 / (2.0 * k2) * (e - 1.0) : 0.5 * V0 * k1 * excess * excess;
+  if (!grad && !hess) return energy;
+  // Derivatives of I4 carry 1/rest_i4: folded into psi' and psi''.
+  const double psi1 = k1 * excess * e / rest_i4,
+               psi2 = k1 * e * (1.0 + 2.0 * k2 * excess * excess) / (rest_i4 * rest_i4);
+  if (grad)
+    for (int i = 0; i < 4; ++i) grad->segment<3>(3 * i) = (2.0 * V0 * psi1 * c(i)) * d;
+  if (hess) {
+    const Eigen::Matrix3d block =
+        4.0 * V0 * psi2 * d * d.transpose() + 2.0 * V0 * psi1 * Eigen::Matrix3d::Identity();
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j) hess->block<3, 3>(3 * i, 3 * j) = (c(i) * c(j)) * block;
+  }
   return energy;
 }
 

@@ -3,6 +3,7 @@
 #include "spinesim/mss/model.hpp"
 #include "spinesim/common/constants.hpp"
 #include "spinesim/common/skew.hpp"
+#include "spinesim/mesh/fibre_field.hpp"
 
 #include "face_angles.hpp"
 #include "hessian_pattern.hpp"
@@ -42,6 +43,17 @@ struct AngleFace {
   FaceRest rest;       ///< its cos and sin
   double k_part[2];    ///< N·mm/rad (unscaled)
   double k;            ///< scaled total
+};
+
+/// One embedded fibre spring (elements.hpp fibre_spring).
+struct FibreSpring {
+  int t;
+  Eigen::Vector4d c;  ///< fibre_coefficients, 1/mm
+  double V0;          ///< rest volume of its tet, mm^3
+  double k1;          ///< MPa (unscaled)
+  double k2;          ///< toe exponent
+  double rest_i4;     ///< |X c|^2 at the rest points as rounded (elements.hpp)
+  double k;           ///< scaled k1
 };
 
 /// Per-tetrahedron terms (radial springs and volume penalty share the vertex set).
@@ -101,6 +113,7 @@ struct KSelect {
   double tet(const TetTerm& t) const {
     return region < 0 ? t.k : (t.region == region ? t.k_unscaled : 0.0);
   }
+  double fibre(const FibreSpring& f) const { return region < 0 ? f.k : (region == 0 ? f.k1 : 0.0); }
   double disc(double k_scaled, double k_unscaled) const {
     return region < 0 ? k_scaled : (region == 0 ? k_unscaled : 0.0);
   }
@@ -133,6 +146,7 @@ struct MssModel::Impl {
   std::vector<detail::TetTermBlockInput> tet_block;
   bool disc_volume_on = false;
   double disc_k_unscaled = 0, disc_k = 0;  // k_g, N/mm^5
+  std::vector<FibreSpring> fibres;         // two per fibre-reinforced tet, when on
 
   HessianPattern pattern;       // 3x3 node blocks of every node pair sharing a tet
   std::vector<int> edge_slots;  // 4 per edge: block (a,b) offsets, a,b in {0,1}
@@ -152,6 +166,7 @@ struct MssModel::Impl {
       const TetProps& tp,
       const std::vector<std::pair<std::array<int, 3>, std::vector<int>>>& unique_faces);
   void build_tet_terms(const TetProps& tp);
+  void build_fibre_springs(const mesh::RegionMaterials& materials, const TetProps& tp);
   void build_damping(const TetProps& tp);
   void build_slots();
   /// Disc volume V(x) = sum of signed tet volumes, and dV/dx into *u (3n) when u != nullptr.
@@ -341,6 +356,25 @@ void MssModel::Impl::build_tet_terms(const TetProps& tp) {
   }
 }
 
+// 5c. Fibre springs: one per family in every fibre-reinforced tet, k1 = k/4 as the nonlinear FEM.
+void MssModel::Impl::build_fibre_springs(const mesh::RegionMaterials& materials,
+                                         const TetProps& tp) {
+  if (!options.fibre_springs) return;
+  require(materials.has_fibres(), "mss: fibre springs need a fibre-reinforced material (\"" +
+                                      materials.name + "\" has no fibres)");
+  const mesh::ElementFibres field = mesh::fibre_field(mesh, materials);
+  for (Eigen::Index t = 0; t < mesh.num_tets(); ++t) {
+    if (!(field.stiffness_mpa(t) > 0.0)) continue;
+    const TetPoints p = tet_points(X, mesh.T, static_cast<int>(t));
+    for (const Eigen::MatrixX3d* dir : {&field.direction_1, &field.direction_2}) {
+      const Eigen::Vector3d a = dir->row(t).transpose().normalized();
+      const Eigen::Vector4d c = fibre_coefficients(p, a);
+      fibres.push_back({static_cast<int>(t), c, tp.V0[t], field.stiffness_mpa(t) / 4.0,
+                        field.toe_k2(t), (p * c).squaredNorm(), 0.0});
+    }
+  }
+}
+
 // 6. Ambient damping (5.11).
 void MssModel::Impl::build_damping(const TetProps& tp) {
   const Eigen::Index nt = mesh.num_tets();
@@ -389,6 +423,7 @@ void MssModel::Impl::build(const mesh::RegionMaterials& materials) {
   const auto unique_faces = build_cylinder();
   build_angle_springs(tp, unique_faces);
   build_tet_terms(tp);
+  build_fibre_springs(materials, tp);
   build_outer_faces();
   build_damping(tp);
   build_slots();
@@ -435,6 +470,7 @@ void MssModel::Impl::apply_scales() {
   for (auto& t : volume) t.k = scale(Term::volume, t.region) * t.k_unscaled;
   tet_block = tet_block_input(KSelect{}, !radial.empty(), !volume.empty());
   disc_k = scale(Term::disc_volume, 0) * disc_k_unscaled;
+  for (auto& f : fibres) f.k = scale(Term::fibre, 0) * f.k1;
 }
 
 MssModel::MssModel(const mesh::TetMesh& mesh, const mesh::RegionMaterials& materials,
@@ -490,6 +526,9 @@ Eigen::Index MssModel::num_angle_springs() const {
 Eigen::Index MssModel::num_volume_terms() const {
   return static_cast<Eigen::Index>(impl_->volume.size());
 }
+Eigen::Index MssModel::num_fibre_springs() const {
+  return static_cast<Eigen::Index>(impl_->fibres.size());
+}
 // Through the outer surface, as volume_mm3, so that volume_change is exactly zero at rest; it
 // differs from the tet sum (rest_volume, which the whole-disc term uses) by round-off only.
 double MssModel::rest_volume_mm3() const { return impl_->outer_rest_volume; }
@@ -510,13 +549,13 @@ void MssModel::set_edge_multipliers(const std::vector<double>& multipliers) {
 
 double MssModel::energy(const Eigen::VectorXd& x) const {
   check_size(x, num_nodes());
-  const bool all[kNumTerms] = {true, true, true, true, true};
+  const bool all[kNumTerms] = {true, true, true, true, true, true};
   return impl_->accumulate(x, all, KSelect{}, nullptr);
 }
 
 double MssModel::gradient(const Eigen::VectorXd& x, Eigen::VectorXd& grad) const {
   check_size(x, num_nodes());
-  const bool all[kNumTerms] = {true, true, true, true, true};
+  const bool all[kNumTerms] = {true, true, true, true, true, true};
   grad.setZero(x.size());
   return impl_->accumulate(x, all, KSelect{}, &grad);
 }
@@ -525,7 +564,7 @@ double MssModel::term_energy(const Eigen::VectorXd& x, Term term, int region_ind
   check_size(x, num_nodes());
   if (region_index != 0 && region_index != 1)
     throw std::invalid_argument("mss: region index must be 0 (annulus) or 1 (nucleus)");
-  bool only[kNumTerms] = {false, false, false, false, false};
+  bool only[kNumTerms] = {false, false, false, false, false, false};
   only[static_cast<int>(term)] = true;
   return impl_->accumulate(x, only, KSelect{region_index}, nullptr);
 }
@@ -535,7 +574,7 @@ void MssModel::term_gradient(const Eigen::VectorXd& x, Term term, int region_ind
   check_size(x, num_nodes());
   if (region_index != 0 && region_index != 1)
     throw std::invalid_argument("mss: region index must be 0 (annulus) or 1 (nucleus)");
-  bool only[kNumTerms] = {false, false, false, false, false};
+  bool only[kNumTerms] = {false, false, false, false, false, false};
   only[static_cast<int>(term)] = true;
   grad.setZero(x.size());
   impl_->accumulate(x, only, KSelect{region_index}, &grad);
@@ -597,6 +636,16 @@ double MssModel::Impl::accumulate(const Eigen::VectorXd& x, const bool* terms, K
     energy += 0.5 * k * excess * excess;
     if (grad) *grad += (k * excess) * u;
   }
+  if (terms[static_cast<int>(Term::fibre)]) {
+    Vector12d g12;
+    for (const FibreSpring& f : m.fibres) {
+      const TetPoints p = tet_points(x, m.mesh.T, f.t);
+      energy +=
+          fibre_spring(p, f.c, f.V0, sel.fibre(f), f.k2, grad ? &g12 : nullptr, nullptr, f.rest_i4);
+      if (grad)
+        for (int c = 0; c < 4; ++c) grad->segment<3>(3 * m.mesh.T(f.t, c)) += g12.segment<3>(3 * c);
+    }
+  }
   return energy;
 }
 
@@ -635,7 +684,7 @@ double MssModel::Impl::tet_terms_gradient(const double* x, KSelect sel, bool wan
 void MssModel::hessian(const Eigen::VectorXd& x, HessianMode mode,
                        Eigen::SparseMatrix<double>& H) const {
   check_size(x, num_nodes());
-  const bool all[kNumTerms] = {true, true, true, true, true};
+  const bool all[kNumTerms] = {true, true, true, true, true, true};
   impl_->assemble_hessian(x, mode, all, KSelect{}, H);
 }
 
@@ -644,7 +693,7 @@ void MssModel::term_hessian(const Eigen::VectorXd& x, Term term, int region_inde
   check_size(x, num_nodes());
   if (region_index != 0 && region_index != 1)
     throw std::invalid_argument("mss: region index must be 0 (annulus) or 1 (nucleus)");
-  bool only[kNumTerms] = {false, false, false, false, false};
+  bool only[kNumTerms] = {false, false, false, false, false, false};
   only[static_cast<int>(term)] = true;
   impl_->assemble_hessian(x, mode, only, KSelect{region_index}, H);
 }
@@ -701,6 +750,14 @@ void MssModel::Impl::assemble_hessian(const Eigen::VectorXd& x, HessianMode mode
     tet_hessians(m.volume, [mode](const TetPoints& p, double k, double rest, Matrix12d* h) {
       volume_penalty(p, k, rest, nullptr, h, mode);
     });
+  if (terms[static_cast<int>(Term::fibre)])
+    for (const FibreSpring& f : m.fibres) {
+      const double k = sel.fibre(f);
+      if (k == 0.0) continue;
+      fibre_spring(tet_points(x, m.mesh.T, f.t), f.c, f.V0, k, f.k2, nullptr, &h12, f.rest_i4);
+      const int nodes[4] = {m.mesh.T(f.t, 0), m.mesh.T(f.t, 1), m.mesh.T(f.t, 2), m.mesh.T(f.t, 3)};
+      scatter(h12, &m.tet_slots[16 * static_cast<std::size_t>(f.t)], 4, nodes);
+    }
   // Whole-disc volume, sparse part k_g (V - V0) H_V (exact mode only; the rank-one part is
   // disc_volume_rank_one's). H_V is trilinear in the arms a, b, c of each tet:
   //   d2V/da db = -[c]x/6,  d2V/da dc = [b]x/6,  d2V/db dc = -[a]x/6, zero diagonal blocks.

@@ -1,6 +1,7 @@
 // The fibre-reinforced disc on the command line: `fem --formulation mixed` writes the pressure
 // and the annulus fibre field; `view --vectors` draws the fibres; `study disc-validation` sets
-// the disc beside in-vitro tests; bad options are one line.
+// the disc beside in-vitro tests; `study disc-identify` fits its material; `study mss-fibres`
+// fits the mass-spring disc to the nonlinear one; bad options are one line.
 #include "cli_runner.hpp"
 
 #include <gtest/gtest.h>
@@ -232,6 +233,57 @@ TEST(CliFibres, DiscIdentifyFitsTheMaterialAndWritesAPreset) {
                  "needs an annulus with fibres and a nucleus");
   expect_refused(run_spinesim("study disc-identify --level L9-L10"), "L9-L10");
   expect_refused(run_spinesim("study disc-identify --cell-size -1"), "--cell-size");
+  EXPECT_FALSE(std::filesystem::exists(unwritten));
+}
+
+// The mass-spring disc fitted to the nonlinear FEM disc (small structured disc, P1, three cases
+// at two levels): a row per case and level with its set, both networks' fits lower the training
+// objective they start from, the files are written; bad requests are one line, nothing written.
+TEST(CliFibres, MssFibresFitsBothNetworksToTheNonlinearDisc) {
+  const std::string out = tmp("mss-fibres-out");
+  std::filesystem::remove_all(out);
+  const CliRun r = run_spinesim("study mss-fibres --mesh '" + disc_vtu() +
+                                "' --cases compression,torsion,flexion --train compression,torsion"
+                                " --levels 0.1,1 --increments 2 --out '" +
+                                out + "' --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["reference"].size(), 6u);
+  EXPECT_GT(j["fibre_springs"].get<int>(), 0);
+  for (const char* network : {"region", "fibre"}) {
+    const auto& fit = j[network];
+    EXPECT_TRUE(fit["success"].get<bool>()) << network;
+    ASSERT_EQ(fit["cases"].size(), 6u) << network;
+    double start = 0;
+    int trained = 0;
+    for (const auto& c : fit["cases"]) {
+      const bool train = c["set"] == "train";
+      EXPECT_EQ(train, c["case"] != "flexion") << c.dump();
+      EXPECT_TRUE(c["converged"].get<bool>()) << c.dump();
+      EXPECT_TRUE(std::isfinite(c["reaction_error"].get<double>())) << c.dump();
+      if (!train) continue;
+      const double er = c["reaction_error_untuned"], eu = c["displacement_error_untuned"];
+      start += er * er + eu * eu;
+      ++trained;
+    }
+    ASSERT_EQ(trained, 4) << network;
+    EXPECT_LE(fit["objective"].get<double>(), 0.5 * start / trained) << network;
+  }
+  EXPECT_TRUE(j["fibre"]["scales"].contains("fibre")) << j["fibre"]["scales"].dump();
+  EXPECT_FALSE(j["region"]["scales"].contains("fibre")) << j["region"]["scales"].dump();
+  for (const char* file : {"mss_fibres.json", "mss_fibres.md"})
+    EXPECT_TRUE(std::filesystem::exists(out + "/" + file)) << file;
+
+  const std::string unwritten = tmp("mss-fibres-unwritten");
+  std::filesystem::remove_all(unwritten);
+  const std::string o = " --out '" + unwritten + "'";
+  expect_refused(run_spinesim("study mss-fibres --material annulus-nucleus" + o), "has no fibres");
+  expect_refused(run_spinesim("study mss-fibres --levels 0,1" + o), "load levels");
+  expect_refused(run_spinesim("study mss-fibres --cases torsion --train torsion" + o),
+                 "none is held out");
+  expect_refused(run_spinesim("study mss-fibres --train bending" + o), "'bending'");
+  expect_refused(run_spinesim("study mss-fibres --fem-order 3" + o), "--fem-order");
+  expect_refused(run_spinesim("study mss-fibres --cell-size 0" + o), "--cell-size");
   EXPECT_FALSE(std::filesystem::exists(unwritten));
 }
 

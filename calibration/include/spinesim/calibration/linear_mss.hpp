@@ -40,14 +40,14 @@ using Vector6d = Eigen::Matrix<double, 6, 1>;
 using Matrix6d = Eigen::Matrix<double, 6, 6>;
 
 /// One calibration knob: the scale of one energy term in one region (0 annulus, 1 nucleus;
-/// Term::disc_volume has region 0 only).
+/// Term::disc_volume and Term::fibre have region 0 only).
 struct Knob {
   mss::Term term = mss::Term::main;
   int region = 0;
   bool operator==(const Knob& o) const { return term == o.term && region == o.region; }
 };
 
-/// "main.annulus", "disc_volume", ... (the names in tuned.json).
+/// "main.annulus", "disc_volume", "fibre", ... (the names in tuned.json).
 std::string knob_name(const Knob& k);
 /// Inverse of knob_name; throws std::invalid_argument for an unknown name.
 Knob knob_from_name(const std::string& name);

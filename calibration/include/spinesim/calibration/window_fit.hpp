@@ -56,6 +56,30 @@ struct WindowFit {
   std::vector<std::string> active_bounds;  ///< e.g. "annulus-E at upper (4.2 MPa)"
 };
 
+/// The general form behind fit_to_windows: unknowns y_j = ln p_j between the logs of each
+/// parameter's bounds, objective ½ |r(p)|², forward-difference Jacobian (one model run per
+/// unknown and point, on `threads` threads), Gauss–Newton Hessian. The model gives the residual
+/// vector (of a fixed length) at p; a non-finite entry makes Ipopt shorten its step. Must be
+/// callable from several threads at once when threads > 1.
+using ResidualModel = std::function<Eigen::VectorXd(const Eigen::VectorXd& parameters)>;
+
+struct LeastSquaresFit {
+  bool success = false;
+  std::string status;  ///< Ipopt's
+  int iterations = 0, model_evaluations = 0;
+  double seconds = 0;
+  Eigen::VectorXd parameters;              ///< p at the end
+  Eigen::VectorXd residuals;               ///< r there
+  double objective = 0;                    ///< ½ |r|²
+  std::vector<std::string> active_bounds;  ///< e.g. "annulus-E at upper (4.2 MPa)"
+};
+
+/// Throws std::invalid_argument (one line) for bad bounds or a start outside them.
+LeastSquaresFit fit_least_squares(const ResidualModel& model,
+                                  const std::vector<FitParameter>& parameters,
+                                  const WindowFitOptions& options = WindowFitOptions(),
+                                  const Progress& progress = Progress());
+
 /// r for one quantity (NaN for a non-positive or NaN q).
 double window_residual(double quantity, const WindowTarget& target);
 

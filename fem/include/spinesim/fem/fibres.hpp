@@ -8,11 +8,11 @@
 // With a . eps a = sum_b (a . g_b)(a . u_b) for shape-function gradients g_b, the element block
 // of nodes (a, b) is  K_ab = k (\int (a . g_a)(a . g_b) dV) a a^T.
 //
-// Fibre field: in every annulus tet two families, a_{1,2} = cos(alpha) e_circ ± sin(alpha) e_axial
-// (mesh/annulus_frames.hpp), alpha and E_f by depth, each with k = E_f / 2 (cross-ply laminate).
+// Fibre field: mesh/fibre_field.hpp (two families per annulus tet, each with k = E_f / 2).
 #pragma once
 
 #include "spinesim/fem/elasticity.hpp"
+#include "spinesim/mesh/fibre_field.hpp"
 #include "spinesim/mesh/material.hpp"
 #include "spinesim/mesh/tet_mesh.hpp"
 
@@ -29,19 +29,9 @@ void add_fibre_stiffness(const TetVertices& X, const Eigen::Vector3d& direction,
 void add_fibre_stiffness(const TetVertices& X, const Eigen::Vector3d& direction,
                          double stiffness_mpa, Eigen::Matrix<double, 30, 30>& Ke);
 
-/// Per-tet fibre families. Rows of tets without fibres have zero stiffness.
-struct ElementFibres {
-  Eigen::MatrixX3d direction_1;   ///< #T×3 unit, +alpha family
-  Eigen::MatrixX3d direction_2;   ///< #T×3 unit, -alpha family
-  Eigen::VectorXd stiffness_mpa;  ///< #T, k of each family (E_f / 2); 0 without fibres
-  Eigen::VectorXd angle_deg;      ///< #T, alpha; NaN without fibres
-  Eigen::VectorXd depth;          ///< #T, depth in the annulus; NaN outside it
-
-  bool empty() const { return stiffness_mpa.size() == 0; }
-};
-
-/// The fibre field of `materials` on `mesh` (empty when no region has fibres).
-ElementFibres fibre_field(const mesh::TetMesh& mesh, const mesh::RegionMaterials& materials);
+/// Per-tet fibre families and the field of a material (mesh/fibre_field.hpp).
+using mesh::ElementFibres;
+using mesh::fibre_field;
 
 /// Adds tet t's fibre families (if any) to Ke.
 template <class ElementMatrix>

@@ -80,6 +80,32 @@ double volume_penalty(const TetPoints& x, double k_v_n_per_mm5, double rest_volu
                       Vector12d* grad = nullptr, Matrix12d* hess = nullptr,
                       HessianMode mode = HessianMode::exact);
 
+/// Fibre-direction coefficients of a rest tetrahedron: c_i = ∇N_i · a (1/mm), N_i its linear
+/// shape functions and a a unit fibre direction, so that F a = Σ_i c_i x_i for the tet's affine
+/// map F, and Σ_i c_i = 0. Throws std::invalid_argument for a degenerate tet.
+Eigen::Vector4d fibre_coefficients(const TetPoints& rest, const Eigen::Vector3d& direction);
+
+/// Embedded fibre spring of one tetrahedron (beyond the thesis). A spring lies along the fibre
+/// direction a through the tet, its two ends on the tet's faces at fixed barycentric
+/// coordinates: it moves with the tet's affine map F, so its stretch is λ = |F a| wherever the
+/// line crosses the tet, λ² = I4 = |d|², d = Σ_i c_i x_i (fibre_coefficients). It carries the
+/// tet's volume V0 of tension-only exponential fibres — the nonlinear FEM's law
+/// (fem/hyperelastic.hpp, Holzapfel, Gasser & Ogden 2000) on the spring's own stretch rather
+/// than the isochoric one, since a spring knows only its length:
+///   E = V0 k1/(2 k2) [exp(k2 ⟨I4 − 1⟩²) − 1]      (k2 = 0: E = V0 k1/2 ⟨I4 − 1⟩²),
+///   dE/dx_i = 2 V0 ψ' c_i d,   d²E/dx_i dx_j = 4 V0 ψ'' c_i c_j d dᵀ + 2 V0 ψ' c_i c_j I,
+///   ψ' = k1 (I4 − 1) e,  ψ'' = k1 e (1 + 2 k2 (I4 − 1)²),  e = exp(k2 (I4 − 1)²),
+/// all zero for I4 <= 1 (a fibre in compression buckles). Both Hessian parts are positive
+/// semi-definite in tension, so there is no projected variant. At small strain ε along a the
+/// energy is V0 2 k1 ε²: the linear fibre (fem/fibres.hpp) with k = 4 k1 in tension.
+/// k1 MPa (>= 0), k2 dimensionless (>= 0), V0 mm^3; energy N·mm. An exponent past the double
+/// range gives an infinite energy (a line search steps back). `rest_i4`: |X c|² at the rest
+/// points as computed (1 up to round-off); I4 is divided by it so that the rest state sits
+/// exactly at the kink, without stiffness.
+double fibre_spring(const TetPoints& x, const Eigen::Vector4d& coefficients, double volume_mm3,
+                    double k1_mpa, double k2, Vector12d* grad = nullptr, Matrix12d* hess = nullptr,
+                    double rest_i4 = 1.0);
+
 /// Rigid spherical probe against one node (penalty contact, beyond the thesis): with
 /// d = |x - c|, penetration p = max(0, r - d),  E = 1/2 k_p p^2, pushing x out radially.
 /// Zero energy, gradient and Hessian when the node is outside the sphere.

@@ -6,6 +6,7 @@
 //        + sum_angles  1/2 k_t (theta - theta0)^2                  torsional springs (5.6)-(5.8)
 //        + sum_tets    1/2 k_v (V_t(x) - V0_t)^2                   volume term (beyond thesis)
 //        + 1/2 k_g (V(x) - V0)^2,  V = sum_t V_t                   whole-disc volume (beyond thesis)
+//        + sum_tets sum_f V0_t psi_f(I4_f(x))                      fibre springs (beyond thesis)
 // Internal force f_int = -dE/dx; ambient damping f_damp = -K_d v per node (5.11) is applied by
 // the integrators. Element formulas: elements.hpp.
 //
@@ -29,6 +30,13 @@
 //                  Why both volume terms: stiff per-tet penalties lock (the disc gets far too
 //                  stiff and still loses volume) while the whole-disc term lets the wall bulge
 //                  freely (tests/mss/test_volume.cpp; numbers in docs/benchmarks.md).
+//   fibres         in every tet of a fibre-reinforced region (mesh/fibre_field.hpp), one embedded
+//                  spring per fibre family along its direction (elements.hpp fibre_spring),
+//                  tension-only with the exponential toe: k1 = k/4 (k = E_f/2 the family's
+//                  linear stiffness, the nonlinear FEM's k1), k2 the region's toe exponent. Off
+//                  unless MssOptions::fibre_springs; annulus scale only. They have no stiffness
+//                  at rest (a fibre at its rest length is at the tension-only kink), so the
+//                  linearised calibration cannot see them: calibration/nonlinear_fit.hpp.
 //   damping (5.11) K_d = MssOptions::damping_n_s_per_mm, or by default 2 zeta omega_1 m_mean with
 //                  omega_1 = (pi / L_m) sqrt(E_mean / rho_mean) (the first axial mode of the
 //                  equivalent cylinder between fixed plates), zeta = MssOptions::damping_ratio.
@@ -64,8 +72,10 @@ namespace spinesim::mss {
 /// The energy terms of the model.
 /// Term::disc_volume is one term for the whole disc: it uses region index 0 (its scale is
 /// scales[disc_volume].by_region[0]; term_energy(x, disc_volume, 1) is zero).
-enum class Term : int { main = 0, radial = 1, torsion = 2, volume = 3, disc_volume = 4 };
-inline constexpr int kNumTerms = 5;
+/// Term::fibre exists in fibre-reinforced regions only: its scale is by_region[0] (by_region[1]
+/// is unused, term_energy(x, fibre, 1) is zero).
+enum class Term : int { main = 0, radial = 1, torsion = 2, volume = 3, disc_volume = 4, fibre = 5 };
+inline constexpr int kNumTerms = 6;
 
 /// Stiffness multipliers for one term, per region (index 0 annulus = region 1, 1 nucleus =
 /// region 2; any other region label counts as annulus).
@@ -78,8 +88,11 @@ struct MssOptions {
   bool torsion_springs = true;    ///< thesis (5.6)-(5.8)
   bool volume_term = false;       ///< per-tetrahedron volume penalty (beyond the thesis)
   bool disc_volume_term = false;  ///< whole-disc volume penalty (beyond the thesis)
-  double radial_factor = 1.0;     ///< c_s in k_s = c_s E V0 / S0^2 (dimensionless)
-  double volume_factor = 1.0;     ///< c_v in k_v = c_v K_bulk / V0 (dimensionless)
+  /// Embedded tension-only fibre springs in fibre-reinforced regions (beyond the thesis); needs
+  /// a material with fibres.
+  bool fibre_springs = false;
+  double radial_factor = 1.0;  ///< c_s in k_s = c_s E V0 / S0^2 (dimensionless)
+  double volume_factor = 1.0;  ///< c_v in k_v = c_v K_bulk / V0 (dimensionless)
   /// c_g in k_g = c_g K_mean / V0_disc (dimensionless). 10: near-incompressible disc — on L4-L5
   /// under 10 % compression dV/V = -4.2, -2.0, -0.69, -0.24 % at c_g = 1, 3, 10, 30 with the
   /// plate force saturating (1.19, 1.47, 1.62, 1.68 kN; no locking), tests/mss/test_volume.cpp.
@@ -114,6 +127,8 @@ inline bool term_enabled(const MssOptions& options, Term term) {
       return options.volume_term;
     case Term::disc_volume:
       return options.disc_volume_term;
+    case Term::fibre:
+      return options.fibre_springs;
   }
   return false;
 }
@@ -157,6 +172,7 @@ class MssModel {
   Eigen::Index num_radial_tets() const;    ///< 0 when radial springs are off
   Eigen::Index num_angle_springs() const;  ///< 0 when torsion springs are off
   Eigen::Index num_volume_terms() const;   ///< 0 when the volume term is off
+  Eigen::Index num_fibre_springs() const;  ///< two per fibre-reinforced tet; 0 when off
 
   /// Replaces the calibration multipliers (all must be finite and > 0).
   void set_scales(const std::array<RegionScales, kNumTerms>& scales);

@@ -1,0 +1,53 @@
+// `spinesim study mss-fibres`: can the mass-spring disc learn the nonlinear fibre-reinforced
+// disc? Two spring networks on the same mesh are fitted to the same nonlinear FEM reference at
+// two load levels (calibration/nonlinear_fit.hpp) — the region-scale network of `calibrate`
+// (thesis springs + per-tet volume term) and the same with the embedded fibre springs — and
+// their errors are reported per load case and level, training and held-out cases apart.
+#pragma once
+
+#include "spinesim/calibration/nonlinear_fit.hpp"
+#include "spinesim/fem/load_cases.hpp"
+#include "spinesim/mesh/material.hpp"
+#include "spinesim/mesh/tet_mesh.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <functional>
+#include <ostream>
+#include <string>
+#include <vector>
+
+namespace spinesim::studies {
+
+struct MssFibreStudyOptions {
+  std::vector<fem::LoadCase> cases = fem::standard_load_cases();
+  std::vector<std::string> train{"compression", "shear-ap", "flexion", "torsion"};
+  std::vector<double> levels{0.1, 1.0};  ///< factors on the standard loads (small, physiological)
+  int fem_order = 1;                     ///< 1: P1 nodal-average volume, 2: P2 mean dilatation
+  int load_increments = 4;
+  int threads = 2;
+};
+
+struct MssFibreStudyResult {
+  std::string mesh_label, material;
+  Eigen::Index nodes = 0, tets = 0, fibre_springs = 0;
+  calibration::NonlinearReference reference;
+  calibration::NonlinearFitResult region, fibre;  ///< without / with the fibre springs
+  double seconds = 0;
+};
+
+/// Throws std::invalid_argument (one line) for a material without fibres, a training case not
+/// among the cases, no held-out case, a bad level, order or thread count.
+void validate(const MssFibreStudyOptions& options, const mesh::RegionMaterials& materials);
+
+/// `status` gets a one-line message before each stage.
+MssFibreStudyResult run_mss_fibre_study(const mesh::TetMesh& mesh,
+                                        const mesh::RegionMaterials& materials,
+                                        const MssFibreStudyOptions& options,
+                                        const std::string& mesh_label,
+                                        const std::function<void(const std::string&)>& status = {});
+
+void print_mss_fibre_study(std::ostream& out, const MssFibreStudyResult& r);
+nlohmann::json mss_fibre_study_json(const MssFibreStudyResult& r);
+
+}  // namespace spinesim::studies

@@ -1,0 +1,294 @@
+// Embedded fibre springs of the mass-spring disc (elements.hpp fibre_spring, MssModel's
+// Term::fibre): the spring between two points on the tet's faces has the stretch the
+// coefficients give, gradient and Hessian against central differences, tension only, zero net
+// force and moment, rigid invariance, the small-strain linear fibre, and the nonlinear FEM's
+// fibre energy (fem/hyperelastic.hpp, an independent implementation) on isochoric deformations.
+#include "spinesim/mss/elements.hpp"
+#include "spinesim/mss/model.hpp"
+
+#include "spinesim/fem/hyperelastic.hpp"
+#include "spinesim/mesh/disc_level.hpp"
+#include "spinesim/mesh/fibre_field.hpp"
+#include "spinesim/mesh/material.hpp"
+#include "spinesim/mesh/structured_disc.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+
+#include <cmath>
+#include <random>
+#include <stdexcept>
+
+namespace spinesim::mss {
+namespace {
+
+constexpr double kStep = 1e-6;  // mm; as tests/mss/test_elements.cpp
+
+TetPoints rest_tet() {
+  TetPoints X;
+  X << 0, 1.5, 0.3, 0.5,  //
+      0, 0, 1.4, 0.5,     //
+      0, 0, 0, 1.3;
+  return X;
+}
+
+Eigen::Matrix3d random_rotation(std::mt19937& rng) {
+  std::normal_distribution<double> n;
+  return Eigen::Quaterniond(n(rng), n(rng), n(rng), n(rng)).normalized().toRotationMatrix();
+}
+
+/// x = F X + t for a deformation gradient F.
+TetPoints deformed(const TetPoints& X, const Eigen::Matrix3d& F,
+                   const Eigen::Vector3d& t = Eigen::Vector3d(1, -2, 3)) {
+  TetPoints x;
+  for (int j = 0; j < 4; ++j) x.col(j) = F * X.col(j) + t;
+  return x;
+}
+
+/// A stretch `lambda` along a, with lateral contraction 1/sqrt(lambda) (det F = 1), and a shear.
+Eigen::Matrix3d stretch_along(const Eigen::Vector3d& a, double lambda, double shear) {
+  const Eigen::Matrix3d aa = a * a.transpose();
+  Eigen::Matrix3d F = lambda * aa + (Eigen::Matrix3d::Identity() - aa) / std::sqrt(lambda);
+  Eigen::Vector3d b = a.unitOrthogonal();
+  return (Eigen::Matrix3d::Identity() + shear * b * a.cross(b).transpose()) * F;
+}
+
+double energy(const TetPoints& x, const Eigen::Vector4d& c, double V0, double k1, double k2) {
+  return fibre_spring(x, c, V0, k1, k2);
+}
+
+TEST(FibreSpring, TheSpringBetweenTwoFacePointsHasTheCoefficientsStretch) {
+  // The literal embedded spring: the line through the centroid along a meets the tet's
+  // boundary at two points with fixed barycentric coordinates; after any deformation the
+  // spring's length over its rest length is |sum c_i x_i|.
+  std::mt19937 rng(7);
+  const TetPoints X = rest_tet();
+  const Eigen::Vector3d a = Eigen::Vector3d(0.3, 0.8, -0.5).normalized();
+  const Eigen::Vector4d c = fibre_coefficients(X, a);
+  EXPECT_NEAR(c.sum(), 0.0, 1e-14);
+  EXPECT_LE((X * c - a).norm(), 1e-14);  // F = I: d = a
+  // Barycentric coordinates along p(s) = centroid + s a are affine in s; each end is where the
+  // first coordinate reaches zero.
+  Eigen::Matrix4d A;
+  A.topRows<3>() = X;
+  A.row(3).setOnes();
+  const Eigen::Matrix4d Ainv = A.inverse();
+  const Eigen::Vector4d w_mid = Eigen::Vector4d::Constant(0.25);
+  const Eigen::Vector4d w_dir = Ainv * Eigen::Vector4d(a.x(), a.y(), a.z(), 0.0);
+  double s_plus = 1e300, s_minus = -1e300;
+  for (int i = 0; i < 4; ++i) {
+    if (w_dir(i) < 0) s_plus = std::min(s_plus, -w_mid(i) / w_dir(i));
+    if (w_dir(i) > 0) s_minus = std::max(s_minus, -w_mid(i) / w_dir(i));
+  }
+  const Eigen::Vector4d w1 = w_mid + s_plus * w_dir, w0 = w_mid + s_minus * w_dir;
+  EXPECT_GE(w1.minCoeff(), -1e-12);
+  EXPECT_GE(w0.minCoeff(), -1e-12);
+  const double rest_length = (X * w1 - X * w0).norm();
+  EXPECT_NEAR(rest_length, s_plus - s_minus, 1e-12);
+  std::normal_distribution<double> n(0.0, 0.2);
+  for (int trial = 0; trial < 5; ++trial) {
+    Eigen::Matrix3d F = Eigen::Matrix3d::Identity();
+    for (int k = 0; k < 9; ++k) F(k / 3, k % 3) += n(rng);
+    const TetPoints x = deformed(X, random_rotation(rng) * F);
+    const double spring_stretch = (x * w1 - x * w0).norm() / rest_length;
+    EXPECT_NEAR(spring_stretch, (x * c).norm(), 1e-12) << "trial " << trial;
+    EXPECT_NEAR((x * c).norm(), (F * a).norm(), 1e-12);
+  }
+}
+
+TEST(FibreSpring, GradientAndHessianMatchCentralDifferences) {
+  const TetPoints X = rest_tet();
+  const double V0 = tet_signed_volume(X);
+  const Eigen::Vector3d a = Eigen::Vector3d(1, 0.4, 0.2).normalized();
+  const Eigen::Vector4d c = fibre_coefficients(X, a);
+  for (const double k2 : {0.0, 10.0, 100.0}) {
+    SCOPED_TRACE(k2);
+    const TetPoints x = deformed(X, stretch_along(a, 1.08, 0.1));
+    Vector12d g;
+    Matrix12d H;
+    const double e = fibre_spring(x, c, V0, 2.5, k2, &g, &H);
+    ASSERT_GT(e, 0.0);
+    Vector12d fd_g;
+    Matrix12d fd_H;
+    for (int i = 0; i < 12; ++i) {
+      TetPoints xp = x, xm = x;
+      xp(i % 3, i / 3) += kStep;
+      xm(i % 3, i / 3) -= kStep;
+      fd_g(i) = (energy(xp, c, V0, 2.5, k2) - energy(xm, c, V0, 2.5, k2)) / (2 * kStep);
+      Vector12d gp, gm;
+      fibre_spring(xp, c, V0, 2.5, k2, &gp);
+      fibre_spring(xm, c, V0, 2.5, k2, &gm);
+      fd_H.col(i) = (gp - gm) / (2 * kStep);
+    }
+    EXPECT_LE((fd_g - g).cwiseAbs().maxCoeff(), 1e-6 * g.cwiseAbs().maxCoeff());
+    EXPECT_LE((fd_H - H).cwiseAbs().maxCoeff(), 1e-6 * H.cwiseAbs().maxCoeff());
+    EXPECT_LE((H - H.transpose()).cwiseAbs().maxCoeff(), 1e-13 * H.norm());
+    EXPECT_GE(Eigen::SelfAdjointEigenSolver<Matrix12d>(H).eigenvalues().minCoeff(),
+              -1e-10 * H.norm());
+    // Zero net force and moment: the forces of one spring balance.
+    Eigen::Vector3d force = Eigen::Vector3d::Zero(), moment = Eigen::Vector3d::Zero();
+    for (int j = 0; j < 4; ++j)
+      force += g.segment<3>(3 * j), moment += x.col(j).cross(g.segment<3>(3 * j));
+    EXPECT_LE(force.norm(), 1e-13 * g.norm());
+    EXPECT_LE(moment.norm(), 1e-12 * g.norm() * x.norm());
+  }
+}
+
+TEST(FibreSpring, CarriesTensionOnly) {
+  const TetPoints X = rest_tet();
+  const Eigen::Vector3d a = Eigen::Vector3d(0.2, 0.1, 1).normalized();
+  const Eigen::Vector4d c = fibre_coefficients(X, a);
+  Vector12d g;
+  Matrix12d H;
+  for (const double lambda : {0.7, 0.95, 1.0}) {
+    const double e =
+        fibre_spring(deformed(X, stretch_along(a, lambda, 0.0)), c, 1.0, 3.0, 10.0, &g, &H);
+    EXPECT_EQ(e, 0.0) << lambda;
+    EXPECT_EQ(g.norm(), 0.0) << lambda;
+    EXPECT_EQ(H.norm(), 0.0) << lambda;
+  }
+  EXPECT_GT(fibre_spring(deformed(X, stretch_along(a, 1.01, 0.0)), c, 1.0, 3.0, 10.0), 0.0);
+}
+
+TEST(FibreSpring, IsRigidInvariantAndTheLinearFibreAtSmallStrain) {
+  std::mt19937 rng(3);
+  const TetPoints X = rest_tet();
+  const double V0 = tet_signed_volume(X);
+  const Eigen::Vector3d a = Eigen::Vector3d(0.6, -0.3, 0.7).normalized();
+  const Eigen::Vector4d c = fibre_coefficients(X, a);
+  const Eigen::Matrix3d F = stretch_along(a, 1.05, 0.2);
+  const double e = fibre_spring(deformed(X, F), c, V0, 2.0, 10.0);
+  const double e_moved =
+      fibre_spring(deformed(X, random_rotation(rng) * F, {5, 6, 7}), c, V0, 2.0, 10.0);
+  EXPECT_NEAR(e_moved, e, 1e-12 * e);
+  // Uniaxial strain eps along a: V0 (k/2) eps^2 with k = 4 k1, to first order in eps.
+  const double k1 = 2.0, eps = 1e-5;
+  const Eigen::Matrix3d Fs = Eigen::Matrix3d::Identity() + eps * a * a.transpose();
+  const double linear = V0 * 0.5 * (4.0 * k1) * eps * eps;
+  EXPECT_NEAR(fibre_spring(deformed(X, Fs), c, V0, k1, 10.0), linear, 3 * eps * linear);
+}
+
+TEST(FibreSpring, EqualsTheNonlinearFemFibreEnergyOnIsochoricDeformations) {
+  // On det F = 1 the FEM's isochoric I4 is the spring's I4: the element's fibre energy
+  // (FEM energy with the family minus without it, times V0) must be the spring's.
+  std::mt19937 rng(11);
+  std::normal_distribution<double> n(0.0, 0.1);
+  const TetPoints X = rest_tet();
+  const double V0 = tet_signed_volume(X);
+  const Eigen::Vector3d a = Eigen::Vector3d(0.5, 0.5, -0.7).normalized();
+  const Eigen::Vector4d c = fibre_coefficients(X, a);
+  fem::FibreHyperelastic matrix = fem::neo_hookean_from_linear(1.0, 0.45);
+  fem::FibreHyperelastic with = matrix;
+  with.fibres.push_back({a, 2.5, 20.0});
+  int in_tension = 0;
+  for (int trial = 0; trial < 20; ++trial) {
+    Eigen::Matrix3d F = Eigen::Matrix3d::Identity();
+    for (int k = 0; k < 9; ++k) F(k / 3, k % 3) += n(rng);
+    F /= std::cbrt(F.determinant());
+    const Eigen::Matrix3d C = F.transpose() * F;
+    const double fem_energy = V0 * (fem::fibre_hyperelastic_point(C, with, false).energy -
+                                    fem::fibre_hyperelastic_point(C, matrix, false).energy);
+    const double spring = fibre_spring(deformed(X, F), c, V0, 2.5, 20.0);
+    EXPECT_NEAR(spring, fem_energy, 1e-9 * std::max(fem_energy, 1e-6)) << "trial " << trial;
+    in_tension += spring > 0.0;
+  }
+  EXPECT_GT(in_tension, 3);
+  EXPECT_LT(in_tension, 17);  // both sides of the kink were sampled
+}
+
+TEST(FibreSpring, DegenerateTetIsRefused) {
+  TetPoints flat = rest_tet();
+  flat.row(2).setZero();
+  EXPECT_THROW(fibre_coefficients(flat, Eigen::Vector3d::UnitX()), std::invalid_argument);
+}
+
+// The model: one spring per family in every fibre-reinforced tet, and its term behaves like the
+// others (scale, term energy, assembled gradient and Hessian).
+class FibreModel : public ::testing::Test {
+ protected:
+  static mesh::TetMesh disc() {
+    return mesh::mesh_structured_level("L4-L5", {}, SPINESIM_DATA_DIR);
+  }
+  static mesh::RegionMaterials material() {
+    mesh::RegionMaterials m;
+    m.name = "test-fibres";
+    m.fallback = {4.2, 0.45, 1200.0};
+    m.by_region[2] = {1.0, 0.49, 1000.0};
+    mesh::FibreReinforcement f;
+    f.modulus_inner_mpa = 100, f.modulus_outer_mpa = 200;
+    f.angle_inner_deg = 45, f.angle_outer_deg = 30;
+    f.toe_k2 = 10;
+    m.fibres[1] = f;
+    return m;
+  }
+};
+
+TEST_F(FibreModel, OneSpringPerFamilyInEveryAnnulusTetAndNoneAtRest) {
+  const mesh::TetMesh m = disc();
+  MssOptions o;
+  o.fibre_springs = true;
+  const MssModel model(m, material(), o);
+  Eigen::Index annulus = 0;
+  for (Eigen::Index t = 0; t < m.num_tets(); ++t) annulus += m.region(t) == 1;
+  ASSERT_GT(annulus, 0);
+  EXPECT_EQ(model.num_fibre_springs(), 2 * annulus);
+  const Eigen::VectorXd X = model.rest_positions_mm();
+  EXPECT_EQ(model.term_energy(X, Term::fibre, 0), 0.0);
+  Eigen::SparseMatrix<double> H;
+  model.term_hessian(X, Term::fibre, 0, HessianMode::exact, H);
+  EXPECT_EQ(H.norm(), 0.0);  // the tension-only kink: no stiffness at rest
+  MssOptions off;
+  EXPECT_EQ(MssModel(m, material(), off).num_fibre_springs(), 0);
+}
+
+TEST_F(FibreModel, ScaledTermAssembledGradientAndHessianAgree) {
+  const mesh::TetMesh m = disc();
+  MssOptions o;
+  o.fibre_springs = true;
+  o.volume_term = true;
+  MssModel model(m, material(), o);
+  // Twist the disc about its axis (y) in proportion to height: the ±angle families stretch.
+  Eigen::VectorXd x = model.rest_positions_mm();
+  for (Eigen::Index i = 0; i < model.num_nodes(); ++i) {
+    const Eigen::Vector3d p = x.segment<3>(3 * i);
+    x.segment<3>(3 * i) = Eigen::AngleAxisd(0.02 * p.y(), Eigen::Vector3d::UnitY()) * p;
+  }
+  const double fibre = model.term_energy(x, Term::fibre, 0);
+  ASSERT_GT(fibre, 0.0);
+  EXPECT_EQ(model.term_energy(x, Term::fibre, 1), 0.0);
+  const double total = model.energy(x);
+  auto scales = o.scales;
+  scales[int(Term::fibre)].by_region[0] = 3.0;
+  model.set_scales(scales);
+  EXPECT_NEAR(model.energy(x) - total, 2.0 * fibre, 1e-9 * total);
+
+  Eigen::VectorXd g;
+  model.gradient(x, g);
+  Eigen::SparseMatrix<double> H;
+  model.hessian(x, HessianMode::exact, H);
+  std::mt19937 rng(5);
+  std::normal_distribution<double> n;
+  Eigen::VectorXd v(x.size());
+  for (Eigen::Index i = 0; i < v.size(); ++i) v(i) = n(rng);
+  const double h = 1e-6;
+  const double fd = (model.energy(x + h * v) - model.energy(x - h * v)) / (2 * h);
+  EXPECT_NEAR(fd, g.dot(v), 1e-6 * std::abs(g.dot(v)));
+  Eigen::VectorXd gp, gm;
+  model.gradient(x + h * v, gp);
+  model.gradient(x - h * v, gm);
+  const Eigen::VectorXd Hv = H * v;
+  EXPECT_LE(((gp - gm) / (2 * h) - Hv).norm(), 1e-6 * Hv.norm());
+}
+
+TEST_F(FibreModel, FibreSpringsNeedAFibreReinforcedMaterial) {
+  mesh::RegionMaterials plain = material();
+  plain.fibres.clear();
+  MssOptions o;
+  o.fibre_springs = true;
+  EXPECT_THROW(MssModel(disc(), plain, o), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace spinesim::mss
