@@ -2,13 +2,15 @@
 // nonlinear fibre-reinforced FEM disc at two load levels (studies/mss_fibre_study.hpp).
 //
 //   spinesim study mss-fibres [--level L4-L5 | --mesh disc.vtu] [--material fibre-reinforced]
-//       [--cell-size 3] [--fem-order 1] [--levels 0.1,1] [--train compression,shear-ap,...]
-//       [--cases all] [--threads 2] [--out DIR] [--json] [--quiet]
+//       [--cell-size 3] [--fem-order 1] [--terms thesis+volume] [--levels 0.1,1] [--train compression,shear-ap,...]
+//       [--cases all] [--threads 2] [--curve-levels 0.2,...,1] [--targets FILE] [--out DIR]
+//       [--json] [--quiet]
 #include "cli_common.hpp"
 #include "spinesim/mesh/disc_level.hpp"
 #include "spinesim/mesh/io.hpp"
 #include "spinesim/mesh/material.hpp"
 #include "spinesim/output/files.hpp"
+#include "spinesim/output/html_report.hpp"
 #include "spinesim/studies/mss_fibre_study.hpp"
 
 #include <cmath>
@@ -22,8 +24,8 @@ namespace {
 
 struct MssFibresArgs {
   std::string level = "L4-L5", mesh_path, material = "fibre-reinforced", cases = "all",
-              train = "compression,shear-ap,flexion,torsion", out;
-  std::vector<double> levels{0.1, 1.0};
+              train = "compression,shear-ap,flexion,torsion", targets, out, terms = "thesis+volume";
+  std::vector<double> levels{0.1, 1.0}, curve_levels{0.2, 0.4, 0.6, 0.8, 1.0};
   double cell_size_mm = 3.0;
   studies::MssFibreStudyOptions options;
   bool json = false, quiet = false;
@@ -46,6 +48,10 @@ void run_mss_fibres(const MssFibresArgs& a) {
   o.cases = a.cases == "all" ? fem::standard_load_cases() : fem::parse_load_cases(a.cases);
   o.train = split(a.train);
   o.levels = a.levels;
+  o.terms = calibration::parse_term_set(a.terms);
+  o.curve_levels = a.curve_levels;
+  o.targets = studies::read_disc_targets(
+      a.targets.empty() ? data_dir() + "/validation/disc_in_vitro.json" : a.targets);
   studies::validate(o, materials);
   if (!a.out.empty()) output::prepare_output_folder(a.out, "--out");
 
@@ -76,6 +82,10 @@ void run_mss_fibres(const MssFibresArgs& a) {
     std::ostringstream md;
     studies::print_mss_fibre_study(md, r);
     output::write_text_file((fs::path(a.out) / "mss_fibres.md").string(), md.str());
+    const output::HtmlReport report = output::write_html_report(a.out, "mss_fibres_report.py");
+    if (report.failed) throw std::runtime_error("--out " + a.out + ": " + report.message);
+    if (!a.quiet && !a.json)
+      std::cerr << (report.written ? "" : "spinesim: warning: ") << report.message << std::endl;
   }
   if (a.json)
     print_json(studies::mss_fibre_study_json(r));
@@ -105,6 +115,11 @@ void register_mss_fibres(CLI::App& study) {
   cmd->add_option("--levels", a->levels, "Load levels, factors on the standard loads (in (0, 2])")
       ->delimiter(',')
       ->capture_default_str();
+  cmd->add_option(
+         "--terms", a->terms,
+         "Network terms: thesis (main, radial, torsion springs), thesis+volume (+ per-tet "
+         "volume term), all (+ whole-disc volume term); the fibre network adds its springs")
+      ->capture_default_str();
   cmd->add_option("--cases", a->cases, "Load cases (comma list or 'all')")->capture_default_str();
   cmd->add_option("--train", a->train, "Training cases (comma list); the others are held out")
       ->capture_default_str();
@@ -112,7 +127,16 @@ void register_mss_fibres(CLI::App& study) {
       ->capture_default_str();
   cmd->add_option("--threads", a->options.threads, "MSS solves side by side")
       ->capture_default_str();
-  cmd->add_option("--out", a->out, "Write mss_fibres.json and mss_fibres.md into this folder");
+  cmd->add_option("--curve-levels", a->curve_levels,
+                  "Moment-rotation curves after the fits at these levels (in (0, 2])")
+      ->delimiter(',')
+      ->capture_default_str();
+  cmd->add_option("--targets", a->targets,
+                  "In-vitro targets drawn beside the curves (default: "
+                  "data/validation/disc_in_vitro.json)");
+  cmd->add_option("--out", a->out,
+                  "Write mss_fibres.json, mss_fibres.md, plots/mss_fibres_curves.png and "
+                  "report.html into this folder");
   add_output_flags(cmd, a->json, a->quiet, "the JSON summary");
   cmd->callback([a] { run_mss_fibres(*a); });
 }

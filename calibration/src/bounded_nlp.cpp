@@ -198,6 +198,9 @@ NlpRun run_bounded_nlp(const NlpFunction& f, const Eigen::VectorXd& start,
   app->Options()->SetIntegerValue("max_iter", settings.max_iterations);
   app->Options()->SetNumericValue("tol", settings.tolerance);
   app->Options()->SetNumericValue("acceptable_tol", settings.acceptable_tolerance);
+  app->Options()->SetIntegerValue("acceptable_iter", settings.acceptable_iterations);
+  app->Options()->SetNumericValue("acceptable_obj_change_tol",
+                                  settings.acceptable_objective_change);
   app->Options()->SetIntegerValue("print_level", settings.print_level);
   app->Options()->SetNumericValue("obj_scaling_factor", objective_scaling);
   app->Options()->SetStringValue("sb", "yes");  // no banner

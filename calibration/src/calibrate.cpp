@@ -11,16 +11,22 @@ namespace spinesim::calibration {
 
 namespace {}  // namespace
 
+void validate_stopping(const IpoptSettings& s) {
+  if (s.max_iterations < 1) throw std::invalid_argument("calibration: max iterations must be >= 1");
+  if (!(s.tolerance > 0) || !(s.acceptable_tolerance > 0) || !(s.acceptable_objective_change > 0))
+    throw std::invalid_argument("calibration: Ipopt tolerances must be > 0");
+  if (s.acceptable_iterations < 0)
+    throw std::invalid_argument("calibration: Ipopt acceptable iterations must be >= 0");
+}
+
 void validate(const IpoptSettings& s) {
+  validate_stopping(s);
   if (!std::isfinite(s.lower_scale) || !std::isfinite(s.upper_scale) || s.lower_scale <= 0)
     throw std::invalid_argument("calibration: scale bounds must be finite and > 0");
   if (!(s.lower_scale < s.upper_scale))
     throw std::invalid_argument("calibration: infeasible bounds, lower scale " +
                                 std::to_string(s.lower_scale) + " is not below upper scale " +
                                 std::to_string(s.upper_scale));
-  if (s.max_iterations < 1) throw std::invalid_argument("calibration: max iterations must be >= 1");
-  if (!(s.tolerance > 0) || !(s.acceptable_tolerance > 0))
-    throw std::invalid_argument("calibration: Ipopt tolerances must be > 0");
 }
 
 CalibrationResult calibrate(Objective& objective, const Eigen::VectorXd& start_log_scales,

@@ -30,6 +30,7 @@ void check_parameters(const std::vector<FitParameter>& parameters,
   }
   if (!(options.log_step > 0) || !(options.log_step < 1) || options.threads < 1)
     throw std::invalid_argument("identification: step in (0, 1) and threads >= 1 expected");
+  validate_stopping(options.ipopt);
 }
 
 void check(const std::vector<FitParameter>& parameters, const std::vector<WindowTarget>& targets,

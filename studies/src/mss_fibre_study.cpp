@@ -1,8 +1,10 @@
 #include "spinesim/studies/mss_fibre_study.hpp"
 
 #include "spinesim/calibration/protocol.hpp"
+#include "spinesim/common/constants.hpp"
 #include "spinesim/common/timer.hpp"
 #include "spinesim/mss/model.hpp"
+#include "spinesim/studies/toolkit.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -14,16 +16,10 @@ namespace spinesim::studies {
 
 namespace {
 
-mss::MssOptions network(bool fibres) {
-  mss::MssOptions o = calibration::term_set_options(calibration::TermSet::thesis_volume);
+mss::MssOptions network(calibration::TermSet terms, bool fibres) {
+  mss::MssOptions o = calibration::term_set_options(terms);
   o.fibre_springs = fibres;
   return o;
-}
-
-std::string percent(double v) {
-  std::ostringstream s;
-  s << std::fixed << std::setprecision(1) << 100.0 * v << " %";
-  return v == v ? s.str() : std::string("n/a");
 }
 
 nlohmann::json fit_json(const calibration::NonlinearFitResult& f) {
@@ -40,6 +36,7 @@ nlohmann::json fit_json(const calibration::NonlinearFitResult& f) {
                      {"displacement_error_untuned", b.displacement_error},
                      {"reaction_error", a.reaction_error},
                      {"displacement_error", a.displacement_error},
+                     {"reaction_wrench", to_json(a.reaction_mss)},
                      {"converged", a.converged}});
   }
   return {{"success", f.fit.success},
@@ -53,6 +50,87 @@ nlohmann::json fit_json(const calibration::NonlinearFitResult& f) {
           {"cases", cases}};
 }
 
+/// The curves of the pure-moment cases: the FEM at `curve_levels`, each fitted network at the
+/// FEM's poses (the fits' scales on copies of the networks).
+std::vector<MomentCurve> moment_curves(const mesh::RegionMaterials& materials,
+                                       const mss::MssModel& region, const mss::MssModel& fibre,
+                                       const MssFibreStudyResult& r, const MssFibreStudyOptions& o,
+                                       const fem::NewtonOptions& newton) {
+  std::vector<fem::LoadCase> moments;
+  for (const fem::LoadCase& c : o.cases)
+    if (c.wrench_local.head<3>().isZero() && !c.wrench_local.tail<3>().isZero())
+      moments.push_back(c);
+  std::vector<MomentCurve> curves;
+  if (moments.empty()) return curves;
+  const calibration::NonlinearReference ref = calibration::nonlinear_reference(
+      region.mesh(), materials, moments, o.curve_levels, o.fem_order, newton);
+  mss::MssModel tuned_region = region, tuned_fibre = fibre;
+  tuned_region.set_scales(r.region.scales);
+  tuned_fibre.set_scales(r.fibre.scales);
+  const auto region_at = calibration::nonlinear_errors(tuned_region, ref);
+  const auto fibre_at = calibration::nonlinear_errors(tuned_fibre, ref);
+  for (std::size_t i = 0; i < ref.cases.size(); ++i) {
+    const calibration::NonlinearReferenceCase& c = ref.cases[i];
+    if (curves.empty() || curves.back().name != c.name) {
+      curves.push_back({c.name,
+                        std::find(o.train.begin(), o.train.end(), c.name) != o.train.end(),
+                        {},
+                        {},
+                        {},
+                        {}});
+    }
+    const Eigen::Vector3d e = c.wrench.tail<3>().normalized();
+    const auto moment_nm = [&](const calibration::Vector6d& reaction) {
+      return -reaction.tail<3>().dot(e) / 1000.0;
+    };
+    MomentCurve& curve = curves.back();
+    curve.rotation_deg.push_back(c.plate_motion.tail<3>().dot(e) * kDegPerRad);
+    curve.fem_moment_nm.push_back(moment_nm(c.reaction));
+    curve.region_moment_nm.push_back(moment_nm(region_at[i].reaction_mss));
+    curve.fibre_moment_nm.push_back(moment_nm(fibre_at[i].reaction_mss));
+  }
+  return curves;
+}
+
+/// The targets in N m/deg named as a curve's case.
+std::vector<DiscValidationRow> corridors(const std::vector<MomentCurve>& curves,
+                                         const nlohmann::json& targets) {
+  std::vector<DiscValidationRow> rows;
+  if (targets.is_null()) return rows;
+  for (const auto& t : targets.at("targets")) {
+    DiscValidationRow row = disc_target_row(t);
+    const bool drawn = std::any_of(curves.begin(), curves.end(),
+                                   [&](const MomentCurve& c) { return c.name == row.quantity; });
+    if (drawn && row.units == "N m/deg") rows.push_back(std::move(row));
+  }
+  return rows;
+}
+
+nlohmann::json curves_json(const std::vector<MomentCurve>& curves) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const MomentCurve& c : curves)
+    out.push_back({{"case", c.name},
+                   {"set", c.trained ? "train" : "held-out"},
+                   {"rotation_deg", c.rotation_deg},
+                   {"fem_moment_nm", c.fem_moment_nm},
+                   {"region_moment_nm", c.region_moment_nm},
+                   {"fibre_moment_nm", c.fibre_moment_nm}});
+  return out;
+}
+
+nlohmann::json corridors_json(const std::vector<DiscValidationRow>& rows) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const DiscValidationRow& t : rows)
+    out.push_back({{"quantity", t.quantity},
+                   {"units", t.units},
+                   {"low", t.low},
+                   {"high", t.high},
+                   {"reported", t.reported},
+                   {"preparation", t.preparation},
+                   {"source", t.source}});
+  return out;
+}
+
 }  // namespace
 
 void validate(const MssFibreStudyOptions& o, const mesh::RegionMaterials& materials) {
@@ -60,9 +138,10 @@ void validate(const MssFibreStudyOptions& o, const mesh::RegionMaterials& materi
     throw std::invalid_argument("study mss-fibres: material '" + materials.name +
                                 "' has no fibres (use fibre-reinforced or a preset with fibres)");
   if (o.levels.empty()) throw std::invalid_argument("study mss-fibres: no load level");
-  for (double l : o.levels)
-    if (!std::isfinite(l) || !(l > 0) || l > 2)
-      throw std::invalid_argument("study mss-fibres: load levels must be in (0, 2]");
+  for (const auto* levels : {&o.levels, &o.curve_levels})
+    for (double l : *levels)
+      if (!std::isfinite(l) || !(l > 0) || l > 2)
+        throw std::invalid_argument("study mss-fibres: load levels must be in (0, 2]");
   if (o.fem_order != 1 && o.fem_order != 2)
     throw std::invalid_argument("study mss-fibres: --fem-order must be 1 or 2");
   if (o.threads < 1 || o.load_increments < 1)
@@ -90,6 +169,7 @@ MssFibreStudyResult run_mss_fibre_study(const mesh::TetMesh& mesh,
   MssFibreStudyResult r;
   r.mesh_label = mesh_label;
   r.material = materials.name;
+  r.terms = calibration::term_set_name(o.terms);
   r.nodes = mesh.num_vertices();
   r.tets = mesh.num_tets();
   fem::NewtonOptions newton;
@@ -108,13 +188,18 @@ MssFibreStudyResult run_mss_fibre_study(const mesh::TetMesh& mesh,
     s << "  Ipopt iteration " << it << ", objective " << objective;
     say(s.str());
   };
-  say("fitting the region-scale network (thesis springs + volume term)");
-  const mss::MssModel region(mesh, materials, network(false));
+  say("fitting the region-scale network (" + calibration::term_set_name(o.terms) + ")");
+  const mss::MssModel region(mesh, materials, network(o.terms, false));
   r.region = calibration::fit_mss_nonlinear(region, r.reference, request, progress);
   say("fitting the network with fibre springs");
-  const mss::MssModel fibre(mesh, materials, network(true));
+  const mss::MssModel fibre(mesh, materials, network(o.terms, true));
   r.fibre_springs = fibre.num_fibre_springs();
   r.fibre = calibration::fit_mss_nonlinear(fibre, r.reference, request, progress);
+  if (!o.curve_levels.empty()) {
+    say("moment-rotation curves");
+    r.curves = moment_curves(materials, region, fibre, r, o, newton);
+    r.corridors = corridors(r.curves, o.targets);
+  }
   r.seconds = timer.seconds();
   return r;
 }
@@ -122,27 +207,26 @@ MssFibreStudyResult run_mss_fibre_study(const mesh::TetMesh& mesh,
 void print_mss_fibre_study(std::ostream& out, const MssFibreStudyResult& r) {
   out << "# Mass-spring disc against the nonlinear FEM disc\n\n"
       << r.mesh_label << ", " << r.nodes << " nodes, " << r.tets << " tets; material " << r.material
-      << "; FEM P" << r.reference.fem_order << "; " << r.fibre_springs << " fibre springs\n\n"
+      << "; FEM P" << r.reference.fem_order << "; network terms " << r.terms << "; "
+      << r.fibre_springs << " fibre springs\n\n"
       << "Errors of the MSS with its plate at the FEM's pose: reaction |S dR|/|S R*| and "
          "displacement of the free vertices ||du||/||u*||.\n\n"
-      << "| case | load | set | FEM rotation/shift | region MSS reaction | region MSS displ. | "
-         "fibre MSS reaction | fibre MSS displ. |\n|---|---:|---|---:|---:|---:|---:|---:|\n";
+      << "| case | load | set | FEM shift (mm) | FEM rotation (deg) | region MSS reaction | "
+         "region MSS displ. | fibre MSS reaction | fibre MSS displ. |\n"
+         "|---|---:|---|---:|---:|---:|---:|---:|---:|\n";
   for (std::size_t i = 0; i < r.fibre.after.size(); ++i) {
     const auto &g = r.region.after[i], &f = r.fibre.after[i];
     const auto& c = r.reference.cases[i];
-    const double rot = c.plate_motion.tail<3>().norm() * 180.0 / M_PI;
-    std::ostringstream motion;
-    motion << std::fixed << std::setprecision(2)
-           << (rot > 0.05 ? rot : c.plate_motion.head<3>().norm()) << (rot > 0.05 ? " deg" : " mm");
-    out << "| " << f.name << " | " << f.level << " x | " << (f.trained ? "train" : "held out")
-        << " | " << motion.str() << " | " << percent(g.reaction_error) << " | "
-        << percent(g.displacement_error) << " | " << percent(f.reaction_error) << " | "
-        << percent(f.displacement_error) << " |\n";
+    out << "| " << f.name << " | " << f.level << "× | " << (f.trained ? "train" : "held out")
+        << " | " << fixed(c.plate_motion.head<3>().norm(), 3) << " | "
+        << fixed(c.plate_motion.tail<3>().norm() * kDegPerRad, 2) << " | "
+        << percent(g.reaction_error) << " | " << percent(g.displacement_error) << " | "
+        << percent(f.reaction_error) << " | " << percent(f.displacement_error) << " |\n";
   }
   for (const auto* fit : {&r.region, &r.fibre}) {
     out << "\n"
         << (fit == &r.region ? "Region network" : "Fibre network") << ": "
-        << (fit->fit.success ? "converged" : "NOT converged (" + fit->fit.status + ")") << ", "
+        << (fit->fit.success ? "converged" : "NOT converged") << " (" << fit->fit.status << "), "
         << fit->fit.iterations << " Ipopt iterations, " << fit->fit.model_evaluations
         << " evaluations, " << std::fixed << std::setprecision(0) << fit->fit.seconds
         << " s; scales:";
@@ -152,9 +236,21 @@ void print_mss_fibre_study(std::ostream& out, const MssFibreStudyResult& r) {
           << fit->fit.parameters(Eigen::Index(j));
     if (!fit->fit.active_bounds.empty()) {
       out << "; at bounds:";
-      for (const auto& b : fit->fit.active_bounds) out << " " << b << ";";
+      for (std::size_t b = 0; b < fit->fit.active_bounds.size(); ++b)
+        out << (b == 0 ? " " : ", ") << fit->fit.active_bounds[b];
     }
-    out << "\n";
+    out << ".\n";
+  }
+  if (!r.curves.empty()) {
+    out << "\nMoment-rotation at the FEM's poses (moment and rotation along the applied "
+           "moment):\n\n"
+        << "| case | set | rotation (deg) | FEM (N m) | region MSS (N m) | fibre MSS (N m) |\n"
+           "|---|---|---:|---:|---:|---:|\n";
+    for (const MomentCurve& c : r.curves)
+      for (std::size_t k = 0; k < c.rotation_deg.size(); ++k)
+        out << "| " << c.name << " | " << (c.trained ? "train" : "held out") << " | "
+            << fixed(c.rotation_deg[k], 2) << " | " << fixed(c.fem_moment_nm[k], 2) << " | "
+            << fixed(c.region_moment_nm[k], 2) << " | " << fixed(c.fibre_moment_nm[k], 2) << " |\n";
   }
   out << "\nFEM reference " << std::fixed << std::setprecision(0) << r.reference.seconds
       << " s; whole study " << r.seconds << " s\n";
@@ -163,21 +259,26 @@ void print_mss_fibre_study(std::ostream& out, const MssFibreStudyResult& r) {
 nlohmann::json mss_fibre_study_json(const MssFibreStudyResult& r) {
   nlohmann::json reference = nlohmann::json::array();
   for (const auto& c : r.reference.cases)
-    reference.push_back(
-        {{"case", c.name},
-         {"level", c.level},
-         {"plate_motion", std::vector<double>(c.plate_motion.data(), c.plate_motion.data() + 6)},
-         {"newton_iterations", c.newton_iterations},
-         {"seconds", c.seconds}});
+    reference.push_back({{"case", c.name},
+                         {"level", c.level},
+                         {"wrench", to_json(c.wrench)},
+                         {"plate_motion", to_json(c.plate_motion)},
+                         {"reaction_wrench", to_json(c.reaction)},
+                         {"newton_iterations", c.newton_iterations},
+                         {"seconds", c.seconds}});
   return {{"mesh", r.mesh_label},
           {"nodes", r.nodes},
           {"tets", r.tets},
           {"material", r.material},
           {"fem_order", r.reference.fem_order},
+          {"terms", r.terms},
+          {"plate_rms_radius_mm", r.reference.plate_rms_radius_mm},
           {"fibre_springs", r.fibre_springs},
           {"reference", reference},
           {"region", fit_json(r.region)},
           {"fibre", fit_json(r.fibre)},
+          {"curves", curves_json(r.curves)},
+          {"corridors", corridors_json(r.corridors)},
           {"seconds", r.seconds}};
 }
 

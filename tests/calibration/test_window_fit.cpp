@@ -67,6 +67,53 @@ TEST(WindowFit, StopsAtAPublishedBoundAndSaysSo) {
   EXPECT_GT(fit.objective, 0.1);  // the windows cannot all be met
 }
 
+// Residuals whose best fit leaves ½|r|² = 1 (ln a is asked to be 1 and -1), plus a deterministic
+// noise of 1e-7 that changes with every bit of p — what a static solve's tolerance does to a
+// forward-difference Jacobian (its noise is ~1e-7 / 1e-3 = 1e-4 in the gradient).
+Eigen::VectorXd noisy_inconsistent_model(const Eigen::VectorXd& p) {
+  Eigen::VectorXd r(3);
+  r << std::log(p(0)) - 1.0, std::log(p(0)) + 1.0, std::log(p(1)) - 0.5;
+  for (Eigen::Index i = 0; i < r.size(); ++i)
+    r(i) += 1e-7 * std::sin(1e9 * p(0) + 3e8 * p(1) + static_cast<double>(i));
+  return r;
+}
+
+TEST(LeastSquaresFit, StopsAtTheAcceptableLevelOnceTheObjectiveStallsUnderNoise) {
+  const std::vector<FitParameter> parameters = {{"a", "", 3.0, 0.01, 100.0},
+                                                {"b", "", 3.0, 0.01, 100.0}};
+  WindowFitOptions strict;  // Ipopt's own acceptable rule: 15 iterations at 1e-5, no change test
+  strict.ipopt.max_iterations = 60;
+  WindowFitOptions stall = strict;
+  stall.ipopt.acceptable_tolerance = 1e-3;
+  stall.ipopt.acceptable_iterations = 3;
+  stall.ipopt.acceptable_objective_change = 1e-6;
+  const LeastSquaresFit a = fit_least_squares(noisy_inconsistent_model, parameters, strict);
+  const LeastSquaresFit b = fit_least_squares(noisy_inconsistent_model, parameters, stall);
+  ASSERT_TRUE(b.success) << b.status;
+  EXPECT_EQ(b.status, "Solved_To_Acceptable_Level");
+  EXPECT_NEAR(b.objective, 1.0, 1e-6);
+  EXPECT_NEAR(std::log(b.parameters(0)), 0.0, 1e-3);
+  EXPECT_NEAR(std::log(b.parameters(1)), 0.5, 1e-3);
+  // Without the change rule the noise keeps Ipopt from both of its levels to the iteration limit.
+  EXPECT_LT(b.iterations, a.iterations) << a.status;
+  EXPECT_LE(b.iterations, 15);
+}
+
+TEST(WindowFit, RefusesBadIpoptStoppingRules) {
+  Eigen::VectorXd truth(3);
+  truth << 2.5, 0.4, 3.0;
+  WindowFitOptions o;
+  o.ipopt.acceptable_iterations = -1;
+  EXPECT_THROW(fit_to_windows(power_model, three_parameters(), windows_around(truth),
+                              {true, true, true, true}, o),
+               std::invalid_argument);
+  o = WindowFitOptions();
+  o.ipopt.acceptable_objective_change = 0;
+  EXPECT_THROW(fit_to_windows(power_model, three_parameters(), windows_around(truth),
+                              {true, true, true, true}, o),
+               std::invalid_argument);
+}
+
 TEST(WindowFit, TwoThreadsGiveTheSameFitToTheLastBit) {
   Eigen::VectorXd truth(3);
   truth << 2.5, 0.4, 3.0;

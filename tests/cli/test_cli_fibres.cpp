@@ -244,7 +244,7 @@ TEST(CliFibres, MssFibresFitsBothNetworksToTheNonlinearDisc) {
   std::filesystem::remove_all(out);
   const CliRun r = run_spinesim("study mss-fibres --mesh '" + disc_vtu() +
                                 "' --cases compression,torsion,flexion --train compression,torsion"
-                                " --levels 0.1,1 --increments 2 --out '" +
+                                " --levels 0.1,1 --increments 2 --curve-levels 0.5,1 --out '" +
                                 out + "' --json");
   ASSERT_EQ(r.status, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
@@ -267,11 +267,47 @@ TEST(CliFibres, MssFibresFitsBothNetworksToTheNonlinearDisc) {
       ++trained;
     }
     ASSERT_EQ(trained, 4) << network;
+    // The reaction error is |S (R - R*)| / |S R*| of the wrenches written beside it.
+    const double rho = j["plate_rms_radius_mm"].get<double>();
+    for (std::size_t i = 0; i < fit["cases"].size(); ++i) {
+      const auto &mss = fit["cases"][i]["reaction_wrench"],
+                 &fem = j["reference"][i]["reaction_wrench"];
+      double diff = 0, norm = 0;
+      for (int k = 0; k < 6; ++k) {
+        const double s = k < 3 ? 1.0 : 1.0 / rho, f = fem[k].get<double>();
+        diff += std::pow(s * (mss[k].get<double>() - f), 2);
+        norm += std::pow(s * f, 2);
+      }
+      EXPECT_NEAR(std::sqrt(diff / norm), fit["cases"][i]["reaction_error"].get<double>(), 1e-9)
+          << network << " " << i;
+    }
     EXPECT_LE(fit["objective"].get<double>(), 0.5 * start / trained) << network;
   }
   EXPECT_TRUE(j["fibre"]["scales"].contains("fibre")) << j["fibre"]["scales"].dump();
   EXPECT_FALSE(j["region"]["scales"].contains("fibre")) << j["region"]["scales"].dump();
-  for (const char* file : {"mss_fibres.json", "mss_fibres.md"})
+  // Curves of the two moment cases at the curve levels: the FEM's moment along its axis is the
+  // applied one (the reaction is −W − ½ θ × W, whose second part is normal to W), rotations and
+  // every network's moments grow with the level; the in-vitro windows of both cases beside them.
+  ASSERT_EQ(j["curves"].size(), 2u);
+  for (const auto& c : j["curves"]) {
+    double standard_nm = 0;
+    for (const auto& ref : j["reference"])
+      if (ref["case"] == c["case"] && ref["level"] == 1.0)
+        for (int k = 3; k < 6; ++k) standard_nm += std::pow(ref["wrench"][k].get<double>(), 2);
+    standard_nm = std::sqrt(standard_nm) / 1000.0;
+    ASSERT_GT(standard_nm, 0) << c.dump();
+    ASSERT_EQ(c["rotation_deg"].size(), 2u);
+    const double levels[2] = {0.5, 1.0};
+    for (int k = 0; k < 2; ++k)
+      EXPECT_NEAR(c["fem_moment_nm"][k].get<double>(), levels[k] * standard_nm, 1e-6 * standard_nm)
+          << c.dump();
+    for (const char* key : {"rotation_deg", "region_moment_nm", "fibre_moment_nm"})
+      EXPECT_GT(c[key][1].get<double>(), c[key][0].get<double>()) << key << c.dump();
+    EXPECT_GT(c["fibre_moment_nm"][0].get<double>(), 0) << c.dump();
+  }
+  EXPECT_EQ(j["corridors"].size(), 2u) << j["corridors"].dump();
+  for (const char* file :
+       {"mss_fibres.json", "mss_fibres.md", "report.html", "plots/mss_fibres_curves.png"})
     EXPECT_TRUE(std::filesystem::exists(out + "/" + file)) << file;
 
   const std::string unwritten = tmp("mss-fibres-unwritten");
@@ -279,10 +315,12 @@ TEST(CliFibres, MssFibresFitsBothNetworksToTheNonlinearDisc) {
   const std::string o = " --out '" + unwritten + "'";
   expect_refused(run_spinesim("study mss-fibres --material annulus-nucleus" + o), "has no fibres");
   expect_refused(run_spinesim("study mss-fibres --levels 0,1" + o), "load levels");
+  expect_refused(run_spinesim("study mss-fibres --curve-levels 0.5,3" + o), "load levels");
   expect_refused(run_spinesim("study mss-fibres --cases torsion --train torsion" + o),
                  "none is held out");
   expect_refused(run_spinesim("study mss-fibres --train bending" + o), "'bending'");
   expect_refused(run_spinesim("study mss-fibres --fem-order 3" + o), "--fem-order");
+  expect_refused(run_spinesim("study mss-fibres --terms springs" + o), "--terms 'springs'");
   expect_refused(run_spinesim("study mss-fibres --cell-size 0" + o), "--cell-size");
   EXPECT_FALSE(std::filesystem::exists(unwritten));
 }

@@ -18,7 +18,13 @@ struct IpoptSettings {
   int max_iterations = 300;
   double tolerance = 1e-8;             ///< Ipopt `tol` (scaled NLP error)
   double acceptable_tolerance = 1e-5;  ///< Ipopt `acceptable_tol`
-  int print_level = 0;                 ///< Ipopt's own output (0 silent ... 12), on stdout
+  /// Ipopt `acceptable_iter`: iterations in a row at the acceptable level before it stops there.
+  int acceptable_iterations = 15;
+  /// Ipopt `acceptable_obj_change_tol`: also needed at the acceptable level — the relative change
+  /// of the objective per iteration below this (Ipopt's default: off). Fits whose gradient comes
+  /// from finite differences stall at a point and need it to stop there.
+  double acceptable_objective_change = 1e20;
+  int print_level = 0;  ///< Ipopt's own output (0 silent ... 12), on stdout
 };
 
 /// Called after every Ipopt iteration: iteration number, objective J, the scaled error.
@@ -35,9 +41,13 @@ struct CalibrationResult {
   Evaluation start, final;  ///< J, its parts and the per-case errors at both ends
 };
 
-/// Checks the settings (0 < lower < upper, finite, max_iterations >= 1): throws
+/// Checks the settings (0 < lower < upper, finite, and validate_stopping's): throws
 /// std::invalid_argument naming the problem ("infeasible bounds ...").
 void validate(const IpoptSettings& settings);
+
+/// Checks the stopping rules alone (max_iterations >= 1, tolerances > 0, acceptable iterations
+/// >= 0), for fits with bounds of their own: throws std::invalid_argument.
+void validate_stopping(const IpoptSettings& settings);
 
 /// Runs Ipopt from `start_log_scales` (clamped into the bounds). Never throws for a failed
 /// solve: `success` is false and `status` says why; throws std::invalid_argument for bad

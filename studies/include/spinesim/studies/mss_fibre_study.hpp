@@ -6,9 +6,11 @@
 #pragma once
 
 #include "spinesim/calibration/nonlinear_fit.hpp"
+#include "spinesim/calibration/protocol.hpp"
 #include "spinesim/fem/load_cases.hpp"
 #include "spinesim/mesh/material.hpp"
 #include "spinesim/mesh/tet_mesh.hpp"
+#include "spinesim/studies/disc_validation.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -24,20 +26,37 @@ struct MssFibreStudyOptions {
   std::vector<std::string> train{"compression", "shear-ap", "flexion", "torsion"};
   std::vector<double> levels{0.1, 1.0};  ///< factors on the standard loads (small, physiological)
   int fem_order = 1;                     ///< 1: P1 nodal-average volume, 2: P2 mean dilatation
+  /// The spring network's terms (both networks; the fibre network adds the fibre springs).
+  calibration::TermSet terms = calibration::TermSet::thesis_volume;
   int load_increments = 4;
   int threads = 2;
+  /// Moment–rotation curves of the moment cases (pure moments among `cases`) after the fits: the
+  /// FEM at these levels and both fitted networks at the FEM's poses. Empty: no curves.
+  std::vector<double> curve_levels{0.2, 0.4, 0.6, 0.8, 1.0};
+  /// The in-vitro targets (read_disc_targets), drawn as corridors beside the curves; null: none.
+  nlohmann::json targets;
+};
+
+/// One moment case's curve: moment and rotation along the case's moment axis e (the applied
+/// moment's direction): rotation θ·e, moment −R·e (the reaction R is minus the load).
+struct MomentCurve {
+  std::string name;
+  bool trained = false;
+  std::vector<double> rotation_deg, fem_moment_nm, region_moment_nm, fibre_moment_nm;
 };
 
 struct MssFibreStudyResult {
-  std::string mesh_label, material;
+  std::string mesh_label, material, terms;
   Eigen::Index nodes = 0, tets = 0, fibre_springs = 0;
   calibration::NonlinearReference reference;
   calibration::NonlinearFitResult region, fibre;  ///< without / with the fibre springs
+  std::vector<MomentCurve> curves;
+  std::vector<DiscValidationRow> corridors;  ///< the targets of the curves' cases, N m/deg
   double seconds = 0;
 };
 
 /// Throws std::invalid_argument (one line) for a material without fibres, a training case not
-/// among the cases, no held-out case, a bad level, order or thread count.
+/// among the cases, no held-out case, a bad level (fit or curve), order or thread count.
 void validate(const MssFibreStudyOptions& options, const mesh::RegionMaterials& materials);
 
 /// `status` gets a one-line message before each stage.
