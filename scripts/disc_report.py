@@ -17,7 +17,7 @@ import json
 import os
 import sys
 
-from report_tools import failer, page_head, pyplot, report_main
+from report_tools import failer, page_head, pyplot, report_main, secant_wedge, write_page
 
 fail = failer("disc report")
 plt = pyplot(fail)
@@ -44,8 +44,7 @@ def paths_figure(s, d):
             top = max(load)
             lo, hi = row["low"] * scale, row["high"] * scale
             # The wedge between load = k·motion for k in [low, high], up to the standard load.
-            ax.fill([0, top / hi, top / lo], [0, top, top], color="C1", alpha=0.25,
-                    label=f"in vitro {row['low']:g}-{row['high']:g} {row['units']}")
+            secant_wedge(ax, top, lo, hi, f"in vitro {row['low']:g}-{row['high']:g} {row['units']}")
             ours = row.get("ours")
             verdict = row.get("verdict", "n/a")
             title = f"{p['load_case']}: {ours:.3g} {row['units']} ({verdict})" \
@@ -98,8 +97,7 @@ def write_report(d):
     if not figures:
         parts.append("<p>The load paths need <code>--model nonlinear</code>.</p>")
     parts.append(table_html(s) + "</body></html>")
-    with open(os.path.join(d, "report.html"), "w") as f:
-        f.write("\n".join(parts))
+    write_page(d, parts)
     return figures
 
 

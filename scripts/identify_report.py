@@ -18,7 +18,7 @@ import math
 import os
 import sys
 
-from report_tools import failer, page_head, pyplot, report_main
+from report_tools import failer, page_head, pyplot, report_main, write_page
 
 fail = failer("identification report")
 plt = pyplot(fail)
@@ -147,8 +147,7 @@ def write_report(d):
                      number(r["identified"]), verdict(r["identified"], r), r["source"]]
                     for r in s.get("held_out", [])]),
              "</body></html>"]
-    with open(os.path.join(d, "report.html"), "w") as f:
-        f.write("\n".join(parts))
+    write_page(d, parts)
     return [name]
 
 

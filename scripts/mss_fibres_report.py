@@ -17,7 +17,7 @@ import json
 import os
 import sys
 
-from report_tools import failer, page_head, pyplot, report_main
+from report_tools import failer, page_head, pyplot, report_main, secant_wedge, write_page
 
 fail = failer("mss-fibres report")
 plt = pyplot(fail)
@@ -45,8 +45,7 @@ def curves_figure(s, d):
         if corridor is not None:
             top = max(max(c["fem_moment_nm"]), 0.0)
             lo, hi = corridor["low"], corridor["high"]
-            ax.fill([0, top / hi, top / lo], [0, top, top], color="C1", alpha=0.2,
-                    label=f"in vitro {lo:g}-{hi:g} N·m/°")
+            secant_wedge(ax, top, lo, hi, f"in vitro {lo:g}-{hi:g} N·m/°", alpha=0.2)
         ax.set_title(f"{c['case']} ({c['set']})", fontsize=10)
         ax.set_xlabel("rotation about the moment's axis (°)")
         ax.set_ylabel("moment (N·m)")
@@ -115,8 +114,7 @@ def write_report(d):
     if sources:
         parts.append(f"<p>In-vitro windows:</p><ul>{sources}</ul>")
     parts.append("</body></html>")
-    with open(os.path.join(d, "report.html"), "w") as f:
-        f.write("\n".join(parts))
+    write_page(d, parts)
     return figures
 
 

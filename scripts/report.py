@@ -17,7 +17,7 @@ import json
 import os
 import sys
 
-from report_tools import failer, folder_argument, guarded, pyplot
+from report_tools import failer, folder_argument, guarded, pyplot, write_page
 
 fail = failer("report")
 plt = pyplot(fail)
@@ -319,8 +319,7 @@ def write_html(d, figures, report_md):
     parts.append("<h2>Text report</h2>")
     parts.append(markdown.markdown(report_md, extensions=["tables", "fenced_code"]))
     parts.append("</body></html>")
-    with open(os.path.join(d, "report.html"), "w") as f:
-        f.write("\n".join(parts))
+    write_page(d, parts)
 
 
 def figures_and_html(d, s, report_md):

@@ -66,3 +66,15 @@ def report_main(argv, doc, fail, write_report):
     print(f"report: {os.path.join(d, 'report.html')} with {len(figures)} figure(s) in "
           f"{os.path.join(d, 'plots')}")
     return 0
+
+
+def secant_wedge(ax, top, low, high, label, alpha=0.25):
+    """The in-vitro window low–high (stiffness, load per motion) as the wedge between
+    load = k·motion for k in [low, high], from the origin up to the load `top`."""
+    ax.fill([0, top / high, top / low], [0, top, top], color="C1", alpha=alpha, label=label)
+
+
+def write_page(d, parts):
+    """DIR/report.html from the page's parts (page_head first, the closing tags last)."""
+    with open(os.path.join(d, "report.html"), "w") as f:
+        f.write("\n".join(parts))

@@ -16,7 +16,7 @@ import json
 import os
 import sys
 
-from report_tools import failer, folder_argument, guarded, pyplot
+from report_tools import failer, folder_argument, guarded, pyplot, write_page
 
 fail = failer("seating report")
 plt = pyplot(fail)
@@ -147,8 +147,7 @@ def main(argv):
     parts += [f"<figure><img src='plots/{n}' alt='{n}'></figure>" for n in figures]
     parts.append(extra + "</body></html>")
     try:
-        with open(os.path.join(d, "report.html"), "w") as f:
-            f.write("\n".join(parts))
+        write_page(d, parts)
     except OSError as e:
         fail(f"cannot write in {d}: {e}")
     print(f"seating report: {os.path.join(d, 'report.html')} with {len(figures)} figures in "

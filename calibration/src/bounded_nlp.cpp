@@ -124,13 +124,13 @@ class BoundedNlp : public Ipopt::TNLP {
       for (Ipopt::Index j = 0; j <= i; ++j) values[e++] = obj_factor * last_.hessian(i, j);
     return true;
   }
-  bool intermediate_callback(Ipopt::AlgorithmMode, Ipopt::Index iter, Ipopt::Number obj_value,
+  bool intermediate_callback(Ipopt::AlgorithmMode mode, Ipopt::Index iter, Ipopt::Number obj_value,
                              Ipopt::Number, Ipopt::Number inf_du, Ipopt::Number, Ipopt::Number,
                              Ipopt::Number, Ipopt::Number, Ipopt::Number, Ipopt::Index,
                              const Ipopt::IpoptData*, Ipopt::IpoptCalculatedQuantities*) override {
     iterations_ = int(iter);
     if (progress_) progress_(int(iter), obj_value, inf_du);
-    return true;
+    return !stalled(mode, obj_value);
   }
   void finalize_solution(Ipopt::SolverReturn, Ipopt::Index n, const Ipopt::Number* x,
                          const Ipopt::Number*, const Ipopt::Number*, Ipopt::Index,
@@ -140,11 +140,28 @@ class BoundedNlp : public Ipopt::TNLP {
   }
 
   const Eigen::VectorXd& final_point() const { return final_; }
+  bool stopped_stalled() const { return stall_count_ >= settings_.stall_iterations && stall_on(); }
   int evaluations() const { return evaluations_; }
   int iterations() const { return iterations_; }
   double evaluation_seconds() const { return eval_seconds_; }
 
  private:
+  bool stall_on() const { return settings_.stall_iterations > 0; }
+
+  /// IpoptSettings' stall rule: true once the objective's relative change per regular
+  /// iteration has stayed below stall_change stall_iterations times in a row.
+  bool stalled(Ipopt::AlgorithmMode mode, double objective) {
+    if (!stall_on() || mode != Ipopt::RegularMode) return false;
+    if (has_objective_ && std::abs(objective - last_objective_) <=
+                              settings_.stall_change * std::max(std::abs(objective), 1e-300))
+      ++stall_count_;
+    else
+      stall_count_ = 0;
+    has_objective_ = true;
+    last_objective_ = objective;
+    return stall_count_ >= settings_.stall_iterations;
+  }
+
   /// f, grad f (and the Hessian) at x, cached: Ipopt asks for them at the same point.
   bool evaluate(Ipopt::Index n, const Ipopt::Number* x) {
     const Eigen::Map<const Eigen::VectorXd> p(x, n);
@@ -167,6 +184,9 @@ class BoundedNlp : public Ipopt::TNLP {
   Eigen::VectorXd start_, lower_, upper_, final_, last_p_;
   HessianKind hessian_;
   IpoptSettings settings_;
+  bool has_objective_ = false;
+  double last_objective_ = 0;
+  int stall_count_ = 0;
   Progress progress_;
   NlpValues last_;
   bool has_last_ = false, last_ok_ = false;
@@ -199,8 +219,6 @@ NlpRun run_bounded_nlp(const NlpFunction& f, const Eigen::VectorXd& start,
   app->Options()->SetNumericValue("tol", settings.tolerance);
   app->Options()->SetNumericValue("acceptable_tol", settings.acceptable_tolerance);
   app->Options()->SetIntegerValue("acceptable_iter", settings.acceptable_iterations);
-  app->Options()->SetNumericValue("acceptable_obj_change_tol",
-                                  settings.acceptable_objective_change);
   app->Options()->SetIntegerValue("print_level", settings.print_level);
   app->Options()->SetNumericValue("obj_scaling_factor", objective_scaling);
   app->Options()->SetStringValue("sb", "yes");  // no banner
@@ -218,6 +236,10 @@ NlpRun run_bounded_nlp(const NlpFunction& f, const Eigen::VectorXd& start,
   const Ipopt::ApplicationReturnStatus st = app->OptimizeTNLP(nlp);
   out.status = status_name(st);
   out.success = st == Ipopt::Solve_Succeeded || st == Ipopt::Solved_To_Acceptable_Level;
+  if (st == Ipopt::User_Requested_Stop && nlp->stopped_stalled()) {
+    out.status = "Objective_Stalled";
+    out.success = true;
+  }
   out.iterations = nlp->iterations();
   out.evaluations = nlp->evaluations();
   out.evaluation_seconds = nlp->evaluation_seconds();

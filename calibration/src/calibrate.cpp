@@ -13,10 +13,10 @@ namespace {}  // namespace
 
 void validate_stopping(const IpoptSettings& s) {
   if (s.max_iterations < 1) throw std::invalid_argument("calibration: max iterations must be >= 1");
-  if (!(s.tolerance > 0) || !(s.acceptable_tolerance > 0) || !(s.acceptable_objective_change > 0))
+  if (!(s.tolerance > 0) || !(s.acceptable_tolerance > 0) || !(s.stall_change > 0))
     throw std::invalid_argument("calibration: Ipopt tolerances must be > 0");
-  if (s.acceptable_iterations < 0)
-    throw std::invalid_argument("calibration: Ipopt acceptable iterations must be >= 0");
+  if (s.acceptable_iterations < 0 || s.stall_iterations < 0)
+    throw std::invalid_argument("calibration: Ipopt acceptable and stall iterations must be >= 0");
 }
 
 void validate(const IpoptSettings& s) {

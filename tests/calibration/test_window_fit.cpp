@@ -78,23 +78,22 @@ Eigen::VectorXd noisy_inconsistent_model(const Eigen::VectorXd& p) {
   return r;
 }
 
-TEST(LeastSquaresFit, StopsAtTheAcceptableLevelOnceTheObjectiveStallsUnderNoise) {
+TEST(LeastSquaresFit, StopsOnceTheObjectiveStallsUnderNoise) {
   const std::vector<FitParameter> parameters = {{"a", "", 3.0, 0.01, 100.0},
                                                 {"b", "", 3.0, 0.01, 100.0}};
-  WindowFitOptions strict;  // Ipopt's own acceptable rule: 15 iterations at 1e-5, no change test
+  WindowFitOptions strict;  // Ipopt's own rules only (acceptable: 15 iterations at 1e-5)
   strict.ipopt.max_iterations = 60;
   WindowFitOptions stall = strict;
-  stall.ipopt.acceptable_tolerance = 1e-3;
-  stall.ipopt.acceptable_iterations = 3;
-  stall.ipopt.acceptable_objective_change = 1e-6;
+  stall.ipopt.stall_iterations = 3;
+  stall.ipopt.stall_change = 1e-6;
   const LeastSquaresFit a = fit_least_squares(noisy_inconsistent_model, parameters, strict);
   const LeastSquaresFit b = fit_least_squares(noisy_inconsistent_model, parameters, stall);
   ASSERT_TRUE(b.success) << b.status;
-  EXPECT_EQ(b.status, "Solved_To_Acceptable_Level");
+  EXPECT_EQ(b.status, "Objective_Stalled");
   EXPECT_NEAR(b.objective, 1.0, 1e-6);
   EXPECT_NEAR(std::log(b.parameters(0)), 0.0, 1e-3);
   EXPECT_NEAR(std::log(b.parameters(1)), 0.5, 1e-3);
-  // Without the change rule the noise keeps Ipopt from both of its levels to the iteration limit.
+  // Without the stall rule the noise keeps Ipopt from both of its levels to the iteration limit.
   EXPECT_LT(b.iterations, a.iterations) << a.status;
   EXPECT_LE(b.iterations, 15);
 }
@@ -108,7 +107,7 @@ TEST(WindowFit, RefusesBadIpoptStoppingRules) {
                               {true, true, true, true}, o),
                std::invalid_argument);
   o = WindowFitOptions();
-  o.ipopt.acceptable_objective_change = 0;
+  o.ipopt.stall_change = 0;
   EXPECT_THROW(fit_to_windows(power_model, three_parameters(), windows_around(truth),
                               {true, true, true, true}, o),
                std::invalid_argument);

@@ -20,10 +20,12 @@ struct IpoptSettings {
   double acceptable_tolerance = 1e-5;  ///< Ipopt `acceptable_tol`
   /// Ipopt `acceptable_iter`: iterations in a row at the acceptable level before it stops there.
   int acceptable_iterations = 15;
-  /// Ipopt `acceptable_obj_change_tol`: also needed at the acceptable level — the relative change
-  /// of the objective per iteration below this (Ipopt's default: off). Fits whose gradient comes
-  /// from finite differences stall at a point and need it to stop there.
-  double acceptable_objective_change = 1e20;
+  /// Stop once the objective's relative change per iteration has stayed below `stall_change`
+  /// this many iterations in a row (0: never); the run then counts as a success with status
+  /// "Objective_Stalled". For fits whose gradient comes from finite differences: their noise
+  /// keeps Ipopt's own error measure above its tolerances at a point it can no longer improve.
+  int stall_iterations = 0;
+  double stall_change = 1e-4;
   int print_level = 0;  ///< Ipopt's own output (0 silent ... 12), on stdout
 };
 
