@@ -13,11 +13,11 @@ error is one line on stderr and exit status 1; a missing tool exits 2.
 Needs python3-matplotlib (Debian package; scripts/install-deps.sh).
 """
 import html
-import json
 import os
 import sys
 
-from report_tools import failer, page_head, pyplot, report_main, secant_wedge, write_page
+from report_tools import (
+    failer, load_summary, page_head, pyplot, report_main, secant_wedge, write_page)
 
 fail = failer("disc report")
 plt = pyplot(fail)
@@ -82,9 +82,7 @@ def table_html(s):
 
 def write_report(d):
     """The figure and report.html from DIR/disc_validation.json; the figures' names."""
-    with open(os.path.join(d, "disc_validation.json")) as f:
-        s = json.load(f)
-    os.makedirs(os.path.join(d, "plots"), exist_ok=True)
+    s = load_summary(d, "disc_validation.json")
     figures = [paths_figure(s, d)] if s.get("paths") else []
     title = f"The disc beside in-vitro tests: {s['mesh']}"
     parts = [page_head(title),

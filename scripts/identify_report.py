@@ -13,12 +13,11 @@ Any error is one line on stderr and exit status 1; a missing tool exits 2.
 Needs python3-matplotlib (Debian package; scripts/install-deps.sh).
 """
 import html
-import json
 import math
 import os
 import sys
 
-from report_tools import failer, page_head, pyplot, report_main, write_page
+from report_tools import failer, load_summary, page_head, pyplot, report_main, write_page
 
 fail = failer("identification report")
 plt = pyplot(fail)
@@ -117,9 +116,7 @@ def verdict(v, r):
 
 
 def write_report(d):
-    with open(os.path.join(d, "disc_identification.json")) as f:
-        s = json.load(f)
-    os.makedirs(os.path.join(d, "plots"), exist_ok=True)
+    s = load_summary(d, "disc_identification.json")
     name = figure(s, d)
     title = "The disc material identified from in-vitro tests"
     parts = [page_head(title),

@@ -13,11 +13,11 @@ missing tool exits 2.
 Needs python3-matplotlib (Debian package; scripts/install-deps.sh).
 """
 import html
-import json
 import os
 import sys
 
-from report_tools import failer, page_head, pyplot, report_main, secant_wedge, write_page
+from report_tools import (
+    failer, load_summary, page_head, pyplot, report_main, secant_wedge, write_page)
 
 fail = failer("mss-fibres report")
 plt = pyplot(fail)
@@ -88,9 +88,7 @@ def fit_html(name, fit):
 
 def write_report(d):
     """The figure and report.html from DIR/mss_fibres.json; the figures' names."""
-    with open(os.path.join(d, "mss_fibres.json")) as f:
-        s = json.load(f)
-    os.makedirs(os.path.join(d, "plots"), exist_ok=True)
+    s = load_summary(d, "mss_fibres.json")
     figures = [curves_figure(s, d)] if s.get("curves") else []
     title = f"The mass-spring disc against the nonlinear FEM disc: {s['mesh']}"
     parts = [page_head(title),

@@ -2,6 +2,7 @@
 identify_report.py): the one-line failure with its exit status, matplotlib without a display, the
 page's head and the main of a one-folder report."""
 import html
+import json
 import os
 import sys
 
@@ -78,3 +79,11 @@ def write_page(d, parts):
     """DIR/report.html from the page's parts (page_head first, the closing tags last)."""
     with open(os.path.join(d, "report.html"), "w") as f:
         f.write("\n".join(parts))
+
+
+def load_summary(d, name):
+    """DIR/name read as JSON, and DIR/plots made for the figures."""
+    with open(os.path.join(d, name)) as f:
+        s = json.load(f)
+    os.makedirs(os.path.join(d, "plots"), exist_ok=True)
+    return s
