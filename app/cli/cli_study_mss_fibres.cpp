@@ -31,14 +31,6 @@ struct MssFibresArgs {
   bool json = false, quiet = false;
 };
 
-std::vector<std::string> split(const std::string& list) {
-  std::vector<std::string> out;
-  std::stringstream s(list);
-  for (std::string item; std::getline(s, item, ',');)
-    if (!item.empty()) out.push_back(item);
-  return out;
-}
-
 void run_mss_fibres(const MssFibresArgs& a) {
   if (a.mesh_path.empty()) mesh::disc_dimensions(a.level, data_dir());  // an unknown level
   if (!std::isfinite(a.cell_size_mm) || a.cell_size_mm <= 0)
@@ -46,7 +38,7 @@ void run_mss_fibres(const MssFibresArgs& a) {
   const mesh::RegionMaterials materials = mesh::load_material(a.material, data_dir());
   studies::MssFibreStudyOptions o = a.options;
   o.cases = a.cases == "all" ? fem::standard_load_cases() : fem::parse_load_cases(a.cases);
-  o.train = split(a.train);
+  o.train = split_list(a.train);
   o.levels = a.levels;
   o.terms = calibration::parse_term_set(a.terms);
   o.curve_levels = a.curve_levels;

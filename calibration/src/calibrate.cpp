@@ -9,8 +9,6 @@
 
 namespace spinesim::calibration {
 
-namespace {}  // namespace
-
 void validate_stopping(const IpoptSettings& s) {
   if (s.max_iterations < 1) throw std::invalid_argument("calibration: max iterations must be >= 1");
   if (!(s.tolerance > 0) || !(s.acceptable_tolerance > 0) || !(s.stall_change > 0))

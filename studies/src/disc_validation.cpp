@@ -82,6 +82,11 @@ DiscValidationRow disc_target_row(const nlohmann::json& t) {
   return row;
 }
 
+nlohmann::json disc_target_json(const DiscValidationRow& row) {
+  return {{"quantity", row.quantity}, {"units", row.units},       {"low", row.low},
+          {"high", row.high},         {"reported", row.reported}, {"source", row.source}};
+}
+
 const std::vector<std::pair<const char*, int>>& nonlinear_disc_cases() {
   static const std::vector<std::pair<const char*, int>> cases = {
       {"compression", 1}, {"torsion", 4}, {"flexion", 3}, {"extension", 3}, {"lateral-bending", 5}};
@@ -307,13 +312,8 @@ void print_disc_validation(std::ostream& os, const DiscValidationResult& r, bool
 nlohmann::json disc_validation_json(const DiscValidationResult& r) {
   nlohmann::json rows = nlohmann::json::array();
   for (const DiscValidationRow& row : r.rows) {
-    nlohmann::json j = {{"quantity", row.quantity},
-                        {"units", row.units},
-                        {"low", row.low},
-                        {"high", row.high},
-                        {"reported", row.reported},
-                        {"source", row.source},
-                        {"tested_as", row.preparation}};
+    nlohmann::json j = disc_target_json(row);
+    j["tested_as"] = row.preparation;
     if (std::isfinite(row.ours)) {
       j["ours"] = row.ours;
       j["verdict"] = row.match() ? "MATCH" : "MISS";

@@ -120,14 +120,10 @@ nlohmann::json curves_json(const std::vector<MomentCurve>& curves) {
 
 nlohmann::json corridors_json(const std::vector<DiscValidationRow>& rows) {
   nlohmann::json out = nlohmann::json::array();
-  for (const DiscValidationRow& t : rows)
-    out.push_back({{"quantity", t.quantity},
-                   {"units", t.units},
-                   {"low", t.low},
-                   {"high", t.high},
-                   {"reported", t.reported},
-                   {"preparation", t.preparation},
-                   {"source", t.source}});
+  for (const DiscValidationRow& t : rows) {
+    out.push_back(disc_target_json(t));
+    out.back()["preparation"] = t.preparation;
+  }
   return out;
 }
 

@@ -77,6 +77,9 @@ std::string disc_target_preparation(const nlohmann::json& target);
 /// One target of a targets file (read_disc_targets) as a row, `ours` not yet known.
 DiscValidationRow disc_target_row(const nlohmann::json& target);
 
+/// A row's window and provenance as JSON: quantity, units, low, high, reported, source.
+nlohmann::json disc_target_json(const DiscValidationRow& row);
+
 /// Reads the targets file; throws std::invalid_argument (one line) when it is unusable.
 nlohmann::json read_disc_targets(const std::string& path);
 
