@@ -16,10 +16,6 @@ namespace spinesim::calibration {
 
 namespace {
 
-double fibre_k2(const mesh::RegionMaterials& materials) {
-  return materials.has_fibres() ? materials.fibres.begin()->second.toe_k2 : 10.0;
-}
-
 /// S = diag(1, 1, 1, 1/ρ, 1/ρ, 1/ρ): moments in N·mm over the plate's RMS radius add to N.
 Vector6d scaled(const Vector6d& w, double rho) {
   Vector6d s = w;
@@ -111,9 +107,9 @@ NonlinearReference nonlinear_reference(const mesh::TetMesh& mesh,
   ref.fem_order = fem_order;
   ref.plate_center_mm = mss::default_plate_center(mesh);
   ref.plate_rms_radius_mm = mesh::plate_rms_radius(mesh, ref.plate_center_mm);
-  const fem::NonlinearDisc disc(mesh,
-                                fem::disc_element_materials(mesh, materials, fibre_k2(materials)),
-                                fem_order, ref.plate_center_mm);
+  const fem::NonlinearDisc disc(
+      mesh, fem::disc_element_materials(mesh, materials, fem::material_fibre_k2(materials)),
+      fem_order, ref.plate_center_mm);
   const int total = int(cases.size() * levels.size());
   for (const fem::LoadCase& lc : cases)
     for (double level : levels) {

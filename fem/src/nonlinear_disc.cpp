@@ -13,6 +13,10 @@
 
 namespace spinesim::fem {
 
+double material_fibre_k2(const mesh::RegionMaterials& materials) {
+  return materials.has_fibres() ? materials.fibres.begin()->second.toe_k2 : 10.0;
+}
+
 std::vector<FibreHyperelastic> disc_element_materials(const mesh::TetMesh& mesh,
                                                       const mesh::RegionMaterials& materials,
                                                       double fibre_k2) {

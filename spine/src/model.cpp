@@ -16,6 +16,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -369,6 +370,30 @@ SpineModel load_spine_model(const std::string& data_dir, const ModelOptions& opt
   return m;
 }
 
+namespace {
+
+/// A nonlinear disc joint's per-direction secants (N·mm/rad: flexion, extension, lateral
+/// bending, torsion), when the entry has them; each finite and within 1 … 1e10.
+std::optional<Eigen::Vector4d> read_secants(const json& entry, const std::string& who) {
+  if (!entry.contains("secant_nmm_per_rad")) return std::nullopt;
+  const json& s = entry.at("secant_nmm_per_rad");
+  const char* keys[4] = {"flexion", "extension", "lateral_bending", "torsion"};
+  Eigen::Vector4d out;
+  for (int k = 0; k < 4; ++k) {
+    if (!s.is_object() || !s.contains(keys[k]) || !s.at(keys[k]).is_number())
+      throw std::invalid_argument(who +
+                                  "'secant_nmm_per_rad' needs numbers for flexion, "
+                                  "extension, lateral_bending and torsion");
+    out(k) = s.at(keys[k]).get<double>();
+    if (!(out(k) >= 1 && out(k) <= 1e10))
+      throw std::invalid_argument(who + "the " + keys[k] +
+                                  " secant lies outside 1 … 1e10 N·mm/rad");
+  }
+  return out;
+}
+
+}  // namespace
+
 void apply_disc_joints(std::vector<Joint>& joints, const std::string& name_or_path,
                        const std::string& data_dir) {
   const fs::path path = resolve_preset(
@@ -377,18 +402,20 @@ void apply_disc_joints(std::vector<Joint>& joints, const std::string& name_or_pa
   const json j = read_json_file(path.string(), "disc joints file");
   if (!j.is_object() || !j.contains("joints") || !j.at("joints").is_object())
     throw std::invalid_argument(who + "expected a 'joints' object");
-  require_known_keys(j, {"formulation", "generated_by", "joints", "material", "source", "units"},
-                     who + "the file");
+  require_known_keys(
+      j, {"formulation", "generated_by", "joints", "material", "moment_nm", "source", "units"},
+      who + "the file");
   // Every level named must be one of the spine's (a typo or an "L6-L7" is not silently unused).
   for (const auto& level : j.at("joints").items()) {
     if (std::none_of(joints.begin(), joints.end(),
                      [&](const Joint& jt) { return jt.name == level.key(); }))
       throw std::invalid_argument(who + "unknown level '" + level.key() + "'");
-    require_known_keys(
-        level.value(),
-        {"K_nmm_per_rad", "cell_size_mm", "diagonal_nmm_per_deg", "joint_point_mm",
-         "mesh_asymmetry_removed", "plate_center_mm", "tets", "thesis_F4_nmm_per_deg"},
-        who + level.key());
+    require_known_keys(level.value(),
+                       {"K_nmm_per_rad", "cell_size_mm", "diagonal_nmm_per_deg", "joint_point_mm",
+                        "mesh_asymmetry_removed", "plate_center_mm", "rest_tangent_nmm_per_rad",
+                        "secant_moment_nm", "secant_nmm_per_rad", "secant_rotation_deg", "tets",
+                        "thesis_F4_nmm_per_deg"},
+                       who + level.key());
   }
   const std::string source = j.contains("source") && j.at("source").is_string()
                                  ? j.at("source").get<std::string>()
@@ -427,6 +454,18 @@ void apply_disc_joints(std::vector<Joint>& joints, const std::string& name_or_pa
     joint.k_flexion = joint.k_extension = sym(0, 0);
     joint.k_torsion = sym(1, 1);
     joint.k_lateral = sym(2, 2);
+    // A nonlinear disc's joint: flexion and extension apart; the coupling must keep the spring
+    // convex on both sides (the softer of the two with the coupling positive definite).
+    if (const auto secant = read_secants(e, who + joint.name + ": ")) {
+      joint.k_flexion = (*secant)(0), joint.k_extension = (*secant)(1);
+      joint.k_lateral = (*secant)(2), joint.k_torsion = (*secant)(3);
+      Eigen::Matrix3d softer = sym;
+      softer.diagonal() << std::min(joint.k_flexion, joint.k_extension), joint.k_torsion,
+          joint.k_lateral;
+      if (!(Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(softer).eigenvalues().minCoeff() > 0))
+        throw std::invalid_argument(who + joint.name +
+                                    ": the secants with the coupling are not positive definite");
+    }
     joint.coupling = sym;
     joint.coupling.diagonal().setZero();
     joint.stiffness_source = source;

@@ -169,8 +169,7 @@ NonlinearDiscQuantities nonlinear_disc_quantities(const mesh::TetMesh& m,
                                                   const StageHooks& hooks) {
   if (options.order != 1 && options.order != 2)
     throw std::invalid_argument("nonlinear disc: order must be 1 or 2");
-  const double k2 = options.fibre_k2.value_or(
-      materials.has_fibres() ? materials.fibres.begin()->second.toe_k2 : 10.0);
+  const double k2 = options.fibre_k2.value_or(fem::material_fibre_k2(materials));
   if (!std::isfinite(k2) || k2 < 0)
     throw std::invalid_argument("nonlinear disc: the fibre toe exponent k2 must be >= 0");
   if (options.load_increments < 1 || options.load_increments > 1000)

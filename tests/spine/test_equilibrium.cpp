@@ -501,7 +501,10 @@ TEST(SpineEquilibrium, SensitivityRefusesALoadIndexOutOfRange) {
 namespace {
 
 /// A disc-joint file with the same coupled 3×3 stiffness at every joint (N·mm/rad).
-std::string disc_joint_file(const Eigen::Matrix3d& K, const std::string& name) {
+/// Every joint with stiffness K and, if given, the nonlinear joints' secants (flexion, extension,
+/// lateral bending, torsion; N·mm/rad).
+std::string disc_joint_file(const Eigen::Matrix3d& K, const std::string& name,
+                            const Eigen::Vector4d* secants = nullptr) {
   const std::string path = std::string(SPINESIM_TEST_TMP) + "/" + name;
   std::ofstream f(path);
   f << "{\"source\": \"test\", \"joints\": {";
@@ -510,7 +513,12 @@ std::string disc_joint_file(const Eigen::Matrix3d& K, const std::string& name) {
     f << (first ? "" : ",") << "\"" << j << "\": {\"K_nmm_per_rad\": [";
     for (int r = 0; r < 3; ++r)
       f << (r ? "," : "") << "[" << K(r, 0) << "," << K(r, 1) << "," << K(r, 2) << "]";
-    f << "]}";
+    f << "]";
+    if (secants)
+      f << ", \"secant_nmm_per_rad\": {\"flexion\": " << (*secants)(0)
+        << ", \"extension\": " << (*secants)(1) << ", \"lateral_bending\": " << (*secants)(2)
+        << ", \"torsion\": " << (*secants)(3) << "}";
+    f << "}";
     first = false;
   }
   f << "}}\n";
@@ -577,6 +585,37 @@ TEST(SpineEquilibrium, GradientMatchesFiniteDifferencesWithDiscJoints) {
   }
 }
 
+// A nonlinear disc's joint (`spine disc-joints --nonlinear`): flexion and extension apart, the
+// couple test's band shift included.
+TEST(SpineEquilibrium, NonlinearDiscJointTurnsByTheSecantOfItsDirection) {
+  sp::ModelOptions o;
+  o.gravity = o.ligaments = o.muscles = o.iap = false;
+  Eigen::Matrix3d K = coupled_stiffness();
+  K(0, 1) = K(1, 0) = K(0, 2) = K(2, 0) = 0;  // flexion uncoupled, as a mirror-symmetric disc
+  const Eigen::Vector4d secants(70000, 110000, 160000, 380000);
+  o.disc_joints = disc_joint_file(K, "disc_joints_secant.json", &secants);
+  const sp::SpineModel m = sp::load_spine_model(SPINESIM_DATA_DIR, o);
+  const sp::Joint& j = m.joints[16];
+  EXPECT_DOUBLE_EQ(j.k_flexion, 70000);
+  EXPECT_DOUBLE_EQ(j.k_extension, 110000);
+  EXPECT_DOUBLE_EQ(j.k_lateral, 160000);
+  EXPECT_DOUBLE_EQ(j.k_torsion, 380000);
+  EXPECT_DOUBLE_EQ(j.coupling(1, 2), 15000);
+  const double band = 0.05 * M_PI / 180;
+  for (double M : {2000.0, -2000.0}) {
+    sp::ExternalLoad l;
+    l.vertebra = sp::vertebra_index("L5");
+    l.moment_nmm = Vector3d(M, 0, 0);
+    sp::SolveOptions tight;
+    tight.tolerance = 1e-7;
+    const sp::SpineSolution s = sp::solve_spine(m, {l}, tight);
+    const double expect =
+        M > 0 ? (M + (j.k_flexion - j.k_extension) * band / 2) / j.k_flexion : M / j.k_extension;
+    ASSERT_LT(std::abs(expect), std::min(j.rom_flexion, j.rom_extension));
+    EXPECT_NEAR(s.theta[3 * 16], expect, 1e-9) << "M = " << M;
+  }
+}
+
 TEST(SpineModelDiscJoints, BadFilesAreRefusedInOneLine) {
   const auto refusal = [](const std::string& path) {
     sp::ModelOptions o;
@@ -588,7 +627,18 @@ TEST(SpineModelDiscJoints, BadFilesAreRefusedInOneLine) {
     }
     return std::string();
   };
-  EXPECT_NE(refusal("no-such-preset").find("presets: fibre-reinforced, tuned-mss"), std::string::npos);
+  EXPECT_NE(refusal("no-such-preset")
+                .find("presets: fibre-reinforced, fibre-reinforced-nonlinear, tuned-mss"),
+            std::string::npos);
+  // Secants: out of range, or too soft for the coupling on one side.
+  const Eigen::Vector4d negative(-5, 90000, 150000, 400000);
+  EXPECT_NE(refusal(disc_joint_file(coupled_stiffness(), "dj_sec.json", &negative))
+                .find("flexion secant lies outside"),
+            std::string::npos);
+  const Eigen::Vector4d soft(90000, 500, 150000, 400000);
+  EXPECT_NE(refusal(disc_joint_file(coupled_stiffness(), "dj_soft.json", &soft))
+                .find("secants with the coupling are not positive definite"),
+            std::string::npos);
   Eigen::Matrix3d indefinite = coupled_stiffness();
   indefinite(1, 1) = -1;
   EXPECT_NE(refusal(disc_joint_file(indefinite, "dj_bad.json")).find("positive definite"),

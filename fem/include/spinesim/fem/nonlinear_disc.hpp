@@ -29,6 +29,10 @@ namespace spinesim::fem {
 /// its (E, ν) (neo_hookean_from_linear), and in a fibre-reinforced region the two families of
 /// fibre_field (fibres.hpp) with k1 = k/4 — the tension stiffness of the linear fibres at small
 /// isochoric strain (hyperelastic.hpp) — and the toe exponent `fibre_k2`.
+/// The toe exponent k2 of the material's fibres (all fibre regions share it; 10 without fibres,
+/// where it is unused).
+double material_fibre_k2(const mesh::RegionMaterials& materials);
+
 std::vector<FibreHyperelastic> disc_element_materials(const mesh::TetMesh& mesh,
                                                       const mesh::RegionMaterials& materials,
                                                       double fibre_k2);
