@@ -34,11 +34,13 @@ TEST(SpineTargets, FusionReducesT1MotionUnderTheForwardForce) {
 }
 
 // With the discs as joint springs (--disc-joints, docs/disc-model.md) the Wilke crate case puts
-// 3819 N (FEM fibre-reinforced discs) or 3830 N (tuned MSS discs) on L4-L5, above the
-// 3240 N ± 15 % window (the thesis's F.4 joints: 3525 N): the discs carry less of the extension
-// moment than F.4's stiffer extension springs, so the muscles pull harder.
+// 3819 N (FEM fibre-reinforced discs), 3830 N (tuned MSS discs) or 3911 N (nonlinear
+// fibre-reinforced discs) on L4-L5, above the 3240 N ± 15 % window (the thesis's F.4 joints:
+// 3525 N): the discs carry less of the extension moment than F.4's stiffer extension springs, so
+// the muscles pull harder. With the nonlinear discs McGill's L5-S1 case also ends 0.2 % above
+// its window (4699 N).
 TEST(SpineTargets, WilkeCrateInsideItsWindowWithDiscJoints) {
-  for (const char* joints : {"fibre-reinforced", "tuned-mss"}) {
+  for (const char* joints : {"fibre-reinforced", "tuned-mss", "fibre-reinforced-nonlinear"}) {
     const json& j = study(std::string("validation --disc-joints ") + joints);
     ASSERT_FALSE(j.empty()) << joints;
     EXPECT_TRUE(j["mcgill"]["pass"].get<bool>()) << joints << ": " << j["mcgill"]["axial_n"];
