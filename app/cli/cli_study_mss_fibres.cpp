@@ -2,7 +2,7 @@
 // nonlinear fibre-reinforced FEM disc at two load levels (studies/mss_fibre_study.hpp).
 //
 //   spinesim study mss-fibres [--level L4-L5 | --mesh disc.vtu] [--material fibre-reinforced]
-//       [--cell-size 3] [--fem-order 1] [--terms all] [--levels 0.1,1] [--train compression,shear-ap,...]
+//       [--cell-size 3] [--fem-order 1] [--terms all] [--fibre-stretch spring] [--levels 0.1,1] [--train compression,shear-ap,...]
 //       [--cases all] [--threads 2] [--curve-levels 0.2,...,1] [--targets FILE] [--out DIR]
 //       [--json] [--quiet]
 #include "cli_common.hpp"
@@ -24,7 +24,8 @@ namespace {
 
 struct MssFibresArgs {
   std::string level = "L4-L5", mesh_path, material = "fibre-reinforced", cases = "all",
-              train = "compression,shear-ap,flexion,torsion", targets, out, terms = "all";
+              train = "compression,shear-ap,flexion,torsion", targets, out, terms = "all",
+              fibre_stretch = "spring";
   std::vector<double> levels{0.1, 1.0}, curve_levels{0.2, 0.4, 0.6, 0.8, 1.0};
   double cell_size_mm = 3.0;
   studies::MssFibreStudyOptions options;
@@ -41,6 +42,7 @@ void run_mss_fibres(const MssFibresArgs& a) {
   o.train = split_list(a.train);
   o.levels = a.levels;
   o.terms = calibration::parse_term_set(a.terms);
+  o.isochoric_fibres = a.fibre_stretch == "isochoric";
   o.curve_levels = a.curve_levels;
   o.targets = studies::read_disc_targets(
       a.targets.empty() ? data_dir() + "/validation/disc_in_vitro.json" : a.targets);
@@ -111,6 +113,11 @@ void register_mss_fibres(CLI::App& study) {
          "--terms", a->terms,
          "Network terms: thesis (main, radial, torsion springs), thesis+volume (+ per-tet "
          "volume term), all (+ whole-disc volume term); the fibre network adds its springs")
+      ->capture_default_str();
+  cmd->add_option("--fibre-stretch", a->fibre_stretch,
+                  "The fibre springs' stretch: spring (their own length) or isochoric (their "
+                  "tet's J^(-2/3) I4, as the FEM)")
+      ->check(CLI::IsMember({"spring", "isochoric"}))
       ->capture_default_str();
   cmd->add_option("--cases", a->cases, "Load cases (comma list or 'all')")->capture_default_str();
   cmd->add_option("--train", a->train, "Training cases (comma list); the others are held out")

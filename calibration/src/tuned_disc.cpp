@@ -96,7 +96,8 @@ nlohmann::json terms_json(const mss::MssOptions& o) {
           {"radial_factor", o.radial_factor},
           {"volume_factor", o.volume_factor},
           {"disc_volume_factor", o.disc_volume_factor},
-          {"fibre_springs", o.fibre_springs}};
+          {"fibre_springs", o.fibre_springs},
+          {"isochoric_fibres", o.isochoric_fibres}};
 }
 
 nlohmann::json to_json(const TunedDisc& t) {
@@ -149,6 +150,7 @@ TunedDisc tuned_disc_from_json(const nlohmann::json& j) {
     t.options.volume_term = terms.at("volume_term").get<bool>();
     t.options.disc_volume_term = terms.at("disc_volume_term").get<bool>();
     t.options.fibre_springs = terms.value("fibre_springs", false);  // files before fibre springs
+    t.options.isochoric_fibres = terms.value("isochoric_fibres", false);
     if (t.options.fibre_springs && !t.materials().has_fibres())
       throw std::invalid_argument(
           "fibre springs in a tuned-disc file whose material has no fibres");

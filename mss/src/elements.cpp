@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 namespace spinesim::mss {
@@ -361,6 +362,88 @@ Eigen::Vector4d fibre_coefficients(const TetPoints& rest, const Eigen::Vector3d&
   Eigen::Vector4d c;
   c << -tail.sum(), tail;
   return c;
+}
+
+namespace {
+
+/// ψ(Ī4) of the tension-only exponential law per unit volume, with ψ' and ψ'' (zero, and ψ 0,
+/// for Ī4 − 1 = `excess` <= 0; NaN propagates).
+double fibre_law(double excess, double k1, double k2, double& psi1, double& psi2) {
+  psi1 = psi2 = 0.0;
+  if (!(excess > 0.0)) return excess == excess ? 0.0 : excess;
+  const double e = std::exp(k2 * excess * excess);
+  psi1 = k1 * excess * e;
+  psi2 = k1 * e * (1.0 + 2.0 * k2 * excess * excess);
+  return k2 > 0.0 ? k1 / (2.0 * k2) * (e - 1.0) : 0.5 * k1 * excess * excess;
+}
+
+/// det[a, b, c] of the arms a = x1 − x0, b = x2 − x0, c = x3 − x0, its gradient (12) and Hessian
+/// (12×12): ∂/∂a = b × c, ∂/∂b = c × a, ∂/∂c = a × b; ∂²/∂a∂b = −[c]×, ∂²/∂a∂c = [b]×,
+/// ∂²/∂b∂c = −[a]×; x0 takes minus the sum of the arms' rows and columns.
+double arm_determinant_derivatives(const TetPoints& x, Vector12d& grad, Matrix12d* hess) {
+  const Eigen::Vector3d a = x.col(1) - x.col(0), b = x.col(2) - x.col(0), c = x.col(3) - x.col(0);
+  const Eigen::Vector3d ga = b.cross(c), gb = c.cross(a), gc = a.cross(b);
+  grad << -(ga + gb + gc), ga, gb, gc;
+  if (hess) {
+    Eigen::Matrix<double, 9, 9> arms = Eigen::Matrix<double, 9, 9>::Zero();
+    arms.block<3, 3>(0, 3) = -skew(c), arms.block<3, 3>(0, 6) = skew(b);
+    arms.block<3, 3>(3, 6) = -skew(a);
+    arms.block<3, 3>(3, 0) = arms.block<3, 3>(0, 3).transpose();
+    arms.block<3, 3>(6, 0) = arms.block<3, 3>(0, 6).transpose();
+    arms.block<3, 3>(6, 3) = arms.block<3, 3>(3, 6).transpose();
+    // x = (x0, arms + x0): H = Pᵀ arms P with P = [−I −I −I; I 0 0; 0 I 0; 0 0 I]ᵀ blocks.
+    Eigen::Matrix<double, 9, 12> P = Eigen::Matrix<double, 9, 12>::Zero();
+    for (int k = 0; k < 3; ++k) {
+      P.block<3, 3>(3 * k, 0) = -Eigen::Matrix3d::Identity();
+      P.block<3, 3>(3 * k, 3 * (k + 1)) = Eigen::Matrix3d::Identity();
+    }
+    *hess = P.transpose() * arms * P;
+  }
+  return a.dot(ga);
+}
+
+}  // namespace
+
+double arm_determinant(const TetPoints& x) {
+  Vector12d unused;
+  return arm_determinant_derivatives(x, unused, nullptr);
+}
+
+double isochoric_fibre(const TetPoints& x, const Eigen::Vector4d& c, double V0, double k1,
+                       double k2, double rest_det, Vector12d* grad, Matrix12d* hess, double rest_i4,
+                       HessianMode mode) {
+  if (grad) grad->setZero();
+  if (hess) hess->setZero();
+  Vector12d gJ;
+  Matrix12d hJ;
+  const double J =
+      arm_determinant_derivatives(x, gJ, hess && mode == HessianMode::exact ? &hJ : nullptr) /
+      rest_det;
+  if (!(J > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+  gJ /= rest_det;
+  const Eigen::Vector3d d = x * c;
+  const double i4 = d.squaredNorm() / rest_i4, j23 = std::pow(J, -2.0 / 3.0), bar = j23 * i4;
+  double psi1 = 0, psi2 = 0;
+  const double energy = V0 * fibre_law(bar - 1.0, k1, k2, psi1, psi2);
+  if (!(psi1 > 0.0) || (!grad && !hess)) return energy;
+  Vector12d gI4;  // ∇I4 = 2 c_i d / rest_i4
+  for (int i = 0; i < 4; ++i) gI4.segment<3>(3 * i) = (2.0 * c(i) / rest_i4) * d;
+  const Vector12d gBar = j23 * gI4 - (2.0 / 3.0) * (bar / J) * gJ;
+  if (grad) *grad = (V0 * psi1) * gBar;
+  if (hess) {
+    Matrix12d hI4 = Matrix12d::Zero();  // ∇²I4 = 2 c_i c_j I / rest_i4
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j)
+        hI4.block<3, 3>(3 * i, 3 * j) = (2.0 * c(i) * c(j) / rest_i4) * Eigen::Matrix3d::Identity();
+    Matrix12d hBar = j23 * hI4;
+    if (mode == HessianMode::exact) {
+      hBar += -(2.0 / 3.0) * j23 / J * (gI4 * gJ.transpose() + gJ * gI4.transpose()) +
+              (10.0 / 9.0) * bar / (J * J) * gJ * gJ.transpose() -
+              (2.0 / 3.0) * (bar / J) * (hJ / rest_det);
+    }
+    *hess = V0 * (psi2 * gBar * gBar.transpose() + psi1 * hBar);
+  }
+  return energy;
 }
 
 double fibre_spring(const TetPoints& x, const Eigen::Vector4d& c, double V0, double k1, double k2,

@@ -54,6 +54,7 @@ struct FibreSpring {
   double k2;          ///< toe exponent
   double rest_i4;     ///< |X c|^2 at the rest points as rounded (elements.hpp)
   double k;           ///< scaled k1
+  double rest_det;    ///< det of its rest tet's arms (isochoric fibres)
 };
 
 /// Per-tetrahedron terms (radial springs and volume penalty share the vertex set).
@@ -370,7 +371,7 @@ void MssModel::Impl::build_fibre_springs(const mesh::RegionMaterials& materials,
       const Eigen::Vector3d a = dir->row(t).transpose().normalized();
       const Eigen::Vector4d c = fibre_coefficients(p, a);
       fibres.push_back({static_cast<int>(t), c, tp.V0[t], field.stiffness_mpa(t) / 4.0,
-                        field.toe_k2(t), (p * c).squaredNorm(), 0.0});
+                        field.toe_k2(t), (p * c).squaredNorm(), 0.0, arm_determinant(p)});
     }
   }
 }
@@ -640,8 +641,11 @@ double MssModel::Impl::accumulate(const Eigen::VectorXd& x, const bool* terms, K
     Vector12d g12;
     for (const FibreSpring& f : m.fibres) {
       const TetPoints p = tet_points(x, m.mesh.T, f.t);
-      energy +=
-          fibre_spring(p, f.c, f.V0, sel.fibre(f), f.k2, grad ? &g12 : nullptr, nullptr, f.rest_i4);
+      energy += m.options.isochoric_fibres
+                    ? isochoric_fibre(p, f.c, f.V0, sel.fibre(f), f.k2, f.rest_det,
+                                      grad ? &g12 : nullptr, nullptr, f.rest_i4)
+                    : fibre_spring(p, f.c, f.V0, sel.fibre(f), f.k2, grad ? &g12 : nullptr, nullptr,
+                                   f.rest_i4);
       if (grad)
         for (int c = 0; c < 4; ++c) grad->segment<3>(3 * m.mesh.T(f.t, c)) += g12.segment<3>(3 * c);
     }
@@ -754,7 +758,11 @@ void MssModel::Impl::assemble_hessian(const Eigen::VectorXd& x, HessianMode mode
     for (const FibreSpring& f : m.fibres) {
       const double k = sel.fibre(f);
       if (k == 0.0) continue;
-      fibre_spring(tet_points(x, m.mesh.T, f.t), f.c, f.V0, k, f.k2, nullptr, &h12, f.rest_i4);
+      if (m.options.isochoric_fibres)
+        isochoric_fibre(tet_points(x, m.mesh.T, f.t), f.c, f.V0, k, f.k2, f.rest_det, nullptr, &h12,
+                        f.rest_i4, mode);
+      else
+        fibre_spring(tet_points(x, m.mesh.T, f.t), f.c, f.V0, k, f.k2, nullptr, &h12, f.rest_i4);
       const int nodes[4] = {m.mesh.T(f.t, 0), m.mesh.T(f.t, 1), m.mesh.T(f.t, 2), m.mesh.T(f.t, 3)};
       scatter(h12, &m.tet_slots[16 * static_cast<std::size_t>(f.t)], 4, nodes);
     }

@@ -16,9 +16,10 @@ namespace spinesim::studies {
 
 namespace {
 
-mss::MssOptions network(calibration::TermSet terms, bool fibres) {
+mss::MssOptions network(calibration::TermSet terms, bool fibres, bool isochoric) {
   mss::MssOptions o = calibration::term_set_options(terms);
   o.fibre_springs = fibres;
+  o.isochoric_fibres = fibres && isochoric;
   return o;
 }
 
@@ -185,11 +186,12 @@ MssFibreStudyResult run_mss_fibre_study(const mesh::TetMesh& mesh,
     say(s.str());
   };
   say("fitting the region-scale network (" + calibration::term_set_name(o.terms) + ")");
-  const mss::MssModel region(mesh, materials, network(o.terms, false));
+  const mss::MssModel region(mesh, materials, network(o.terms, false, false));
   r.region = calibration::fit_mss_nonlinear(region, r.reference, request, progress);
   say("fitting the network with fibre springs");
-  const mss::MssModel fibre(mesh, materials, network(o.terms, true));
+  const mss::MssModel fibre(mesh, materials, network(o.terms, true, o.isochoric_fibres));
   r.fibre_springs = fibre.num_fibre_springs();
+  r.fibre_stretch = o.isochoric_fibres ? "isochoric" : "spring";
   r.fibre = calibration::fit_mss_nonlinear(fibre, r.reference, request, progress);
   if (!o.curve_levels.empty()) {
     say("moment-rotation curves");
@@ -204,7 +206,7 @@ void print_mss_fibre_study(std::ostream& out, const MssFibreStudyResult& r) {
   out << "# Mass-spring disc against the nonlinear FEM disc\n\n"
       << r.mesh_label << ", " << r.nodes << " nodes, " << r.tets << " tets; material " << r.material
       << "; FEM P" << r.reference.fem_order << "; network terms " << r.terms << "; "
-      << r.fibre_springs << " fibre springs\n\n"
+      << r.fibre_springs << " fibre springs (" << r.fibre_stretch << " stretch)\n\n"
       << "Errors of the MSS with its plate at the FEM's pose: reaction |S dR|/|S R*| and "
          "displacement of the free vertices ||du||/||u*||.\n\n"
       << "| case | load | set | FEM shift (mm) | FEM rotation (deg) | region MSS reaction | "
@@ -270,6 +272,7 @@ nlohmann::json mss_fibre_study_json(const MssFibreStudyResult& r) {
           {"terms", r.terms},
           {"plate_rms_radius_mm", r.reference.plate_rms_radius_mm},
           {"fibre_springs", r.fibre_springs},
+          {"fibre_stretch", r.fibre_stretch},
           {"reference", reference},
           {"region", fit_json(r.region)},
           {"fibre", fit_json(r.fibre)},

@@ -198,6 +198,89 @@ TEST(FibreSpring, EqualsTheNonlinearFemFibreEnergyOnIsochoricDeformations) {
   EXPECT_LT(in_tension, 17);  // both sides of the kink were sampled
 }
 
+// The isochoric fibre element: the FEM's fibre energy on every deformation (not only det F = 1),
+// gradient and exact Hessian against central differences, the projected Hessian positive
+// semi-definite, balanced forces, and an inverted tet without energy.
+double rest_det(const TetPoints& X) {
+  Eigen::Matrix3d D;
+  D << X.col(1) - X.col(0), X.col(2) - X.col(0), X.col(3) - X.col(0);
+  EXPECT_NEAR(arm_determinant(X), D.determinant(), 1e-14 * std::abs(D.determinant()));
+  return arm_determinant(X);
+}
+
+TEST(IsochoricFibre, EqualsTheNonlinearFemFibreEnergyOnEveryDeformation) {
+  std::mt19937 rng(12);
+  std::normal_distribution<double> n(0.0, 0.12);
+  const TetPoints X = rest_tet();
+  const double V0 = tet_signed_volume(X);
+  const Eigen::Vector3d a = Eigen::Vector3d(0.5, 0.5, -0.7).normalized();
+  const Eigen::Vector4d c = fibre_coefficients(X, a);
+  fem::FibreHyperelastic matrix = fem::neo_hookean_from_linear(1.0, 0.45);
+  fem::FibreHyperelastic with = matrix;
+  with.fibres.push_back({a, 2.5, 20.0});
+  int in_tension = 0, spring_differs = 0;
+  for (int trial = 0; trial < 30; ++trial) {
+    Eigen::Matrix3d F = Eigen::Matrix3d::Identity();
+    for (int k = 0; k < 9; ++k) F(k / 3, k % 3) += n(rng);
+    ASSERT_GT(F.determinant(), 0.2);
+    const Eigen::Matrix3d C = F.transpose() * F;
+    const double fem_energy = V0 * (fem::fibre_hyperelastic_point(C, with, false).energy -
+                                    fem::fibre_hyperelastic_point(C, matrix, false).energy);
+    const TetPoints x = deformed(X, F);
+    const double element = isochoric_fibre(x, c, V0, 2.5, 20.0, rest_det(X));
+    EXPECT_NEAR(element, fem_energy, 1e-9 * std::max(fem_energy, 1e-6)) << "trial " << trial;
+    in_tension += element > 0.0;
+    spring_differs += std::abs(fibre_spring(x, c, V0, 2.5, 20.0) - element) > 1e-3 * element;
+  }
+  EXPECT_GT(in_tension, 5);
+  EXPECT_LT(in_tension, 25);
+  EXPECT_GT(spring_differs, 3);  // det F != 1: the spring's own stretch is another measure
+}
+
+TEST(IsochoricFibre, GradientAndHessiansMatchCentralDifferences) {
+  const TetPoints X = rest_tet();
+  const double V0 = tet_signed_volume(X), D = rest_det(X);
+  const Eigen::Vector3d a = Eigen::Vector3d(1, 0.4, 0.2).normalized();
+  const Eigen::Vector4d c = fibre_coefficients(X, a);
+  for (const double k2 : {0.0, 10.0, 100.0}) {
+    SCOPED_TRACE(k2);
+    // Stretched along a and swollen by 6 %: every J term of the Hessian is at work.
+    const TetPoints x = deformed(X, 1.02 * stretch_along(a, 1.08, 0.1));
+    Vector12d g;
+    Matrix12d H, Hp;
+    const double e = isochoric_fibre(x, c, V0, 2.5, k2, D, &g, &H);
+    isochoric_fibre(x, c, V0, 2.5, k2, D, nullptr, &Hp, 1.0, HessianMode::projected);
+    ASSERT_GT(e, 0.0);
+    Vector12d fd_g;
+    Matrix12d fd_H;
+    for (int i = 0; i < 12; ++i) {
+      TetPoints xp = x, xm = x;
+      xp(i % 3, i / 3) += kStep;
+      xm(i % 3, i / 3) -= kStep;
+      fd_g(i) = (isochoric_fibre(xp, c, V0, 2.5, k2, D) - isochoric_fibre(xm, c, V0, 2.5, k2, D)) /
+                (2 * kStep);
+      Vector12d gp, gm;
+      isochoric_fibre(xp, c, V0, 2.5, k2, D, &gp);
+      isochoric_fibre(xm, c, V0, 2.5, k2, D, &gm);
+      fd_H.col(i) = (gp - gm) / (2 * kStep);
+    }
+    EXPECT_LE((fd_g - g).cwiseAbs().maxCoeff(), 1e-6 * g.cwiseAbs().maxCoeff());
+    EXPECT_LE((fd_H - H).cwiseAbs().maxCoeff(), 1e-6 * H.cwiseAbs().maxCoeff());
+    EXPECT_LE((H - H.transpose()).cwiseAbs().maxCoeff(), 1e-13 * H.norm());
+    EXPECT_GE(Eigen::SelfAdjointEigenSolver<Matrix12d>(Hp).eigenvalues().minCoeff(),
+              -1e-10 * Hp.norm());
+    EXPECT_GT((H - Hp).norm(), 1e-3 * H.norm());  // the J terms are not negligible here
+    Eigen::Vector3d force = Eigen::Vector3d::Zero(), moment = Eigen::Vector3d::Zero();
+    for (int j = 0; j < 4; ++j)
+      force += g.segment<3>(3 * j), moment += x.col(j).cross(g.segment<3>(3 * j));
+    EXPECT_LE(force.norm(), 1e-13 * g.norm());
+    EXPECT_LE(moment.norm(), 1e-12 * g.norm() * x.norm());
+  }
+  TetPoints inverted = X;
+  inverted.col(3) = X.col(0) - (X.col(3) - X.col(0));
+  EXPECT_TRUE(std::isnan(isochoric_fibre(inverted, c, V0, 2.5, 10.0, D)));
+}
+
 TEST(FibreSpring, DegenerateTetIsRefused) {
   TetPoints flat = rest_tet();
   flat.row(2).setZero();
@@ -223,12 +306,22 @@ class FibreModel : public ::testing::Test {
     m.fibres[1] = f;
     return m;
   }
+  static void none_at_rest(bool isochoric);
+  static void assembled_derivatives(bool isochoric);
 };
 
 TEST_F(FibreModel, OneSpringPerFamilyInEveryAnnulusTetAndNoneAtRest) {
+  for (const bool isochoric : {false, true}) {
+    SCOPED_TRACE(isochoric);
+    none_at_rest(isochoric);
+  }
+}
+
+void FibreModel::none_at_rest(bool isochoric) {
   const mesh::TetMesh m = disc();
   MssOptions o;
   o.fibre_springs = true;
+  o.isochoric_fibres = isochoric;
   const MssModel model(m, material(), o);
   Eigen::Index annulus = 0;
   for (Eigen::Index t = 0; t < m.num_tets(); ++t) annulus += m.region(t) == 1;
@@ -244,9 +337,17 @@ TEST_F(FibreModel, OneSpringPerFamilyInEveryAnnulusTetAndNoneAtRest) {
 }
 
 TEST_F(FibreModel, ScaledTermAssembledGradientAndHessianAgree) {
+  for (const bool isochoric : {false, true}) {
+    SCOPED_TRACE(isochoric);
+    assembled_derivatives(isochoric);
+  }
+}
+
+void FibreModel::assembled_derivatives(bool isochoric) {
   const mesh::TetMesh m = disc();
   MssOptions o;
   o.fibre_springs = true;
+  o.isochoric_fibres = isochoric;
   o.volume_term = true;
   MssModel model(m, material(), o);
   // Twist the disc about its axis (y) in proportion to height: the ±angle families stretch.

@@ -106,6 +106,26 @@ double fibre_spring(const TetPoints& x, const Eigen::Vector4d& coefficients, dou
                     double k1_mpa, double k2, Vector12d* grad = nullptr, Matrix12d* hess = nullptr,
                     double rest_i4 = 1.0);
 
+/// The same law on the tet's isochoric fibre stretch, as the nonlinear FEM takes it:
+///   Ī4 = J^(−2/3) I4,  J = det F = det[x1 − x0, x2 − x0, x3 − x0] / `rest_det` (the rest
+///   points' same determinant),  E = V0 ψ(Ī4),
+///   ∇Ī4 = J^(−2/3) ∇I4 − (2/3) (Ī4 / J) ∇J,
+///   ∇²Ī4 = J^(−2/3) ∇²I4 − (2/3) J^(−5/3) (∇I4 ∇Jᵀ + ∇J ∇I4ᵀ) + (10/9) Ī4 J^(−2) ∇J ∇Jᵀ
+///          − (2/3) (Ī4 / J) ∇²J,
+///   ∇²E = V0 (ψ'' ∇Ī4 ∇Ī4ᵀ + ψ' ∇²Ī4).
+/// Not a spring any more — a tet element that sees the volume change, so that a fibre does not
+/// stretch merely because its tet swells. The exact Hessian is indefinite (the J terms);
+/// HessianMode::projected keeps V0 (ψ'' ∇Ī4 ∇Ī4ᵀ + ψ' J^(−2/3) ∇²I4), positive semi-definite.
+/// An inverted tet (J <= 0) has no energy: NaN, as the FEM's.
+/// det[x1 − x0, x2 − x0, x3 − x0] as isochoric_fibre computes it: pass this of the rest points
+/// as `rest_det`, so that J is exactly 1 at rest (the tension-only kink without stiffness).
+double arm_determinant(const TetPoints& x);
+
+double isochoric_fibre(const TetPoints& x, const Eigen::Vector4d& coefficients, double volume_mm3,
+                       double k1_mpa, double k2, double rest_det, Vector12d* grad = nullptr,
+                       Matrix12d* hess = nullptr, double rest_i4 = 1.0,
+                       HessianMode mode = HessianMode::exact);
+
 /// Rigid spherical probe against one node (penalty contact, beyond the thesis): with
 /// d = |x - c|, penetration p = max(0, r - d),  E = 1/2 k_p p^2, pushing x out radially.
 /// Zero energy, gradient and Hessian when the node is outside the sphere.

@@ -32,6 +32,8 @@ struct MssFibreStudyOptions {
   /// halves (0.062 → 0.030 on L4-L5) and its moments at 7.5 N·m come within −5…+13 % of the
   /// FEM's instead of −13…+20 % (docs/disc-model.md); the region network leaves it at its bound.
   calibration::TermSet terms = calibration::TermSet::all;
+  /// The fibre network's fibres on their tet's isochoric stretch, as the FEM (mss::MssOptions).
+  bool isochoric_fibres = false;
   int load_increments = 4;
   int threads = 2;
   /// Moment–rotation curves of the moment cases (pure moments among `cases`) after the fits: the
@@ -51,6 +53,7 @@ struct MomentCurve {
 
 struct MssFibreStudyResult {
   std::string mesh_label, material, terms;
+  std::string fibre_stretch = "spring";  ///< "spring" or "isochoric" (the fibre network's)
   Eigen::Index nodes = 0, tets = 0, fibre_springs = 0;
   calibration::NonlinearReference reference;
   calibration::NonlinearFitResult region, fibre;  ///< without / with the fibre springs
