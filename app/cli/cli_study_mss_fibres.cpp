@@ -2,7 +2,7 @@
 // nonlinear fibre-reinforced FEM disc at two load levels (studies/mss_fibre_study.hpp).
 //
 //   spinesim study mss-fibres [--level L4-L5 | --mesh disc.vtu] [--material fibre-reinforced]
-//       [--cell-size 3] [--fem-order 1] [--terms all] [--fibre-stretch spring] [--levels 0.1,1] [--train compression,shear-ap,...]
+//       [--cell-size 3] [--fem-order 1] [--terms all] [--fibre-stretch isochoric] [--levels 0.1,1] [--train compression,shear-ap,...]
 //       [--cases all] [--threads 2] [--curve-levels 0.2,...,1] [--targets FILE] [--out DIR]
 //       [--json] [--quiet]
 #include "cli_common.hpp"
@@ -25,7 +25,7 @@ namespace {
 struct MssFibresArgs {
   std::string level = "L4-L5", mesh_path, material = "fibre-reinforced", cases = "all",
               train = "compression,shear-ap,flexion,torsion", targets, out, terms = "all",
-              fibre_stretch = "spring";
+              fibre_stretch = "isochoric";
   std::vector<double> levels{0.1, 1.0}, curve_levels{0.2, 0.4, 0.6, 0.8, 1.0};
   double cell_size_mm = 3.0;
   studies::MssFibreStudyOptions options;

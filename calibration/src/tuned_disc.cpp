@@ -150,6 +150,7 @@ TunedDisc tuned_disc_from_json(const nlohmann::json& j) {
     t.options.volume_term = terms.at("volume_term").get<bool>();
     t.options.disc_volume_term = terms.at("disc_volume_term").get<bool>();
     t.options.fibre_springs = terms.value("fibre_springs", false);  // files before fibre springs
+    // Files from before the isochoric fibres: the spring's own stretch.
     t.options.isochoric_fibres = terms.value("isochoric_fibres", false);
     if (t.options.fibre_springs && !t.materials().has_fibres())
       throw std::invalid_argument(

@@ -250,6 +250,7 @@ TEST(CliFibres, MssFibresFitsBothNetworksToTheNonlinearDisc) {
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["reference"].size(), 6u);
   EXPECT_GT(j["fibre_springs"].get<int>(), 0);
+  EXPECT_EQ(j["fibre_stretch"], "isochoric");  // the default: the FEM's measure
   for (const char* network : {"region", "fibre"}) {
     const auto& fit = j[network];
     EXPECT_TRUE(fit["success"].get<bool>()) << network;
@@ -322,6 +323,7 @@ TEST(CliFibres, MssFibresFitsBothNetworksToTheNonlinearDisc) {
   expect_refused(run_spinesim("study mss-fibres --fem-order 3" + o), "--fem-order");
   expect_refused(run_spinesim("study mss-fibres --terms springs" + o), "--terms 'springs'");
   expect_refused(run_spinesim("study mss-fibres --cell-size 0" + o), "--cell-size");
+  expect_refused(run_spinesim("study mss-fibres --fibre-stretch length" + o), "--fibre-stretch");
   EXPECT_FALSE(std::filesystem::exists(unwritten));
 }
 

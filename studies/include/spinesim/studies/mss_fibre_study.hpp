@@ -33,7 +33,7 @@ struct MssFibreStudyOptions {
   /// FEM's instead of −13…+20 % (docs/disc-model.md); the region network leaves it at its bound.
   calibration::TermSet terms = calibration::TermSet::all;
   /// The fibre network's fibres on their tet's isochoric stretch, as the FEM (mss::MssOptions).
-  bool isochoric_fibres = false;
+  bool isochoric_fibres = true;
   int load_increments = 4;
   int threads = 2;
   /// Moment–rotation curves of the moment cases (pure moments among `cases`) after the fits: the
