@@ -55,6 +55,12 @@ struct CalibrateArgs {
   calibration::PerSpringWeights per_spring_weights;
   CLI::Option* smoothness_option = nullptr;
   int per_spring_max_iterations = calibration::per_spring_ipopt_defaults().max_iterations;
+  /// Against the nonlinear FEM at several load levels (calibration/nonlinear_protocol.hpp).
+  bool nonlinear = false;
+  std::vector<double> load_levels{0.1, 1.0};
+  std::string fibre_stretch = "isochoric";
+  CLI::App* cmd = nullptr;  ///< to ask which options were given
+  bool given(const char* option) const { return cmd->count(option) > 0; }
 };
 
 std::vector<fem::LoadCase> other_cases(const std::vector<fem::LoadCase>& train) {
@@ -70,10 +76,12 @@ std::vector<fem::LoadCase> other_cases(const std::vector<fem::LoadCase>& train) 
 /// --level all: every level's parametric disc, one tuned set file (tuned_set.hpp), written only
 /// when every level succeeded (calibration/levels.hpp).
 void run_all_levels(const CalibrateArgs& a, const CalibrationRequest& rq,
+                    const std::optional<calibration::NonlinearCalibrationRequest>& nonlinear,
                     const mesh::RegionMaterials& materials) {
   AllLevelsRequest all;
   all.data_dir = data_dir();
   all.calibration = rq;
+  all.nonlinear = nonlinear;
   if (a.cell_size_option->count()) all.cell_size_mm = a.cell_size_mm;
   all.transfer = !a.no_transfer;
   if (a.structured) all.structured = mesh::StructuredDiscOptions();
@@ -81,9 +89,18 @@ void run_all_levels(const CalibrateArgs& a, const CalibrationRequest& rq,
   cmd << "spinesim calibrate --level all" << (a.structured ? " --structured" : "")
       << (a.cell_size_option->count() ? " --cell-size " + std::to_string(a.cell_size_mm)
                                       : std::string())
-      << " --material " << a.material << " --terms " << a.terms << " --train " << a.train
-      << (a.holdout.empty() ? "" : " --holdout " + a.holdout) << " --order " << a.order
-      << " --check-load-scale " << rq.check_load_scale << (a.no_check ? " --no-check" : "");
+      << " --material " << a.material << " --terms "
+      << (nonlinear ? term_set_name(nonlinear->terms) : a.terms) << " --train " << a.train
+      << (a.holdout.empty() ? "" : " --holdout " + a.holdout);
+  if (nonlinear) {
+    cmd << " --nonlinear --order " << nonlinear->fem_order << " --load-levels ";
+    for (std::size_t i = 0; i < nonlinear->load_levels.size(); ++i)
+      cmd << (i ? "," : "") << nonlinear->load_levels[i];
+    cmd << " --fibre-stretch " << a.fibre_stretch;
+  } else {
+    cmd << " --order " << a.order << " --check-load-scale " << rq.check_load_scale
+        << (a.no_check ? " --no-check" : "");
+  }
   all.generated_by = cmd.str();
   // One line on a terminal: the level being calibrated, its stage, how many are done, the ETA.
   ProgressBar bar(int(mesh::disc_levels().size()), a.quiet || a.json, "levels");
@@ -100,7 +117,8 @@ void run_all_levels(const CalibrateArgs& a, const CalibrationRequest& rq,
     print_json(j);
     return;
   }
-  print_all_levels(std::cout, r, a.terms, rq.check_load_scale);
+  print_all_levels(std::cout, r, nonlinear ? term_set_name(nonlinear->terms) : a.terms,
+                   rq.check_load_scale);
   std::cout << "\nwrote " << a.out << "\n";
 }
 
@@ -128,10 +146,63 @@ void check_files_and_modes(const CalibrateArgs& a) {
        a.per_spring_max_iterations != calibration::per_spring_ipopt_defaults().max_iterations))
     throw std::invalid_argument(
         "--smoothness and --per-spring-max-iterations go with --per-spring");
+  if (a.nonlinear) {
+    for (const char* linear_only :
+         {"--per-spring", "--transfer-mesh", "--check-load-scale", "--no-check",
+          "--reaction-weight", "--stiffness-weight", "--regularisation"})
+      if (a.given(linear_only))
+        throw std::invalid_argument(std::string(linear_only) +
+                                    " belongs to the linear calibration, not to --nonlinear");
+  } else {
+    for (const char* nonlinear_only : {"--load-levels", "--fibre-stretch"})
+      if (a.given(nonlinear_only))
+        throw std::invalid_argument(std::string(nonlinear_only) + " goes with --nonlinear");
+  }
   require_output_folder(a.out, "--out");
   if (!a.mesh_path.empty() && std::filesystem::exists(a.out) &&
       std::filesystem::exists(a.mesh_path) && std::filesystem::equivalent(a.out, a.mesh_path))
     throw std::invalid_argument("--out " + a.out + " is the input mesh: give another file");
+}
+
+/// --nonlinear: the request from the linear one's cases and the nonlinear options (--order and
+/// --terms default to 1 and all there, as `study mss-fibres`).
+calibration::NonlinearCalibrationRequest nonlinear_request(const CalibrateArgs& a,
+                                                           const CalibrationRequest& rq) {
+  calibration::NonlinearCalibrationRequest n;
+  n.train = rq.train;
+  n.holdout = rq.holdout;
+  n.load_levels = a.load_levels;
+  n.fem_order = a.given("--order") ? a.order : 1;
+  n.terms = a.given("--terms") ? rq.terms : TermSet::all;
+  n.isochoric_fibres = a.fibre_stretch == "isochoric";
+  n.fit.lower_scale = a.ipopt.lower_scale;
+  n.fit.upper_scale = a.ipopt.upper_scale;
+  if (a.given("--max-iterations")) n.fit.fit.ipopt.max_iterations = a.ipopt.max_iterations;
+  calibration::validate(n);
+  return n;
+}
+
+/// One disc against the nonlinear FEM; the file only when Ipopt succeeded.
+void run_nonlinear(const CalibrateArgs& a, const calibration::NonlinearCalibrationRequest& rq,
+                   const mesh::TetMesh& m, const mesh::RegionMaterials& materials,
+                   const StatusLine& status) {
+  const calibration::NonlinearCalibrationOutcome o =
+      calibration::calibrate_disc_nonlinear(m, materials, rq, status);
+  nlohmann::json j = calibration::to_json(o.tuned);
+  j["mesh_file"] = a.mesh_path.empty() ? nlohmann::json(nullptr) : nlohmann::json(a.mesh_path);
+  if (o.success) {
+    write_text_file(a.out, calibration::to_json(o.tuned).dump(2) + "\n");
+    j["out"] = a.out;
+  }
+  if (a.json)
+    print_json(j);
+  else
+    print_nonlinear_calibration(std::cout, o);
+  if (!o.success)
+    throw std::runtime_error("Ipopt did not converge (" + o.fit.fit.status + " after " +
+                             std::to_string(o.fit.fit.iterations) + " iterations): no " + a.out +
+                             " written");
+  if (!a.json) std::cout << "\nwrote " << a.out << "\n";
 }
 
 void run_calibrate(const CalibrateArgs& a) {
@@ -167,12 +238,14 @@ void run_calibrate(const CalibrateArgs& a) {
   rq.per_spring_ipopt.max_iterations = a.per_spring_max_iterations;
   calibration::validate(rq.per_spring_ipopt);
   const auto materials = mesh::load_material(a.material, data_dir());
+  std::optional<calibration::NonlinearCalibrationRequest> nonlinear;
+  if (a.nonlinear) nonlinear = nonlinear_request(a, rq);
 
   const bool chatty = !a.quiet && !a.json && isatty(STDERR_FILENO);
   const auto status = [chatty](const std::string& s) {
     if (chatty) std::cerr << "  " << s << std::endl;
   };
-  if (a.level == "all") return run_all_levels(a, rq, materials);
+  if (a.level == "all") return run_all_levels(a, rq, nonlinear, materials);
 
   // 2. The mesh: read, or the level's parametric disc; and the transfer meshes.
   for (const std::string& path : a.transfer_meshes) {
@@ -186,14 +259,15 @@ void run_calibrate(const CalibrateArgs& a) {
   } else {  // as `mesh disc --level [--structured]`
     std::optional<mesh::StructuredDiscOptions> structured;
     if (a.structured) structured.emplace();
-    calibration::LevelMeshes meshes =
-        calibration::mesh_level(a.level, structured, a.cell_size_mm,
-                                !a.no_transfer && a.transfer_meshes.empty(), data_dir(), status);
+    calibration::LevelMeshes meshes = calibration::mesh_level(
+        a.level, structured, a.cell_size_mm,
+        !a.nonlinear && !a.no_transfer && a.transfer_meshes.empty(), data_dir(), status);
     m = std::move(meshes.mesh);
     for (auto& t : meshes.transfer) rq.transfer_meshes.push_back(std::move(t));
   }
 
   // 3. Calibrate, report, write only a successful result.
+  if (nonlinear) return run_nonlinear(a, *nonlinear, m, materials, status);
   const CalibrationOutcome o = calibrate_disc(m, materials, rq, status);
   nlohmann::json j = calibration::to_json(o.tuned);
   j["mesh_file"] = a.mesh_path.empty() ? nlohmann::json(nullptr) : nlohmann::json(a.mesh_path);
@@ -287,6 +361,19 @@ void register_calibrate(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--no-check", a->no_check,
                 "Skip the nonlinear MSS-vs-FEM check (errors then linearised only)");
+  cmd->add_flag("--nonlinear", a->nonlinear,
+                "Fit to the nonlinear FEM disc (tension-only fibres, finite strain) at every "
+                "--load-levels, the network's plate at the FEM's pose; with a fibre material the "
+                "network gets the embedded fibre elements. --order defaults to 1, --terms to all");
+  cmd->add_option("--load-levels", a->load_levels,
+                  "With --nonlinear: factors on the standard loads, each in (0, 2]")
+      ->delimiter(',')
+      ->capture_default_str();
+  cmd->add_option("--fibre-stretch", a->fibre_stretch,
+                  "With --nonlinear and a fibre material: the fibre elements' stretch, isochoric "
+                  "(their tet's J^(-2/3) I4, as the FEM) or spring (their own length)")
+      ->check(CLI::IsMember({"spring", "isochoric"}))
+      ->capture_default_str();
   cmd->add_option("--out", a->out, "Tuned parameter file to write (JSON); required");
   add_output_flags(cmd, a->json, a->quiet, "the tuned file\'s contents as JSON");
   cmd->footer(
@@ -307,6 +394,7 @@ void register_calibrate(CLI::App& app) {
       "region-only fit is reported beside it, transfer meshes get the region-level scales "
       "(per-spring ones do not\n"
       "transfer), and the file (kind per-spring) is written only when both stages succeed.");
+  a->cmd = cmd;
   cmd->callback([a] { run_calibrate(*a); });
 }
 

@@ -67,6 +67,16 @@ double worst(const nlohmann::json& rows, const char* key) {
   return w;
 }
 
+/// The worst errors of the training and held-out rows of a tuned file's report.
+void summarise_errors(const nlohmann::json& rep, LevelCalibration& row) {
+  row.train_untuned = worst(rep["train"], "untuned_error");
+  row.train_tuned = worst(rep["train"], "tuned_error");
+  if (!rep["holdout"].empty()) {
+    row.holdout_untuned = worst(rep["holdout"], "untuned_error");
+    row.holdout_tuned = worst(rep["holdout"], "tuned_error");
+  }
+}
+
 /// The report's numbers of one level, from its tuned file's report.
 void summarise(const CalibrationOutcome& o, LevelCalibration& row) {
   row.success = o.result.success;
@@ -75,17 +85,26 @@ void summarise(const CalibrationOutcome& o, LevelCalibration& row) {
   row.seconds = o.total_seconds;
   if (!row.success) return;
   const auto& rep = o.tuned.report;
-  row.train_untuned = worst(rep["train"], "untuned_error");
-  row.train_tuned = worst(rep["train"], "tuned_error");
-  if (!rep["holdout"].empty()) {
-    row.holdout_untuned = worst(rep["holdout"], "untuned_error");
-    row.holdout_tuned = worst(rep["holdout"], "tuned_error");
-  }
+  summarise_errors(rep, row);
   row.k6_ratio_min = 1e300, row.k6_ratio_max = 0;
   for (const auto& v : rep["stiffness_diagonal"]["ratio_tuned"]) {
     row.k6_ratio_min = std::min(row.k6_ratio_min, v.get<double>());
     row.k6_ratio_max = std::max(row.k6_ratio_max, v.get<double>());
   }
+}
+
+void summarise(const NonlinearCalibrationOutcome& o, LevelCalibration& row) {
+  row.success = o.success;
+  row.status = o.fit.fit.status;
+  row.iterations = o.fit.fit.iterations;
+  row.seconds = o.total_seconds;
+  row.k6_ratio_min = row.k6_ratio_max = NAN;
+  if (!row.success) return;
+  const auto& rep = o.tuned.report;
+  summarise_errors(rep, row);
+  row.train_reaction_tuned = worst(rep["train"], "tuned_reaction_error");
+  if (!rep["holdout"].empty())
+    row.holdout_reaction_tuned = worst(rep["holdout"], "tuned_reaction_error");
 }
 
 }  // namespace
@@ -112,6 +131,13 @@ AllLevelsResult calibrate_all_levels(const mesh::RegionMaterials& materials,
   r.set.generated_by = request.generated_by;
   r.set.settings = {{"check_load_scale", rq.nonlinear_check ? nlohmann::json(rq.check_load_scale)
                                                             : nlohmann::json(nullptr)}};
+  if (request.nonlinear) {
+    validate(*request.nonlinear);
+    r.set.settings = {{"reference", "nonlinear FEM"},
+                      {"load_levels", request.nonlinear->load_levels},
+                      {"fem_order", request.nonlinear->fem_order},
+                      {"check_load_scale", nullptr}};
+  }
   if (request.structured) {
     mesh::validate(*request.structured);
     r.set.settings["mesh"] =
@@ -140,18 +166,25 @@ AllLevelsResult calibrate_all_levels(const mesh::RegionMaterials& materials,
                                               : default_level_cell_size_mm(level, data_dir);
       cell_by_level[level] = row.cell_size_mm;
     }
-    LevelMeshes meshes =
-        mesh_level(level, request.structured, row.cell_size_mm, request.transfer, data_dir, status);
+    LevelMeshes meshes = mesh_level(level, request.structured, row.cell_size_mm,
+                                    request.transfer && !request.nonlinear, data_dir, status);
     const mesh::TetMesh& m = meshes.mesh;
-    CalibrationRequest level_rq = rq;
-    level_rq.transfer_meshes = std::move(meshes.transfer);
-    const CalibrationOutcome o = calibrate_disc(m, materials, level_rq, status);
-    ++done;
     row.level = level;
     row.tets = m.num_tets();
-    summarise(o, row);
+    if (request.nonlinear) {
+      const NonlinearCalibrationOutcome o =
+          calibrate_disc_nonlinear(m, materials, *request.nonlinear, status);
+      summarise(o, row);
+      if (row.success) r.set.levels.emplace(level, o.tuned);
+    } else {
+      CalibrationRequest level_rq = rq;
+      level_rq.transfer_meshes = std::move(meshes.transfer);
+      const CalibrationOutcome o = calibrate_disc(m, materials, level_rq, status);
+      summarise(o, row);
+      if (row.success) r.set.levels.emplace(level, o.tuned);
+    }
+    ++done;
     r.levels.push_back(row);
-    if (row.success) r.set.levels.emplace(level, o.tuned);
   }
   if (!request.structured) r.set.settings["cell_size_mm"] = cell_by_level;
   return r;

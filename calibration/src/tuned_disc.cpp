@@ -67,8 +67,17 @@ nlohmann::json material_signature(const mesh::RegionMaterials& materials) {
                           {"nu", m.poisson_ratio},
                           {"density_kg_m3", m.density_kg_m3}};
   };
-  return {{"annulus", one(materials.at(int(mesh::Region::annulus)))},
-          {"nucleus", one(materials.at(int(mesh::Region::nucleus)))}};
+  nlohmann::json sig = {{"annulus", one(materials.at(int(mesh::Region::annulus)))},
+                        {"nucleus", one(materials.at(int(mesh::Region::nucleus)))}};
+  // The annulus fibres, so that a file fitted with fibre elements rebuilds its material.
+  const auto f = materials.fibres.find(int(mesh::Region::annulus));
+  if (f != materials.fibres.end())
+    sig["annulus"]["fibres"] = {{"E_inner_mpa", f->second.modulus_inner_mpa},
+                                {"E_outer_mpa", f->second.modulus_outer_mpa},
+                                {"angle_inner_deg", f->second.angle_inner_deg},
+                                {"angle_outer_deg", f->second.angle_outer_deg},
+                                {"k2", f->second.toe_k2}};
+  return sig;
 }
 
 mss::MssOptions TunedDisc::mss_options() const {
@@ -233,6 +242,12 @@ std::string check_applies(const TunedDisc& t, const mesh::TetMesh& mesh,
     for (const char* key : {"E_mpa", "nu"})
       same = same && t.material.contains(region) && t.material[region].contains(key) &&
              same_number(t.material[region][key].get<double>(), sig[region][key].get<double>());
+  // Fibres: files from before the signature carried them have none; only compared when both do.
+  if (t.material.contains("annulus") && t.material["annulus"].contains("fibres") &&
+      sig["annulus"].contains("fibres"))
+    for (const auto& [key, value] : sig["annulus"]["fibres"].items())
+      same = same && t.material["annulus"]["fibres"].contains(key) &&
+             same_number(t.material["annulus"]["fibres"][key].get<double>(), value.get<double>());
   if (!same)
     throw std::invalid_argument("the tuned parameters were fitted for material '" +
                                 t.material_name + "' and do not apply to material '" +

@@ -110,24 +110,69 @@ void print_calibration(std::ostream& os, const CalibrationOutcome& o,
        << " (this mesh only: `mss --params` refuses the file on any other mesh)\n";
 }
 
+void print_nonlinear_calibration(std::ostream& os,
+                                 const calibration::NonlinearCalibrationOutcome& o) {
+  const auto& rep = o.tuned.report;
+  const auto& f = o.fit.fit;
+  os << "Calibration of " << (o.tuned.level.empty() ? "disc" : o.tuned.level) << " against the "
+     << "nonlinear FEM (P" << o.tuned.fem_order << "), material " << o.tuned.material_name
+     << ", terms " << rep["terms"].get<std::string>() << ", " << rep["fibre_elements"]
+     << " fibre elements (" << rep["fibre_stretch"].get<std::string>() << " stretch)\n"
+     << "Ipopt: " << f.status << " after " << f.iterations << " iterations, " << f.model_evaluations
+     << " network evaluations, " << fixed(f.seconds, 1) << " s; FEM reference "
+     << fixed(o.reference.seconds, 1) << " s\n\n"
+     << "Errors against the FEM, the network's plate at the FEM's pose (untuned = scales 1):\n\n";
+  TextTable cases({"case", "load", "set", "FEM rotation (deg)", "displacement (untuned > tuned)",
+                   "reaction (untuned > tuned)"});
+  for (const char* set : {"train", "holdout"})
+    for (const auto& row : rep[set])
+      cases.add(
+          {row["name"].get<std::string>(), fixed(row["level"].get<double>(), 2) + "x",
+           set == std::string("train") ? "train" : "held out",
+           fixed(row["fem_plate_rotation_deg"].get<double>(), 2),
+           pct(row["untuned_error"].get<double>()) + " > " + pct(row["tuned_error"].get<double>()),
+           pct(row["untuned_reaction_error"].get<double>()) + " > " +
+               pct(row["tuned_reaction_error"].get<double>())});
+  cases.print(os, false);
+  os << "\nScales:";
+  for (const auto& [name, scale] : o.tuned.scales) os << " " << name << " " << fixed(scale, 3);
+  os << "\n";
+  if (!f.active_bounds.empty()) {
+    os << "At a bound:";
+    for (const auto& b : f.active_bounds) os << " " << b;
+    os << "\n";
+  }
+}
+
 void print_all_levels(std::ostream& os, const AllLevelsResult& r, const std::string& terms,
                       double check_load_scale) {
-  TextTable table({"level", "tets", "train max (untuned>tuned)", "holdout max (untuned>tuned)",
-                   "K6 diag ratio (tuned, min-max)", "Ipopt its", "time (s)"});
+  const bool nonlinear = r.set.settings.value("reference", "") == "nonlinear FEM";
   const auto pair = [](double u, double t) {
     return fixed(100 * u, 0) + ">" + fixed(100 * t, 1) + "%";
   };
+  const auto or_dash = [](double v) { return std::isnan(v) ? std::string("-") : percent(v); };
+  TextTable table({"level", "tets", "train max (untuned>tuned)", "holdout max (untuned>tuned)",
+                   nonlinear ? "reaction max (train / holdout)" : "K6 diag ratio (tuned, min-max)",
+                   "Ipopt its", "time (s)"});
   for (const auto& l : r.levels) {
     if (!l.success) continue;
     table.add({l.level, std::to_string(l.tets), pair(l.train_untuned, l.train_tuned),
                std::isnan(l.holdout_untuned) ? std::string("-")
                                              : pair(l.holdout_untuned, l.holdout_tuned),
-               fixed(l.k6_ratio_min, 3) + "-" + fixed(l.k6_ratio_max, 3),
+               nonlinear
+                   ? or_dash(l.train_reaction_tuned) + " / " + or_dash(l.holdout_reaction_tuned)
+                   : fixed(l.k6_ratio_min, 3) + "-" + fixed(l.k6_ratio_max, 3),
                std::to_string(l.iterations), fixed(l.seconds, 1)});
   }
   os << "Calibration of all " << r.set.levels.size() << " levels, material " << r.set.material_name
-     << ", terms " << terms << " (errors: relative nodal displacement, nonlinear check at loads x "
-     << check_load_scale << ")\n\n";
+     << ", terms " << terms;
+  if (nonlinear)
+    os << ", against the nonlinear FEM at load levels " << r.set.settings.at("load_levels").dump()
+       << " x the standard loads (errors: relative nodal displacement and reaction over every "
+          "level, the MSS's plate at the FEM's pose)\n\n";
+  else
+    os << " (errors: relative nodal displacement, nonlinear check at loads x " << check_load_scale
+       << ")\n\n";
   table.print(os, false);
 }
 

@@ -95,7 +95,7 @@ TEST(TunedDisc, FileRoundTrip) {
 TEST(TunedDisc, ThesisOnlyFileRoundTrips) {
   TunedDisc t = sample_tuned(l4l5_mesh());
   t.options = mss::MssOptions();
-  t.options.isochoric_fibres = false;  // either stretch round-trips
+  t.options.isochoric_fibres = false;                            // either stretch round-trips
   t.scales = {{"main.annulus", 0.5}, {"torsion.nucleus", 2.0}};  // a subset: the rest stay 1
   expect_same(t, tuned_disc_from_json(to_json(t)));
 }
@@ -317,6 +317,39 @@ TEST(CheckApplies, RefusesAnotherMaterial) {
   mesh::RegionMaterials other_nu = two_materials();
   other_nu.by_region[int(mesh::Region::nucleus)].poisson_ratio = 0.45;
   expect_not_applicable(t, m, other_nu, {two_materials().name});
+}
+
+// A file fitted with fibre elements carries its fibres: it rebuilds the fibre material (so the
+// fibre elements can be built from the file alone) and refuses the same matrix with other fibres.
+TEST(CheckApplies, AFibreFileCarriesAndComparesItsFibres) {
+  const mesh::TetMesh m = l4l5_mesh();
+  mesh::RegionMaterials fibred = two_materials();
+  mesh::FibreReinforcement f;
+  f.modulus_inner_mpa = 59, f.modulus_outer_mpa = 136;
+  f.angle_inner_deg = 45, f.angle_outer_deg = 28;
+  f.toe_k2 = 12.5;
+  fibred.fibres[int(mesh::Region::annulus)] = f;
+  TunedDisc t = sample_tuned(m);
+  t.material = material_signature(fibred);
+  t.options.fibre_springs = true;
+  t.scales["fibre"] = 0.9;
+  const TunedDisc back = tuned_disc_from_json(to_json(t));
+  const mesh::RegionMaterials rebuilt = back.materials();
+  ASSERT_TRUE(rebuilt.has_fibres());
+  const mesh::FibreReinforcement& g = rebuilt.fibres.at(int(mesh::Region::annulus));
+  EXPECT_EQ(g.modulus_inner_mpa, 59);
+  EXPECT_EQ(g.modulus_outer_mpa, 136);
+  EXPECT_EQ(g.angle_inner_deg, 45);
+  EXPECT_EQ(g.angle_outer_deg, 28);
+  EXPECT_EQ(g.toe_k2, 12.5);
+  EXPECT_EQ(check_applies(back, m, fibred), "");
+  for (auto change : {+[](mesh::FibreReinforcement& x) { x.toe_k2 = 10; },
+                      +[](mesh::FibreReinforcement& x) { x.angle_outer_deg = 30; },
+                      +[](mesh::FibreReinforcement& x) { x.modulus_outer_mpa = 100; }}) {
+    mesh::RegionMaterials other = fibred;
+    change(other.fibres.at(int(mesh::Region::annulus)));
+    expect_not_applicable(back, m, other, {two_materials().name});
+  }
 }
 
 TEST(CheckApplies, RefusesAnotherLevel) {

@@ -4,6 +4,7 @@
 // one tuned set (tuned_set.hpp) that is only complete when every level succeeded.
 #pragma once
 
+#include "spinesim/calibration/nonlinear_protocol.hpp"
 #include "spinesim/calibration/protocol.hpp"
 #include "spinesim/calibration/tuned_set.hpp"
 #include "spinesim/mesh/mesher.hpp"
@@ -50,6 +51,9 @@ struct AllLevelsRequest {
   /// Set: calibrate each level's structured disc of these options (the mesh the spine's offline
   /// discs simulate) instead of the CGAL disc; its second resolution has 4 more sectors.
   std::optional<mesh::StructuredDiscOptions> structured;
+  /// Set: each level calibrated against the nonlinear FEM disc by this request
+  /// (nonlinear_protocol.hpp) instead of `calibration`, whose cases and transfer are then unused.
+  std::optional<NonlinearCalibrationRequest> nonlinear;
   std::vector<std::string> levels;  ///< empty: mesh::disc_levels()
   std::string generated_by;         ///< recorded in the set
 };
@@ -63,10 +67,14 @@ struct LevelCalibration {
   std::string status;  ///< Ipopt's status
   int iterations = 0;
   double seconds = 0;
-  /// Worst relative displacement error over the training / held-out cases (nonlinear check);
-  /// NaN when there is no such case.
+  /// Worst relative displacement error over the training / held-out cases (nonlinear check;
+  /// against the nonlinear FEM: over every load level); NaN when there is no such case.
   double train_untuned = 0, train_tuned = 0, holdout_untuned = NAN, holdout_tuned = NAN;
-  double k6_ratio_min = 0, k6_ratio_max = 0;  ///< tuned / FEM stiffness diagonal
+  /// Tuned / FEM stiffness diagonal; NaN against the nonlinear FEM (no rest stiffness compared).
+  double k6_ratio_min = 0, k6_ratio_max = 0;
+  /// Against the nonlinear FEM: worst reaction error over the training / held-out cases; NaN
+  /// otherwise.
+  double train_reaction_tuned = NAN, holdout_reaction_tuned = NAN;
 };
 
 struct AllLevelsResult {

@@ -35,6 +35,11 @@ mss::MssModel tuned_model(const calibration::TunedDisc& tuned, const mesh::TetMe
 void print_calibration(std::ostream& os, const CalibrationOutcome& o,
                        const CalibrationRequest& request);
 
+/// Readable summary of a calibration against the nonlinear FEM: every (case, level) untuned
+/// beside tuned (displacement and reaction), the scales, Ipopt.
+void print_nonlinear_calibration(std::ostream& os,
+                                 const calibration::NonlinearCalibrationOutcome& o);
+
 /// The table of `calibrate --level all`: tets, train and held-out worst errors (untuned >
 /// tuned), K6 ratio range, Ipopt iterations and time per level.
 void print_all_levels(std::ostream& os, const AllLevelsResult& r, const std::string& terms,
