@@ -290,6 +290,24 @@ void run_calibrate(const CalibrateArgs& a) {
   if (!a.json) std::cout << "\nwrote " << a.out << "\n";
 }
 
+/// --nonlinear and the options that go with it.
+void add_nonlinear_options(CLI::App* cmd, CalibrateArgs& args) {
+  CalibrateArgs* a = &args;
+  cmd->add_flag("--nonlinear", a->nonlinear,
+                "Fit to the nonlinear FEM disc (tension-only fibres, finite strain) at every "
+                "--load-levels, the network's plate at the FEM's pose; with a fibre material the "
+                "network gets the embedded fibre elements. --order defaults to 1, --terms to all");
+  cmd->add_option("--load-levels", a->load_levels,
+                  "With --nonlinear: factors on the standard loads, each in (0, 2]")
+      ->delimiter(',')
+      ->capture_default_str();
+  cmd->add_option("--fibre-stretch", a->fibre_stretch,
+                  "With --nonlinear and a fibre material: the fibre elements' stretch, isochoric "
+                  "(their tet's J^(-2/3) I4, as the FEM) or spring (their own length)")
+      ->check(CLI::IsMember({"spring", "isochoric"}))
+      ->capture_default_str();
+}
+
 }  // namespace
 
 void register_calibrate(CLI::App& app) {
@@ -361,19 +379,7 @@ void register_calibrate(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--no-check", a->no_check,
                 "Skip the nonlinear MSS-vs-FEM check (errors then linearised only)");
-  cmd->add_flag("--nonlinear", a->nonlinear,
-                "Fit to the nonlinear FEM disc (tension-only fibres, finite strain) at every "
-                "--load-levels, the network's plate at the FEM's pose; with a fibre material the "
-                "network gets the embedded fibre elements. --order defaults to 1, --terms to all");
-  cmd->add_option("--load-levels", a->load_levels,
-                  "With --nonlinear: factors on the standard loads, each in (0, 2]")
-      ->delimiter(',')
-      ->capture_default_str();
-  cmd->add_option("--fibre-stretch", a->fibre_stretch,
-                  "With --nonlinear and a fibre material: the fibre elements' stretch, isochoric "
-                  "(their tet's J^(-2/3) I4, as the FEM) or spring (their own length)")
-      ->check(CLI::IsMember({"spring", "isochoric"}))
-      ->capture_default_str();
+  add_nonlinear_options(cmd, *a);
   cmd->add_option("--out", a->out, "Tuned parameter file to write (JSON); required");
   add_output_flags(cmd, a->json, a->quiet, "the tuned file\'s contents as JSON");
   cmd->footer(
