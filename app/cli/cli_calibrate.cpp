@@ -182,18 +182,26 @@ calibration::NonlinearCalibrationRequest nonlinear_request(const CalibrateArgs& 
   return n;
 }
 
+/// Writes the tuned file when `success`; returns what --json prints: the file's contents, the
+/// mesh it was read from and (when written) where it went.
+nlohmann::json write_tuned_file(const CalibrateArgs& a, const calibration::TunedDisc& tuned,
+                                bool success) {
+  nlohmann::json j = calibration::to_json(tuned);
+  j["mesh_file"] = a.mesh_path.empty() ? nlohmann::json(nullptr) : nlohmann::json(a.mesh_path);
+  if (success) {
+    write_text_file(a.out, calibration::to_json(tuned).dump(2) + "\n");
+    j["out"] = a.out;
+  }
+  return j;
+}
+
 /// One disc against the nonlinear FEM; the file only when Ipopt succeeded.
 void run_nonlinear(const CalibrateArgs& a, const calibration::NonlinearCalibrationRequest& rq,
                    const mesh::TetMesh& m, const mesh::RegionMaterials& materials,
                    const StatusLine& status) {
   const calibration::NonlinearCalibrationOutcome o =
       calibration::calibrate_disc_nonlinear(m, materials, rq, status);
-  nlohmann::json j = calibration::to_json(o.tuned);
-  j["mesh_file"] = a.mesh_path.empty() ? nlohmann::json(nullptr) : nlohmann::json(a.mesh_path);
-  if (o.success) {
-    write_text_file(a.out, calibration::to_json(o.tuned).dump(2) + "\n");
-    j["out"] = a.out;
-  }
+  const nlohmann::json j = write_tuned_file(a, o.tuned, o.success);
   if (a.json)
     print_json(j);
   else
@@ -213,11 +221,8 @@ void run_calibrate(const CalibrateArgs& a) {
   rq.holdout = a.holdout.empty()     ? other_cases(rq.train)
                : a.holdout == "none" ? std::vector<fem::LoadCase>()
                                      : fem::parse_load_cases(a.holdout);
-  for (const auto& h :
-       rq.holdout)  // calibrate_disc checks it too, but only after meshing (17 times for all)
-    for (const auto& t : rq.train)
-      if (h.name == t.name)
-        throw std::invalid_argument("case '" + h.name + "' is both trained on and held out");
+  // calibrate_disc checks it too, but only after meshing (17 times for --level all).
+  calibration::check_cases(rq.train, rq.holdout);
   rq.fem_order = a.order;
   rq.terms = parse_term_set(a.terms);
   rq.weights = a.weights;
@@ -269,12 +274,7 @@ void run_calibrate(const CalibrateArgs& a) {
   // 3. Calibrate, report, write only a successful result.
   if (nonlinear) return run_nonlinear(a, *nonlinear, m, materials, status);
   const CalibrationOutcome o = calibrate_disc(m, materials, rq, status);
-  nlohmann::json j = calibration::to_json(o.tuned);
-  j["mesh_file"] = a.mesh_path.empty() ? nlohmann::json(nullptr) : nlohmann::json(a.mesh_path);
-  if (o.success) {
-    write_text_file(a.out, calibration::to_json(o.tuned).dump(2) + "\n");
-    j["out"] = a.out;
-  }
+  const nlohmann::json j = write_tuned_file(a, o.tuned, o.success);
   if (a.json)
     print_json(j);
   else

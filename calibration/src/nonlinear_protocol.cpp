@@ -73,12 +73,7 @@ nlohmann::json report(const NonlinearCalibrationOutcome& o, const NonlinearCalib
 }  // namespace
 
 void validate(const NonlinearCalibrationRequest& rq) {
-  if (rq.train.empty())
-    throw std::invalid_argument("calibration needs at least one training case (--train)");
-  for (const auto& h : rq.holdout)
-    for (const auto& t : rq.train)
-      if (h.name == t.name)
-        throw std::invalid_argument("case '" + h.name + "' is both trained on and held out");
+  check_cases(rq.train, rq.holdout);
   if (rq.load_levels.empty()) throw std::invalid_argument("--nonlinear needs a load level");
   for (double l : rq.load_levels)
     if (!std::isfinite(l) || !(l > 0) || l > 2)

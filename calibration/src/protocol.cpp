@@ -95,14 +95,23 @@ nlohmann::json per_spring_json(const PerSpringResult& r, const CalibrationReques
        "per-spring multipliers belong to this mesh; other meshes get the region-level scales"}};
 }
 
-/// Refuses a request that cannot run (before any work).
-void check_request(const mesh::TetMesh& m, const CalibrationRequest& rq) {
-  if (rq.train.empty())
+}  // namespace
+
+void check_cases(const std::vector<fem::LoadCase>& train,
+                 const std::vector<fem::LoadCase>& holdout) {
+  if (train.empty())
     throw std::invalid_argument("calibration needs at least one training case (--train)");
-  for (const auto& h : rq.holdout)
-    for (const auto& t : rq.train)
+  for (const auto& h : holdout)
+    for (const auto& t : train)
       if (h.name == t.name)
         throw std::invalid_argument("case '" + h.name + "' is both trained on and held out");
+}
+
+namespace {
+
+/// Refuses a request that cannot run (before any work).
+void check_request(const mesh::TetMesh& m, const CalibrationRequest& rq) {
+  check_cases(rq.train, rq.holdout);
   validate(rq.ipopt);
   if (rq.per_spring) {
     validate(rq.per_spring_ipopt);

@@ -30,6 +30,11 @@ TermSet parse_term_set(const std::string& name);  ///< "thesis", "thesis+volume"
 std::string term_set_name(TermSet t);
 mss::MssOptions term_set_options(TermSet t);
 
+/// Throws std::invalid_argument (one line) for no training case or a case both trained and held
+/// out.
+void check_cases(const std::vector<fem::LoadCase>& train,
+                 const std::vector<fem::LoadCase>& holdout);
+
 struct CalibrationRequest {
   std::vector<fem::LoadCase> train, holdout;
   int fem_order = 2;
