@@ -446,6 +446,21 @@ double isochoric_fibre(const TetPoints& x, const Eigen::Vector4d& c, double V0, 
   return energy;
 }
 
+Matrix12d fibre_rest_tangent(const TetPoints& X, const Eigen::Vector4d& c, double V0, double k1,
+                             double rest_det, double rest_i4, bool isochoric) {
+  const Eigen::Vector3d d = X * c;
+  Vector12d g;  // ∇I4 = 2 c_i d / rest_i4
+  for (int i = 0; i < 4; ++i) g.segment<3>(3 * i) = (2.0 * c(i) / rest_i4) * d;
+  if (isochoric) {  // ∇Ī4 = J^(-2/3) ∇I4 - (2/3) (Ī4 / J) ∇J, with J and Ī4 as computed at rest
+    Vector12d gJ;
+    const double J = arm_determinant_derivatives(X, gJ, nullptr) / rest_det;
+    gJ /= rest_det;
+    const double j23 = std::pow(J, -2.0 / 3.0), bar = j23 * d.squaredNorm() / rest_i4;
+    g = j23 * g - (2.0 / 3.0) * (bar / J) * gJ;
+  }
+  return (V0 * k1) * g * g.transpose();
+}
+
 double fibre_spring(const TetPoints& x, const Eigen::Vector4d& c, double V0, double k1, double k2,
                     Vector12d* grad, Matrix12d* hess, double rest_i4) {
   // I4 = |d|^2 / rest_i4: dividing by the rest value as rounded puts the rest state exactly at

@@ -184,8 +184,9 @@ struct MssModel::Impl {
   double tet_terms_gradient(const double* x, KSelect sel, bool want_radial, bool want_volume,
                             double* g) const;
   /// Sparse Hessian of the selected terms (the whole-disc term without its rank-one part).
+  /// fibres_tension_side: the fibre elements' rest tangent from the tension side (x = rest).
   void assemble_hessian(const Eigen::VectorXd& x, HessianMode mode, const bool* terms, KSelect sel,
-                        Eigen::SparseMatrix<double>& H) const;
+                        Eigen::SparseMatrix<double>& H, bool fibres_tension_side = false) const;
 };
 
 /// Per-tetrahedron material constants and rest volumes (the inputs of every term).
@@ -692,6 +693,11 @@ void MssModel::hessian(const Eigen::VectorXd& x, HessianMode mode,
   impl_->assemble_hessian(x, mode, all, KSelect{}, H);
 }
 
+void MssModel::rest_tangent(Eigen::SparseMatrix<double>& H) const {
+  const bool all[kNumTerms] = {true, true, true, true, true, true};
+  impl_->assemble_hessian(impl_->X, HessianMode::exact, all, KSelect{}, H, true);
+}
+
 void MssModel::term_hessian(const Eigen::VectorXd& x, Term term, int region_index, HessianMode mode,
                             Eigen::SparseMatrix<double>& H) const {
   check_size(x, num_nodes());
@@ -703,7 +709,8 @@ void MssModel::term_hessian(const Eigen::VectorXd& x, Term term, int region_inde
 }
 
 void MssModel::Impl::assemble_hessian(const Eigen::VectorXd& x, HessianMode mode, const bool* terms,
-                                      KSelect sel, Eigen::SparseMatrix<double>& H) const {
+                                      KSelect sel, Eigen::SparseMatrix<double>& H,
+                                      bool fibres_tension_side) const {
   const Impl& m = *this;
   m.pattern.reset(H);
   double* val = H.valuePtr();
@@ -758,7 +765,10 @@ void MssModel::Impl::assemble_hessian(const Eigen::VectorXd& x, HessianMode mode
     for (const FibreSpring& f : m.fibres) {
       const double k = sel.fibre(f);
       if (k == 0.0) continue;
-      if (m.options.isochoric_fibres)
+      if (fibres_tension_side)
+        h12 = fibre_rest_tangent(tet_points(x, m.mesh.T, f.t), f.c, f.V0, k, f.rest_det, f.rest_i4,
+                                 m.options.isochoric_fibres);
+      else if (m.options.isochoric_fibres)
         isochoric_fibre(tet_points(x, m.mesh.T, f.t), f.c, f.V0, k, f.k2, f.rest_det, nullptr, &h12,
                         f.rest_i4, mode);
       else

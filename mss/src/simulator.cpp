@@ -11,11 +11,13 @@
 // The implicit step starts from y_n (free nodes where they are, endplates at their new poses);
 // each Newton iteration solves (K + M_r/dt^2 + K_d D_r/dt) d = -dPhi/dy. With one iteration the
 // full step is taken, and that step is exactly Baraff & Witkin's (1998) linearised backward
-// Euler about x_n; with more, a backtracking line search on Phi guards every step. (Starting from
+// Euler about x_n; with more, a backtracking line search on Phi guards every step (and the one
+// step of a frozen network with fibre elements, see below). (Starting from
 // the predictor y_n + dt u instead was tried: with a penalty probe the predictor extrapolates a
 // node out of contact, the step drops it back in, and the contact flips every step.)
-// MatrixUpdate::frozen uses the rest stiffness (exact = projected at rest) and keeps the numeric
-// factor across steps; it is refactorised only when the plate mode (or the wrench-mode centre)
+// MatrixUpdate::frozen uses the rest stiffness (exact = projected at rest; the fibre elements,
+// whose exact Hessian at their tension-only kink is zero, from their tension side: model.hpp
+// rest_tangent) and keeps the numeric factor across steps; it is refactorised only when the plate mode (or the wrench-mode centre)
 // changes. MatrixUpdate::every_iteration factorises the current Hessian each iteration (exact,
 // falling back to projected).
 // Probe contacts never enter the factorised matrix. Each Newton direction solves the quadratic
@@ -110,7 +112,7 @@ struct Simulator::Impl {
 
   // Workspaces (sized once per reduced system): full 3#nodes and reduced vectors.
   Eigen::VectorXd x, v;
-  Eigen::VectorXd y, yn, un, yhat, r, d, y_trial, r_trial, tmp;
+  Eigen::VectorXd y, yn, un, yhat, r, d, y_trial, r_trial, tmp, phi_work;
   Eigen::VectorXd contact_y0;    ///< A^-1 (-r) of the step (contact_direction)
   Eigen::MatrixXd contact_Zall;  ///< A^-1 of each pair's contact column (made when first active)
 
@@ -152,7 +154,8 @@ void Simulator::Impl::ensure_space(PlateMode mode, const Eigen::Vector3d& c) {
   tangent = detail::TangentSolver();
   frozen_ready = false;
   const Eigen::Index n = space.size();
-  for (Eigen::VectorXd* w : {&y, &yn, &un, &yhat, &r, &d, &y_trial, &r_trial, &tmp}) w->setZero(n);
+  for (Eigen::VectorXd* w : {&y, &yn, &un, &yhat, &r, &d, &y_trial, &r_trial, &tmp, &phi_work})
+    w->setZero(n);
   have_space = true;
 }
 
@@ -162,12 +165,13 @@ double Simulator::Impl::phi_and_gradient(ReducedPotential& pot, const Eigen::Vec
   double phi = pot.value_and_gradient(yy, rr);
   tmp = yy - yhat;
   phi += 0.5 * mass.quadratic_form(tmp) / (dt * dt);
-  mass.apply(tmp, d);  // d is free here: it is set after the gradient
-  rr.noalias() += d / (dt * dt);
+  // Its own workspace: the line search evaluates Phi between trials along the direction d.
+  mass.apply(tmp, phi_work);
+  rr.noalias() += phi_work / (dt * dt);
   tmp = yy - yn;
   phi += 0.5 * kd * damp.quadratic_form(tmp) / dt;
-  damp.apply(tmp, d);
-  rr.noalias() += (kd / dt) * d;
+  damp.apply(tmp, phi_work);
+  rr.noalias() += (kd / dt) * phi_work;
   return phi;
 }
 
@@ -360,6 +364,10 @@ StepReport Simulator::Impl::implicit_step(State& s, const Boundary& bc,
   const double r0 = space.force_norm(r);
   const bool probes = !loads.probes().empty();
   const bool frozen = opt.matrix_update == MatrixUpdate::frozen;
+  // A fixed matrix underestimates stiffening fibres far from rest (their exponential toe), and
+  // a full step with it then overshoots and diverges (measured: 3 kN on a fibre-tuned L4-L5
+  // disc). So a frozen step of a network with fibre elements is always line-searched.
+  const bool line_search = opt.newton_iterations > 1 || (frozen && model->num_fibre_springs() > 0);
   int it = 0;
   while (it < opt.newton_iterations) {
     if (!std::isfinite(phi) || !r.allFinite())
@@ -388,7 +396,7 @@ StepReport Simulator::Impl::implicit_step(State& s, const Boundary& bc,
       d = -r;
       tangent.solve_in_place(d);
     }
-    if (opt.newton_iterations == 1) {  // Baraff-Witkin: one linearised step, no line search
+    if (!line_search) {  // Baraff-Witkin: one linearised step, no line search
       y += d;
       ++it;
       break;
@@ -468,7 +476,7 @@ Simulator::Simulator(const MssModel& model, const DynamicsOptions& options)
   d.opt = options;
   d.kd = model.damping_n_s_per_mm();
   const Eigen::VectorXd& X = model.rest_positions_mm();
-  model.hessian(X, HessianMode::exact, d.H_rest);
+  model.rest_tangent(d.H_rest);  // fibre elements from their tension side (frozen factor)
   d.H = d.H_rest;
   d.probe_k_default = detail::default_probe_stiffness(model, d.H_rest);
   const Eigen::MatrixX3d& V = model.mesh().V;

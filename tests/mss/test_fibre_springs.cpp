@@ -20,6 +20,7 @@
 #include <cmath>
 #include <random>
 #include <stdexcept>
+#include <string>
 
 namespace spinesim::mss {
 namespace {
@@ -282,6 +283,37 @@ TEST(IsochoricFibre, GradientAndHessiansMatchCentralDifferences) {
   EXPECT_TRUE(std::isnan(isochoric_fibre(inverted, c, V0, 2.5, 10.0, D)));
 }
 
+// The tension side of the rest Hessian (fibre_rest_tangent), for both stretch measures: the
+// limit of the exact Hessian as the fibre is stretched from rest, first order in the stretch;
+// from the compression side the Hessian is zero. A rank-one positive semi-definite matrix.
+TEST(FibreRestTangent, IsTheLimitOfTheHessianFromTheTensionSide) {
+  const TetPoints X = rest_tet();
+  const double V0 = tet_signed_volume(X), D = rest_det(X);
+  const Eigen::Vector3d a = Eigen::Vector3d(0.2, -0.6, 0.7).normalized();
+  const Eigen::Vector4d c = fibre_coefficients(X, a);
+  for (const bool isochoric : {false, true})
+    for (const double k2 : {0.0, 20.0}) {
+      SCOPED_TRACE(std::string(isochoric ? "isochoric" : "spring") + ", k2 " + std::to_string(k2));
+      const Matrix12d T = fibre_rest_tangent(X, c, V0, 2.5, D, 1.0, isochoric);
+      auto hessian = [&](double lambda) {
+        Matrix12d H;
+        const TetPoints x = deformed(X, stretch_along(a, lambda, 0.0));
+        if (isochoric)
+          isochoric_fibre(x, c, V0, 2.5, k2, D, nullptr, &H);
+        else
+          fibre_spring(x, c, V0, 2.5, k2, nullptr, &H);
+        return H;
+      };
+      const double e3 = (hessian(1 + 1e-3) - T).norm(), e4 = (hessian(1 + 1e-4) - T).norm();
+      EXPECT_LT(e4, 1e-3 * T.norm());
+      EXPECT_NEAR(e3 / e4, 10.0, 1.0);  // first order
+      EXPECT_EQ(hessian(1 - 1e-4).norm(), 0.0);
+      const Eigen::SelfAdjointEigenSolver<Matrix12d> eig(T);
+      EXPECT_GE(eig.eigenvalues().minCoeff(), -1e-12 * T.norm());
+      EXPECT_LE(eig.eigenvalues()(10), 1e-12 * T.norm());  // rank one
+    }
+}
+
 TEST(FibreSpring, DegenerateTetIsRefused) {
   TetPoints flat = rest_tet();
   flat.row(2).setZero();
@@ -382,6 +414,41 @@ void FibreModel::assembled_derivatives(bool isochoric) {
   model.gradient(x - h * v, gm);
   const Eigen::VectorXd Hv = H * v;
   EXPECT_LE(((gp - gm) / (2 * h) - Hv).norm(), 1e-6 * Hv.norm());
+}
+
+// rest_tangent: the rest Hessian plus every fibre's tension side. At rest each fibre is in
+// tension for exactly one of ±v (unless v leaves its stretch alone), so the fibre energies at
+// X + hv and X - hv add up to h²/2 vᵀ (T - H0) v to O(h³): the tension sides, seen through the
+// element energies alone. Without fibre elements T is the rest Hessian itself.
+TEST_F(FibreModel, RestTangentAddsEveryFibresTensionSide) {
+  for (const bool isochoric : {false, true}) {
+    SCOPED_TRACE(isochoric);
+    MssOptions o;
+    o.fibre_springs = true;
+    o.isochoric_fibres = isochoric;
+    const MssModel model(disc(), material(), o);
+    const Eigen::VectorXd X = model.rest_positions_mm();
+    Eigen::SparseMatrix<double> T, H0;
+    model.rest_tangent(T);
+    model.hessian(X, HessianMode::exact, H0);
+    std::mt19937 rng(3);
+    std::normal_distribution<double> n;
+    for (int trial = 0; trial < 5; ++trial) {
+      Eigen::VectorXd v(X.size());
+      for (Eigen::Index i = 0; i < v.size(); ++i) v(i) = n(rng);
+      const double h = 1e-5;
+      const double both = model.term_energy(X + h * v, Term::fibre, 0) +
+                          model.term_energy(X - h * v, Term::fibre, 0);
+      const double quad = v.dot((T - H0) * v);
+      ASSERT_GT(quad, 0.0);
+      EXPECT_NEAR(2.0 * both / (h * h), quad, 1e-4 * quad) << "trial " << trial;
+    }
+  }
+  const MssModel plain(disc(), material(), MssOptions());
+  Eigen::SparseMatrix<double> T, H0;
+  plain.rest_tangent(T);
+  plain.hessian(plain.rest_positions_mm(), HessianMode::exact, H0);
+  EXPECT_EQ((T - H0).norm(), 0.0);
 }
 
 TEST_F(FibreModel, FibreSpringsNeedAFibreReinforcedMaterial) {

@@ -126,6 +126,17 @@ double isochoric_fibre(const TetPoints& x, const Eigen::Vector4d& coefficients, 
                        Matrix12d* hess = nullptr, double rest_i4 = 1.0,
                        HessianMode mode = HessianMode::exact);
 
+/// The tension side of a fibre element's Hessian at rest, where the fibre sits at its
+/// tension-only kink: V0 k1 g gᵀ, g = ∇Ī4 (isochoric_fibre) or ∇I4 (`isochoric` false:
+/// fibre_spring), since ψ'(0) = 0 and ψ''(0⁺) = k1. It is the limit of the exact Hessian as the
+/// fibre is stretched from rest; the compression side is zero. `rest` are the rest points and
+/// `rest_det`, `rest_i4` their values as the elements take them. A solver that keeps one factor
+/// of the rest stiffness needs this side: without it a network whose fibres carry the load is
+/// factorised far too soft, and the fixed-matrix step overshoots and diverges.
+Matrix12d fibre_rest_tangent(const TetPoints& rest, const Eigen::Vector4d& coefficients,
+                             double volume_mm3, double k1_mpa, double rest_det, double rest_i4,
+                             bool isochoric);
+
 /// Rigid spherical probe against one node (penalty contact, beyond the thesis): with
 /// d = |x - c|, penetration p = max(0, r - d),  E = 1/2 k_p p^2, pushing x out radially.
 /// Zero energy, gradient and Hessian when the node is outside the sphere.

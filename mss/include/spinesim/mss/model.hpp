@@ -200,6 +200,13 @@ class MssModel {
   /// without the whole-disc volume term's rank-one part (see disc_volume_rank_one).
   void hessian(const Eigen::VectorXd& x_mm, HessianMode mode, Eigen::SparseMatrix<double>& H) const;
 
+  /// The stiffness at rest that a fixed-matrix solver factorises: hessian(rest, exact) with
+  /// every fibre element's tension-side tangent (elements.hpp fibre_rest_tangent) in place of
+  /// its exact one, which is zero at the kink. Equal to the rest Hessian without fibre elements.
+  /// It bounds the fibres' true tangent from above near rest (a compressed fibre has none), so
+  /// a step with this fixed matrix does not overshoot there.
+  void rest_tangent(Eigen::SparseMatrix<double>& H) const;
+
   /// Hessian of term_energy(x, term, region_index), same pattern as hessian() (without the
   /// whole-disc term's rank-one part: that is disc_volume_rank_one(x, u) / its scale). The
   /// model's energy is linear in the scales, so hessian() = sum over terms and regions of
