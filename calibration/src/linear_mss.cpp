@@ -123,6 +123,12 @@ LinearMss::LinearMss(const mss::MssModel& model, std::vector<Knob> knobs, const 
   const mesh::TetMesh& mesh = model.mesh();
   const Eigen::VectorXd& X = model.rest_positions_mm();
   if (knobs.empty()) throw std::invalid_argument("calibration: no stiffness knobs to tune");
+  // A fibre element at rest sits at its tension-only kink: its Hessian there is zero, and a
+  // linear response would silently leave the fibres out (a disc far too soft).
+  if (model.num_fibre_springs() > 0)
+    throw std::invalid_argument(
+        "calibration: the network has fibre elements, which have no stiffness at rest "
+        "(tension only): it has no linear response at rest; use its nonlinear responses");
   for (const Knob& k : knobs)
     if (!mss::term_enabled(model.options(), k.term))
       throw std::invalid_argument("calibration: knob " + knob_name(k) +

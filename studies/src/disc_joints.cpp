@@ -97,6 +97,11 @@ DiscJointSet compute_tuned_disc_joints(const std::string& data_dir, const std::s
     d.tets = m.num_tets();
     d.plate_center_mm = fem::DiscFem::default_plate_center(m);
     const mss::MssModel mss = calibration::build_tuned_model(td, m, td.materials());
+    if (mss.num_fibre_springs() > 0)
+      throw std::invalid_argument(
+          "disc joints: " + joint.name +
+          "'s tuned network has fibre elements (a nonlinear fit), which have no stiffness at rest; "
+          "its joint comes from the nonlinear disc, not from a rest linearisation");
     std::vector<calibration::Knob> knobs;
     Eigen::VectorXd scales(Eigen::Index(td.scales.size()));
     for (const auto& [name, scale] : td.scales) {

@@ -1,6 +1,7 @@
 // The linearised MSS against independent answers: the nonlinear static solver at small loads,
 // the energy form of K6, and its derivative in the scales.
 #include "spinesim/calibration/linear_mss.hpp"
+#include "spinesim/mesh/material.hpp"
 #include "spinesim/mss/solver.hpp"
 
 #include "calibration_fixtures.hpp"
@@ -111,6 +112,13 @@ TEST(LinearMss, BadInputIsRefused) {
   no_plate.surface.setZero();
   EXPECT_THROW(LinearMss(mss::MssModel(no_plate, two_materials()), {{mss::Term::main, 0}}, c),
                std::invalid_argument);
+  // Fibre elements have no stiffness at rest: no linear response that would include them.
+  mss::MssOptions fibres;
+  fibres.fibre_springs = true;
+  const mss::MssModel with_fibres(m, mesh::load_material("fibre-reinforced", SPINESIM_DATA_DIR),
+                                  fibres);
+  ASSERT_GT(with_fibres.num_fibre_springs(), 0);
+  EXPECT_THROW(LinearMss(with_fibres, {{mss::Term::main, 0}}, c), std::invalid_argument);
 }
 
 }  // namespace

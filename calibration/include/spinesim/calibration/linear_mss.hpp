@@ -66,7 +66,8 @@ class LinearMss {
  public:
   /// Precomputes K_j for `knobs` at the rest state of `model` (its current scales are
   /// irrelevant: every K_j is unscaled). Throws std::invalid_argument if a knob's term is off in
-  /// the model, or the mesh has no superior or no inferior endplate nodes.
+  /// the model, the mesh has no superior or no inferior endplate nodes, or the model has fibre
+  /// elements (tension only, without stiffness at rest: no linear response to take).
   LinearMss(const mss::MssModel& model, std::vector<Knob> knobs,
             const Eigen::Vector3d& plate_center_mm);
   ~LinearMss();
