@@ -1,5 +1,6 @@
 // Disc joints (studies/disc_joints.hpp): the shipped file is what the generator makes (the
 // kernel, the rotational stiffness about the joint point, is tested in tests/fem).
+#include "spinesim/calibration/tuned_set.hpp"
 #include "spinesim/common/constants.hpp"
 #include "spinesim/fem/disc_fem.hpp"
 #include "spinesim/fem/plate_stiffness.hpp"
@@ -37,6 +38,35 @@ TEST(DiscJoints, TheShippedFileIsWhatTheGeneratorMakes) {
   EXPECT_EQ(set.joints[0].K(0, 1), 0.0);
   EXPECT_EQ(set.joints[0].K(0, 2), 0.0);
   EXPECT_LT(set.joints[0].mesh_asymmetry, 1e-2);
+}
+
+// A tuned set whose network has fibre elements (a `calibrate --nonlinear` fit) has no joint at
+// rest: its fibres have no stiffness there, and the condensed network would leave them out.
+TEST(DiscJoints, ATunedSetWithFibreElementsIsRefused) {
+  const calibration::TunedSet shipped =
+      calibration::read_tuned_set(calibration::shipped_tuned_set_path(SPINESIM_DATA_DIR));
+  calibration::TunedSet set = shipped;
+  const mesh::RegionMaterials fibres = test::material("fibre-reinforced");
+  set.material_name = fibres.name;
+  set.levels = {{"L4-L5", calibration::tuned_level(shipped, "L4-L5")}};
+  calibration::TunedDisc& td = set.levels.at("L4-L5");
+  td.material_name = fibres.name;
+  td.material = calibration::material_signature(fibres);
+  td.options.fibre_springs = true;
+  td.scales["fibre"] = 1.0;
+  const std::string path = std::string(SPINESIM_TEST_TMP) + "/fibre_tuned_set.json";
+  std::ofstream(path) << calibration::to_json(set).dump(1);
+  try {
+    compute_tuned_disc_joints(SPINESIM_DATA_DIR, path, {"L4-L5"});
+    ADD_FAILURE() << "a fibre network's rest linearisation was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("fibre elements"), std::string::npos) << e.what();
+  }
+  // The same set without the fibre elements gives its joint.
+  td.options.fibre_springs = false;
+  td.scales.erase("fibre");
+  std::ofstream(path) << calibration::to_json(set).dump(1);
+  EXPECT_EQ(compute_tuned_disc_joints(SPINESIM_DATA_DIR, path, {"L4-L5"}).joints.size(), 1u);
 }
 
 // The nonlinear joints' plate kinematics (t = (R − I)(c − J), the moment moved to J) against
