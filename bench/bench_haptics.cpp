@@ -10,6 +10,8 @@
 //     disc_palpation.hpp) of the L4-L5 CGAL disc with the tuned model's terms (main, radial,
 //     torsion springs and the per-tet volume term; the scales do not change the cost), the 4 mm
 //     probe free (0) or held 2 mm into the anterior wall (1); frozen implicit Euler at 1 ms.
+//     A third argument 1 adds the embedded fibre elements of a fibre-reinforced annulus (the
+//     network `calibrate --nonlinear` fits): their frozen steps are line-searched.
 #include "spinesim/haptics/device.hpp"
 #include "spinesim/haptics/disc_palpation.hpp"
 #include "spinesim/haptics/renderer.hpp"
@@ -172,7 +174,10 @@ void DiscPalpationStep(benchmark::State& state) {
                                sm::disc_frame_in_spine("L4-L5", SPINESIM_DATA_DIR));
   spinesim::mss::MssOptions o;
   o.volume_term = true;
-  const spinesim::mss::MssModel model(m, sm::load_material("real-disc", SPINESIM_DATA_DIR), o);
+  o.fibre_springs = state.range(2) != 0;
+  const spinesim::mss::MssModel model(
+      m, sm::load_material(o.fibre_springs ? "fibre-reinforced" : "real-disc", SPINESIM_DATA_DIR),
+      o);
   spinesim::mss::Boundary bc;
   bc.plate_center_mm = spinesim::mss::default_plate_center(m);
   sh::DiscPalpationOptions po;
@@ -194,7 +199,8 @@ void DiscPalpationStep(benchmark::State& state) {
   state.counters["tets"] = double(m.num_tets());
 }
 BENCHMARK(DiscPalpationStep)
-    ->ArgsProduct({{20, 25, 30, 40}, {0, 1}})
+    ->ArgsProduct({{20, 25, 30, 40}, {0, 1}, {0}})
+    ->ArgsProduct({{40}, {0, 1}, {1}})
     ->Unit(benchmark::kMicrosecond)
     ->Iterations(500);
 

@@ -98,6 +98,15 @@ void Gradient(benchmark::State& state) {
   set_counters(state, model);
 }
 
+/// The energy alone (what a line-search trial needs), beside Gradient.
+void Energy(benchmark::State& state) {
+  const MssModel& model = disc_model(state.range(0) / 1000.0);
+  Eigen::VectorXd x = model.rest_positions_mm();
+  x *= 1.01;
+  for (auto _ : state) benchmark::DoNotOptimize(model.energy(x));
+  set_counters(state, model);
+}
+
 /// One term's gradient (argument: Term index; region 0 and 1 both), on the 2.5 mm L4-L5 disc
 /// with the per-tet volume term on: where the force evaluation's time goes.
 void TermGradient(benchmark::State& state) {
@@ -225,6 +234,7 @@ void sizes(benchmark::internal::Benchmark* b) {
 }  // namespace
 
 BENCHMARK(Gradient)->Apply(sizes);
+BENCHMARK(Energy)->Apply(sizes);
 BENCHMARK(TermGradient)->DenseRange(0, 3)->Unit(benchmark::kMicrosecond);
 BENCHMARK(Hessian)->Apply(sizes);
 BENCHMARK(ImplicitFrozen)->Apply(sizes);

@@ -364,10 +364,6 @@ Eigen::Vector4d fibre_coefficients(const TetPoints& rest, const Eigen::Vector3d&
   return c;
 }
 
-namespace {
-
-/// ψ(Ī4) of the tension-only exponential law per unit volume, with ψ' and ψ'' (zero, and ψ 0,
-/// for Ī4 − 1 = `excess` <= 0; NaN propagates).
 double fibre_law(double excess, double k1, double k2, double& psi1, double& psi2) {
   psi1 = psi2 = 0.0;
   if (!(excess > 0.0)) return excess == excess ? 0.0 : excess;
@@ -376,6 +372,8 @@ double fibre_law(double excess, double k1, double k2, double& psi1, double& psi2
   psi2 = k1 * e * (1.0 + 2.0 * k2 * excess * excess);
   return k2 > 0.0 ? k1 / (2.0 * k2) * (e - 1.0) : 0.5 * k1 * excess * excess;
 }
+
+namespace {
 
 /// det[a, b, c] of the arms a = x1 − x0, b = x2 − x0, c = x3 − x0, its gradient (12) and Hessian
 /// (12×12): ∂/∂a = b × c, ∂/∂b = c × a, ∂/∂c = a × b; ∂²/∂a∂b = −[c]×, ∂²/∂a∂c = [b]×,
@@ -420,9 +418,14 @@ double isochoric_fibre(const TetPoints& x, const Eigen::Vector4d& c, double V0, 
       arm_determinant_derivatives(x, gJ, hess && mode == HessianMode::exact ? &hJ : nullptr) /
       rest_det;
   if (!(J > 0.0)) return std::numeric_limits<double>::quiet_NaN();
-  gJ /= rest_det;
   const Eigen::Vector3d d = x * c;
-  const double i4 = d.squaredNorm() / rest_i4, j23 = std::pow(J, -2.0 / 3.0), bar = j23 * i4;
+  const double i4 = d.squaredNorm() / rest_i4;
+  // A slack fibre (Ī4 = J^(-2/3) I4 <= 1, i.e. I4³ <= J²) has no energy, force or stiffness:
+  // decided without the cube root, which is most of a slack fibre's cost (about half the fibres
+  // of a loaded disc, and all of them at rest). A NaN I4 goes on and propagates.
+  if (i4 * i4 * i4 <= J * J) return 0.0;
+  gJ /= rest_det;
+  const double cbrt_J = std::cbrt(J), j23 = 1.0 / (cbrt_J * cbrt_J), bar = j23 * i4;
   double psi1 = 0, psi2 = 0;
   const double energy = V0 * fibre_law(bar - 1.0, k1, k2, psi1, psi2);
   if (!(psi1 > 0.0) || (!grad && !hess)) return energy;

@@ -416,6 +416,74 @@ void FibreModel::assembled_derivatives(bool isochoric) {
   EXPECT_LE(((gp - gm) / (2 * h) - Hv).norm(), 1e-6 * Hv.norm());
 }
 
+// The model sums its isochoric fibre forces per tet (J and ∇J once for both families): it must
+// be the element kernel summed, element by element, on a twisted disc (one family stretched, the
+// other slack), a stretched one (both stretched), and with one tet inverted (NaN energy, no
+// force from that tet's fibres, as the element).
+TEST_F(FibreModel, TheIsochoricFibreForceIsTheElementKernelSummed) {
+  const mesh::TetMesh m = disc();
+  MssOptions o;
+  o.fibre_springs = true;
+  const MssModel model(m, material(), o);
+  const Eigen::VectorXd X = model.rest_positions_mm();
+  const mesh::ElementFibres field = mesh::fibre_field(m, material());
+  auto reference = [&](const Eigen::VectorXd& x, Eigen::VectorXd& g) {
+    g.setZero(x.size());
+    double e = 0;
+    for (Eigen::Index t = 0; t < m.num_tets(); ++t) {
+      if (!(field.stiffness_mpa(t) > 0.0)) continue;
+      TetPoints P, p;
+      for (int k = 0; k < 4; ++k)
+        P.col(k) = X.segment<3>(3 * m.T(t, k)), p.col(k) = x.segment<3>(3 * m.T(t, k));
+      for (const Eigen::MatrixX3d* dir : {&field.direction_1, &field.direction_2}) {
+        const Eigen::Vector4d c = fibre_coefficients(P, dir->row(t).transpose().normalized());
+        Vector12d g12;
+        e += isochoric_fibre(p, c, tet_signed_volume(P), field.stiffness_mpa(t) / 4.0,
+                             field.toe_k2(t), arm_determinant(P), &g12, nullptr,
+                             (P * c).squaredNorm());
+        for (int k = 0; k < 4; ++k) g.segment<3>(3 * m.T(t, k)) += g12.segment<3>(3 * k);
+      }
+    }
+    return e;
+  };
+  std::mt19937 rng(11);
+  std::normal_distribution<double> n(0.0, 0.01);
+  Eigen::VectorXd twisted = X, stretched = X;
+  for (Eigen::Index i = 0; i < model.num_nodes(); ++i) {
+    const Eigen::Vector3d p = X.segment<3>(3 * i);
+    twisted.segment<3>(3 * i) = Eigen::AngleAxisd(0.02 * p.y(), Eigen::Vector3d::UnitY()) * p;
+    stretched.segment<3>(3 * i) = Eigen::Vector3d(p.x(), 1.05 * p.y(), p.z());
+  }
+  Eigen::VectorXd inverted = twisted;
+  const Eigen::Index t0 = [&] {
+    for (Eigen::Index t = 0; t < m.num_tets(); ++t)
+      if (field.stiffness_mpa(t) > 0.0) return t;
+    return Eigen::Index(-1);
+  }();
+  ASSERT_GE(t0, 0);
+  // Move vertex 0 of an annulus tet through its opposite face.
+  const Eigen::Vector3d q0 = X.segment<3>(3 * m.T(t0, 0)),
+                        face = (X.segment<3>(3 * m.T(t0, 1)) + X.segment<3>(3 * m.T(t0, 2)) +
+                                X.segment<3>(3 * m.T(t0, 3))) /
+                               3.0;
+  inverted.segment<3>(3 * m.T(t0, 0)) = q0 + 2.0 * (face - q0);
+  for (Eigen::VectorXd* x : {&twisted, &stretched, &inverted}) {
+    for (Eigen::Index i = 0; i < x->size(); ++i) (*x)(i) += n(rng);
+    Eigen::VectorXd g, g_ref;
+    const double e = model.term_energy(*x, Term::fibre, 0);
+    model.term_gradient(*x, Term::fibre, 0, g);
+    const double e_ref = reference(*x, g_ref);
+    ASSERT_GT(g_ref.norm(), 0.0);
+    EXPECT_LE((g - g_ref).norm(), 1e-12 * g_ref.norm());
+    if (x == &inverted) {
+      EXPECT_TRUE(std::isnan(e) && std::isnan(e_ref));
+    } else {
+      EXPECT_NEAR(e, e_ref, 1e-12 * e_ref);
+      EXPECT_GT(e, 0.0);
+    }
+  }
+}
+
 // rest_tangent: the rest Hessian plus every fibre's tension side. At rest each fibre is in
 // tension for exactly one of ±v (unless v leaves its stretch alone), so the fibre energies at
 // X + hv and X - hv add up to h²/2 vᵀ (T - H0) v to O(h³): the tension sides, seen through the

@@ -106,6 +106,10 @@ double fibre_spring(const TetPoints& x, const Eigen::Vector4d& coefficients, dou
                     double k1_mpa, double k2, Vector12d* grad = nullptr, Matrix12d* hess = nullptr,
                     double rest_i4 = 1.0);
 
+/// The law itself per unit rest volume: ψ(I4) for `excess` = I4 − 1 (or Ī4 − 1), with ψ' and ψ''
+/// in `psi1`, `psi2`; all zero for excess <= 0, and a NaN excess returned as the energy.
+double fibre_law(double excess, double k1_mpa, double k2, double& psi1, double& psi2);
+
 /// The same law on the tet's isochoric fibre stretch, as the nonlinear FEM takes it:
 ///   Ī4 = J^(−2/3) I4,  J = det F = det[x1 − x0, x2 − x0, x3 − x0] / `rest_det` (the rest
 ///   points' same determinant),  E = V0 ψ(Ī4),
