@@ -41,10 +41,24 @@ class ReducedPotential {
     return model_->energy(x_) + (no_loads() ? 0.0 : loads_->energy(x_)) - plate_work(y);
   }
 
+  /// Keep the model's energy and gradient for the next value_and_gradient at exactly the same
+  /// full positions (bit for bit): an implicit step starts where the previous step's accepted
+  /// trial ended, so its first force evaluation is then free. Only while the model does not
+  /// change (the Simulator's contract).
+  void reuse_repeated_points(bool on) {
+    reuse_ = on;
+    have_last_ = false;
+  }
   /// Pi(y) and r = dPi/dy (r preallocated to space.size()).
   double value_and_gradient(const Eigen::VectorXd& y, Eigen::VectorXd& r) {
     space_->set_unknown_positions(y, x_);
-    double e = model_->gradient(x_, g_);
+    double e;
+    if (reuse_ && have_last_ && x_ == last_x_) {
+      e = last_energy_;  // g_ still holds its gradient
+    } else {
+      e = model_->gradient(x_, g_);
+      if (reuse_) last_x_ = x_, last_energy_ = e, have_last_ = true;
+    }
     if (no_loads()) {
       space_->reduce_vector(g_, r);
     } else {
@@ -67,6 +81,9 @@ class ReducedPotential {
   const ExternalLoads* loads_ = nullptr;
   Vector6d wrench_ = Vector6d::Zero();
   Eigen::VectorXd x_, g_, gtot_;
+  bool reuse_ = false, have_last_ = false;
+  Eigen::VectorXd last_x_;  ///< where g_ was evaluated, when reuse_
+  double last_energy_ = 0;
 };
 
 }  // namespace spinesim::mss::detail

@@ -150,6 +150,7 @@ void Simulator::Impl::ensure_space(PlateMode mode, const Eigen::Vector3d& c) {
   inertia.plate = mass.plate / (dt * dt) + kd / dt * damp.plate;
   plate_mass.compute(mass.plate);
   potential = ReducedPotential(*model, space, nullptr, Vector6d::Zero());
+  potential.reuse_repeated_points(true);
   A = space.pattern();
   tangent = detail::TangentSolver();
   frozen_ready = false;

@@ -78,5 +78,45 @@ TEST(FrozenFibreNetwork, ReachesTheRefreshedRunsStateUnderStiffeningLoads) {
   }
 }
 
+// A Simulator keeps the model's forces at the state its last step ended in, and a line-searched
+// step starts there, so its first force evaluation is free. The steps must be exactly those of
+// a Simulator that has never seen the state: bit for bit, under a moment and under a moving probe
+// (whose contacts change the loads, not the model's forces).
+TEST(FrozenFibreNetwork, KeptForcesStepExactlyAsAFreshSimulator) {
+  const mesh::TetMesh m = mesh::mesh_structured_level("L4-L5", {}, SPINESIM_DATA_DIR);
+  const MssModel model = fibre_network(m);
+  DynamicsOptions o;
+  o.matrix_update = MatrixUpdate::frozen;
+  Boundary moment = fixtures::wrench_boundary(m, vec6(0, 0, 0, 7500, 0, 0));
+  Boundary probe;
+  probe.plate_center_mm = default_plate_center(m);
+  // The probe at the most anterior outer-wall node, pressed in along the disc's anterior axis.
+  const Eigen::Vector3d n = m.frame.axes.col(2);
+  Eigen::Index front = -1;
+  for (Eigen::Index i = 0; i < m.V.rows(); ++i)
+    if (m.surface(i) == 3 && (front < 0 || m.V.row(i).dot(n) > m.V.row(front).dot(n))) front = i;
+  ASSERT_GE(front, 0);
+  for (const bool with_probe : {false, true}) {
+    SCOPED_TRACE(with_probe ? "probe" : "moment");
+    Simulator kept(model, o);
+    State s = kept.rest_state();
+    for (int k = 1; k <= 40; ++k) {
+      Boundary bc = with_probe ? probe : moment;
+      if (with_probe)
+        bc.probes = {{m.V.row(front).transpose() + (4.0 - 0.05 * k) * n, 4.0, 50.0}};
+      else
+        bc.wrench *= std::min(1.0, k / 10.0);
+      State fresh_state = s;
+      Simulator fresh(model, o);
+      const StepReport a = kept.step(s, bc), b = fresh.step(fresh_state, bc);
+      ASSERT_TRUE(a.ok && b.ok) << a.message << b.message;
+      ASSERT_EQ(a.newton_iterations, b.newton_iterations);
+      ASSERT_TRUE(s.x_mm == fresh_state.x_mm) << "step " << k;
+      ASSERT_TRUE(s.v_mm_s == fresh_state.v_mm_s) << "step " << k;
+    }
+    EXPECT_GT((s.x_mm - model.rest_positions_mm()).norm(), 0.1);
+  }
+}
+
 }  // namespace
 }  // namespace spinesim::mss

@@ -68,7 +68,8 @@ struct StepReport {
   std::string message;  ///< why the step was rejected
 };
 
-/// Steps one model under a boundary that may change every step. Holds the factorisation.
+/// Steps one model under a boundary that may change every step. Holds the factorisation and the
+/// model's forces at the last state, so the model must not change (set_scales) while it steps.
 class Simulator {
  public:
   /// Throws std::invalid_argument for dt <= 0 or non-finite, newton_iterations < 1.
