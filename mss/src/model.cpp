@@ -138,15 +138,16 @@ double isochoric_fibres_gradient(const std::vector<FibreSpring>& fibres, const E
     for (int k = 0; k < 4; ++k) p[k] = Eigen::Map<const Eigen::Vector3d>(x + 3 * v[k]);
     const Eigen::Vector3d a = p[1] - p[0], b = p[2] - p[0], c = p[3] - p[0];
     const Eigen::Vector3d ga = b.cross(c), gb = c.cross(a), gc = a.cross(b);
-    const double det = a.dot(ga);
+    // The families of a tet share its rest determinant, hence J.
+    const double rest_det = fibres[first].rest_det, J = a.dot(ga) / rest_det;
+    if (!(J > 0.0)) {
+      energy += std::numeric_limits<double>::quiet_NaN();
+      first = end;
+      continue;
+    }
     double j23 = 0.0, det_coefficient = 0.0;  // j23 made at the first stretched fibre
     for (std::size_t f = first; f < end; ++f) {
       const FibreSpring& s = fibres[f];
-      const double J = det / s.rest_det;
-      if (!(J > 0.0)) {
-        energy += std::numeric_limits<double>::quiet_NaN();
-        continue;
-      }
       const Eigen::Vector3d d = s.c(0) * p[0] + s.c(1) * p[1] + s.c(2) * p[2] + s.c(3) * p[3];
       const double i4 = d.squaredNorm() / s.rest_i4;
       if (i4 * i4 * i4 <= J * J) continue;  // slack
@@ -164,7 +165,7 @@ double isochoric_fibres_gradient(const std::vector<FibreSpring>& fibres, const E
         const Eigen::Vector3d gi = (w * j23 * 2.0 * s.c(k4) / s.rest_i4) * d;
         for (int e = 0; e < 3; ++e) g[3 * v[k4] + e] += gi(e);
       }
-      det_coefficient -= w * (2.0 / 3.0) * (bar / J) / s.rest_det;
+      det_coefficient -= w * (2.0 / 3.0) * (bar / J) / rest_det;
     }
     if (det_coefficient != 0.0) {
       const Eigen::Vector3d g0 = -(ga + gb + gc);
