@@ -43,6 +43,7 @@ struct CalibrateArgs {
   std::string holdout;  ///< default: every other case
   double cell_size_mm = 2.0;
   CLI::Option* cell_size_option = nullptr;
+  calibration::CellSizeRule cell_size_rule;  ///< --level all without --cell-size
   double check_load_scale = CalibrationRequest().check_load_scale;
   int order = 2;
   calibration::Weights weights;
@@ -83,12 +84,18 @@ void run_all_levels(const CalibrateArgs& a, const CalibrationRequest& rq,
   all.calibration = rq;
   all.nonlinear = nonlinear;
   if (a.cell_size_option->count()) all.cell_size_mm = a.cell_size_mm;
+  all.cell_size_rule = a.cell_size_rule;
   all.transfer = !a.no_transfer;
   if (a.structured) all.structured = mesh::StructuredDiscOptions();
   std::ostringstream cmd;
   cmd << "spinesim calibrate --level all" << (a.structured ? " --structured" : "")
       << (a.cell_size_option->count() ? " --cell-size " + std::to_string(a.cell_size_mm)
                                       : std::string())
+      << (a.given("--max-cell-size") ? " --max-cell-size " + fixed(a.cell_size_rule.max_mm, 2)
+                                     : std::string())
+      << (a.given("--cells-through-height")
+              ? " --cells-through-height " + fixed(a.cell_size_rule.cells_through_height, 2)
+              : std::string())
       << " --material " << a.material << " --terms "
       << (nonlinear ? term_set_name(nonlinear->terms) : a.terms) << " --train " << a.train
       << (a.holdout.empty() ? "" : " --holdout " + a.holdout);
@@ -107,9 +114,14 @@ void run_all_levels(const CalibrateArgs& a, const CalibrationRequest& rq,
   const AllLevelsResult r = calibrate_all_levels(
       materials, all, [&bar](int done, const std::string& label) { bar.update(done, label); });
   bar.finish();
-  if (!r.failed().empty())
+  if (!r.failed().empty()) {
+    // The other levels' results are not lost: their table goes to stderr before the refusal.
+    if (!a.quiet)
+      print_all_levels(std::cerr, r, nonlinear ? term_set_name(nonlinear->terms) : a.terms,
+                       rq.check_load_scale);
     throw std::runtime_error("Ipopt did not converge for " + r.failed() + ": no " + a.out +
                              " written");
+  }
   write_text_file(a.out, calibration::to_json(r.set).dump(1) + "\n");
   if (a.json) {
     nlohmann::json j = calibration::to_json(r.set);
@@ -133,6 +145,12 @@ void check_files_and_modes(const CalibrateArgs& a) {
     throw std::invalid_argument("--cell-size is the CGAL mesher's: --structured takes none");
   if (a.order != 1 && a.order != 2) throw std::invalid_argument("--order must be 1 or 2");
   if (!(a.cell_size_mm > 0)) throw std::invalid_argument("--cell-size must be > 0 mm");
+  const bool rule_given = a.given("--max-cell-size") || a.given("--cells-through-height");
+  if (rule_given && (a.level != "all" || a.structured || a.cell_size_option->count()))
+    throw std::invalid_argument(
+        "--max-cell-size and --cells-through-height size each level's CGAL disc with --level "
+        "all and no --cell-size");
+  calibration::validate(a.cell_size_rule);
   if (a.level == "all" && !a.transfer_meshes.empty())
     throw std::invalid_argument(
         "--transfer-mesh is one disc's: with --level all each level is checked at 1.5x its cell "
@@ -324,6 +342,13 @@ void register_calibrate(CLI::App& app) {
                                         "With --level: CGAL cell size, mm (--level all without it: "
                                         "min(2, disc height / 5) per level)")
                             ->capture_default_str();
+  cmd->add_option("--max-cell-size", a->cell_size_rule.max_mm,
+                  "--level all: the largest cell, mm (each level: min(this, height / "
+                  "--cells-through-height))")
+      ->capture_default_str();
+  cmd->add_option("--cells-through-height", a->cell_size_rule.cells_through_height,
+                  "--level all: cells through each disc's height (at most --max-cell-size each)")
+      ->capture_default_str();
   cmd->add_option(
          "--material", a->material,
          "Preset (real-disc, annulus-nucleus, fibre-reinforced, rubber, polyethylene) or JSON "

@@ -23,8 +23,26 @@ std::pair<std::string, mesh::TetMesh> coarser_level_mesh(const std::string& leve
   return {label.str(), mesh::mesh_disc_level(dims.level, options, data_dir)};
 }
 
-double default_level_cell_size_mm(const std::string& level, const std::string& data_dir) {
-  return std::min(2.0, mesh::disc_dimensions(level, data_dir).height_mm / 5.0);
+double CellSizeRule::cell_size_mm(double height_mm) const {
+  return std::min(max_mm, height_mm / cells_through_height);
+}
+
+std::string CellSizeRule::describe() const {
+  std::ostringstream s;
+  s << "min(" << max_mm << " mm, disc height / " << cells_through_height << ")";
+  return s.str();
+}
+
+void validate(const CellSizeRule& rule) {
+  if (!(rule.max_mm >= 0.5 && rule.max_mm <= 10))
+    throw std::invalid_argument("--max-cell-size must be 0.5 to 10 mm");
+  if (!(rule.cells_through_height >= 1 && rule.cells_through_height <= 20))
+    throw std::invalid_argument("--cells-through-height must be 1 to 20");
+}
+
+double default_level_cell_size_mm(const std::string& level, const std::string& data_dir,
+                                  const CellSizeRule& rule) {
+  return rule.cell_size_mm(mesh::disc_dimensions(level, data_dir).height_mm);
 }
 
 LevelMeshes mesh_level(const std::string& level,
@@ -151,8 +169,9 @@ AllLevelsResult calibrate_all_levels(const mesh::RegionMaterials& materials,
     r.set.settings["mesh"] =
         "parametric disc (data/disc_morphometry.csv), CGAL, placed in the spine (as `mesh disc "
         "--level`)";
+    validate(request.cell_size_rule);
     r.set.settings["cell_size_rule"] =
-        request.cell_size_mm ? "as given" : "min(2 mm, disc height / 5)";
+        request.cell_size_mm ? "as given" : request.cell_size_rule.describe();
   }
   nlohmann::json cell_by_level = nlohmann::json::object();
   int done = 0;
@@ -162,8 +181,9 @@ AllLevelsResult calibrate_all_levels(const mesh::RegionMaterials& materials,
     };
     LevelCalibration row;
     if (!request.structured) {
-      row.cell_size_mm = request.cell_size_mm ? *request.cell_size_mm
-                                              : default_level_cell_size_mm(level, data_dir);
+      row.cell_size_mm = request.cell_size_mm
+                             ? *request.cell_size_mm
+                             : default_level_cell_size_mm(level, data_dir, request.cell_size_rule);
       cell_by_level[level] = row.cell_size_mm;
     }
     LevelMeshes meshes = mesh_level(level, request.structured, row.cell_size_mm,

@@ -22,15 +22,19 @@ std::vector<fem::LoadCase> all_cases(const NonlinearCalibrationRequest& rq) {
 /// One (case, level) row of the report: untuned (scales 1) beside tuned.
 nlohmann::json case_row(const NonlinearCaseError& before, const NonlinearCaseError& after,
                         const NonlinearReferenceCase& ref) {
-  return {{"name", after.name},
-          {"level", after.level},
-          {"untuned_error", before.displacement_error},
-          {"tuned_error", after.displacement_error},
-          {"untuned_reaction_error", before.reaction_error},
-          {"tuned_reaction_error", after.reaction_error},
-          {"fem_plate_rotation_deg", ref.plate_motion.tail<3>().norm() * kDegPerRad},
-          {"fem_plate_shift_mm", ref.plate_motion.head<3>().norm()},
-          {"converged", before.converged && after.converged}};
+  nlohmann::json row = {{"name", after.name},
+                        {"level", after.level},
+                        {"untuned_error", before.displacement_error},
+                        {"tuned_error", after.displacement_error},
+                        {"untuned_reaction_error", before.reaction_error},
+                        {"tuned_reaction_error", after.reaction_error},
+                        {"fem_plate_rotation_deg", ref.plate_motion.tail<3>().norm() * kDegPerRad},
+                        {"fem_plate_shift_mm", ref.plate_motion.head<3>().norm()},
+                        {"converged", before.converged && after.converged}};
+  // Why a solve failed (the untuned network's, else the tuned one's).
+  if (!before.converged) row["message"] = "untuned: " + before.message;
+  if (!after.converged) row["message"] = "tuned: " + after.message;
+  return row;
 }
 
 nlohmann::json report(const NonlinearCalibrationOutcome& o, const NonlinearCalibrationRequest& rq,

@@ -66,6 +66,10 @@ std::string shipped_tuned_set_path(const std::string& data_dir) {
   return data_dir + "/tuned_discs.json";
 }
 
+std::string shipped_fibre_tuned_set_path(const std::string& data_dir) {
+  return data_dir + "/tuned_fibre_discs.json";
+}
+
 const TunedDisc& tuned_level(const TunedSet& set, const std::string& level) {
   auto it = set.levels.find(level);
   if (it != set.levels.end()) return it->second;

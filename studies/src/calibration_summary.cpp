@@ -155,7 +155,11 @@ void print_all_levels(std::ostream& os, const AllLevelsResult& r, const std::str
                    nonlinear ? "reaction max (train / holdout)" : "K6 diag ratio (tuned, min-max)",
                    "Ipopt its", "time (s)"});
   for (const auto& l : r.levels) {
-    if (!l.success) continue;
+    if (!l.success) {
+      table.add({l.level, std::to_string(l.tets), "failed: " + l.status, "-", "-",
+                 std::to_string(l.iterations), fixed(l.seconds, 1)});
+      continue;
+    }
     table.add({l.level, std::to_string(l.tets), pair(l.train_untuned, l.train_tuned),
                std::isnan(l.holdout_untuned) ? std::string("-")
                                              : pair(l.holdout_untuned, l.holdout_tuned),
@@ -164,8 +168,10 @@ void print_all_levels(std::ostream& os, const AllLevelsResult& r, const std::str
                    : fixed(l.k6_ratio_min, 3) + "-" + fixed(l.k6_ratio_max, 3),
                std::to_string(l.iterations), fixed(l.seconds, 1)});
   }
-  os << "Calibration of all " << r.set.levels.size() << " levels, material " << r.set.material_name
-     << ", terms " << terms;
+  const bool all = r.set.levels.size() == r.levels.size();
+  os << "Calibration of " << (all ? "all " : "") << r.levels.size() << " levels"
+     << (all ? "" : " (" + std::to_string(r.set.levels.size()) + " succeeded)") << ", material "
+     << r.set.material_name << ", terms " << terms;
   if (nonlinear)
     os << ", against the nonlinear FEM at load levels " << r.set.settings.at("load_levels").dump()
        << " x the standard loads (errors: relative nodal displacement and reaction over every "

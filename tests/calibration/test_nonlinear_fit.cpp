@@ -71,6 +71,31 @@ NonlinearReference synthetic_reference(const mss::MssModel& truth) {
   return ref;
 }
 
+// The two ways to the MSS's equilibrium at a reference pose agree where both converge: Newton
+// from the reference's field, and the plate moved there in kPoseSteps steps from rest (the
+// fallback when the first does not converge). Flexion at 0.08 rad (4.6 degrees) and
+// torsion: same positions to 1e-6 mm and reaction to 1e-6 of its size.
+TEST(MssAtReferencePose, PoseStepsReachTheSameEquilibriumAsNewtonFromTheField) {
+  const mss::MssModel truth(disc(), fibre_material(), fibre_options());
+  const NonlinearReference ref = synthetic_reference(truth);
+  for (const NonlinearReferenceCase& c : ref.cases) {
+    if (c.level != 1.0) continue;
+    SCOPED_TRACE(c.name);
+    // The field is the truth's own; start from a third of it so that Newton has work to do.
+    NonlinearReferenceCase far = c;
+    far.vertex_displacement_mm *= 1.0 / 3.0;
+    const mss::StaticResult field =
+        mss_at_reference_pose(truth, ref, far, {}, PoseStart::fem_field);
+    const mss::StaticResult steps =
+        mss_at_reference_pose(truth, ref, far, {}, PoseStart::pose_steps);
+    ASSERT_TRUE(field.converged) << field.message;
+    ASSERT_TRUE(steps.converged) << steps.message;
+    EXPECT_LT((field.x_mm - steps.x_mm).cwiseAbs().maxCoeff(), 1e-6);
+    EXPECT_LT((field.reaction_wrench - steps.reaction_wrench).norm(), 1e-6 * c.reaction.norm());
+    EXPECT_LT((steps.reaction_wrench - c.reaction).norm(), 1e-6 * c.reaction.norm());
+  }
+}
+
 TEST(NonlinearFit, RecoversTheScalesThatMadeTheReference) {
   const mesh::TetMesh m = disc();
   mss::MssModel truth(m, fibre_material(), fibre_options());

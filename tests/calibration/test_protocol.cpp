@@ -15,6 +15,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -101,6 +102,26 @@ TEST(LevelCalibration, DefaultCellSizeGivesThinDiscsFiveCellsThroughTheirHeight)
     const double h = mesh::disc_dimensions(level, SPINESIM_DATA_DIR).height_mm;
     EXPECT_DOUBLE_EQ(default_level_cell_size_mm(level, SPINESIM_DATA_DIR), std::min(2.0, h / 5));
   }
+}
+
+TEST(LevelCalibration, ACellSizeRuleCapsTheCellAndCountsCellsThroughTheHeight) {
+  const CellSizeRule palpation{4.0, 2.5};
+  EXPECT_EQ(CellSizeRule().describe(), "min(2 mm, disc height / 5)");
+  EXPECT_EQ(palpation.describe(), "min(4 mm, disc height / 2.5)");
+  for (const std::string& level : {"T4-T5", "T12-L1", "L4-L5"}) {
+    const double h = mesh::disc_dimensions(level, SPINESIM_DATA_DIR).height_mm;
+    const double cell = default_level_cell_size_mm(level, SPINESIM_DATA_DIR, palpation);
+    EXPECT_DOUBLE_EQ(cell, std::min(4.0, h / 2.5));
+    EXPECT_LE(cell, 4.0);
+    EXPECT_GE(h / cell, 2.5 - 1e-12);
+  }
+  // The thinnest disc (T4-T5, 4.5 mm) gets 1.8 mm cells; the thickest is capped at 4 mm.
+  EXPECT_DOUBLE_EQ(default_level_cell_size_mm("T4-T5", SPINESIM_DATA_DIR, palpation), 1.8);
+  EXPECT_DOUBLE_EQ(default_level_cell_size_mm("L4-L5", SPINESIM_DATA_DIR, palpation), 4.0);
+  EXPECT_THROW(validate(CellSizeRule{0.1, 5}), std::invalid_argument);
+  EXPECT_THROW(validate(CellSizeRule{2, 0}), std::invalid_argument);
+  EXPECT_THROW(validate(CellSizeRule{NAN, 5}), std::invalid_argument);
+  EXPECT_NO_THROW(validate(palpation));
 }
 
 TEST(LevelCalibration, TheSecondResolutionIsTheProtocols) {

@@ -278,6 +278,15 @@ TEST(CalibrateCliRefuses, BadOptions) {
   expect_refused_without(run_spinesim("calibrate" + mesh + " --train compression,twist" + to),
                          "twist", out);
   expect_refused_without(run_spinesim("calibrate" + mesh + " --order 3" + to), "--order", out);
+  // The per-level cell rule is --level all's, without a single --cell-size; refused before meshing.
+  expect_refused_without(run_spinesim("calibrate --level L4-L5 --cells-through-height 3" + to),
+                         "--level all", out);
+  expect_refused_without(run_spinesim("calibrate --level all --cell-size 3 --max-cell-size 4" + to),
+                         "--level all", out);
+  expect_refused_without(run_spinesim("calibrate --level all --max-cell-size 0.1" + to),
+                         "--max-cell-size", out);
+  expect_refused_without(run_spinesim("calibrate --level all --cells-through-height 0" + to),
+                         "--cells-through-height", out);
   expect_refused_without(run_spinesim("calibrate" + mesh + " --material unobtainium" + to),
                          "unobtainium", out);
   expect_refused_without(

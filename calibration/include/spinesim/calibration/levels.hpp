@@ -25,10 +25,22 @@ std::pair<std::string, mesh::TetMesh> coarser_level_mesh(const std::string& leve
                                                          const std::string& data_dir,
                                                          const StatusLine& status = StatusLine());
 
-/// The cell size of a level's disc when none is given: min(2 mm, disc height / 5), so that the
-/// thin thoracic discs (4.5-7 mm) get at least five cells through their height (at 2 mm the
-/// fitted MSS stays much further off the FEM there: calibration/README.md).
-double default_level_cell_size_mm(const std::string& level, const std::string& data_dir);
+/// How `--level all` sizes each level's cells when no single size is given: min(max_mm, disc
+/// height / cells_through_height). The default, min(2 mm, height / 5), gives the thin thoracic
+/// discs (4.5-7 mm) five cells through their height (at 2 mm the fitted MSS stays much further
+/// off the FEM there: calibration/README.md). The palpated discs' set uses min(4 mm, height / 2.5),
+/// near the resolutions the palpation loop can step within its budget.
+struct CellSizeRule {
+  double max_mm = 2.0;
+  double cells_through_height = 5.0;
+  double cell_size_mm(double height_mm) const;
+  std::string describe() const;  ///< "min(2 mm, disc height / 5)"
+};
+void validate(const CellSizeRule& rule);  ///< throws std::invalid_argument naming the option
+
+/// The cell size of a level's disc under `rule`.
+double default_level_cell_size_mm(const std::string& level, const std::string& data_dir,
+                                  const CellSizeRule& rule = CellSizeRule());
 
 /// A level's disc as the protocol meshes it, and its second resolution for the transfer check.
 struct LevelMeshes {
@@ -46,7 +58,8 @@ LevelMeshes mesh_level(const std::string& level,
 struct AllLevelsRequest {
   std::string data_dir;                ///< the morphometry's folder (disc_morphometry.csv)
   CalibrationRequest calibration;      ///< per level; its transfer_meshes must be empty
-  std::optional<double> cell_size_mm;  ///< every level's; default: default_level_cell_size_mm
+  std::optional<double> cell_size_mm;  ///< every level's; default: by cell_size_rule
+  CellSizeRule cell_size_rule;         ///< when cell_size_mm is not set
   bool transfer = true;                ///< check each level on its second resolution
   /// Set: calibrate each level's structured disc of these options (the mesh the spine's offline
   /// discs simulate) instead of the CGAL disc; its second resolution has 4 more sectors.

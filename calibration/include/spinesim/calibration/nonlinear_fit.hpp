@@ -83,6 +83,20 @@ struct NonlinearCaseError {
   std::string message;  ///< why the MSS solve did not converge
 };
 
+/// How the MSS's equilibrium at a reference pose is found: Newton from the FEM's displacement
+/// field; then, where that does not converge, the plate moved to the pose in equal steps of its
+/// translation and rotation vector from rest, each solve started from the last equilibrium.
+enum class PoseStart { fem_field_then_steps, fem_field, pose_steps };
+inline constexpr int kPoseSteps = 8;
+
+/// The MSS with its superior plate at the reference case's pose (as nonlinear_errors and the fit
+/// solve it); a failure's message says what each start tried.
+mss::StaticResult mss_at_reference_pose(const mss::MssModel& model,
+                                        const NonlinearReference& reference,
+                                        const NonlinearReferenceCase& c,
+                                        const mss::StaticOptions& options = {},
+                                        PoseStart start = PoseStart::fem_field_then_steps);
+
 /// Every reference case; `train` names the training cases (for the flag only).
 std::vector<NonlinearCaseError> nonlinear_errors(const mss::MssModel& model,
                                                  const NonlinearReference& reference,

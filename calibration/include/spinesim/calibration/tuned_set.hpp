@@ -30,6 +30,9 @@ TunedSet read_tuned_set(const std::string& path);
 
 /// The shipped file's path under a data folder: DATA_DIR/tuned_discs.json.
 std::string shipped_tuned_set_path(const std::string& data_dir);
+/// The shipped fibre-network set (the nonlinear fibre-reinforced disc, fitted at the palpated
+/// discs' resolution): DATA_DIR/tuned_fibre_discs.json.
+std::string shipped_fibre_tuned_set_path(const std::string& data_dir);
 
 /// One level's entry; throws std::invalid_argument naming the levels present when missing.
 const TunedDisc& tuned_level(const TunedSet& set, const std::string& level);
