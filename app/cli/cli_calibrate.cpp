@@ -326,6 +326,22 @@ void add_nonlinear_options(CLI::App* cmd, CalibrateArgs& args) {
       ->capture_default_str();
 }
 
+/// The CGAL cell size of --level: one size, or the per-level rule of --level all.
+void add_cell_size_options(CLI::App* cmd, CalibrateArgs& args) {
+  CalibrateArgs* a = &args;
+  a->cell_size_option = cmd->add_option("--cell-size", a->cell_size_mm,
+                                        "With --level: CGAL cell size, mm (--level all without it: "
+                                        "min(2, disc height / 5) per level)")
+                            ->capture_default_str();
+  cmd->add_option("--max-cell-size", a->cell_size_rule.max_mm,
+                  "--level all: the largest cell, mm (each level: min(this, height / "
+                  "--cells-through-height))")
+      ->capture_default_str();
+  cmd->add_option("--cells-through-height", a->cell_size_rule.cells_through_height,
+                  "--level all: cells through each disc's height (at most --max-cell-size each)")
+      ->capture_default_str();
+}
+
 }  // namespace
 
 void register_calibrate(CLI::App& app) {
@@ -338,17 +354,7 @@ void register_calibrate(CLI::App& app) {
                   "Or mesh this level's parametric disc (T1-T2 ... L5-S1); `all`: every level into "
                   "one tuned-set file "
                   "(as data/tuned_discs.json)");
-  a->cell_size_option = cmd->add_option("--cell-size", a->cell_size_mm,
-                                        "With --level: CGAL cell size, mm (--level all without it: "
-                                        "min(2, disc height / 5) per level)")
-                            ->capture_default_str();
-  cmd->add_option("--max-cell-size", a->cell_size_rule.max_mm,
-                  "--level all: the largest cell, mm (each level: min(this, height / "
-                  "--cells-through-height))")
-      ->capture_default_str();
-  cmd->add_option("--cells-through-height", a->cell_size_rule.cells_through_height,
-                  "--level all: cells through each disc's height (at most --max-cell-size each)")
-      ->capture_default_str();
+  add_cell_size_options(cmd, *a);
   cmd->add_option(
          "--material", a->material,
          "Preset (real-disc, annulus-nucleus, fibre-reinforced, rubber, polyethylene) or JSON "

@@ -147,7 +147,10 @@ void add_disc_flags(CLI::App* run, HapticsRunRequest& request) {
   run->add_option("--level", request.scene.level, "--scene disc: the disc level (T1-T2 ... L5-S1)")
       ->capture_default_str();
   run->add_option("--params", request.disc_params,
-                  "--scene disc: tuned set or tuned.json (default: data/tuned_discs.json)");
+                  "--scene disc: tuned set or tuned.json, or a shipped set: fibre-reinforced "
+                  "(the default: the nonlinear fibre disc's fibre network, "
+                  "data/tuned_fibre_discs.json) or real-disc (the linear isotropic disc's, "
+                  "data/tuned_discs.json)");
   run->add_option("--disc-budget-us", request.disc_budget_us,
                   "--scene disc: the disc step's p99 must fit this; at start the finest mesh "
                   "(2, 2.5, 3, 4 mm cells) that does is chosen")

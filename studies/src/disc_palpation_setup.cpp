@@ -25,6 +25,13 @@ std::pair<Eigen::Vector3d, Eigen::Vector3d> disc_anterior_wall(const mesh::TetMe
   return {disc.V.row(best).transpose(), A.col(2)};
 }
 
+std::string palpation_params_path(const std::string& params, const std::string& data_dir) {
+  if (params.empty() || params == "fibre-reinforced")
+    return calibration::shipped_fibre_tuned_set_path(data_dir);
+  if (params == "real-disc") return calibration::shipped_tuned_set_path(data_dir);
+  return params;
+}
+
 namespace {
 
 /// The step's percentiles with the probe pressed 2 mm into the anterior wall (after 50 steps of
@@ -56,8 +63,7 @@ DiscSetup make_disc_setup(const DiscSceneRequest& request, const std::string& da
   if (request.cell_sizes_mm.empty())
     throw std::invalid_argument("disc palpation: no candidate resolution");
   DiscSetup s;
-  s.tuned_file =
-      request.params.empty() ? (fs::path(data_dir) / "tuned_discs.json").string() : request.params;
+  s.tuned_file = palpation_params_path(request.params, data_dir);
   // The level and its tuned parameters, refused before any meshing.
   mesh::disc_dimensions(request.level, data_dir);
   std::optional<calibration::TunedSet> set;

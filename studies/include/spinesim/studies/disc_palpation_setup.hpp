@@ -17,9 +17,14 @@
 
 namespace spinesim::studies {
 
+/// The palpated disc's parameters: "" or "fibre-reinforced" name the shipped fibre-network set
+/// (data/tuned_fibre_discs.json: the nonlinear fibre-reinforced disc), "real-disc" the shipped
+/// linear set (data/tuned_discs.json: the isotropic real-disc); anything else is a file's path.
+std::string palpation_params_path(const std::string& params, const std::string& data_dir);
+
 struct DiscSceneRequest {
   std::string level = "L4-L5";
-  std::string params;      ///< tuned set or tuned.json; "": data/tuned_discs.json
+  std::string params;      ///< tuned set or tuned.json, or a shipped set's name (below)
   double budget_us = 500;  ///< the disc step's p99 must fit this (half the 1 ms tick)
   std::vector<double> cell_sizes_mm = {2.0, 2.5, 3.0, 4.0};  ///< finest first
   int min_tets = 5000;  ///< below this the note says the target resolution was not held

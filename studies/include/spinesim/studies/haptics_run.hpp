@@ -88,7 +88,7 @@ struct HapticsRunRequest {
   /// spine::solve_seated; the hook pushes on the seated spine leaning on the backrest).
   std::string posture = "standing";
   spine::Chair chair;
-  /// Disc palpation (scene "disc"): the tuned parameters ("": data/tuned_discs.json) and the
+  /// Disc palpation (scene "disc"): the tuned parameters (palpation_params_path) and the
   /// budget the disc's step must fit (us); the coupling is coupling_stiffness/damping.
   std::string disc_params;
   double disc_budget_us = 500;
