@@ -29,6 +29,10 @@ std::string palpation_params_path(const std::string& params, const std::string& 
   if (params.empty() || params == "fibre-reinforced")
     return calibration::shipped_fibre_tuned_set_path(data_dir);
   if (params == "real-disc") return calibration::shipped_tuned_set_path(data_dir);
+  if (!fs::exists(params))
+    throw std::invalid_argument("--params '" + params +
+                                "': no such file (or name a shipped set: fibre-reinforced, "
+                                "real-disc)");
   return params;
 }
 

@@ -18,7 +18,15 @@ TEST(DiscPalpationSetup, TheDefaultIsTheFibreSetAndTheShippedSetsHaveNames) {
   EXPECT_EQ(palpation_params_path("fibre-reinforced", kData),
             calibration::shipped_fibre_tuned_set_path(kData));
   EXPECT_EQ(palpation_params_path("real-disc", kData), calibration::shipped_tuned_set_path(kData));
-  EXPECT_EQ(palpation_params_path("my/tuned.json", kData), "my/tuned.json");
+  const std::string file = calibration::shipped_tuned_set_path(kData);  // any existing file
+  EXPECT_EQ(palpation_params_path(file, kData), file);
+  try {  // a name that is neither a shipped set nor a file says which names there are
+    palpation_params_path("fibre", kData);
+    ADD_FAILURE() << "an unknown name was taken";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("fibre-reinforced, real-disc"), std::string::npos)
+        << e.what();
+  }
 }
 
 // At 4 mm on L4-L5 (the budget check's coarsest disc): the default builds the fibre network of

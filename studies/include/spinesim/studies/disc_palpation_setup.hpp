@@ -19,7 +19,8 @@ namespace spinesim::studies {
 
 /// The palpated disc's parameters: "" or "fibre-reinforced" name the shipped fibre-network set
 /// (data/tuned_fibre_discs.json: the nonlinear fibre-reinforced disc), "real-disc" the shipped
-/// linear set (data/tuned_discs.json: the isotropic real-disc); anything else is a file's path.
+/// linear set (data/tuned_discs.json: the isotropic real-disc); anything else is a file's path,
+/// which must exist (std::invalid_argument naming the shipped sets otherwise).
 std::string palpation_params_path(const std::string& params, const std::string& data_dir);
 
 struct DiscSceneRequest {
