@@ -52,7 +52,8 @@ struct CalibrateArgs {
   bool no_transfer = false;
   bool no_check = false, json = false, quiet = false;
   bool per_spring = false;
-  bool structured = false;  ///< the level's structured (haptic-resolution) disc, default options
+  bool structured = false;  ///< the level's structured (haptic-resolution) disc
+  mesh::StructuredDiscOptions structured_options;  ///< its resolution (--sectors, ...)
   calibration::PerSpringWeights per_spring_weights;
   CLI::Option* smoothness_option = nullptr;
   int per_spring_max_iterations = calibration::per_spring_ipopt_defaults().max_iterations;
@@ -86,10 +87,13 @@ void run_all_levels(const CalibrateArgs& a, const CalibrationRequest& rq,
   if (a.cell_size_option->count()) all.cell_size_mm = a.cell_size_mm;
   all.cell_size_rule = a.cell_size_rule;
   all.transfer = !a.no_transfer;
-  if (a.structured) all.structured = mesh::StructuredDiscOptions();
+  if (a.structured) all.structured = a.structured_options;
   std::ostringstream cmd;
-  cmd << "spinesim calibrate --level all" << (a.structured ? " --structured" : "")
-      << (a.cell_size_option->count() ? " --cell-size " + std::to_string(a.cell_size_mm)
+  cmd << "spinesim calibrate --level all" << (a.structured ? " --structured" : "");
+  if (a.structured && (a.given("--sectors") || a.given("--rings") || a.given("--layers")))
+    cmd << " --sectors " << a.structured_options.sectors << " --rings "
+        << a.structured_options.rings << " --layers " << a.structured_options.layers;
+  cmd << (a.cell_size_option->count() ? " --cell-size " + std::to_string(a.cell_size_mm)
                                       : std::string())
       << (a.given("--max-cell-size") ? " --max-cell-size " + fixed(a.cell_size_rule.max_mm, 2)
                                      : std::string())
@@ -143,6 +147,11 @@ void check_files_and_modes(const CalibrateArgs& a) {
     throw std::invalid_argument("--structured meshes a level: give --level, not --mesh");
   if (a.structured && a.cell_size_option->count())
     throw std::invalid_argument("--cell-size is the CGAL mesher's: --structured takes none");
+  if (!a.structured && (a.given("--sectors") || a.given("--rings") || a.given("--layers")))
+    throw std::invalid_argument(
+        "--sectors, --rings and --layers size the structured disc: add "
+        "--structured");
+  if (a.structured) mesh::validate(a.structured_options);
   if (a.order != 1 && a.order != 2) throw std::invalid_argument("--order must be 1 or 2");
   if (!(a.cell_size_mm > 0)) throw std::invalid_argument("--cell-size must be > 0 mm");
   const bool rule_given = a.given("--max-cell-size") || a.given("--cells-through-height");
@@ -281,7 +290,7 @@ void run_calibrate(const CalibrateArgs& a) {
     m = mesh::read_tet_mesh(a.mesh_path);
   } else {  // as `mesh disc --level [--structured]`
     std::optional<mesh::StructuredDiscOptions> structured;
-    if (a.structured) structured.emplace();
+    if (a.structured) structured = a.structured_options;
     calibration::LevelMeshes meshes = calibration::mesh_level(
         a.level, structured, a.cell_size_mm,
         !a.nonlinear && !a.no_transfer && a.transfer_meshes.empty(), data_dir(), status);
@@ -395,7 +404,16 @@ void register_calibrate(CLI::App& app) {
   cmd->add_flag("--structured", a->structured,
                 "With --level: calibrate the level's structured disc (12 sectors x 3 rings x 2 "
                 "layers, as `mesh disc --structured`: the mesh the spine's offline discs simulate; "
-                "its second resolution has 16 sectors)");
+                "its second resolution has 4 more sectors)");
+  cmd->add_option("--sectors", a->structured_options.sectors,
+                  "With --structured: samples around the outline (>= 6)")
+      ->capture_default_str();
+  cmd->add_option("--rings", a->structured_options.rings,
+                  "With --structured: point rings, rim and nucleus boundary included (>= 2)")
+      ->capture_default_str();
+  cmd->add_option("--layers", a->structured_options.layers,
+                  "With --structured: tet layers through the height (>= 1)")
+      ->capture_default_str();
   cmd->add_flag("--no-transfer", a->no_transfer, "With --level: skip the second-resolution check");
   cmd->add_flag("--per-spring", a->per_spring,
                 "After the region fit, one stiffness multiplier per main spring "

@@ -4,7 +4,7 @@
 //
 //   spinesim haptics run --scene spine --device sim --script data/haptics/drag_t1_lateral.csv \
 //       --record drag.csv
-//   spinesim spine discs --record drag.csv --out discs-out [--params data/tuned_structured_discs.json]
+//   spinesim spine discs --record drag.csv --out discs-out [--params real-disc|fibre-reinforced|SET.json]
 #include "cli_common.hpp"
 
 #include "spinesim/studies/spine_discs.hpp"
@@ -50,8 +50,10 @@ void register_spine_discs(CLI::App& spine) {
   cmd->add_option("--out", a->request.out, "Output folder (created; its parent must exist)")
       ->required();
   cmd->add_option("--params", a->request.tuned,
-                  "Tuned set of the structured discs (default: data/tuned_structured_discs.json; "
-                  "each level must have been calibrated on its structured disc)");
+                  "Tuned set of the structured discs: real-disc (default; the linear "
+                  "calibration, data/tuned_structured_discs.json), fibre-reinforced (the fibre "
+                  "networks of the nonlinear disc, data/tuned_structured_fibre_discs.json) or a "
+                  "file; each level must have been calibrated on its structured disc");
   cmd->add_option("--frame-period", a->request.frame_period_s,
                   "A ParaView frame and disc_motion.csv rows every this many seconds")
       ->capture_default_str();
@@ -68,8 +70,9 @@ void register_spine_discs(CLI::App& spine) {
                 "is kept; ~50x slower)");
   add_output_flags(cmd, a->json, a->quiet, "the summary and per-disc table as JSON");
   cmd->footer(
-      "Each disc: the level's structured disc (12 sectors x 3 rings x 2 layers) in the spine "
-      "frame, inferior\nendplate on the lower vertebra, superior on the upper (the sacrum fixed), "
+      "Each disc: the level's structured disc at the resolution its set was calibrated on "
+      "(real-disc:\n12 sectors x 3 rings x 2 layers) in the spine frame, inferior\nendplate on the "
+      "lower vertebra, superior on the upper (the sacrum fixed), "
       "implicit Euler at 1 ms\n(one step per recorded tick), started at its static equilibrium "
       "in the first recorded posture.\nWritten: OUT/spine.pvd (part 0 discs: displacement, "
       "volume_change, spring_strain, disc; part 1\nvertebrae), OUT/discs.csv (peaks per disc), "

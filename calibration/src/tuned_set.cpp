@@ -70,6 +70,32 @@ std::string shipped_fibre_tuned_set_path(const std::string& data_dir) {
   return data_dir + "/tuned_fibre_discs.json";
 }
 
+std::string shipped_structured_tuned_set_path(const std::string& data_dir) {
+  return data_dir + "/tuned_structured_discs.json";
+}
+
+std::string shipped_structured_fibre_tuned_set_path(const std::string& data_dir) {
+  return data_dir + "/tuned_structured_fibre_discs.json";
+}
+
+mesh::StructuredDiscOptions structured_resolution(const TunedSet& set) {
+  mesh::StructuredDiscOptions o;
+  const auto it = set.settings.find("structured");
+  if (it == set.settings.end()) return o;
+  try {
+    o.sectors = it->at("sectors").get<int>();
+    o.rings = it->at("rings").get<int>();
+    o.layers = it->at("layers").get<int>();
+    o.match_area = it->value("match_area", false);
+  } catch (const nlohmann::json::exception&) {
+    throw std::invalid_argument(
+        "tuned set: settings.structured must have integer sectors, rings and layers (and a "
+        "boolean match_area)");
+  }
+  mesh::validate(o);
+  return o;
+}
+
 const TunedDisc& tuned_level(const TunedSet& set, const std::string& level) {
   auto it = set.levels.find(level);
   if (it != set.levels.end()) return it->second;

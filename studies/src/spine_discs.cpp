@@ -248,9 +248,25 @@ std::string table_csv(const SpineDiscsResult& r) {
 
 }  // namespace
 
-SpineDiscs build_spine_discs(const spine::SpineModel& model, const calibration::TunedSet& tuned,
-                             const mesh::StructuredDiscOptions& options) {
+std::string spine_discs_params_path(const std::string& params, const std::string& data_dir) {
+  if (params.empty() || params == "real-disc")
+    return calibration::shipped_structured_tuned_set_path(data_dir);
+  if (params == "fibre-reinforced")
+    return calibration::shipped_structured_fibre_tuned_set_path(data_dir);
+  if (!fs::exists(params))
+    throw std::invalid_argument("--params '" + params +
+                                "': no such file (or name a shipped set: real-disc, "
+                                "fibre-reinforced)");
+  return params;
+}
+
+SpineDiscs build_spine_discs(const spine::SpineModel& model, const calibration::TunedSet& tuned) {
+  const mesh::StructuredDiscOptions options = calibration::structured_resolution(tuned);
+  const std::string resolution = std::to_string(options.sectors) + " sectors x " +
+                                 std::to_string(options.rings) + " rings x " +
+                                 std::to_string(options.layers) + " layers";
   SpineDiscs d;
+  d.resolution = resolution;
   for (const std::string& level : mesh::disc_levels()) {
     const calibration::TunedDisc& entry = calibration::tuned_level(tuned, level);
     const mesh::TetMesh m = mesh::mesh_structured_level(level, options, studies::data_dir());
@@ -258,7 +274,7 @@ SpineDiscs build_spine_discs(const spine::SpineModel& model, const calibration::
     if (!(entry.mesh == here))
       throw std::invalid_argument(
           level + ": its tuned parameters were fitted on another mesh (" + mesh_label(entry.mesh) +
-          ") than the structured disc simulated (" + mesh_label(here) +
+          ") than the structured disc simulated (" + resolution + ", " + mesh_label(here) +
           "): calibrate the structured discs with `spinesim calibrate --level all --structured`");
     d.levels.push_back(level);
     d.models.push_back(calibration::build_tuned_model(entry, m, entry.materials()));
@@ -283,10 +299,9 @@ SpineDiscsResult run_spine_discs(const SpineDiscsRequest& request, const std::st
   r.fingerprint = rec.fingerprint;
   r.recording_complete = rec.complete;
   r.recording_incomplete = rec.incomplete_reason;
-  const std::string tuned_path = request.tuned.empty()
-                                     ? (fs::path(data_dir) / "tuned_structured_discs.json").string()
-                                     : request.tuned;
+  const std::string tuned_path = spine_discs_params_path(request.tuned, data_dir);
   const SpineDiscs discs = build_spine_discs(model, calibration::read_tuned_set(tuned_path));
+  r.resolution = discs.resolution;
   VertebraSurfacesResult surfaces;
   if (request.vertebra_triangles > 0) {
     VertebraSurfacesRequest vs;
@@ -395,7 +410,8 @@ nlohmann::json spine_discs_json(const SpineDiscsResult& r) {
           {"diverged", !r.diverged.empty()},
           {"diverged_reason", r.diverged},
           {"spine_model", r.fingerprint},
-          {"tuned", r.request.tuned.empty() ? "data/tuned_structured_discs.json" : r.request.tuned},
+          {"tuned", r.request.tuned.empty() ? "real-disc" : r.request.tuned},
+          {"resolution", r.resolution},
           {"integrator", "implicit Euler"},
           {"dt_s", 1e-3},
           {"newton_iterations", r.request.newton_iterations},
@@ -419,8 +435,9 @@ nlohmann::json spine_discs_json(const SpineDiscsResult& r) {
 
 std::string spine_discs_table(const SpineDiscsResult& r) {
   std::ostringstream os;
-  os << "The hybrid spine offline: " << r.discs << " tuned structured discs (" << r.tets
-     << " tets), implicit Euler at 1 ms, " << r.steps << " steps of " << r.request.recording
+  os << "The hybrid spine offline: " << r.discs << " tuned structured discs (" << r.resolution
+     << ", " << r.tets << " tets; " << (r.request.tuned.empty() ? "real-disc" : r.request.tuned)
+     << "), implicit Euler at 1 ms, " << r.steps << " steps of " << r.request.recording
      << (r.recording_complete ? "" : " (not whole: " + r.recording_incomplete + ")") << "\n"
      << "stepping " << fixed(r.stepping_s, 2) << " s for " << fixed(r.simulated_s, 2)
      << " s simulated: " << fixed(r.speedup(), 2) << "x real time ("

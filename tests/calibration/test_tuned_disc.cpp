@@ -572,6 +572,42 @@ TEST(PerSpringFile, ATunedSetRefusesIt) {
   }
 }
 
+TEST(TunedSet, StructuredResolutionIsTheRecordedOneOrTheDefault) {
+  TunedSet set;
+  const mesh::StructuredDiscOptions defaults;
+  mesh::StructuredDiscOptions r = structured_resolution(set);
+  EXPECT_EQ(r.sectors, defaults.sectors);
+  EXPECT_EQ(r.rings, defaults.rings);
+  EXPECT_EQ(r.layers, defaults.layers);
+  EXPECT_EQ(r.match_area, defaults.match_area);
+  set.settings["structured"] = {{"sectors", 24}, {"rings", 4}, {"layers", 4}, {"match_area", true}};
+  r = structured_resolution(set);
+  EXPECT_EQ(r.sectors, 24);
+  EXPECT_EQ(r.rings, 4);
+  EXPECT_EQ(r.layers, 4);
+  EXPECT_TRUE(r.match_area);
+  // It survives the file.
+  set.material_name = two_materials().name;
+  set.levels.emplace("L4-L5", sample_tuned(l4l5_mesh()));
+  EXPECT_EQ(structured_resolution(tuned_set_from_json(to_json(set))).sectors, 24);
+}
+
+TEST(TunedSet, MalformedStructuredResolutionIsRefusedInOneLine) {
+  for (const json bad : {json({{"sectors", 24}, {"rings", 4}}),
+                         json({{"sectors", "24"}, {"rings", 4}, {"layers", 4}}),
+                         json({{"sectors", 5}, {"rings", 4}, {"layers", 4}}),
+                         json({{"sectors", 24}, {"rings", 1}, {"layers", 4}}), json(3)}) {
+    TunedSet set;
+    set.settings["structured"] = bad;
+    try {
+      structured_resolution(set);
+      ADD_FAILURE() << "accepted " << bad.dump();
+    } catch (const std::invalid_argument& e) {
+      EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
+    }
+  }
+}
+
 // A file whose "format" is not a string (found by the fuzzer: the set-or-disc dispatch threw
 // nlohmann's type_error, which ended the program) is refused in one line like any bad file.
 TEST(TunedDiscRefuses, FormatThatIsNotAStringInAFile) {

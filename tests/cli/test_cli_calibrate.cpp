@@ -287,6 +287,13 @@ TEST(CalibrateCliRefuses, BadOptions) {
                          "--max-cell-size", out);
   expect_refused_without(run_spinesim("calibrate --level all --cells-through-height 0" + to),
                          "--cells-through-height", out);
+  // The structured resolution is the structured disc's; a bad one is refused before meshing.
+  expect_refused_without(run_spinesim("calibrate --level L4-L5 --sectors 24" + to), "--structured",
+                         out);
+  expect_refused_without(run_spinesim("calibrate --level all --structured --rings 1" + to), "rings",
+                         out);
+  expect_refused_without(run_spinesim("calibrate --level all --structured --sectors 5" + to),
+                         "sectors", out);
   expect_refused_without(run_spinesim("calibrate" + mesh + " --material unobtainium" + to),
                          "unobtainium", out);
   expect_refused_without(

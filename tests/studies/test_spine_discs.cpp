@@ -121,6 +121,40 @@ TEST(SpineDiscs, ASetFittedOnOtherMeshesOrMissingALevelIsRefused) {
   }
 }
 
+// The discs are meshed at the resolution the set records: the shipped linear set's 12 x 3 x 2
+// entries do not fit a 16-sector disc, and the refusal names the resolution simulated.
+TEST(SpineDiscs, TheSetsRecordedResolutionIsTheMeshSimulated) {
+  EXPECT_EQ(st::build_spine_discs(model(), structured_set()).resolution,
+            "12 sectors x 3 rings x 2 layers");
+  cal::TunedSet other = structured_set();
+  other.settings["structured"] = {{"sectors", 16}, {"rings", 3}, {"layers", 2}};
+  try {
+    st::build_spine_discs(model(), other);
+    ADD_FAILURE() << "12-sector entries were accepted for 16-sector discs";
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("fitted on another mesh"), std::string::npos) << what;
+    EXPECT_NE(what.find("16 sectors x 3 rings x 2 layers"), std::string::npos) << what;
+  }
+}
+
+TEST(SpineDiscs, ParamsNameAShippedSetOrAFile) {
+  const std::string data = SPINESIM_DATA_DIR;
+  EXPECT_EQ(st::spine_discs_params_path("", data), data + "/tuned_structured_discs.json");
+  EXPECT_EQ(st::spine_discs_params_path("real-disc", data), data + "/tuned_structured_discs.json");
+  EXPECT_EQ(st::spine_discs_params_path("fibre-reinforced", data),
+            data + "/tuned_structured_fibre_discs.json");
+  const std::string file = data + "/tuned_discs.json";
+  EXPECT_EQ(st::spine_discs_params_path(file, data), file);
+  try {
+    st::spine_discs_params_path("fibre", data);
+    ADD_FAILURE() << "an unknown name was taken for a file";
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("real-disc, fibre-reinforced"), std::string::npos) << what;
+  }
+}
+
 TEST(SpineDiscs, StillSpineLeavesEveryDiscAtRest) {
   st::SpineDiscsRequest rq;
   rq.recording = recording("still.csv", 40, -1, [](int) { return Eigen::Vector3d::Zero(); });

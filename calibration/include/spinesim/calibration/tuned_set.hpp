@@ -7,6 +7,7 @@
 #pragma once
 
 #include "spinesim/calibration/tuned_disc.hpp"
+#include "spinesim/mesh/structured_disc.hpp"
 
 #include <map>
 #include <string>
@@ -33,6 +34,17 @@ std::string shipped_tuned_set_path(const std::string& data_dir);
 /// The shipped fibre-network set (the nonlinear fibre-reinforced disc, fitted at the palpated
 /// discs' resolution): DATA_DIR/tuned_fibre_discs.json.
 std::string shipped_fibre_tuned_set_path(const std::string& data_dir);
+
+/// The shipped sets of the spine's offline (structured) discs: the linear calibration
+/// (DATA_DIR/tuned_structured_discs.json) and the fibre network of the nonlinear fibre-reinforced
+/// disc (DATA_DIR/tuned_structured_fibre_discs.json).
+std::string shipped_structured_tuned_set_path(const std::string& data_dir);
+std::string shipped_structured_fibre_tuned_set_path(const std::string& data_dir);
+
+/// The structured-disc resolution a set was calibrated on (its settings' "structured" object,
+/// written by `calibrate --level all --structured`); the default resolution when the set records
+/// none. Throws std::invalid_argument (one line) for a malformed or invalid resolution.
+mesh::StructuredDiscOptions structured_resolution(const TunedSet& set);
 
 /// One level's entry; throws std::invalid_argument naming the levels present when missing.
 const TunedDisc& tuned_level(const TunedSet& set, const std::string& level);

@@ -9,7 +9,9 @@
 // Each disc must have been calibrated on the very mesh simulated (its tuned entry's mesh
 // fingerprint): the coarse structured discs do not inherit the fine CGAL meshes' scales well
 // (docs/benchmarks.md, "The hybrid spine offline"), so data/tuned_structured_discs.json holds
-// their own (`spinesim calibrate --level all --structured`).
+// their own (`spinesim calibrate --level all --structured`). A set records the structured
+// resolution it was fitted on, and the discs are meshed at it: the fibre networks of the
+// nonlinear disc (data/tuned_structured_fibre_discs.json) need finer discs than the linear set.
 //
 // Written to the output folder:
 //   spine.pvd + spine/  ParaView time series, two parts per frame: part 0 all 17 discs in one
@@ -50,17 +52,26 @@ struct SpineDiscs {
   /// Per disc: index of the upper and lower vertebra in the spine model (T1 = 0 … L5 = 16); the
   /// lower of L5-S1 is -1 (the sacrum, fixed).
   std::vector<int> upper, lower;
+  std::string resolution;  ///< the structured discs' "S sectors x R rings x L layers"
 };
 
-/// Builds the discs. Throws std::invalid_argument (one line) for a level missing from `tuned`,
-/// or an entry fitted on another mesh than this level's structured disc (naming both meshes and
-/// how to calibrate the structured ones), or another material than the set's.
-SpineDiscs build_spine_discs(const spine::SpineModel& model, const calibration::TunedSet& tuned,
-                             const mesh::StructuredDiscOptions& options = {});
+/// What `spine discs --params` names: "" or "real-disc" the shipped linear set
+/// (data/tuned_structured_discs.json), "fibre-reinforced" the shipped fibre networks of the
+/// nonlinear disc (data/tuned_structured_fibre_discs.json); anything else is a file's path, which
+/// must exist (std::invalid_argument naming the shipped sets otherwise).
+std::string spine_discs_params_path(const std::string& params, const std::string& data_dir);
+
+/// Builds the discs, each meshed at the structured resolution the set was calibrated on
+/// (calibration::structured_resolution). Throws std::invalid_argument (one line) for a level
+/// missing from `tuned`, or an entry fitted on another mesh than this level's structured disc
+/// (naming both meshes and how to calibrate the structured ones), or another material than the
+/// set's.
+SpineDiscs build_spine_discs(const spine::SpineModel& model, const calibration::TunedSet& tuned);
 
 struct SpineDiscsRequest {
-  std::string recording;         ///< a compliant-stage recording (haptic_recording.hpp)
-  std::string tuned;             ///< tuned set; empty: data/tuned_structured_discs.json
+  std::string recording;  ///< a compliant-stage recording (haptic_recording.hpp)
+  std::string
+      tuned;  ///< tuned set's path or a shipped name (spine_discs_params_path); empty: real-disc
   std::string out;               ///< output folder (created if missing; its parent must exist)
   double frame_period_s = 0.05;  ///< a .pvd frame (and disc_motion.csv rows) this often
   int vertebra_triangles = 500;  ///< per vertebra surface in the series; 0: no vertebrae
@@ -93,6 +104,7 @@ struct SpineDiscsResult {
   std::string diverged;
   int steps = 0, frames = 0, discs = 0;
   long tets = 0;
+  std::string resolution;  ///< the structured discs' (SpineDiscs::resolution)
   /// Simulated time; wall-clock of the steps alone, of the per-step measurements (reactions,
   /// volumes, inverted tets: one force evaluation a disc) and of the whole run.
   double simulated_s = 0, stepping_s = 0, measuring_s = 0, total_s = 0;
