@@ -17,15 +17,12 @@ const TunedSet& shipped() {
   return set;
 }
 
-TEST(ShippedFibreDiscs, EveryLevelIsAFibreNetworkFittedToTheNonlinearDisc) {
-  const TunedSet& set = shipped();
+/// Every level of `set` is a P2-fitted fibre network whose fit beats the untuned network.
+void expect_fibre_networks_fitted_to_the_nonlinear_disc(const TunedSet& set) {
   EXPECT_EQ(set.material_name, "fibre-reinforced");
-  EXPECT_EQ(set.settings["cell_size_rule"], CellSizeRule({4.0, 2.5}).describe());
   for (const std::string& level : mesh::disc_levels()) {
     SCOPED_TRACE(level);
     const TunedDisc& d = tuned_level(set, level);
-    EXPECT_DOUBLE_EQ(set.settings["cell_size_mm"][level].get<double>(),
-                     default_level_cell_size_mm(level, SPINESIM_DATA_DIR, {4.0, 2.5}));
     EXPECT_EQ(d.fem_order, 2);
     EXPECT_TRUE(d.options.fibre_springs);
     EXPECT_TRUE(d.options.isochoric_fibres);
@@ -50,6 +47,31 @@ TEST(ShippedFibreDiscs, EveryLevelIsAFibreNetworkFittedToTheNonlinearDisc) {
       EXPECT_EQ(levels, std::set<double>({0.1, 1.0})) << part;
     }
   }
+}
+
+TEST(ShippedFibreDiscs, EveryLevelIsAFibreNetworkFittedToTheNonlinearDisc) {
+  const TunedSet& set = shipped();
+  EXPECT_EQ(set.settings["cell_size_rule"], CellSizeRule({4.0, 2.5}).describe());
+  for (const std::string& level : mesh::disc_levels())
+    EXPECT_DOUBLE_EQ(set.settings["cell_size_mm"][level].get<double>(),
+                     default_level_cell_size_mm(level, SPINESIM_DATA_DIR, {4.0, 2.5}))
+        << level;
+  expect_fibre_networks_fitted_to_the_nonlinear_disc(set);
+}
+
+// The spine's offline discs with fibres (data/tuned_structured_fibre_discs.json, `calibrate
+// --level all --structured --sectors 24 --rings 4 --layers 4 --material fibre-reinforced
+// --nonlinear --order 2`): the resolution it records is the one it was fitted on.
+TEST(ShippedStructuredFibreDiscs, EveryLevelIsAFibreNetworkAtItsRecordedResolution) {
+  const TunedSet set = read_tuned_set(shipped_structured_fibre_tuned_set_path(SPINESIM_DATA_DIR));
+  const mesh::StructuredDiscOptions r = structured_resolution(set);
+  EXPECT_EQ(r.sectors, 24);
+  EXPECT_EQ(r.rings, 4);
+  EXPECT_EQ(r.layers, 4);
+  for (const std::string& level : mesh::disc_levels())
+    EXPECT_EQ(tuned_level(set, level).mesh.tets, 3 * r.layers * r.sectors * (2 * r.rings - 1))
+        << level;
+  expect_fibre_networks_fitted_to_the_nonlinear_disc(set);
 }
 
 }  // namespace

@@ -186,15 +186,22 @@ TEST(SpineDiscs, StillSpineLeavesEveryDiscAtRest) {
   EXPECT_TRUE(fs::exists(fs::path(rq.out) / "spine" / "spine_000001.vtu"));
 }
 
-TEST(SpineDiscs, PressingT1DownCompressesOnlyT1T2AsAStaticSolveDoes) {
-  const st::SpineDiscs d = st::build_spine_discs(model(), structured_set());
+// Both shipped sets: the linear calibration, and the fibre networks of the nonlinear disc (whose
+// frozen steps are line-searched, mss/README.md).
+class SpineDiscsPress : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(SpineDiscsPress, PressingT1DownCompressesOnlyT1T2AsAStaticSolveDoes) {
+  const std::string params = GetParam();
+  const st::SpineDiscs d = st::build_spine_discs(
+      model(), cal::read_tuned_set(st::spine_discs_params_path(params, SPINESIM_DATA_DIR)));
   const Eigen::Vector3d axis = d.models[0].mesh().frame.axes.col(1);  // T1-T2's axial direction
   const double depth = 0.1;                                           // mm
   st::SpineDiscsRequest rq;
   rq.recording = recording("press.csv", 300, 0, [&](int k) {
     return Eigen::Vector3d(-depth * std::min(1.0, k / 50.0) * axis);
   });
-  rq.out = scratch("press-out").string();
+  rq.tuned = params;
+  rq.out = scratch("press-out-" + params).string();
   rq.frame_period_s = 0.01;
   rq.vertebra_triangles = 0;
   const st::SpineDiscsResult r = st::run_spine_discs(rq, SPINESIM_DATA_DIR);
@@ -219,6 +226,23 @@ TEST(SpineDiscs, PressingT1DownCompressesOnlyT1T2AsAStaticSolveDoes) {
   const Eigen::Vector3d f_static = A.transpose() * s.reaction_wrench.head<3>();
   EXPECT_NEAR(f.y(), f_static.y(), 1e-3 * std::abs(f_static.y()));  // 1e-5 measured
   EXPECT_NEAR(last[2], -depth, 1e-4);                               // dy: the axis shortened
+}
+
+INSTANTIATE_TEST_SUITE_P(ShippedSets, SpineDiscsPress,
+                         ::testing::Values("real-disc", "fibre-reinforced"), [](const auto& info) {
+                           return std::string(info.param) == "real-disc" ? "Linear" : "Fibre";
+                         });
+
+TEST(SpineDiscs, ShippedFibreSetIsMeshedAtItsOwnFinerResolution) {
+  const cal::TunedSet set =
+      cal::read_tuned_set(cal::shipped_structured_fibre_tuned_set_path(SPINESIM_DATA_DIR));
+  const st::SpineDiscs d = st::build_spine_discs(model(), set);
+  EXPECT_EQ(d.resolution, "24 sectors x 4 rings x 4 layers");
+  ASSERT_EQ(d.models.size(), 17u);
+  for (const auto& m : d.models) {
+    EXPECT_EQ(m.mesh().num_tets(), 2016);
+    EXPECT_GT(m.num_fibre_springs(), 0);
+  }
 }
 
 TEST(SpineDiscs, BadRequestsAreRefusedBeforeAnythingIsWritten) {
