@@ -2,6 +2,7 @@
 
 #include "json_file.hpp"
 
+#include <filesystem>
 #include <fstream>
 #include <stdexcept>
 
@@ -76,6 +77,20 @@ std::string shipped_structured_tuned_set_path(const std::string& data_dir) {
 
 std::string shipped_structured_fibre_tuned_set_path(const std::string& data_dir) {
   return data_dir + "/tuned_structured_fibre_discs.json";
+}
+
+std::string tuned_set_path(const std::string& params, const std::vector<ShippedSet>& shipped) {
+  if (shipped.empty()) throw std::invalid_argument("tuned_set_path: no shipped sets");
+  if (params.empty()) return shipped.front().path;
+  std::string names;
+  for (const ShippedSet& s : shipped) {
+    if (params == s.name) return s.path;
+    names += (names.empty() ? "" : ", ") + s.name;
+  }
+  if (!std::filesystem::exists(params))
+    throw std::invalid_argument("--params '" + params +
+                                "': no such file (or name a shipped set: " + names + ")");
+  return params;
 }
 
 mesh::StructuredDiscOptions structured_resolution(const TunedSet& set) {

@@ -5,12 +5,10 @@
 #include "spinesim/mss/boundary.hpp"
 #include "spinesim/studies/toolkit.hpp"
 
-#include <filesystem>
 #include <optional>
 #include <stdexcept>
 
 namespace spinesim::studies {
-namespace fs = std::filesystem;
 
 std::pair<Eigen::Vector3d, Eigen::Vector3d> disc_anterior_wall(const mesh::TetMesh& disc) {
   // In the disc's frame: the node furthest anterior (+z) within the middle third of the height.
@@ -26,14 +24,9 @@ std::pair<Eigen::Vector3d, Eigen::Vector3d> disc_anterior_wall(const mesh::TetMe
 }
 
 std::string palpation_params_path(const std::string& params, const std::string& data_dir) {
-  if (params.empty() || params == "fibre-reinforced")
-    return calibration::shipped_fibre_tuned_set_path(data_dir);
-  if (params == "real-disc") return calibration::shipped_tuned_set_path(data_dir);
-  if (!fs::exists(params))
-    throw std::invalid_argument("--params '" + params +
-                                "': no such file (or name a shipped set: fibre-reinforced, "
-                                "real-disc)");
-  return params;
+  return calibration::tuned_set_path(
+      params, {{"fibre-reinforced", calibration::shipped_fibre_tuned_set_path(data_dir)},
+               {"real-disc", calibration::shipped_tuned_set_path(data_dir)}});
 }
 
 namespace {

@@ -249,15 +249,10 @@ std::string table_csv(const SpineDiscsResult& r) {
 }  // namespace
 
 std::string spine_discs_params_path(const std::string& params, const std::string& data_dir) {
-  if (params.empty() || params == "real-disc")
-    return calibration::shipped_structured_tuned_set_path(data_dir);
-  if (params == "fibre-reinforced")
-    return calibration::shipped_structured_fibre_tuned_set_path(data_dir);
-  if (!fs::exists(params))
-    throw std::invalid_argument("--params '" + params +
-                                "': no such file (or name a shipped set: real-disc, "
-                                "fibre-reinforced)");
-  return params;
+  return calibration::tuned_set_path(
+      params,
+      {{"real-disc", calibration::shipped_structured_tuned_set_path(data_dir)},
+       {"fibre-reinforced", calibration::shipped_structured_fibre_tuned_set_path(data_dir)}});
 }
 
 SpineDiscs build_spine_discs(const spine::SpineModel& model, const calibration::TunedSet& tuned) {

@@ -608,6 +608,28 @@ TEST(TunedSet, MalformedStructuredResolutionIsRefusedInOneLine) {
   }
 }
 
+TEST(TunedSet, ParamsNameTheFirstShippedSetAShippedNameOrAFile) {
+  const std::vector<ShippedSet> shipped = {{"real-disc", "/data/a.json"},
+                                           {"fibre-reinforced", "/data/b.json"}};
+  EXPECT_EQ(tuned_set_path("", shipped), "/data/a.json");
+  EXPECT_EQ(tuned_set_path("real-disc", shipped), "/data/a.json");
+  EXPECT_EQ(tuned_set_path("fibre-reinforced", shipped), "/data/b.json");
+  const std::string file =
+      (std::filesystem::temp_directory_path() / "tuned_set_path.json").string();
+  std::ofstream(file) << "{}";
+  EXPECT_EQ(tuned_set_path(file, shipped), file);
+  std::filesystem::remove(file);
+  try {
+    tuned_set_path("fibre", shipped);
+    ADD_FAILURE() << "accepted an unknown name";
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("real-disc, fibre-reinforced"), std::string::npos) << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+  }
+  EXPECT_THROW(tuned_set_path("", {}), std::invalid_argument);
+}
+
 // A file whose "format" is not a string (found by the fuzzer: the set-or-disc dispatch threw
 // nlohmann's type_error, which ended the program) is refused in one line like any bad file.
 TEST(TunedDiscRefuses, FormatThatIsNotAStringInAFile) {

@@ -11,6 +11,7 @@
 
 #include <map>
 #include <string>
+#include <vector>
 
 namespace spinesim::calibration {
 
@@ -40,6 +41,16 @@ std::string shipped_fibre_tuned_set_path(const std::string& data_dir);
 /// disc (DATA_DIR/tuned_structured_fibre_discs.json).
 std::string shipped_structured_tuned_set_path(const std::string& data_dir);
 std::string shipped_structured_fibre_tuned_set_path(const std::string& data_dir);
+
+/// A shipped set a command offers by name ("real-disc", "fibre-reinforced").
+struct ShippedSet {
+  std::string name;
+  std::string path;
+};
+/// The tuned set a user named with --params: empty names the first of `shipped`; a shipped
+/// set's name gives its path; anything else must be an existing file. Throws
+/// std::invalid_argument (one line, listing the shipped names) otherwise.
+std::string tuned_set_path(const std::string& params, const std::vector<ShippedSet>& shipped);
 
 /// The structured-disc resolution a set was calibrated on (its settings' "structured" object,
 /// written by `calibrate --level all --structured`); the default resolution when the set records
