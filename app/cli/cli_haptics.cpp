@@ -190,7 +190,9 @@ void add_haptics_run_flags(CLI::App* cmd, HapticsRunFlags& f, bool viewer) {
       ->capture_default_str();
   cmd->add_option("--script", f.request.script,
                   "sim: the hand's set-point trajectory, CSV t_s,x_mm,y_mm,z_mm[,button] "
-                  "(default: data/haptics/ for the scene)");
+                  "(default: data/haptics/ for the scene), or hostile:NAME, a trajectory built "
+                  "to break the tick's bounds (teleport, start-inside, sweep, skim, shake, "
+                  "hammer; haptics/README.md)");
   cmd->add_option("--replay", f.request.replay, "replay: a file written by --record");
   cmd->add_option("--sdk-lib", f.request.sdk_library,
                   "openhaptics/dhd: the vendor's shared library (default libHD.so / libdhd.so)");

@@ -32,6 +32,20 @@ Eigen::Vector3d closest_point_on_triangle(const Eigen::Vector3d& p, const Eigen:
   return a + ab * (vb * denom) + ac * (vc * denom);
 }
 
+double winding_number(const AabbTree& tree, const Eigen::Vector3d& p) {
+  const auto& V = tree.vertices();
+  const auto& F = tree.triangles();
+  double sum = 0;
+  for (Eigen::Index t = 0; t < F.rows(); ++t) {
+    const Eigen::Vector3d a = V.row(F(t, 0)).transpose() - p, b = V.row(F(t, 1)).transpose() - p,
+                          c = V.row(F(t, 2)).transpose() - p;
+    const double la = a.norm(), lb = b.norm(), lc = c.norm();
+    sum += 2 * std::atan2(a.dot(b.cross(c)),
+                          la * lb * lc + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la);
+  }
+  return sum / (4 * M_PI);
+}
+
 AabbTree::AabbTree(const Eigen::MatrixX3d& V, const Eigen::MatrixX3i& F) : V_(V), F_(F) {
   if (F.rows() == 0) throw std::invalid_argument("AABB tree: the surface has no triangles");
   if (F.minCoeff() < 0 || F.maxCoeff() >= V.rows())
@@ -122,6 +136,25 @@ int AabbTree::sphere_query(const Eigen::Vector3d& center, double radius, int* ou
     stack[top++] = n.left;
   }
   return found;
+}
+
+double AabbTree::entry(const Eigen::Vector3d& p0, const Eigen::Vector3d& m, double radius,
+                       const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+  // Slabs of the grown box (Kay & Kajiya 1986): the segment is inside all three on [t_in, t_out].
+  double t_in = 0, t_out = 1;
+  for (int k = 0; k < 3; ++k) {
+    const double a = lo[k] - radius, b = hi[k] + radius;
+    if (m[k] == 0) {
+      if (p0[k] < a || p0[k] > b) return 2;
+      continue;
+    }
+    double ta = (a - p0[k]) / m[k], tb = (b - p0[k]) / m[k];
+    if (ta > tb) std::swap(ta, tb);
+    t_in = std::max(t_in, ta);
+    t_out = std::min(t_out, tb);
+    if (t_in > t_out) return 2;
+  }
+  return t_in;
 }
 
 std::vector<int> AabbTree::sphere_query_brute_force(const Eigen::Vector3d& center,

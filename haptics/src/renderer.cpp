@@ -13,11 +13,11 @@ namespace spinesim::haptics {
 // Sphere proxy
 
 SphereProxyRenderer::SphereProxyRenderer(const ProxyParameters& p) : p_(p) {
-  candidates_.resize(8192);
   if (!(p.radius_mm > 0) || !std::isfinite(p.radius_mm))
     throw std::invalid_argument("probe radius must be > 0 mm");
   if (!(p.stiffness_n_per_mm > 0) || !(p.damping_n_s_per_mm >= 0) || !(p.skin_mm > 0))
     throw std::invalid_argument("proxy: stiffness must be > 0, damping >= 0, skin > 0");
+  if (p.max_work < 64) throw std::invalid_argument("proxy: the work bound must be >= 64");
 }
 
 void SphereProxyRenderer::reset(const Eigen::Vector3d& device_mm) {
@@ -105,11 +105,6 @@ double sweep_triangle(const Eigen::Vector3d& p0, const Eigen::Vector3d& m, doubl
 
 }  // namespace
 
-SphereProxyRenderer::SphereProxyRenderer(const ProxyParameters& p, int max_triangles)
-    : SphereProxyRenderer(p) {
-  candidates_.resize(std::size_t(std::max(1, max_triangles)));
-}
-
 RenderOutput SphereProxyRenderer::render(const ProbeState& probe, const Scene& scene,
                                          const ScenePoses& poses, double) {
   RenderOutput out;
@@ -119,43 +114,45 @@ RenderOutput SphereProxyRenderer::render(const ProbeState& probe, const Scene& s
   Eigen::Vector3d goal = device;
   Eigen::Vector3d normals[3];
   int active = 0, touched = -1;
+  int budget = p_.max_work;
 
   for (int iteration = 0; iteration < 4; ++iteration) {
     const Eigen::Vector3d move = goal - proxy;
     const double length = move.norm();
     if (length < 1e-12) break;
-    // Earliest contact along the move, over the triangles near the swept sphere of every body;
-    // the sphere stops `skin` short of it.
-    double t_hit = 2;
+    // Earliest contact along the move over every body, each searched along the swept sphere
+    // (its tree pruned by the earliest contact so far) within what is left of the tick's
+    // budget; the sphere stops `skin` short of it. When the budget runs out, the proxy moves
+    // only as far as the search has proven free and the rest waits for the next tick.
+    double t_hit = 2, t_free = 1;
     int hit_body = -1, hit_triangle = -1;
     for (int bi = 0; bi < scene.size(); ++bi) {
       const AabbTree& tree = scene.body(bi).tree;
       const auto& pose = poses.pose[std::size_t(bi)];
       const Eigen::Vector3d p0 = pose.R.transpose() * (proxy - pose.t);
       const Eigen::Vector3d m = pose.R.transpose() * move;
-      const double reach = 0.5 * length + r + 2 * skin;
-      const int found =
-          tree.sphere_query(p0 + 0.5 * m, reach, candidates_.data(), int(candidates_.size()));
-      out.candidates += found;
-      if (found > int(candidates_.size())) {
-        out.truncated = true;  // too much to check: do not move into the unknown
-        t_hit = 0;
+      if (tree.root_entry(p0, m, r + 2 * skin) >= std::min(t_hit, t_free)) continue;
+      const auto& F = tree.triangles();
+      const auto& V = tree.vertices();
+      const AabbTree::Sweep sweep = tree.sweep(p0, m, r + 2 * skin, budget, [&](int t) {
+        ++out.candidates;
+        return sweep_triangle(p0, m, r + skin, V.row(F(t, 0)), V.row(F(t, 1)), V.row(F(t, 2)),
+                              tree.normal(t));
+      });
+      if (sweep.t < t_hit) {
+        t_hit = sweep.t;
         hit_body = bi;
-        hit_triangle = candidates_[0];
+        hit_triangle = sweep.triangle;
       }
-      const int n = std::min(found, int(candidates_.size()));
-      for (int k = 0; k < n; ++k) {
-        const int t = candidates_[std::size_t(k)];
-        const auto& F = tree.triangles();
-        const auto& V = tree.vertices();
-        const double th = sweep_triangle(p0, m, r + skin, V.row(F(t, 0)), V.row(F(t, 1)),
-                                         V.row(F(t, 2)), tree.normal(t));
-        if (th < t_hit) {
-          t_hit = th;
-          hit_body = bi;
-          hit_triangle = t;
-        }
+      if (!sweep.complete) {
+        out.truncated = true;
+        t_free = std::min(t_free, sweep.t_free);
       }
+    }
+    if (out.truncated && t_free < std::min(t_hit, 1.0)) {
+      // Proven free only up to t_free: go there (short of it by the skin) and stop this tick.
+      proxy += std::max(0.0, t_free - skin / length) * move;
+      break;
     }
     if (t_hit > 1) {
       proxy = goal;
@@ -176,9 +173,10 @@ RenderOutput SphereProxyRenderer::render(const ProbeState& probe, const Scene& s
     n = pose.R * n;
     if (active < 3) normals[active++] = n;
     goal = constrain_goal(proxy, device, normals, active);
-    if (active == 3 || out.truncated) break;
+    if (active == 3) break;
   }
 
+  out.work = p_.max_work - budget;
   const Eigen::Vector3d spring = proxy - device;
   out.contact = touched >= 0 || spring.norm() > 10 * skin;
   out.body = touched;
@@ -227,6 +225,7 @@ RenderOutput GaoGibsonRenderer::render(const ProbeState& probe, const Scene& sce
     const Eigen::Vector3d v = R.transpose() * probe.velocity_mm_s;
     const int found = body.tree.sphere_query(c, r, candidates_.data(), int(candidates_.size()));
     out.candidates += found;
+    out.work += std::min(found, int(candidates_.size()));
     if (found > int(candidates_.size())) out.truncated = true;
     const int n = std::min(found, int(candidates_.size()));
     if (n > 0 && body.samples.first.empty())

@@ -169,6 +169,7 @@ void ServoLoop::tick(double now_s, double period_s) {
   st.fading_ticks += report.fading;
   st.contact_ticks += out.contact;
   st.truncated_ticks += out.truncated;
+  st.max_render_work = std::max(st.max_render_work, out.work);
 
   publish_status(now_s, force, out, *poses);
 

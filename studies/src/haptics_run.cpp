@@ -1,4 +1,6 @@
 #include "spinesim/studies/haptics_run.hpp"
+
+#include "spinesim/haptics/hostile.hpp"
 #include "spinesim/studies/spine_database.hpp"
 
 #include "spinesim/common/atomic_file.hpp"
@@ -6,6 +8,7 @@
 #include "spinesim/common/timer.hpp"
 #include "spinesim/haptics/compliant_stage.hpp"
 #include "spinesim/haptics/disc_palpation.hpp"
+#include "spinesim/haptics/hostile.hpp"
 #include "spinesim/haptics/recording.hpp"
 #include "spinesim/haptics/renderer.hpp"
 #include "spinesim/mesh/vertebra_geometry.hpp"
@@ -23,6 +26,18 @@
 namespace spinesim::studies {
 
 namespace fs = std::filesystem;
+
+std::string hostile_script_name(const std::string& script) {
+  const std::string prefix = "hostile:";
+  if (script.compare(0, prefix.size(), prefix) != 0) return {};
+  const std::string name = script.substr(prefix.size());
+  for (const std::string& n : haptics::hostile_names())
+    if (n == name) return name;
+  std::string known;
+  for (const std::string& n : haptics::hostile_names()) known += (known.empty() ? "" : ", ") + n;
+  throw std::invalid_argument("--script " + script +
+                              ": no such hostile trajectory (there are: " + known + ")");
+}
 
 std::string default_haptic_script(const std::string& scene, const std::string& data_dir) {
   const fs::path dir = fs::path(data_dir) / "haptics";
@@ -69,6 +84,7 @@ void check_haptics_request(const HapticsRunRequest& r) {
     throw std::invalid_argument("--replay is for --device replay");
   if (r.device != "sim" && !r.script.empty())
     throw std::invalid_argument("--script is for --device sim");
+  hostile_script_name(r.script);  // an unknown hostile:NAME, before anything slow
   if (!r.spine.empty() && r.spine != "multirate" && r.spine != "database")
     throw std::invalid_argument("--spine " + r.spine + ": give multirate or database");
   if (r.posture != "standing" && r.posture != "seated")
@@ -345,7 +361,8 @@ HapticsRunResult run_haptics(const HapticsRunRequest& request, const std::string
   const double T = 1e-3;
   // Files are read (and refused) before the scene is built.
   haptics::Trajectory trajectory;
-  if (request.device == "sim") {
+  const std::string hostile = hostile_script_name(request.script);
+  if (request.device == "sim" && hostile.empty()) {
     result.request.script = request.script.empty()
                                 ? default_haptic_script(request.scene.scene, data_dir)
                                 : request.script;
@@ -353,14 +370,15 @@ HapticsRunResult run_haptics(const HapticsRunRequest& request, const std::string
   } else if (request.device == "replay") {
     trajectory = haptics::read_trajectory(request.replay);
   }
+
+  HapticScene scene = build_haptic_scene(request.scene, data_dir, scene_progress);
+  if (!hostile.empty()) trajectory = haptics::hostile_trajectory(hostile, scene.scene);
   double duration = request.duration_s;
   if (duration == 0)
     duration = request.device == "null"    ? 10.0
                : request.device == "mouse" ? 3600.0  // until the window closes
                                            : trajectory.duration_s() + T;
   result.request.duration_s = duration;
-
-  HapticScene scene = build_haptic_scene(request.scene, data_dir, scene_progress);
   describe_scene(request, scene, &result);
   result.passive_limit_n_per_mm = haptics::passive_stiffness_limit(result.capabilities, T);
   result.stiffness_n_per_mm = request.stiffness_n_per_mm > 0
@@ -500,6 +518,7 @@ nlohmann::json haptics_run_json(const HapticsRunResult& r) {
           {"fading_ticks", s.fading_ticks},
           {"contact_ticks", s.contact_ticks},
           {"truncated_ticks", s.truncated_ticks},
+          {"max_render_work", s.max_render_work},
           {"passivity_energy_mj", {{"min", s.passivity_min_mj}, {"final", s.passivity_final_mj}}},
           {"realtime_priority", {{"enabled", s.realtime_priority}, {"reason", s.realtime_reason}}},
           {"spin_us", r.request.spin_us},

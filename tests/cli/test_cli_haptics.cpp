@@ -81,6 +81,21 @@ TEST(CliHaptics, PlaneRunReportsTheLoopsStatisticsAndRecordsAReplayableRun) {
   EXPECT_NEAR(k["contact_ticks"].get<double>(), contact_s / 1e-3, 20);
 }
 
+// A hostile trajectory runs on any scene: the plane pressed by a 30 Hz shake and swept at 2.5 m/s.
+TEST(CliHaptics, HostileTrajectoriesRunAndReportTheTicksWork) {
+  for (const std::string name : {"shake", "sweep"}) {
+    const auto r = run_spinesim("haptics run --scene plane --device sim --script hostile:" + name +
+                                " --no-realtime --spin-us 0 --json --quiet");
+    ASSERT_EQ(r.status, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["script"], "hostile:" + name);
+    EXPECT_GT(j["contact_ticks"].get<int>(), 20) << name;
+    EXPECT_GT(j["max_render_work"].get<int>(), 0) << name;
+    EXPECT_LE(j["max_render_work"].get<int>(), 4096) << name;
+    EXPECT_LE(j["max_force_n"].get<double>(), j["peak_force_n"].get<double>() * (1 + 1e-12));
+  }
+}
+
 TEST(CliHaptics, VendorBackendRunsAgainstTheFakeLibraryAndReportsAFault) {
   const std::string hd = SPINESIM_FAKE_HD;
   const auto r = run_spinesim("haptics run --scene plane --device openhaptics --sdk-lib '" + hd +
@@ -185,6 +200,7 @@ TEST(CliHaptics, BadInputIsRefusedInOneLineWithNothingWritten) {
   expect_refused(run_spinesim(base + "--script /nonexistent.csv"), "cannot read");
   expect_refused(run_spinesim(base + "--script /dev/zero"), "not a regular file");
   expect_refused(run_spinesim(base + "--script '" + tmp_dir().string() + "'"), "a directory");
+  expect_refused(run_spinesim(base + "--script hostile:wobble"), "no such hostile trajectory");
   expect_refused(run_spinesim(base + "--renderer magic"), "--renderer");
   expect_refused(run_spinesim(base + "--scene moon"), "--scene");
   expect_refused(run_spinesim(base + "--vertebrae /nonexistent.json"), "--vertebrae");

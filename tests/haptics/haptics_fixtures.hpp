@@ -13,6 +13,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <map>
@@ -49,6 +50,18 @@ inline const mesh::VertebraSurface& vertebra(const std::string& name,
   s.frame = v.frame;
   s.surface = mesh::read_surface(file.string(), 1.0, mesh::UpAxis::y);
   return memory.emplace(key, std::move(s)).first->second;
+}
+
+// Outside every body, at least `r − tol` from its surface (the proxy sphere does not overlap
+// it): the distance by the tree, inside/outside by the winding number (a nearest triangle's
+// normal cannot tell at an edge, where the probe may lie behind one face and before the other).
+inline bool clear_of_surfaces(const Scene& scene, const ScenePoses& poses, const Eigen::Vector3d& p,
+                              double r, double tol) {
+  const auto near = nearest_surface(scene, poses, p, r + 1, false);
+  if (near.body >= 0 && near.distance_mm < r - tol) return false;
+  for (int i = 0; i < scene.size(); ++i)
+    if (winding_number(scene.body(i).tree, to_body(poses, i, p)) > 0.5) return false;
+  return true;
 }
 
 /// Identity poses for every body.

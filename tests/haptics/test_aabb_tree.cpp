@@ -131,3 +131,105 @@ TEST(AabbTree, ClosestPointEqualsBruteForce) {
     EXPECT_NEAR((q - p).norm(), d, 1e-12);
   }
 }
+
+namespace {
+
+// A sphere moving from p0 by m: the earliest t in [0, 1] at which it comes within r of the
+// triangle, by bisection on the distance along the move after a dense scan (the brute-force
+// oracle of AabbTree::sweep: any triangle sweep function works, this one is two-sided).
+double sweep_by_scan(const sh::AabbTree& tree, int t, const Eigen::Vector3d& p0,
+                     const Eigen::Vector3d& m, double r) {
+  const auto& F = tree.triangles();
+  const auto& V = tree.vertices();
+  auto distance = [&](double s) {
+    const Eigen::Vector3d p = p0 + s * m;
+    return (sh::closest_point_on_triangle(p, V.row(F(t, 0)), V.row(F(t, 1)), V.row(F(t, 2))) - p)
+        .norm();
+  };
+  if (distance(0) <= r) return 0;
+  const int n = 64;
+  for (int k = 1; k <= n; ++k) {
+    if (distance(double(k) / n) > r) continue;
+    double a = double(k - 1) / n, b = double(k) / n;
+    for (int i = 0; i < 50; ++i) (distance(0.5 * (a + b)) > r ? a : b) = 0.5 * (a + b);
+    return b;
+  }
+  return 2;
+}
+
+}  // namespace
+
+// The swept search equals testing every triangle, and a search that runs out of budget never
+// claims the move free past a contact; its work is at most the budget, for moves of any length.
+TEST(AabbTree, BudgetedSweepEqualsBruteForceAndNeverClaimsAContactFree) {
+  const auto& v = sh::testing::vertebra("L3");
+  const sh::AabbTree tree(v.surface.V, v.surface.F);
+  const Eigen::Vector3d lo = tree.bounds_min(), hi = tree.bounds_max();
+  const Eigen::Vector3d centre = 0.5 * (lo + hi), size = hi - lo;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1, 1), length(0.5, 400);
+  std::vector<double> scan(std::size_t(tree.triangle_count()));
+  int complete_hits = 0, partial = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    const Eigen::Vector3d p0 =
+        centre + 0.8 * size.cwiseProduct(Eigen::Vector3d(u(rng), u(rng), u(rng)));
+    const Eigen::Vector3d m = length(rng) * Eigen::Vector3d(u(rng), u(rng), u(rng)).normalized();
+    const double r = 4;
+    // The oracle: every triangle, the closed-form sweep replaced by a scan.
+    double truth = 2;
+    for (int t = 0; t < tree.triangle_count(); ++t) {
+      scan[std::size_t(t)] = sweep_by_scan(tree, t, p0, m, r);
+      truth = std::min(truth, scan[std::size_t(t)]);
+    }
+    auto sweep = [&](int t) { return scan[std::size_t(t)]; };
+    int budget = 1 << 30;
+    const sh::AabbTree::Sweep full = tree.sweep(p0, m, r, budget, sweep);
+    ASSERT_TRUE(full.complete);
+    EXPECT_EQ(full.t, truth) << "trial " << trial;
+    EXPECT_EQ(full.t_free, std::min(truth, 1.0));
+    if (truth <= 1) {
+      ++complete_hits;
+      EXPECT_EQ(scan[std::size_t(full.triangle)], truth);
+    }
+    for (const int limit : {1, 16, 100, 400}) {
+      int left = limit;
+      const sh::AabbTree::Sweep part = tree.sweep(p0, m, r, left, sweep);
+      EXPECT_GE(left, 0);
+      EXPECT_LE(part.t_free, std::min(truth, 1.0)) << "trial " << trial << ", budget " << limit;
+      if (part.complete) {
+        EXPECT_EQ(part.t, truth);
+      } else {
+        ++partial;
+        EXPECT_EQ(left, 0);
+      }
+    }
+  }
+  EXPECT_GT(complete_hits, 30);
+  EXPECT_GT(partial, 100);
+}
+
+// The entry time of a segment into a grown box, against a dense scan of the point's distance.
+TEST(AabbTree, EntryIsWhenTheSegmentFirstComesWithinTheGrowthOfTheBox) {
+  std::mt19937 rng(8);
+  std::uniform_real_distribution<double> u(-10, 10);
+  const Eigen::Vector3d lo(-2, -1, -3), hi(1, 2, 0.5);
+  for (int trial = 0; trial < 2000; ++trial) {
+    const Eigen::Vector3d p0(u(rng), u(rng), u(rng)), m(2 * u(rng), 2 * u(rng), 2 * u(rng));
+    const double r = 0.1 * std::abs(u(rng));
+    const double t = sh::AabbTree::entry(p0, m, r, lo, hi);
+    // Inside the grown box (a superset of the points within r of the box) at t, outside before.
+    auto inside = [&](double s) {
+      const Eigen::Vector3d p = p0 + s * m;
+      return ((p.array() >= lo.array() - r) && (p.array() <= hi.array() + r)).all();
+    };
+    if (t <= 1) {
+      EXPECT_TRUE(inside(std::min(1.0, t + 1e-9))) << trial;
+      for (int k = 0; k < 200; ++k) {
+        const double s = t * k / 200.0;
+        if (s < t - 1e-9) EXPECT_FALSE(inside(s)) << trial;
+      }
+    } else {
+      for (int k = 0; k <= 400; ++k) EXPECT_FALSE(inside(k / 400.0)) << trial;
+    }
+  }
+}

@@ -30,34 +30,6 @@ sh::Scene plane_scene(double spacing) {
   return scene;
 }
 
-// Generalised winding number of a closed surface about p (Jacobson et al. 2013): Σ of the
-// triangles' solid angles (Van Oosterom & Strackee 1983) over 4π; 1 inside, 0 outside.
-double winding_number(const sh::AabbTree& tree, const Eigen::Vector3d& p) {
-  const auto& V = tree.vertices();
-  const auto& F = tree.triangles();
-  double sum = 0;
-  for (Eigen::Index t = 0; t < F.rows(); ++t) {
-    const Eigen::Vector3d a = V.row(F(t, 0)).transpose() - p, b = V.row(F(t, 1)).transpose() - p,
-                          c = V.row(F(t, 2)).transpose() - p;
-    const double la = a.norm(), lb = b.norm(), lc = c.norm();
-    sum += 2 * std::atan2(a.dot(b.cross(c)),
-                          la * lb * lc + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la);
-  }
-  return sum / (4 * M_PI);
-}
-
-// Outside every body, at least `r − tol` from its surface (the proxy sphere does not overlap
-// it): the distance by the tree, inside/outside by the winding number (a nearest triangle's
-// normal cannot tell at an edge, where the probe may lie behind one face and before the other).
-bool clear_of_surfaces(const sh::Scene& scene, const sh::ScenePoses& poses,
-                       const Eigen::Vector3d& p, double r, double tol) {
-  const auto near = sh::nearest_surface(scene, poses, p, r + 1, false);
-  if (near.body >= 0 && near.distance_mm < r - tol) return false;
-  for (int i = 0; i < scene.size(); ++i)
-    if (winding_number(scene.body(i).tree, sh::to_body(poses, i, p)) > 0.5) return false;
-  return true;
-}
-
 }  // namespace
 
 TEST(GaoGibson, PlaneForceIsTheDepthIntegral) {
@@ -177,7 +149,8 @@ TEST(SphereProxy, FastSweepAcrossASpinousProcessStaysOnItsSide) {
     for (int i = 1; i <= steps; ++i) {
       probe.position_mm = left + (right - left) * double(i) / steps;
       out = proxy.render(probe, scene, poses, 1e-3);
-      ASSERT_TRUE(clear_of_surfaces(scene, poses, out.proxy_mm, r, 1e-6)) << steps << " " << i;
+      ASSERT_TRUE(sh::testing::clear_of_surfaces(scene, poses, out.proxy_mm, r, 1e-6))
+          << steps << " " << i;
     }
     EXPECT_GT((out.proxy_mm - world(mid_local)).dot(lateral), 0) << steps;
     EXPECT_TRUE(out.contact);
@@ -224,13 +197,14 @@ TEST(SphereProxy, SweepAcrossTheGapBetweenTwoVertebraeNeverEntersEither) {
     for (int i = 1; i <= steps; ++i) {
       probe.position_mm = from + (to - from) * double(i) / steps;
       const auto out = proxy.render(probe, scene, poses, 1e-3);
-      ASSERT_TRUE(clear_of_surfaces(scene, poses, out.proxy_mm, r, 1e-6)) << steps << " " << i;
+      ASSERT_TRUE(sh::testing::clear_of_surfaces(scene, poses, out.proxy_mm, r, 1e-6))
+          << steps << " " << i;
     }
     sh::RenderOutput out;
     for (int i = 1; i <= 60; ++i) {
       probe.position_mm = to + 0.5 * i * l4.frame.axes.col(2);
       out = proxy.render(probe, scene, poses, 1e-3);
-      ASSERT_TRUE(clear_of_surfaces(scene, poses, out.proxy_mm, r, 1e-6));
+      ASSERT_TRUE(sh::testing::clear_of_surfaces(scene, poses, out.proxy_mm, r, 1e-6));
     }
     EXPECT_FALSE(out.contact) << steps << ": the proxy stayed caught";
   }
@@ -262,7 +236,8 @@ TEST(SphereProxy, RandomFastTrajectoriesNeverEnterTwoVertebrae) {
       sh::ProbeState probe;
       probe.position_mm = device;
       const auto out = proxy.render(probe, scene, poses, 1e-3);
-      ASSERT_TRUE(clear_of_surfaces(scene, poses, out.proxy_mm, r, 1e-6)) << r << " " << tick;
+      ASSERT_TRUE(sh::testing::clear_of_surfaces(scene, poses, out.proxy_mm, r, 1e-6))
+          << r << " " << tick;
       ASSERT_TRUE(out.force_n.allFinite());
       contacts += out.contact;
     }

@@ -9,6 +9,7 @@
 
 #include <Eigen/Core>
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -34,6 +35,12 @@ inline double box_distance_squared(const Eigen::Vector3d& p, const Eigen::Vector
 Eigen::Vector3d closest_point_on_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
                                           const Eigen::Vector3d& b, const Eigen::Vector3d& c);
 
+class AabbTree;
+/// Generalised winding number of the tree's closed surface about p (Jacobson et al. 2013): the
+/// sum of the triangles' solid angles (Van Oosterom & Strackee 1983) over 4π; 1 inside, 0
+/// outside. O(triangles): for set-up and tests, not for a tick.
+double winding_number(const AabbTree& tree, const Eigen::Vector3d& p);
+
 class AabbTree {
  public:
   AabbTree() = default;
@@ -48,6 +55,32 @@ class AabbTree {
 
   /// The same set by testing every triangle (the brute-force oracle).
   std::vector<int> sphere_query_brute_force(const Eigen::Vector3d& center, double radius) const;
+
+  /// The earliest contact of a sphere of `radius` moving from p0 to p0 + m, within a budget of
+  /// work. `sweep(t)` gives the earliest t in [0, 1] at which the sphere touches triangle t (> 1:
+  /// never); it is asked only for triangles whose box, grown by `radius`, the segment enters
+  /// before the earliest contact found so far (nearer child first). Each node visited and each
+  /// triangle swept spends one unit of `budget`; when it runs out the search stops and
+  /// `t_free` says how far the move is proven free (the smallest entry of what was left
+  /// unsearched). No allocation: the work of one call is at most the budget, whatever the move.
+  struct Sweep {
+    double t = 2;          ///< earliest contact found (> 1: none)
+    int triangle = -1;     ///< its triangle
+    double t_free = 1;     ///< no contact before this (= min(t, 1) when complete)
+    bool complete = true;  ///< false: the budget ran out first
+  };
+  template <class TriangleSweep>
+  Sweep sweep(const Eigen::Vector3d& p0, const Eigen::Vector3d& m, double radius, int& budget,
+              TriangleSweep&& sweep_triangle) const;
+  /// When the segment p0 + t m (t in [0, 1]) enters the box [lo, hi] grown by `radius` (0 if it
+  /// starts inside; > 1 if never): a lower bound on the sphere's first contact with anything in
+  /// the box.
+  static double entry(const Eigen::Vector3d& p0, const Eigen::Vector3d& m, double radius,
+                      const Eigen::Vector3d& lo, const Eigen::Vector3d& hi);
+  /// The root box's entry (entry() on bounds_min/bounds_max); > 1 for an empty tree.
+  double root_entry(const Eigen::Vector3d& p0, const Eigen::Vector3d& m, double radius) const {
+    return nodes_.empty() ? 2 : entry(p0, m, radius, nodes_[0].lo, nodes_[0].hi);
+  }
 
   /// Smallest distance from p to the surface, over the triangles within `max_distance` (returns
   /// max_distance when none is closer); `triangle` gets the closest one (−1 if none) and
@@ -89,5 +122,53 @@ class AabbTree {
   std::vector<Node> nodes_;
   int depth_ = 0;
 };
+
+template <class TriangleSweep>
+AabbTree::Sweep AabbTree::sweep(const Eigen::Vector3d& p0, const Eigen::Vector3d& m, double radius,
+                                int& budget, TriangleSweep&& sweep_triangle) const {
+  Sweep out;
+  if (nodes_.empty()) return out;
+  // Depth-first, nearer child on top; each entry remembers its box's entry time, so what is
+  // left on the stack when the budget runs out bounds the unsearched part from below.
+  struct Entry {
+    int node;
+    double t;
+  };
+  Entry stack[kMaxDepth + 2];
+  int top = 0;
+  const double t0 = entry(p0, m, radius, nodes_[0].lo, nodes_[0].hi);
+  if (t0 <= 1) stack[top++] = {0, t0};
+  while (top > 0) {
+    const Entry e = stack[--top];
+    if (e.t >= out.t) continue;
+    if (budget <= 0) {
+      out.complete = false;
+      double t_free = e.t;
+      for (int k = 0; k < top; ++k) t_free = std::min(t_free, stack[k].t);
+      out.t_free = std::min(t_free, std::min(out.t, 1.0));
+      return out;
+    }
+    --budget;
+    const Node& n = nodes_[std::size_t(e.node)];
+    if (n.triangle >= 0) {
+      const double t = sweep_triangle(n.triangle);
+      if (t < out.t) {
+        out.t = t;
+        out.triangle = n.triangle;
+      }
+      continue;
+    }
+    const Node& l = nodes_[std::size_t(n.left)];
+    const Node& r = nodes_[std::size_t(n.right)];
+    const double tl = entry(p0, m, radius, l.lo, l.hi), tr = entry(p0, m, radius, r.lo, r.hi);
+    const bool left_first = tl <= tr;
+    const Entry first{left_first ? n.left : n.right, left_first ? tl : tr};
+    const Entry second{left_first ? n.right : n.left, left_first ? tr : tl};
+    if (second.t <= 1 && second.t < out.t) stack[top++] = second;
+    if (first.t <= 1 && first.t < out.t) stack[top++] = first;
+  }
+  out.t_free = std::min(out.t, 1.0);
+  return out;
+}
 
 }  // namespace spinesim::haptics

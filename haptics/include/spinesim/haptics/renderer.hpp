@@ -32,7 +32,8 @@ struct RenderOutput {
                                                        ///< deepest sample (Gao–Gibson)
   Eigen::Vector3d proxy_mm = Eigen::Vector3d::Zero();  ///< the proxy (Gao–Gibson: the probe)
   int candidates = 0;                                  ///< triangles looked at this tick
-  bool truncated = false;                              ///< a fixed buffer was too small
+  int work = 0;  ///< collision work: tree nodes visited + triangles swept (proxy), or candidates
+  bool truncated = false;  ///< the tick's work reached its bound (or a fixed buffer was full)
   /// Disc palpation (disc_palpation.hpp): the disc's state this render used.
   bool disc = false;
   bool disc_contact = false;
@@ -56,13 +57,15 @@ struct ProxyParameters {
   double stiffness_n_per_mm = 0.5;  ///< spring from the device to the proxy
   double damping_n_s_per_mm = 0.0;  ///< on the device's velocity, in contact only
   double skin_mm = 1e-3;            ///< the proxy stops this far from a surface
+  /// The tick's bound on collision work: tree nodes visited plus triangles swept, over every
+  /// body and proxy iteration. At the bound the proxy stops where the search has proven the
+  /// way free and goes on next tick (RenderOutput::truncated).
+  int max_work = 4096;
 };
 
 class SphereProxyRenderer final : public ForceRenderer {
  public:
   explicit SphereProxyRenderer(const ProxyParameters& p);
-  /// With a candidate buffer of `max_triangles` (default 8192) allocated here, once.
-  SphereProxyRenderer(const ProxyParameters& p, int max_triangles);
   const char* name() const override { return "proxy"; }
   void reset(const Eigen::Vector3d& device_mm) override;
   RenderOutput render(const ProbeState& probe, const Scene& scene, const ScenePoses& poses,
@@ -74,7 +77,6 @@ class SphereProxyRenderer final : public ForceRenderer {
   ProxyParameters p_;
   Eigen::Vector3d proxy_ = Eigen::Vector3d::Zero();  ///< world, or in `anchor_`'s frame
   int anchor_ = -1;                                  ///< body the proxy rides (−1: world)
-  std::vector<int> candidates_;                      ///< fixed buffer of the sweep's triangles
 };
 
 /// Which magnitude law of the thesis: eq 4.9 (sum over the samples) or eq 4.10 (the same sum

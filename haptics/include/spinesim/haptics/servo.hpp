@@ -89,6 +89,7 @@ struct ServoStats {
   double max_force_n = 0;             ///< largest commanded force
   std::int64_t clamped_ticks = 0, limited_ticks = 0, non_finite_ticks = 0, fading_ticks = 0;
   std::int64_t contact_ticks = 0, truncated_ticks = 0;
+  int max_render_work = 0;  ///< the largest RenderOutput::work of a tick
   /// The compliant stage: ticks hooked, the largest force on the spine, ticks it was clamped.
   std::int64_t hooked_ticks = 0, spine_clamped_ticks = 0;
   double max_spine_force_n = 0;

@@ -100,6 +100,9 @@ struct HapticsRunRequest {
   const HapticsLiveHooks* live = nullptr;   ///< a viewer's hooks (null: none)
 };
 
+/// The hostile trajectory a --script of the form "hostile:NAME" names (haptics/hostile.hpp), or ""
+/// for any other script; throws std::invalid_argument (one line) for an unknown NAME.
+std::string hostile_script_name(const std::string& script);
 /// The shipped scripts (data/haptics/), and the default one for a scene.
 std::string default_haptic_script(const std::string& scene, const std::string& data_dir);
 
