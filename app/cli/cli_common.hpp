@@ -66,6 +66,7 @@ struct HapticsRunFlags {
   studies::HapticsRunRequest request;
   std::string workspace_center, chair_file;
   bool no_realtime = false;
+  bool no_floor = false;
   /// A run that misses more than this share of its deadlines ends with a warning (--strict: an
   /// error, exit status 1).
   double max_missed_percent = 1.0;

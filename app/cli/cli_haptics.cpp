@@ -231,6 +231,10 @@ void add_haptics_run_flags(CLI::App* cmd, HapticsRunFlags& f, bool viewer) {
                   "(0: sleep only; steadier periods on virtual machines for some CPU)")
       ->capture_default_str();
   cmd->add_flag("--no-realtime", f.no_realtime, "Do not ask for real-time (SCHED_FIFO) priority");
+  cmd->add_flag("--no-floor", f.no_floor,
+                "Do not measure the machine's floor beside the loop (a bare periodic thread, like "
+                "cyclictest, whose late wake-ups are reported next to the loop's missed "
+                "deadlines)");
   cmd->add_option("--spine", f.request.spine,
                   "Compliant stage (--scene spine): press the stylus button on a vertebra to drag "
                   "it; multirate (equilibrium solves in a worker + their sensitivity) or database "
@@ -265,6 +269,7 @@ void add_haptics_run_flags(CLI::App* cmd, HapticsRunFlags& f, bool viewer) {
 
 void resolve_haptics_run_flags(HapticsRunFlags& f) {
   f.request.realtime_priority = !f.no_realtime;
+  f.request.measure_floor = !f.no_floor;
   if (!f.workspace_center.empty()) {
     const auto v = parse_numbers(f.workspace_center, 3, "--workspace-center");
     f.request.workspace_center_mm = Eigen::Vector3d(v[0], v[1], v[2]);

@@ -349,6 +349,17 @@ std::unique_ptr<haptics::HapticRecordingWriter> start_recording(const HapticsRun
   return record;
 }
 
+std::string floor_line(const HapticsRunResult& r) {
+  if (r.floor.wakeups == 0) return "";
+  const auto& s = r.stats;
+  const double missed = s.ticks ? 100.0 * double(s.missed_deadlines) / double(s.ticks) : 0;
+  return "  the machine's floor in the same run (a bare periodic thread): " +
+         std::to_string(r.floor.late) + " of " + std::to_string(r.floor.wakeups) +
+         " wake-ups a period late (" + fixed(r.floor.late_percent, 2) + " %; the loop " +
+         fixed(missed, 2) + " %), wake-up latency p99 " + fixed(r.floor.latency_us.p99, 0) +
+         " us, max " + fixed(r.floor.latency_us.max, 0) + " us\n";
+}
+
 }  // namespace
 
 HapticsRunResult run_haptics(const HapticsRunRequest& request, const std::string& data_dir,
@@ -422,6 +433,9 @@ HapticsRunResult run_haptics(const HapticsRunRequest& request, const std::string
   if (disc.palpation) disc.palpation->start();
   int calls = 0;
   HapticsLiveFrame live;
+  haptics::LatencyProbe floor;
+  if (request.measure_floor)
+    floor.start(T, request.realtime_priority, haptics::ServoOptions{}.priority, duration + 1);
   result.stats = loop.run([&](const haptics::ServoStatus& s, double now) {
     haptics::ScenePoses p;  // the rigid stage's bodies stay at the reference posture
     p.time_s = now;
@@ -435,6 +449,7 @@ HapticsRunResult run_haptics(const HapticsRunRequest& request, const std::string
       request.live->frame(live);
     }
   });
+  result.floor = floor.stop();
   device->close();
   if (compliant.response) finish_compliant(compliant, &result);
   if (disc.palpation) finish_disc(disc, &result);
@@ -510,6 +525,16 @@ nlohmann::json haptics_run_json(const HapticsRunResult& r) {
           {"period_us", pct(s.period_us)},
           {"compute_us", pct(s.compute_us)},
           {"missed_deadlines", s.missed_deadlines},
+          {"floor", r.floor.wakeups == 0
+                        ? nlohmann::json(nullptr)
+                        : nlohmann::json{{"wakeups", r.floor.wakeups},
+                                         {"latency_us", pct(r.floor.latency_us)},
+                                         {"late", r.floor.late},
+                                         {"late_percent", r.floor.late_percent},
+                                         {"realtime_priority", r.floor.realtime_priority},
+                                         {"what",
+                                          "a bare periodic thread beside the servo: wake-ups more "
+                                          "than one period late (cyclictest's measure)"}}},
           {"max_force_n", s.max_force_n},
           {"peak_force_n", r.capabilities.peak_force_n},
           {"clamped_ticks", s.clamped_ticks},
@@ -568,9 +593,9 @@ std::string haptics_run_table(const HapticsRunResult& r) {
   t.print(os, false);
   os << "\n  " << s.ticks << " ticks in " << fixed(s.seconds, 2) << " s (" << fixed(s.rate_hz, 1)
      << " Hz), " << s.missed_deadlines << " missed deadlines, stopped: " << s.stop_reason << "\n"
-     << "  force: max " << fixed(s.max_force_n, 3) << " N; contact " << s.contact_ticks
-     << " ticks, clamped " << s.clamped_ticks << ", limited " << s.limited_ticks << ", faded "
-     << s.fading_ticks << "\n"
+     << floor_line(r) << "  force: max " << fixed(s.max_force_n, 3) << " N; contact "
+     << s.contact_ticks << " ticks, clamped " << s.clamped_ticks << ", limited " << s.limited_ticks
+     << ", faded " << s.fading_ticks << "\n"
      << "  passivity energy: min " << fixed(s.passivity_min_mj, 3) << " mJ, final "
      << fixed(s.passivity_final_mj, 3) << " mJ\n";
   if (!r.spine.empty()) {
@@ -612,7 +637,11 @@ std::string missed_deadlines_warning(const HapticsRunResult& r, double max_misse
   return std::to_string(s.missed_deadlines) + " of " + std::to_string(s.ticks) +
          " deadlines missed (" + fixed(percent, 2) + " %, more than the " +
          fixed(max_missed_percent, 2) + " % allowed): the loop did not hold its rate here (" +
-         fixed(s.rate_hz, 1) + " Hz)";
+         fixed(s.rate_hz, 1) + " Hz" +
+         (r.floor.wakeups ? "; the machine's own floor in the same run: " +
+                                fixed(r.floor.late_percent, 2) + " % of a bare thread's wake-ups"
+                          : std::string()) +
+         ")";
 }
 
 nlohmann::json haptic_devices_json(const std::string& openhaptics_lib, const std::string& dhd_lib) {

@@ -93,7 +93,15 @@ TEST(CliHaptics, HostileTrajectoriesRunAndReportTheTicksWork) {
     EXPECT_GT(j["max_render_work"].get<int>(), 0) << name;
     EXPECT_LE(j["max_render_work"].get<int>(), 4096) << name;
     EXPECT_LE(j["max_force_n"].get<double>(), j["peak_force_n"].get<double>() * (1 + 1e-12));
+    // The machine's floor was measured beside the loop, over the same run.
+    ASSERT_TRUE(j["floor"].is_object()) << name;
+    EXPECT_GE(j["floor"]["wakeups"].get<int>(), j["ticks"].get<int>() / 2) << name;
+    EXPECT_LE(j["floor"]["late"].get<int>(), j["floor"]["wakeups"].get<int>()) << name;
   }
+  const auto off = run_spinesim(
+      "haptics run --scene plane --device sim --duration 0.2 --no-floor --no-realtime --json");
+  ASSERT_EQ(off.status, 0) << off.err;
+  EXPECT_TRUE(nlohmann::json::parse(off.out)["floor"].is_null());
 }
 
 TEST(CliHaptics, VendorBackendRunsAgainstTheFakeLibraryAndReportsAFault) {

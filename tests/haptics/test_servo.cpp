@@ -4,16 +4,19 @@
 // settles while a wall far too stiff is reported; a tick allocates nothing; the thread keeps
 // time and zeroes the force at the end.
 #include "haptics_fixtures.hpp"
+#include "spinesim/haptics/latency_probe.hpp"
 #include "spinesim/haptics/servo.hpp"
 
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
 #include <new>
 #include <random>
+#include <thread>
 
 namespace sh = spinesim::haptics;
 
@@ -313,4 +316,31 @@ TEST(ServoLoop, ThreadKeepsTimeAndZeroesTheForceAtTheEnd) {
   EXPECT_EQ(recorded, std::size_t(stats.ticks));
   EXPECT_GT(stats.fading_ticks, 300);
   EXPECT_EQ(stats.realtime_reason, "not asked for");
+}
+
+// The floor probe: a bare periodic thread. Its counts are consistent (it cannot wake more often
+// than its period allows, late ≤ all), its percentiles ordered, and stop() is idempotent.
+TEST(LatencyProbe, CountsItsWakeUpsAndStopsCleanly) {
+  sh::LatencyProbe probe;
+  const double T = 1e-3;
+  const auto t0 = std::chrono::steady_clock::now();
+  probe.start(T, false, 0, 1.0);
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  const sh::LatencyProbeStats s = probe.stop();
+  const double elapsed =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_GE(s.wakeups, 1);
+  EXPECT_LE(s.wakeups, std::int64_t(elapsed / T) + 2);
+  EXPECT_LE(s.late, s.wakeups);
+  EXPECT_GE(s.latency_us.p50, 0);
+  EXPECT_LE(s.latency_us.p50, s.latency_us.p99);
+  EXPECT_LE(s.latency_us.p99, s.latency_us.p999);
+  EXPECT_LE(s.latency_us.p999, s.latency_us.max);
+  EXPECT_FALSE(s.realtime_priority);
+  EXPECT_EQ(s.realtime_reason, "not asked for");
+  EXPECT_EQ(probe.stop().wakeups, s.wakeups);  // idempotent
+  // Started again, it starts from zero.
+  probe.start(T, false, 0, 0.1);
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  EXPECT_LE(probe.stop().wakeups, s.wakeups);
 }

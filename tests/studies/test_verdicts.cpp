@@ -20,6 +20,14 @@ TEST(HapticsRun, MissedDeadlinesAreJudgedAgainstTheLimit) {
   r.stats.missed_deadlines = 2;  // 0.07 %: within 1 %
   EXPECT_EQ(missed_deadlines_warning(r, 1.0), "");
   EXPECT_NE(missed_deadlines_warning(r, 0.0), "");
+  // With the floor measured beside it, the warning says how much of it the machine misses.
+  r.stats.missed_deadlines = 611;
+  r.floor.wakeups = 2870;
+  r.floor.late = 30;
+  r.floor.late_percent = 100.0 * 30 / 2870;
+  const std::string f = missed_deadlines_warning(r, 1.0);
+  EXPECT_NE(f.find("the machine's own floor in the same run: 1.05 %"), std::string::npos) << f;
+  EXPECT_EQ(f.find('\n'), std::string::npos);
   r.stats.ticks = 0;  // a run that never ticked has nothing to judge
   EXPECT_EQ(missed_deadlines_warning(r, 0.0), "");
 }

@@ -5,6 +5,7 @@
 #pragma once
 
 #include "spinesim/haptics/device.hpp"
+#include "spinesim/haptics/latency_probe.hpp"
 #include "spinesim/haptics/scene.hpp"
 #include "spinesim/haptics/scene_builder.hpp"
 #include "spinesim/haptics/servo.hpp"
@@ -95,6 +96,7 @@ struct HapticsRunRequest {
   double disc_cell_size_mm = 0;  ///< > 0: this resolution, not the budget check's choice
   std::string write_scene;       ///< folder: each body's surface as <name>.obj (world, mm)
   bool realtime_priority = true;
+  bool measure_floor = true;                ///< run the latency probe beside the servo
   double spin_us = 400;                     ///< spin this long before each deadline (0: sleep only)
   const std::atomic<bool>* stop = nullptr;  ///< set by the front end (Ctrl-C) to end the run
   const HapticsLiveHooks* live = nullptr;   ///< a viewer's hooks (null: none)
@@ -116,6 +118,9 @@ struct HapticsRunResult {
   haptics::DeviceCapabilities capabilities;
   double stiffness_n_per_mm = 0, passive_limit_n_per_mm = 0;
   haptics::ServoStats stats;
+  /// The machine's floor in the same run: a bare periodic thread beside the servo
+  /// (haptics/latency_probe.hpp; wakeups = 0 when it was not run).
+  haptics::LatencyProbeStats floor;
   std::int64_t recorded_rows = 0;
   // The compliant stage (spine empty: off).
   std::string spine;
