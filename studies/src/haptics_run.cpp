@@ -475,6 +475,7 @@ nlohmann::json disc_json(const HapticsRunResult& r) {
     tried.push_back({{"cell_size_mm", c.cell_size_mm},
                      {"tets", c.tets},
                      {"step_us", {{"p50", c.step_us.p50}, {"p99", c.step_us.p99}}},
+                     {"step_cpu_us", {{"p50", c.step_cpu_us.p50}, {"p99", c.step_cpu_us.p99}}},
                      {"fits", c.fits}});
   const auto& p = r.disc_step_us;
   return {

@@ -37,8 +37,9 @@ struct DiscSceneRequest {
 struct DiscCandidate {
   double cell_size_mm = 0;
   long tets = 0;
-  haptics::Percentiles step_us;
-  bool fits = false;
+  haptics::Percentiles step_us;      ///< wall time of a step: the solver and the host's stalls
+  haptics::Percentiles step_cpu_us;  ///< the step thread's CPU time: the solver's own cost
+  bool fits = false;                 ///< step_cpu_us.p99 within the budget
 };
 
 struct DiscSetup {
