@@ -385,8 +385,15 @@ TEST(CliHaptics, BadDiscInputIsRefused) {
   const std::string base = "haptics run --duration 1 --record '" + rec + "' ";
   expect_refused(run_spinesim(base + "--scene disc --level L9-L10"), "L9-L10");
   expect_refused(run_spinesim(base + "--scene spine --disc-budget-us 300"), "--scene disc");
-  expect_refused(run_spinesim(base + "--scene disc --disc-budget-us 1 --triangles 300"),
-                 "no resolution");  // nothing steps within 1 us
+  // Nothing steps within 1 us: the run still starts, on the coarsest disc, and says so.
+  const auto slow = run_spinesim(
+      "haptics run --duration 0.3 --scene disc --disc-budget-us 1 --triangles 300 --json --quiet");
+  ASSERT_EQ(slow.status, 0) << slow.err;
+  const auto disc = nlohmann::json::parse(slow.out)["disc_palpation"];
+  EXPECT_NE(disc["note"].get<std::string>().find("no resolution fits"), std::string::npos);
+  EXPECT_EQ(disc["cell_size_mm"].get<double>(),
+            disc["budget_check"].back()["cell_size_mm"].get<double>());
+  for (const auto& c : disc["budget_check"]) EXPECT_FALSE(c["fits"].get<bool>());
   expect_refused(run_spinesim(base + "--scene disc --disc-cell-size 0.1"), "--disc-cell-size");
   // A tuned set without the level.
   const std::string set = tmp("one_level.json");
