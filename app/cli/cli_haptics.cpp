@@ -12,6 +12,7 @@
 #include "cli_common.hpp"
 #include "spinesim/studies/seating_study.hpp"
 
+#include "spinesim/mesh/vertebra_cache.hpp"
 #include "spinesim/studies/haptic_drag_study.hpp"
 #include "spinesim/studies/haptic_plane_study.hpp"
 #include "spinesim/studies/haptics_run.hpp"
@@ -173,6 +174,11 @@ void add_scene_flags(CLI::App* cmd, haptics::HapticSceneRequest& scene) {
                   "Folder holding artisynth-lss/ (for --vertebrae real; default: "
                   "$SPINESIM_TESTDATA_DIR or the shared test-data folder)");
   cmd->add_option("--triangles", scene.triangles, "Triangles per generated vertebra")
+      ->capture_default_str();
+  scene.cache_dir = mesh::default_cache_dir();
+  cmd->add_option("--cache-dir", scene.cache_dir,
+                  "Folder where generated vertebrae are kept between runs, so that a run starts "
+                  "in about a second (none: mesh them every time)")
       ->capture_default_str();
 }
 

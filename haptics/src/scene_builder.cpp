@@ -5,6 +5,7 @@
 #include "spinesim/common/timer.hpp"
 #include "spinesim/mesh/disc_geometry.hpp"
 #include "spinesim/mesh/io.hpp"
+#include "spinesim/mesh/vertebra_cache.hpp"
 #include "spinesim/mesh/vertebra_geometry.hpp"
 
 #include <Eigen/Geometry>
@@ -241,8 +242,12 @@ HapticScene build_haptic_scene(const HapticSceneRequest& r, const std::string& d
         out.sources.push_back(it->second.second);
       } else {
         const auto v = mesh::parametric_vertebra(names[i], data_dir);
-        out.scene.add_body(names[i], mesh::mesh_vertebra(v, r.triangles).surface);
+        bool hit = false;
+        const std::string cache = r.cache_dir == "none" ? "" : r.cache_dir;
+        out.scene.add_body(names[i],
+                           mesh::cached_vertebra_surface(v, r.triangles, cache, &hit).surface);
         out.sources.push_back("generated");
+        out.cached += hit;
       }
       if (progress) progress(int(i + 1), int(names.size()));
     }

@@ -189,6 +189,7 @@ void describe_scene(const HapticsRunRequest& request, const HapticScene& scene,
   result->bodies = scene.scene.size();
   result->triangles = scene.scene.triangle_count();
   result->scene_seconds = scene.seconds;
+  result->scene_cached_bodies = scene.cached;
   result->registered = scene.registered;
   result->registration = scene.registration;
   for (int i = 0; !request.write_scene.empty() && i < scene.scene.size(); ++i) {
@@ -365,6 +366,7 @@ std::string floor_line(const HapticsRunResult& r) {
 HapticsRunResult run_haptics(const HapticsRunRequest& request, const std::string& data_dir,
                              const std::function<void(const haptics::ServoStatus&)>& status,
                              const std::function<void(int, int)>& scene_progress) {
+  const Timer startup;
   check_haptics_request(request);
   HapticsRunResult result;
   result.request = request;
@@ -433,6 +435,7 @@ HapticsRunResult run_haptics(const HapticsRunRequest& request, const std::string
   if (disc.palpation) disc.palpation->start();
   int calls = 0;
   HapticsLiveFrame live;
+  result.startup_seconds = startup.seconds();
   haptics::LatencyProbe floor;
   if (request.measure_floor)
     floor.start(T, request.realtime_priority, haptics::ServoOptions{}.priority, duration + 1);
@@ -510,6 +513,8 @@ nlohmann::json haptics_run_json(const HapticsRunResult& r) {
           {"bodies", r.bodies},
           {"triangles", r.triangles},
           {"scene_seconds", r.scene_seconds},
+          {"scene_cached_bodies", r.scene_cached_bodies},
+          {"startup_seconds", r.startup_seconds},
           {"vertebrae", r.request.scene.vertebrae},
           {"registration", r.registered ? registration_json(r.registration) : nlohmann::json()},
           {"device", r.request.device},
@@ -574,7 +579,10 @@ std::string haptics_run_table(const HapticsRunResult& r) {
   const auto& s = r.stats;
   std::ostringstream os;
   os << "  scene      " << r.scene_description << " (" << r.bodies << " bodies, " << r.triangles
-     << " triangles, built in " << fixed(r.scene_seconds, 1) << " s)\n"
+     << " triangles, built in " << fixed(r.scene_seconds, 1) << " s"
+     << (r.scene_cached_bodies ? ", " + std::to_string(r.scene_cached_bodies) + " from the cache"
+                               : std::string())
+     << "; first tick " << fixed(r.startup_seconds, 1) << " s after the start)\n"
      << "  device     " << r.request.device << " (" << r.capabilities.description << ", peak "
      << fixed(r.capabilities.peak_force_n, 2) << " N)\n"
      << "  renderer   " << r.request.renderer << ", probe radius "

@@ -26,6 +26,9 @@ struct HapticSceneRequest {
   std::string vertebrae = "generated";  ///< generated, real, or a scene JSON file
   int triangles = 6000;                 ///< per generated body
   std::string testdata_dir;             ///< for `real`: the folder holding artisynth-lss/
+  /// Where generated vertebrae are kept between runs (mesh/vertebra_cache.hpp); empty: mesh
+  /// them every time.
+  std::string cache_dir;
 };
 
 /// How the real vertebrae were registered: one rigid motion (a rotation about the lateral axis
@@ -43,6 +46,7 @@ struct HapticScene {
   haptics::Scene scene;
   std::string description;
   std::vector<std::string> sources;  ///< per body: "generated", "real", or the file
+  int cached = 0;                    ///< generated bodies read from the cache
   Eigen::Vector3d center_mm = Eigen::Vector3d::Zero();
   bool registered = false;
   Registration registration;

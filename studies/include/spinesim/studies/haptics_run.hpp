@@ -115,6 +115,8 @@ struct HapticsRunResult {
   bool registered = false;
   Registration registration;  ///< of the real vertebrae, when used
   double scene_seconds = 0;
+  int scene_cached_bodies = 0;  ///< generated bodies read from the vertebra cache
+  double startup_seconds = 0;   ///< from the call to the first tick (scene, disc, stage, device)
   haptics::DeviceCapabilities capabilities;
   double stiffness_n_per_mm = 0, passive_limit_n_per_mm = 0;
   haptics::ServoStats stats;
