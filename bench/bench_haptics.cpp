@@ -14,6 +14,7 @@
 //     network `calibrate --nonlinear` fits): their frozen steps are line-searched.
 #include "spinesim/haptics/device.hpp"
 #include "spinesim/haptics/disc_palpation.hpp"
+#include "spinesim/haptics/hostile.hpp"
 #include "spinesim/haptics/renderer.hpp"
 #include "spinesim/mesh/disc_geometry.hpp"
 #include "spinesim/mesh/material.hpp"
@@ -28,6 +29,8 @@
 #include <CGAL/AABB_triangle_primitive.h>
 #include <CGAL/Simple_cartesian.h>
 
+#include <algorithm>
+#include <chrono>
 #include <random>
 #include <vector>
 
@@ -163,6 +166,51 @@ void GaoGibsonTick(benchmark::State& state) {
   tick<sh::GaoGibsonRenderer>(state, p);
 }
 BENCHMARK(GaoGibsonTick)->Arg(2)->Arg(4)->Arg(10)->Unit(benchmark::kMicrosecond);
+
+// The proxy along each hostile trajectory (haptics/hostile.hpp; the device at the set-point,
+// no hand): the mean per tick from the benchmark, the tail and the largest collision work from
+// the ticks' own clocks. Arg: the trajectory (0 teleport … 5 hammer), the work bound.
+void HostileProxyTick(benchmark::State& state) {
+  auto& s = spine();
+  const std::string name = sh::hostile_names()[std::size_t(state.range(0))];
+  const sh::Trajectory path = sh::hostile_trajectory(name, s.scene);
+  sh::ProxyParameters p;
+  p.radius_mm = 4;
+  p.max_work = int(state.range(1));
+  sh::SphereProxyRenderer renderer(p);
+  const sh::ScenePoses poses{};
+  const double T = 1e-3;
+  double t = 0;
+  renderer.reset(path.position_at(0));
+  std::vector<double> us;
+  int max_work = 0;
+  std::int64_t bounded = 0;
+  for (auto _ : state) {
+    const auto start = std::chrono::steady_clock::now();
+    sh::ProbeState probe{path.position_at(t), path.velocity_at(t)};
+    const auto out = renderer.render(probe, s.scene, poses, T);
+    us.push_back(std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start)
+                     .count());
+    benchmark::DoNotOptimize(out);
+    max_work = std::max(max_work, out.work);
+    bounded += out.truncated;
+    t += T;
+    if (t > path.duration_s()) {
+      t = 0;
+      renderer.reset(path.position_at(0));
+    }
+  }
+  std::sort(us.begin(), us.end());
+  state.SetLabel(name);
+  state.counters["p999_us"] = us[std::min(us.size() - 1, std::size_t(0.999 * double(us.size())))];
+  state.counters["max_us"] = us.back();
+  state.counters["max_work"] = max_work;
+  state.counters["at_bound"] = double(bounded) / double(state.iterations());
+}
+BENCHMARK(HostileProxyTick)
+    ->ArgsProduct({{0, 1, 2, 3, 4, 5}, {4096}})
+    ->Args({2, 256})
+    ->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 
