@@ -363,6 +363,31 @@ std::string floor_line(const HapticsRunResult& r) {
 
 }  // namespace
 
+namespace {
+
+// The scripted or replayed hand (empty for a hostile script, which needs the scene first).
+haptics::Trajectory read_hand_trajectory(const HapticsRunRequest& request,
+                                         const std::string& data_dir, HapticsRunResult* result) {
+  if (request.device == "sim" && hostile_script_name(request.script).empty()) {
+    result->request.script = request.script.empty()
+                                 ? default_haptic_script(request.scene.scene, data_dir)
+                                 : request.script;
+    return haptics::read_trajectory(result->request.script);
+  }
+  if (request.device == "replay") return haptics::read_trajectory(request.replay);
+  return {};
+}
+
+double run_duration(const HapticsRunRequest& request, const haptics::Trajectory& trajectory,
+                    double T) {
+  if (request.duration_s != 0) return request.duration_s;
+  return request.device == "null"    ? 10.0
+         : request.device == "mouse" ? 3600.0  // until the window closes
+                                     : trajectory.duration_s() + T;
+}
+
+}  // namespace
+
 HapticsRunResult run_haptics(const HapticsRunRequest& request, const std::string& data_dir,
                              const std::function<void(const haptics::ServoStatus&)>& status,
                              const std::function<void(int, int)>& scene_progress) {
@@ -373,24 +398,11 @@ HapticsRunResult run_haptics(const HapticsRunRequest& request, const std::string
   result.capabilities = haptics::device_model(request.model);
   const double T = 1e-3;
   // Files are read (and refused) before the scene is built.
-  haptics::Trajectory trajectory;
-  const std::string hostile = hostile_script_name(request.script);
-  if (request.device == "sim" && hostile.empty()) {
-    result.request.script = request.script.empty()
-                                ? default_haptic_script(request.scene.scene, data_dir)
-                                : request.script;
-    trajectory = haptics::read_trajectory(result.request.script);
-  } else if (request.device == "replay") {
-    trajectory = haptics::read_trajectory(request.replay);
-  }
-
+  haptics::Trajectory trajectory = read_hand_trajectory(request, data_dir, &result);
   HapticScene scene = build_haptic_scene(request.scene, data_dir, scene_progress);
+  const std::string hostile = hostile_script_name(request.script);
   if (!hostile.empty()) trajectory = haptics::hostile_trajectory(hostile, scene.scene);
-  double duration = request.duration_s;
-  if (duration == 0)
-    duration = request.device == "null"    ? 10.0
-               : request.device == "mouse" ? 3600.0  // until the window closes
-                                           : trajectory.duration_s() + T;
+  const double duration = run_duration(request, trajectory, T);
   result.request.duration_s = duration;
   describe_scene(request, scene, &result);
   result.passive_limit_n_per_mm = haptics::passive_stiffness_limit(result.capabilities, T);
