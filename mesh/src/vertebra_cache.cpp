@@ -133,7 +133,8 @@ VertebraSurface cached_vertebra_surface(const ParametricVertebra& v, int target_
     std::error_code ec;
     fs::create_directories(cache_dir, ec);
     for (const auto& e : fs::directory_iterator(cache_dir, ec))
-      if (e.path().filename().string().rfind(prefix, 0) == 0 && e.path().string() != path)
+      if (e.path().filename().string().rfind(prefix, 0) == 0 && e.path().extension() == ".bin" &&
+          e.path().string() != path)  // not another run's file being written (".bin.tmp-…")
         fs::remove(e.path(), ec);
     write_cached(path, key, out.surface);
   } catch (const std::exception&) {}
