@@ -192,14 +192,19 @@ const std::vector<std::string>& hostile_names() {
   return names;
 }
 
+void check_hostile_name(const std::string& name) {
+  std::string known;
+  for (const std::string& n : hostile_names()) {
+    if (n == name) return;
+    known += (known.empty() ? "" : ", ") + n;
+  }
+  throw std::invalid_argument("no such hostile trajectory '" + name + "' (there are: " + known +
+                              ")");
+}
+
 Trajectory hostile_trajectory(const std::string& name, const Scene& scene,
                               const ScenePoses& poses) {
-  std::string known;
-  for (const std::string& n : hostile_names()) known += (known.empty() ? "" : ", ") + n;
-  bool found = false;
-  for (const std::string& n : hostile_names()) found = found || n == name;
-  if (!found)
-    throw std::invalid_argument("no hostile trajectory '" + name + "' (there are: " + known + ")");
+  check_hostile_name(name);
   const Layout l = layout_of(scene, poses);
   if (name == "teleport") return teleport(l);
   if (name == "start-inside") return start_inside(l);

@@ -31,12 +31,12 @@ std::string hostile_script_name(const std::string& script) {
   const std::string prefix = "hostile:";
   if (script.compare(0, prefix.size(), prefix) != 0) return {};
   const std::string name = script.substr(prefix.size());
-  for (const std::string& n : haptics::hostile_names())
-    if (n == name) return name;
-  std::string known;
-  for (const std::string& n : haptics::hostile_names()) known += (known.empty() ? "" : ", ") + n;
-  throw std::invalid_argument("--script " + script +
-                              ": no such hostile trajectory (there are: " + known + ")");
+  try {
+    haptics::check_hostile_name(name);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument("--script " + script + ": " + e.what());
+  }
+  return name;
 }
 
 std::string default_haptic_script(const std::string& scene, const std::string& data_dir) {

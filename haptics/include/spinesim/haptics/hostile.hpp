@@ -21,6 +21,8 @@ namespace spinesim::haptics {
 
 /// The names above, in that order.
 const std::vector<std::string>& hostile_names();
+/// Throws std::invalid_argument (one line, naming the trajectories) unless `name` is one of them.
+void check_hostile_name(const std::string& name);
 
 /// The trajectory `name` for `scene` at `poses` (world frame, mm). Throws std::invalid_argument
 /// (one line, naming the trajectories) for an unknown name or an empty scene.
