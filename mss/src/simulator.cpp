@@ -103,8 +103,11 @@ struct Simulator::Impl {
     Eigen::Vector3d n;
     double p0, k;
     bool active;
+    int probe;
+    double radius;
   };
   std::vector<Pair> pairs;
+  std::vector<Eigen::Matrix3d> probe_K;  ///< each probe's stiffness in the last contact solve
   Eigen::MatrixXd base_W,
       base_Z;  ///< low-rank part of the factorised matrix (rank-one volume term)
   std::unordered_map<int, Eigen::MatrixXd>
@@ -126,6 +129,9 @@ struct Simulator::Impl {
   /// active-set loop on the linearised gaps (more low-rank terms, Woodbury).
   /// Returns whether the active set settled within kActiveSetPasses.
   bool contact_direction(const ExternalLoads& loads, const Eigen::VectorXd& xs);
+  /// probe_K from the contact solve's active pairs and its Woodbury matrix S.
+  void contact_stiffness(const std::vector<std::size_t>& active, const Eigen::MatrixXd& S,
+                         std::size_t probes);
   /// A^-1 of the reduced unit vectors of a free node (key = node) or of the plate DOF (key -1).
   const Eigen::MatrixXd& contact_solve(int key);
   /// out += scale A^-1 P^T (e_i v): the A^-1 image of a node vector (cached solves).
@@ -240,15 +246,18 @@ bool Simulator::Impl::contact_direction(const ExternalLoads& loads, const Eigen:
   // Candidate (probe, node) pairs: unknown nodes within two radii of a probe centre, with the
   // outward normal n and penetration p0 = r - |x - c| (negative: a gap) at the start.
   pairs.clear();
-  for (const Probe& p : loads.probes())
+  for (std::size_t pi = 0; pi < loads.probes().size(); ++pi) {
+    const Probe& p = loads.probes()[pi];
     for (Eigen::Index i = 0; i < model->num_nodes(); ++i) {
       const Eigen::Vector3d a = xs.segment<3>(3 * i) - p.center_mm;
       const double dist = a.norm();
       if (dist >= 2.0 * p.radius_mm || dist <= 1e-12 * p.radius_mm || !space.is_unknown(int(i)) ||
           !loads.touchable(i))
         continue;
-      pairs.push_back({int(i), a / dist, p.radius_mm - dist, p.stiffness_n_per_mm, false});
+      pairs.push_back({int(i), a / dist, p.radius_mm - dist, p.stiffness_n_per_mm, false, int(pi),
+                       p.radius_mm});
     }
+  }
   const auto node_step = [&](int i) -> Eigen::Vector3d {
     if (space.role(i) == detail::NodeRole::free) return d.segment<3>(3 * space.free_index(i));
     return detail::plate_map(model->rest_positions_mm().segment<3>(3 * i) - space.center()) *
@@ -283,6 +292,7 @@ bool Simulator::Impl::contact_direction(const ExternalLoads& loads, const Eigen:
   std::vector<char> made(pairs.size(), 0);
   bool settled = false;
   std::vector<std::size_t> active;
+  Eigen::MatrixXd last_S;  // I + W^T A^-1 W of the last pass (base and active contact columns)
   for (int pass = 0; pass < kActiveSetPasses && !settled; ++pass) {
     active.clear();
     for (std::size_t p = 0; p < pairs.size(); ++p)
@@ -312,8 +322,8 @@ bool Simulator::Impl::contact_direction(const ExternalLoads& loads, const Eigen:
         for (Eigen::Index b = 0; b < m; ++b) S(a, b) += wdot(a, zcol(b));
         t(a) = wdot(a, d);
       }
-      const Eigen::MatrixXd Ss = 0.5 * (S + S.transpose());
-      t = Ss.ldlt().solve(t);
+      last_S = 0.5 * (S + S.transpose());
+      t = last_S.ldlt().solve(t);
       for (Eigen::Index b = 0; b < m; ++b) d.noalias() -= t(b) * zcol(b);
     }
     settled = true;
@@ -323,7 +333,39 @@ bool Simulator::Impl::contact_direction(const ExternalLoads& loads, const Eigen:
       c.active = inside;
     }
   }
+  contact_stiffness(active, last_S, loads.probes().size());
   return settled;
+}
+
+void Simulator::Impl::contact_stiffness(const std::vector<std::size_t>& active,
+                                        const Eigen::MatrixXd& S, std::size_t probes) {
+  // Moving a probe's centre by dc changes the active pairs' gaps by n.dc; the step's quadratic
+  // model then answers with dd = T^-1 W N dc (T = A + G G^T the whole matrix, G = [base W,
+  // contact W], N the rows sqrt(k) n^T), and the disc's force on the probe F = -sum k p n
+  // changes by dF = -N^T (I - W^T T^-1 W) N dc. With Q = G^T A^-1 G (S = I + Q, the matrix of
+  // the Woodbury solve), G^T T^-1 G = I - S^-1, so the probe's stiffness -dF/dc is
+  // N^T [S^-1]_contacts N: k n n^T per pair on a rigid disc, 0 on a limp one. The step's
+  // matrix has only the Gauss-Newton part of the contact; the force itself also turns with the
+  // probe (n follows c), which adds -k p (I - n n^T) / |x - c| per pair: a frictionless sphere
+  // on a node tends to slide off it, so the tangential stiffness can be negative.
+  probe_K.assign(probes, Eigen::Matrix3d::Zero());
+  if (active.empty()) return;
+  for (const std::size_t a : active) {
+    const Pair& c = pairs[a];
+    const double dist = c.p0 > 0 ? c.radius - c.p0 : 0;
+    if (dist > 0)
+      probe_K[std::size_t(c.probe)] -=
+          c.k * c.p0 / dist * (Eigen::Matrix3d::Identity() - c.n * c.n.transpose());
+  }
+  const Eigen::Index r0 = S.rows() - Eigen::Index(active.size());
+  const Eigen::MatrixXd Sinv = S.ldlt().solve(Eigen::MatrixXd::Identity(S.rows(), S.cols()));
+  for (std::size_t a = 0; a < active.size(); ++a)
+    for (std::size_t b = 0; b < active.size(); ++b) {
+      const Pair &pa = pairs[active[a]], &pb = pairs[active[b]];
+      if (pa.probe != pb.probe) continue;
+      probe_K[std::size_t(pa.probe)] += Sinv(r0 + Eigen::Index(a), r0 + Eigen::Index(b)) *
+                                        std::sqrt(pa.k * pb.k) * pa.n * pb.n.transpose();
+    }
 }
 
 StepReport Simulator::Impl::explicit_step(State& s, const Boundary& bc, const ExternalLoads& loads,
@@ -392,6 +434,7 @@ StepReport Simulator::Impl::implicit_step(State& s, const Boundary& bc,
       contact_direction(loads, pot.x());
       contacts_attached = true;
     } else {
+      probe_K.clear();
       if (contacts_attached) tangent.set_low_rank(base_W, base_Z);
       contacts_attached = false;
       d = -r;
@@ -524,6 +567,12 @@ StepReport Simulator::step(State& s, const Boundary& bc) {
     default:
       return d.implicit_step(s, bc, loads);
   }
+}
+
+Eigen::Matrix3d Simulator::probe_stiffness(int probe) const {
+  const Impl& d = *impl_;
+  if (probe < 0 || std::size_t(probe) >= d.probe_K.size()) return Eigen::Matrix3d::Zero();
+  return d.probe_K[std::size_t(probe)];
 }
 
 double Simulator::predicted_stable_dt_s(Integrator integrator) const {

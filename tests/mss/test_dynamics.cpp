@@ -7,6 +7,8 @@
 #include "spinesim/mss/solver.hpp"
 
 #include "solver_fixtures.hpp"
+
+#include <Eigen/Eigenvalues>
 #include "stability.hpp"
 
 #include <gtest/gtest.h>
@@ -374,6 +376,67 @@ TEST_F(DynamicsDisc, ProbePressHoldAndWithdrawWithoutChatter) {
     EXPECT_LT(f_max, 1.05 * f_static);
     EXPECT_LT(jump, 0.1 * f_static);
   }
+}
+
+TEST_F(DynamicsDisc, ProbeStiffnessIsTheStepsFiniteDifference) {
+  // probe_stiffness is -dF/dc of the step map: from one pressed state, step with the probe's
+  // centre moved by +-h along each axis and difference the disc's force on it after the step.
+  const double ymid = 0.5 * (mesh_.V.col(1).minCoeff() + mesh_.V.col(1).maxCoeff());
+  int node = -1;
+  for (Eigen::Index i = 0; i < mesh_.num_vertices(); ++i)
+    if (mesh_.surface(i) == 3 && std::abs(mesh_.V(i, 1) - ymid) < 2.0 &&
+        (node < 0 || mesh_.V(i, 2) > mesh_.V(node, 2)))
+      node = int(i);
+  ASSERT_GE(node, 0);
+  const double r = 4.0;
+  const Eigen::Vector3d c = mesh_.V.row(node).transpose() + Eigen::Vector3d(0.3, 0.2, r - 1.0);
+  Boundary bc;
+  bc.probes.push_back(Probe{c, r, default_probe_stiffness(model_)});
+  for (const double dt : {1e-3, 1e-2}) {
+    DynamicsOptions o;
+    o.dt_s = dt;
+    o.matrix_update = MatrixUpdate::frozen;
+    Simulator sim(model_, o);
+    State s = run(sim, sim.rest_state(), bc, 30);                // pressed 1 mm, settled
+    EXPECT_EQ(sim.probe_stiffness(1), Eigen::Matrix3d::Zero());  // no such probe
+    State s0 = s;
+    ASSERT_TRUE(sim.step(s0, bc).ok);
+    const Eigen::Matrix3d K = sim.probe_stiffness(0);
+    Eigen::Matrix3d fd;
+    const double h = 1e-3;
+    for (int k = 0; k < 3; ++k) {
+      Eigen::Vector3d f[2];
+      for (int side = 0; side < 2; ++side) {
+        Boundary moved = bc;
+        moved.probes[0].center_mm(k) += side ? -h : h;
+        State t = s;
+        ASSERT_TRUE(sim.step(t, moved).ok);
+        f[side] = probe_forces(model_, moved, t.x_mm)[0];
+      }
+      fd.col(k) = -(f[0] - f[1]) / (2 * h);
+    }
+    const double err = (K - fd).norm() / fd.norm();
+    std::printf(
+        "probe stiffness, dt %.0f ms: |K| %.2f N/mm (penalty %.0f N/mm per node), "
+        "relative difference from the step's finite difference %.2e\n",
+        1e3 * dt, K.norm(), bc.probes[0].stiffness_n_per_mm, err);
+    // The rest is the nodes' own geometric terms (the step's matrix is Gauss-Newton): ~5 %.
+    EXPECT_LT(err, 0.08);
+    EXPECT_NEAR(K(2, 2), fd(2, 2), 0.01 * fd(2, 2));  // along the wall's normal (+z)
+    EXPECT_LT((K - K.transpose()).norm(), 1e-9 * K.norm());
+    // Tangentially a frictionless sphere slides off the nodes (negative); the normal is stiff.
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(K);
+    EXPECT_GT(eig.eigenvalues().maxCoeff(), 10.0);
+    EXPECT_LT(K.norm(), 0.5 * bc.probes[0].stiffness_n_per_mm);  // the disc yields
+  }
+  // Out of contact: zero.
+  DynamicsOptions o;
+  Simulator sim(model_, o);
+  State s = sim.rest_state();
+  Boundary away = bc;
+  away.probes[0].center_mm += Eigen::Vector3d(0, 0, 50);
+  ASSERT_TRUE(sim.step(s, away).ok);
+  EXPECT_EQ(sim.probe_stiffness(0), Eigen::Matrix3d::Zero());
 }
 
 TEST_F(DynamicsDisc, ImplicitEulerAtOneMillisecondIsStableAndReachesTheStaticSolution) {

@@ -91,6 +91,14 @@ class Simulator {
   /// = 4 (2/omega_max undamped); implicit +infinity. Measured limits lie 0-4 % above them.
   double predicted_stable_dt_s(Integrator integrator) const;
 
+  /// A probe's stiffness in the last implicit step's linearisation, -dF/dc (N/mm, symmetric
+  /// positive semi-definite): how the disc's force F on the probe (solver.hpp probe_forces)
+  /// changes when the probe's centre c moves within a step, the disc answering through the
+  /// step's matrix (M/dt^2 + K_d/dt + K, so it includes the step's damping) in series with the
+  /// contact penalty. Zero out of contact, before any implicit step with probes, or for an index
+  /// outside bc.probes. A multirate renderer's local contact model.
+  Eigen::Matrix3d probe_stiffness(int probe) const;
+
   const DynamicsOptions& options() const;
 
  private:
