@@ -12,6 +12,7 @@
 #include <time.h>
 
 #include <Eigen/Dense>
+#include <Eigen/Eigenvalues>
 
 #include <algorithm>
 #include <array>
@@ -46,6 +47,8 @@ mss::DynamicsOptions dynamics(const DiscPalpationOptions& o) {
   require(std::isfinite(o.dt_s) && o.dt_s > 0 && o.dt_s <= 0.01, "the step must be in (0, 10] ms");
   require(o.newton_iterations >= 1 && o.newton_iterations <= 20,
           "the Newton iterations must be 1 to 20");
+  require(std::isfinite(o.force_scale) && o.force_scale >= 1 && o.force_scale <= 1e4,
+          "the force scale must be 1 to 10,000 (disc N per felt N)");
   mss::DynamicsOptions d;
   d.integrator = mss::Integrator::implicit_euler;
   d.dt_s = o.dt_s;
@@ -55,6 +58,15 @@ mss::DynamicsOptions dynamics(const DiscPalpationOptions& o) {
 }
 
 }  // namespace
+
+LocalContact evaluate_local_model(const DiscContact& c, double kcd, const Eigen::Vector3d& device) {
+  LocalContact out{device, Eigen::Vector3d::Zero(), false};
+  if (!c.model) return out;
+  const Eigen::Vector3d p = c.model_inverse * (kcd * device + c.model_offset);
+  const Eigen::Vector3d f = kcd * (p - device);  // the disc's force on the probe, balanced
+  if (!p.allFinite() || !(f.dot(c.model_normal) > 0)) return out;
+  return {p, f, true};
+}
 
 double surface_gap_mm(const mesh::TetMesh& m) {
   // Boundary faces (the faces of exactly one tet) of the outer wall.
@@ -116,7 +128,7 @@ DiscPalpation::~DiscPalpation() { stop(); }
 
 Eigen::Vector3d DiscPalpation::place_probe(const Eigen::Vector3d& device) const {
   // The nodes that can touch the probe on its way from the device towards the surface.
-  const double r = options_.probe_radius_mm, kc = options_.coupling_stiffness_n_per_mm;
+  const double r = options_.probe_radius_mm, kc = disc_coupling_n_per_mm();
   const Eigen::VectorXd& x = state_.x_mm;
   auto energy = [&](const Eigen::Vector3d& p, Eigen::Vector3d* g, Eigen::Matrix3d* H) {
     double e = 0.5 * kc * (p - device).squaredNorm();
@@ -165,6 +177,56 @@ Eigen::Vector3d DiscPalpation::place_probe(const Eigen::Vector3d& device) const 
   return p;
 }
 
+double DiscPalpation::indentation_mm(const Eigen::Vector3d& p) const {
+  const double r2 = options_.probe_radius_mm * options_.probe_radius_mm;
+  const Eigen::VectorXd& x = state_.x_mm;
+  const Eigen::VectorXd& X = model_.rest_positions_mm();
+  double worst = 0;
+  for (const Eigen::Index i : surface_nodes_)
+    if ((p - x.segment<3>(3 * i)).squaredNorm() < 1.21 * r2)  // touched, or just left
+      worst = std::max(worst, (x.segment<3>(3 * i) - X.segment<3>(3 * i)).norm());
+  return worst;
+}
+
+void DiscPalpation::update_local_model(const Eigen::Vector3d& device) {
+  const double kcd = disc_coupling_n_per_mm();
+  last_.model = false;
+  if (!armed_) return;  // started inside: no disc force until the hand has been outside
+  Eigen::Matrix3d K;
+  Eigen::Vector3d p0, f0, n;
+  if (last_.contact && last_.force_n.norm() > 0) {
+    // The step's contact stiffness, its negative (sliding) directions dropped: the local model
+    // is then a spring network no stiffer than s k_c in series, so the servo's loop is passive.
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(sim_.probe_stiffness(0));
+    model_trusted_ = kcd + eig.eigenvalues().minCoeff() > 0.5 * kcd;
+    K = eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).asDiagonal() *
+        eig.eigenvectors().transpose();
+    p0 = last_.probe_mm;
+    f0 = last_.force_n;
+    n = f0.normalized();
+    normal_stiffness_ = n.dot(K * n);
+  } else {
+    // The onset plane: tangent to the probe sphere resting on the nearest surface node.
+    const Eigen::VectorXd& x = state_.x_mm;
+    Eigen::Index best = -1;
+    double best2 = 0;
+    for (const Eigen::Index i : surface_nodes_) {
+      const double d2 = (device - x.segment<3>(3 * i)).squaredNorm();
+      if (best < 0 || d2 < best2) best = i, best2 = d2;
+    }
+    if (best < 0 || !(best2 > 0)) return;
+    n = (device - x.segment<3>(3 * best)) / std::sqrt(best2);
+    p0 = x.segment<3>(3 * best) + options_.probe_radius_mm * n;
+    f0.setZero();
+    const double kn = normal_stiffness_ > 0 ? normal_stiffness_ : k_p_;
+    K = kn * n * n.transpose();
+  }
+  last_.model_inverse = (kcd * Eigen::Matrix3d::Identity() + K).inverse();
+  last_.model_offset = f0 + K * p0;
+  last_.model_normal = n;
+  last_.model = last_.model_inverse.allFinite() && last_.model_offset.allFinite();
+}
+
 bool DiscPalpation::touches_disc(const Eigen::Vector3d& point) const {
   const double r = options_.probe_radius_mm;
   const Eigen::VectorXd& x = state_.x_mm;
@@ -189,7 +251,26 @@ const DiscContact& DiscPalpation::step(const Eigen::Vector3d& device_mm) {
     armed_ = true;
     last_.probe_mm = device_mm;  // the probe starts from here, outside
   }
-  const Eigen::Vector3d p = armed_ ? place_probe(device_mm) : device_mm;
+  // In contact, the probe goes where the coupling balances the disc's response as the last step
+  // linearised it (its local model); placed against the disc's old nodes instead, the probe
+  // would sink into them by a step's motion and the stiff penalty would push the disc ahead of
+  // the hand (measured: 3x the balanced force a step after, relaxing over ~50 ms, at 10 ms steps).
+  // Only at a physiological force scale (s > 1: the coupling s k_c is stiff, tens of N/mm), and
+  // while the coupling outweighs the contact's negative (sliding) stiffness by 2x and the probe
+  // moves less than r/4; else the nodes place it (on a soft coupling a frictionless sphere slides
+  // between the nodes, which the one-node model does not see).
+  Eigen::Vector3d p = device_mm;
+  if (armed_) {
+    const LocalContact predicted =
+        options_.force_scale > 1 && last_.contact && last_.model && model_trusted_
+            ? evaluate_local_model(last_, disc_coupling_n_per_mm(), device_mm)
+            : LocalContact{device_mm, Eigen::Vector3d::Zero(), false};
+    p = predicted.contact &&
+                (predicted.probe_mm - last_.probe_mm).norm() <= 0.25 * options_.probe_radius_mm
+            ? predicted.probe_mm
+            : place_probe(device_mm);
+  }
+  last_.device_mm = device_mm;
   bc_.probes[0].center_mm = p;
   const mss::StepReport report = sim_.step(state_, bc_);
   ++last_.step;
@@ -199,6 +280,8 @@ const DiscContact& DiscPalpation::step(const Eigen::Vector3d& device_mm) {
                                 : Eigen::Vector3d::Zero().eval();
   last_.volume_change = mss::volume_change(model_, state_.x_mm);
   last_.failed = !report.ok;
+  last_.indentation_mm = last_.contact ? indentation_mm(p) : 0.0;
+  update_local_model(device_mm);
   last_.step_us =
       std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count();
   return last_;
@@ -245,6 +328,52 @@ void DiscPalpation::run() {
   }
 }
 
+std::vector<Eigen::Vector3d> palpate_offline(const mss::MssModel& model,
+                                             const mss::Boundary& plates,
+                                             const DiscPalpationOptions& options,
+                                             const std::vector<Eigen::Vector3d>& device_mm,
+                                             double tick_s) {
+  const double every = options.dt_s / tick_s;
+  const long n_every = std::lround(every);
+  if (!(tick_s > 0) || n_every < 1 || std::abs(every - double(n_every)) > 1e-9 * every ||
+      (!options.multirate && n_every != 1))
+    throw std::invalid_argument(
+        "disc palpation: the step must be a whole number of ticks (one tick when direct)");
+  DiscPalpationOptions o = options;
+  o.realtime_priority = false;
+  DiscPalpation disc(model, plates, o);
+  const double kcd = disc.disc_coupling_n_per_mm();
+  std::vector<Eigen::Vector3d> force(device_mm.size(), Eigen::Vector3d::Zero());
+  DiscContact seen;  // what the servo sees: the last finished step
+  for (std::size_t k = 0; k < device_mm.size(); ++k) {
+    const Eigen::Vector3d& x = device_mm[k];
+    if (!options.multirate) {
+      const DiscContact& c = disc.step(x);
+      if (c.contact) force[k] = kcd * (c.probe_mm - x);
+      continue;
+    }
+    const LocalContact local = evaluate_local_model(seen, kcd, x);
+    if (local.contact) force[k] = local.force_n;
+    if (long(k) % n_every == 0) seen = disc.step(x);
+  }
+  return force;
+}
+
+ForceError force_error(const std::vector<Eigen::Vector3d>& run,
+                       const std::vector<Eigen::Vector3d>& reference) {
+  ForceError e;
+  const std::size_t n = std::min(run.size(), reference.size());
+  double sum2 = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double d = (run[k] - reference[k]).norm();
+    sum2 += d * d;
+    e.max_n = std::max(e.max_n, d);
+    e.peak_n = std::max(e.peak_n, reference[k].norm());
+  }
+  e.rms_n = n ? std::sqrt(sum2 / double(n)) : 0;
+  return e;
+}
+
 DiscCouplingRenderer::DiscCouplingRenderer(ForceRenderer& rigid, DiscPalpation& disc)
     : rigid_(rigid), palpation_(disc) {}
 
@@ -263,8 +392,24 @@ RenderOutput DiscCouplingRenderer::render(const ProbeState& probe, const Scene& 
   out.disc_volume_change = disc_.volume_change;
   out.disc_force_n = disc_.force_n;
   out.disc_probe_mm = disc_.contact ? disc_.probe_mm : probe.position_mm;
-  if (!disc_.contact) return out;
   const DiscPalpationOptions& o = palpation_.options();
+  if (o.multirate) {
+    // The worker's local model at this tick's device position; none when it is stale.
+    if (disc_.step != model_step_) model_step_ = disc_.step, ticks_on_model_ = 0;
+    const bool stale = ++ticks_on_model_ * dt_s > DiscPalpation::kStaleSteps * o.dt_s;
+    stale_ticks_ += stale;
+    LocalContact local{probe.position_mm, Eigen::Vector3d::Zero(), false};
+    if (!stale)
+      local = evaluate_local_model(disc_, palpation_.disc_coupling_n_per_mm(), probe.position_mm);
+    disc_.contact = local.contact;
+    disc_.probe_mm = local.probe_mm;
+    disc_.force_n = local.force_n;
+    out.disc_contact = local.contact;
+    out.disc_force_n = local.force_n;
+    out.disc_probe_mm = local.probe_mm;
+  }
+  out.disc_indentation_mm = disc_.contact ? disc_.indentation_mm : 0.0;
+  if (!disc_.contact) return out;
   const Eigen::Vector3d f = o.coupling_stiffness_n_per_mm * (disc_.probe_mm - probe.position_mm) -
                             o.coupling_damping_n_s_per_mm * probe.velocity_mm_s;
   out.force_n += f;

@@ -70,7 +70,7 @@ HapticRecordingWriter::HapticRecordingWriter(const std::string& path,
   if (disc)
     std::fprintf(file_,
                  ",disc_contact,disc_probe_x_mm,disc_probe_y_mm,disc_probe_z_mm,disc_fx_n,"
-                 "disc_fy_n,disc_fz_n,disc_volume_change");
+                 "disc_fy_n,disc_fz_n,disc_volume_change,disc_indentation_mm");
   if (model) {
     std::fprintf(file_,
                  ",attached,hook_vertebra,hook_ref_x_mm,hook_ref_y_mm,hook_ref_z_mm,"
@@ -98,10 +98,10 @@ void HapticRecordingWriter::append(const haptics::TickRecord* rows, std::size_t 
                  r.force_n.y(), r.force_n.z(), r.proxy_mm.x(), r.proxy_mm.y(), r.proxy_mm.z(),
                  r.contact ? 1 : 0, static_cast<long long>(r.tick));
     if (disc_)
-      std::fprintf(file_, ",%d,%.4f,%.4f,%.4f,%.5f,%.5f,%.5f,%.7f", r.disc_contact ? 1 : 0,
+      std::fprintf(file_, ",%d,%.4f,%.4f,%.4f,%.5f,%.5f,%.5f,%.7f,%.5f", r.disc_contact ? 1 : 0,
                    r.disc_probe_mm.x(), r.disc_probe_mm.y(), r.disc_probe_mm.z(),
                    r.disc_force_n.x(), r.disc_force_n.y(), r.disc_force_n.z(),
-                   r.disc_volume_change);
+                   r.disc_volume_change, r.disc_indentation_mm);
     if (!centres_.empty()) {
       const auto& h = r.hook;
       std::fprintf(file_, ",%d,%d,%.5f,%.5f,%.5f,%.4f,%.4f,%.4f,%.5f,%.5f,%.5f", h.attached ? 1 : 0,

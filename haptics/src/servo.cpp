@@ -110,6 +110,7 @@ void ServoLoop::publish_status(double now_s, const Eigen::Vector3d& force, const
   status.disc = out.disc;
   status.disc_contact = out.disc_contact;
   status.disc_volume_change = out.disc_volume_change;
+  status.disc_indentation_mm = out.disc_indentation_mm;
   status.disc_force_n = out.disc_force_n;
   status.disc_probe_mm = out.disc_probe_mm;
   status.poses = poses;
@@ -190,6 +191,7 @@ void ServoLoop::tick(double now_s, double period_s) {
       r.disc = out.disc;
       r.disc_contact = out.disc_contact;
       r.disc_volume_change = float(out.disc_volume_change);
+      r.disc_indentation_mm = float(out.disc_indentation_mm);
       r.disc_force_n = out.disc_force_n.cast<float>();
       r.disc_probe_mm = out.disc_probe_mm.cast<float>();
       r.compliant = stage_ != nullptr;

@@ -13,6 +13,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <thread>
 
 namespace sh = spinesim::haptics;
@@ -112,23 +113,28 @@ TEST(DiscPalpation, CouplingBalancesTheDiscsForceAndBoundsTheFeltStiffness) {
 }
 
 TEST(DiscPalpation, PressingInAndOutIsPassive) {
-  const sh::DiscPalpationOptions o = options();
-  sh::DiscPalpation p(disc(), held_plates(), o);
-  const auto [wall, n] = anterior_wall();
-  sh::PassivityObserver observer;
-  Vector3d held = Vector3d::Zero(), last = wall + 2.0 * n;
-  p.step(wall + 10.0 * n);
-  for (int k = 0; k < 1500; ++k) {  // three 0.5 s cycles, 5 mm into the disc at the deepest
-    const double depth = -2.0 + 3.5 * (1 - std::cos(2 * M_PI * k / 500.0));
-    const Vector3d device = wall - depth * n;
-    observer.add(held, device - last, 1e-3);
-    last = device;
-    const sh::DiscContact& c = p.step(device);
-    held = c.contact ? Vector3d(o.coupling_stiffness_n_per_mm * (c.probe_mm - device))
-                     : Vector3d::Zero();
+  for (const double scale : {1.0, 30.0}) {
+    sh::DiscPalpationOptions o = options();
+    o.force_scale = scale;  // 30: the probe is placed by the disc's local model
+    sh::DiscPalpation p(disc(), held_plates(), o);
+    const auto [wall, n] = anterior_wall();
+    sh::PassivityObserver observer;
+    Vector3d held = Vector3d::Zero(), last = wall + 2.0 * n;
+    p.step(wall + 10.0 * n);
+    for (int k = 0; k < 1500; ++k) {  // three 0.5 s cycles, 5 mm into the disc at the deepest
+      const double depth = -2.0 + 3.5 * (1 - std::cos(2 * M_PI * k / 500.0));
+      const Vector3d device = wall - depth * n;
+      observer.add(held, device - last, 1e-3);
+      last = device;
+      const sh::DiscContact& c = p.step(device);
+      held = c.contact ? Vector3d(o.coupling_stiffness_n_per_mm * (c.probe_mm - device))
+                       : Vector3d::Zero();
+    }
+    std::printf("force scale %.0f: hand's work on the felt force, least %.4f mJ, end %.4f mJ\n",
+                scale, observer.minimum_mj(), observer.energy_mj());
+    EXPECT_GE(observer.minimum_mj(), -1e-9);
+    EXPECT_GT(observer.energy_mj(), 0.0);  // the disc dissipated some of the hand's work
   }
-  EXPECT_GE(observer.minimum_mj(), -1e-9);
-  EXPECT_GT(observer.energy_mj(), 0.0);  // the disc dissipated some of the hand's work
 }
 
 TEST(DiscPalpation, ThreadStepsAtItsRateAndTheRendererAddsTheCoupling) {
@@ -176,4 +182,102 @@ TEST(DiscPalpation, BadOptionsAreRefused) {
     bad(o);
     EXPECT_THROW(sh::DiscPalpation(disc(), held_plates(), o), std::invalid_argument);
   }
+}
+
+namespace {
+
+/// Approach from 6 mm out over 0.2 s, press `depth` mm past first touch over `press_s`, hold
+/// 0.2 s, withdraw over `press_s`: the device's path at 1 kHz, 1.2 s.
+std::vector<Vector3d> press_path(double depth, double press_s = 0.4) {
+  const auto [wall, n] = anterior_wall();
+  const double r = options().probe_radius_mm;
+  std::vector<Vector3d> path;
+  for (int k = 0; k < 1200; ++k) {
+    const double t = k * 1e-3;
+    const double in = t < 0.2             ? -6.0 + 6.0 * t / 0.2
+                      : t < 0.2 + press_s ? depth * (t - 0.2) / press_s
+                      : t < 0.4 + press_s
+                          ? depth
+                          : depth * std::max(0.0, 1 - (t - 0.4 - press_s) / press_s);
+    path.push_back(wall + (r - in) * n);
+  }
+  return path;
+}
+
+}  // namespace
+
+TEST(DiscPalpation, ForceScaleDeformsTheDiscAndKeepsTheFeltStiffness) {
+  // Scaled, the disc meets s k_c and the hand feels a 1/s share: the disc is indented far more
+  // for the same hand travel, and the felt stiffness stays within k_c.
+  const std::vector<Vector3d> path = press_path(3.0);
+  double indentation[2] = {0, 0};
+  for (const int i : {0, 1}) {
+    sh::DiscPalpationOptions o = options();
+    o.force_scale = i ? 30.0 : 1.0;
+    sh::DiscPalpation p(disc(), held_plates(), o);
+    const Vector3d n = anterior_wall().second;
+    double previous_felt = 0, previous_depth = -1e9, max_stiffness = 0;
+    for (std::size_t k = 0; k < 600; ++k) {
+      const sh::DiscContact& c = p.step(path[k]);
+      ASSERT_FALSE(c.failed);
+      indentation[i] = std::max(indentation[i], c.indentation_mm);
+      const double felt =
+          c.contact ? o.coupling_stiffness_n_per_mm * (c.probe_mm - path[k]).dot(n) : 0.0;
+      const double depth = -path[k].dot(n);
+      if (depth > previous_depth && previous_depth > -1e8 && felt > 0)
+        max_stiffness = std::max(max_stiffness, (felt - previous_felt) / (depth - previous_depth));
+      previous_felt = felt, previous_depth = depth;
+    }
+    std::printf(
+        "force scale %.0f: wall indented %.3f mm at 3 mm of hand travel, felt stiffness "
+        "at most %.3f N/mm\n",
+        o.force_scale, indentation[i], max_stiffness);
+    EXPECT_LE(max_stiffness, o.coupling_stiffness_n_per_mm * 1.001);
+  }
+  EXPECT_GT(indentation[0], 0.0);
+  EXPECT_GT(indentation[1], 5.0 * indentation[0]);
+  EXPECT_GT(indentation[1], 0.5);  // visibly: half a millimetre and more
+}
+
+TEST(DiscPalpation, MultirateLocalModelFollowsTheSynchronousSolve) {
+  // The disc stepped every 10 ms with the local contact model between steps, against the disc
+  // stepped every 1 ms: the felt force along the same hand path, a brisk press (30 mm/s).
+  const std::vector<Vector3d> path = press_path(3.0, 0.1);
+  sh::DiscPalpationOptions sync = options();
+  sync.force_scale = 30;
+  sh::DiscPalpationOptions multi = sync;
+  multi.multirate = true;
+  multi.dt_s = 10e-3;
+  const auto reference = sh::palpate_offline(disc(), held_plates(), sync, path, 1e-3);
+  const auto run = sh::palpate_offline(disc(), held_plates(), multi, path, 1e-3);
+  const sh::ForceError e = sh::force_error(run, reference);
+  if (std::getenv("MR_TRACE"))
+    for (std::size_t k = 0; k < path.size(); k += 5)
+      std::printf("%zu %.3f %.3f\n", k, run[k].norm(), reference[k].norm());
+  // Without the local model (each step's force held for the next 10 ms): the error to beat.
+  std::vector<Vector3d> held(path.size(), Vector3d::Zero());
+  for (std::size_t k = 1; k < path.size(); ++k) held[k] = run[k - (k - 1) % 10];
+  const sh::ForceError zero_order = sh::force_error(held, reference);
+  std::printf(
+      "multirate (10 ms worker, local model at 1 kHz) vs synchronous 1 ms: peak %.2f N, "
+      "RMS error %.2f %%, max %.2f %%; force held between steps: RMS %.2f %%\n",
+      e.peak_n, 100 * e.relative_rms(), 100 * e.relative_max(), 100 * zero_order.relative_rms());
+  EXPECT_GT(e.peak_n, 10.0);  // hundreds of newtons' scale: tens of N on this coarse disc
+  EXPECT_LT(e.relative_rms(), 0.05);
+  EXPECT_LT(e.relative_max(), 0.15);  // the largest at the first touch, within a worker period
+  EXPECT_LT(e.relative_rms(), zero_order.relative_rms());
+  // Passive: the hand's work on the felt force (1/s of the disc's) never goes negative.
+  sh::PassivityObserver observer;
+  for (std::size_t k = 1; k < path.size(); ++k)
+    observer.add(run[k - 1] / multi.force_scale, path[k] - path[k - 1], 1e-3);
+  EXPECT_GE(observer.minimum_mj(), -1e-9);
+  EXPECT_THROW(sh::palpate_offline(disc(), held_plates(), sync, path, 2e-3), std::invalid_argument);
+}
+
+TEST(DiscPalpation, LocalModelWithoutAStepRendersNothing) {
+  const sh::DiscContact none;
+  const sh::LocalContact c = sh::evaluate_local_model(none, 15.0, Vector3d(1, 2, 3));
+  EXPECT_FALSE(c.contact);
+  EXPECT_EQ(c.probe_mm, Vector3d(1, 2, 3));
+  EXPECT_EQ(c.force_n, Vector3d::Zero());
 }

@@ -1,4 +1,4 @@
-// Disc palpation: the probe presses into a tuned mass-spring disc simulated at 1 kHz.
+// Disc palpation: the probe presses into a tuned mass-spring disc simulated beside the servo.
 //
 // The disc runs in its own thread, not in the servo thread: its implicit step allocates (CHOLMOD's
 // solves) and takes a few hundred microseconds, and the servo tick must stay allocation-free and
@@ -22,6 +22,24 @@
 // probe is moved towards its new place in steps of r/4 from where it was, so it cannot jump over
 // the wall's nodes; and until the device has once been outside the disc (a start inside it), the
 // probe is not put in at all.
+//
+// Force scale s (disc N per felt N): the disc meets a coupling spring s k_c while the hand
+// feels k_c (p_s - x_d), the disc's force divided by s, so a device's few newtons stand for the
+// hundreds of newtons a disc meets and the disc visibly deforms. The felt stiffness stays
+// within k_c (k_c s K (s k_c + K)^-1 for a disc contact stiffness K).
+//
+// Multirate (options.multirate): a disc whose step does not fit a millisecond (the FEM
+// resolution, >= 20,000 tets, takes ~5 ms here) is stepped every dt (up to 10 ms) on its thread,
+// which after each step also publishes a local contact model that the servo evaluates every
+// tick (Cavusoglu & Tendick's multirate local model; the contact compliance of Courtecuisse et
+// al.): the disc's force on the probe near the step's probe position p0,
+//     F(p) = F0 - K (p - p0),   K = mss::Simulator::probe_stiffness (the step's linearisation,
+//                                   its negative tangential part, a sliding sphere, dropped)
+// and the coupling's balance s k_c (x_d - p) + F(p) = 0 solved for p each tick in closed form,
+// p = (s k_c I + K)^-1 (s k_c x_d + F0 + K p0). Out of contact the model is the plane of the
+// nearest surface node (F0 = 0, K = k_n n n^T with the last contact's normal stiffness k_n), so
+// a touch is felt within the tick, not a worker period later. Contact holds while F(p).n > 0; a
+// model older than kStaleSteps worker periods renders no disc force.
 #pragma once
 
 #include "spinesim/haptics/renderer.hpp"
@@ -46,8 +64,10 @@ struct DiscPalpationOptions {
   double coupling_damping_n_s_per_mm = 0;    ///< b, on the device velocity while in contact
   double probe_radius_mm = 4;
   double probe_penalty_n_per_mm = 0;  ///< k_p per node; 0: mss::default_probe_stiffness
-  double dt_s = 1e-3;
+  double dt_s = 1e-3;  ///< the disc's step (multirate: its worker period, up to 10 ms)
   int newton_iterations = 1;
+  double force_scale = 1;  ///< s: disc N per felt N (>= 1)
+  bool multirate = false;  ///< the servo evaluates the worker's local contact model each tick
   bool realtime_priority = true;  ///< SCHED_FIFO for the disc thread (below the servo's)
   int priority = 70;
 };
@@ -58,10 +78,28 @@ struct DiscContact {
   Eigen::Vector3d probe_mm = Eigen::Vector3d::Zero();  ///< the simulated probe p_s
   Eigen::Vector3d force_n = Eigen::Vector3d::Zero();   ///< the disc's force on the probe
   bool contact = false;
-  double volume_change = 0;  ///< (V - V0) / V0
-  double step_us = 0;        ///< this step's compute time
-  bool failed = false;       ///< a step was rejected (the disc is held as it was)
+  double volume_change = 0;   ///< (V - V0) / V0
+  double step_us = 0;         ///< this step's compute time
+  bool failed = false;        ///< a step was rejected (the disc is held as it was)
+  double indentation_mm = 0;  ///< the touched wall nodes' largest displacement from rest
+  Eigen::Vector3d device_mm = Eigen::Vector3d::Zero();  ///< the device position the step used
+  /// The local contact model (multirate): p = inverse (s k_c x_d + offset); contact while
+  /// s k_c (p - x_d).normal > 0. model = false: none (no force).
+  bool model = false;
+  Eigen::Matrix3d model_inverse = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d model_offset = Eigen::Vector3d::Zero();
+  Eigen::Vector3d model_normal = Eigen::Vector3d::Zero();
 };
+
+/// The local model evaluated at the device position `device_mm` (multirate servo side): the
+/// simulated probe (`probe_mm`), the disc's force on it (disc N) and whether it touches; free of
+/// the disc the probe is the device. Allocation-free.
+struct LocalContact {
+  Eigen::Vector3d probe_mm, force_n;
+  bool contact = false;
+};
+LocalContact evaluate_local_model(const DiscContact& c, double disc_coupling_n_per_mm,
+                                  const Eigen::Vector3d& device_mm);
 
 /// The contact is node-based (the MSS's spherical probe pushes surface nodes): a probe smaller
 /// than the gaps between surface nodes slips through the wall. This is the largest circumradius
@@ -99,6 +137,12 @@ class DiscPalpation {
   const mss::MssModel& model() const { return model_; }
   const mss::State& state() const { return state_; }
   double probe_penalty_n_per_mm() const { return k_p_; }
+  /// s k_c: the coupling the disc meets (disc N/mm).
+  double disc_coupling_n_per_mm() const {
+    return options_.force_scale * options_.coupling_stiffness_n_per_mm;
+  }
+  /// A local model older than this many worker steps renders no disc force.
+  static constexpr int kStaleSteps = 10;
   const DiscPalpationOptions& options() const { return options_; }
 
   struct Stats {
@@ -116,6 +160,10 @@ class DiscPalpation {
   Eigen::Vector3d place_probe(const Eigen::Vector3d& device_mm) const;
   /// The probe at `point` overlaps a surface node, or `point` is inside a tetrahedron.
   bool touches_disc(const Eigen::Vector3d& point) const;
+  /// The touched wall nodes' largest displacement from rest with the probe at `p` (mm).
+  double indentation_mm(const Eigen::Vector3d& p) const;
+  /// last_'s local contact model after a step for the device at `device_mm`.
+  void update_local_model(const Eigen::Vector3d& device_mm);
 
   const mss::MssModel& model_;
   DiscPalpationOptions options_;
@@ -124,7 +172,9 @@ class DiscPalpation {
   mss::Boundary bc_;
   double k_p_ = 0;
   std::vector<Eigen::Index> surface_nodes_;
-  bool armed_ = false;  ///< the device has been outside the disc since the start
+  bool armed_ = false;           ///< the device has been outside the disc since the start
+  double normal_stiffness_ = 0;  ///< the last contact's n.K.n (the onset plane's), disc N/mm
+  bool model_trusted_ = false;   ///< the last contact's model places the next step's probe
   DiscContact last_;
   TripleBuffer<Eigen::Vector3d> device_;
   TripleBuffer<DiscContact> out_;
@@ -134,11 +184,35 @@ class DiscPalpation {
   Stats stats_;
 };
 
+/// Palpation off the clock, for checks: the device at `device_mm[k]` at tick k (period
+/// `tick_s`); returns the coupling force s k_c (p_s - x_d) on the disc's probe per tick (disc N,
+/// zero out of contact). Direct (options.multirate false): the disc stepped every tick (dt_s
+/// must equal tick_s), as the synchronous reference. Multirate: the disc stepped every
+/// dt_s / tick_s ticks with the device where it is then, its local model evaluated every tick
+/// from the next one on (the servo sees a step once it is done).
+std::vector<Eigen::Vector3d> palpate_offline(const mss::MssModel& model,
+                                             const mss::Boundary& plates,
+                                             const DiscPalpationOptions& options,
+                                             const std::vector<Eigen::Vector3d>& device_mm,
+                                             double tick_s);
+
+/// Force error of a run against a reference, relative to the reference's peak |F|.
+struct ForceError {
+  double rms_n = 0, max_n = 0, peak_n = 0;
+  double relative_rms() const { return peak_n > 0 ? rms_n / peak_n : 0; }
+  double relative_max() const { return peak_n > 0 ? max_n / peak_n : 0; }
+};
+/// Over the common length of `run` and `reference`.
+ForceError force_error(const std::vector<Eigen::Vector3d>& run,
+                       const std::vector<Eigen::Vector3d>& reference);
+
 /// The servo's renderer for the disc scene: the rigid stage (the two vertebrae, by `rigid`) plus
 /// the coupling force to the disc thread's probe. Allocation-free.
 class DiscCouplingRenderer final : public ForceRenderer {
  public:
   DiscCouplingRenderer(ForceRenderer& rigid, DiscPalpation& disc);
+  /// Ticks that rendered no disc force because the local model was stale (multirate).
+  std::int64_t stale_ticks() const { return stale_ticks_; }
   const char* name() const override { return "proxy + disc coupling"; }
   void reset(const Eigen::Vector3d& device_mm) override;
   RenderOutput render(const ProbeState& probe, const Scene& scene, const ScenePoses& poses,
@@ -150,6 +224,7 @@ class DiscCouplingRenderer final : public ForceRenderer {
   ForceRenderer& rigid_;
   DiscPalpation& palpation_;
   DiscContact disc_;
+  std::int64_t model_step_ = -1, ticks_on_model_ = 0, stale_ticks_ = 0;
 };
 
 }  // namespace spinesim::haptics

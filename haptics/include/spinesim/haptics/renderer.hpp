@@ -39,6 +39,7 @@ struct RenderOutput {
   bool disc_contact = false;
   double disc_volume_change = 0;                            ///< (V - V0) / V0
   Eigen::Vector3d disc_force_n = Eigen::Vector3d::Zero();   ///< the disc's force on its probe
+  double disc_indentation_mm = 0;  ///< the disc wall's indentation under the probe (mm)
   Eigen::Vector3d disc_probe_mm = Eigen::Vector3d::Zero();  ///< the simulated probe
 };
 

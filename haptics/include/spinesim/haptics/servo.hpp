@@ -47,7 +47,8 @@ struct ServoStatus {
   /// Disc palpation (disc = false without it): contact, volume change, the disc's force.
   bool disc = false, disc_contact = false;
   double disc_volume_change = 0;
-  Eigen::Vector3d disc_force_n = Eigen::Vector3d::Zero();
+  double disc_indentation_mm = 0;  ///< the disc wall's indentation under the probe
+  Eigen::Vector3d disc_force_n = Eigen::Vector3d::Zero();  ///< disc N (the felt force x scale)
   Eigen::Vector3d disc_probe_mm = Eigen::Vector3d::Zero();  ///< the disc thread's probe
   /// The bodies' poses this tick's render used (the compliant stage's vertebrae moved).
   ScenePoses poses;
@@ -69,7 +70,7 @@ struct TickRecord {
   HookState hook;
   // Disc palpation (disc = false without it).
   bool disc = false, disc_contact = false;
-  float disc_volume_change = 0;
+  float disc_volume_change = 0, disc_indentation_mm = 0;
   Eigen::Vector3f disc_force_n = Eigen::Vector3f::Zero(), disc_probe_mm = Eigen::Vector3f::Zero();
   std::array<Eigen::Matrix3f, kSpineVertebrae> R;
   std::array<Eigen::Vector3f, kSpineVertebrae> t;
