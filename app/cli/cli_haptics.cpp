@@ -83,11 +83,11 @@ void run_haptics_cli(HapticsArgs& args) {
           if (!live) return;
           if (s.disc)
             std::fprintf(stderr,
-                         "\r  t %6.1f s | %6.1f Hz | force %5.2f N | disc %s, %5.2f N, volume "
-                         "%+7.3f %%  ",
+                         "\r  t %6.1f s | %6.1f Hz | felt %5.2f N | disc %s, load %6.1f N, "
+                         "indented %5.2f mm, volume %+7.3f %%  ",
                          s.time_s, s.time_s > 0 ? double(s.ticks) / s.time_s : 0.0,
                          s.force_n.norm(), s.disc_contact ? "pressed" : "free   ",
-                         s.disc_force_n.norm(), 100 * s.disc_volume_change);
+                         s.disc_force_n.norm(), s.disc_indentation_mm, 100 * s.disc_volume_change);
           else if (s.hook.attached || s.hook.gain > 0)
             std::fprintf(
                 stderr, "\r  t %6.1f s | %6.1f Hz | force %5.2f N | hooked %s, spine %6.1f N  ",
@@ -152,10 +152,22 @@ void add_disc_flags(CLI::App* run, HapticsRunRequest& request) {
                   "(the default: the nonlinear fibre disc's fibre network, "
                   "data/tuned_fibre_discs.json) or real-disc (the linear isotropic disc's, "
                   "data/tuned_discs.json)");
-  run->add_option("--disc-budget-us", request.disc_budget_us,
-                  "--scene disc: the disc step's p99 must fit this; at start the finest mesh "
-                  "(2, 2.5, 3, 4 mm cells) that does is chosen")
+  run->add_option("--disc-solver", request.disc_solver,
+                  "--scene disc: multirate (the disc stepped every --disc-period-ms on its "
+                  "thread, its local contact model felt every tick; meshes >= 20,000 tets) or "
+                  "direct (the disc stepped every 1 ms tick; a few thousand tets)")
       ->capture_default_str();
+  run->add_option("--disc-period-ms", request.disc_period_ms,
+                  "--disc-solver multirate: the disc's step, 1 to 10 ms")
+      ->capture_default_str();
+  run->add_option("--disc-budget-us", request.disc_budget_us,
+                  "--scene disc: the disc step's CPU p99 must fit this (default: 80 % of the "
+                  "period, multirate, from 1.5, 2, 2.5, 3 mm cells; 500 us, direct, from 2, 2.5, "
+                  "3, 4 mm); at start the finest mesh that does is chosen");
+  run->add_flag("--disc-sync-check", request.disc_sync_check,
+                "--disc-solver multirate: after the run, step the disc every 1 ms along the "
+                "recorded hand path (off the clock: ~5 s per second at 20,000 tets) and report "
+                "the felt force's error against it");
   run->add_option("--disc-cell-size", request.disc_cell_size_mm,
                   "--scene disc: use this CGAL cell size (mm) instead of the budget check's "
                   "choice (its step is still measured and reported)");
@@ -248,8 +260,8 @@ void add_haptics_run_flags(CLI::App* cmd, HapticsRunFlags& f, bool viewer) {
   cmd->add_option("--database", f.request.database,
                   "--spine database: the database file (default data/spine/displacement_db.json)");
   cmd->add_option("--force-scale", f.request.force_scale,
-                  "Spine force per felt force, N/N (default: 600 N on the spine at the device's "
-                  "peak force)");
+                  "Spine or disc force per felt force, N/N (default: 600 N on the spine, 100 N on "
+                  "the disc, at the device's peak force)");
   cmd->add_option("--coupling-stiffness", f.request.coupling_stiffness_n_per_mm,
                   "Felt stiffness of the hook spring (--spine) or of the disc coupling (--scene "
                   "disc), N/mm (default: the rendering stiffness)");

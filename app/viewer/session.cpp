@@ -276,9 +276,9 @@ void SessionController::panel() {
                 s.hook.load.force_n.norm(), s.hook.felt_force_n.norm(), s.hook.gain);
   }
   if (setup_.disc) {
-    ImGui::Text("disc %s: %s, %.2f N, volume %+.3f %%", setup_.disc_level.c_str(),
-                s.disc_contact ? "pressed" : "free", s.disc_force_n.norm(),
-                100 * s.disc_volume_change);
+    ImGui::Text("disc %s: %s | load %.1f N | indented %.2f mm | volume %+.3f %%",
+                setup_.disc_level.c_str(), s.disc_contact ? "pressed" : "free",
+                s.disc_force_n.norm(), s.disc_indentation_mm, 100 * s.disc_volume_change);
     int f = int(field_);
     if (ImGui::Combo("field", &f, kDiscFieldNames, 3)) field_ = DiscField(f), field_changed_ = true;
     color_legend(kDiscFieldLabels[int(field_)], lo_, hi_);

@@ -120,6 +120,11 @@ DiscPalpation::DiscPalpation(const mss::MssModel& model, const mss::Boundary& pl
   for (Eigen::Index i = 0; i < model.num_nodes(); ++i)
     if (model.mesh().surface(i) != 0) surface_nodes_.push_back(i);
   last_.probe_mm = Eigen::Vector3d::Constant(1e9);
+  // The factorisation (~0.2 s at 20,000 tets) is done here, not in the disc thread's first
+  // loaded step while the hand is on the disc.
+  if (!sim_.prepare(bc_))
+    throw std::invalid_argument(
+        "disc palpation: the disc's implicit matrix is not positive definite");
   out_.write(last_);
   positions_.reset(state_.x_mm);
 }
@@ -317,6 +322,7 @@ void DiscPalpation::run() {
     if (stats_.step_us.size() < stats_.step_us.capacity())
       stats_.step_us.push_back(float(c.step_us));
     stats_.max_force_n = std::max(stats_.max_force_n, c.force_n.norm());
+    stats_.max_indentation_mm = std::max(stats_.max_indentation_mm, c.indentation_mm);
     stats_.min_volume_change = std::min(stats_.min_volume_change, c.volume_change);
     stats_.max_volume_change = std::max(stats_.max_volume_change, c.volume_change);
     deadline += options_.dt_s;

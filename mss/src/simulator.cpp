@@ -134,6 +134,9 @@ struct Simulator::Impl {
                          std::size_t probes);
   /// A^-1 of the reduced unit vectors of a free node (key = node) or of the plate DOF (key -1).
   const Eigen::MatrixXd& contact_solve(int key);
+  /// contact_solve of every free node in `nodes` not cached yet, in one multi-column solve (a
+  /// touch meets several new nodes at once).
+  void prefetch_solves(const std::vector<int>& nodes);
   /// out += scale A^-1 P^T (e_i v): the A^-1 image of a node vector (cached solves).
   void add_inverse(int i, const Eigen::Vector3d& v, double scale, Eigen::Ref<Eigen::VectorXd> out);
   /// w^T z for a pair's contact column w = P^T (e_i sqrt(k) n).
@@ -218,6 +221,22 @@ const Eigen::MatrixXd& Simulator::Impl::contact_solve(int key) {
   return contact_solves.emplace(key, std::move(G)).first->second;
 }
 
+void Simulator::Impl::prefetch_solves(const std::vector<int>& nodes) {
+  std::vector<int> missing;
+  for (const int i : nodes)
+    if (space.role(i) == detail::NodeRole::free && !contact_solves.count(i) &&
+        std::find(missing.begin(), missing.end(), i) == missing.end())
+      missing.push_back(i);
+  if (missing.size() < 2) return;  // one node: contact_solve does it
+  Eigen::MatrixXd G = Eigen::MatrixXd::Zero(space.size(), 3 * Eigen::Index(missing.size()));
+  for (std::size_t k = 0; k < missing.size(); ++k)
+    for (int c = 0; c < 3; ++c)
+      G(3 * space.free_index(missing[k]) + c, 3 * Eigen::Index(k) + c) = 1;
+  tangent.cholesky().solve_in_place(G);
+  for (std::size_t k = 0; k < missing.size(); ++k)
+    contact_solves.emplace(missing[k], G.middleCols<3>(3 * Eigen::Index(k)));
+}
+
 void Simulator::Impl::add_inverse(int i, const Eigen::Vector3d& v, double scale,
                                   Eigen::Ref<Eigen::VectorXd> out) {
   if (space.role(i) == detail::NodeRole::free) {
@@ -298,6 +317,10 @@ bool Simulator::Impl::contact_direction(const ExternalLoads& loads, const Eigen:
     for (std::size_t p = 0; p < pairs.size(); ++p)
       if (pairs[p].active) active.push_back(p);
     const Eigen::Index m = r0 + Eigen::Index(active.size());
+    std::vector<int> fresh;
+    for (const std::size_t p : active)
+      if (!made[p]) fresh.push_back(pairs[p].node);
+    prefetch_solves(fresh);
     d = contact_y0;
     for (const std::size_t p : active) {
       auto z = contact_Zall.col(Eigen::Index(p));
@@ -573,6 +596,14 @@ Eigen::Matrix3d Simulator::probe_stiffness(int probe) const {
   const Impl& d = *impl_;
   if (probe < 0 || std::size_t(probe) >= d.probe_K.size()) return Eigen::Matrix3d::Zero();
   return d.probe_K[std::size_t(probe)];
+}
+
+bool Simulator::prepare(const Boundary& bc) {
+  Impl& d = *impl_;
+  validate(bc, d.model->num_nodes());
+  d.ensure_space(bc.plate_mode, bc.plate_center_mm);
+  if (d.opt.integrator != Integrator::implicit_euler) return true;
+  return d.opt.matrix_update == MatrixUpdate::frozen ? d.factor_frozen() : true;
 }
 
 double Simulator::predicted_stable_dt_s(Integrator integrator) const {

@@ -119,6 +119,33 @@ void SparseCholesky::solve_in_place(Eigen::VectorXd& b) {
   }
 }
 
+void SparseCholesky::solve_in_place(Eigen::MatrixXd& B) {
+  Impl& d = *impl_;
+  if (!d.factorized) throw std::logic_error("mss: solve before a successful factorisation");
+  if (B.rows() != d.n) throw std::logic_error("mss: right-hand side has the wrong size");
+  if (B.cols() == 0) return;
+  if (!d.cholmod()) {
+    B = d.llt.solve(B).eval();
+    return;
+  }
+  cholmod_dense b;
+  std::memset(&b, 0, sizeof(b));
+  b.nrow = b.d = std::size_t(d.n);
+  b.ncol = std::size_t(B.cols());
+  b.nzmax = b.nrow * b.ncol;
+  b.x = B.data();
+  b.xtype = CHOLMOD_REAL;
+  b.dtype = CHOLMOD_DOUBLE;
+  cholmod_dense* X = nullptr;
+  cholmod_dense *Y = nullptr, *E = nullptr;
+  const bool ok = cholmod_solve2(CHOLMOD_A, d.L, &b, nullptr, &X, nullptr, &Y, &E, &d.common);
+  if (ok) std::memcpy(B.data(), X->x, std::size_t(B.size()) * sizeof(double));
+  cholmod_free_dense(&X, &d.common);
+  cholmod_free_dense(&Y, &d.common);
+  cholmod_free_dense(&E, &d.common);
+  if (!ok) throw std::runtime_error("mss: CHOLMOD solve failed");
+}
+
 double SparseCholesky::factor_nonzeros() const {
   const Impl& d = *impl_;
   if (!d.factorized) return 0;

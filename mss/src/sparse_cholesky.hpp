@@ -34,6 +34,9 @@ class SparseCholesky {
   bool factorized() const;
   /// b <- A^-1 b. Throws std::logic_error before a successful factorize().
   void solve_in_place(Eigen::VectorXd& b);
+  /// B <- A^-1 B for several right-hand sides at once (one pass over the factor for all of
+  /// them). Allocates.
+  void solve_in_place(Eigen::MatrixXd& B);
   /// Nonzeros of the factor (after factorize), for reports.
   double factor_nonzeros() const;
 

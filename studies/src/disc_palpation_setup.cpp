@@ -89,6 +89,9 @@ DiscSetup make_disc_setup(const DiscSceneRequest& request, const std::string& da
     throw std::invalid_argument("--disc-cell-size must be 0.5 to 10 mm (0: the budget check)");
   const std::vector<double> cells =
       fixed_size ? std::vector<double>{request.fixed_cell_size_mm} : request.cell_sizes_mm;
+  const std::string period = request.palpation.multirate
+                                 ? fixed(1e3 * request.palpation.dt_s, 0) + " ms worker period"
+                                 : "1 ms tick";
   for (const double cell : cells) {
     if (stage) stage("meshing " + request.level + " at " + fixed(cell, 1) + " mm, timing its step");
     mesh::MeshOptions mo;
@@ -114,10 +117,11 @@ DiscSetup make_disc_setup(const DiscSceneRequest& request, const std::string& da
       s.note = std::string(fixed_size ? "the asked " : "no resolution fits; the coarsest, ") +
                fixed(cell, 1) + " mm disc's step (CPU p99 " + fixed(c.step_cpu_us.p99, 0) +
                " us, wall p99 " + fixed(c.step_us.p99, 0) + " us) does not fit the " +
-               fixed(request.budget_us, 0) +
-               " us budget: the disc thread will overrun and the disc lag the hand (give a "
+               fixed(request.budget_us, 0) + " us budget of the " + period +
+               ": the disc thread will overrun and the disc lag the hand (give a "
                "larger --disc-budget-us or a coarser --disc-cell-size)";
     s.chosen = c;
+    s.plates = held_plates(model->mesh());
     s.palpation = std::make_unique<haptics::DiscPalpation>(*model, held_plates(model->mesh()),
                                                            request.palpation);
     s.model = std::move(model);

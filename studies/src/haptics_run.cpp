@@ -97,21 +97,40 @@ void check_haptics_request(const HapticsRunRequest& r) {
   if (!r.spine.empty() && r.scene.scene != "spine")
     throw std::invalid_argument(
         "--spine needs --scene spine (the compliant stage drags the spine)");
-  if (r.spine.empty() && (r.force_scale != 0 || !r.database.empty()))
-    throw std::invalid_argument("--force-scale and --database are for --spine multirate|database");
+  if (r.spine.empty() && r.scene.scene != "disc" && r.force_scale != 0)
+    throw std::invalid_argument("--force-scale is for --spine multirate|database or --scene disc");
+  if (r.spine.empty() && !r.database.empty())
+    throw std::invalid_argument("--database is for --spine multirate|database");
   if (r.spine.empty() && r.scene.scene != "disc" &&
       (r.coupling_stiffness_n_per_mm != 0 || r.coupling_damping_n_s_per_mm != 0))
     throw std::invalid_argument(
         "--coupling-stiffness and --coupling-damping are for --spine or --scene disc");
   if (r.scene.scene != "disc" &&
-      (!r.disc_params.empty() || r.disc_budget_us != 500 || r.disc_cell_size_mm != 0))
+      (!r.disc_params.empty() || r.disc_budget_us != 0 || r.disc_cell_size_mm != 0 ||
+       r.disc_solver != "multirate" || r.disc_period_ms != 10 || r.disc_sync_check))
     throw std::invalid_argument(
-        "--params, --disc-budget-us and --disc-cell-size are for --scene disc");
+        "--params, --disc-solver, --disc-period-ms, --disc-budget-us, --disc-cell-size and "
+        "--disc-sync-check are for --scene disc");
+  if (r.disc_solver != "multirate" && r.disc_solver != "direct")
+    throw std::invalid_argument("--disc-solver " + r.disc_solver +
+                                ": unknown (multirate or direct)");
+  if (!(r.disc_period_ms >= 1 && r.disc_period_ms <= 10))
+    throw std::invalid_argument("--disc-period-ms must be 1 to 10 ms");
+  if (r.disc_solver == "direct" && (r.disc_period_ms != 10 || r.disc_sync_check))
+    throw std::invalid_argument(
+        "--disc-period-ms and --disc-sync-check are for --disc-solver multirate");
+  if (!(r.disc_budget_us >= 0) || !std::isfinite(r.disc_budget_us))
+    throw std::invalid_argument("--disc-budget-us must be >= 0 (0: the default)");
   if (!(r.force_scale >= 0) || !std::isfinite(r.force_scale))
     throw std::invalid_argument("--force-scale must be > 0 (0: the default)");
   if (!(r.coupling_stiffness_n_per_mm >= 0) || !std::isfinite(r.coupling_stiffness_n_per_mm) ||
       !(r.coupling_damping_n_s_per_mm >= 0) || !std::isfinite(r.coupling_damping_n_s_per_mm))
     throw std::invalid_argument("--coupling-stiffness and --coupling-damping must be >= 0");
+  if (r.scene.scene == "disc" && r.force_scale != 0 &&
+      !(r.force_scale >= 1 && r.force_scale * haptics::device_model(r.model).peak_force_n <= 1000))
+    throw std::invalid_argument(
+        "--force-scale on the disc must be >= 1 and put at most 1000 N on the disc at the "
+        "device's peak force");
   if (!r.spine.empty() && r.force_scale > 0) {
     // Both responses answer for the thesis's validated 600 N (3.3.5).
     const double peak = haptics::device_model(r.model).peak_force_n;
@@ -285,6 +304,10 @@ void finish_compliant(CompliantSetup& c, HapticsRunResult* result) {
   }
 }
 
+/// The disc's load at the device's peak force by default (N): a palpating hand's hundred newtons
+/// indent the anterior wall by a few millimetres (docs/benchmarks.md).
+constexpr double kDiscLoadAtPeakN = 100;
+
 /// The disc scene's disc, at the finest resolution that fits the budget, coupled at the request's
 /// stiffness (default: the rendering stiffness, within the device's passive limit).
 DiscSetup make_disc(const HapticsRunRequest& request, const std::string& data_dir,
@@ -292,7 +315,19 @@ DiscSetup make_disc(const HapticsRunRequest& request, const std::string& data_di
   DiscSceneRequest d;
   d.level = request.scene.level;
   d.params = request.disc_params;
-  d.budget_us = request.disc_budget_us;
+  const bool multirate = request.disc_solver == "multirate";
+  d.palpation.multirate = multirate;
+  d.palpation.dt_s = multirate ? 1e-3 * request.disc_period_ms : 1e-3;
+  d.budget_us = request.disc_budget_us > 0 ? request.disc_budget_us
+                : multirate                ? 800 * request.disc_period_ms
+                                           : 500;
+  if (multirate) {  // the FEM reference's resolution: >= 20,000 tets
+    d.cell_sizes_mm = {1.5, 2.0, 2.5, 3.0};
+    d.min_tets = 20000;
+  }
+  const double peak = result.capabilities.peak_force_n;
+  d.palpation.force_scale =
+      request.force_scale > 0 ? request.force_scale : std::max(1.0, kDiscLoadAtPeakN / peak);
   d.fixed_cell_size_mm = request.disc_cell_size_mm;
   d.palpation.coupling_stiffness_n_per_mm = request.coupling_stiffness_n_per_mm > 0
                                                 ? request.coupling_stiffness_n_per_mm
@@ -313,7 +348,35 @@ DiscSetup make_disc(const HapticsRunRequest& request, const std::string& data_di
   result.disc_note = setup.note;
   result.disc_candidates = setup.tried;
   result.coupling_stiffness_n_per_mm = d.palpation.coupling_stiffness_n_per_mm;
+  result.force_scale = d.palpation.force_scale;
+  result.request.disc_budget_us = d.budget_us;
   return setup;
+}
+
+/// The hand's path and the disc force it met, per tick (for --disc-sync-check).
+struct DiscTrace {
+  std::vector<Eigen::Vector3d> device_mm, force_n;
+  void append(const haptics::TickRecord* rows, std::size_t n) {
+    for (std::size_t i = 0; i < n; ++i) {
+      device_mm.push_back(rows[i].probe_mm);
+      force_n.push_back(rows[i].disc_contact ? Eigen::Vector3d(rows[i].disc_force_n.cast<double>())
+                                             : Eigen::Vector3d::Zero());
+    }
+  }
+};
+
+/// The live run's disc force against the disc stepped every tick off the clock along the same
+/// hand path (the synchronous solve).
+void sync_check(const DiscSetup& d, const DiscTrace& trace, double T, HapticsRunResult* result) {
+  const Timer timer;
+  haptics::DiscPalpationOptions o = d.palpation->options();
+  o.multirate = false;
+  o.dt_s = T;
+  const std::vector<Eigen::Vector3d> reference =
+      haptics::palpate_offline(*d.model, d.plates, o, trace.device_mm, T);
+  result->sync_error = haptics::force_error(trace.force_n, reference);
+  result->sync_ticks = std::int64_t(reference.size());
+  result->sync_seconds = timer.seconds();
 }
 
 void finish_disc(DiscSetup& d, HapticsRunResult* result) {
@@ -326,16 +389,25 @@ void finish_disc(DiscSetup& d, HapticsRunResult* result) {
   result->disc_max_force_n = st.max_force_n;
   result->disc_volume_change_min = st.min_volume_change;
   result->disc_volume_change_max = st.max_volume_change;
+  result->disc_max_indentation_mm = st.max_indentation_mm;
+  result->disc_rate_hz = result->stats.seconds > 0 ? double(st.steps) / result->stats.seconds : 0;
   result->disc_thread = st.realtime_reason;
 }
 
-// The --record file, fed by the loop's writer thread (null without --record).
+// The --record file, fed by the loop's writer thread (null without --record), and the disc trace
+// (when not null).
 std::unique_ptr<haptics::HapticRecordingWriter> start_recording(const HapticsRunRequest& request,
                                                                 const HapticsRunResult& result,
                                                                 const spine::SpineModel* model,
-                                                                bool disc,
+                                                                bool disc, DiscTrace* trace,
                                                                 haptics::ServoLoop& loop) {
-  if (request.record.empty()) return nullptr;
+  if (request.record.empty()) {
+    if (trace)
+      loop.record_to(
+          [trace](const haptics::TickRecord* rows, std::size_t n) { trace->append(rows, n); },
+          1 << 13);
+    return nullptr;
+  }
   std::ostringstream what;
   what << "device " << request.device << ", renderer " << request.renderer << ", probe radius "
        << request.probe_radius_mm << " mm";
@@ -345,8 +417,12 @@ std::unique_ptr<haptics::HapticRecordingWriter> start_recording(const HapticsRun
   auto record = std::make_unique<haptics::HapticRecordingWriter>(request.record, what.str(), model,
                                                                  request.spine, disc);
   haptics::HapticRecordingWriter* sink = record.get();
-  loop.record_to([sink](const haptics::TickRecord* rows, std::size_t n) { sink->append(rows, n); },
-                 1 << 13);
+  loop.record_to(
+      [sink, trace](const haptics::TickRecord* rows, std::size_t n) {
+        sink->append(rows, n);
+        if (trace) trace->append(rows, n);
+      },
+      1 << 13);
   return record;
 }
 
@@ -437,8 +513,10 @@ HapticsRunResult run_haptics(const HapticsRunRequest& request, const std::string
     loop.set_compliant_stage(compliant.stage.get());
     compliant.response->start();
   }
+  DiscTrace trace;
   const std::unique_ptr<haptics::HapticRecordingWriter> record =
-      start_recording(request, result, compliant.model.get(), disc.palpation != nullptr, loop);
+      start_recording(request, result, compliant.model.get(), disc.palpation != nullptr,
+                      request.disc_sync_check ? &trace : nullptr, loop);
 
   if (request.live && request.live->ready)
     request.live->ready({scene, disc.model.get(), result.disc_level, result.capabilities,
@@ -467,7 +545,11 @@ HapticsRunResult run_haptics(const HapticsRunRequest& request, const std::string
   result.floor = floor.stop();
   device->close();
   if (compliant.response) finish_compliant(compliant, &result);
-  if (disc.palpation) finish_disc(disc, &result);
+  if (disc.palpation) {
+    finish_disc(disc, &result);
+    if (coupled) result.disc_stale_ticks = coupled->stale_ticks();
+    if (request.disc_sync_check) sync_check(disc, trace, T, &result);
+  }
   if (request.stop && request.stop->load())
     result.stats.stop_reason = request.live ? "window closed" : "interrupted";
   if (result.stats.error && !device->last_error().empty())
@@ -493,13 +575,34 @@ nlohmann::json disc_json(const HapticsRunResult& r) {
                      {"step_cpu_us", {{"p50", c.step_cpu_us.p50}, {"p99", c.step_cpu_us.p99}}},
                      {"fits", c.fits}});
   const auto& p = r.disc_step_us;
+  const bool multi = r.request.disc_solver == "multirate";
+  nlohmann::json sync;
+  if (r.sync_ticks > 0)
+    sync = {{"ticks", r.sync_ticks},
+            {"seconds", r.sync_seconds},
+            {"reference", "the disc stepped every 1 ms along the recorded hand path"},
+            {"peak_force_n", r.sync_error.peak_n},
+            {"rms_error_n", r.sync_error.rms_n},
+            {"max_error_n", r.sync_error.max_n},
+            {"relative_rms_error", r.sync_error.relative_rms()},
+            {"relative_max_error", r.sync_error.relative_max()}};
   return {
       {"level", r.disc_level},
+      {"solver", r.request.disc_solver},
+      {"period_ms", multi ? r.request.disc_period_ms : 1.0},
+      {"rate_hz", r.disc_rate_hz},
+      {"stale_ticks", r.disc_stale_ticks},
+      {"force_scale", r.force_scale},
+      {"max_load_n", r.disc_max_force_n},
+      {"max_indentation_mm", r.disc_max_indentation_mm},
+      {"sync_check", sync},
       {"tets", r.disc_tets},
       {"cell_size_mm", r.disc_cell_size_mm},
       {"tuned", r.disc_tuned_file},
       {"cpu", cpu_description()},
-      {"thread", "own thread at 1 kHz behind a virtual coupling"},
+      {"thread", multi ? "own thread at 1/period; the servo evaluates its local contact model "
+                         "every tick"
+                       : "own thread at 1 kHz behind a virtual coupling"},
       {"thread_priority", r.disc_thread},
       {"budget_us", r.request.disc_budget_us},
       {"budget_check", tried},
@@ -632,17 +735,29 @@ std::string haptics_run_table(const HapticsRunResult& r) {
   }
   if (!r.disc_level.empty()) {
     const auto& p = r.disc_step_us;
+    const bool multi = r.request.disc_solver == "multirate";
+    const std::string period = multi ? fixed(r.request.disc_period_ms, 0) + " ms" : "1 ms";
     os << "  disc: " << r.disc_level << ", " << r.disc_tets << " tets (CGAL "
-       << fixed(r.disc_cell_size_mm, 1) << " mm, " << r.disc_tuned_file
-       << "), own thread at 1 kHz behind a coupling of " << fixed(r.coupling_stiffness_n_per_mm, 2)
-       << " N/mm\n"
+       << fixed(r.disc_cell_size_mm, 1) << " mm, " << r.disc_tuned_file << "), "
+       << (multi ? "stepped every " + period + ", its local contact model felt every tick"
+                 : std::string("stepped every tick"))
+       << "; coupling " << fixed(r.coupling_stiffness_n_per_mm, 2) << " N/mm felt, force scale "
+       << fixed(r.force_scale, 1) << " disc N per felt N\n"
        << "  disc step (us): p50 " << fixed(p.p50, 0) << ", p99 " << fixed(p.p99, 0) << ", max "
-       << fixed(p.max, 0) << "; " << r.disc_steps << " steps, " << r.disc_overruns
-       << " overran the 1 ms, " << r.disc_failed_steps << " rejected; on " << cpu_description()
-       << "\n"
-       << "  disc: contact force max " << fixed(r.disc_max_force_n, 2) << " N, volume change "
+       << fixed(p.max, 0) << "; " << r.disc_steps << " steps (" << fixed(r.disc_rate_hz, 1)
+       << " Hz), " << r.disc_overruns << " overran the " << period << ", " << r.disc_failed_steps
+       << " rejected" << (multi ? ", " + std::to_string(r.disc_stale_ticks) + " stale ticks" : "")
+       << "; on " << cpu_description() << "\n"
+       << "  disc: load max " << fixed(r.disc_max_force_n, 1) << " N, indentation max "
+       << fixed(r.disc_max_indentation_mm, 2) << " mm, volume change "
        << fixed(100 * r.disc_volume_change_min, 3) << " .. "
        << fixed(100 * r.disc_volume_change_max, 3) << " %\n";
+    if (r.sync_ticks > 0)
+      os << "  against the synchronous solve (1 ms steps, " << r.sync_ticks << " ticks, "
+         << fixed(r.sync_seconds, 1) << " s): force RMS error " << fixed(r.sync_error.rms_n, 2)
+         << " N (" << fixed(100 * r.sync_error.relative_rms(), 2) << " % of the "
+         << fixed(r.sync_error.peak_n, 1) << " N peak), max " << fixed(r.sync_error.max_n, 2)
+         << " N (" << fixed(100 * r.sync_error.relative_max(), 2) << " %)\n";
     if (!r.disc_note.empty()) os << "  note: " << r.disc_note << "\n";
   }
   if (!r.request.record.empty())

@@ -357,13 +357,20 @@ TEST(CliHaptics, DiscPalpationPressesTheTunedDiscAndRecordsItsResponse) {
   EXPECT_EQ(d["tets"].get<long>(), d["budget_check"][0]["tets"].get<long>());
   EXPECT_GT(d["steps"].get<long>(), 100);  // the disc thread ran (its rate is the machine's)
   EXPECT_EQ(d["failed_steps"].get<long>(), 0);
-  EXPECT_GT(d["max_contact_force_n"].get<double>(), 0.3);  // pressed 4 mm at 0.5 N/mm coupling
+  EXPECT_EQ(d["solver"], "multirate");
+  EXPECT_EQ(d["period_ms"].get<double>(), 10.0);
+  EXPECT_GT(d["rate_hz"].get<double>(), 50.0);
+  // The disc meets the hand's force times the scale (100 N at the Touch's 3.3 N peak).
+  EXPECT_NEAR(d["force_scale"].get<double>(), 100 / 3.3, 0.1);
+  EXPECT_GT(d["max_load_n"].get<double>(), 5.0);
+  EXPECT_GT(d["max_indentation_mm"].get<double>(), 0.3);  // visibly indented
+  EXPECT_TRUE(d["sync_check"].is_null());
   EXPECT_LT(d["volume_change"]["min"].get<double>(), 0.0);
   EXPECT_GE(j["passivity_energy_mj"]["min"].get<double>(), 0.0);
   const std::string text = slurp(rec);
   const auto header = text.find("t_s,");
   ASSERT_NE(header, std::string::npos);
-  EXPECT_NE(text.find("disc_volume_change", header), std::string::npos);
+  EXPECT_NE(text.find("disc_volume_change,disc_indentation_mm", header), std::string::npos);
   // Some row has the disc in contact with a non-zero force.
   std::istringstream rows(text.substr(header));
   std::string line;
@@ -374,10 +381,26 @@ TEST(CliHaptics, DiscPalpationPressesTheTunedDiscAndRecordsItsResponse) {
     std::vector<double> v;
     std::stringstream ss(line);
     for (std::string c; std::getline(ss, c, ',');) v.push_back(std::stod(c));
-    ASSERT_EQ(v.size(), 21u);  // 13 common + 8 disc columns
-    if (v[13] == 1 && std::hypot(v[17], v[18], v[19]) > 0.1) ++pressed;
+    ASSERT_EQ(v.size(), 22u);  // 13 common + 9 disc columns
+    if (v[13] == 1 && std::hypot(v[17], v[18], v[19]) > 0.1 && v[21] > 0) ++pressed;
   }
   EXPECT_GT(pressed, 100);
+}
+
+TEST(CliHaptics, MultirateDiscFollowsTheSynchronousSolve) {
+  // The shipped press (4 mm past the anterior wall) on a coarse disc; after the run the hand's
+  // path goes through the disc stepped every 1 ms off the clock.
+  const auto r = run_spinesim(
+      "haptics run --scene disc --level L4-L5 --triangles 1500 --no-realtime --disc-cell-size 4 "
+      "--disc-sync-check --json --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto d = nlohmann::json::parse(r.out)["disc_palpation"];
+  const auto& s = d["sync_check"];
+  ASSERT_TRUE(s.is_object()) << d.dump();
+  EXPECT_EQ(s["ticks"].get<long>(), nlohmann::json::parse(r.out)["ticks"].get<long>());
+  EXPECT_GT(s["peak_force_n"].get<double>(), 5.0);
+  // A shared machine: a late worker step makes the felt force lag; a few % of the peak at most.
+  EXPECT_LT(s["relative_rms_error"].get<double>(), 0.05) << s.dump();
 }
 
 TEST(CliHaptics, BadDiscInputIsRefused) {
@@ -387,7 +410,8 @@ TEST(CliHaptics, BadDiscInputIsRefused) {
   expect_refused(run_spinesim(base + "--scene spine --disc-budget-us 300"), "--scene disc");
   // Nothing steps within 1 us: the run still starts, on the coarsest disc, and says so.
   const auto slow = run_spinesim(
-      "haptics run --duration 0.3 --scene disc --disc-budget-us 1 --triangles 300 --json --quiet");
+      "haptics run --duration 0.3 --scene disc --disc-solver direct --disc-budget-us 1 "
+      "--triangles 300 --json --quiet");
   ASSERT_EQ(slow.status, 0) << slow.err;
   const auto disc = nlohmann::json::parse(slow.out)["disc_palpation"];
   EXPECT_NE(disc["note"].get<std::string>().find("no resolution fits"), std::string::npos);
@@ -395,6 +419,13 @@ TEST(CliHaptics, BadDiscInputIsRefused) {
             disc["budget_check"].back()["cell_size_mm"].get<double>());
   for (const auto& c : disc["budget_check"]) EXPECT_FALSE(c["fits"].get<bool>());
   expect_refused(run_spinesim(base + "--scene disc --disc-cell-size 0.1"), "--disc-cell-size");
+  expect_refused(run_spinesim(base + "--scene disc --disc-solver sometimes"), "--disc-solver");
+  expect_refused(run_spinesim(base + "--scene disc --disc-period-ms 20"), "--disc-period-ms");
+  expect_refused(run_spinesim(base + "--scene disc --disc-solver direct --disc-sync-check"),
+                 "multirate");
+  expect_refused(run_spinesim(base + "--scene disc --force-scale 0.5"), "--force-scale");
+  expect_refused(run_spinesim(base + "--scene disc --force-scale 1000"), "1000 N");
+  expect_refused(run_spinesim(base + "--scene plane --disc-sync-check"), "--scene disc");
   // A tuned set without the level.
   const std::string set = tmp("one_level.json");
   {

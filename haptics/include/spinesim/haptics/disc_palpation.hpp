@@ -149,6 +149,7 @@ class DiscPalpation {
     std::int64_t steps = 0, overruns = 0, failed_steps = 0;  ///< overrun: ended past its deadline
     std::vector<float> step_us;                              ///< every step (thread runs)
     double max_force_n = 0, min_volume_change = 0, max_volume_change = 0;
+    double max_indentation_mm = 0;
     bool realtime_priority = false;
     std::string realtime_reason;
   };

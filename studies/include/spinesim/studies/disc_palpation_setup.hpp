@@ -45,6 +45,7 @@ struct DiscCandidate {
 struct DiscSetup {
   std::unique_ptr<mss::MssModel> model;  ///< owns its mesh
   std::unique_ptr<haptics::DiscPalpation> palpation;
+  mss::Boundary plates;  ///< the endplates, held
   std::vector<DiscCandidate> tried;
   DiscCandidate chosen;
   std::string tuned_file, note;

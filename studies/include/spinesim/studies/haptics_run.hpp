@@ -83,7 +83,9 @@ struct HapticsRunRequest {
   std::string database;  ///< the database file ("": data/spine/displacement_db.json)
   double coupling_stiffness_n_per_mm = 0;  ///< felt hook spring (0: the rendering stiffness)
   double coupling_damping_n_s_per_mm = 0;  ///< felt, relative to the hook
-  double force_scale = 0;     ///< spine N per felt N (0: the spine's 600 N at the device's peak)
+  /// Spine or disc N per felt N (0: the spine's 600 N, or 100 N on the disc, at the device's
+  /// peak force).
+  double force_scale = 0;
   bool spine_recruit = true;  ///< muscles recruited in the spine solves (as the database)
   /// The spine's posture for --spine multirate: "standing" or "seated" (in `chair`, solved by
   /// spine::solve_seated; the hook pushes on the seated spine leaning on the backrest).
@@ -92,7 +94,14 @@ struct HapticsRunRequest {
   /// Disc palpation (scene "disc"): the tuned parameters (palpation_params_path) and the
   /// budget the disc's step must fit (us); the coupling is coupling_stiffness/damping.
   std::string disc_params;
-  double disc_budget_us = 500;
+  /// "multirate": the disc stepped every disc_period_ms on its thread, its local contact model
+  /// felt every tick (haptics/disc_palpation.hpp); "direct": the disc stepped every tick.
+  std::string disc_solver = "multirate";
+  double disc_period_ms = 10;  ///< multirate: the disc's step, 1-10 ms
+  double disc_budget_us = 0;   ///< 0: 500 us (direct) or 80 % of the period (multirate)
+  /// After the run, the hand's recorded path through a synchronous solve (the disc stepped every
+  /// 1 ms off the clock) and the felt force's error against it (multirate only).
+  bool disc_sync_check = false;
   double disc_cell_size_mm = 0;  ///< > 0: this resolution, not the budget check's choice
   std::string write_scene;       ///< folder: each body's surface as <name>.obj (world, mm)
   bool realtime_priority = true;
@@ -138,6 +147,12 @@ struct HapticsRunResult {
   std::int64_t disc_steps = 0, disc_overruns = 0, disc_failed_steps = 0;
   haptics::Percentiles disc_step_us;
   double disc_max_force_n = 0, disc_volume_change_min = 0, disc_volume_change_max = 0;
+  double disc_max_indentation_mm = 0, disc_rate_hz = 0;
+  std::int64_t disc_stale_ticks = 0;  ///< multirate: ticks whose local model was stale
+  /// --disc-sync-check: the felt force's error against the synchronous solve (disc N).
+  std::int64_t sync_ticks = 0;
+  double sync_seconds = 0;
+  haptics::ForceError sync_error;
 };
 
 /// Refuses what cannot run (flags, device backend, output folders), before any work: throws
