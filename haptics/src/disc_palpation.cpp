@@ -203,11 +203,19 @@ void DiscPalpation::update_local_model(const Eigen::Vector3d& device) {
     // The step's contact stiffness, its negative (sliding) directions dropped: the local model
     // is then a spring network no stiffer than s k_c in series, so the servo's loop is passive.
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(sim_.probe_stiffness(0));
-    model_trusted_ = kcd + eig.eigenvalues().minCoeff() > 0.5 * kcd;
     K = eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).asDiagonal() *
         eig.eigenvectors().transpose();
     p0 = last_.probe_mm;
     f0 = last_.force_n;
+    // The probe is massless: the disc's force on it should balance the coupling's. A step whose
+    // contact set grew beyond what the last linearisation knew (new wall nodes met at the full
+    // penalty) leaves the disc pushing far harder than the hand (measured: 325 N against 45 N
+    // at 10 ms steps); such a step's force is not passed on (the coupling's is, which the hand's
+    // own spring bounds) and its model does not place the next probe.
+    const Eigen::Vector3d coupling = kcd * (p0 - device);
+    const bool balanced = f0.norm() <= 1.5 * coupling.norm() + 1.0;
+    model_trusted_ = kcd + eig.eigenvalues().minCoeff() > 0.5 * kcd;
+    if (!balanced) f0 = coupling;
     n = f0.normalized();
     normal_stiffness_ = n.dot(K * n);
   } else {
@@ -261,8 +269,8 @@ const DiscContact& DiscPalpation::step(const Eigen::Vector3d& device_mm) {
   // would sink into them by a step's motion and the stiff penalty would push the disc ahead of
   // the hand (measured: 3x the balanced force a step after, relaxing over ~50 ms, at 10 ms steps).
   // Only at a physiological force scale (s > 1: the coupling s k_c is stiff, tens of N/mm), and
-  // while the coupling outweighs the contact's negative (sliding) stiffness by 2x and the probe
-  // moves less than r/4; else the nodes place it (on a soft coupling a frictionless sphere slides
+  // while the coupling outweighs the contact's negative (sliding) stiffness by 2x
+  // and the probe moves less than r/4; else the nodes place it (on a soft coupling a frictionless sphere slides
   // between the nodes, which the one-node model does not see).
   Eigen::Vector3d p = device_mm;
   if (armed_) {
