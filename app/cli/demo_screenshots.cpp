@@ -58,11 +58,12 @@ std::string take_demo_screenshots(const std::string& out) {
        "Ch. 4.5, 6.3: the thesis's users watched the spine in HOOPS while they dragged it."},
       {"view_disc_displacement.png",
        "--scene disc --device sim --disc-cell-size 3 --screenshot-at 2.5",
-       "The viewer on disc palpation: the L4-L5 disc pressed 2 mm, coloured by displacement",
+       "The viewer on disc palpation: the hand 2 mm past the L4-L5 disc's anterior wall, the disc "
+       "coloured by displacement (its indentation and load below)",
        "Ch. 5.3, 6.4: the MSS disc under the probe (fig 5.8 plots its force)."},
       {"view_disc_volume.png",
        "--scene disc --device sim --disc-cell-size 3 --field volume_change --screenshot-at 5.0",
-       "The same disc pressed 4 mm, coloured by each tet's volume change",
+       "The same disc, the hand 4 mm past the wall, coloured by each tet's volume change",
        "Ch. 5.2: the MSS's volume springs keep the disc's volume; the thesis shows no picture."}};
   nlohmann::json list = nlohmann::json::array();
   for (const Shot& s : shots) {
@@ -79,10 +80,14 @@ std::string take_demo_screenshots(const std::string& out) {
     if (j["compliant_stage"].is_object())
       ours += "; largest force on the spine " +
               fixed(j["compliant_stage"].value("max_spine_force_n", 0.0), 0) + " N";
-    if (j["disc_palpation"].is_object())
-      ours += "; disc " + std::to_string(j["disc_palpation"].value("tets", 0)) +
-              " tets, largest contact force " +
-              fixed(j["disc_palpation"].value("max_contact_force_n", 0.0), 2) + " N";
+    if (j["disc_palpation"].is_object()) {
+      const auto& d = j["disc_palpation"];
+      ours += "; disc " + std::to_string(d.value("tets", 0)) + " tets (" +
+              d.value("solver", std::string()) + "), indented up to " +
+              fixed(d.value("max_indentation_mm", 0.0), 2) + " mm under a load of up to " +
+              fixed(d.value("max_load_n", 0.0), 1) + " N (force scale " +
+              fixed(d.value("force_scale", 0.0), 1) + " disc N per felt N)";
+    }
     list.push_back({{"file", s.file}, {"title", s.title}, {"thesis", s.thesis}, {"ours", ours}});
   }
   std::ofstream((fs::path(out) / "viewer.json").string()) << list.dump(2) << "\n";
