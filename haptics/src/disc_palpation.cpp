@@ -325,7 +325,7 @@ void DiscPalpation::run() {
     out_.write(c);
     ++stats_.steps;
     // Same-size copy assignment: no allocation on the disc thread.
-    if (stats_.steps % kPositionsEvery == 0) positions_.write(state_.x_mm);
+    if (stats_.steps % positions_every() == 0) positions_.write(state_.x_mm);
     stats_.failed_steps += c.failed;
     if (stats_.step_us.size() < stats_.step_us.capacity())
       stats_.step_us.push_back(float(c.step_us));

@@ -78,7 +78,9 @@ TEST(CliHaptics, PlaneRunReportsTheLoopsStatisticsAndRecordsAReplayableRun) {
   ASSERT_EQ(replay.status, 0) << replay.err;
   const auto k = nlohmann::json::parse(replay.out);
   const double contact_s = rows.back()[0] - rows[first][0];
-  EXPECT_NEAR(k["contact_ticks"].get<double>(), contact_s / 1e-3, 20);
+  // A tick that misses its deadline skips that period of the recording (a loaded machine).
+  EXPECT_NEAR(k["contact_ticks"].get<double>(), contact_s / 1e-3,
+              20 + 2 * k["missed_deadlines"].get<double>());
 }
 
 // A hostile trajectory runs on any scene: the plane pressed by a 30 Hz shake and swept at 2.5 m/s.

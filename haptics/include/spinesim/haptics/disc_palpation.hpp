@@ -50,7 +50,9 @@
 
 #include <Eigen/Core>
 
+#include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -129,10 +131,15 @@ class DiscPalpation {
   void set_device(const Eigen::Vector3d& device_mm) { device_.write(device_mm); }
   const DiscContact& latest() { return out_.read(); }
   /// Graphics side (one reader): the disc's node positions (3 #nodes, mm), published by the disc
-  /// thread every `kPositionsEvery` steps (a copy of ~100 kB is not made every millisecond).
+  /// thread every `positions_every()` steps (a copy of ~100 kB is not made every millisecond).
   /// No allocation, no wait.
   const Eigen::VectorXd& latest_positions() { return positions_.read(); }
   static constexpr int kPositionsEvery = 10;
+  /// Steps between two publications: every 10 ms of the disc's time (every step of a multirate
+  /// worker, whose step is 10 ms).
+  int positions_every() const {
+    return std::max(1, int(std::lround(kPositionsEvery * 1e-3 / options_.dt_s)));
+  }
 
   const mss::MssModel& model() const { return model_; }
   const mss::State& state() const { return state_; }
