@@ -290,6 +290,16 @@ TEST_F(DynamicsBox, SwitchingFromPoseToWrenchKeepsTheState) {
 class DynamicsDisc : public ::testing::Test {
  protected:
   DynamicsDisc() : mesh_(fixtures::l4_l5(3.5)), model_(mesh_, fixtures::real_disc()) {}
+  /// The outer wall's most anterior (+z) node near mid-height (-1: none).
+  int anterior_wall_node() const {
+    const double ymid = 0.5 * (mesh_.V.col(1).minCoeff() + mesh_.V.col(1).maxCoeff());
+    int node = -1;
+    for (Eigen::Index i = 0; i < mesh_.num_vertices(); ++i)
+      if (mesh_.surface(i) == 3 && std::abs(mesh_.V(i, 1) - ymid) < 2.0 &&
+          (node < 0 || mesh_.V(i, 2) > mesh_.V(node, 2)))
+        node = int(i);
+    return node;
+  }
   const mesh::TetMesh& mesh_;
   MssModel model_;
 };
@@ -328,12 +338,7 @@ TEST_F(DynamicsDisc, ProbePressHoldAndWithdrawWithoutChatter) {
   // withdrawn; default penalty (several hundred N/mm). One implicit step per ms: a linear step
   // that changes the contact set is iterated until the set settles, else nodes flip in and out
   // of the probe and the force jumps by orders of magnitude.
-  const double ymid = 0.5 * (mesh_.V.col(1).minCoeff() + mesh_.V.col(1).maxCoeff());
-  int node = -1;
-  for (Eigen::Index i = 0; i < mesh_.num_vertices(); ++i)
-    if (mesh_.surface(i) == 3 && std::abs(mesh_.V(i, 1) - ymid) < 2.0 &&
-        (node < 0 || mesh_.V(i, 2) > mesh_.V(node, 2)))
-      node = int(i);
+  const int node = anterior_wall_node();
   ASSERT_GE(node, 0);
   const Eigen::Vector3d p = mesh_.V.row(node).transpose(), n(0.0, 0.0, 1.0);
   const double r = 3.0, depth = 2.0, speed = 20.0, hold = 0.05, press = depth / speed;
@@ -381,12 +386,7 @@ TEST_F(DynamicsDisc, ProbePressHoldAndWithdrawWithoutChatter) {
 TEST_F(DynamicsDisc, ProbeStiffnessIsTheStepsFiniteDifference) {
   // probe_stiffness is -dF/dc of the step map: from one pressed state, step with the probe's
   // centre moved by +-h along each axis and difference the disc's force on it after the step.
-  const double ymid = 0.5 * (mesh_.V.col(1).minCoeff() + mesh_.V.col(1).maxCoeff());
-  int node = -1;
-  for (Eigen::Index i = 0; i < mesh_.num_vertices(); ++i)
-    if (mesh_.surface(i) == 3 && std::abs(mesh_.V(i, 1) - ymid) < 2.0 &&
-        (node < 0 || mesh_.V(i, 2) > mesh_.V(node, 2)))
-      node = int(i);
+  const int node = anterior_wall_node();
   ASSERT_GE(node, 0);
   const double r = 4.0;
   const Eigen::Vector3d c = mesh_.V.row(node).transpose() + Eigen::Vector3d(0.3, 0.2, r - 1.0);
