@@ -14,6 +14,9 @@ scene frame (x lateral, y up, z anterior), for a probe of radius 4 mm:
                       T1's spinous tip from behind, presses the button there, drags T1 40 mm
                       (to the left, backwards, or left-up-backwards), holds, brings it back and
                       lets go.
+  twist_t1_axial.csv  the 6-DOF hook: as the drags, but the hand stays at the tip and turns the
+                      stylus 30 deg about the spine's long axis (y), holds, turns back, lets go
+                      (columns rx_deg,ry_deg,rz_deg: the stylus's rotation vector).
   press_disc_l4l5.csv the L4-L5 disc (scene disc) pressed at its anterior wall at mid-height,
                       along the disc's anterior axis: 2 mm, then 4 mm past first touch, each held
                       (needs the disc mesh and /usr/bin/python3's meshio).
@@ -33,15 +36,17 @@ def load_obj(path):
     return vertices
 
 
-def write(path, header, rows):
+def write(path, header, rows, rotations=None):
+    """rows: (t, x, y, z[, button]); rotations: one (rx, ry, rz) in degrees per row, or None."""
     with open(path, "w") as f:
         f.write("# spinesim haptic script (scripts/make-haptic-scripts.py): " + header + "\n")
-        f.write("# units: s, mm; frame x lateral (right = -x), y superior, z anterior; probe radius 4 mm\n")
-        f.write("t_s,x_mm,y_mm,z_mm,button\n")
-        for row in rows:
+        f.write("# units: s, mm, deg; frame x lateral (right = -x), y superior, z anterior; probe radius 4 mm\n")
+        f.write("t_s,x_mm,y_mm,z_mm,button" + (",rx_deg,ry_deg,rz_deg" if rotations else "") + "\n")
+        for k, row in enumerate(rows):
             t, x, y, z = row[:4]
             button = row[4] if len(row) > 4 else 0
-            f.write(f"{t:.3f},{x:.3f},{y:.3f},{z:.3f},{button}\n")
+            turn = "".join(f",{a:.3f}" for a in rotations[k]) if rotations else ""
+            f.write(f"{t:.3f},{x:.3f},{y:.3f},{z:.3f},{button}{turn}\n")
 
 
 def main():
@@ -95,6 +100,14 @@ def main():
                 (7.5, *away, 0)]
         write(os.path.join(out, f"drag_t1_{name}.csv"),
               f"drag T1 {name}ly 40 mm from its spinous tip (button held 1.0-6.5 s)", rows)
+
+    rows = [(0.0, *away, 0), (0.8, *touch, 0), (1.0, *touch, 1), (1.5, *touch, 1),
+            (3.0, *touch, 1), (4.0, *touch, 1), (5.5, *touch, 1), (6.0, *touch, 0),
+            (7.0, *away, 0)]
+    turns = [(0, 0, 0)] * 4 + [(0, 30, 0), (0, 30, 0)] + [(0, 0, 0)] * 3
+    write(os.path.join(out, "twist_t1_axial.csv"),
+          "6-DOF: hook T1 at its spinous tip and turn the stylus 30 deg about the long axis "
+          "(button held 1.0-6.0 s)", rows, turns)
 
     if len(sys.argv) > 3:
         write_disc_press(sys.argv[3], out)

@@ -90,10 +90,13 @@ void run_haptics_cli(HapticsArgs& args) {
                          s.disc_force_n.norm(), s.disc_indentation_mm, 100 * s.disc_volume_change);
           else if (s.hook.attached || s.hook.gain > 0)
             std::fprintf(
-                stderr, "\r  t %6.1f s | %6.1f Hz | force %5.2f N | hooked %s, spine %6.1f N  ",
+                stderr,
+                "\r  t %6.1f s | %6.1f Hz | force %5.2f N | hooked %s, spine %6.1f N, %5.2f N m, "
+                "torque %5.1f N mm  ",
                 s.time_s, s.time_s > 0 ? double(s.ticks) / s.time_s : 0.0, s.force_n.norm(),
                 spine::vertebra_names()[std::size_t(std::max(0, s.hook.load.vertebra))].c_str(),
-                s.hook.load.force_n.norm());
+                s.hook.load.force_n.norm(), s.hook.load.moment_nmm.norm() / 1000,
+                s.torque_nmm.norm());
           else
             std::fprintf(stderr, "\r  t %6.1f s | %6.1f Hz | force %5.2f N | %s        ", s.time_s,
                          s.time_s > 0 ? double(s.ticks) / s.time_s : 0.0, s.force_n.norm(),
@@ -204,7 +207,9 @@ void add_haptics_run_flags(CLI::App* cmd, HapticsRunFlags& f, bool viewer) {
                       : "sim, replay, null, openhaptics or dhd (mouse: in spinesim view)")
       ->capture_default_str();
   cmd->add_option("--model", f.request.model,
-                  "Device capability record: touch, premium-1.5, omega.3 (peak force, stiffness)")
+                  "Device capability record: touch, premium-1.5, omega.3; 6-DOF: sigma.7, "
+                  "premium-1.5-6dof (torque), omega.6 (turn sensed, no torque) (peak force and "
+                  "torque, stiffness; haptics devices lists them)")
       ->capture_default_str();
   cmd->add_option("--script", f.request.script,
                   "sim: the hand's set-point trajectory, CSV t_s,x_mm,y_mm,z_mm[,button] "
@@ -268,6 +273,11 @@ void add_haptics_run_flags(CLI::App* cmd, HapticsRunFlags& f, bool viewer) {
   cmd->add_option("--coupling-damping", f.request.coupling_damping_n_s_per_mm,
                   "Felt damping of the hook spring or the disc coupling, N*s/mm")
       ->capture_default_str();
+  cmd->add_option("--rotational-stiffness", f.request.rotational_stiffness_nmm_per_rad,
+                  "--spine multirate on a 6-DOF device with torque (--model sigma.7, "
+                  "premium-1.5-6dof): the hook's torsional spring, felt, N*mm/rad; the stylus's "
+                  "turn twists the hooked vertebra and the hand feels the spine's moment / "
+                  "--force-scale (default: the device's usable rotational stiffness; 0: off)");
   cmd->add_flag("--no-recruit{false}", f.request.spine_recruit,
                 "--spine multirate: passive spine solves (muscles off)");
   cmd->add_option("--posture", f.request.posture,

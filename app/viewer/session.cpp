@@ -274,6 +274,9 @@ void SessionController::panel() {
                     ? spine::vertebra_names()[std::size_t(v)].c_str()
                     : "-",
                 s.hook.load.force_n.norm(), s.hook.felt_force_n.norm(), s.hook.gain);
+    if (s.hook.load.twist)
+      ImGui::Text("twist %.1f deg: spine moment %.2f N m (felt %.0f N mm)", s.hook.twist_deg.norm(),
+                  s.hook.load.moment_nmm.norm() / 1000, s.hook.felt_torque_nmm.norm());
   }
   if (setup_.disc) {
     ImGui::Text("disc %s: %s | load %.1f N | indented %.2f mm | volume %+.3f %%",

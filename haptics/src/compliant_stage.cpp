@@ -2,6 +2,8 @@
 
 #include "blas_threads.hpp"
 
+#include "spinesim/common/constants.hpp"
+#include "spinesim/common/rotation.hpp"
 #include "spinesim/common/timer.hpp"
 #include "spinesim/spine/kinematics.hpp"
 
@@ -75,6 +77,7 @@ LocalSpineModel MultirateSpine::solve(const HookLoad& load, const LocalSpineMode
   spine::ExternalLoad l;
   l.vertebra = load.vertebra;
   l.force_n = load.force_n;
+  l.moment_nmm = load.moment_nmm;
   l.has_point = true;
   l.point_mm = load.point_mm;
   const std::vector<spine::ExternalLoad> loads = {l};
@@ -83,23 +86,41 @@ LocalSpineModel MultirateSpine::solve(const HookLoad& load, const LocalSpineMode
   out.vertebra = load.vertebra;
   out.point_mm = load.point_mm;
   out.force_n = load.force_n;
+  out.moment_nmm = load.moment_nmm;
   out.relative = s.displacement - baseline_;
+  const auto flat = [](const SpineDisplacement& d) {
+    Eigen::Matrix<double, 6 * kSpineVertebrae, 1> v;
+    for (int i = 0; i < kSpineVertebrae; ++i) v.segment<6>(6 * i) = d.row(i).transpose();
+    return v;
+  };
   if (previous && !full) {
-    // Broyden: the smallest change of S that maps the last force step onto the last response
-    // step.
-    out.sensitivity = previous->sensitivity;
-    const Eigen::Vector3d dF = load.force_n - previous->force_n;
-    if (dF.squaredNorm() > 1e-6) {
-      Eigen::Matrix<double, 6 * kSpineVertebrae, 1> dd;
-      for (int i = 0; i < kSpineVertebrae; ++i)
-        dd.segment<6>(6 * i) = (out.relative.row(i) - previous->relative.row(i)).transpose();
-      out.sensitivity += (dd - out.sensitivity * dF) * dF.transpose() / dF.squaredNorm();
-    }
+    // Broyden: the smallest change of S that maps the last load step onto the last response
+    // step. The moment is measured in N × 50 mm (a vertebra's size), so that a newton and a
+    // newton-metre-ish couple weigh alike in "smallest".
+    const double arm_mm = 50;
+    Eigen::Matrix<double, 6 * kSpineVertebrae, 6> S = previous->sensitivity;
+    S.rightCols<3>() *= arm_mm;
+    Eigen::Matrix<double, 6, 1> du;
+    du << load.force_n - previous->force_n, (load.moment_nmm - previous->moment_nmm) / arm_mm;
+    if (du.squaredNorm() > 1e-6)
+      S += (flat(out.relative - previous->relative) - S * du) * du.transpose() / du.squaredNorm();
+    S.rightCols<3>() /= arm_mm;
+    out.sensitivity = S;
     return out;
   }
-  out.sensitivity = spine::displacement_sensitivity(
+  out.sensitivity.leftCols<3>() = spine::displacement_sensitivity(
       model_, loads, s, 0, options_.solve, options_.sensitivity_step_n,
       full ? spine::SensitivityMethod::automatic : spine::SensitivityMethod::fixed_muscles);
+  if (load.twist && full) {
+    // ∂d/∂M by forward differences of whole solves (recruitment changes with the couple).
+    for (int k = 0; k < 3; ++k) {
+      std::vector<spine::ExternalLoad> moved = loads;
+      moved[0].moment_nmm[k] += options_.sensitivity_step_nmm;
+      const spine::SpineSolution sk = spine::solve_spine(model_, moved, options_.solve);
+      out.sensitivity.col(3 + k) =
+          flat(sk.displacement - s.displacement) / options_.sensitivity_step_nmm;
+    }
+  }
   return out;
 }
 
@@ -109,14 +130,15 @@ bool made_for(const LocalSpineModel& m, const HookLoad& load) {
   return load.vertebra >= 0 && m.vertebra == load.vertebra && m.point_mm == load.point_mm;
 }
 
-/// The local model's linear prediction at `force`, into `out` (or blended into it with weight w).
-void linear_prediction(const LocalSpineModel& m, const Eigen::Vector3d& force, double w,
+/// The local model's linear prediction at `load`, into `out` (or blended into it with weight w).
+void linear_prediction(const LocalSpineModel& m, const HookLoad& load, double w,
                        SpineDisplacement& out) {
-  const Eigen::Vector3d dF = force - m.force_n;
+  Eigen::Matrix<double, 6, 1> dW;
+  dW << load.force_n - m.force_n, load.moment_nmm - m.moment_nmm;
   for (int i = 0; i < kSpineVertebrae; ++i)
     for (int c = 0; c < 6; ++c)
       out(i, c) =
-          (1 - w) * out(i, c) + w * (m.relative(i, c) + m.sensitivity.row(6 * i + c).dot(dF));
+          (1 - w) * out(i, c) + w * (m.relative(i, c) + m.sensitivity.row(6 * i + c).dot(dW));
 }
 
 }  // namespace
@@ -136,10 +158,10 @@ void MultirateSpine::predict(const HookLoad& load, SpineDisplacement& relative) 
   relative.setZero();
   double w = 1;
   if (handover_left_ > 0) {
-    linear_prediction(previous_, load.force_n, 1, relative);
+    linear_prediction(previous_, load, 1, relative);
     w = 1.0 - double(handover_left_) / double(options_.handover_ticks + 1);
   }
-  linear_prediction(current_, load.force_n, w, relative);
+  linear_prediction(current_, load, w, relative);
 }
 
 void MultirateSpine::publish(const HookLoad& load) {
@@ -169,7 +191,7 @@ void MultirateSpine::run() {
   while (!stop_.load()) {
     const HookLoad load = request_.read();
     if (load.vertebra < 0 || (load.vertebra == last.vertebra && load.point_mm == last.point_mm &&
-                              load.force_n == last.force_n)) {
+                              load.force_n == last.force_n && load.moment_nmm == last.moment_nmm)) {
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
       continue;
     }
@@ -210,8 +232,11 @@ CompliantStage::CompliantStage(SpineResponse& response,
   for (int b : body_of)
     if (b < 0 || b >= kMaxBodies)
       throw std::invalid_argument("compliant stage: every vertebra T1-L5 must be in the scene");
-  if (!(p.damping_n_s_per_mm >= 0) || !(p.ramp_s >= 0))
-    throw std::invalid_argument("compliant stage: coupling damping and ramp must be >= 0");
+  if (!(p.damping_n_s_per_mm >= 0) || !(p.ramp_s >= 0) ||
+      !(p.rotational_stiffness_nmm_per_rad >= 0) || !(p.rotational_damping_nmm_s_per_rad >= 0))
+    throw std::invalid_argument(
+        "compliant stage: coupling damping, ramp and rotational stiffness must be >= 0");
+  twists_ = p.rotational_stiffness_nmm_per_rad > 0 && response.max_moment_nmm() > 0;
 }
 
 void CompliantStage::update(const DeviceState& device, const RenderOutput& last, double dt_s,
@@ -226,7 +251,13 @@ void CompliantStage::update(const DeviceState& device, const RenderOutput& last,
         s.attached = true;
         s.load.vertebra = i;
         s.load.point_mm = to_body(poses, last.body, last.proxy_mm);
+        s.load.twist = twists_;
         last_hook_mm_ = last.proxy_mm;
+        grip_at_press_ = device.orientation;
+        Vector6d held;
+        held << s.load.force_n, s.load.moment_nmm;
+        hook_at(held, &vertebra_at_press_);
+        last_vertebra_ = vertebra_at_press_;
       }
   }
   if (!pressed) s.attached = false;
@@ -235,22 +266,45 @@ void CompliantStage::update(const DeviceState& device, const RenderOutput& last,
   if (s.gain == 0 && !s.attached) {
     s.load.vertebra = -1;
     s.load.force_n.setZero();
+    s.load.moment_nmm.setZero();
     s.felt_force_n.setZero();
+    s.felt_torque_nmm.setZero();
+    s.twist_deg.setZero();
     s.clamped = false;
   } else {
     const double spring = s.gain * p_.force_scale * p_.stiffness_n_per_mm;  // on the spine, N/mm
-    Eigen::Vector3d spine_force = equilibrium_force(device.position_mm, spring);
-    const double most = response_.max_force_n();
-    s.clamped = !(spine_force.norm() <= most);
-    if (s.clamped) spine_force *= most / spine_force.norm();
-    if (!spine_force.allFinite()) spine_force.setZero();
-    s.load.force_n = spine_force;
-    s.hook_mm = hook_at(spine_force);
+    const double torsion =
+        twists_ ? s.gain * p_.force_scale * p_.rotational_stiffness_nmm_per_rad : 0;  // N·mm/rad
+    const Eigen::Matrix3d turn = device.orientation * grip_at_press_.transpose();
+    Vector6d W = equilibrium_load(device.position_mm, turn, spring, torsion);
+    const double most = response_.max_force_n(), most_moment = response_.max_moment_nmm();
+    const bool force_clamped = !(W.head<3>().norm() <= most);
+    if (force_clamped) W.head<3>() *= most / W.head<3>().norm();
+    const bool moment_clamped = twists_ && !(W.tail<3>().norm() <= most_moment);
+    if (moment_clamped) W.tail<3>() *= most_moment / W.tail<3>().norm();
+    if (!twists_) W.tail<3>().setZero();
+    if (!W.allFinite()) W.setZero();
+    s.clamped = force_clamped || moment_clamped;
+    s.load.force_n = W.head<3>();
+    s.load.moment_nmm = W.tail<3>();
+    Eigen::Matrix3d vertebra;
+    s.hook_mm = hook_at(W, &vertebra);
     const Eigen::Vector3d hook_velocity =
         dt_s > 0 ? Eigen::Vector3d((s.hook_mm - last_hook_mm_) / dt_s) : Eigen::Vector3d::Zero();
+    const Eigen::Vector3d vertebra_spin =
+        dt_s > 0 ? Eigen::Vector3d(rotation_log_total(vertebra * last_vertebra_.transpose()) / dt_s)
+                 : Eigen::Vector3d::Zero();
     last_hook_mm_ = s.hook_mm;
-    s.felt_force_n = -spine_force / p_.force_scale -
+    last_vertebra_ = vertebra;
+    s.felt_force_n = -s.load.force_n / p_.force_scale -
                      s.gain * p_.damping_n_s_per_mm * (device.velocity_mm_s - hook_velocity);
+    s.twist_deg =
+        twists_ ? Eigen::Vector3d(twist(turn, vertebra) / kRadPerDeg) : Eigen::Vector3d::Zero();
+    s.felt_torque_nmm = twists_
+                            ? Eigen::Vector3d(-s.load.moment_nmm / p_.force_scale -
+                                              s.gain * p_.rotational_damping_nmm_s_per_rad *
+                                                  (device.angular_velocity_rad_s - vertebra_spin))
+                            : Eigen::Vector3d::Zero();
   }
   response_.predict(s.load, relative_);
   response_.publish(s.load);
@@ -258,34 +312,60 @@ void CompliantStage::update(const DeviceState& device, const RenderOutput& last,
   relative_poses(centres_, response_.baseline(), absolute_, body_of_, poses);
 }
 
-Eigen::Vector3d CompliantStage::hook_at(const Eigen::Vector3d& force) {
+Eigen::Vector3d CompliantStage::hook_at(const Vector6d& W, Eigen::Matrix3d* rotation) {
   HookLoad load = state_.load;
-  load.force_n = force;
+  load.force_n = W.head<3>();
+  load.moment_nmm = W.tail<3>();
   response_.predict(load, relative_);
   const int v = load.vertebra;
   const auto& base = response_.baseline();
   const spine::Pose a = pose_of(centres_[std::size_t(v)], base.row(v));
   const spine::Pose b = pose_of(centres_[std::size_t(v)], base.row(v) + relative_.row(v));
+  if (rotation) *rotation = b.R * a.R.transpose();
   return b.apply(a.R.transpose() * (load.point_mm - a.t));
 }
 
-Eigen::Vector3d CompliantStage::equilibrium_force(const Eigen::Vector3d& probe_mm,
-                                                  double spring_n_per_mm) {
-  // g(F) = F − c (probe − hook(F)) = 0 from the last tick's force; the hook point in the
-  // response's reference posture is load.point_mm, carried by the vertebra's relative motion.
-  Eigen::Vector3d F = state_.load.force_n;
-  if (!F.allFinite()) F.setZero();
-  const double delta = 1.0;  // N, the Jacobian's difference step
+Eigen::Vector3d CompliantStage::twist(const Eigen::Matrix3d& turn,
+                                      const Eigen::Matrix3d& vertebra) const {
+  return rotation_log_total(turn * (vertebra * vertebra_at_press_.transpose()).transpose());
+}
+
+CompliantStage::Vector6d CompliantStage::equilibrium_load(const Eigen::Vector3d& probe_mm,
+                                                          const Eigen::Matrix3d& turn,
+                                                          double spring_n_per_mm,
+                                                          double torsion_nmm_per_rad) {
+  // g(F, M) = (F − c (probe − hook(F, M)), M − c_r φ(F, M)) = 0 from the last tick's load; the
+  // hook point in the response's reference posture is load.point_mm, carried by the vertebra's
+  // relative motion, and φ is the stylus's turn against the vertebra's. Without a torsional
+  // spring only the force is solved for (M stays 0).
+  Vector6d W;
+  W << state_.load.force_n, state_.load.moment_nmm;
+  if (!W.allFinite() || !(torsion_nmm_per_rad > 0)) W.tail<3>().setZero();
+  if (!W.allFinite()) W.setZero();
+  const bool six = torsion_nmm_per_rad > 0;
+  const auto residual = [&](const Vector6d& w) {
+    Eigen::Matrix3d R;
+    Vector6d g;
+    g.head<3>() = w.head<3>() - spring_n_per_mm * (probe_mm - hook_at(w, &R));
+    g.tail<3>() = six ? Eigen::Vector3d(w.tail<3>() - torsion_nmm_per_rad * twist(turn, R))
+                      : Eigen::Vector3d(w.tail<3>());
+    return g;
+  };
+  const double arm_mm = 50;  // a moment residual in N·mm weighs as a force one in N at 50 mm
   for (int it = 0; it < 3; ++it) {
-    const Eigen::Vector3d h0 = hook_at(F);
-    const Eigen::Vector3d g = F - spring_n_per_mm * (probe_mm - h0);
-    if (g.norm() < 1e-3) break;
-    Eigen::Matrix3d J = Eigen::Matrix3d::Identity();
-    for (int a = 0; a < 3; ++a)
-      J.col(a) += spring_n_per_mm * (hook_at(F + delta * Eigen::Vector3d::Unit(a)) - h0) / delta;
-    F -= J.partialPivLu().solve(g);
+    const Vector6d g0 = residual(W);
+    if (std::hypot(g0.head<3>().norm(), g0.tail<3>().norm() / arm_mm) < 1e-3) break;
+    Eigen::Matrix<double, 6, 6> J = Eigen::Matrix<double, 6, 6>::Identity();
+    for (int a = 0; a < (six ? 6 : 3); ++a) {
+      const double delta = a < 3 ? 1.0 : arm_mm;  // N, N·mm: the Jacobian's difference steps
+      J.col(a) = (residual(W + delta * Vector6d::Unit(a)) - g0) / delta;
+    }
+    if (six)
+      W -= J.partialPivLu().solve(g0);
+    else
+      W.head<3>() -= J.topLeftCorner<3, 3>().partialPivLu().solve(g0.head<3>());
   }
-  return F;
+  return W;
 }
 
 Eigen::Vector3d CompliantStage::blend(const Eigen::Vector3d& contact_force_n) const {

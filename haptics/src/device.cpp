@@ -1,6 +1,10 @@
 #include "spinesim/haptics/device.hpp"
 
+#include "spinesim/common/constants.hpp"
 #include "spinesim/common/input_file.hpp"
+#include "spinesim/common/rotation.hpp"
+
+#include <Eigen/Geometry>
 
 #include <algorithm>
 #include <cmath>
@@ -10,6 +14,22 @@
 #include <stdexcept>
 
 namespace spinesim::haptics {
+
+namespace {
+
+DeviceCapabilities six_dof(DeviceCapabilities c, int torque_axes, double peak_torque_nmm,
+                           double continuous_torque_nmm, double usable_nmm_per_rad,
+                           double damping_nmm_s_per_rad) {
+  c.senses_orientation = true;
+  c.torque_axes = torque_axes;
+  c.peak_torque_nmm = peak_torque_nmm;
+  c.continuous_torque_nmm = continuous_torque_nmm;
+  c.usable_rotational_stiffness_nmm_per_rad = usable_nmm_per_rad;
+  c.rotational_damping_nmm_s_per_rad = damping_nmm_s_per_rad;
+  return c;
+}
+
+}  // namespace
 
 const std::vector<DeviceCapabilities>& device_models() {
   // Sources: the vendors' specification sheets as quoted (not re-measured here). The physical
@@ -29,7 +49,29 @@ const std::vector<DeviceCapabilities>& device_models() {
       {"omega.3", "Force Dimension omega.3", Eigen::Vector3d(160, 110, 160), 12.0, 12.0, 14.5, 0.02,
        "Force Dimension omega.3 specification sheet: workspace 160 mm diameter x 110 mm, "
        "continuous force 12.0 N, closed-loop stiffness 14.5 N/mm; damping 0.02 N s/mm is an "
-       "assumption"}};
+       "assumption"},
+      six_dof({"premium-1.5-6dof", "3D Systems PHANToM Premium 1.5 6DOF",
+               Eigen::Vector3d(381, 267, 191), 8.5, 1.4, 3.5, 0.004,
+               "3D Systems PHANToM Premium 1.5/6DOF specification sheet: workspace 381 x 267 x "
+               "191 mm, maximum force 8.5 N, continuous 1.4 N; torque peak 515 mNm (Rx, Ry) and "
+               "170 mNm (Rz), continuous 188 mNm (Rx, Ry) and 48 mNm (Rz); the smaller axis is "
+               "taken for all three; rotational damping 0.2 N mm s/rad and usable rotational "
+               "stiffness 200 N mm/rad are assumptions"},
+              3, 170, 48, 200, 0.2),
+      six_dof({"sigma.7", "Force Dimension sigma.7", Eigen::Vector3d(190, 130, 190), 20.0, 20.0,
+               14.5, 0.02,
+               "Force Dimension sigma.7 specification sheet: workspace 190 mm diameter x 130 mm, "
+               "continuous force 20 N, continuous torque 400 mNm (also taken as the peak), "
+               "translational stiffness taken as the omega's 14.5 N/mm; damping 0.02 N s/mm, "
+               "rotational damping 0.5 N mm s/rad and usable rotational stiffness 300 N mm/rad "
+               "are assumptions"},
+              3, 400, 400, 300, 0.5),
+      six_dof({"omega.6", "Force Dimension omega.6", Eigen::Vector3d(160, 110, 160), 12.0, 12.0,
+               14.5, 0.02,
+               "Force Dimension omega.6 specification sheet: the omega.3's translation and forces, "
+               "with a wrist whose three rotations are sensed but not actuated (no torque); "
+               "damping 0.02 N s/mm is an assumption"},
+              0, 0, 0, 0, 0)};
   return models;
 }
 
@@ -46,6 +88,10 @@ double passive_stiffness_limit(const DeviceCapabilities& c, double period_s,
                                double virtual_damping) {
   return std::max(0.0,
                   2.0 * (c.physical_damping_n_s_per_mm - std::abs(virtual_damping)) / period_s);
+}
+
+double passive_rotational_stiffness_limit(const DeviceCapabilities& c, double period_s) {
+  return c.renders_torque() ? 2.0 * c.rotational_damping_nmm_s_per_rad / period_s : 0.0;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -77,10 +123,51 @@ Eigen::Vector3d Trajectory::velocity_at(double t) const {
   return (position_mm[i + 1] - position_mm[i]) / (t_s[i + 1] - t_s[i]);
 }
 
+namespace {
+
+Eigen::Quaterniond quaternion_of(const Eigen::Vector3d& rotation_deg) {
+  return Eigen::Quaterniond(rotation_exp(rotation_deg * kRadPerDeg));
+}
+
+}  // namespace
+
+Eigen::Matrix3d Trajectory::orientation_at(double t) const {
+  if (rotation_deg.empty()) return Eigen::Matrix3d::Identity();
+  if (t <= t_s.front()) return quaternion_of(rotation_deg.front()).toRotationMatrix();
+  if (t >= t_s.back()) return quaternion_of(rotation_deg.back()).toRotationMatrix();
+  const std::size_t i = segment(t_s, t);
+  const double f = (t - t_s[i]) / (t_s[i + 1] - t_s[i]);
+  return quaternion_of(rotation_deg[i])
+      .slerp(f, quaternion_of(rotation_deg[i + 1]))
+      .toRotationMatrix();
+}
+
+Eigen::Vector3d Trajectory::angular_velocity_at(double t) const {
+  if (rotation_deg.empty() || t_s.size() < 2 || t < t_s.front() || t >= t_s.back())
+    return Eigen::Vector3d::Zero();
+  const std::size_t i = segment(t_s, t);
+  const Eigen::Matrix3d R0 = quaternion_of(rotation_deg[i]).toRotationMatrix();
+  const Eigen::Matrix3d R1 = quaternion_of(rotation_deg[i + 1]).toRotationMatrix();
+  return rotation_log_total(R1 * R0.transpose()) / (t_s[i + 1] - t_s[i]);
+}
+
 unsigned Trajectory::buttons_at(double t) const {
   if (t_s.empty()) return 0;
   return buttons[segment(t_s, t)];
 }
+
+namespace {
+
+double finite_cell(const std::string& cell, const std::string& where) {
+  char* end = nullptr;
+  const double v = std::strtod(cell.c_str(), &end);
+  while (end && (*end == ' ' || *end == '\r' || *end == '\t')) ++end;
+  if (end == cell.c_str() || (end && *end != '\0') || !std::isfinite(v))
+    throw std::invalid_argument(where + ": '" + cell + "' is not a finite number");
+  return v;
+}
+
+}  // namespace
 
 Trajectory read_trajectory(const std::string& path) {
   // Only a regular file is read (a FIFO or device is refused by name), at most 1 GiB.
@@ -88,6 +175,7 @@ Trajectory read_trajectory(const std::string& path) {
   Trajectory tr;
   std::string line;
   int line_no = 0;
+  int rotation_column = -1;  // the column of rx_deg (ry_deg, rz_deg follow), from the header
   while (std::getline(in, line)) {
     ++line_no;
     const auto first = line.find_first_not_of(" \t\r");
@@ -99,18 +187,18 @@ Trajectory read_trajectory(const std::string& path) {
     std::string cell;
     while (std::getline(ss, cell, ',')) cells.push_back(cell);
     const std::string where = path + ":" + std::to_string(line_no);
-    if (tr.t_s.empty() && !cells.empty() && cells[0].find("t_s") != std::string::npos) continue;
+    if (tr.t_s.empty() && !cells.empty() && cells[0].find("t_s") != std::string::npos) {
+      for (std::size_t k = 0; k + 2 < cells.size(); ++k)
+        if (cells[k] == "rx_deg" && cells[k + 1] == "ry_deg" && cells[k + 2] == "rz_deg")
+          rotation_column = int(k);
+      continue;
+    }
     if (cells.size() < 4)
       throw std::invalid_argument(where + ": expected t_s,x_mm,y_mm,z_mm[,button,...], got " +
                                   std::to_string(cells.size()) + " cells");
     double v[5] = {0, 0, 0, 0, 0};
-    for (std::size_t k = 0; k < std::min<std::size_t>(cells.size(), 5); ++k) {
-      char* end = nullptr;
-      v[k] = std::strtod(cells[k].c_str(), &end);
-      while (end && (*end == ' ' || *end == '\r' || *end == '\t')) ++end;
-      if (end == cells[k].c_str() || (end && *end != '\0') || !std::isfinite(v[k]))
-        throw std::invalid_argument(where + ": '" + cells[k] + "' is not a finite number");
-    }
+    for (std::size_t k = 0; k < std::min<std::size_t>(cells.size(), 5); ++k)
+      v[k] = finite_cell(cells[k], where);
     if (v[0] < 0) throw std::invalid_argument(where + ": negative time");
     if (!tr.t_s.empty() && !(v[0] > tr.t_s.back()))
       throw std::invalid_argument(where + ": time " + cells[0] +
@@ -121,6 +209,19 @@ Trajectory read_trajectory(const std::string& path) {
     tr.t_s.push_back(v[0]);
     tr.position_mm.emplace_back(v[1], v[2], v[3]);
     tr.buttons.push_back(unsigned(v[4]));
+    if (rotation_column >= 0) {
+      if (int(cells.size()) < rotation_column + 3)
+        throw std::invalid_argument(where +
+                                    ": the header names rx_deg,ry_deg,rz_deg but the row "
+                                    "has only " +
+                                    std::to_string(cells.size()) + " cells");
+      Eigen::Vector3d r;
+      for (int k = 0; k < 3; ++k)
+        r[k] = finite_cell(cells[std::size_t(rotation_column + k)], where);
+      if (r.norm() > 180)
+        throw std::invalid_argument(where + ": a rotation of more than 180 degrees");
+      tr.rotation_deg.push_back(r);
+    }
     if (tr.t_s.size() > 50000000) throw std::invalid_argument(path + ": more than 50 million rows");
   }
   if (tr.t_s.empty()) throw std::invalid_argument(path + ": no trajectory rows");
@@ -153,11 +254,38 @@ void hold_for_one_period(const HandModel& hand, const DeviceCapabilities& caps, 
   }
 }
 
+/// The stylus's orientation over one servo period with the torque held: a rigid body of the
+/// hand's inertia (isotropic) turned by the wrist's rotational spring and damper towards
+/// `set_orientation(t)`, the device's rotational damping and `torque` (N·mm, scene axes);
+/// semi-implicit Euler in 10 sub-steps, the orientation advanced by the exponential map.
+template <class SetOrientation, class SetAngularVelocity>
+void turn_for_one_period(const HandModel& hand, const DeviceCapabilities& caps, double period,
+                         const Eigen::Vector3d& torque, Eigen::Matrix3d& R, Eigen::Vector3d& w,
+                         const SetOrientation& set_orientation,
+                         const SetAngularVelocity& set_angular_velocity) {
+  const int substeps = 10;
+  const double h = period / substeps, inertia = hand.inertia_kg_mm2 * 1e-3;  // t·mm²
+  for (int k = 0; k < substeps; ++k) {
+    const double t = k * h;
+    const Eigen::Vector3d grip =
+        hand.rotational_stiffness_nmm_per_rad *
+            rotation_log_total(set_orientation(t) * R.transpose()) +
+        hand.rotational_damping_nmm_s_per_rad * (set_angular_velocity(t) - w);
+    w += h * (grip - caps.rotational_damping_nmm_s_per_rad * w + torque) / inertia;
+    R = rotation_exp(h * w) * R;
+  }
+  // Keep R a rotation to round-off (the products drift over millions of ticks).
+  const Eigen::Quaterniond q(R);
+  R = q.normalized().toRotationMatrix();
+}
+
 void check_hand(const char* who, double period_s, const HandModel& hand) {
   if (!(period_s > 0)) throw std::invalid_argument(std::string(who) + ": period must be > 0");
   if (!(hand.mass_kg > 0) || !(hand.stiffness_n_per_mm > 0) || !(hand.damping_n_s_per_mm >= 0) ||
-      !(hand.max_force_n >= 0))
-    throw std::invalid_argument(std::string(who) + ": hand mass and stiffness must be > 0");
+      !(hand.max_force_n >= 0) || !(hand.inertia_kg_mm2 > 0) ||
+      !(hand.rotational_stiffness_nmm_per_rad > 0) || !(hand.rotational_damping_nmm_s_per_rad >= 0))
+    throw std::invalid_argument(std::string(who) +
+                                ": hand mass, inertia and stiffnesses must be > 0");
 }
 
 class SimDevice final : public Device {
@@ -174,21 +302,40 @@ class SimDevice final : public Device {
     x_ = script_.position_at(time_);
     v_.setZero();
     force_.setZero();
+    R_ = script_.orientation_at(time_);
+    w_.setZero();
+    torque_.setZero();
   }
-  void close() override { force_.setZero(); }
+  void close() override {
+    force_.setZero();
+    torque_.setZero();
+  }
   bool read(DeviceState& s) override {
     hold_for_one_period(
         hand_, caps_, period_, force_, x_, v_,
         [&](double since) { return script_.position_at(time_ + since); },
         [&](double since) { return script_.velocity_at(time_ + since); });
+    if (caps_.senses_orientation)
+      turn_for_one_period(
+          hand_, caps_, period_, torque_, R_, w_,
+          [&](double since) { return script_.orientation_at(time_ + since); },
+          [&](double since) { return script_.angular_velocity_at(time_ + since); });
     time_ += period_;
     s.position_mm = x_;
     s.velocity_mm_s = v_;
+    s.orientation = R_;
+    s.angular_velocity_rad_s = w_;
     s.buttons = script_.buttons_at(time_);
     return true;
   }
   bool write_force(const Eigen::Vector3d& f) override {
     force_ = f;
+    torque_.setZero();  // a force-only command holds no torque
+    return true;
+  }
+  bool write_wrench(const Eigen::Vector3d& f, const Eigen::Vector3d& torque) override {
+    force_ = f;
+    torque_ = caps_.renders_torque() ? torque : Eigen::Vector3d::Zero();
     return true;
   }
   // The hand holds the script's last set-point for as long as the loop runs.
@@ -202,6 +349,8 @@ class SimDevice final : public Device {
   double time_ = 0;
   Eigen::Vector3d x_ = Eigen::Vector3d::Zero(), v_ = Eigen::Vector3d::Zero(),
                   force_ = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d R_ = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d w_ = Eigen::Vector3d::Zero(), torque_ = Eigen::Vector3d::Zero();
 };
 
 class MouseDevice final : public Device {
@@ -278,6 +427,8 @@ class ReplayDevice final : public Device {
   bool read(DeviceState& s) override {
     s.position_mm = rec_.position_at(time_);
     s.velocity_mm_s = rec_.velocity_at(time_);
+    s.orientation = rec_.orientation_at(time_);
+    s.angular_velocity_rad_s = rec_.angular_velocity_at(time_);
     s.buttons = rec_.buttons_at(time_);
     time_ += period_;
     return true;

@@ -25,6 +25,9 @@ namespace {
 
 constexpr int kCommonColumns = 13, kHookColumns = 11, kVertebrae = 17;
 constexpr int kDragColumns = kCommonColumns + kHookColumns + 6 * kVertebrae;
+constexpr int kSixDofColumns = 9;  // rotation, torque, and with the stage the spine's moment
+constexpr const char* kSixDofHeader = ",rx_deg,ry_deg,rz_deg,tx_nmm,ty_nmm,tz_nmm";
+constexpr const char* kSpineMomentHeader = ",spine_mx_nmm,spine_my_nmm,spine_mz_nmm";
 
 void fnv(std::uint64_t& h, double v) {
   unsigned char b[sizeof v];
@@ -50,15 +53,16 @@ std::string spine_model_fingerprint(const spine::SpineModel& m) {
 HapticRecordingWriter::HapticRecordingWriter(const std::string& path,
                                              const std::string& description,
                                              const spine::SpineModel* model,
-                                             const std::string& response, bool disc)
-    : path_(path), disc_(disc) {
+                                             const std::string& response, bool disc, bool six_dof)
+    : path_(path), disc_(disc), six_dof_(six_dof) {
   file_ = std::fopen(path.c_str(), "w");
   if (!file_) throw std::runtime_error("--record " + path + ": cannot write there");
-  std::fprintf(file_,
-               "# spinesim haptics recording 1: every servo tick; %s\n"
-               "# units: s, mm, N, deg; frame x lateral (right = -x), y superior, z anterior. "
-               "Columns 1-5 are a trajectory (--device replay --replay FILE plays them)\n",
-               description.c_str());
+  std::fprintf(
+      file_,
+      "# spinesim haptics recording 1: every servo tick; %s\n"
+      "# units: s, mm, N, N mm, deg; frame x lateral (right = -x), y superior, z anterior. "
+      "Columns 1-5 are a trajectory (--device replay --replay FILE plays them)\n",
+      description.c_str());
   if (model)
     std::fprintf(file_,
                  "# spine model %s; compliant stage %s; vertebra motion: the F.1 centre's "
@@ -81,6 +85,7 @@ HapticRecordingWriter::HapticRecordingWriter(const std::string& path,
         std::fprintf(file_, ",%s_%s", v.name.c_str(), c);
     }
   }
+  if (six_dof) std::fprintf(file_, "%s%s", kSixDofHeader, model ? kSpineMomentHeader : "");
   std::fputc('\n', file_);
   if (std::fflush(file_) != 0) failed_ = true;
 }
@@ -100,8 +105,8 @@ void HapticRecordingWriter::append(const haptics::TickRecord* rows, std::size_t 
     if (disc_)
       std::fprintf(file_, ",%d,%.4f,%.4f,%.4f,%.5f,%.5f,%.5f,%.7f,%.5f", r.disc_contact ? 1 : 0,
                    r.disc_probe_mm.x(), r.disc_probe_mm.y(), r.disc_probe_mm.z(),
-                   r.disc_force_n.x(), r.disc_force_n.y(), r.disc_force_n.z(),
-                   r.disc_volume_change, r.disc_indentation_mm);
+                   r.disc_force_n.x(), r.disc_force_n.y(), r.disc_force_n.z(), r.disc_volume_change,
+                   r.disc_indentation_mm);
     if (!centres_.empty()) {
       const auto& h = r.hook;
       std::fprintf(file_, ",%d,%d,%.5f,%.5f,%.5f,%.4f,%.4f,%.4f,%.5f,%.5f,%.5f", h.attached ? 1 : 0,
@@ -115,6 +120,13 @@ void HapticRecordingWriter::append(const haptics::TickRecord* rows, std::size_t 
         std::fprintf(file_, ",%.5f,%.5f,%.5f,%.5f,%.5f,%.5f", d.x(), d.y(), d.z(), rot.x(), rot.y(),
                      rot.z());
       }
+    }
+    if (six_dof_) {
+      std::fprintf(file_, ",%.5f,%.5f,%.5f,%.4f,%.4f,%.4f", r.rotation_deg.x(), r.rotation_deg.y(),
+                   r.rotation_deg.z(), r.torque_nmm.x(), r.torque_nmm.y(), r.torque_nmm.z());
+      if (!centres_.empty())
+        std::fprintf(file_, ",%.3f,%.3f,%.3f", r.hook.load.moment_nmm.x(),
+                     r.hook.load.moment_nmm.y(), r.hook.load.moment_nmm.z());
     }
     std::fputc('\n', file_);
   }
@@ -149,11 +161,13 @@ spine::Pose DragFrame::pose(const spine::SpineModel& m, int i) const {
 
 namespace {
 
-/// Parses one data row into `f`; false with `why` when a cell is not a finite number.
-bool parse_row(const std::string& line, DragFrame& f, std::string& why) {
-  double v[kDragColumns];
+/// Parses one data row into `f` (with the 6-DOF columns when `six_dof`); false with `why` when a
+/// cell is not a finite number.
+bool parse_row(const std::string& line, bool six_dof, DragFrame& f, std::string& why) {
+  double v[kDragColumns + kSixDofColumns];
+  const int columns = kDragColumns + (six_dof ? kSixDofColumns : 0);
   const char* p = line.c_str();
-  for (int k = 0; k < kDragColumns; ++k) {
+  for (int k = 0; k < columns; ++k) {
     char* end = nullptr;
     errno = 0;
     v[k] = std::strtod(p, &end);
@@ -162,9 +176,9 @@ bool parse_row(const std::string& line, DragFrame& f, std::string& why) {
       return false;
     }
     p = end;
-    if (k + 1 < kDragColumns) {
+    if (k + 1 < columns) {
       if (*p != ',') {
-        why = "expected " + std::to_string(kDragColumns) + " columns, got " + std::to_string(k + 1);
+        why = "expected " + std::to_string(columns) + " columns, got " + std::to_string(k + 1);
         return false;
       }
       ++p;
@@ -172,7 +186,7 @@ bool parse_row(const std::string& line, DragFrame& f, std::string& why) {
   }
   while (*p == ' ' || *p == '\r') ++p;
   if (*p != '\0') {
-    why = "more than " + std::to_string(kDragColumns) + " columns";
+    why = "more than " + std::to_string(columns) + " columns";
     return false;
   }
   // Counts become integers only when they are whole numbers in range (a cast of 1e40 is
@@ -198,6 +212,12 @@ bool parse_row(const std::string& line, DragFrame& f, std::string& why) {
   f.spine_force_n = Eigen::Vector3d(v[21], v[22], v[23]);
   for (int i = 0; i < kVertebrae; ++i)
     for (int c = 0; c < 6; ++c) f.motion(i, c) = v[kCommonColumns + kHookColumns + 6 * i + c];
+  if (six_dof) {
+    const double* t = v + kDragColumns;
+    f.rotation_deg = Eigen::Vector3d(t[0], t[1], t[2]);
+    f.torque_nmm = Eigen::Vector3d(t[3], t[4], t[5]);
+    f.spine_moment_nmm = Eigen::Vector3d(t[6], t[7], t[8]);
+  }
   return true;
 }
 
@@ -241,14 +261,21 @@ DragRecording read_drag_recording(const std::string& path, const spine::SpineMod
                                     ": not a compliant-stage recording (no spine model "
                                     "line: record with haptics run --spine …)");
       header = true;
+      const std::string six = std::string(kSixDofHeader) + kSpineMomentHeader;
+      rec.six_dof =
+          line.size() >= six.size() && line.compare(line.size() - six.size(), six.size(), six) == 0;
       continue;
     }
     DragFrame f;
     std::string why;
-    if (!parse_row(line, f, why)) throw std::invalid_argument(where + ": " + why);
+    if (!parse_row(line, rec.six_dof, f, why)) throw std::invalid_argument(where + ": " + why);
     if (!rec.frames.empty() && f.tick != rec.frames.back().tick + 1)
       throw std::invalid_argument(where + ": missing frames: tick " + std::to_string(f.tick) +
                                   " follows tick " + std::to_string(rec.frames.back().tick));
+    if (!(f.spine_moment_nmm.norm() <= spine::kMaxMomentNmm) || !(f.rotation_deg.norm() <= 180.001))
+      throw std::invalid_argument(where + ": a hook moment beyond " +
+                                  std::to_string(int(spine::kMaxMomentNmm)) +
+                                  " N mm, or a stylus turned past half a turn");
     if (!(f.spine_force_n.norm() <= spine::kMaxForceN))
       throw std::invalid_argument(where + ": a hook force beyond " +
                                   std::to_string(int(spine::kMaxForceN)) +

@@ -2,6 +2,9 @@
 
 #include "monotonic_clock.hpp"
 
+#include "spinesim/common/constants.hpp"
+#include "spinesim/common/rotation.hpp"
+
 #include <pthread.h>
 #include <sched.h>
 #include <time.h>
@@ -57,7 +60,8 @@ ServoLoop::ServoLoop(Device& device, ForceRenderer& renderer, const Scene& scene
       scene_(scene),
       poses_(poses),
       safety_(safety),
-      passivity_(device.capabilities().physical_damping_n_s_per_mm),
+      passivity_(device.capabilities().physical_damping_n_s_per_mm,
+                 device.capabilities().rotational_damping_nmm_s_per_rad),
       options_(options) {
   if (!(options.period_s >= 1e-4 && options.period_s <= 0.1))
     throw std::invalid_argument("servo period must be 0.1 to 100 ms");
@@ -72,6 +76,8 @@ ServoLoop::ServoLoop(Device& device, ForceRenderer& renderer, const Scene& scene
   device_.read(s);  // the starting position (a sim device advances one period)
   state_ = s;
   held_from_mm_ = s.position_mm;
+  held_from_R_ = s.orientation;
+  six_dof_ = device_.capabilities().senses_orientation;
   renderer_.reset(s.position_mm);
 }
 
@@ -87,14 +93,14 @@ void ServoLoop::set_compliant_stage(CompliantStage* stage) {
 }
 
 void ServoLoop::fail_device() {
-  device_.write_force(Eigen::Vector3d::Zero());
+  write_zero();
   device_failed_ = true;
   stats_.error = true;
   stats_.stop_reason = "device error";
   stop_.store(true);
 }
 
-void ServoLoop::publish_status(double now_s, const Eigen::Vector3d& force, const RenderOutput& out,
+void ServoLoop::publish_status(double now_s, const Wrench& command, const RenderOutput& out,
                                const ScenePoses& poses) {
   ServoStats& st = stats_;
   ServoStatus status;
@@ -102,7 +108,9 @@ void ServoLoop::publish_status(double now_s, const Eigen::Vector3d& force, const
   status.time_s = now_s;
   status.probe_mm = state_.position_mm;
   status.proxy_mm = out.proxy_mm;
-  status.force_n = force;
+  status.force_n = command.force_n;
+  status.torque_nmm = command.torque_nmm;
+  status.rotation_deg = rotation_log_total(state_.orientation) / kRadPerDeg;
   status.contact = out.contact;
   status.body = out.body;
   status.buttons = state_.buttons;
@@ -124,6 +132,7 @@ void ServoLoop::publish_status(double now_s, const Eigen::Vector3d& force, const
     st.hooked_ticks += h.attached;
     st.spine_clamped_ticks += h.clamped;
     st.max_spine_force_n = std::max(st.max_spine_force_n, h.load.force_n.norm());
+    st.max_spine_moment_nmm = std::max(st.max_spine_moment_nmm, h.load.moment_nmm.norm());
   }
   status_.write(status);
 }
@@ -138,6 +147,11 @@ void ServoLoop::tick(double now_s, double period_s) {
   // The force held over the last period did its work over the device's motion since then.
   passivity_.add(held_force_, state_.position_mm - held_from_mm_, period_s);
   held_from_mm_ = state_.position_mm;
+  if (six_dof_) {
+    passivity_.add_rotation(
+        held_torque_, rotation_log_total(state_.orientation * held_from_R_.transpose()), period_s);
+    held_from_R_ = state_.orientation;
+  }
   const ScenePoses* poses = &poses_.read();
   if (stage_) {
     stage_poses_.time_s = poses->time_s;
@@ -155,15 +169,21 @@ void ServoLoop::tick(double now_s, double period_s) {
   in.contact = out.contact;
   in.penetration_mm = out.penetration_mm;
   SafetyReport report;
-  const Eigen::Vector3d force =
-      safety_.apply(stage_ ? stage_->blend(out.force_n) : out.force_n, in, &report);
-  if (!device_.write_force(force)) {
+  Wrench demand;
+  demand.force_n = stage_ ? stage_->blend(out.force_n) : out.force_n;
+  if (stage_) demand.torque_nmm = stage_->torque();
+  const Wrench command = safety_.apply(demand, in, &report);
+  if (!device_.write_wrench(command.force_n, command.torque_nmm)) {
     fail_device();
   }
-  held_force_ = device_failed_ ? Eigen::Vector3d::Zero() : force;
+  held_force_ = device_failed_ ? Eigen::Vector3d::Zero() : command.force_n;
+  held_torque_ = device_failed_ ? Eigen::Vector3d::Zero() : command.torque_nmm;
 
   ++st.ticks;
-  st.max_force_n = std::max(st.max_force_n, force.norm());
+  st.max_force_n = std::max(st.max_force_n, command.force_n.norm());
+  st.max_torque_nmm = std::max(st.max_torque_nmm, command.torque_nmm.norm());
+  st.torque_clamped_ticks += report.torque_clamped;
+  st.torque_limited_ticks += report.torque_limited;
   st.clamped_ticks += report.clamped;
   st.limited_ticks += report.limited;
   st.non_finite_ticks += report.non_finite;
@@ -172,40 +192,45 @@ void ServoLoop::tick(double now_s, double period_s) {
   st.truncated_ticks += out.truncated;
   st.max_render_work = std::max(st.max_render_work, out.work);
 
-  publish_status(now_s, force, out, *poses);
+  publish_status(now_s, command, out, *poses);
+  if (!ring_.empty()) record(now_s, command, out, *poses);
+}
 
-  if (!ring_.empty()) {
-    const std::size_t head = ring_head_.load(std::memory_order_relaxed);
-    const std::size_t next = (head + 1) % ring_.size();
-    if (next == ring_tail_.load(std::memory_order_acquire)) {
-      ring_dropped_.fetch_add(1);  // the writer fell behind: never wait for it
-    } else {
-      TickRecord& r = ring_[head];
-      r.t_s = now_s;
-      r.tick = st.ticks;
-      r.probe_mm = state_.position_mm;
-      r.force_n = force;
-      r.proxy_mm = out.proxy_mm;
-      r.buttons = state_.buttons;
-      r.contact = out.contact;
-      r.disc = out.disc;
-      r.disc_contact = out.disc_contact;
-      r.disc_volume_change = float(out.disc_volume_change);
-      r.disc_indentation_mm = float(out.disc_indentation_mm);
-      r.disc_force_n = out.disc_force_n.cast<float>();
-      r.disc_probe_mm = out.disc_probe_mm.cast<float>();
-      r.compliant = stage_ != nullptr;
-      if (stage_) {
-        r.hook = stage_->state();
-        const auto& body = stage_->bodies();
-        for (int i = 0; i < kSpineVertebrae; ++i) {
-          const spine::Pose& p = poses->pose[std::size_t(body[std::size_t(i)])];
-          r.R[std::size_t(i)] = p.R.cast<float>();
-          r.t[std::size_t(i)] = p.t.cast<float>();
-        }
+void ServoLoop::record(double now_s, const Wrench& command, const RenderOutput& out,
+                       const ScenePoses& poses) {
+  const std::size_t head = ring_head_.load(std::memory_order_relaxed);
+  const std::size_t next = (head + 1) % ring_.size();
+  if (next == ring_tail_.load(std::memory_order_acquire)) {
+    ring_dropped_.fetch_add(1);  // the writer fell behind: never wait for it
+  } else {
+    TickRecord& r = ring_[head];
+    r.t_s = now_s;
+    r.tick = stats_.ticks;
+    r.probe_mm = state_.position_mm;
+    r.force_n = command.force_n;
+    r.six_dof = six_dof_;
+    r.rotation_deg = (rotation_log_total(state_.orientation) / kRadPerDeg).cast<float>();
+    r.torque_nmm = command.torque_nmm.cast<float>();
+    r.proxy_mm = out.proxy_mm;
+    r.buttons = state_.buttons;
+    r.contact = out.contact;
+    r.disc = out.disc;
+    r.disc_contact = out.disc_contact;
+    r.disc_volume_change = float(out.disc_volume_change);
+    r.disc_indentation_mm = float(out.disc_indentation_mm);
+    r.disc_force_n = out.disc_force_n.cast<float>();
+    r.disc_probe_mm = out.disc_probe_mm.cast<float>();
+    r.compliant = stage_ != nullptr;
+    if (stage_) {
+      r.hook = stage_->state();
+      const auto& body = stage_->bodies();
+      for (int i = 0; i < kSpineVertebrae; ++i) {
+        const spine::Pose& p = poses.pose[std::size_t(body[std::size_t(i)])];
+        r.R[std::size_t(i)] = p.R.cast<float>();
+        r.t[std::size_t(i)] = p.t.cast<float>();
       }
-      ring_head_.store(next, std::memory_order_release);
     }
+    ring_head_.store(next, std::memory_order_release);
   }
 }
 
@@ -265,7 +290,7 @@ ServoStats ServoLoop::run(const std::function<void(const ServoStatus&, double)>&
     } catch (const std::exception& e) {
       error_text = e.what();
     }
-    device_.write_force(Eigen::Vector3d::Zero());
+    write_zero();
     stats_.seconds = monotonic_s() - t0;
     done.store(true);
   };

@@ -328,10 +328,15 @@ class MappedDevice final : public Device {
     if (!d_->read(s)) return false;
     s.position_mm = c_ + R_ * s.position_mm;
     s.velocity_mm_s = R_ * s.velocity_mm_s;
+    s.orientation = R_ * s.orientation;
+    s.angular_velocity_rad_s = R_ * s.angular_velocity_rad_s;
     return true;
   }
   bool write_force(const Eigen::Vector3d& f) override {
     return d_->write_force(R_.transpose() * f);
+  }
+  bool write_wrench(const Eigen::Vector3d& f, const Eigen::Vector3d& torque) override {
+    return d_->write_wrench(R_.transpose() * f, R_.transpose() * torque);
   }
   bool finished() const override { return d_->finished(); }
   std::string last_error() const override { return d_->last_error(); }

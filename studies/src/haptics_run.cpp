@@ -123,6 +123,12 @@ void check_haptics_request(const HapticsRunRequest& r) {
     throw std::invalid_argument("--disc-budget-us must be >= 0 (0: the default)");
   if (!(r.force_scale >= 0) || !std::isfinite(r.force_scale))
     throw std::invalid_argument("--force-scale must be > 0 (0: the default)");
+  if (!std::isnan(r.rotational_stiffness_nmm_per_rad) &&
+      (!(r.rotational_stiffness_nmm_per_rad >= 0) ||
+       !std::isfinite(r.rotational_stiffness_nmm_per_rad)))
+    throw std::invalid_argument("--rotational-stiffness must be >= 0 N mm/rad");
+  if (!std::isnan(r.rotational_stiffness_nmm_per_rad) && r.spine.empty())
+    throw std::invalid_argument("--rotational-stiffness is for --spine multirate (a 6-DOF hook)");
   if (!(r.coupling_stiffness_n_per_mm >= 0) || !std::isfinite(r.coupling_stiffness_n_per_mm) ||
       !(r.coupling_damping_n_s_per_mm >= 0) || !std::isfinite(r.coupling_damping_n_s_per_mm))
     throw std::invalid_argument("--coupling-stiffness and --coupling-damping must be >= 0");
@@ -245,6 +251,44 @@ void seat_for_haptics(const HapticsRunRequest& request, CompliantSetup& c,
   *c.model = std::move(sm.model);
 }
 
+/// The hook's torsional spring (6-DOF): on a device with torque motors and a response that takes
+/// moments, the requested stiffness (default: the device's usable one, within half its passive
+/// limit), refused beyond the passive limit; otherwise none, with the reason in the result.
+void set_torsion(const HapticsRunRequest& request, HapticsRunResult& result,
+                 const haptics::SpineResponse& response, haptics::CouplingParameters& p) {
+  const auto& caps = result.capabilities;
+  const double limit = haptics::passive_rotational_stiffness_limit(caps, 1e-3);
+  result.rotational_passive_limit_nmm_per_rad = limit;
+  const double asked = request.rotational_stiffness_nmm_per_rad;
+  if (!caps.renders_torque()) {
+    result.twist_note = caps.senses_orientation ? "the " + caps.model +
+                                                      " senses the stylus's turn but has no torque "
+                                                      "motors: the hook holds no orientation"
+                                                : "";
+    return;
+  }
+  if (request.device == "openhaptics" || request.device == "dhd") {
+    result.twist_note = "the " + request.device +
+                        " backend drives three degrees of freedom (no orientation read, no "
+                        "torque sent): the hook holds no orientation";
+    return;
+  }
+  if (response.max_moment_nmm() <= 0) {
+    result.twist_note = std::string("the ") + response.name() +
+                        " spine knows forces only: the hook holds no orientation (use --spine "
+                        "multirate)";
+    return;
+  }
+  p.rotational_stiffness_nmm_per_rad =
+      std::isnan(asked) ? std::min(caps.usable_rotational_stiffness_nmm_per_rad, 0.5 * limit)
+                        : asked;
+  if (p.rotational_stiffness_nmm_per_rad > limit)
+    throw std::invalid_argument(
+        "--rotational-stiffness " + fixed(p.rotational_stiffness_nmm_per_rad, 0) +
+        " N mm/rad is beyond the device's passive limit (" + fixed(limit, 0) + " N mm/rad)");
+  if (p.rotational_stiffness_nmm_per_rad == 0) result.twist_note = "--rotational-stiffness 0";
+}
+
 CompliantSetup make_compliant_stage(const HapticsRunRequest& request, const std::string& data_dir,
                                     const haptics::Scene& scene, HapticsRunResult& result) {
   CompliantSetup c;
@@ -278,6 +322,7 @@ CompliantSetup make_compliant_stage(const HapticsRunRequest& request, const std:
                                 " N/mm is beyond the device's passive limit (" +
                                 fixed(result.passive_limit_n_per_mm, 2) + " N/mm)");
   p.damping_n_s_per_mm = request.coupling_damping_n_s_per_mm;
+  set_torsion(request, result, *c.response, p);
   std::vector<Eigen::Vector3d> centres;
   std::array<int, haptics::kSpineVertebrae> body_of{};
   for (int i = 0; i < haptics::kSpineVertebrae; ++i) {
@@ -288,6 +333,8 @@ CompliantSetup make_compliant_stage(const HapticsRunRequest& request, const std:
   result.spine = request.spine;
   result.force_scale = p.force_scale;
   result.coupling_stiffness_n_per_mm = p.stiffness_n_per_mm;
+  result.rotational_stiffness_nmm_per_rad =
+      c.stage->twists() ? p.rotational_stiffness_nmm_per_rad : 0;
   result.spine_max_force_n = most;
   return c;
 }
@@ -414,8 +461,9 @@ std::unique_ptr<haptics::HapticRecordingWriter> start_recording(const HapticsRun
   if (disc)
     what << "; disc " << result.disc_level << " (" << result.disc_tets << " tets, "
          << result.disc_tuned_file << ")";
-  auto record = std::make_unique<haptics::HapticRecordingWriter>(request.record, what.str(), model,
-                                                                 request.spine, disc);
+  auto record = std::make_unique<haptics::HapticRecordingWriter>(
+      request.record, what.str(), model, request.spine, disc,
+      result.capabilities.senses_orientation);
   haptics::HapticRecordingWriter* sink = record.get();
   loop.record_to(
       [sink, trace](const haptics::TickRecord* rows, std::size_t n) {
@@ -658,6 +706,15 @@ nlohmann::json haptics_run_json(const HapticsRunResult& r) {
                                           "than one period late (cyclictest's measure)"}}},
           {"max_force_n", s.max_force_n},
           {"peak_force_n", r.capabilities.peak_force_n},
+          {"six_dof",
+           !r.capabilities.senses_orientation
+               ? nlohmann::json(nullptr)
+               : nlohmann::json{{"torque_axes", r.capabilities.torque_axes},
+                                {"peak_torque_nmm", r.capabilities.peak_torque_nmm},
+                                {"continuous_torque_nmm", r.capabilities.continuous_torque_nmm},
+                                {"max_torque_nmm", s.max_torque_nmm},
+                                {"torque_clamped_ticks", s.torque_clamped_ticks},
+                                {"torque_limited_ticks", s.torque_limited_ticks}}},
           {"clamped_ticks", s.clamped_ticks},
           {"limited_ticks", s.limited_ticks},
           {"non_finite_ticks", s.non_finite_ticks},
@@ -682,6 +739,12 @@ nlohmann::json haptics_run_json(const HapticsRunResult& r) {
                                 {"hooked_ticks", s.hooked_ticks},
                                 {"max_spine_force_n", s.max_spine_force_n},
                                 {"spine_clamped_ticks", s.spine_clamped_ticks},
+                                {"rotational_stiffness_nmm_per_rad",
+                                 r.rotational_stiffness_nmm_per_rad},
+                                {"rotational_passive_limit_nmm_per_rad",
+                                 r.rotational_passive_limit_nmm_per_rad},
+                                {"max_spine_moment_nmm", s.max_spine_moment_nmm},
+                                {"twist_note", r.twist_note},
                                 {"worker_solves", r.worker_solves},
                                 {"worker_failures", r.worker_failures},
                                 {"worker_update_ms", r.worker_update_ms},
@@ -728,6 +791,15 @@ std::string haptics_run_table(const HapticsRunResult& r) {
        << fixed(r.coupling_stiffness_n_per_mm, 2) << " N/mm; hooked " << s.hooked_ticks
        << " ticks, spine force max " << fixed(s.max_spine_force_n, 1) << " N (clamped "
        << s.spine_clamped_ticks << ")\n";
+    if (r.rotational_stiffness_nmm_per_rad > 0)
+      os << "  twist: torsional spring " << fixed(r.rotational_stiffness_nmm_per_rad, 0)
+         << " N mm/rad felt (passive up to " << fixed(r.rotational_passive_limit_nmm_per_rad, 0)
+         << "); spine moment max " << fixed(s.max_spine_moment_nmm / 1000, 2)
+         << " N m, torque on the hand max " << fixed(s.max_torque_nmm, 1) << " N mm (peak "
+         << fixed(r.capabilities.peak_torque_nmm, 0) << "; clamped " << s.torque_clamped_ticks
+         << ", limited " << s.torque_limited_ticks << ")\n";
+    else if (!r.twist_note.empty())
+      os << "  twist: none (" << r.twist_note << ")\n";
     if (r.spine == "multirate")
       os << "  worker: " << r.worker_solves << " updates, " << fixed(r.worker_update_ms, 1)
          << " ms each (" << fixed(r.worker_rate_hz, 1) << " Hz), " << r.worker_failures << " failed"
@@ -809,6 +881,12 @@ nlohmann::json haptic_devices_json(const std::string& openhaptics_lib, const std
          {"usable_stiffness_n_per_mm", m.usable_stiffness_n_per_mm},
          {"physical_damping_n_s_per_mm", m.physical_damping_n_s_per_mm},
          {"passive_stiffness_limit_at_1khz_n_per_mm", haptics::passive_stiffness_limit(m, 1e-3)},
+         {"senses_orientation", m.senses_orientation},
+         {"torque_axes", m.torque_axes},
+         {"peak_torque_nmm", m.peak_torque_nmm},
+         {"continuous_torque_nmm", m.continuous_torque_nmm},
+         {"usable_rotational_stiffness_nmm_per_rad", m.usable_rotational_stiffness_nmm_per_rad},
+         {"rotational_damping_nmm_s_per_rad", m.rotational_damping_nmm_s_per_rad},
          {"source", m.source}});
   return {{"backends", backends}, {"models", models}};
 }
@@ -825,15 +903,19 @@ std::string haptic_devices_table(const std::string& openhaptics_lib, const std::
   }
   b.print(os, false);
   os << "\n";
-  TextTable t(
-      {"model", "workspace mm", "peak N", "cont. N", "stiffness N/mm", "passive limit N/mm"});
+  TextTable t({"model", "workspace mm", "peak N", "cont. N", "stiffness N/mm", "passive limit N/mm",
+               "DOF", "peak torque N mm"});
   for (const auto& m : haptics::device_models())
     t.add({m.model,
            fixed(m.workspace_mm.x(), 0) + " x " + fixed(m.workspace_mm.y(), 0) + " x " +
                fixed(m.workspace_mm.z(), 0),
            fixed(m.peak_force_n, 2), fixed(m.continuous_force_n, 2),
            fixed(m.usable_stiffness_n_per_mm, 2),
-           fixed(haptics::passive_stiffness_limit(m, 1e-3), 1)});
+           fixed(haptics::passive_stiffness_limit(m, 1e-3), 1),
+           !m.senses_orientation ? "3"
+           : m.renders_torque()  ? "6"
+                                 : "6 (3 forced)",
+           m.renders_torque() ? fixed(m.peak_torque_nmm, 0) : "-"});
   t.print(os, false);
   return os.str();
 }

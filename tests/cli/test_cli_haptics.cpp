@@ -170,9 +170,19 @@ TEST(CliHaptics, DevicesListsBackendsAndModels) {
   const auto r = run_spinesim("haptics devices --json");
   ASSERT_EQ(r.status, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
-  EXPECT_EQ(j["models"].size(), 3u);
+  EXPECT_EQ(j["models"].size(), 6u);
   EXPECT_EQ(j["backends"][0]["name"], "sim");
-  for (const auto& m : j["models"]) EXPECT_FALSE(m["source"].get<std::string>().empty());
+  int with_torque = 0;
+  for (const auto& m : j["models"]) {
+    EXPECT_FALSE(m["source"].get<std::string>().empty());
+    if (m["torque_axes"].get<int>() == 3) {
+      ++with_torque;
+      EXPECT_TRUE(m["senses_orientation"].get<bool>());
+      EXPECT_GE(m["peak_torque_nmm"].get<double>(), m["continuous_torque_nmm"].get<double>());
+      EXPECT_GT(m["continuous_torque_nmm"].get<double>(), 0);
+    }
+  }
+  EXPECT_EQ(with_torque, 2);  // sigma.7, premium-1.5-6dof (the omega.6's wrist is not driven)
 }
 
 TEST(CliHaptics, PlaneStudyReproducesTheThesisFindings) {
@@ -322,6 +332,71 @@ TEST(CliHaptics, DragOfT1RecordsTheSpineAndAKilledRunLeavesReadableRows) {
     ++complete;
   }
   EXPECT_GT(complete, 1000);
+}
+
+// 6-DOF from the command line: the shipped twist script on a simulated sigma.7 turns the hooked
+// T1 about the long axis, the hand feels the spine's moment as a torque within the device's
+// peak, the recording carries the stylus's turn and the moments, and replaying it twists the
+// spine the same way; a device without torque motors, or the database, says why nothing twists.
+TEST(CliHaptics, SixDofTwistOfT1IsFeltAsATorqueAndItsRecordingReplays) {
+  const std::string rec = tmp("twist_rec.csv");
+  const std::string script = std::string(SPINESIM_DATA_DIR) + "/haptics/twist_t1_axial.csv";
+  const std::string common =
+      "haptics run --scene spine --triangles 1500 --spine multirate "
+      "--model sigma.7 --no-realtime --json ";
+  const auto r = run_spinesim(common + "--script '" + script + "' --record '" + rec + "'");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  const auto& six = j["six_dof"];
+  ASSERT_TRUE(six.is_object());
+  EXPECT_EQ(six["torque_axes"].get<int>(), 3);
+  const double peak = six["peak_torque_nmm"].get<double>();
+  EXPECT_GT(six["max_torque_nmm"].get<double>(), 30.0);
+  EXPECT_LE(six["max_torque_nmm"].get<double>(), peak);
+  const auto& c = j["compliant_stage"];
+  EXPECT_GT(c["rotational_stiffness_nmm_per_rad"].get<double>(), 0);
+  EXPECT_LE(c["rotational_stiffness_nmm_per_rad"].get<double>(),
+            c["rotational_passive_limit_nmm_per_rad"].get<double>());
+  const double moment = c["max_spine_moment_nmm"].get<double>();
+  EXPECT_GT(moment, 1000.0);  // N·mm on T1
+  EXPECT_GE(j["passivity_energy_mj"]["min"].get<double>(), -1.0);
+  // The recording: T1 turned about y the way the stylus did; the stylus's turn and the moments
+  // are columns.
+  std::ifstream in(rec);
+  std::string header;
+  while (std::getline(in, header) && header[0] == '#') {}
+  EXPECT_NE(header.find(",rx_deg,ry_deg,rz_deg,tx_nmm,ty_nmm,tz_nmm,spine_mx_nmm"),
+            std::string::npos);
+  const auto rows = recording_rows(rec);
+  ASSERT_GT(rows.size(), 3000u);
+  const std::size_t columns = rows[0].size();
+  ASSERT_EQ(columns, 135u);  // 13 + 11 hook + 6 x 17 vertebrae + turn, torque and moment
+  double t1_turn = 0, stylus_turn = 0;
+  for (const auto& row : rows) {
+    t1_turn = std::max(t1_turn, row[24 + 4]);  // T1_ry_deg
+    stylus_turn = std::max(stylus_turn, row[columns - 8]);
+  }
+  EXPECT_GT(stylus_turn, 20.0);
+  EXPECT_GT(t1_turn, 1.0);
+  EXPECT_LT(t1_turn, stylus_turn);
+  // Replayed: the device follows the recorded turn and the hook twists the spine again.
+  const auto again = run_spinesim(common + "--device replay --replay '" + rec + "'");
+  ASSERT_EQ(again.status, 0) << again.err;
+  const auto ja = nlohmann::json::parse(again.out);
+  EXPECT_NEAR(ja["compliant_stage"]["max_spine_moment_nmm"].get<double>(), moment, 0.25 * moment);
+  // No torque motors, or a response without moments: nothing twists, and the run says why.
+  const auto omega = run_spinesim(
+      "haptics run --scene spine --triangles 1500 --spine multirate --model omega.6 "
+      "--no-realtime --duration 0.5 --script '" +
+      script + "'");
+  ASSERT_EQ(omega.status, 0) << omega.err;
+  EXPECT_NE(omega.out.find("no torque motors"), std::string::npos) << omega.out;
+  const auto bad = run_spinesim(
+      "haptics run --scene spine --triangles 1500 --spine multirate --model sigma.7 "
+      "--no-realtime --duration 0.5 --rotational-stiffness 5000 --script '" +
+      script + "'");
+  EXPECT_NE(bad.status, 0);
+  EXPECT_NE(bad.err.find("passive limit"), std::string::npos) << bad.err;
 }
 
 TEST(CliHaptics, OfflineDiscsRefuseBadInputInOneLineWithNothingWritten) {

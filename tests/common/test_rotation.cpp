@@ -1,12 +1,14 @@
 // The rotation-vector maps of common/rotation.hpp that the others lean on: exp(φ) − I formed
 // directly equals exp(φ) − I, is exact to rounding at angles where exp(φ) − I loses the
 // small displacement's digits (checked in long double from the closed form), and is
-// continuous across its small-angle series.
+// continuous across its small-angle series; the total log inverts exp everywhere, half a turn
+// included.
 #include "spinesim/common/rotation.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 
 namespace spinesim {
 namespace {
@@ -43,6 +45,32 @@ TEST(RotationExpMinusIdentity, IsExpMinusIdentityAndKeepsSmallDisplacementsExact
   const Eigen::Vector3d phi = 0.999999e-8 * Eigen::Vector3d(1, 2, 2) / 3.0;
   const Eigen::Vector3d exact = displacement_long_double(phi, arm);
   EXPECT_LE((rotation_exp_minus_identity(phi) * arm - exact).norm(), 1e-14 * exact.norm());
+}
+
+TEST(RotationLogTotal, InvertsExpEverywhereAndAtHalfATurnGivesOneOfItsAxes) {
+  std::mt19937 rng(11);
+  std::normal_distribution<double> n(0, 1);
+  std::uniform_real_distribution<double> angle(0, kPi * (1 - 1e-9));
+  for (int k = 0; k < 1000; ++k) {
+    const Eigen::Vector3d axis = Eigen::Vector3d(n(rng), n(rng), n(rng)).normalized();
+    const Eigen::Vector3d phi = angle(rng) * axis;
+    const Eigen::Vector3d back = rotation_log_total(rotation_exp(phi));
+    EXPECT_LT((back - phi).norm(), 1e-9 * std::max(1.0, 1 / (kPi - phi.norm()))) << phi.norm();
+    if (phi.norm() < kPi - 1e-3 && phi.norm() > 1e-3)
+      EXPECT_LT((back - rotation_log(rotation_exp(phi))).norm(), 1e-9);
+  }
+  EXPECT_LT(rotation_log_total(rotation_exp(Eigen::Vector3d(1e-10, 0, 0))).x() - 1e-10, 1e-20);
+  // Half a turn, where rotation_log throws: one of the two axes, and exp of it is the rotation.
+  const Eigen::Vector3d axes[] = {Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(),
+                                  Eigen::Vector3d(1, 1, 1).normalized()};
+  for (const Eigen::Vector3d& axis : axes) {
+    const Eigen::Matrix3d R = rotation_exp(kPi * axis);
+    EXPECT_THROW(rotation_log(R), std::domain_error);
+    const Eigen::Vector3d phi = rotation_log_total(R);
+    EXPECT_NEAR(phi.norm(), kPi, 1e-9);
+    EXPECT_NEAR(std::abs(phi.normalized().dot(axis)), 1.0, 1e-9);
+    EXPECT_LT((rotation_exp(phi) - R).norm(), 1e-9);
+  }
 }
 
 }  // namespace

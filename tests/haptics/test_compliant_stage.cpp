@@ -7,6 +7,7 @@
 #include "spinesim/haptics/servo.hpp"
 
 #include "allocation_counter.hpp"
+#include "column_fixture.hpp"
 
 #include <gtest/gtest.h>
 
@@ -16,34 +17,11 @@
 namespace sh = spinesim::haptics;
 namespace sp = spinesim::spine;
 using Eigen::Vector3d;
+using spinesim::haptics::testing::at;
+using spinesim::haptics::testing::Column;
+using spinesim::haptics::testing::touching;
 
 namespace {
-
-/// A closed box of half-size h centred at c (12 triangles, outward normals).
-spinesim::mesh::TriSurface box(const Vector3d& c, double h) {
-  spinesim::mesh::TriSurface s;
-  s.V.resize(8, 3);
-  for (int i = 0; i < 8; ++i)
-    s.V.row(i) = (c + h * Vector3d(i & 1 ? 1 : -1, i & 2 ? 1 : -1, i & 4 ? 1 : -1)).transpose();
-  s.F.resize(12, 3);
-  s.F << 0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4, 2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6,
-      1, 3, 5, 3, 7, 5;
-  return s;
-}
-
-/// 17 "vertebrae" as 10 mm boxes 30 mm apart along y (T1 on top), body i = vertebra i.
-struct Column {
-  sh::Scene scene;
-  std::vector<Vector3d> centres;
-  std::array<int, sh::kSpineVertebrae> body_of{};
-  Column() {
-    for (int i = 0; i < sh::kSpineVertebrae; ++i) {
-      centres.push_back(Vector3d(0, 600 - 30.0 * i, 0));
-      scene.add_body("V" + std::to_string(i), box(centres.back(), 5));
-      body_of[std::size_t(i)] = i;
-    }
-  }
-};
 
 /// A linear spine: the hooked vertebra translates by F / k, the others by half that.
 class LinearSpine final : public sh::SpineResponse {
@@ -63,21 +41,6 @@ class LinearSpine final : public sh::SpineResponse {
   double k_, max_;
   sh::SpineDisplacement base_ = sh::SpineDisplacement::Zero();
 };
-
-sh::DeviceState at(const Vector3d& p, unsigned buttons) {
-  sh::DeviceState s;
-  s.position_mm = p;
-  s.buttons = buttons;
-  return s;
-}
-
-sh::RenderOutput touching(int body, const Vector3d& proxy) {
-  sh::RenderOutput r;
-  r.contact = true;
-  r.body = body;
-  r.proxy_mm = proxy;
-  return r;
-}
 
 }  // namespace
 

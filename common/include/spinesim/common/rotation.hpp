@@ -1,6 +1,6 @@
 // Finite rotations by the rotation vector φ (rad; axis φ/|φ|, angle |φ|), one definition for
 // every module (the spine's joint coordinates, the nonlinear disc's plate):
-//   exp: φ → R,   log: R → φ (|φ| < π),
+//   exp: φ → R,   log: R → φ (|φ| < π; rotation_log_total: every R, never throwing),
 //   right Jacobian:         exp(φ + δ) ≈ exp(φ) exp(J_r(φ) δ),
 //   inverse left Jacobian:  log(exp(δ) R) ≈ log(R) + J_l⁻¹(log R) δ
 // (Barfoot, State Estimation for Robotics, 2017, §7.1; small-angle series below 1e-6 rad).
@@ -10,6 +10,7 @@
 #include "spinesim/common/skew.hpp"
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include <algorithm>
 #include <cmath>
@@ -44,6 +45,16 @@ inline Eigen::Vector3d rotation_log(const Eigen::Matrix3d& R) {
   if (a < 1e-8) return 0.5 * w;
   if (kPi - a < 1e-6) throw std::domain_error("rotation_log: rotation of 180 degrees");
   return a / (2 * std::sin(a)) * w;
+}
+
+/// log for every rotation, never throwing (for the real-time code): by way of the unit
+/// quaternion, φ = 2 atan2(|v|, w) v / |v| with w ≥ 0; at 180° one of the two opposite axes.
+inline Eigen::Vector3d rotation_log_total(const Eigen::Matrix3d& R) {
+  Eigen::Quaterniond q(R);
+  if (q.w() < 0) q.coeffs() = -q.coeffs();
+  const double n = q.vec().norm();
+  if (n < 1e-12) return 2.0 * q.vec();  // w = 1 to round-off
+  return 2.0 * std::atan2(n, q.w()) / n * q.vec();
 }
 
 inline Eigen::Matrix3d right_jacobian(const Eigen::Vector3d& phi) {

@@ -15,6 +15,11 @@
 // Both give each vertebra's motion relative to the spine under gravity alone (the scene shows
 // the vertebrae at the reference posture, so at zero hook force nothing moves).
 //
+// On a 6-DOF device the hook also holds the vertebra's orientation: a torsional spring joins the
+// stylus's turn since the press to the vertebra's, its moment (scaled as the force) loads the
+// spine, and the hand feels the reaction as a torque (needs a response that takes moments: the
+// multirate spine; the database knows forces only).
+//
 // Units: mm, N, s. Frame: the spine's (x lateral, y superior, z anterior).
 #pragma once
 
@@ -43,11 +48,15 @@ inline constexpr int kSpineVertebrae = 17;  ///< T1…L5
 using SpineDisplacement = Eigen::Matrix<double, kSpineVertebrae, 6>;
 
 /// The load the hook puts on the spine: a force (N, world) at a point fixed in a vertebra
-/// (reference coordinates, mm). vertebra −1: no load.
+/// (reference coordinates, mm) and a couple (N·mm, world). vertebra −1: no load. `twist`: the
+/// hook holds the orientation too (the couple may be non-zero; the worker then differentiates
+/// with respect to it).
 struct HookLoad {
   int vertebra = -1;
   Eigen::Vector3d point_mm = Eigen::Vector3d::Zero();
   Eigen::Vector3d force_n = Eigen::Vector3d::Zero();
+  Eigen::Vector3d moment_nmm = Eigen::Vector3d::Zero();
+  bool twist = false;
 };
 
 /// The rigid motion that takes the spine from displacement `from` to displacement `to` (both
@@ -71,6 +80,9 @@ class SpineResponse {
   virtual const SpineDisplacement& baseline() const = 0;
   /// Largest hook force (N) this answers for; the stage clamps the force to it.
   virtual double max_force_n() const = 0;
+  /// Largest hook moment (N·mm) this answers for; 0: it knows no moments (the hook holds no
+  /// orientation, and a 6-DOF hand feels no torque).
+  virtual double max_moment_nmm() const { return 0; }
   /// Starts and stops a worker thread, if there is one.
   virtual void start() {}
   virtual void stop() {}
@@ -92,15 +104,18 @@ class DatabaseResponse final : public SpineResponse {
   SpineDisplacement baseline_;
 };
 
-/// The worker's latest linearisation: the solution at F0 and ∂d/∂F there.
+/// The worker's latest linearisation: the solution at the load (F0, M0) and ∂d/∂(F, M) there.
 struct LocalSpineModel {
   int vertebra = -1;  ///< −1: nothing solved yet
   Eigen::Vector3d point_mm = Eigen::Vector3d::Zero(), force_n = Eigen::Vector3d::Zero();
-  SpineDisplacement relative = SpineDisplacement::Zero();  ///< at force_n
-  Eigen::Matrix<double, 6 * kSpineVertebrae, 3> sensitivity =
-      Eigen::Matrix<double, 6 * kSpineVertebrae, 3>::Zero();  ///< mm/N, deg/N; rows 6 i + c
-  std::int64_t solve = 0;                                     ///< sequence number
-  double solved_at_s = 0;                                     ///< on the worker's clock
+  Eigen::Vector3d moment_nmm = Eigen::Vector3d::Zero();
+  SpineDisplacement relative = SpineDisplacement::Zero();  ///< at force_n, moment_nmm
+  /// Columns 0–2: mm/N, deg/N; columns 3–5 (a twisting hook; else zero): mm/(N·mm), deg/(N·mm);
+  /// rows 6 i + c.
+  Eigen::Matrix<double, 6 * kSpineVertebrae, 6> sensitivity =
+      Eigen::Matrix<double, 6 * kSpineVertebrae, 6>::Zero();
+  std::int64_t solve = 0;  ///< sequence number
+  double solved_at_s = 0;  ///< on the worker's clock
 };
 
 struct MultirateOptions {
@@ -108,6 +123,11 @@ struct MultirateOptions {
   double max_force_n = 600;   ///< the thesis's validated range (3.3.5)
   /// Forward-difference step of the sensitivity (spine::displacement_sensitivity), N.
   double sensitivity_step_n = 5;
+  /// Forward-difference step of the sensitivity to the hook's moment (whole solves), N·mm.
+  double sensitivity_step_nmm = 500;
+  /// Largest hook moment (N·mm): 15 N·m, the largest pure moment of the in-vitro tests the
+  /// spine is validated against is 10 N·m.
+  double max_moment_nmm = 15000;
   /// With recruitment, the full sensitivity (three extra solves) every this many updates; in
   /// between, Broyden's secant update from consecutive solves keeps it current at one solve per
   /// update.
@@ -135,6 +155,7 @@ class MultirateSpine final : public SpineResponse {
   void publish(const HookLoad& load) override;
   const SpineDisplacement& baseline() const override { return baseline_; }
   double max_force_n() const override { return options_.max_force_n; }
+  double max_moment_nmm() const override { return options_.max_moment_nmm; }
   void start() override;
   void stop() override;
 
@@ -150,7 +171,9 @@ class MultirateSpine final : public SpineResponse {
   std::int64_t model_in_use() const { return current_.solve; }
   /// One update for `load` on the calling thread (the worker's body; tests call it directly):
   /// the solve, and the sensitivity — `previous` (same hook) updated by the secant, or new
-  /// (`full`: through whole solves; otherwise at fixed muscle forces).
+  /// (`full`: through whole solves; otherwise at fixed muscle forces, with no moment columns —
+  /// a rigid twist until the full one arrives). A twisting hook's moment columns come from
+  /// forward differences of whole solves.
   LocalSpineModel solve(const HookLoad& load, const LocalSpineModel* previous = nullptr,
                         bool full = true) const;
 
@@ -173,19 +196,26 @@ class MultirateSpine final : public SpineResponse {
 struct CouplingParameters {
   double stiffness_n_per_mm = 0.2;  ///< felt spring, within the device's usable stiffness
   double damping_n_s_per_mm = 0;    ///< felt, on the probe's velocity relative to the hook
-  double force_scale = 100;         ///< spine force per felt force (N/N)
-  double ramp_s = 0.3;              ///< attach and release blend over this long
-  unsigned button_mask = 1;         ///< the stylus button that hooks
+  double force_scale = 100;         ///< spine force per felt force (N/N), and moment per torque
+  /// The torsional spring of a 6-DOF hook (felt, N·mm/rad; 0: the hook holds no orientation)
+  /// and its damping on the stylus's angular velocity relative to the vertebra's.
+  double rotational_stiffness_nmm_per_rad = 0;
+  double rotational_damping_nmm_s_per_rad = 0;
+  double ramp_s = 0.3;       ///< attach and release blend over this long
+  unsigned button_mask = 1;  ///< the stylus button that hooks
 };
 
 /// The stage's state after a tick (for the status line and the recording).
 struct HookState {
-  bool attached = false;                                   ///< button held on a hooked vertebra
-  double gain = 0;                                         ///< the attach/release blend, 0…1
-  HookLoad load;                                           ///< on the spine
-  Eigen::Vector3d hook_mm = Eigen::Vector3d::Zero();       ///< the hook point, world
-  Eigen::Vector3d felt_force_n = Eigen::Vector3d::Zero();  ///< the spring's force on the hand
-  bool clamped = false;  ///< the spine force was limited to the response's max_force_n
+  bool attached = false;                                      ///< button held on a hooked vertebra
+  double gain = 0;                                            ///< the attach/release blend, 0…1
+  HookLoad load;                                              ///< on the spine
+  Eigen::Vector3d hook_mm = Eigen::Vector3d::Zero();          ///< the hook point, world
+  Eigen::Vector3d felt_force_n = Eigen::Vector3d::Zero();     ///< the spring's force on the hand
+  Eigen::Vector3d felt_torque_nmm = Eigen::Vector3d::Zero();  ///< the torsional spring's
+  /// The stylus's turn since the press minus the vertebra's (rotation vector, deg).
+  Eigen::Vector3d twist_deg = Eigen::Vector3d::Zero();
+  bool clamped = false;  ///< the spine force (or moment) was limited to the response's
 };
 
 /// Drives a SpineResponse from the device and the renderer, inside the servo tick.
@@ -206,6 +236,11 @@ class CompliantStage {
   /// After the render: the force for the hand — the rendered contact force blended with the
   /// hook spring's by the attach gain.
   Eigen::Vector3d blend(const Eigen::Vector3d& contact_force_n) const;
+  /// The torque for the hand (zero unless a 6-DOF hook holds a vertebra).
+  const Eigen::Vector3d& torque() const { return state_.felt_torque_nmm; }
+  /// Whether a hook holds the orientation (the coupling's rotational stiffness is > 0 and the
+  /// response takes moments).
+  bool twists() const { return twists_; }
 
   const HookState& state() const { return state_; }
   const SpineDisplacement& displacement() const { return relative_; }  ///< last prediction
@@ -219,11 +254,21 @@ class CompliantStage {
   CouplingParameters p_;
   HookState state_;
   SpineDisplacement relative_ = SpineDisplacement::Zero(), absolute_;
-  /// The hook point in the world under `force` (predicts into relative_).
-  Eigen::Vector3d hook_at(const Eigen::Vector3d& force);
-  Eigen::Vector3d equilibrium_force(const Eigen::Vector3d& probe_mm, double spring_n_per_mm);
+  using Vector6d = Eigen::Matrix<double, 6, 1>;
+  /// The hook point in the world and the hooked vertebra's rotation from the baseline under the
+  /// load (F, M) (predicts into relative_).
+  Eigen::Vector3d hook_at(const Vector6d& load, Eigen::Matrix3d* rotation = nullptr);
+  /// The load (F, M) in equilibrium with the springs: F = c (probe − hook), M = c_r φ.
+  Vector6d equilibrium_load(const Eigen::Vector3d& probe_mm, const Eigen::Matrix3d& turn,
+                            double spring_n_per_mm, double torsion_nmm_per_rad);
+  /// The twist φ (rad): the stylus's turn since the press against the vertebra's.
+  Eigen::Vector3d twist(const Eigen::Matrix3d& turn, const Eigen::Matrix3d& vertebra) const;
   unsigned last_buttons_ = 0;
   Eigen::Vector3d last_hook_mm_ = Eigen::Vector3d::Zero();
+  bool twists_ = false;
+  Eigen::Matrix3d grip_at_press_ = Eigen::Matrix3d::Identity();      ///< stylus, at the press
+  Eigen::Matrix3d vertebra_at_press_ = Eigen::Matrix3d::Identity();  ///< from the baseline
+  Eigen::Matrix3d last_vertebra_ = Eigen::Matrix3d::Identity();
 };
 
 }  // namespace spinesim::haptics

@@ -1,7 +1,8 @@
-// The device layer: one interface for PHANToM-class 3-DOF devices (position in, force out,
-// stylus buttons) with a capability record per model, and the devices that need no hardware:
+// The device layer: one interface for PHANToM-class devices — 3-DOF (position in, force out,
+// stylus buttons) and 6-DOF (also the stylus's orientation in and a torque out) — with a
+// capability record per model, and the devices that need no hardware:
 // `sim` (a simulated hand holding a simulated device), `replay` (a recorded run) and `null`.
-// Units: mm, mm/s, N, s; the device frame is the scene frame (x lateral, y up, z anterior).
+// Units: mm, mm/s, N, N·mm, rad, s; the device frame is the scene frame (x lateral, y up, z anterior).
 #pragma once
 
 #include "spinesim/haptics/triple_buffer.hpp"
@@ -26,10 +27,20 @@ struct DeviceCapabilities {
   /// 1995: b > K T / 2 + |B|). Not published: an assumption for each model.
   double physical_damping_n_s_per_mm = 0;
   std::string source;
+  // Rotations (6-DOF devices). A device that senses the stylus's orientation but has no motors
+  // on its wrist (omega.6) has torque_axes 0: it is held and turned, but no torque is felt.
+  bool senses_orientation = false;
+  int torque_axes = 0;               ///< 3: torque about every axis; 0: none
+  double peak_torque_nmm = 0;        ///< the smallest axis's, so no axis is asked for more
+  double continuous_torque_nmm = 0;  ///< likewise
+  double usable_rotational_stiffness_nmm_per_rad = 0;  ///< an assumption, as the damping
+  double rotational_damping_nmm_s_per_rad = 0;         ///< an assumption (not published)
+  bool renders_torque() const { return torque_axes == 3 && peak_torque_nmm > 0; }
 };
 
 /// The models this program knows: "touch" (Geomagic Touch / PHANToM Omni), "premium-1.5"
-/// (PHANToM Premium 1.5), "omega.3" (Force Dimension). Throws std::invalid_argument for an
+/// (PHANToM Premium 1.5), "omega.3" (Force Dimension), and the 6-DOF "premium-1.5-6dof",
+/// "sigma.7" (torque on three axes) and "omega.6" (orientation sensed, no torque). Throws std::invalid_argument for an
 /// unknown name, listing the known ones.
 const std::vector<DeviceCapabilities>& device_models();
 const DeviceCapabilities& device_model(const std::string& name);
@@ -38,10 +49,16 @@ const DeviceCapabilities& device_model(const std::string& name);
 /// damping B (Colgate & Brown 1995): K < 2 (b − |B|) / T, b the device's physical damping.
 double passive_stiffness_limit(const DeviceCapabilities& c, double period_s,
                                double virtual_damping_n_s_per_mm = 0);
+/// The same bound for a torsional spring on a device with torque motors: 2 b_r / T (N·mm/rad).
+double passive_rotational_stiffness_limit(const DeviceCapabilities& c, double period_s);
 
 struct DeviceState {
   Eigen::Vector3d position_mm = Eigen::Vector3d::Zero();
   Eigen::Vector3d velocity_mm_s = Eigen::Vector3d::Zero();
+  /// The stylus's orientation (stylus frame → scene frame; identity on a 3-DOF device) and its
+  /// angular velocity (rad/s, scene axes).
+  Eigen::Matrix3d orientation = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d angular_velocity_rad_s = Eigen::Vector3d::Zero();
   unsigned buttons = 0;  ///< bit 0: the stylus's first button
 };
 
@@ -60,6 +77,12 @@ class Device {
   virtual bool read(DeviceState& state) = 0;
   /// Commands a force for the rest of the tick; false on a device error. Must not allocate.
   virtual bool write_force(const Eigen::Vector3d& force_n) = 0;
+  /// Commands a force and a torque (N·mm, scene axes). A device without torque motors drops the
+  /// torque (the servo loop's safety chain has already zeroed it for such a device).
+  virtual bool write_wrench(const Eigen::Vector3d& force_n, const Eigen::Vector3d& torque_nmm) {
+    (void)torque_nmm;
+    return write_force(force_n);
+  }
   /// True once a scripted or replayed device has nothing more to play.
   virtual bool finished() const { return false; }
   /// The last error's text (empty if none).
@@ -67,20 +90,30 @@ class Device {
 };
 
 /// A set-point trajectory: times (s, strictly increasing from 0 or later), positions (mm),
-/// buttons. Read from CSV `t_s,x_mm,y_mm,z_mm[,button[,…]]` with '#' comment lines and an
-/// optional header row; columns after the fifth are ignored (a `--record` file replays).
+/// buttons, and for a 6-DOF hand the stylus's orientation. Read from CSV
+/// `t_s,x_mm,y_mm,z_mm[,button[,…]]` with '#' comment lines and an optional header row; when the
+/// header names columns `rx_deg,ry_deg,rz_deg` (the stylus's rotation vector, degrees, scene
+/// axes) they are read too; other columns after the fifth are ignored (a `--record` file
+/// replays, orientation included).
 struct Trajectory {
   std::vector<double> t_s;
   std::vector<Eigen::Vector3d> position_mm;
   std::vector<unsigned> buttons;
+  std::vector<Eigen::Vector3d> rotation_deg;  ///< empty: no orientation (identity)
   double duration_s() const { return t_s.empty() ? 0 : t_s.back(); }
   /// Linear interpolation (held constant past the ends); no allocation.
   Eigen::Vector3d position_at(double t) const;
   Eigen::Vector3d velocity_at(double t) const;
   unsigned buttons_at(double t) const;
+  /// The orientation at t: spherical linear interpolation between the rows (identity without
+  /// orientation columns), and the angular velocity of that interpolation (rad/s).
+  Eigen::Matrix3d orientation_at(double t) const;
+  Eigen::Vector3d angular_velocity_at(double t) const;
+  bool has_orientation() const { return !rotation_deg.empty(); }
 };
 /// Throws std::invalid_argument with one line "PATH:LINE: problem" for a missing file, a bad
-/// number, NaN/inf, times not strictly increasing, or an empty trajectory.
+/// number, NaN/inf, times not strictly increasing, a rotation of more than half a turn, or an
+/// empty trajectory.
 Trajectory read_trajectory(const std::string& path);
 
 /// A human hand (an assumption, see haptics/README.md): mass, grip stiffness and damping pulling
@@ -92,13 +125,21 @@ struct HandModel {
   /// The most the hand pushes or pulls with (N; 0: no limit). A person holding a desktop device
   /// pushes with a few newtons, not with whatever a far set-point would ask of the grip spring.
   double max_force_n = 0;
+  // The wrist, for 6-DOF devices (assumptions, see haptics/README.md): the hand and stylus's
+  // moment of inertia about the grip, and the grip's rotational stiffness and damping towards
+  // the scripted orientation.
+  double inertia_kg_mm2 = 300;
+  double rotational_stiffness_nmm_per_rad = 2000;
+  double rotational_damping_nmm_s_per_rad = 20;
 };
 
 /// `sim`: the device is a point mass held by the hand model and driven by the commanded force
 /// (held for the whole servo period, as a real device's DAC holds it), integrated with
 /// semi-implicit Euler at 10 sub-steps per period, with the device's physical damping. Each
 /// read() advances the simulation by one servo period, so the closed loop is deterministic. Past
-/// the script's end the hand holds its last set-point (the loop's duration ends the run).
+/// the script's end the hand holds its last set-point (the loop's duration ends the run). When
+/// the device senses orientation, the stylus is also a rigid body turned by the wrist towards the
+/// script's orientation and, if the device has torque motors, by the commanded torque.
 std::unique_ptr<Device> make_sim_device(const Trajectory& script, const DeviceCapabilities& caps,
                                         double period_s, const HandModel& hand = HandModel());
 /// What a pointing device (the viewer's mouse and keyboard) gives the `mouse` device, written by

@@ -8,6 +8,9 @@
 // the hand, the proxy, contact, the tick number; with the compliant stage also the hook
 // (attached, vertebra, world point, the force on the spine) and every vertebra's rigid motion
 // from the reference posture: its F.1 centre's displacement (mm) and its rotation vector (deg).
+// On a 6-DOF device the row ends with the stylus's rotation vector (deg: `rx_deg,ry_deg,rz_deg`,
+// which --device replay plays too) and the commanded torque (N·mm), and with the compliant stage
+// the hook's moment on the spine (N·mm).
 // The header names the spine model by a fingerprint of its geometry, so a recording is never
 // replayed on another model.
 #pragma once
@@ -33,7 +36,7 @@ class HapticRecordingWriter {
   /// the disc's force on it, its volume change).
   HapticRecordingWriter(const std::string& path, const std::string& description,
                         const spine::SpineModel* model, const std::string& response,
-                        bool disc = false);
+                        bool disc = false, bool six_dof = false);
   ~HapticRecordingWriter();
   /// Appends rows, flushes and syncs them (the loop's writer thread).
   void append(const haptics::TickRecord* rows, std::size_t n);
@@ -48,7 +51,7 @@ class HapticRecordingWriter {
   std::FILE* file_ = nullptr;
   std::vector<Eigen::Vector3d> centres_;
   std::int64_t rows_ = 0;
-  bool disc_ = false;
+  bool disc_ = false, six_dof_ = false;
   bool failed_ = false;
 };
 
@@ -60,6 +63,10 @@ struct DragFrame {
   int hook_vertebra = -1;
   Eigen::Vector3d probe_mm, proxy_mm, hand_force_n, hook_mm, spine_force_n;
   Eigen::Vector3d hook_ref_mm;  ///< the hook point in its vertebra's reference coordinates
+  /// 6-DOF recordings (zero otherwise): the stylus's rotation vector (deg), the torque on the
+  /// hand (N·mm), the hook's moment on the spine (N·mm).
+  Eigen::Vector3d rotation_deg = Eigen::Vector3d::Zero(), torque_nmm = Eigen::Vector3d::Zero(),
+                  spine_moment_nmm = Eigen::Vector3d::Zero();
   /// Per vertebra T1…L5: centre displacement (mm), rotation vector (deg).
   Eigen::Matrix<double, 17, 6> motion;
   /// The rigid motion of vertebra i (x ↦ R x + t, reference coordinates).
@@ -68,6 +75,7 @@ struct DragFrame {
 
 struct DragRecording {
   std::string path, fingerprint, response;
+  bool six_dof = false;  ///< the header names the 6-DOF columns
   std::vector<DragFrame> frames;
   /// The run ended by itself and its end line counts exactly the rows read (false: a killed or
   /// stopped run, read to its last whole row; incomplete_reason says which).

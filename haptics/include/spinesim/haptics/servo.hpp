@@ -39,6 +39,8 @@ struct ServoStatus {
   double time_s = 0;
   Eigen::Vector3d probe_mm = Eigen::Vector3d::Zero(), proxy_mm = Eigen::Vector3d::Zero();
   Eigen::Vector3d force_n = Eigen::Vector3d::Zero();
+  /// 6-DOF devices: the stylus's rotation vector (deg) and the commanded torque (N·mm).
+  Eigen::Vector3d rotation_deg = Eigen::Vector3d::Zero(), torque_nmm = Eigen::Vector3d::Zero();
   bool contact = false;
   int body = -1;
   unsigned buttons = 0;
@@ -48,7 +50,7 @@ struct ServoStatus {
   bool disc = false, disc_contact = false;
   double disc_volume_change = 0;
   double disc_indentation_mm = 0;  ///< the disc wall's indentation under the probe
-  Eigen::Vector3d disc_force_n = Eigen::Vector3d::Zero();  ///< disc N (the felt force x scale)
+  Eigen::Vector3d disc_force_n = Eigen::Vector3d::Zero();   ///< disc N (the felt force x scale)
   Eigen::Vector3d disc_probe_mm = Eigen::Vector3d::Zero();  ///< the disc thread's probe
   /// The bodies' poses this tick's render used (the compliant stage's vertebrae moved).
   ScenePoses poses;
@@ -64,6 +66,9 @@ struct TickRecord {
   Eigen::Vector3d probe_mm, force_n, proxy_mm;
   unsigned buttons = 0;
   bool contact = false;
+  /// 6-DOF devices (six_dof = false otherwise): the stylus's rotation vector (deg), the torque.
+  bool six_dof = false;
+  Eigen::Vector3f rotation_deg = Eigen::Vector3f::Zero(), torque_nmm = Eigen::Vector3f::Zero();
   // The compliant stage (when there is one): the hook and every vertebra's rigid motion from the
   // reference posture (x ↦ R x + t; single precision is 0.1 µm over the spine).
   bool compliant = false;
@@ -88,12 +93,14 @@ struct ServoStats {
   Percentiles period_us, compute_us;
   std::int64_t missed_deadlines = 0;  ///< ticks that woke a period late or ended past the next
   double max_force_n = 0;             ///< largest commanded force
+  double max_torque_nmm = 0;          ///< largest commanded torque (6-DOF devices)
+  std::int64_t torque_clamped_ticks = 0, torque_limited_ticks = 0;
   std::int64_t clamped_ticks = 0, limited_ticks = 0, non_finite_ticks = 0, fading_ticks = 0;
   std::int64_t contact_ticks = 0, truncated_ticks = 0;
   int max_render_work = 0;  ///< the largest RenderOutput::work of a tick
   /// The compliant stage: ticks hooked, the largest force on the spine, ticks it was clamped.
   std::int64_t hooked_ticks = 0, spine_clamped_ticks = 0;
-  double max_spine_force_n = 0;
+  double max_spine_force_n = 0, max_spine_moment_nmm = 0;
   double passivity_min_mj = 0, passivity_final_mj = 0;
   bool realtime_priority = false;
   std::string realtime_reason;
@@ -150,6 +157,11 @@ class ServoLoop {
   DeviceState state_;
   Eigen::Vector3d held_force_ = Eigen::Vector3d::Zero();  ///< commanded at the last tick
   Eigen::Vector3d held_from_mm_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d held_torque_ = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d held_from_R_ = Eigen::Matrix3d::Identity();
+  bool six_dof_ = false;  ///< the device senses the stylus's orientation
+  /// Zero force and torque to the device (the end of a run, a failure).
+  void write_zero() { device_.write_wrench(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()); }
   // Recording: a single-producer single-consumer ring.
   std::vector<TickRecord> ring_;
   std::atomic<std::size_t> ring_head_{0}, ring_tail_{0};
@@ -159,8 +171,10 @@ class ServoLoop {
   /// A device read or write failed: zero force, stop, report (no allocation: the reason is a literal).
   void fail_device();
   /// The tick's status for the slower threads (and the stage's hook statistics).
-  void publish_status(double now_s, const Eigen::Vector3d& force, const RenderOutput& out,
+  void publish_status(double now_s, const Wrench& command, const RenderOutput& out,
                       const ScenePoses& poses);
+  void record(double now_s, const Wrench& command, const RenderOutput& out,
+              const ScenePoses& poses);
   CompliantStage* stage_ = nullptr;
   ScenePoses stage_poses_;  ///< the scene's poses with the stage's vertebrae, kept across ticks
   RenderOutput last_out_;

@@ -83,6 +83,9 @@ struct HapticsRunRequest {
   std::string database;  ///< the database file ("": data/spine/displacement_db.json)
   double coupling_stiffness_n_per_mm = 0;  ///< felt hook spring (0: the rendering stiffness)
   double coupling_damping_n_s_per_mm = 0;  ///< felt, relative to the hook
+  /// 6-DOF devices with torque (--spine multirate): the hook's torsional spring, felt (N·mm/rad;
+  /// NaN: the device's usable rotational stiffness; 0: the hook holds no orientation).
+  double rotational_stiffness_nmm_per_rad = std::nan("");
   /// Spine or disc N per felt N (0: the spine's 600 N, or 100 N on the disc, at the device's
   /// peak force).
   double force_scale = 0;
@@ -136,6 +139,9 @@ struct HapticsRunResult {
   // The compliant stage (spine empty: off).
   std::string spine;
   double coupling_stiffness_n_per_mm = 0, force_scale = 0, spine_max_force_n = 0;
+  double rotational_stiffness_nmm_per_rad = 0;  ///< 0: the hook holds no orientation
+  double rotational_passive_limit_nmm_per_rad = 0;
+  std::string twist_note;  ///< why the hook holds no orientation, when it does not
   std::int64_t worker_solves = 0, worker_failures = 0;
   double worker_update_ms = 0, worker_rate_hz = 0;  ///< per update (solve + sensitivity)
   std::string worker_error;
