@@ -1,8 +1,8 @@
 #include "spinesim/mesh/vertebra_cache.hpp"
 
-#include "spinesim/common/atomic_file.hpp"
+#include "cache_identity.hpp"
 
-#include <sys/stat.h>
+#include "spinesim/common/atomic_file.hpp"
 
 #include <cstdint>
 #include <cstdio>
@@ -14,29 +14,15 @@
 namespace spinesim::mesh {
 
 namespace fs = std::filesystem;
+using detail::fnv1a;
+using detail::program_identity;
 
 namespace {
 
 constexpr char kMagic[8] = {'S', 'P', 'V', 'C', 'v', '1', '\n', '\0'};
 
-std::uint64_t fnv1a(const std::string& s) {
-  std::uint64_t h = 14695981039346656037ull;
-  for (const unsigned char c : s) {
-    h ^= c;
-    h *= 1099511628211ull;
-  }
-  return h;
-}
-
 void put(std::ostringstream& os, const Eigen::Vector3d& x) {
   for (int k = 0; k < 3; ++k) os << x[k] << ' ';
-}
-
-std::string program_identity() {
-  struct stat st {};
-  if (::stat("/proc/self/exe", &st) != 0) return "unknown-program";
-  return std::to_string(st.st_size) + ":" + std::to_string(st.st_mtim.tv_sec) + "." +
-         std::to_string(st.st_mtim.tv_nsec);
 }
 
 std::string file_prefix(const ParametricVertebra& v, int target_triangles) {

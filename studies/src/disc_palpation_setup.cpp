@@ -1,12 +1,15 @@
 #include "spinesim/studies/disc_palpation_setup.hpp"
 
 #include "spinesim/calibration/tuned_set.hpp"
+#include "spinesim/common/timer.hpp"
+#include "spinesim/mesh/disc_cache.hpp"
 #include "spinesim/mesh/disc_level.hpp"
 #include "spinesim/mss/boundary.hpp"
 #include "spinesim/studies/toolkit.hpp"
 
 #include <time.h>
 
+#include <algorithm>
 #include <optional>
 #include <stdexcept>
 
@@ -39,25 +42,31 @@ double thread_cpu_us() {
   return 1e6 * double(ts.tv_sec) + 1e-3 * double(ts.tv_nsec);
 }
 
-/// The step's percentiles with the probe pressed 2 mm into the anterior wall (after 50 steps of
-/// approach from 10 mm out and 50 of pressing in): wall time, and the thread's CPU time, which
-/// leaves out the time the host took the core away (a stall is not the solver's cost).
+/// The step's percentiles with the probe pressed 2 mm into the anterior wall (after 10 steps
+/// 3 mm out, 20 of pressing in, 0.25 mm a step, and 30 of holding): wall time, and the thread's CPU time, which
+/// leaves out the time the host took the core away (a stall is not the solver's cost). At most
+/// 300 pressed steps, and no more than half a second in all once 40 are in: a 21,000-tet disc
+/// steps in about 5 ms, and 400 steps of it were 2 s of every run's start.
 void measure_step(haptics::DiscPalpation& p, const mesh::TetMesh& m, DiscCandidate* c) {
   const auto [wall, n] = disc_anterior_wall(m);
   const double r = p.options().probe_radius_mm;
   std::vector<float> us, cpu;
-  for (int k = 0; k < 400; ++k) {
-    const double depth = k < 50 ? -10.0 : std::min(2.0, -10.0 + 12.0 * (k - 50) / 50.0);
+  const Timer pressed;
+  for (int k = 0; k < 360; ++k) {
+    const double depth = k < 10 ? -3.0 : std::min(2.0, -3.0 + 5.0 * (k - 10) / 20.0);
     const double cpu0 = thread_cpu_us();
     const haptics::DiscContact& step = p.step(wall - (depth - r) * n);
     const double cpu1 = thread_cpu_us();
-    if (k >= 100) {
+    if (k >= 60) {  // after 30 steps of holding: the contact's onset is not the step's cost
       us.push_back(float(step.step_us));
       cpu.push_back(float(cpu1 - cpu0));
+      if (us.size() >= 40 && pressed.seconds() > 0.5) break;
     }
   }
   c->step_us = haptics::percentiles(us);
   c->step_cpu_us = haptics::percentiles(cpu);
+  std::sort(cpu.begin(), cpu.end());
+  c->judged_cpu_us = double(cpu[cpu.size() >= 4 ? cpu.size() - 4 : 0]);
 }
 
 mss::Boundary held_plates(const mesh::TetMesh& m) {
@@ -96,7 +105,7 @@ DiscSetup make_disc_setup(const DiscSceneRequest& request, const std::string& da
     if (stage) stage("meshing " + request.level + " at " + fixed(cell, 1) + " mm, timing its step");
     mesh::MeshOptions mo;
     mo.cell_size_mm = cell;
-    const mesh::TetMesh m = mesh::mesh_disc_level(request.level, mo, data_dir);
+    const mesh::TetMesh m = mesh::cached_disc_level(request.level, mo, data_dir, request.cache_dir);
     const calibration::TunedDisc tuned = calibration::read_tuned_for_mesh(s.tuned_file, &m);
     auto model = std::make_unique<mss::MssModel>(
         calibration::build_tuned_model(tuned, m, tuned.materials()));
@@ -108,14 +117,15 @@ DiscSetup make_disc_setup(const DiscSceneRequest& request, const std::string& da
       haptics::DiscPalpation trial(*model, held_plates(model->mesh()), quiet);
       measure_step(trial, model->mesh(), &c);
     }
-    c.fits = c.step_cpu_us.p99 <= request.budget_us;
+    c.fits = c.judged_cpu_us <= request.budget_us;
     s.tried.push_back(c);
     const bool last = cell == cells.back();
     if (!c.fits && !last) continue;
     // The asked size, or the coarsest when none fits: the run starts and says what it holds.
     if (!c.fits)
       s.note = std::string(fixed_size ? "the asked " : "no resolution fits; the coarsest, ") +
-               fixed(cell, 1) + " mm disc's step (CPU p99 " + fixed(c.step_cpu_us.p99, 0) +
+               fixed(cell, 1) + " mm disc's step (CPU " + fixed(c.judged_cpu_us, 0) +
+               " us at the fourth-worst step, CPU p99 " + fixed(c.step_cpu_us.p99, 0) +
                " us, wall p99 " + fixed(c.step_us.p99, 0) + " us) does not fit the " +
                fixed(request.budget_us, 0) + " us budget of the " + period +
                ": the disc thread will overrun and the disc lag the hand (give a "
@@ -131,7 +141,7 @@ DiscSetup make_disc_setup(const DiscSceneRequest& request, const std::string& da
     const DiscCandidate& finest = s.tried.front();
     s.note = "could not hold " + std::to_string(request.min_tets) + " tets within " +
              fixed(request.budget_us, 0) + " us on this CPU (" + std::to_string(finest.tets) +
-             " tets: step CPU p99 " + fixed(finest.step_cpu_us.p99, 0) + " us); running " +
+             " tets: fourth-worst step CPU " + fixed(finest.judged_cpu_us, 0) + " us); running " +
              std::to_string(s.chosen.tets) + " tets";
   }
   return s;

@@ -376,6 +376,7 @@ DiscSetup make_disc(const HapticsRunRequest& request, const std::string& data_di
   d.palpation.force_scale =
       request.force_scale > 0 ? request.force_scale : std::max(1.0, kDiscLoadAtPeakN / peak);
   d.fixed_cell_size_mm = request.disc_cell_size_mm;
+  d.cache_dir = request.scene.cache_dir == "none" ? "" : request.scene.cache_dir;
   d.palpation.coupling_stiffness_n_per_mm = request.coupling_stiffness_n_per_mm > 0
                                                 ? request.coupling_stiffness_n_per_mm
                                                 : result.stiffness_n_per_mm;
@@ -621,6 +622,7 @@ nlohmann::json disc_json(const HapticsRunResult& r) {
                      {"tets", c.tets},
                      {"step_us", {{"p50", c.step_us.p50}, {"p99", c.step_us.p99}}},
                      {"step_cpu_us", {{"p50", c.step_cpu_us.p50}, {"p99", c.step_cpu_us.p99}}},
+                     {"judged_cpu_us", c.judged_cpu_us},
                      {"fits", c.fits}});
   const auto& p = r.disc_step_us;
   const bool multi = r.request.disc_solver == "multirate";
