@@ -47,7 +47,18 @@ std::string default_haptic_script(const std::string& scene, const std::string& d
   return (dir / "stroke_spinous.csv").string();
 }
 
-namespace {}  // namespace
+namespace {
+
+void check_twist_request(const HapticsRunRequest& r) {
+  const double k = r.rotational_stiffness_nmm_per_rad;
+  if (std::isnan(k)) return;  // the device's own
+  if (!(k >= 0) || !std::isfinite(k))
+    throw std::invalid_argument("--rotational-stiffness must be >= 0 N mm/rad");
+  if (r.spine.empty())
+    throw std::invalid_argument("--rotational-stiffness is for --spine multirate (a 6-DOF hook)");
+}
+
+}  // namespace
 
 void check_haptics_request(const HapticsRunRequest& r) {
   check_scene_name(r.scene.scene);
@@ -123,12 +134,7 @@ void check_haptics_request(const HapticsRunRequest& r) {
     throw std::invalid_argument("--disc-budget-us must be >= 0 (0: the default)");
   if (!(r.force_scale >= 0) || !std::isfinite(r.force_scale))
     throw std::invalid_argument("--force-scale must be > 0 (0: the default)");
-  if (!std::isnan(r.rotational_stiffness_nmm_per_rad) &&
-      (!(r.rotational_stiffness_nmm_per_rad >= 0) ||
-       !std::isfinite(r.rotational_stiffness_nmm_per_rad)))
-    throw std::invalid_argument("--rotational-stiffness must be >= 0 N mm/rad");
-  if (!std::isnan(r.rotational_stiffness_nmm_per_rad) && r.spine.empty())
-    throw std::invalid_argument("--rotational-stiffness is for --spine multirate (a 6-DOF hook)");
+  check_twist_request(r);
   if (!(r.coupling_stiffness_n_per_mm >= 0) || !std::isfinite(r.coupling_stiffness_n_per_mm) ||
       !(r.coupling_damping_n_s_per_mm >= 0) || !std::isfinite(r.coupling_damping_n_s_per_mm))
     throw std::invalid_argument("--coupling-stiffness and --coupling-damping must be >= 0");
