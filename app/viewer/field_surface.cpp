@@ -30,6 +30,14 @@ Eigen::VectorXd FieldSurface::from_cells(const Eigen::VectorXd& c) const {
   return out;
 }
 
+void FieldSurface::point_range(const Eigen::VectorXd& p, double floor, double& lo,
+                               double& hi) const {
+  Eigen::VectorXd corners(F_.size());
+  for (Eigen::Index f = 0; f < F_.rows(); ++f)
+    for (int k = 0; k < 3; ++k) corners(3 * f + k) = p(F_(f, k));
+  range(corners, floor, lo, hi);
+}
+
 void FieldSurface::range(const Eigen::VectorXd& v, double floor, double& lo, double& hi) {
   // Non-finite values mean "no data" (a fibre field's nucleus): they are drawn grey and take no
   // part in the range.

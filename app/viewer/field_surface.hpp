@@ -35,6 +35,9 @@ class FieldSurface {
   /// at least `floor` wide (so that a field at rest shows its lowest colour, not noise).
   /// Non-finite values are ignored (and drawn grey).
   static void range(const Eigen::VectorXd& values, double floor, double& lo, double& hi);
+  /// The same for a point field (#V), over the surface's own points: the legend then reaches the
+  /// deepest point (a pressed node), which the triangles' corner means fall short of.
+  void point_range(const Eigen::VectorXd& point_values, double floor, double& lo, double& hi) const;
   /// `body` shows the surface at `V` (#V×3) coloured by `values` on [lo, hi].
   void fill(Body& body, const Eigen::MatrixX3d& V, const Eigen::VectorXd& values, double lo,
             double hi) const;

@@ -194,18 +194,18 @@ class SessionController final : public Controller {
   void color_disc(Body& body, const Eigen::VectorXd& x) {
     const mss::MssModel& m = *setup_.disc;
     Eigen::VectorXd values;
-    double floor = 0;
     if (field_ == DiscField::displacement) {
-      values = setup_.disc_surface.from_points(mss::displacement(m, x).rowwise().norm());
-      floor = 1e-4;  // mm: a disc at rest shows its lowest colour, a pressed one its pattern
-    } else if (field_ == DiscField::spring_strain) {
-      values = setup_.disc_surface.from_cells(mss::tet_edge_strain(m, x));
-      floor = 1e-5;
+      const Eigen::VectorXd u = mss::displacement(m, x).rowwise().norm();
+      values = setup_.disc_surface.from_points(u);
+      // 0.1 µm: a disc at rest shows its lowest colour, a pressed one its pattern; the legend
+      // reaches the pressed node's displacement (the panel's indentation), not the corner mean.
+      setup_.disc_surface.point_range(u, 1e-4, lo_, hi_);
     } else {
-      values = setup_.disc_surface.from_cells(mss::tet_volume_change(m, x));
-      floor = 1e-5;
+      values = setup_.disc_surface.from_cells(field_ == DiscField::spring_strain
+                                                  ? mss::tet_edge_strain(m, x)
+                                                  : mss::tet_volume_change(m, x));
+      FieldSurface::range(values, 1e-5, lo_, hi_);
     }
-    FieldSurface::range(values, floor, lo_, hi_);
     const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>> V(
         x.data(), x.size() / 3, 3);
     setup_.disc_surface.fill(body, V, values, lo_, hi_);
