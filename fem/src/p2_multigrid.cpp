@@ -14,9 +14,11 @@ namespace {
 // Kernels on row-major n×6 blocks (the 6 plate right-hand sides side by side) and a symmetric
 // matrix stored as its lower triangle in CSC with the diagonal first in every column. The
 // default build targets baseline x86-64 (SSE2); target_clones adds an AVX2+FMA version picked
-// at load time, which roughly doubles the throughput of these loops where available.
+// at load time, which roughly doubles the throughput of these loops where available. Not under
+// ThreadSanitizer: the clones' resolvers run while the dynamic loader relocates the program,
+// before the sanitizer's runtime is up, and the instrumented resolver crashed it at start.
 constexpr int kCols = 6;
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && !defined(__SANITIZE_THREAD__)
 #define SPINESIM_KERNEL __attribute__((target_clones("arch=haswell", "default")))
 #else
 #define SPINESIM_KERNEL

@@ -279,7 +279,8 @@ TEST(MultirateSpine, NewLocalModelsAreBlendedInWithoutAStep) {
   int n0 = 0, n20 = 0;
   const double at_once = largest_tick_jump_mm(m, 0, n0);
   const double blended = largest_tick_jump_mm(m, 20, n20);
-#if defined(__SANITIZE_ADDRESS__)
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+  // The sanitized builds solve 5-15 times slower; the worker's thread still ran beside the ticks.
   if (n0 < 5 || n20 < 5)
     GTEST_SKIP() << "the worker made " << n0 << " and " << n20
                  << " models in 4.5 s: too slow here to compare handovers";
