@@ -23,12 +23,14 @@ echo "6-DOF twist (servo, spine worker, latency probe) under ThreadSanitizer: cl
   --cache-dir "$cache" --json > /dev/null
 echo "multirate disc (servo, disc worker) under ThreadSanitizer: clean"
 if command -v xvfb-run > /dev/null; then
+  # The window closes at the screenshot (without one it stays open for a person to look).
   view() {
     xvfb-run -a -s '-screen 0 1280x960x24' "$bin" view --device sim --no-realtime \
-      --cache-dir "$cache" --json "$@" > /dev/null
+      --cache-dir "$cache" --screenshot "$cache/view.png" --json "$@" > /dev/null
   }
-  view --scene disc --disc-solver direct --disc-cell-size 4 --duration 3
-  view --scene spine --triangles 1500 --spine multirate --duration 3 \
+  view --scene disc --disc-solver direct --disc-cell-size 4 --screenshot-at 2.5
+  view --scene disc --disc-cell-size 3 --screenshot-at 2.5
+  view --scene spine --triangles 1500 --spine multirate --screenshot-at 3 \
     --script data/haptics/drag_t1_lateral.csv
   echo "viewer sessions (GUI thread, session thread, disc and spine workers): clean"
 fi
