@@ -160,6 +160,11 @@ void add_disc_flags(CLI::App* run, HapticsRunRequest& request) {
                   "thread, its local contact model felt every tick; meshes >= 20,000 tets) or "
                   "direct (the disc stepped every 1 ms tick; a few thousand tets)")
       ->capture_default_str();
+  run->add_option("--disc-model", request.disc_model,
+                  "--scene disc: mss (the tuned mass-spring disc) or fem (the linear FEM disc the "
+                  "tuned set was matched to, on the same mesh: static, its compliance at the "
+                  "probe solved as the probe moves)")
+      ->capture_default_str();
   run->add_option("--disc-period-ms", request.disc_period_ms,
                   "--disc-solver multirate: the disc's step, 1 to 10 ms")
       ->capture_default_str();
@@ -271,7 +276,9 @@ void add_haptics_run_flags(CLI::App* cmd, HapticsRunFlags& f, bool viewer) {
                   "Felt stiffness of the hook spring (--spine) or of the disc coupling (--scene "
                   "disc), N/mm (default: the rendering stiffness)");
   cmd->add_option("--coupling-damping", f.request.coupling_damping_n_s_per_mm,
-                  "Felt damping of the hook spring or the disc coupling, N*s/mm")
+                  "Felt damping of the hook spring or the disc coupling, N*s/mm (0: none; the "
+                  "FEM disc's coupling gets k_c T / 2, the least that keeps a sampled spring "
+                  "passive)")
       ->capture_default_str();
   cmd->add_option("--rotational-stiffness", f.request.rotational_stiffness_nmm_per_rad,
                   "--spine multirate on a 6-DOF device with torque (--model sigma.7, "

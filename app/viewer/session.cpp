@@ -33,7 +33,7 @@ struct Setup {
   std::vector<Body> bodies;  ///< the rigid stage, reference coordinates
   std::optional<mss::MssModel> disc;
   FieldSurface disc_surface;
-  std::string disc_level, device, spine, description;
+  std::string disc_level, disc_model, device, spine, description;
   double probe_radius_mm = 4;
   Eigen::Vector3d start_mm = Eigen::Vector3d::Zero();
 };
@@ -165,6 +165,7 @@ class SessionController final : public Controller {
       c.disc_surface = FieldSurface(s.disc->mesh().T);
     }
     c.disc_level = s.disc_level;
+    c.disc_model = s.disc_model;
     c.device = s.device;
     c.spine = s.spine;
     c.description = s.scene.description;
@@ -279,8 +280,9 @@ void SessionController::panel() {
                   s.hook.load.moment_nmm.norm() / 1000, s.hook.felt_torque_nmm.norm());
   }
   if (setup_.disc) {
-    ImGui::Text("disc %s: %s | load %.1f N | indented %.2f mm | volume %+.3f %%",
-                setup_.disc_level.c_str(), s.disc_contact ? "pressed" : "free",
+    ImGui::Text("disc %s (%s): %s | load %.1f N | indented %.2f mm | volume %+.3f %%",
+                setup_.disc_level.c_str(), setup_.disc_model.c_str(),
+                s.disc_contact ? "pressed" : "free",
                 s.disc_force_n.norm(), s.disc_indentation_mm, 100 * s.disc_volume_change);
     int f = int(field_);
     if (ImGui::Combo("field", &f, kDiscFieldNames, 3)) field_ = DiscField(f), field_changed_ = true;

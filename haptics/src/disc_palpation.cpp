@@ -93,14 +93,56 @@ double surface_gap_mm(const mesh::TetMesh& m) {
   return gap;
 }
 
+MssPalpableDisc::MssPalpableDisc(const mss::MssModel& model, const mss::Boundary& plates,
+                                 double radius_mm, double penalty_n_per_mm,
+                                 const mss::DynamicsOptions& dynamics)
+    : model_(model), sim_(model, dynamics), bc_(plates) {
+  mss::validate(bc_, model.num_nodes());
+  state_ = sim_.rest_state();
+  mss::Probe probe;
+  probe.radius_mm = radius_mm;
+  probe.stiffness_n_per_mm =
+      penalty_n_per_mm > 0 ? penalty_n_per_mm : mss::default_probe_stiffness(model);
+  probe.center_mm = Eigen::Vector3d::Constant(1e9);  // far away until the first step
+  bc_.probes = {probe};
+  // The factorisation (~0.2 s at 20,000 tets) is done here, not in the disc thread's first
+  // loaded step while the hand is on the disc.
+  if (!sim_.prepare(bc_))
+    throw std::invalid_argument(
+        "disc palpation: the disc's implicit matrix is not positive definite");
+}
+
+bool MssPalpableDisc::step(const Eigen::Vector3d& center_mm) {
+  bc_.probes[0].center_mm = center_mm;
+  const bool ok = sim_.step(state_, bc_).ok;
+  force_ = mss::probe_forces(model_, bc_, state_.x_mm)[0];
+  return ok;
+}
+
+double MssPalpableDisc::volume_change() const { return mss::volume_change(model_, state_.x_mm); }
+
+std::unique_ptr<PalpableDisc> make_mss_palpable_disc(const mss::MssModel& model,
+                                                     const mss::Boundary& plates,
+                                                     const DiscPalpationOptions& options) {
+  return std::make_unique<MssPalpableDisc>(model, plates, options.probe_radius_mm,
+                                           options.probe_penalty_n_per_mm, dynamics(options));
+}
+
 DiscPalpation::DiscPalpation(const mss::MssModel& model, const mss::Boundary& plates,
                              const DiscPalpationOptions& options)
-    : model_(model), options_(options), sim_(model, dynamics(options)), bc_(plates) {
+    : DiscPalpation(make_mss_palpable_disc(model, plates, options), options) {}
+
+DiscPalpation::DiscPalpation(std::unique_ptr<PalpableDisc> disc,
+                             const DiscPalpationOptions& options)
+    : options_(options), disc_(std::move(disc)) {
   // CHOLMOD's supernodal solves call OpenBLAS, whose threads busy-wait beside the servo thread
   // (blas_threads.hpp); measured: the 5,099-tet step pressed took 1.5 ms with them.
   detail::use_one_blas_thread();
-  mss::validate(bc_, model.num_nodes());
-  const double gap = surface_gap_mm(model.mesh());
+  dynamics(options);  // validates the options
+  require(disc_ != nullptr, "no disc");
+  require(disc_->probe_radius_mm() == options.probe_radius_mm,
+          "the disc was made for another probe radius");
+  const double gap = surface_gap_mm(disc_->mesh());
   if (!(options.probe_radius_mm > gap)) {
     char why[256];
     std::snprintf(why, sizeof why,
@@ -109,24 +151,12 @@ DiscPalpation::DiscPalpation(const mss::MssModel& model, const mss::Boundary& pl
                   options.probe_radius_mm, gap);
     throw std::invalid_argument(why);
   }
-  state_ = sim_.rest_state();
-  k_p_ = options.probe_penalty_n_per_mm > 0 ? options.probe_penalty_n_per_mm
-                                            : mss::default_probe_stiffness(model);
-  mss::Probe probe;
-  probe.radius_mm = options.probe_radius_mm;
-  probe.stiffness_n_per_mm = k_p_;
-  probe.center_mm = Eigen::Vector3d::Constant(1e9);  // far away until the first step
-  bc_.probes = {probe};
-  for (Eigen::Index i = 0; i < model.num_nodes(); ++i)
-    if (model.mesh().surface(i) != 0) surface_nodes_.push_back(i);
+  const mesh::TetMesh& m = disc_->mesh();
+  for (Eigen::Index i = 0; i < m.num_vertices(); ++i)
+    if (m.surface(i) != 0) surface_nodes_.push_back(i);
   last_.probe_mm = Eigen::Vector3d::Constant(1e9);
-  // The factorisation (~0.2 s at 20,000 tets) is done here, not in the disc thread's first
-  // loaded step while the hand is on the disc.
-  if (!sim_.prepare(bc_))
-    throw std::invalid_argument(
-        "disc palpation: the disc's implicit matrix is not positive definite");
   out_.write(last_);
-  positions_.reset(state_.x_mm);
+  positions_.reset(disc_->positions_mm());
 }
 
 DiscPalpation::~DiscPalpation() { stop(); }
@@ -134,7 +164,8 @@ DiscPalpation::~DiscPalpation() { stop(); }
 Eigen::Vector3d DiscPalpation::place_probe(const Eigen::Vector3d& device) const {
   // The nodes that can touch the probe on its way from the device towards the surface.
   const double r = options_.probe_radius_mm, kc = disc_coupling_n_per_mm();
-  const Eigen::VectorXd& x = state_.x_mm;
+  const double k_p = disc_->probe_penalty_n_per_mm();
+  const Eigen::VectorXd& x = disc_->positions_mm();
   auto energy = [&](const Eigen::Vector3d& p, Eigen::Vector3d* g, Eigen::Matrix3d* H) {
     double e = 0.5 * kc * (p - device).squaredNorm();
     if (g) *g = kc * (p - device);
@@ -144,11 +175,11 @@ Eigen::Vector3d DiscPalpation::place_probe(const Eigen::Vector3d& device) const 
       const double dist2 = d.squaredNorm();
       if (dist2 >= r * r) continue;
       const double dist = std::sqrt(dist2), pen = r - dist;
-      e += 0.5 * k_p_ * pen * pen;
+      e += 0.5 * k_p * pen * pen;
       if (dist < 1e-12) continue;  // no direction to push along
       const Eigen::Vector3d n = d / dist;
-      if (g) *g -= k_p_ * pen * n;
-      if (H) *H += k_p_ * n * n.transpose();  // Gauss-Newton: the convex part
+      if (g) *g -= k_p * pen * n;
+      if (H) *H += k_p * n * n.transpose();  // Gauss-Newton: the convex part
     }
     return e;
   };
@@ -184,8 +215,8 @@ Eigen::Vector3d DiscPalpation::place_probe(const Eigen::Vector3d& device) const 
 
 double DiscPalpation::indentation_mm(const Eigen::Vector3d& p) const {
   const double r2 = options_.probe_radius_mm * options_.probe_radius_mm;
-  const Eigen::VectorXd& x = state_.x_mm;
-  const Eigen::VectorXd& X = model_.rest_positions_mm();
+  const Eigen::VectorXd& x = disc_->positions_mm();
+  const Eigen::VectorXd& X = disc_->rest_positions_mm();
   double worst = 0;
   for (const Eigen::Index i : surface_nodes_)
     if ((p - x.segment<3>(3 * i)).squaredNorm() < 1.21 * r2)  // touched, or just left
@@ -202,7 +233,7 @@ void DiscPalpation::update_local_model(const Eigen::Vector3d& device) {
   if (last_.contact && last_.force_n.norm() > 0) {
     // The step's contact stiffness, its negative (sliding) directions dropped: the local model
     // is then a spring network no stiffer than s k_c in series, so the servo's loop is passive.
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(sim_.probe_stiffness(0));
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(disc_->probe_stiffness());
     K = eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).asDiagonal() *
         eig.eigenvectors().transpose();
     p0 = last_.probe_mm;
@@ -220,7 +251,7 @@ void DiscPalpation::update_local_model(const Eigen::Vector3d& device) {
     normal_stiffness_ = n.dot(K * n);
   } else {
     // The onset plane: tangent to the probe sphere resting on the nearest surface node.
-    const Eigen::VectorXd& x = state_.x_mm;
+    const Eigen::VectorXd& x = disc_->positions_mm();
     Eigen::Index best = -1;
     double best2 = 0;
     for (const Eigen::Index i : surface_nodes_) {
@@ -231,7 +262,7 @@ void DiscPalpation::update_local_model(const Eigen::Vector3d& device) {
     n = (device - x.segment<3>(3 * best)) / std::sqrt(best2);
     p0 = x.segment<3>(3 * best) + options_.probe_radius_mm * n;
     f0.setZero();
-    const double kn = normal_stiffness_ > 0 ? normal_stiffness_ : k_p_;
+    const double kn = normal_stiffness_ > 0 ? normal_stiffness_ : disc_->probe_penalty_n_per_mm();
     K = kn * n * n.transpose();
   }
   last_.model_inverse = (kcd * Eigen::Matrix3d::Identity() + K).inverse();
@@ -242,10 +273,10 @@ void DiscPalpation::update_local_model(const Eigen::Vector3d& device) {
 
 bool DiscPalpation::touches_disc(const Eigen::Vector3d& point) const {
   const double r = options_.probe_radius_mm;
-  const Eigen::VectorXd& x = state_.x_mm;
+  const Eigen::VectorXd& x = disc_->positions_mm();
   for (const Eigen::Index i : surface_nodes_)
     if ((point - x.segment<3>(3 * i)).squaredNorm() < r * r) return true;
-  const mesh::TetMesh& m = model_.mesh();
+  const mesh::TetMesh& m = disc_->mesh();
   for (Eigen::Index t = 0; t < m.num_tets(); ++t) {
     const Eigen::Vector3d a = x.segment<3>(3 * m.T(t, 0));
     Eigen::Matrix3d E;
@@ -284,15 +315,13 @@ const DiscContact& DiscPalpation::step(const Eigen::Vector3d& device_mm) {
             : place_probe(device_mm);
   }
   last_.device_mm = device_mm;
-  bc_.probes[0].center_mm = p;
-  const mss::StepReport report = sim_.step(state_, bc_);
+  const bool ok = disc_->step(p);
   ++last_.step;
   last_.probe_mm = p;
   last_.contact = p != device_mm;
-  last_.force_n = last_.contact ? mss::probe_forces(model_, bc_, state_.x_mm)[0]
-                                : Eigen::Vector3d::Zero().eval();
-  last_.volume_change = mss::volume_change(model_, state_.x_mm);
-  last_.failed = !report.ok;
+  last_.force_n = last_.contact ? disc_->probe_force_n() : Eigen::Vector3d::Zero().eval();
+  last_.volume_change = disc_->volume_change();
+  last_.failed = !ok;
   last_.indentation_mm = last_.contact ? indentation_mm(p) : 0.0;
   update_local_model(device_mm);
   last_.step_us =
@@ -325,7 +354,7 @@ void DiscPalpation::run() {
     out_.write(c);
     ++stats_.steps;
     // Same-size copy assignment: no allocation on the disc thread.
-    if (stats_.steps % positions_every() == 0) positions_.write(state_.x_mm);
+    if (stats_.steps % positions_every() == 0) positions_.write(disc_->positions_mm());
     stats_.failed_steps += c.failed;
     if (stats_.step_us.size() < stats_.step_us.capacity())
       stats_.step_us.push_back(float(c.step_us));
@@ -333,11 +362,18 @@ void DiscPalpation::run() {
     stats_.max_indentation_mm = std::max(stats_.max_indentation_mm, c.indentation_mm);
     stats_.min_volume_change = std::min(stats_.min_volume_change, c.volume_change);
     stats_.max_volume_change = std::max(stats_.max_volume_change, c.volume_change);
+    // The disc's clock keeps the wall clock's: each step advances the disc by dt, so a step
+    // that ends past the next one's start is followed at once by the next, on the same grid
+    // (one slow step among fast ones costs no step). More than a whole period behind, the
+    // missed grid points are dropped and the grid restarts now: the steps never pile up.
     deadline += options_.dt_s;
     const double now = monotonic_s();
-    if (now > deadline) {  // this step ended past the next one's start: skip, do not pile up
+    if (now > deadline) {
       ++stats_.overruns;
-      deadline = now + options_.dt_s;
+      if (now > deadline + options_.dt_s) {
+        stats_.dropped_periods += std::int64_t((now - deadline) / options_.dt_s);
+        deadline = now;
+      }
     }
   }
 }
@@ -347,6 +383,14 @@ std::vector<Eigen::Vector3d> palpate_offline(const mss::MssModel& model,
                                              const DiscPalpationOptions& options,
                                              const std::vector<Eigen::Vector3d>& device_mm,
                                              double tick_s) {
+  return palpate_offline([&] { return make_mss_palpable_disc(model, plates, options); }, options,
+                         device_mm, tick_s);
+}
+
+std::vector<Eigen::Vector3d> palpate_offline(
+    const std::function<std::unique_ptr<PalpableDisc>()>& make_disc,
+    const DiscPalpationOptions& options, const std::vector<Eigen::Vector3d>& device_mm,
+    double tick_s) {
   const double every = options.dt_s / tick_s;
   const long n_every = std::lround(every);
   if (!(tick_s > 0) || n_every < 1 || std::abs(every - double(n_every)) > 1e-9 * every ||
@@ -355,7 +399,7 @@ std::vector<Eigen::Vector3d> palpate_offline(const mss::MssModel& model,
         "disc palpation: the step must be a whole number of ticks (one tick when direct)");
   DiscPalpationOptions o = options;
   o.realtime_priority = false;
-  DiscPalpation disc(model, plates, o);
+  DiscPalpation disc(make_disc(), o);
   const double kcd = disc.disc_coupling_n_per_mm();
   std::vector<Eigen::Vector3d> force(device_mm.size(), Eigen::Vector3d::Zero());
   DiscContact seen;  // what the servo sees: the last finished step

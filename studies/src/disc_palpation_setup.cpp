@@ -2,6 +2,7 @@
 
 #include "spinesim/calibration/tuned_set.hpp"
 #include "spinesim/common/timer.hpp"
+#include "spinesim/fem/contact_disc.hpp"
 #include "spinesim/mesh/disc_cache.hpp"
 #include "spinesim/mesh/disc_level.hpp"
 #include "spinesim/mss/boundary.hpp"
@@ -35,6 +36,31 @@ std::string palpation_params_path(const std::string& params, const std::string& 
 }
 
 namespace {
+
+/// fem::ContactDisc behind the palpation interface: each step is the static equilibrium.
+class FemPalpableDisc final : public haptics::PalpableDisc {
+ public:
+  FemPalpableDisc(const mesh::TetMesh& mesh, const mesh::RegionMaterials& materials,
+                  const fem::ContactDiscOptions& options)
+      : disc_(mesh, materials, options), radius_(options.probe_radius_mm) {}
+  const char* name() const override { return "linear FEM"; }
+  const mesh::TetMesh& mesh() const override { return disc_.mesh(); }
+  const Eigen::VectorXd& rest_positions_mm() const override { return disc_.rest_positions_mm(); }
+  const Eigen::VectorXd& positions_mm() const override { return disc_.positions_mm(); }
+  double probe_radius_mm() const override { return radius_; }
+  double probe_penalty_n_per_mm() const override { return disc_.penalty_n_per_mm(); }
+  bool step(const Eigen::Vector3d& center_mm) override { return disc_.solve(center_mm).ok; }
+  Eigen::Vector3d probe_force_n() const override { return disc_.probe_force_n(); }
+  // The normal springs' linearisation, as the mass-spring disc's probe gives: the exact one's
+  // negative directions along the convex wall (about -F / r) would make the palpation's local
+  // model untrusted at 29 N on a 4 mm probe and the probe then creep to its balance.
+  Eigen::Matrix3d probe_stiffness() const override { return disc_.probe_stiffness_gauss_newton(); }
+  double volume_change() const override { return disc_.volume_change(); }
+
+ private:
+  fem::ContactDisc disc_;
+  double radius_;
+};
 
 double thread_cpu_us() {
   timespec ts{};
@@ -77,12 +103,27 @@ mss::Boundary held_plates(const mesh::TetMesh& m) {
 
 }  // namespace
 
+std::unique_ptr<haptics::PalpableDisc> make_fem_palpable_disc(
+    const mesh::TetMesh& mesh, const mesh::RegionMaterials& materials, double radius_mm,
+    double penalty_n_per_mm) {
+  fem::ContactDiscOptions o;
+  o.probe_radius_mm = radius_mm;
+  o.penalty_n_per_mm = penalty_n_per_mm;
+  return std::make_unique<FemPalpableDisc>(mesh, materials, o);
+}
+
 DiscSetup make_disc_setup(const DiscSceneRequest& request, const std::string& data_dir,
                           const std::function<void(const std::string&)>& stage) {
   if (!(request.budget_us > 0) || request.budget_us > 1e6)
     throw std::invalid_argument("--disc-budget-us must be > 0 and at most 1 s");
   if (request.cell_sizes_mm.empty())
     throw std::invalid_argument("disc palpation: no candidate resolution");
+  if (request.disc_model != "mss" && request.disc_model != "fem")
+    throw std::invalid_argument(
+        "--disc-model must be mss (the tuned mass-spring disc) or fem (its "
+        "linear FEM), got '" +
+        request.disc_model + "'");
+  const bool fem_disc = request.disc_model == "fem";
   DiscSetup s;
   s.tuned_file = palpation_params_path(request.params, data_dir);
   // The level and its tuned parameters, refused before any meshing.
@@ -112,9 +153,18 @@ DiscSetup make_disc_setup(const DiscSceneRequest& request, const std::string& da
     DiscCandidate c;
     c.cell_size_mm = cell;
     c.tets = long(m.num_tets());
+    const mss::MssModel& tuned_model = *model;
+    const mesh::RegionMaterials materials = tuned.materials();
+    const haptics::DiscPalpationOptions& po = request.palpation;
+    auto make = [fem_disc, &tuned_model, materials,
+                 po]() -> std::unique_ptr<haptics::PalpableDisc> {
+      if (fem_disc)
+        return make_fem_palpable_disc(tuned_model.mesh(), materials, po.probe_radius_mm,
+                                      po.probe_penalty_n_per_mm);
+      return haptics::make_mss_palpable_disc(tuned_model, held_plates(tuned_model.mesh()), po);
+    };
     {
-      haptics::DiscPalpationOptions quiet = request.palpation;
-      haptics::DiscPalpation trial(*model, held_plates(model->mesh()), quiet);
+      haptics::DiscPalpation trial(make(), request.palpation);
       measure_step(trial, model->mesh(), &c);
     }
     c.fits = c.judged_cpu_us <= request.budget_us;
@@ -132,8 +182,8 @@ DiscSetup make_disc_setup(const DiscSceneRequest& request, const std::string& da
                "larger --disc-budget-us or a coarser --disc-cell-size)";
     s.chosen = c;
     s.plates = held_plates(model->mesh());
-    s.palpation = std::make_unique<haptics::DiscPalpation>(*model, held_plates(model->mesh()),
-                                                           request.palpation);
+    s.palpation = std::make_unique<haptics::DiscPalpation>(make(), request.palpation);
+    s.make_disc = make;
     s.model = std::move(model);
     break;
   }

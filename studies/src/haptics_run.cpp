@@ -60,6 +60,31 @@ void check_twist_request(const HapticsRunRequest& r) {
 
 }  // namespace
 
+/// The disc scene's flags (one line for each refusal).
+void check_disc_request(const HapticsRunRequest& r) {
+  if (r.scene.scene != "disc" &&
+      (!r.disc_params.empty() || r.disc_budget_us != 0 || r.disc_cell_size_mm != 0 ||
+       r.disc_solver != "multirate" || r.disc_model != "mss" || r.disc_period_ms != 10 ||
+       r.disc_sync_check))
+    throw std::invalid_argument(
+        "--params, --disc-solver, --disc-model, --disc-period-ms, --disc-budget-us, "
+        "--disc-cell-size and --disc-sync-check are for --scene disc");
+  if (r.disc_model != "mss" && r.disc_model != "fem")
+    throw std::invalid_argument("--disc-model " + r.disc_model +
+                                ": unknown (mss, the tuned mass-spring disc, or fem, its linear "
+                                "FEM)");
+  if (r.disc_solver != "multirate" && r.disc_solver != "direct")
+    throw std::invalid_argument("--disc-solver " + r.disc_solver +
+                                ": unknown (multirate or direct)");
+  if (!(r.disc_period_ms >= 1 && r.disc_period_ms <= 10))
+    throw std::invalid_argument("--disc-period-ms must be 1 to 10 ms");
+  if (r.disc_solver == "direct" && (r.disc_period_ms != 10 || r.disc_sync_check))
+    throw std::invalid_argument(
+        "--disc-period-ms and --disc-sync-check are for --disc-solver multirate");
+  if (!(r.disc_budget_us >= 0) || !std::isfinite(r.disc_budget_us))
+    throw std::invalid_argument("--disc-budget-us must be >= 0 (0: the default)");
+}
+
 void check_haptics_request(const HapticsRunRequest& r) {
   check_scene_name(r.scene.scene);
   if (!(r.probe_radius_mm > 0) || !std::isfinite(r.probe_radius_mm) || r.probe_radius_mm > 100)
@@ -116,22 +141,7 @@ void check_haptics_request(const HapticsRunRequest& r) {
       (r.coupling_stiffness_n_per_mm != 0 || r.coupling_damping_n_s_per_mm != 0))
     throw std::invalid_argument(
         "--coupling-stiffness and --coupling-damping are for --spine or --scene disc");
-  if (r.scene.scene != "disc" &&
-      (!r.disc_params.empty() || r.disc_budget_us != 0 || r.disc_cell_size_mm != 0 ||
-       r.disc_solver != "multirate" || r.disc_period_ms != 10 || r.disc_sync_check))
-    throw std::invalid_argument(
-        "--params, --disc-solver, --disc-period-ms, --disc-budget-us, --disc-cell-size and "
-        "--disc-sync-check are for --scene disc");
-  if (r.disc_solver != "multirate" && r.disc_solver != "direct")
-    throw std::invalid_argument("--disc-solver " + r.disc_solver +
-                                ": unknown (multirate or direct)");
-  if (!(r.disc_period_ms >= 1 && r.disc_period_ms <= 10))
-    throw std::invalid_argument("--disc-period-ms must be 1 to 10 ms");
-  if (r.disc_solver == "direct" && (r.disc_period_ms != 10 || r.disc_sync_check))
-    throw std::invalid_argument(
-        "--disc-period-ms and --disc-sync-check are for --disc-solver multirate");
-  if (!(r.disc_budget_us >= 0) || !std::isfinite(r.disc_budget_us))
-    throw std::invalid_argument("--disc-budget-us must be >= 0 (0: the default)");
+  check_disc_request(r);
   if (!(r.force_scale >= 0) || !std::isfinite(r.force_scale))
     throw std::invalid_argument("--force-scale must be > 0 (0: the default)");
   check_twist_request(r);
@@ -368,6 +378,7 @@ DiscSetup make_disc(const HapticsRunRequest& request, const std::string& data_di
   DiscSceneRequest d;
   d.level = request.scene.level;
   d.params = request.disc_params;
+  d.disc_model = request.disc_model;
   const bool multirate = request.disc_solver == "multirate";
   d.palpation.multirate = multirate;
   d.palpation.dt_s = multirate ? 1e-3 * request.disc_period_ms : 1e-3;
@@ -391,7 +402,13 @@ DiscSetup make_disc(const HapticsRunRequest& request, const std::string& data_di
                                 fixed(d.palpation.coupling_stiffness_n_per_mm, 2) +
                                 " N/mm is beyond the device's passive limit (" +
                                 fixed(result.passive_limit_n_per_mm, 2) + " N/mm)");
-  d.palpation.coupling_damping_n_s_per_mm = request.coupling_damping_n_s_per_mm;
+  // The static FEM disc keeps none of the hand's work: its held-for-a-tick spring would give back
+  // a little more than it took, so its coupling gets Colgate & Brown's damping k_c T / 2 unless
+  // one is given (the mass-spring disc's implicit steps dissipate more than that by themselves).
+  d.palpation.coupling_damping_n_s_per_mm =
+      request.coupling_damping_n_s_per_mm > 0 || request.disc_model != "fem"
+          ? request.coupling_damping_n_s_per_mm
+          : 0.5 * d.palpation.coupling_stiffness_n_per_mm * 1e-3;
   d.palpation.probe_radius_mm = request.probe_radius_mm;
   d.palpation.realtime_priority = request.realtime_priority;
   DiscSetup setup = make_disc_setup(d, data_dir);
@@ -402,6 +419,7 @@ DiscSetup make_disc(const HapticsRunRequest& request, const std::string& data_di
   result.disc_note = setup.note;
   result.disc_candidates = setup.tried;
   result.coupling_stiffness_n_per_mm = d.palpation.coupling_stiffness_n_per_mm;
+  result.coupling_damping_n_s_per_mm = d.palpation.coupling_damping_n_s_per_mm;
   result.force_scale = d.palpation.force_scale;
   result.request.disc_budget_us = d.budget_us;
   return setup;
@@ -427,7 +445,7 @@ void sync_check(const DiscSetup& d, const DiscTrace& trace, double T, HapticsRun
   o.multirate = false;
   o.dt_s = T;
   const std::vector<Eigen::Vector3d> reference =
-      haptics::palpate_offline(*d.model, d.plates, o, trace.device_mm, T);
+      haptics::palpate_offline(d.make_disc, o, trace.device_mm, T);
   result->sync_error = haptics::force_error(trace.force_n, reference);
   result->sync_ticks = std::int64_t(reference.size());
   result->sync_seconds = timer.seconds();
@@ -438,6 +456,7 @@ void finish_disc(DiscSetup& d, HapticsRunResult* result) {
   const auto& st = d.palpation->stats();
   result->disc_steps = st.steps;
   result->disc_overruns = st.overruns;
+  result->disc_dropped_periods = st.dropped_periods;
   result->disc_failed_steps = st.failed_steps;
   result->disc_step_us = haptics::percentiles(st.step_us);
   result->disc_max_force_n = st.max_force_n;
@@ -576,7 +595,8 @@ HapticsRunResult run_haptics(const HapticsRunRequest& request, const std::string
   if (request.live && request.live->ready)
     request.live->ready({scene, disc.model.get(), result.disc_level, result.capabilities,
                          result.stiffness_n_per_mm, request.probe_radius_mm, request.device,
-                         request.spine, start});
+                         request.spine, start,
+                         disc.palpation ? disc.palpation->disc().name() : ""});
   if (disc.palpation) disc.palpation->start();
   int calls = 0;
   HapticsLiveFrame live;
@@ -645,6 +665,7 @@ nlohmann::json disc_json(const HapticsRunResult& r) {
   return {
       {"level", r.disc_level},
       {"solver", r.request.disc_solver},
+      {"model", r.request.disc_model == "fem" ? "linear FEM" : "mass-spring"},
       {"period_ms", multi ? r.request.disc_period_ms : 1.0},
       {"rate_hz", r.disc_rate_hz},
       {"stale_ticks", r.disc_stale_ticks},
@@ -664,8 +685,10 @@ nlohmann::json disc_json(const HapticsRunResult& r) {
       {"budget_check", tried},
       {"note", r.disc_note},
       {"coupling_stiffness_n_per_mm", r.coupling_stiffness_n_per_mm},
+      {"coupling_damping_n_s_per_mm", r.coupling_damping_n_s_per_mm},
       {"steps", r.disc_steps},
       {"overruns", r.disc_overruns},
+      {"dropped_periods", r.disc_dropped_periods},
       {"failed_steps", r.disc_failed_steps},
       {"step_us", {{"p50", p.p50}, {"p99", p.p99}, {"p999", p.p999}, {"max", p.max}}},
       {"max_contact_force_n", r.disc_max_force_n},
@@ -817,17 +840,20 @@ std::string haptics_run_table(const HapticsRunResult& r) {
     const auto& p = r.disc_step_us;
     const bool multi = r.request.disc_solver == "multirate";
     const std::string period = multi ? fixed(r.request.disc_period_ms, 0) + " ms" : "1 ms";
-    os << "  disc: " << r.disc_level << ", " << r.disc_tets << " tets (CGAL "
-       << fixed(r.disc_cell_size_mm, 1) << " mm, " << r.disc_tuned_file << "), "
+    os << "  disc: " << r.disc_level << ", "
+       << (r.request.disc_model == "fem" ? "the linear FEM disc" : "the tuned mass-spring disc")
+       << ", " << r.disc_tets << " tets (CGAL " << fixed(r.disc_cell_size_mm, 1) << " mm, "
+       << r.disc_tuned_file << "), "
        << (multi ? "stepped every " + period + ", its local contact model felt every tick"
                  : std::string("stepped every tick"))
        << "; coupling " << fixed(r.coupling_stiffness_n_per_mm, 2) << " N/mm felt, force scale "
        << fixed(r.force_scale, 1) << " disc N per felt N\n"
        << "  disc step (us): p50 " << fixed(p.p50, 0) << ", p99 " << fixed(p.p99, 0) << ", max "
        << fixed(p.max, 0) << "; " << r.disc_steps << " steps (" << fixed(r.disc_rate_hz, 1)
-       << " Hz), " << r.disc_overruns << " overran the " << period << ", " << r.disc_failed_steps
-       << " rejected" << (multi ? ", " + std::to_string(r.disc_stale_ticks) + " stale ticks" : "")
-       << "; on " << cpu_description() << "\n"
+       << " Hz), " << r.disc_overruns << " overran the " << period << " (" << r.disc_dropped_periods
+       << " periods dropped), " << r.disc_failed_steps << " rejected"
+       << (multi ? ", " + std::to_string(r.disc_stale_ticks) + " stale ticks" : "") << "; on "
+       << cpu_description() << "\n"
        << "  disc: load max " << fixed(r.disc_max_force_n, 1) << " N, indentation max "
        << fixed(r.disc_max_indentation_mm, 2) << " mm, volume change "
        << fixed(100 * r.disc_volume_change_min, 3) << " .. "

@@ -480,6 +480,27 @@ TEST(CliHaptics, MultirateDiscFollowsTheSynchronousSolve) {
   EXPECT_LT(s["relative_rms_error"].get<double>(), 0.05) << s.dump();
 }
 
+TEST(CliHaptics, TheFemDiscIsPalpatedOnTheWorkerAndFollowsTheSynchronousSolve) {
+  // The linear FEM disc itself on the coarse mesh: the same press, the same check; its coupling
+  // damped by k_c T / 2 unless told otherwise, and the run passive.
+  const auto r = run_spinesim(
+      "haptics run --scene disc --level L4-L5 --disc-model fem --triangles 1500 --no-realtime "
+      "--disc-cell-size 4 --disc-sync-check --json --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  const auto d = j["disc_palpation"];
+  EXPECT_EQ(d["model"].get<std::string>(), "linear FEM");
+  EXPECT_EQ(d["failed_steps"].get<long>(), 0);
+  EXPECT_GT(d["max_indentation_mm"].get<double>(), 0.1);
+  EXPECT_NEAR(d["coupling_damping_n_s_per_mm"].get<double>(),
+              0.5e-3 * d["coupling_stiffness_n_per_mm"].get<double>(), 1e-12);
+  const auto& s = d["sync_check"];
+  ASSERT_TRUE(s.is_object()) << d.dump();
+  EXPECT_GT(s["peak_force_n"].get<double>(), 5.0);
+  EXPECT_LT(s["relative_rms_error"].get<double>(), 0.05) << s.dump();
+  EXPECT_GE(j["passivity_energy_mj"]["min"].get<double>(), -1e-6);
+}
+
 TEST(CliHaptics, BadDiscInputIsRefused) {
   const std::string rec = tmp("never_disc.csv");
   const std::string base = "haptics run --duration 1 --record '" + rec + "' ";
@@ -497,6 +518,8 @@ TEST(CliHaptics, BadDiscInputIsRefused) {
   for (const auto& c : disc["budget_check"]) EXPECT_FALSE(c["fits"].get<bool>());
   expect_refused(run_spinesim(base + "--scene disc --disc-cell-size 0.1"), "--disc-cell-size");
   expect_refused(run_spinesim(base + "--scene disc --disc-solver sometimes"), "--disc-solver");
+  expect_refused(run_spinesim(base + "--scene disc --disc-model hex"), "--disc-model");
+  expect_refused(run_spinesim(base + "--scene spine --disc-model fem"), "--scene disc");
   expect_refused(run_spinesim(base + "--scene disc --disc-period-ms 20"), "--disc-period-ms");
   expect_refused(run_spinesim(base + "--scene disc --disc-solver direct --disc-sync-check"),
                  "multirate");

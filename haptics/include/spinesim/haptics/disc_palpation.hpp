@@ -1,4 +1,7 @@
-// Disc palpation: the probe presses into a tuned mass-spring disc simulated beside the servo.
+// Disc palpation: the probe presses into a disc simulated beside the servo — the tuned
+// mass-spring disc, or any disc behind palpable_disc.hpp (the studies layer puts the linear FEM
+// disc there). Below, "step the disc" is the mass-spring disc's implicit step; a static disc
+// is solved to its equilibrium with the probe where the step places it.
 //
 // The disc runs in its own thread, not in the servo thread: its implicit step allocates (CHOLMOD's
 // solves) and takes a few hundred microseconds, and the servo tick must stay allocation-free and
@@ -42,6 +45,7 @@
 // model older than kStaleSteps worker periods renders no disc force.
 #pragma once
 
+#include "spinesim/haptics/palpable_disc.hpp"
 #include "spinesim/haptics/renderer.hpp"
 #include "spinesim/haptics/triple_buffer.hpp"
 #include "spinesim/mss/model.hpp"
@@ -54,6 +58,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <thread>
@@ -73,6 +78,12 @@ struct DiscPalpationOptions {
   bool realtime_priority = true;  ///< SCHED_FIFO for the disc thread (below the servo's)
   int priority = 70;
 };
+
+/// The tuned mass-spring disc of `model` held by `plates`, stepped as the options say (frozen
+/// implicit Euler at dt_s). Throws std::invalid_argument (one line) for bad options.
+std::unique_ptr<PalpableDisc> make_mss_palpable_disc(const mss::MssModel& model,
+                                                     const mss::Boundary& plates,
+                                                     const DiscPalpationOptions& options);
 
 /// What the disc thread publishes after each step.
 struct DiscContact {
@@ -111,10 +122,13 @@ double surface_gap_mm(const mesh::TetMesh& mesh);
 
 class DiscPalpation {
  public:
-  /// `plates`: the endplates' poses (both held; the disc between its vertebrae). Throws
-  /// std::invalid_argument for bad options or a probe radius within surface_gap_mm (one line).
+  /// The tuned mass-spring disc. `plates`: the endplates' poses (both held; the disc between its
+  /// vertebrae). Throws std::invalid_argument for bad options or a probe radius within
+  /// surface_gap_mm (one line).
   DiscPalpation(const mss::MssModel& model, const mss::Boundary& plates,
                 const DiscPalpationOptions& options);
+  /// Any disc (palpable_disc.hpp) made with options.probe_radius_mm; the same refusals.
+  DiscPalpation(std::unique_ptr<PalpableDisc> disc, const DiscPalpationOptions& options);
   ~DiscPalpation();
   DiscPalpation(const DiscPalpation&) = delete;
   DiscPalpation& operator=(const DiscPalpation&) = delete;
@@ -141,9 +155,8 @@ class DiscPalpation {
     return std::max(1, int(std::lround(kPositionsEvery * 1e-3 / options_.dt_s)));
   }
 
-  const mss::MssModel& model() const { return model_; }
-  const mss::State& state() const { return state_; }
-  double probe_penalty_n_per_mm() const { return k_p_; }
+  const PalpableDisc& disc() const { return *disc_; }
+  double probe_penalty_n_per_mm() const { return disc_->probe_penalty_n_per_mm(); }
   /// s k_c: the coupling the disc meets (disc N/mm).
   double disc_coupling_n_per_mm() const {
     return options_.force_scale * options_.coupling_stiffness_n_per_mm;
@@ -154,6 +167,8 @@ class DiscPalpation {
 
   struct Stats {
     std::int64_t steps = 0, overruns = 0, failed_steps = 0;  ///< overrun: ended past its deadline
+    /// Worker periods given up because the steps fell more than a period behind the clock.
+    std::int64_t dropped_periods = 0;
     std::vector<float> step_us;                              ///< every step (thread runs)
     double max_force_n = 0, min_volume_change = 0, max_volume_change = 0;
     double max_indentation_mm = 0;
@@ -173,12 +188,8 @@ class DiscPalpation {
   /// last_'s local contact model after a step for the device at `device_mm`.
   void update_local_model(const Eigen::Vector3d& device_mm);
 
-  const mss::MssModel& model_;
   DiscPalpationOptions options_;
-  mss::Simulator sim_;
-  mss::State state_;
-  mss::Boundary bc_;
-  double k_p_ = 0;
+  std::unique_ptr<PalpableDisc> disc_;
   std::vector<Eigen::Index> surface_nodes_;
   bool armed_ = false;           ///< the device has been outside the disc since the start
   double normal_stiffness_ = 0;  ///< the last contact's n.K.n (the onset plane's), disc N/mm
@@ -203,6 +214,11 @@ std::vector<Eigen::Vector3d> palpate_offline(const mss::MssModel& model,
                                              const DiscPalpationOptions& options,
                                              const std::vector<Eigen::Vector3d>& device_mm,
                                              double tick_s);
+/// The same for any disc, made afresh by `make_disc`.
+std::vector<Eigen::Vector3d> palpate_offline(
+    const std::function<std::unique_ptr<PalpableDisc>()>& make_disc,
+    const DiscPalpationOptions& options, const std::vector<Eigen::Vector3d>& device_mm,
+    double tick_s);
 
 /// Force error of a run against a reference, relative to the reference's peak |F|.
 struct ForceError {

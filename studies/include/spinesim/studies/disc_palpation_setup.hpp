@@ -5,13 +5,19 @@
 // and stepped with the probe pressed 2 mm into its anterior wall (up to 300 steps, at most about
 // half a second of them); the first whose fourth-worst step (CPU time) fits the budget is used.
 // What could not be held (no candidate of >= min_tets fits) is said in `note`.
+//
+// The disc stepped is the tuned mass-spring disc (`disc_model` "mss") or, with "fem", the linear
+// FEM disc it was tuned to (fem/contact_disc.hpp: the tuned set's material on the same mesh, both
+// endplates held, static under the probe) — the reference itself palpated at its resolution.
 #pragma once
 
 #include "spinesim/haptics/disc_palpation.hpp"
+#include "spinesim/haptics/palpable_disc.hpp"
 #include "spinesim/haptics/servo.hpp"
 #include "spinesim/mesh/tet_mesh.hpp"
 #include "spinesim/mss/model.hpp"
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -34,6 +40,7 @@ struct DiscSceneRequest {
   double fixed_cell_size_mm = 0;
   /// Where meshed candidates are kept between runs (mesh/disc_cache.hpp); "": mesh every time.
   std::string cache_dir;
+  std::string disc_model = "mss";  ///< "mss": the tuned mass-spring disc; "fem": its linear FEM
   haptics::DiscPalpationOptions palpation;
 };
 
@@ -49,7 +56,11 @@ struct DiscCandidate {
 };
 
 struct DiscSetup {
-  std::unique_ptr<mss::MssModel> model;  ///< owns its mesh
+  /// The tuned mass-spring disc on the chosen mesh (owns the mesh; with the FEM disc it is what
+  /// the viewer colours the disc's mesh by).
+  std::unique_ptr<mss::MssModel> model;
+  /// Makes the palpated disc afresh (the synchronous check's reference runs on its own copy).
+  std::function<std::unique_ptr<haptics::PalpableDisc>()> make_disc;
   std::unique_ptr<haptics::DiscPalpation> palpation;
   mss::Boundary plates;  ///< the endplates, held
   std::vector<DiscCandidate> tried;
@@ -61,6 +72,13 @@ struct DiscSetup {
 /// parameters, bad palpation options, or when no candidate fits the budget (naming the fastest).
 DiscSetup make_disc_setup(const DiscSceneRequest& request, const std::string& data_dir,
                           const std::function<void(const std::string&)>& stage = {});
+
+/// The linear FEM disc of `mesh` and `materials` under a probe of `radius_mm` (penalty 0: the
+/// FEM's default, fem::ContactDisc::default_penalty) behind the palpation interface.
+std::unique_ptr<haptics::PalpableDisc> make_fem_palpable_disc(const mesh::TetMesh& mesh,
+                                                              const mesh::RegionMaterials& materials,
+                                                              double radius_mm,
+                                                              double penalty_n_per_mm);
 
 /// The disc's anterior wall point at mid-height and its outward normal (spine frame): where the
 /// budget check presses, and where the shipped script presses.

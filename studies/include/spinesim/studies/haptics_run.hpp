@@ -44,6 +44,7 @@ struct HapticsLiveSetup {
   double stiffness_n_per_mm = 0, probe_radius_mm = 0;
   std::string device, spine;  ///< the device's name; the compliant stage ("": none)
   Eigen::Vector3d device_start_mm = Eigen::Vector3d::Zero();  ///< mouse: where the probe starts
+  std::string disc_model;  ///< what is palpated: "mass-spring" or "linear FEM" ("": no disc)
 };
 
 /// What a viewer gets about every 10 ms while the loop runs (from the slow side).
@@ -100,6 +101,8 @@ struct HapticsRunRequest {
   /// "multirate": the disc stepped every disc_period_ms on its thread, its local contact model
   /// felt every tick (haptics/disc_palpation.hpp); "direct": the disc stepped every tick.
   std::string disc_solver = "multirate";
+  /// "mss": the tuned mass-spring disc; "fem": the linear FEM disc it was tuned to (static).
+  std::string disc_model = "mss";
   double disc_period_ms = 10;  ///< multirate: the disc's step, 1-10 ms
   double disc_budget_us = 0;   ///< 0: 500 us (direct) or 80 % of the period (multirate)
   /// After the run, the hand's recorded path through a synchronous solve (the disc stepped every
@@ -139,6 +142,7 @@ struct HapticsRunResult {
   // The compliant stage (spine empty: off).
   std::string spine;
   double coupling_stiffness_n_per_mm = 0, force_scale = 0, spine_max_force_n = 0;
+  double coupling_damping_n_s_per_mm = 0;  ///< the disc coupling's, as used
   double rotational_stiffness_nmm_per_rad = 0;  ///< 0: the hook holds no orientation
   double rotational_passive_limit_nmm_per_rad = 0;
   std::string twist_note;  ///< why the hook holds no orientation, when it does not
@@ -151,6 +155,7 @@ struct HapticsRunResult {
   double disc_cell_size_mm = 0;
   std::vector<DiscCandidate> disc_candidates;  ///< the budget check, finest first
   std::int64_t disc_steps = 0, disc_overruns = 0, disc_failed_steps = 0;
+  std::int64_t disc_dropped_periods = 0;  ///< worker periods given up (more than one behind)
   haptics::Percentiles disc_step_us;
   double disc_max_force_n = 0, disc_volume_change_min = 0, disc_volume_change_max = 0;
   double disc_max_indentation_mm = 0, disc_rate_hz = 0;
