@@ -27,6 +27,7 @@ ROWS = [
     ("plane", "default", []),
     ("vertebra", "default", []),
     ("disc", "default (multirate, 21k tets)", []),
+    ("disc", "--disc-model fem (the linear FEM disc, 21k tets)", ["--disc-model", "fem"]),
 ] + [("spine", "hostile:" + h, ["--script", "hostile:" + h])
      for h in ["teleport", "start-inside", "sweep", "skim", "shake", "hammer"]] + [
     ("spine", "hostile:hammer --spine multirate",

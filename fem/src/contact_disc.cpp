@@ -82,7 +82,7 @@ ContactDisc::ContactDisc(const mesh::TetMesh& m, const mesh::RegionMaterials& ma
   require(std::isfinite(o.penalty_n_per_mm) && o.penalty_n_per_mm >= 0,
           "the penalty must be >= 0 N/mm (0: the default)");
   require(std::isfinite(o.margin_mm) && o.margin_mm >= 0, "the margin must be >= 0 mm");
-  require(o.max_iterations >= 1 && o.relative_tolerance > 0 && o.max_cached_nodes >= 16,
+  require(o.max_iterations >= 1 && o.relative_tolerance > 0 && o.max_cache_mb > 0,
           "bad solver options");
   mesh::require_endplate_labels(m);
   d.mesh = m;
@@ -138,7 +138,10 @@ int ContactDisc::Impl::ensure_columns(const std::vector<Eigen::Index>& nodes) {
     for (int c = 0; c < 3; ++c) rhs(dof(missing[k]) + c, 3 * Eigen::Index(k) + c) = 1;
   const Eigen::MatrixXd G = solver.solve(rhs);
   // Least recently used out first, never one of `nodes` (they carry this clock).
-  while (cache.size() + missing.size() > std::size_t(options.max_cached_nodes)) {
+  const double node_mb = 3.0 * double(n) * sizeof(double) / 1e6;
+  const std::size_t cap =
+      std::max<std::size_t>(16, std::size_t(options.max_cache_mb / std::max(node_mb, 1e-12)));
+  while (cache.size() + missing.size() > cap) {
     auto oldest = cache.end();
     for (auto it = cache.begin(); it != cache.end(); ++it)
       if (it->second.used < clock &&
@@ -298,6 +301,21 @@ ContactSolveReport ContactDisc::solve(const Eigen::Vector3d& c) {
   return report;
 }
 
+int ContactDisc::prefetch(const Eigen::Vector3d& c, double reach_mm, int max_nodes) {
+  Impl& d = *impl_;
+  std::vector<std::pair<double, Eigen::Index>> near;
+  for (const Eigen::Index i : d.wall) {
+    const double dist = (d.x.segment<3>(3 * i) - c).norm();
+    if (dist < reach_mm && d.cache.find(i) == d.cache.end()) near.emplace_back(dist, i);
+  }
+  if (near.empty() || max_nodes < 1) return 0;
+  const std::size_t k = std::min(near.size(), std::size_t(max_nodes));
+  std::partial_sort(near.begin(), near.begin() + std::ptrdiff_t(k), near.end());
+  std::vector<Eigen::Index> nodes = d.S;  // the contact's own nodes stay cached
+  for (std::size_t a = 0; a < k; ++a) nodes.push_back(near[a].second);
+  return d.ensure_columns(nodes);
+}
+
 const mesh::TetMesh& ContactDisc::mesh() const { return impl_->mesh; }
 const Eigen::VectorXd& ContactDisc::rest_positions_mm() const { return impl_->X; }
 const Eigen::VectorXd& ContactDisc::positions_mm() const { return impl_->x; }
@@ -311,5 +329,6 @@ double ContactDisc::penalty_n_per_mm() const { return impl_->k_p; }
 double ContactDisc::default_penalty() const { return 100 * impl_->trace / (2 * impl_->edges); }
 Eigen::Index ContactDisc::num_free_dofs() const { return impl_->pattern.lower.rows(); }
 std::int64_t ContactDisc::column_solves() const { return impl_->column_solves; }
+std::size_t ContactDisc::cached_nodes() const { return impl_->cache.size(); }
 
 }  // namespace spinesim::fem

@@ -12,7 +12,7 @@
 //
 // Method. K_ff is assembled and factorised once (CHOLMOD). A wall node near the probe gets its
 // compliance columns G_i = K_ff^-1 E_i (one 3-column solve, cached, least recently used dropped
-// beyond `max_cached_nodes`). With the candidate set S (wall nodes within r + margin of c) the
+// beyond `max_cache_mb`). With the candidate set S (wall nodes within r + margin of c) the
 // equilibrium condenses exactly to the contact nodes: with W = G restricted to the rows of S (the
 // Schur complement's inverse), u_S minimises
 //   Phi(u_S) = u_S^T W^-1 u_S / 2 + sum_i k_p/2 max(0, r - |c - x_i|)^2,
@@ -47,7 +47,9 @@ struct ContactDiscOptions {
   double margin_mm = 0;
   int max_iterations = 50;
   double relative_tolerance = 1e-10;  ///< |gradient| <= tol (|W^-1 u_S| + |f_S| + 1e-12)
-  int max_cached_nodes = 512;         ///< compliance columns kept (3 #free doubles per node)
+  /// Memory for the cached compliance columns (3 x 3 #free doubles a node: 0.3 MB a node at
+  /// 20,000 tets); at least 16 nodes are kept whatever it says.
+  double max_cache_mb = 128;
 };
 
 struct ContactSolveReport {
@@ -69,6 +71,11 @@ class ContactDisc {
   /// On failure the disc keeps its last equilibrium.
   ContactSolveReport solve(const Eigen::Vector3d& center_mm);
 
+  /// Solves ahead the compliance columns of up to `max_nodes` uncached wall nodes within
+  /// `reach_mm` of `center_mm` (nearest first, one multi-column solve), so that a touch there
+  /// does not pay for them. Returns how many were solved.
+  int prefetch(const Eigen::Vector3d& center_mm, double reach_mm, int max_nodes);
+
   const mesh::TetMesh& mesh() const;
   const Eigen::VectorXd& rest_positions_mm() const;  ///< 3 #V
   const Eigen::VectorXd& positions_mm() const;       ///< 3 #V, the last equilibrium
@@ -82,6 +89,7 @@ class ContactDisc {
   double default_penalty() const;
   Eigen::Index num_free_dofs() const;
   std::int64_t column_solves() const;  ///< nodes whose compliance columns were solved
+  std::size_t cached_nodes() const;    ///< nodes whose columns are kept now
 
  private:
   struct Impl;
