@@ -1,6 +1,7 @@
 // ContactDisc: the condensed contact solve against a brute-force Newton solve of the whole
 // system (the penalty Hessian added to the full stiffness, no condensation, no cached columns),
 // its sphere stiffness against finite differences of the force, and its bookkeeping.
+#include "../haptics/disc_fixture.hpp"
 #include "spinesim/fem/assembly.hpp"
 #include "spinesim/fem/contact_disc.hpp"
 #include "spinesim/fem/fe_space.hpp"
@@ -19,29 +20,14 @@ using Eigen::Vector3d;
 
 namespace {
 
-const mesh::TetMesh& disc_mesh() {
-  static const mesh::TetMesh m = [] {
-    mesh::StructuredDiscOptions o;  // 2400 tets
-    o.sectors = 40;
-    o.layers = 4;
-    return mesh::mesh_structured_disc(mesh::disc_dimensions("L4-L5", SPINESIM_DATA_DIR), o);
-  }();
-  return m;
-}
+const mesh::TetMesh& disc_mesh() { return spinesim::test::structured_l4l5_disc(); }
 
 const mesh::RegionMaterials& material() {
   static const mesh::RegionMaterials m = mesh::load_material("fibre-reinforced", SPINESIM_DATA_DIR);
   return m;
 }
 
-/// The most anterior mid-height wall node and the outward normal (+z).
-Vector3d anterior_wall() {
-  const auto& V = disc_mesh().V;
-  Eigen::Index best = 0;
-  for (Eigen::Index i = 0; i < V.rows(); ++i)
-    if (std::abs(V(i, 1)) < 1e-9 && V(i, 2) > V(best, 2)) best = i;
-  return V.row(best).transpose();
-}
+Vector3d anterior_wall() { return spinesim::test::anterior_wall(disc_mesh()).first; }
 
 /// Brute force: Newton on the whole free system K u - f(u) = 0 with the exact penalty Hessian,
 /// every wall node a candidate, Eigen's own sparse Cholesky. Returns the positions (3 #V).

@@ -3,6 +3,7 @@
 // disc's contact force (what the hand feels is what the disc pushes with); the felt stiffness
 // never exceeds the coupling's; pressing in and out in cycles is passive (the rigid stage's
 // observer); the thread steps at its rate; bad options are refused.
+#include "disc_fixture.hpp"
 #include "spinesim/haptics/disc_palpation.hpp"
 #include "spinesim/haptics/safety.hpp"
 #include "spinesim/mesh/disc_geometry.hpp"
@@ -24,24 +25,13 @@ using Eigen::Vector3d;
 namespace {
 
 const mss::MssModel& disc() {
-  static const mss::MssModel m = [] {
-    mesh::StructuredDiscOptions o;  // 2400 tets, surface nodes 2.8-3.7 mm apart
-    o.sectors = 40;
-    o.layers = 4;
-    const mesh::TetMesh t =
-        mesh::mesh_structured_disc(mesh::disc_dimensions("L4-L5", SPINESIM_DATA_DIR), o);
-    return mss::MssModel(t, mesh::load_material("real-disc", SPINESIM_DATA_DIR));
-  }();
+  static const mss::MssModel m(spinesim::test::structured_l4l5_disc(),
+                               mesh::load_material("real-disc", SPINESIM_DATA_DIR));
   return m;
 }
 
-/// The disc's most anterior surface point (local frame: +z anterior) and its outward normal.
 std::pair<Vector3d, Vector3d> anterior_wall() {
-  const auto& V = disc().mesh().V;
-  Eigen::Index best = 0;
-  for (Eigen::Index i = 0; i < V.rows(); ++i)
-    if (std::abs(V(i, 1)) < 1e-9 && V(i, 2) > V(best, 2)) best = i;  // mid-height node
-  return {V.row(best).transpose(), Vector3d(0, 0, 1)};
+  return spinesim::test::anterior_wall(disc().mesh());
 }
 
 sh::DiscPalpationOptions options() {
@@ -186,22 +176,8 @@ TEST(DiscPalpation, BadOptionsAreRefused) {
 
 namespace {
 
-/// Approach from 6 mm out over 0.2 s, press `depth` mm past first touch over `press_s`, hold
-/// 0.2 s, withdraw over `press_s`: the device's path at 1 kHz, 1.2 s.
 std::vector<Vector3d> press_path(double depth, double press_s = 0.4) {
-  const auto [wall, n] = anterior_wall();
-  const double r = options().probe_radius_mm;
-  std::vector<Vector3d> path;
-  for (int k = 0; k < 1200; ++k) {
-    const double t = k * 1e-3;
-    const double in = t < 0.2             ? -6.0 + 6.0 * t / 0.2
-                      : t < 0.2 + press_s ? depth * (t - 0.2) / press_s
-                      : t < 0.4 + press_s
-                          ? depth
-                          : depth * std::max(0.0, 1 - (t - 0.4 - press_s) / press_s);
-    path.push_back(wall + (r - in) * n);
-  }
-  return path;
+  return spinesim::test::press_path(disc().mesh(), options().probe_radius_mm, depth, press_s);
 }
 
 }  // namespace

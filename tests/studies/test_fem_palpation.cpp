@@ -1,6 +1,7 @@
 // Palpating the linear FEM disc (`haptics run --scene disc --disc-model fem`): the multirate
 // worker's local contact model against the synchronous solve (the FEM equilibrium every 1 ms),
 // passivity of the hand's work, the force balance of a held press, and the scene's set-up.
+#include "../haptics/disc_fixture.hpp"
 #include "spinesim/haptics/disc_palpation.hpp"
 #include "spinesim/haptics/safety.hpp"
 #include "spinesim/mesh/disc_level.hpp"
@@ -21,28 +22,14 @@ namespace {
 
 const std::string kData = SPINESIM_DATA_DIR;
 
-const mesh::TetMesh& disc_mesh() {
-  static const mesh::TetMesh m = [] {
-    mesh::StructuredDiscOptions o;  // 2400 tets, surface nodes 2.8-3.7 mm apart
-    o.sectors = 40;
-    o.layers = 4;
-    return mesh::mesh_structured_disc(mesh::disc_dimensions("L4-L5", kData), o);
-  }();
-  return m;
-}
+const mesh::TetMesh& disc_mesh() { return spinesim::test::structured_l4l5_disc(); }
 
 std::unique_ptr<sh::PalpableDisc> fem_disc() {
   return make_fem_palpable_disc(disc_mesh(), mesh::load_material("fibre-reinforced", kData), 4.0,
                                 0.0);
 }
 
-std::pair<Vector3d, Vector3d> anterior_wall() {
-  const auto& V = disc_mesh().V;
-  Eigen::Index best = 0;
-  for (Eigen::Index i = 0; i < V.rows(); ++i)
-    if (std::abs(V(i, 1)) < 1e-9 && V(i, 2) > V(best, 2)) best = i;
-  return {V.row(best).transpose(), Vector3d(0, 0, 1)};
-}
+std::pair<Vector3d, Vector3d> anterior_wall() { return spinesim::test::anterior_wall(disc_mesh()); }
 
 sh::DiscPalpationOptions options() {
   sh::DiscPalpationOptions o;
@@ -53,20 +40,8 @@ sh::DiscPalpationOptions options() {
   return o;
 }
 
-/// From 6 mm out to `depth` mm past the wall in `press_s`, held 0.2 s, back out as fast.
 std::vector<Vector3d> press_path(double depth, double press_s) {
-  const auto [wall, n] = anterior_wall();
-  std::vector<Vector3d> path;
-  for (int k = 0; k < 1200; ++k) {
-    const double t = k * 1e-3;
-    const double in = t < 0.2             ? -6.0 + 6.0 * t / 0.2
-                      : t < 0.2 + press_s ? depth * (t - 0.2) / press_s
-                      : t < 0.4 + press_s
-                          ? depth
-                          : depth * std::max(0.0, 1 - (t - 0.4 - press_s) / press_s);
-    path.push_back(wall + (4.0 - in) * n);
-  }
-  return path;
+  return spinesim::test::press_path(disc_mesh(), 4.0, depth, press_s);
 }
 
 TEST(FemPalpation, HeldPressBalancesTheCouplingAndIndentsTheWall) {
