@@ -8,6 +8,7 @@
 #include "write_checks.hpp"
 #include "xml_escape.hpp"
 
+#include <lz4.h>
 #include <lzma.h>
 #include <tinyxml2.h>
 #include <zlib.h>
@@ -143,12 +144,19 @@ void write_zlib_blocks(const unsigned char* data, std::size_t nbytes, std::ostre
   base64_encode(packed, os);
 }
 
+/// Whether a <DataArray> states its tuple count. VTK sizes the arrays of a Piece from the Piece,
+/// but a <FieldData> array from its NumberOfTuples alone: without it VTK reads the array empty.
+enum class Tuples { implied, stated };
+
 /// One <DataArray> with `n` values of C++ type T (VTK type name `vtk_type`), tuple-major.
 template <class T>
 void write_data_array(std::ostream& os, const char* vtk_type, const std::string& name, int ncomp,
-                      const std::vector<T>& data, VtuEncoding enc, const char* indent) {
+                      const std::vector<T>& data, VtuEncoding enc, const char* indent,
+                      Tuples tuples = Tuples::implied) {
   os << indent << "<DataArray type=\"" << vtk_type << "\" Name=\"" << detail::xml_escape(name)
-     << "\" NumberOfComponents=\"" << ncomp << "\" format=\""
+     << "\" NumberOfComponents=\"" << ncomp;
+  if (tuples == Tuples::stated) os << "\" NumberOfTuples=\"" << data.size() / std::size_t(ncomp);
+  os << "\" format=\""
      << (enc == VtuEncoding::ascii ? "ascii" : "binary") << "\">\n"
      << indent << "  ";
   if (enc == VtuEncoding::zlib) {
@@ -243,7 +251,7 @@ void check_arrays(const std::string& path, const std::vector<DataArray>& arrays,
 using detail::RawArray;
 
 /// How the binary arrays of a file are compressed (VTKFile compressor=…).
-enum class Compressor { none, zlib, lzma };
+enum class Compressor { none, zlib, lzma, lz4 };
 
 struct Reader : detail::FileError {
   bool swap_bytes = false;
@@ -380,6 +388,12 @@ void inflate_block(const Reader& r, const std::string& name, const unsigned char
   if (r.compressor == Compressor::zlib) {
     uLongf dlen = uLongf(usize);
     ok = ::uncompress(dst, &dlen, src, uLong(csize)) == Z_OK && dlen == usize;
+  } else if (r.compressor == Compressor::lz4) {
+    // VTK's LZ4 compressor stores raw LZ4 blocks (no frame), one per VTK block.
+    ok = csize <= std::uint64_t(std::numeric_limits<int>::max()) &&
+         usize <= std::uint64_t(std::numeric_limits<int>::max()) &&
+         LZ4_decompress_safe(reinterpret_cast<const char*>(src), reinterpret_cast<char*>(dst),
+                             int(csize), int(usize)) == int(usize);
   } else {
     lzma_stream z = LZMA_STREAM_INIT;
     if (lzma_auto_decoder(&z, UINT64_MAX, 0) == LZMA_OK) {
@@ -561,10 +575,12 @@ void read_envelope(Reader& r, const tinyxml2::XMLElement* root) {
       r.compressor = Compressor::zlib;
     else if (std::strcmp(comp, "vtkLZMADataCompressor") == 0)
       r.compressor = Compressor::lzma;
+    else if (std::strcmp(comp, "vtkLZ4DataCompressor") == 0)
+      r.compressor = Compressor::lz4;
     else
       r.fail(std::string("data compressed with ") + comp +
-             ", which is not supported; re-save it with zlib or LZMA compression, or uncompressed "
-             "(ParaView: Compressor Type ZLib or None)");
+             ", which is not supported; re-save it with zlib, LZ4 or LZMA compression, or "
+             "uncompressed (ParaView: Compressor Type ZLib, LZ4, LZMA or None)");
   }
   const char* order = root->Attribute("byte_order");
   const bool file_little = !order || std::strcmp(order, "BigEndian") != 0;
@@ -625,9 +641,11 @@ void write_vtu(const std::string& path, const TetMesh& m, const std::vector<Data
        << (enc == VtuEncoding::zlib ? " compressor=\"vtkZLibDataCompressor\"" : "") << ">\n"
        << "  <UnstructuredGrid>\n"
        << "    <FieldData>\n";
-    write_data_array(os, "Float64", "disc_frame", 12, frame, VtuEncoding::ascii, "      ");
+    write_data_array(os, "Float64", "disc_frame", 12, frame, VtuEncoding::ascii, "      ",
+                     Tuples::stated);
     if (!source.empty())
-      write_data_array(os, "UInt8", "source", 1, source, VtuEncoding::ascii, "      ");
+      write_data_array(os, "UInt8", "source", 1, source, VtuEncoding::ascii, "      ",
+                       Tuples::stated);
     os << "    </FieldData>\n"
        << "    <Piece NumberOfPoints=\"" << m.num_vertices() << "\" NumberOfCells=\"" << nt
        << "\">\n"

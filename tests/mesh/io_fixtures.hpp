@@ -6,8 +6,12 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <functional>
+#include <sstream>
 #include <string>
 #include <utility>
 
@@ -57,6 +61,44 @@ inline void expect_one_line_refusal(const std::function<void()>& read, const std
     EXPECT_NE(msg.find(path), std::string::npos) << msg;
     EXPECT_NE(msg.find(needle), std::string::npos) << msg;
   }
+}
+
+/// The whole file at `path`, bytes as they are.
+inline std::string slurp(const std::string& path) {
+  std::ifstream is(path, std::ios::binary);
+  std::stringstream ss;
+  ss << is.rdbuf();
+  return ss.str();
+}
+
+/// Writes `text` to `path`.
+inline void spit(const std::string& path, const std::string& text) {
+  std::ofstream os(path, std::ios::binary);
+  os << text;
+}
+
+/// Whether Debian's /usr/bin/python3 imports `modules` (e.g. "meshio, numpy").
+inline bool python_has(const std::string& modules) {
+  return std::filesystem::exists("/usr/bin/python3") &&
+         std::system(("/usr/bin/python3 -c 'import " + modules + "' >/dev/null 2>&1").c_str()) == 0;
+}
+
+/// Runs /usr/bin/python3 on `script` (saved in `dir`) with `args` and returns its stdout; a
+/// non-zero exit fails the test with the script's stderr.
+inline std::string run_python(const std::string& dir, const std::string& script,
+                              const std::string& args) {
+  const std::string py = dir + "/script.py";
+  spit(py, script);
+  const std::string err = dir + "/stderr.txt";
+  const std::string cmd = "/usr/bin/python3 " + py + " " + args + " 2>" + err;
+  std::string out;
+  FILE* p = popen(cmd.c_str(), "r");
+  if (!p) return out;
+  char buf[4096];
+  while (std::fgets(buf, sizeof buf, p)) out += buf;
+  const int rc = pclose(p);
+  EXPECT_EQ(rc, 0) << out << slurp(err);
+  return out;
 }
 
 }  // namespace spinesim::mesh::test

@@ -24,12 +24,7 @@ namespace {
 
 std::string tmp_dir(const std::string& name) { return test::fresh_tmp_dir("io_pvd_", name); }
 
-std::string slurp(const std::string& path) {
-  std::ifstream is(path, std::ios::binary);
-  std::stringstream ss;
-  ss << is.rdbuf();
-  return ss.str();
-}
+using test::slurp;
 
 int count_files(const std::string& dir) {
   int n = 0;

@@ -38,38 +38,12 @@ std::string data_file(const std::string& name) {
 
 std::string tmp_dir(const std::string& name) { return test::fresh_tmp_dir("io_vtu_", name); }
 
-std::string slurp(const std::string& path) {
-  std::ifstream is(path, std::ios::binary);
-  std::stringstream ss;
-  ss << is.rdbuf();
-  return ss.str();
-}
+using test::python_has;
+using test::run_python;
+using test::slurp;
+using test::spit;
 
-void spit(const std::string& path, const std::string& text) {
-  std::ofstream os(path, std::ios::binary);
-  os << text;
-}
-
-bool has_meshio() {
-  return fs::exists("/usr/bin/python3") &&
-         std::system("/usr/bin/python3 -c 'import meshio, numpy' >/dev/null 2>&1") == 0;
-}
-
-/// Runs /usr/bin/python3 on `script` with `args`, returns stdout; fails the test on error.
-std::string run_python(const std::string& dir, const std::string& script, const std::string& args) {
-  const std::string py = dir + "/script.py";
-  spit(py, script);
-  const std::string err = dir + "/stderr.txt";
-  const std::string cmd = "/usr/bin/python3 " + py + " " + args + " 2>" + err;
-  std::string out;
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return out;
-  char buf[4096];
-  while (std::fgets(buf, sizeof buf, p)) out += buf;
-  const int rc = pclose(p);
-  EXPECT_EQ(rc, 0) << out << slurp(err);
-  return out;
-}
+bool has_meshio() { return python_has("meshio, numpy"); }
 
 int count_tmp_files(const std::string& dir) {
   int n = 0;
@@ -553,11 +527,21 @@ TEST(IoVtu, BadEncodingsGiveOneLineErrors) {
       },
       "appended");
   expect_read_error(
-      "lz4",
+      "unknown_compressor",
       [](std::string& s) {
-        replace_once(s, "header_type=", "compressor=\"vtkLZ4DataCompressor\" header_type=");
+        replace_once(s, "header_type=", "compressor=\"vtkBrotliDataCompressor\" header_type=");
       },
-      "vtkLZ4DataCompressor");
+      "vtkBrotliDataCompressor");
+  expect_read_error(
+      "corrupt_lz4",
+      [](std::string& s) {
+        // An LZ4 block whose literal run claims more bytes than the block holds.
+        replace_once(s, "header_type=\"UInt64\"",
+                     "header_type=\"UInt32\" compressor=\"vtkLZ4DataCompressor\"");
+        const auto [a, b] = array_body(s, "Points");
+        s.replace(a, b - a, "AQAAAGAAAABgAAAACAAAAA==8P8BAgMEBQY=");
+      },
+      "does not decompress", VtuEncoding::binary);
   expect_read_error(
       "corrupt_zlib",
       [](std::string& s) {

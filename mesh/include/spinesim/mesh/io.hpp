@@ -7,7 +7,8 @@
 //   - CellData `region` (Int32) then the caller's cell arrays (Float64);
 //   - PointData `surface` (Int32) then the caller's point arrays (Float64, NumberOfComponents =
 //     columns), e.g. `displacement`, 3 components, mm;
-//   - FieldData (always ASCII) `disc_frame`: 12 Float64 = origin (mm), then the 3 columns of
+//   - FieldData (always ASCII, with NumberOfTuples, which VTK needs to size a field array)
+//     `disc_frame`: one tuple of 12 Float64 = origin (mm), then the 3 columns of
 //     `axes` (lateral, axial, anterior); and `source`: the provenance string as UInt8 character
 //     codes (not VTK's String type, which meshio cannot read).
 // Writers refuse bad input (non-finite values, wrong array sizes) before touching the disk, write
@@ -68,7 +69,7 @@ void write_surface_vtu(const std::string& path, const TriSurface& s,
 /// Reads a VTU with a single Piece, in every encoding the VTK XML format allows: DataArrays
 /// format="ascii", "binary" (inline base64) or "appended" (<AppendedData> raw or base64, arrays
 /// located by their offsets); header_type UInt32 or UInt64; uncompressed, or compressed with
-/// vtkZLibDataCompressor or vtkLZMADataCompressor (VTK's block header: #blocks, block size,
+/// vtkZLibDataCompressor, vtkLZ4DataCompressor or vtkLZMADataCompressor (VTK's block header: #blocks, block size,
 /// last block size, compressed sizes); any VTK numeric type, either byte order. A file whose
 /// header announces more than 4 GiB for one array is refused (corrupt or hostile).
 /// Cells: VTK_TETRA (10); VTK_QUADRATIC_TETRA (24) is read by its 4 corner vertices and
