@@ -106,6 +106,9 @@ void DiscFem::Impl::pressures_for(const Eigen::VectorXd& p, PlateSolution& s) co
     count(pressure.vertex(i)) += 1;
   }
   s.pressure_mpa = s.pressure_mpa.cwiseQuotient(count.cwiseMax(1.0));
+  s.element_mean_stress_mpa.resize(T.rows(), 4);
+  for (Eigen::Index t = 0; t < T.rows(); ++t)
+    for (int a = 0; a < 4; ++a) s.element_mean_stress_mpa(t, a) = p(pressure.elements(t, a));
   double sum = 0, volume = 0;
   TetVertices X;
   for (Eigen::Index t = 0; t < T.rows(); ++t) {

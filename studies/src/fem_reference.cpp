@@ -62,6 +62,11 @@ FemRunResult run_fem_reference(const mesh::TetMesh& m, const mesh::RegionMateria
     r.solution = solver.solve_motion(rq.motion ? *rq.motion : fem::Vector6d::Zero());
   }
   r.load_solve_s = timer.seconds();
+  const bool mixed = rq.formulation == fem::Formulation::mixed;
+  r.fields = fem::element_fields(m, materials, r.fibres, rq.order, r.solution.node_displacement_mm,
+                                 mixed ? &r.solution.element_mean_stress_mpa : nullptr);
+  for (Eigen::Index t = 0; t < m.num_tets(); ++t)
+    r.strain_energy_mj += r.fields.strain_energy_density_mpa(t) * mesh::tet_volume(m, t);
   hooks.end_stage();
   r.timings = solver.timings();
   return r;
@@ -97,6 +102,18 @@ nlohmann::json fem_run_json(const FemRunResult& r, const std::string& mesh_label
   j["formulation"] = formulation_name(r.request.formulation);
   if (std::isfinite(sol.nucleus_pressure_mpa)) j["nucleus_pressure_mpa"] = sol.nucleus_pressure_mpa;
   j["fibres"] = !r.fibres.empty();
+  const fem::ElementFields& f = r.fields;
+  j["fields"] = {{"max_von_mises_mpa", f.von_mises_mpa.maxCoeff()},
+                 {"max_pressure_mpa", f.pressure_mpa.maxCoeff()},
+                 {"min_pressure_mpa", f.pressure_mpa.minCoeff()},
+                 {"max_principal_strain", f.principal_strain.col(0).maxCoeff()},
+                 {"min_principal_strain", f.principal_strain.col(2).minCoeff()},
+                 {"strain_energy_mj", r.strain_energy_mj}};
+  if (!r.fibres.empty()) {
+    j["fields"]["max_fibre_stress_mpa"] = f.fibre_stress_mpa.maxCoeff();
+    j["fields"]["min_fibre_stress_mpa"] = f.fibre_stress_mpa.minCoeff();
+  }
+  j["fields_units"] = "per-tet means; MPa, strain 1, mJ (= N·mm)";
   return j;
 }
 
@@ -114,17 +131,29 @@ void write_fem_vtu(const std::string& path, const mesh::TetMesh& m, const FemRun
   std::vector<mesh::DataArray> points{{"displacement", r.solution.displacement_mm}};
   if (r.solution.pressure_mpa.size() == m.num_vertices())
     points.push_back({"pressure", r.solution.pressure_mpa});
-  std::vector<mesh::DataArray> cells;
+  const fem::ElementFields& f = r.fields;
+  std::vector<mesh::DataArray> cells = {
+      {"stress_MPa", f.stress_mpa},  // symmetric tensors: xx yy zz xy yz xz (ParaView's order)
+      {"von_mises_MPa", f.von_mises_mpa},
+      {"pressure_MPa", f.pressure_mpa},
+      {"strain", f.strain},
+      {"principal_strain", f.principal_strain},
+      {"principal_strain_direction_1", f.principal_strain_directions.leftCols(3)},
+      {"principal_strain_direction_2", f.principal_strain_directions.middleCols(3, 3)},
+      {"principal_strain_direction_3", f.principal_strain_directions.rightCols(3)},
+      {"strain_energy_density_MPa", f.strain_energy_density_mpa}};
   if (!r.fibres.empty()) {
+    cells.push_back({"fibre_stretch", f.fibre_stretch});
+    cells.push_back({"fibre_stress_MPa", f.fibre_stress_mpa});
     // VTU files hold finite numbers only (io.hpp): cells without fibres get zero vectors, angle
     // 0 and depth -1 (outside [0, 1]).
     const auto finite_or = [](const Eigen::VectorXd& v, double fill) {
       return Eigen::VectorXd(v.unaryExpr([fill](double x) { return std::isfinite(x) ? x : fill; }));
     };
-    cells = {{"fibre_direction_1", r.fibres.direction_1},
-             {"fibre_direction_2", r.fibres.direction_2},
-             {"fibre_angle_deg", finite_or(r.fibres.angle_deg, 0.0)},
-             {"annulus_depth", finite_or(r.fibres.depth, -1.0)}};
+    cells.insert(cells.end(), {{"fibre_direction_1", r.fibres.direction_1},
+                               {"fibre_direction_2", r.fibres.direction_2},
+                               {"fibre_angle_deg", finite_or(r.fibres.angle_deg, 0.0)},
+                               {"annulus_depth", finite_or(r.fibres.depth, -1.0)}});
   }
   mesh::write_vtu(path, m, points, cells);
 }
@@ -144,6 +173,14 @@ void print_fem_run(std::ostream& os, const FemRunResult& r, const std::string& m
      << " N·mm\n";
   if (std::isfinite(r.solution.nucleus_pressure_mpa))
     os << "  nucleus pressure " << r.solution.nucleus_pressure_mpa << " MPa (volume mean)\n";
+  const fem::ElementFields& f = r.fields;
+  os << "  stress        von Mises up to " << f.von_mises_mpa.maxCoeff() << " MPa, pressure "
+     << f.pressure_mpa.minCoeff() << " .. " << f.pressure_mpa.maxCoeff() << " MPa (tet means)\n"
+     << "  strain        principal " << f.principal_strain.col(2).minCoeff() << " .. "
+     << f.principal_strain.col(0).maxCoeff() << ", energy " << r.strain_energy_mj << " mJ\n";
+  if (!r.fibres.empty())
+    os << "  fibre stress  " << f.fibre_stress_mpa.minCoeff() << " .. "
+       << f.fibre_stress_mpa.maxCoeff() << " MPa\n";
   print_stiffness(os, r.stiffness);
 }
 

@@ -14,6 +14,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <memory>
 
 namespace spinesim::test_cli {
@@ -80,6 +81,58 @@ TEST(CliFibres, MixedFemWritesThePressureAndTheFibreField) {
     if (m.region(t) == 2)
       for (int a = 0; a < 4; ++a) nucleus += p->values(m.T(t, a), 0), ++n;
   EXPECT_GT(nucleus / n, 0.0);
+}
+
+TEST(CliFibres, FemWritesStressStrainAndFibreFieldsThatVtkReadsWhole) {
+  std::vector<mesh::DataArray> points, cells;
+  const mesh::TetMesh m = mesh::read_vtu(fibre_result(), &points, &cells);
+  std::map<std::string, const mesh::DataArray*> by_name;
+  for (const auto& a : cells) by_name[a.name] = &a;
+  for (const char* name : {"stress_MPa", "von_mises_MPa", "pressure_MPa", "strain", "principal_strain",
+                           "principal_strain_direction_1", "strain_energy_density_MPa",
+                           "fibre_stretch", "fibre_stress_MPa"})
+    ASSERT_TRUE(by_name.count(name)) << name;
+  const Eigen::MatrixXd& stress = by_name["stress_MPa"]->values;
+  const Eigen::MatrixXd& fibre_stress = by_name["fibre_stress_MPa"]->values;
+  ASSERT_EQ(stress.cols(), 6);
+  double nucleus_pressure = 0, volume = 0;
+  for (Eigen::Index t = 0; t < m.num_tets(); ++t) {
+    // Pressure is the stress's negative mean; fibres carry stress in the annulus only.
+    EXPECT_NEAR(by_name["pressure_MPa"]->values(t, 0), -stress.row(t).head<3>().sum() / 3, 1e-12);
+    if (m.region(t) == 2) {
+      EXPECT_EQ(fibre_stress.row(t).norm(), 0.0);
+      nucleus_pressure += by_name["pressure_MPa"]->values(t, 0) * mesh::tet_volume(m, t);
+      volume += mesh::tet_volume(m, t);
+    }
+  }
+  EXPECT_GT(fibre_stress.cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_GT(nucleus_pressure / volume, 0.0);  // compressed
+  if (std::system("/usr/bin/python3 -c 'import vtk' >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "python3-vtk9 not available";
+  // VTK itself reads every array with one tuple per cell or point (and the field data whole).
+  const std::string script = tmp("vtk_counts.py"), out = tmp("vtk_counts.txt");
+  std::ofstream(script) << "import sys, vtk\n"
+                           "r = vtk.vtkXMLUnstructuredGridReader(); r.SetFileName(sys.argv[1]); r.Update()\n"
+                           "g = r.GetOutput()\n"
+                           "for kind, d in (('cell', g.GetCellData()), ('point', g.GetPointData()), "
+                           "('field', g.GetFieldData())):\n"
+                           "    for i in range(d.GetNumberOfArrays()):\n"
+                           "        a = d.GetAbstractArray(i)\n"
+                           "        print(kind, a.GetName(), a.GetNumberOfTuples(), a.GetNumberOfComponents())\n";
+  ASSERT_EQ(std::system(("/usr/bin/python3 '" + script + "' '" + fibre_result() + "' > '" + out + "'").c_str()), 0);
+  std::ifstream in(out);
+  std::map<std::string, std::pair<long, long>> vtk;
+  for (std::string kind, name; in >> kind >> name;) {
+    long tuples = 0, components = 0;
+    in >> tuples >> components;
+    vtk[kind + ":" + name] = {tuples, components};
+  }
+  for (const auto& a : cells)
+    EXPECT_EQ(vtk["cell:" + a.name], std::make_pair(long(m.num_tets()), long(a.values.cols()))) << a.name;
+  for (const auto& a : points)
+    EXPECT_EQ(vtk["point:" + a.name], std::make_pair(long(m.num_vertices()), long(a.values.cols()))) << a.name;
+  EXPECT_EQ(vtk["field:disc_frame"], std::make_pair(1L, 12L));
+  EXPECT_EQ(vtk.size(), cells.size() + points.size() + 2 /* region, surface */ + 2 /* frame, source */);
 }
 
 TEST(CliFibres, BadFormulationsAreOneLine) {

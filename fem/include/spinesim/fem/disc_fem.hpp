@@ -74,6 +74,9 @@ struct PlateSolution {
   /// and its volume average over the nucleus (region 2), the intradiscal pressure.
   Eigen::VectorXd pressure_mpa;
   double nucleus_pressure_mpa = std::numeric_limits<double>::quiet_NaN();
+  /// Mixed formulation only (empty otherwise): the mean stress p (MPa, tension > 0) at each
+  /// tet's four vertices, for the tet's region — what stress_fields.hpp needs.
+  Eigen::MatrixX4d element_mean_stress_mpa;
 };
 
 /// Solver object: assembles and factorises once, then answers any number of plate loads.

@@ -6,6 +6,7 @@
 #include "spinesim/fem/disc_fem.hpp"
 #include "spinesim/fem/load_cases.hpp"
 #include "spinesim/fem/plate_stiffness.hpp"
+#include "spinesim/fem/stress_fields.hpp"
 #include "spinesim/mesh/material.hpp"
 #include "spinesim/mesh/tet_mesh.hpp"
 #include "spinesim/studies/toolkit.hpp"
@@ -50,6 +51,8 @@ struct FemRunResult {
   fem::Timings timings;
   double load_solve_s = 0;
   fem::ElementFibres fibres;  ///< the annulus fibre field (empty without fibres)
+  fem::ElementFields fields;  ///< per-tet stress, strain and energy (stress_fields.hpp)
+  double strain_energy_mj = 0;  ///< sum over tets of energy density × volume (N·mm = mJ)
 };
 
 /// Assembles, factorises and solves the one load. Stages: assembly, solve (2). Throws
