@@ -42,6 +42,7 @@ void add_plate_load_options(CLI::App* cmd, std::string& motion, std::string& wre
 void register_mesh(CLI::App& app);
 void register_mesh_vertebrae(CLI::App& mesh);  ///< mesh vertebrae, under `mesh`
 void register_fem(CLI::App& app);
+void register_export(CLI::App& app);  ///< in cli_fem.cpp: the fem problem for other solvers
 void register_mss(CLI::App& app);        ///< mss, mss compare (cli_mss.cpp)
 void register_calibrate(CLI::App& app);  ///< calibrate (cli_calibrate.cpp)
 void register_study(

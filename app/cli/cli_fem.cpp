@@ -17,6 +17,7 @@
 #include "spinesim/mesh/io.hpp"
 #include "spinesim/mesh/material.hpp"
 
+#include <filesystem>
 #include <iostream>
 #include <memory>
 
@@ -30,8 +31,8 @@ struct FemArgs {
   bool json = false, quiet = false;
 };
 
-void run_fem(const FemArgs& a) {
-  // 1. Every option parsed before any work: bad input fails fast, nothing is written.
+/// The solve `a` asks for, every option checked before any work.
+FemRunRequest fem_request(const FemArgs& a) {
   const int loads = int(!a.motion.empty()) + int(!a.wrench.empty()) + int(!a.load_case.empty());
   if (loads > 1) throw std::invalid_argument("give at most one of --motion, --wrench and --case");
   FemRunRequest rq;
@@ -45,6 +46,14 @@ void run_fem(const FemArgs& a) {
   if (!a.wrench.empty())
     rq.wrench = parse_numbers(a.wrench, 6, "--wrench Fx,Fy,Fz,Mx,My,Mz (N, N·mm)");
   if (!a.load_case.empty()) rq.load_case = &fem::load_case(a.load_case);
+  if (!a.center.empty())
+    rq.center = Eigen::Vector3d(parse_numbers(a.center, 3, "--center x,y,z (mm)"));
+  return rq;
+}
+
+void run_fem(const FemArgs& a) {
+  // 1. Every option parsed before any work: bad input fails fast, nothing is written.
+  const FemRunRequest rq = fem_request(a);
   const auto materials = mesh::load_material(a.material, data_dir());
   if (!a.out.empty()) require_output_folder(a.out, "--out");  // a device or FIFO before the solve
 
@@ -54,8 +63,6 @@ void run_fem(const FemArgs& a) {
   const mesh::TetMesh m = mesh::read_tet_mesh(a.mesh_path);
   mesh::require_endplate_labels(m);
   progress.end(std::to_string(m.num_tets()) + " tets");
-  if (!a.center.empty())
-    rq.center = Eigen::Vector3d(parse_numbers(a.center, 3, "--center x,y,z (mm)"));
   const FemRunResult r = run_fem_reference(m, materials, rq, progress.hooks());
 
   // 3. Files and report.
@@ -72,7 +79,54 @@ void run_fem(const FemArgs& a) {
     print_fem_run(std::cout, r, a.mesh_path);
 }
 
+void run_export(const FemArgs& a, const std::string& format) {
+  if (format != "abaqus")
+    throw std::invalid_argument("--format '" + format + "' is not known (abaqus: an .inp deck CalculiX runs)");
+  const FemRunRequest rq = fem_request(a);
+  const auto materials = mesh::load_material(a.material, data_dir());
+  require_output_folder(a.out, "--out");
+  const mesh::TetMesh m = mesh::read_tet_mesh(a.mesh_path);
+  const DeckExport e = export_abaqus_deck(
+      a.out, m, materials, rq, m.source + ", material " + materials.name + " (spinesim export)");
+  nlohmann::json j = {{"out", a.out},
+                      {"format", format},
+                      {"element", e.element},
+                      {"tets", m.num_tets()},
+                      {"material", materials.name},
+                      {"load", e.load},
+                      {"load_value", to_json(Eigen::VectorXd(e.load == "motion" ? motion_rad_to_deg(e.value) : e.value))},
+                      {"load_units", e.load == "motion" ? "tx,ty,tz [mm], rx,ry,rz [deg]"
+                                                        : "Fx,Fy,Fz [N], Mx,My,Mz [N·mm]"},
+                      {"plate_center_mm", to_json(Eigen::VectorXd(e.center))}};
+  if (a.json) {
+    print_json(j);
+    return;
+  }
+  std::cout << "wrote " << a.out << ": " << m.num_tets() << " " << e.element << " elements, material "
+            << materials.name << ", plate " << e.load << " " << j["load_value"].dump() << " ("
+            << j["load_units"].get<std::string>() << ")\n"
+            << "run it with: ccx -i " << std::filesystem::path(a.out).stem().string()
+            << "   (results in the .dat and .frd files beside it)\n";
+}
+
 }  // namespace
+
+void register_export(CLI::App& app) {
+  auto a = std::make_shared<FemArgs>();
+  auto format = std::make_shared<std::string>("abaqus");
+  auto* cmd = app.add_subcommand(
+      "export", "Write the linear disc problem for another solver (abaqus: a CalculiX/Abaqus .inp deck)");
+  cmd->add_option("--format", *format, "abaqus (.inp: C3D4/C3D10, materials with the fibres as "
+                                        "per-element anisotropic elasticity, endplates, the load)")
+      ->capture_default_str();
+  cmd->add_option("--mesh", a->mesh_path, "Disc mesh (VTU with `surface` endplate labels)")->required();
+  cmd->add_option("--material", a->material, "Preset or JSON file, as for `fem`")->capture_default_str();
+  cmd->add_option("--order", a->order, "1 (C3D4) or 2 (C3D10)")->capture_default_str();
+  add_plate_load_options(cmd, a->motion, a->wrench, a->load_case, a->center);
+  cmd->add_option("--out", a->out, "The deck to write (.inp)")->required();
+  add_output_flags(cmd, a->json, a->quiet);
+  cmd->callback([a, format] { run_export(*a, *format); });
+}
 
 void register_fem(CLI::App& app) {
   auto a = std::make_shared<FemArgs>();

@@ -52,6 +52,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   spinesim::cli::register_mesh(app);
   spinesim::cli::register_fem(app);
+  spinesim::cli::register_export(app);
   spinesim::cli::register_mss(app);
   spinesim::cli::register_calibrate(app);
   spinesim::cli::register_spine(app);

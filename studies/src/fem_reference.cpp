@@ -1,7 +1,9 @@
 #include "spinesim/studies/fem_reference.hpp"
 #include "spinesim/common/constants.hpp"
 
+#include "spinesim/common/atomic_file.hpp"
 #include "spinesim/common/timer.hpp"
+#include "spinesim/fem/abaqus_deck.hpp"
 #include "spinesim/mesh/io.hpp"
 
 #include "spinesim/studies/toolkit.hpp"
@@ -156,6 +158,33 @@ void write_fem_vtu(const std::string& path, const mesh::TetMesh& m, const FemRun
                                {"annulus_depth", finite_or(r.fibres.depth, -1.0)}});
   }
   mesh::write_vtu(path, m, points, cells);
+}
+
+DeckExport export_abaqus_deck(const std::string& path, const mesh::TetMesh& m,
+                              const mesh::RegionMaterials& materials, const FemRunRequest& rq,
+                              const std::string& title) {
+  if (int(rq.motion.has_value()) + int(rq.wrench.has_value()) + int(rq.load_case != nullptr) > 1)
+    throw std::invalid_argument("give at most one of --motion, --wrench and --case");
+  if (rq.formulation == fem::Formulation::mixed)
+    throw std::invalid_argument(
+        "--formulation mixed has no CalculiX element (Taylor-Hood P2-P1); export the displacement "
+        "form (C3D10)");
+  mesh::require_endplate_labels(m);
+  fem::AbaqusDeck deck;
+  deck.order = rq.order;
+  deck.title = title;
+  deck.plate_center_mm = rq.center ? *rq.center : fem::DiscFem::default_plate_center(m);
+  deck.prescribed_motion = !(rq.wrench || rq.load_case);
+  if (rq.load_case)
+    deck.load = fem::global_wrench(*rq.load_case, m.frame);
+  else if (rq.wrench)
+    deck.load = *rq.wrench;
+  else if (rq.motion)
+    deck.load = *rq.motion;
+  write_atomically("export", path,
+                   [&](std::ostream& os) { fem::write_abaqus_deck(os, m, materials, deck); });
+  return {rq.order == 1 ? "C3D4" : "C3D10", deck.prescribed_motion ? "motion" : "wrench",
+          deck.load, deck.plate_center_mm};
 }
 
 void print_fem_run(std::ostream& os, const FemRunResult& r, const std::string& mesh_label) {

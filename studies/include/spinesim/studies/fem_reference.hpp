@@ -65,6 +65,22 @@ FemRunResult run_fem_reference(const mesh::TetMesh& m, const mesh::RegionMateria
 /// (per degree), max |u|, timings, case; with units.
 nlohmann::json fem_run_json(const FemRunResult& r, const std::string& mesh_label);
 
+/// What `export --format abaqus` wrote: the deck's element type, load and counts.
+struct DeckExport {
+  std::string element;  ///< C3D4 or C3D10
+  std::string load;     ///< "motion" or "wrench"
+  fem::Vector6d value = fem::Vector6d::Zero();  ///< (t mm, theta rad) or (F N, M N·mm), global
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();
+};
+
+/// Writes the problem `request` describes (order, load or case, centre; no load: zero motion)
+/// as an Abaqus/CalculiX deck at `path` (fem/abaqus_deck.hpp), atomically. Throws
+/// std::invalid_argument for the mixed formulation (CalculiX has no Taylor–Hood element) or
+/// more than one load.
+DeckExport export_abaqus_deck(const std::string& path, const mesh::TetMesh& m,
+                              const mesh::RegionMaterials& materials, const FemRunRequest& request,
+                              const std::string& title);
+
 /// The readable summary: plate centre, motion, reaction and the 6x6 stiffness.
 void print_fem_run(std::ostream& os, const FemRunResult& r, const std::string& mesh_label);
 
