@@ -4,6 +4,8 @@
 #include "spinesim/fem/assembly.hpp"
 #include "spinesim/fem/dirichlet.hpp"
 #include "spinesim/fem/fibres.hpp"
+
+#include "fibre_fixtures.hpp"
 #include "spinesim/fem/mixed.hpp"
 #include "spinesim/fem/quadrature.hpp"
 #include "spinesim/mesh/annulus_frames.hpp"
@@ -141,26 +143,10 @@ TEST(FibreStiffness, PatchTestWithUniformFibresDisplacementAndMixed) {
   }
 }
 
-mesh::RegionMaterials fibre_annulus() {
-  mesh::RegionMaterials mat;
-  mat.by_region[1] = {4.2, 0.45, 1038};
-  mat.by_region[2] = {1.0, 0.49, 1038};
-  mat.fallback = mat.by_region[1];
-  mesh::FibreReinforcement f;
-  f.modulus_inner_mpa = 60;
-  f.modulus_outer_mpa = 140;
-  f.angle_inner_deg = 45;
-  f.angle_outer_deg = 28;
-  mat.fibres[1] = f;
-  return mat;
-}
+using test::fibre_annulus;
 
 mesh::TetMesh sample_disc(const mesh::DiscFrame& placement = {}) {
-  mesh::StructuredDiscOptions opt;
-  opt.sectors = 24;
-  opt.rings = 6;
-  opt.layers = 3;
-  return mesh::mesh_structured_disc({"test", 50, 36, 50, 36, 10}, opt, placement);
+  return test::structured_test_disc(24, 6, 3, placement);
 }
 
 TEST(FibreField, FollowsTheOutlineAtTheLamellaAngle) {

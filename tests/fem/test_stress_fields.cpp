@@ -7,7 +7,8 @@
 #include "spinesim/fem/fe_space.hpp"
 #include "spinesim/fem/stress_fields.hpp"
 #include "spinesim/mesh/box_mesh.hpp"
-#include "spinesim/mesh/structured_disc.hpp"
+
+#include "fibre_fixtures.hpp"
 
 #include <gtest/gtest.h>
 
@@ -55,24 +56,9 @@ Eigen::Matrix3d from_voigt(const Vector6d& s) {
   return t;
 }
 
-mesh::TetMesh sample_disc() {
-  mesh::StructuredDiscOptions opt;
-  opt.sectors = 16;
-  opt.rings = 4;
-  opt.layers = 2;
-  return mesh::mesh_structured_disc({"test", 50, 36, 50, 36, 10}, opt, {});
-}
+mesh::TetMesh sample_disc() { return test::structured_test_disc(16, 4, 2); }
 
-mesh::RegionMaterials fibre_annulus() {
-  mesh::RegionMaterials mat = two_regions();
-  mesh::FibreReinforcement f;
-  f.modulus_inner_mpa = 60;
-  f.modulus_outer_mpa = 140;
-  f.angle_inner_deg = 45;
-  f.angle_outer_deg = 28;
-  mat.fibres[1] = f;
-  return mat;
-}
+using test::fibre_annulus;
 
 }  // namespace
 

@@ -4,7 +4,7 @@
 // sum_e f_e^2 / (2 k_e) over the unique edges equals the model's main-spring energy.
 #include "spinesim/mss/quantities.hpp"
 
-#include "spinesim/mesh/box_mesh.hpp"
+#include "solver_fixtures.hpp"
 
 #include <gtest/gtest.h>
 
@@ -18,17 +18,17 @@
 namespace spinesim::mss {
 namespace {
 
+/// The shared box with its x > 0 half nucleus, and the real disc with a softer nucleus: edges on
+/// the interface carry both regions' parts.
 mesh::TetMesh two_region_box() {
-  mesh::TetMesh m = spinesim::mesh::box_mesh(3, 2, 2, 10.0, 6.0, 8.0);
+  mesh::TetMesh m = fixtures::small_box();
   for (Eigen::Index t = 0; t < m.num_tets(); ++t)
-    if (m.V(m.T(t, 0), 0) + m.V(m.T(t, 3), 0) > 10.0) m.region(t) = 2;
+    if (m.V(m.T(t, 0), 0) + m.V(m.T(t, 3), 0) > 0.0) m.region(t) = 2;
   return m;
 }
 
 mesh::RegionMaterials materials() {
-  mesh::RegionMaterials m;
-  m.name = "test";
-  m.fallback = {4.2, 0.45, 1200.0};
+  mesh::RegionMaterials m = fixtures::real_disc();
   m.by_region[2] = {1.0, 0.49, 1000.0};
   return m;
 }
