@@ -102,6 +102,10 @@ bool read_cells(const FileError& e, const RawGrid& g, TetMesh& m) {
 void read_field_data(const FileError& e, const RawGrid& g, TetMesh& m) {
   if (g.disc_frame) {
     const RawArray& f = *g.disc_frame;
+    if (f.v.empty())
+      e.fail("FieldData 'disc_frame' is empty: a VTK program (ParaView) saved this file from a "
+             "spinesim file written before field arrays stated NumberOfTuples, and VTK dropped "
+             "the frame; write the disc again with this spinesim and re-save it");
     if (f.v.size() != 12) e.fail("FieldData 'disc_frame' must have 12 values");
     for (double x : f.v)
       if (!std::isfinite(x)) e.fail("FieldData 'disc_frame' contains non-finite values");

@@ -206,3 +206,25 @@ TEST(IoVtuVtk, ReadsEveryEncodingVtkWritesBackToTheSameMesh) {
   }
   EXPECT_EQ(files, 2 * (1 + 4 * 3));  // 2 headers x (ASCII + 4 compressors x 3 layouts)
 }
+
+TEST(IoVtuVtk, AFrameVtkDroppedFromAnOlderFileIsNamedNotMisread) {
+  if (!has_vtk()) GTEST_SKIP() << "/usr/bin/python3 with VTK (python3-vtk9) not available";
+  // Field arrays without NumberOfTuples, as spinesim wrote them before: VTK reads them empty
+  // and writes them back empty.
+  const Fixture f = fixture();
+  const std::string dir = test::fresh_tmp_dir("io_vtu_vtk_", "old_frame");
+  write_vtu(dir + "/old.vtu", f.mesh, {}, {}, {VtuEncoding::ascii});
+  std::string text = test::slurp(dir + "/old.vtu");
+  for (std::size_t at; (at = text.find(" NumberOfTuples=\"")) != std::string::npos;)
+    text.erase(at, text.find('"', at + 17) + 1 - at);
+  test::spit(dir + "/old.vtu", text);
+  const char* resave = R"PY(
+import sys, vtk
+r = vtk.vtkXMLUnstructuredGridReader(); r.SetFileName(sys.argv[1]); r.Update()
+w = vtk.vtkXMLUnstructuredGridWriter(); w.SetInputData(r.GetOutput()); w.SetFileName(sys.argv[2]); w.Write()
+print(r.GetOutput().GetFieldData().GetAbstractArray("disc_frame").GetNumberOfTuples())
+)PY";
+  EXPECT_EQ(test::run_python(dir, resave, dir + "/old.vtu " + dir + "/resaved.vtu"), "0\n");
+  test::expect_one_line_refusal([&] { read_vtu(dir + "/resaved.vtu"); }, dir + "/resaved.vtu",
+                                "'disc_frame' is empty");
+}
