@@ -44,6 +44,14 @@ const std::string& fibre_result() {
     EXPECT_EQ(j["formulation"], "mixed");
     EXPECT_EQ(j["fibres"], true);
     EXPECT_GT(j["nucleus_pressure_mpa"].get<double>(), 0.0);
+    // The field summary: the stored energy is the plate's work -1/2 reaction . q (q in rad).
+    const auto q = j["plate_motion"].get<std::vector<double>>();
+    const auto w = j["reaction_wrench"].get<std::vector<double>>();
+    double work = 0;
+    for (int k = 0; k < 6; ++k) work -= 0.5 * w[std::size_t(k)] * q[std::size_t(k)] * (k < 3 ? 1.0 : M_PI / 180);
+    EXPECT_NEAR(j["fields"]["strain_energy_mj"].get<double>(), work, 1e-6 * work);
+    EXPECT_GT(j["fields"]["max_von_mises_mpa"].get<double>(), 0.0);
+    EXPECT_GT(j["fields"]["max_fibre_stress_mpa"].get<double>(), 0.0);
     return p;
   }();
   return path;
