@@ -95,7 +95,7 @@ def write_report(d):
     if not figures:
         parts.append("<p>The load paths need <code>--model nonlinear</code>.</p>")
     parts.append(table_html(s) + "</body></html>")
-    write_page(d, parts)
+    write_page(d, parts, s.get("provenance"))
     return figures
 
 

@@ -144,7 +144,7 @@ def write_report(d):
                      number(r["identified"]), verdict(r["identified"], r), r["source"]]
                     for r in s.get("held_out", [])]),
              "</body></html>"]
-    write_page(d, parts)
+    write_page(d, parts, s.get("provenance"))
     return [name]
 
 

@@ -11,9 +11,11 @@ packages=(
   libcgal-dev              # CGAL 5.5 Mesh_3
   coinor-libipopt-dev      # Ipopt 3.11
   libcli11-dev nlohmann-json3-dev libtinyxml2-dev
+  libssl-dev               # libcrypto's SHA-256: the input files' hashes in every output's provenance
   zlib1g-dev liblzma-dev liblz4-dev   # compressed VTU files (VTK's zlib, LZMA and LZ4 compressors)
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-meshio python3-numpy   # independent VTU reader used by the tests
+  python3-jsonschema       # an independent validator of the study files' JSON Schema (tests)
   python3-vtk9             # VTK itself (what ParaView reads and writes with): the tests' second VTU oracle
   calculix-ccx             # CalculiX 2.20: the independent FEM reference of the tests
   python3-matplotlib python3-markdown    # the demo's report.html and its plots (scripts/report.py)

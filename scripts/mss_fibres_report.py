@@ -112,7 +112,7 @@ def write_report(d):
     if sources:
         parts.append(f"<p>In-vitro windows:</p><ul>{sources}</ul>")
     parts.append("</body></html>")
-    write_page(d, parts)
+    write_page(d, parts, s.get("provenance"))
     return figures
 
 

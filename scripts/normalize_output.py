@@ -3,7 +3,7 @@
 
 A record is a folder: NAME.json (stdout of one command), NAME.status (its exit status),
 NAME.stderr, and files/ (everything the commands wrote). JSON is compared as data, with the
-keys in TIMING_KEYS dropped wherever they stand; text files are compared line by line after
+keys in TIMING_KEYS and the provenance dropped wherever they stand; text files are compared line by line after
 TIMING_TEXT masks durations. Numbers that are not bit-identical but agree to ROUND_OFF relative to
 the largest magnitude of their array (or line) are counted separately as round-off: floating-point
 sums depend on the order of operations, which a change of compiler flags or of what the linker
@@ -48,10 +48,20 @@ VARYING_KEYS = {"bytes"}
 NOT_TIMING = {"speed_mm_s", "dt_s", "time_s", "hold_s", "rest_s", "duration_s", "start_s", "t_s", "end_s", "frame_dt_s"}
 
 
+# What made an output (binary path, commit, command line): differs between the two records.
+PROVENANCE_KEYS = {"provenance"}
+PROVENANCE_TEXT = [
+    re.compile(r"^# provenance: .*$", re.M),                                  # CSV first line
+    re.compile(r'<DataArray type="UInt8" Name="provenance"[^>]*>[^<]*</DataArray>\s*'),  # VTU
+    re.compile(r"\n## Provenance\n.*\Z", re.S),                               # markdown report
+    re.compile(r"<footer><h2>Provenance</h2>.*?</footer>", re.S),              # report.html
+]
+
+
 def strip(value):
     if isinstance(value, dict):
         return {k: strip(v) for k, v in value.items()
-                if k not in VARYING_KEYS and (k in NOT_TIMING or not TIMING_KEYS.search(k))}
+                if k not in VARYING_KEYS and k not in PROVENANCE_KEYS and (k in NOT_TIMING or not TIMING_KEYS.search(k))}
     if isinstance(value, list):
         return [strip(v) for v in value]
     return value
@@ -93,6 +103,8 @@ def load_json(path):
 
 
 def mask(text):
+    for p in PROVENANCE_TEXT:
+        text = p.sub("", text)
     return [TIMING_TEXT.sub("<time>", line) for line in text.splitlines()]
 
 

@@ -75,8 +75,29 @@ def secant_wedge(ax, top, low, high, label, alpha=0.25):
     ax.fill([0, top / high, top / low], [0, top, top], color="C1", alpha=alpha, label=label)
 
 
-def write_page(d, parts):
-    """DIR/report.html from the page's parts (page_head first, the closing tags last)."""
+def provenance_html(provenance):
+    """The page's footer from a summary's "provenance" (program, commit, command, folder and the
+    inputs' SHA-256), or "" without one."""
+    if not provenance:
+        return ""
+    p = provenance
+    rows = "".join(f"<tr><td><code>{html.escape(i['path'])}</code></td><td>{i['bytes']}</td>"
+                   f"<td><code>{html.escape(str(i['sha256']))}</code></td></tr>"
+                   for i in p.get("inputs", []))
+    table = (f"<table><tr><th>input</th><th>bytes</th><th>SHA-256</th></tr>{rows}</table>"
+             if rows else "")
+    return (f"<footer><h2>Provenance</h2><p>Made by {html.escape(p['program'])} "
+            f"{html.escape(p['version'])} (commit <code>{html.escape(p['commit'])}</code>) with "
+            f"<pre>{html.escape(p['command'])}</pre> in <code>"
+            f"{html.escape(p['working_directory'])}</code>.</p>{table}</footer>")
+
+
+def write_page(d, parts, provenance=None):
+    """DIR/report.html from the page's parts (page_head first, the closing tags last), with the
+    provenance footer of the summary it reports (its "provenance" object) before the close."""
+    footer = provenance_html(provenance)
+    if footer and parts and parts[-1].endswith("</body></html>"):
+        parts = parts[:-1] + [parts[-1][:-len("</body></html>")] + footer + "</body></html>"]
     with open(os.path.join(d, "report.html"), "w") as f:
         f.write("\n".join(parts))
 

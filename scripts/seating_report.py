@@ -118,7 +118,7 @@ def findings_html(findings):
 
 
 def read_and_draw(d, one, many):
-    """The run's JSON and its figures: (title, figure names, extra HTML)."""
+    """The run's JSON and its figures: (title, figure names, extra HTML, provenance)."""
     if os.path.exists(many):
         with open(many) as f:
             s = json.load(f)
@@ -131,14 +131,14 @@ def read_and_draw(d, one, many):
         title = f"The spine in a chair: {chair_text(s)}"
         figures = [contacts(s, d), l5s1(s, d)]
         extra = ""
-    return title, figures, extra
+    return title, figures, extra, s.get("provenance")
 
 
 def main(argv):
     d = folder_argument(argv, __doc__)
     one, many = os.path.join(d, "seating.json"), os.path.join(d, "seating_sweep.json")
     os.makedirs(os.path.join(d, "plots"), exist_ok=True)
-    title, figures, extra = guarded(fail, d, lambda: read_and_draw(d, one, many))
+    title, figures, extra, provenance = guarded(fail, d, lambda: read_and_draw(d, one, many))
     parts = ["<!DOCTYPE html><html><head><meta charset='utf-8'>",
              f"<title>{html.escape(title)}</title><style>body{{font-family:sans-serif;"
              "max-width:1100px;margin:2em auto}img{max-width:100%}table{border-collapse:collapse}"
@@ -147,7 +147,7 @@ def main(argv):
     parts += [f"<figure><img src='plots/{n}' alt='{n}'></figure>" for n in figures]
     parts.append(extra + "</body></html>")
     try:
-        write_page(d, parts)
+        write_page(d, parts, provenance)
     except OSError as e:
         fail(f"cannot write in {d}: {e}")
     print(f"seating report: {os.path.join(d, 'report.html')} with {len(figures)} figures in "

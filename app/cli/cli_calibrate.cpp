@@ -126,7 +126,7 @@ void run_all_levels(const CalibrateArgs& a, const CalibrationRequest& rq,
     throw std::runtime_error("Ipopt did not converge for " + r.failed() + ": no " + a.out +
                              " written");
   }
-  write_text_file(a.out, calibration::to_json(r.set).dump(1) + "\n");
+  write_json_file(a.out, calibration::to_json(r.set), 1);
   if (a.json) {
     nlohmann::json j = calibration::to_json(r.set);
     j["out"] = a.out;
@@ -216,7 +216,7 @@ nlohmann::json write_tuned_file(const CalibrateArgs& a, const calibration::Tuned
   nlohmann::json j = calibration::to_json(tuned);
   j["mesh_file"] = a.mesh_path.empty() ? nlohmann::json(nullptr) : nlohmann::json(a.mesh_path);
   if (success) {
-    write_text_file(a.out, calibration::to_json(tuned).dump(2) + "\n");
+    write_json_file(a.out, calibration::to_json(tuned));
     j["out"] = a.out;
   }
   return j;

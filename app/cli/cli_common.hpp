@@ -18,6 +18,7 @@
 #include <CLI/CLI.hpp>
 #include <Eigen/Core>
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -38,6 +39,10 @@ void add_output_flags(CLI::App* cmd, bool& json, bool& quiet,
 void add_plate_load_options(CLI::App* cmd, std::string& motion, std::string& wrench,
                             std::string& load_case, std::string& center);
 
+/// The whole command line: every verb registered, --save-study on each, --version (cli_app.cpp).
+/// `spinesim run` builds a second one for the study it runs.
+std::unique_ptr<CLI::App> make_app();
+
 // Sub-command registration; each lives in its own cli_<verb>.cpp.
 void register_mesh(CLI::App& app);
 void register_mesh_vertebrae(CLI::App& mesh);  ///< mesh vertebrae, under `mesh`
@@ -57,6 +62,7 @@ void register_mss_fibres(CLI::App& study);       ///< study mss-fibres (cli_stud
 void register_seating(CLI::App& study);          ///< study seating|seating-sweep|seating-validation
 void register_demo(CLI::App& app);
 void register_view(CLI::App& app);
+void register_run(CLI::App& app);  ///< run STUDY, run --schema (cli_run.cpp)
 
 /// --scene, --vertebrae, --testdata, --triangles: the haptic scene's flags (haptics run, view).
 void add_scene_flags(CLI::App* cmd, haptics::HapticSceneRequest& scene);

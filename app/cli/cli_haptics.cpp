@@ -135,7 +135,7 @@ struct PlaneArgs {
 
 void run_plane(const PlaneArgs& a) {
   const auto result = run_haptic_plane_study(a.request);
-  if (!a.out.empty()) write_text_file(a.out, haptic_plane_csv(result));
+  if (!a.out.empty()) write_csv_file(a.out, haptic_plane_csv(result));
   if (a.json)
     print_json(haptic_plane_json(result));
   else if (a.csv)

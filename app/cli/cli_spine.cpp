@@ -125,7 +125,7 @@ void solve(const SpineSolveArgs& a) {
     std::cerr << "spinesim: warning: " << one_line(w) << std::endl;
 
   // 3. Output.
-  if (!a.csv.empty()) write_text_file(a.csv, spine_solve_csv(run.solution));
+  if (!a.csv.empty()) write_csv_file(a.csv, spine_solve_csv(run.solution));
   if (a.json)
     print_json(spine_solve_json(run, a.csv));
   else

@@ -45,7 +45,7 @@ void run_disc_joints(const DiscJointsArgs& a) {
                 a.tuned == "shipped" ? calibration::shipped_tuned_set_path(data_dir()) : a.tuned,
                 levels, progress.hooks());
   const nlohmann::json j = disc_joints_json(set);
-  if (!a.out.empty()) write_text_file(a.out, j.dump(1) + "\n");
+  if (!a.out.empty()) write_json_file(a.out, j, 1);
   if (a.json)
     print_json(j);
   else

@@ -257,7 +257,7 @@ void run_materials(const MaterialsArgs& a) {
   study.cell_size_mm = a.cell_size_mm;
 
   // 3. Tables, CSV, summary.
-  if (!a.csv.empty()) write_text_file(a.csv, materials_csv(study.results));
+  if (!a.csv.empty()) write_csv_file(a.csv, materials_csv(study.results));
   if (a.json) {
     print_json(materials_study_json(m, study, a.csv));
   } else {
@@ -421,7 +421,7 @@ template <class Study>
 void emit_spine_study(const SpineStudyArgs& a, const Study& s, const char* title,
                       std::string (*to_csv)(const Study&), nlohmann::json (*to_json)(const Study&),
                       void (*print)(std::ostream&, const Study&, bool)) {
-  if (!a.csv.empty()) write_text_file(a.csv, to_csv(s));
+  if (!a.csv.empty()) write_csv_file(a.csv, to_csv(s));
   if (a.json) {
     nlohmann::json j = to_json(s);
     j["csv"] = a.csv.empty() ? nlohmann::json(nullptr) : nlohmann::json(a.csv);

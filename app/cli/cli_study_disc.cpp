@@ -39,14 +39,14 @@ struct DiscValidationArgs {
 /// report.html (scripts/disc_report.py).
 void write_out_folder(const std::string& out, const DiscValidationResult& r) {
   namespace fs = std::filesystem;
-  output::write_text_file((fs::path(out) / "disc_validation.json").string(),
-                          disc_validation_json(r).dump(2) + "\n");
+  output::write_json_file((fs::path(out) / "disc_validation.json").string(),
+                          disc_validation_json(r));
   std::ostringstream rows, paths;
   write_disc_validation_csv(rows, r);
-  output::write_text_file((fs::path(out) / "disc_validation.csv").string(), rows.str());
+  output::write_csv_file((fs::path(out) / "disc_validation.csv").string(), rows.str());
   if (!r.paths.empty()) {
     write_disc_paths_csv(paths, r);
-    output::write_text_file((fs::path(out) / "disc_paths.csv").string(), paths.str());
+    output::write_csv_file((fs::path(out) / "disc_paths.csv").string(), paths.str());
   }
   const output::HtmlReport report = output::write_html_report(out, "disc_report.py");
   if (report.failed) throw std::runtime_error("--out " + out + ": " + report.message);
@@ -115,14 +115,14 @@ void run_disc_validation(const DiscValidationArgs& a) {
 
   // 3. Output.
   if (!a.csv.empty()) {
-    std::ofstream f(a.csv);
-    write_disc_validation_csv(f, r);
-    if (!f) throw std::runtime_error("--csv " + a.csv + ": could not write the file");
+    std::ostringstream rows;
+    write_disc_validation_csv(rows, r);
+    output::write_csv_file(a.csv, rows.str());
   }
   if (!a.paths.empty()) {
-    std::ofstream f(a.paths);
-    write_disc_paths_csv(f, r);
-    if (!f) throw std::runtime_error("--paths " + a.paths + ": could not write the file");
+    std::ostringstream rows;
+    write_disc_paths_csv(rows, r);
+    output::write_csv_file(a.paths, rows.str());
   }
   if (!a.out.empty()) write_out_folder(a.out, r);
   if (a.json)

@@ -81,17 +81,17 @@ void run_disc_identify(const DiscIdentifyArgs& a) {
 
   // 3. Output: the preset only for a finished identification.
   const nlohmann::json preset = studies::identified_material_json(r, base);
-  if (!a.preset.empty() && r.success) output::write_text_file(a.preset, preset.dump(2) + "\n");
+  if (!a.preset.empty() && r.success) output::write_json_file(a.preset, preset);
   if (!a.out.empty()) {
     namespace fs = std::filesystem;
-    output::write_text_file((fs::path(a.out) / "disc_identification.json").string(),
-                            studies::disc_identification_json(r).dump(2) + "\n");
+    output::write_json_file((fs::path(a.out) / "disc_identification.json").string(),
+                            studies::disc_identification_json(r));
     std::ostringstream md;
     studies::print_disc_identification(md, r, true);
-    output::write_text_file((fs::path(a.out) / "disc_identification.md").string(), md.str());
+    output::write_text_file((fs::path(a.out) / "disc_identification.md").string(),
+                            md.str() + output::markdown_provenance());
     if (r.success)
-      output::write_text_file((fs::path(a.out) / "disc-identified.json").string(),
-                              preset.dump(2) + "\n");
+      output::write_json_file((fs::path(a.out) / "disc-identified.json").string(), preset);
     const output::HtmlReport report = output::write_html_report(a.out, "identify_report.py");
     if (report.failed) throw std::runtime_error("--out " + a.out + ": " + report.message);
     std::cerr << (report.written ? "" : "spinesim: warning: ") << report.message << std::endl;

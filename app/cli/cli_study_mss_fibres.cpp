@@ -71,11 +71,12 @@ void run_mss_fibres(const MssFibresArgs& a) {
       });
   if (!a.out.empty()) {
     namespace fs = std::filesystem;
-    output::write_text_file((fs::path(a.out) / "mss_fibres.json").string(),
-                            studies::mss_fibre_study_json(r).dump(2) + "\n");
+    output::write_json_file((fs::path(a.out) / "mss_fibres.json").string(),
+                            studies::mss_fibre_study_json(r));
     std::ostringstream md;
     studies::print_mss_fibre_study(md, r);
-    output::write_text_file((fs::path(a.out) / "mss_fibres.md").string(), md.str());
+    output::write_text_file((fs::path(a.out) / "mss_fibres.md").string(),
+                            md.str() + output::markdown_provenance());
     const output::HtmlReport report = output::write_html_report(a.out, "mss_fibres_report.py");
     if (report.failed) throw std::runtime_error("--out " + a.out + ": " + report.message);
     if (!a.quiet && !a.json)

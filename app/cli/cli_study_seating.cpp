@@ -83,10 +83,10 @@ void resolve(SeatingArgs& a) {
 /// --json; true when the JSON went to stdout (nothing else is printed then).
 bool emit(const SeatingArgs& a, const nlohmann::json& j, const std::string& csv,
           const std::string& stem) {
-  if (!a.csv.empty()) write_text_file(a.csv, csv);
+  if (!a.csv.empty()) write_csv_file(a.csv, csv);
   if (!a.out.empty()) {
-    write_text_file((fs::path(a.out) / (stem + ".json")).string(), j.dump(2) + "\n");
-    write_text_file((fs::path(a.out) / (stem + ".csv")).string(), csv);
+    write_json_file((fs::path(a.out) / (stem + ".json")).string(), j);
+    write_csv_file((fs::path(a.out) / (stem + ".csv")).string(), csv);
     const HtmlReport r = write_html_report(a.out, "seating_report.py");
     if (r.failed) throw std::runtime_error("--out " + a.out + ": " + r.message);
     std::cerr << (r.written ? "" : "spinesim: warning: ") << r.message << std::endl;
@@ -125,7 +125,7 @@ void run_validation(SeatingArgs& a) {
   if (!a.csv.empty()) require_output_folder(a.csv, "--csv");
   Progress progress(kSittingValidationStages, a.quiet || a.json);
   const SittingValidation v = run_sitting_validation(data_dir(), a.request.model, progress.hooks());
-  if (!a.csv.empty()) write_text_file(a.csv, sitting_validation_csv(v));
+  if (!a.csv.empty()) write_csv_file(a.csv, sitting_validation_csv(v));
   if (a.json) {
     print_json(sitting_validation_json(v));
     return;

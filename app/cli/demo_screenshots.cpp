@@ -90,7 +90,7 @@ std::string take_demo_screenshots(const std::string& out) {
     }
     list.push_back({{"file", s.file}, {"title", s.title}, {"thesis", s.thesis}, {"ours", ours}});
   }
-  std::ofstream((fs::path(out) / "viewer.json").string()) << list.dump(2) << "\n";
+  output::write_json_file((fs::path(out) / "viewer.json").string(), list);
   return std::to_string(list.size()) + " of " + std::to_string(shots.size()) +
          " viewer screenshots" + (prefix.empty() ? "" : " (under xvfb-run)");
 }

@@ -10,13 +10,16 @@
 // Every verb has --help and --json (one JSON object on stdout). Bad input, a malformed command
 // line included: one line on stderr, exit status 1, no partial output file.
 #include "cli_common.hpp"
+#include "study_file.hpp"
 #include "suggest.hpp"
 
 #include "spinesim/common/memory.hpp"
 #include "spinesim/common/pending_output.hpp"
+#include "spinesim/common/provenance.hpp"
 
 #include <cstdlib>
 #include <iostream>
+#include <memory>
 #include <new>
 #include <string>
 #include <vector>
@@ -44,26 +47,13 @@ int main(int argc, char** argv) {
   spinesim::keep_freed_memory();  // Newton's large temporaries, reused (common/memory.hpp)
   // A run killed by Ctrl-C, SIGTERM or SIGHUP removes what it had not finished writing.
   spinesim::remove_pending_outputs_on_signals();
+  spinesim::record_run_command(argc, argv);  // every output says what made it (provenance.hpp)
   if (openblas_set_num_threads && !std::getenv("OPENBLAS_NUM_THREADS")) openblas_set_num_threads(1);
-  CLI::App app{
-      "spinesim: finite-element-validated intervertebral-disc deformation\n"
-      "(CGAL disc meshes, linear FEM reference, mass-spring discs, spine model)"};
-  app.set_version_flag("--version", std::string("spinesim ") + SPINESIM_VERSION);
-  app.require_subcommand(1);
-  spinesim::cli::register_mesh(app);
-  spinesim::cli::register_fem(app);
-  spinesim::cli::register_export(app);
-  spinesim::cli::register_mss(app);
-  spinesim::cli::register_calibrate(app);
-  spinesim::cli::register_spine(app);
-  spinesim::cli::register_study(app);
-  spinesim::cli::register_haptics(app);
-  spinesim::cli::register_demo(app);
-  spinesim::cli::register_view(app);
-  spinesim::cli::register_bench(app);
-  spinesim::cli::require_plain_numbers(app);
+  const std::unique_ptr<CLI::App> program = spinesim::cli::make_app();
+  CLI::App& app = *program;
   try {
     app.parse(argc, argv);
+    spinesim::cli::save_study_if_asked(app);
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
   } catch (const CLI::CallForAllHelp& e) {

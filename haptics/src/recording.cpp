@@ -2,6 +2,7 @@
 #include "spinesim/common/constants.hpp"
 
 #include "spinesim/common/input_file.hpp"
+#include "spinesim/common/provenance.hpp"
 #include "spinesim/output/format.hpp"
 #include "spinesim/spine/equilibrium.hpp"
 #include "spinesim/spine/kinematics.hpp"
@@ -63,6 +64,7 @@ HapticRecordingWriter::HapticRecordingWriter(const std::string& path,
       "# units: s, mm, N, N mm, deg; frame x lateral (right = -x), y superior, z anterior. "
       "Columns 1-5 are a trajectory (--device replay --replay FILE plays them)\n",
       description.c_str());
+  std::fputs(csv_provenance_line().c_str(), file_);  // what made the recording
   if (model)
     std::fprintf(file_,
                  "# spine model %s; compliant stage %s; vertebra motion: the F.1 centre's "

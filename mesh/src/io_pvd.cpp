@@ -8,6 +8,7 @@
 #include "spinesim/mesh/io.hpp"
 
 #include "spinesim/common/atomic_file.hpp"
+#include "spinesim/common/provenance.hpp"
 #include "xml_escape.hpp"
 
 #include <tinyxml2.h>
@@ -85,6 +86,7 @@ std::vector<PvdEntry> read_pvd(const std::string& path) {
   tinyxml2::XMLDocument doc;
   if (doc.LoadFile(path.c_str()) != tinyxml2::XML_SUCCESS)
     throw std::invalid_argument(who + "not a readable XML file");
+  record_input_file(path);
   const tinyxml2::XMLElement* root = doc.RootElement();
   const char* type = root ? root->Attribute("type") : nullptr;
   if (!root || std::string(root->Name()) != "VTKFile" || !type || std::string(type) != "Collection")

@@ -298,6 +298,7 @@ TetMesh read_vtk_legacy(const std::string& path, std::vector<DataArray>* point_d
   std::ifstream in(path, std::ios::binary);
   LegacyReader r(
       path, std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()));
+  record_input_file(path);
   read_header(r);
   detail::RawGrid g;
   bool have_points = false, have_types = false;

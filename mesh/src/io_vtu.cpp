@@ -4,6 +4,7 @@
 #include "spinesim/common/input_file.hpp"
 
 #include "spinesim/common/atomic_file.hpp"
+#include "spinesim/common/provenance.hpp"
 #include "vtk_grid.hpp"
 #include "write_checks.hpp"
 #include "xml_escape.hpp"
@@ -608,6 +609,16 @@ void collect_offsets(Reader& r, const tinyxml2::XMLElement* e) {
 
 }  // namespace
 
+/// The run's provenance (common/provenance.hpp) as the FieldData array "provenance": the JSON
+/// text's bytes, UInt8, like "source" (numpy: bytes(array).decode()). Nothing outside a recorded
+/// run.
+std::vector<std::uint8_t> provenance_bytes() {
+  const nlohmann::json p = run_provenance();
+  if (p.is_null()) return {};
+  const std::string text = p.dump();
+  return std::vector<std::uint8_t>(text.begin(), text.end());
+}
+
 // ==========================================================================================
 
 void write_vtu(const std::string& path, const TetMesh& m, const std::vector<DataArray>& point_data,
@@ -632,6 +643,7 @@ void write_vtu(const std::string& path, const TetMesh& m, const std::vector<Data
     for (int i = 0; i < 3; ++i) frame[std::size_t(3 + 3 * c + i)] = m.frame.axes(i, c);
   const std::vector<std::uint8_t> source(m.source.begin(), m.source.end());
   const VtuEncoding enc = options.encoding;
+  const std::vector<std::uint8_t> provenance = provenance_bytes();
 
   // 3. Write to a temporary file, then rename.
   write_atomically("write_vtu", path, [&](std::ostream& os) {
@@ -646,6 +658,8 @@ void write_vtu(const std::string& path, const TetMesh& m, const std::vector<Data
     if (!source.empty())
       write_data_array(os, "UInt8", "source", 1, source, VtuEncoding::ascii, "      ",
                        Tuples::stated);
+    if (!provenance.empty())
+      write_data_array(os, "UInt8", "provenance", 1, provenance, enc, "      ", Tuples::stated);
     os << "    </FieldData>\n"
        << "    <Piece NumberOfPoints=\"" << m.num_vertices() << "\" NumberOfCells=\"" << nt
        << "\">\n"
@@ -679,14 +693,20 @@ void write_surface_vtu(const std::string& path, const TriSurface& s,
 
   const std::size_t nf = std::size_t(s.F.rows());
   const VtuEncoding enc = options.encoding;
+  const std::vector<std::uint8_t> provenance = provenance_bytes();
   write_atomically("write_vtu", path, [&](std::ostream& os) {
     const char* in = "        ";
     os << "<?xml version=\"1.0\"?>\n"
        << "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" "
           "header_type=\"UInt64\""
        << (enc == VtuEncoding::zlib ? " compressor=\"vtkZLibDataCompressor\"" : "") << ">\n"
-       << "  <UnstructuredGrid>\n"
-       << "    <Piece NumberOfPoints=\"" << s.V.rows() << "\" NumberOfCells=\"" << nf << "\">\n"
+       << "  <UnstructuredGrid>\n";
+    if (!provenance.empty()) {
+      os << "    <FieldData>\n";
+      write_data_array(os, "UInt8", "provenance", 1, provenance, enc, "      ", Tuples::stated);
+      os << "    </FieldData>\n";
+    }
+    os << "    <Piece NumberOfPoints=\"" << s.V.rows() << "\" NumberOfCells=\"" << nf << "\">\n"
        << "      <PointData>\n";
     write_extra_arrays(os, point_data, enc, in);
     os << "      </PointData>\n"
@@ -712,6 +732,7 @@ detail::RawGrid read_raw_vtu(Reader& r, const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   if (!in && !in.eof()) r.fail("cannot read the file");
+  record_input_file(path);
   text = split_appended(r, std::move(text));
   tinyxml2::XMLDocument doc;
   if (doc.Parse(text.data(), text.size()) != tinyxml2::XML_SUCCESS) {

@@ -127,7 +127,9 @@ RegionMaterials material_from_json(const nlohmann::json& j) {
       if (!j.contains("annulus") || !j.contains("nucleus"))
         throw std::invalid_argument("material '" + r.name +
                                     "': per-region files need both 'annulus' and 'nucleus'");
-      require_known_keys(j, {"name", "source", "description", "notes", "annulus", "nucleus"},
+      require_known_keys(j,
+                         {"name", "source", "description", "notes", "annulus", "nucleus",
+                          "provenance"},
                          "material '" + r.name + "'");
       r.by_region[int(Region::annulus)] =
           parse_one(j.at("annulus"), "material '" + r.name + "' annulus", {"fibres"});

@@ -2,6 +2,7 @@
 #include "spinesim/mss/simulator.hpp"
 
 #include "spinesim/common/atomic_file.hpp"
+#include "spinesim/common/provenance.hpp"
 #include "spinesim/mss/quantities.hpp"
 
 #include <cctype>
@@ -18,6 +19,30 @@ namespace fs = std::filesystem;
 
 void write_text_file(const std::string& path, const std::string& text) {
   write_text_atomically(path, text);
+}
+
+void write_json_file(const std::string& path, const nlohmann::json& j, int indent) {
+  write_text_atomically(path, with_provenance(j).dump(indent) + "\n");
+}
+
+void write_csv_file(const std::string& path, const std::string& csv) {
+  write_text_atomically(path, csv_provenance_line() + csv);
+}
+
+std::string markdown_provenance() {
+  const nlohmann::json p = run_provenance();
+  if (p.is_null()) return "";
+  std::string md = "\n## Provenance\n\nMade by spinesim " + p["version"].get<std::string>() +
+                   " (commit `" + p["commit"].get<std::string>() + "`) with\n\n```\n" +
+                   p["command"].get<std::string>() + "\n```\n\nin `" +
+                   p["working_directory"].get<std::string>() + "`.\n";
+  if (!p["inputs"].empty()) {
+    md += "\n| input | bytes | SHA-256 |\n|---|---:|---|\n";
+    for (const auto& in : p["inputs"])
+      md += "| `" + in["path"].get<std::string>() + "` | " + in["bytes"].dump() + " | `" +
+            (in["sha256"].is_string() ? in["sha256"].get<std::string>() : "-") + "` |\n";
+  }
+  return md;
 }
 
 void require_output_folder(const std::string& path, const std::string& option) {

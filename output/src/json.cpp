@@ -1,5 +1,7 @@
 #include "spinesim/output/json.hpp"
 
+#include "spinesim/common/provenance.hpp"
+
 #include <iostream>
 
 namespace spinesim::output {
@@ -9,7 +11,7 @@ bool g_json_printed = false;
 }  // namespace
 
 void print_json(const nlohmann::json& j) {
-  std::cout << j.dump(2) << std::endl;
+  std::cout << with_provenance(j).dump(2) << std::endl;
   g_json_printed = true;
 }
 

@@ -403,7 +403,9 @@ void apply_disc_joints(std::vector<Joint>& joints, const std::string& name_or_pa
   if (!j.is_object() || !j.contains("joints") || !j.at("joints").is_object())
     throw std::invalid_argument(who + "expected a 'joints' object");
   require_known_keys(
-      j, {"formulation", "generated_by", "joints", "material", "moment_nm", "source", "units"},
+      j,
+      {"formulation", "generated_by", "joints", "material", "moment_nm", "provenance", "source",
+       "units"},
       who + "the file");
   // Every level named must be one of the spine's (a typo or an "L6-L7" is not silently unused).
   for (const auto& level : j.at("joints").items()) {

@@ -241,8 +241,8 @@ void Demo::spine_studies() {
   print_trends(t, spine_trends, true);
   validation_text = v.str(), fusion_text = f.str(), trends_text = t.str();
   // The per-run numbers behind the findings, for the report's plots (scripts/report.py).
-  write_text_file((fs::path(rq.out) / "spine_fusion.csv").string(), fusion_csv(spine_fusion));
-  write_text_file((fs::path(rq.out) / "spine_trends.csv").string(), trends_csv(spine_trends));
+  write_csv_file((fs::path(rq.out) / "spine_fusion.csv").string(), fusion_csv(spine_fusion));
+  write_csv_file((fs::path(rq.out) / "spine_trends.csv").string(), trends_csv(spine_trends));
 }
 
 // 7. The haptic loop: the thesis's plane test of the Gao-Gibson force, and the simulated hand
@@ -251,7 +251,7 @@ void Demo::haptics() {
   hooks.begin_stage("haptic plane test (Gao-Gibson eqs 4.9, 4.10)");
   haptic_plane = run_haptic_plane_study(HapticPlaneRequest());
   haptic_plane_path = (fs::path(rq.out) / "haptic_plane.csv").string();
-  write_text_file(haptic_plane_path, haptic_plane_csv(haptic_plane));
+  write_csv_file(haptic_plane_path, haptic_plane_csv(haptic_plane));
   hooks.end_stage(std::to_string(haptic_plane.rows.size()) + " depths");
   hooks.begin_stage("haptic loop: simulated hand strokes the spine's spinous processes");
   HapticsRunRequest request;
@@ -455,9 +455,9 @@ DemoResult run_demo(const DemoRequest& rq, const StageHooks& hooks) {
   DemoResult r;
   r.report_markdown = demo.report();
   r.report_path = (fs::path(rq.out) / "report.md").string();
-  write_text_file(r.report_path, r.report_markdown);
+  write_text_file(r.report_path, r.report_markdown + markdown_provenance());
   r.summary = demo.summary(r.report_path);
-  write_text_file((fs::path(rq.out) / "summary.json").string(), r.summary.dump(2) + "\n");
+  write_json_file((fs::path(rq.out) / "summary.json").string(), r.summary);
   hooks.begin_stage("viewer screenshots");
   r.viewer_note = rq.viewer_screenshots ? rq.viewer_screenshots(rq.out) : "not asked for";
   hooks.end_stage(r.viewer_note);

@@ -163,7 +163,7 @@ DriveStudyResult run_drive_study(const mesh::TetMesh& m, const DriveStudyRequest
   }
   r.json_path = (fs::path(o.out) / "drive.json").string();
   r.summary = drive_summary(m, r);
-  write_text_file(r.json_path, r.summary.dump(2) + "\n");
+  write_json_file(r.json_path, r.summary);
   return r;
 }
 

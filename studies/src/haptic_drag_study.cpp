@@ -183,7 +183,7 @@ HapticDragResult run_haptic_drag_study(const HapticDragRequest& request,
       measure_pose_error(model, rec, request, false, mr);
       if (method == "multirate" || c.pairs_csv.empty()) {
         c.pairs_csv = (fs::path(request.out) / ("pairs_" + name + ".csv")).string();
-        write_text_file(c.pairs_csv, pairs_csv(model, rec));
+        write_csv_file(c.pairs_csv, pairs_csv(model, rec));
       }
       c.methods.push_back(mr);
       if (method == "database") {

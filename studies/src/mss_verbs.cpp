@@ -174,7 +174,7 @@ MssCompareResult run_mss_compare(const MssCompareRequest& rq, const std::string&
   out.comparison.constants = out.choice.constants;
   hooks.end_stage();
 
-  if (!rq.csv.empty()) write_text_file(rq.csv, comparison_csv(out.comparison));
+  if (!rq.csv.empty()) write_csv_file(rq.csv, comparison_csv(out.comparison));
   out.json = comparison_json(out.comparison);
   out.json["mesh"] = rq.mesh_path;
   out.json["model_variant"] = out.choice.variant;

@@ -241,7 +241,7 @@ ProbeStudyResult run_probe_study(const mesh::TetMesh& m, const mesh::RegionMater
   r.json_path = (fs::path(o.out) / "probe.json").string();
   r.summary = probe_summary(m, materials, model, r);
   r.stats.add_to(r.summary);
-  write_text_file(r.json_path, r.summary.dump(2) + "\n");
+  write_json_file(r.json_path, r.summary);
   hooks.end_stage();
   return r;
 }

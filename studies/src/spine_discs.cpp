@@ -364,11 +364,11 @@ SpineDiscsResult run_spine_discs(const SpineDiscsRequest& request, const std::st
   r.table_csv = (fs::path(request.out) / "discs.csv").string();
   r.motion_csv = (fs::path(request.out) / "disc_motion.csv").string();
   r.json = (fs::path(request.out) / "discs.json").string();
-  write_text_file(r.table_csv, table_csv(r));
-  write_text_file(r.motion_csv, motion.str());
+  write_csv_file(r.table_csv, table_csv(r));
+  write_csv_file(r.motion_csv, motion.str());
   r.total_s = total.seconds();
   r.diverged = spine_discs_diverged(r);
-  write_text_file(r.json, spine_discs_json(r).dump(1) + "\n");
+  write_json_file(r.json, spine_discs_json(r), 1);
   return r;
 }
 

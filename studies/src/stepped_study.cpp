@@ -38,7 +38,7 @@ bool SteppedRun::step(int k, const mss::Boundary& bc) {
 
 void SteppedRun::finish() {
   frames_.finish();
-  write_text_file(csv_path_, csv_.str());
+  write_csv_file(csv_path_, csv_.str());
 }
 
 nlohmann::json study_mesh_json(const mesh::TetMesh& m) {

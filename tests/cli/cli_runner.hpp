@@ -3,6 +3,7 @@
 #pragma once
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <sys/wait.h>
 #include <unistd.h>
@@ -38,6 +39,27 @@ inline std::string slurp(const std::string& path) {
   std::stringstream ss;
   ss << is.rdbuf();
   return ss.str();
+}
+
+/// Writes `text` to `path`.
+inline void spit(const std::string& path, const std::string& text) {
+  std::ofstream os(path, std::ios::binary);
+  os << text;
+}
+
+/// The table of a CSV file the program wrote, after checking its first line: the provenance,
+/// "# provenance: {…}" with the program, its commit and the command line.
+inline std::string csv_table(const std::string& path) {
+  const std::string text = slurp(path);
+  const std::string mark = "# provenance: ";
+  const auto end = text.find('\n');
+  EXPECT_EQ(text.rfind(mark, 0), 0u) << path << " has no provenance line";
+  if (text.rfind(mark, 0) != 0 || end == std::string::npos) return text;
+  const nlohmann::json p = nlohmann::json::parse(text.substr(mark.size(), end - mark.size()));
+  EXPECT_EQ(p.at("program"), "spinesim") << path;
+  EXPECT_FALSE(p.at("commit").get<std::string>().empty()) << path;
+  EXPECT_NE(p.at("command").get<std::string>().find("spinesim"), std::string::npos) << path;
+  return text.substr(end + 1);
 }
 
 struct CliRun {

@@ -140,7 +140,9 @@ TEST(CliFibres, FemWritesStressStrainAndFibreFieldsThatVtkReadsWhole) {
   for (const auto& a : points)
     EXPECT_EQ(vtk["point:" + a.name], std::make_pair(long(m.num_vertices()), long(a.values.cols()))) << a.name;
   EXPECT_EQ(vtk["field:disc_frame"], std::make_pair(1L, 12L));
-  EXPECT_EQ(vtk.size(), cells.size() + points.size() + 2 /* region, surface */ + 2 /* frame, source */);
+  EXPECT_EQ(vtk["field:provenance"].second, 1L);  // the JSON text, as bytes
+  EXPECT_EQ(vtk.size(), cells.size() + points.size() + 2 /* region, surface */ +
+                            3 /* frame, source, provenance */);
 }
 
 TEST(CliFibres, BadFormulationsAreOneLine) {
@@ -214,11 +216,7 @@ TEST(CliFibres, DiscValidationRunsTheNonlinearDisc) {
   const auto j = nlohmann::json::parse(r.out);
   ASSERT_EQ(j["rows"].size(), 6u);
   for (const auto& row : j["rows"]) EXPECT_TRUE(row["ours"].is_number()) << row.dump();
-  std::ifstream f(paths);
-  std::string line;
-  int lines = 0;
-  while (std::getline(f, line)) ++lines;
-  EXPECT_EQ(lines, 1 + 5 * 3);
+  EXPECT_EQ(count_lines(csv_table(paths)), 1 + 5 * 3);
   for (const char* file : {"disc_validation.json", "disc_validation.csv", "disc_paths.csv",
                            "report.html", "plots/disc_paths.png"})
     EXPECT_TRUE(std::filesystem::exists(out + "/" + file)) << file << "\n" << r.err;

@@ -110,7 +110,7 @@ TEST(MaterialsStudy, StifferMaterialsStifferDiscAndTheTunedMssMatchesTheFem) {
 
   // CSV: one row per material x model, the same numbers as the JSON.
   EXPECT_EQ(j["csv"], csv);
-  const auto rows = read_csv(slurp(csv));
+  const auto rows = read_csv(csv_table(csv));
   ASSERT_EQ(rows.size(), 9u);
   std::set<std::string> seen;
   for (const auto& row : rows) {

@@ -213,7 +213,7 @@ TEST_F(MssCli, CompareGivesEightFiniteCases) {
   const auto& ratio = j["stiffness_diagonal"]["ratio_mss_over_fem"];
   expect_finite_vector(ratio, 6, "stiffness ratio");
   for (const auto& v : ratio) EXPECT_GT(v.get<double>(), 0.0);
-  EXPECT_EQ(count_lines(slurp(csv)), 9);
+  EXPECT_EQ(count_lines(csv_table(csv)), 9);
 
   const CliRun two =
       run_spinesim("mss compare --mesh '" + disc_ + "' --order 1 --cases compression,torsion");
@@ -295,7 +295,7 @@ TEST_F(MssCli, ProbeStudyWritesSeriesCsvAndSummary) {
   EXPECT_EQ(files.size(), j["frames"].get<std::size_t>());
   EXPECT_GE(files.size(), 12u);
   for (const auto& f : files) EXPECT_TRUE(fs::exists(f)) << f;
-  const std::string csv = slurp(dir + "/probe.csv");
+  const std::string csv = csv_table(dir + "/probe.csv");
   EXPECT_EQ(count_lines(csv), 241);
   EXPECT_EQ(csv.rfind("time_s,site,probe_active,", 0), 0u);
   EXPECT_EQ(csv.find("nan"), std::string::npos);
@@ -321,7 +321,7 @@ TEST_F(MssCli, DriveStudyPolyethyleneIsStifferThanTheRealDisc) {
     const auto files = pvd_files(run["files"]["pvd"].get<std::string>());
     EXPECT_EQ(files.size(), run["frames"].get<std::size_t>());
     for (const auto& f : files) EXPECT_TRUE(fs::exists(f)) << f;
-    const std::string csv = slurp(run["files"]["csv"].get<std::string>());
+    const std::string csv = csv_table(run["files"]["csv"].get<std::string>());
     EXPECT_EQ(count_lines(csv), 121);
     EXPECT_EQ(csv.find("nan"), std::string::npos);
   }

@@ -111,11 +111,7 @@ TEST(CliSeating, SweepWritesOneRowPerValueItsPlotsAndTheLiteratureTrends) {
       "study seating-sweep --parameter lumbar-support --values 0,25,50 --quiet --csv '" + csv +
       "' --out '" + out + "'");
   ASSERT_EQ(r.status, 0) << r.err;
-  std::ifstream f(csv);
-  std::string line;
-  int rows = 0;
-  while (std::getline(f, line)) rows += !line.empty();
-  EXPECT_EQ(rows, 4);  // header + 3
+  EXPECT_EQ(count_lines(csv_table(csv)), 4);  // header + 3
   EXPECT_NE(r.out.find("lumbar-support"), std::string::npos);
   EXPECT_NE(r.out.find("Andersson"), std::string::npos) << r.out;
   EXPECT_TRUE(fs::exists(fs::path(out) / "seating_sweep.json"));

@@ -91,7 +91,7 @@ TEST(SpineSolveCli, JsonGivesEveryVertebraJointMuscleAndLigament) {
   EXPECT_GT(j["vertebrae"][0]["translation_mm"][2].get<double>(), 0.0);
   EXPECT_GT(joint(j, "L5-S1")["axial_n"].get<double>(), 0.0);
   // The CSV: a header and one row per vertebra.
-  EXPECT_EQ(count_lines(slurp(csv)), 18);
+  EXPECT_EQ(count_lines(csv_table(csv)), 18);
   EXPECT_EQ(j["csv"], csv);
 }
 
@@ -242,7 +242,7 @@ TEST(FusionStudy, TablesAndCsvCoverEveryFusionAndLoad) {
   ASSERT_EQ(r.status, 0) << r.err;
   const json j = json::parse(r.out);
   EXPECT_EQ(j["runs"].size(), 12u);
-  EXPECT_EQ(count_lines(slurp(csv)), 13);
+  EXPECT_EQ(count_lines(csv_table(csv)), 13);
   EXPECT_FALSE(j["findings"].empty());
   for (const auto& f : j["findings"]) EXPECT_TRUE(f["match"].is_boolean());
 }

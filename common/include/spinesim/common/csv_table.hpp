@@ -6,6 +6,7 @@
 #pragma once
 
 #include "spinesim/common/numbers.hpp"
+#include "spinesim/common/provenance.hpp"
 
 #include <cmath>
 #include <cstddef>
@@ -57,6 +58,7 @@ struct CsvTable {
 inline CsvTable read_csv(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw std::invalid_argument("cannot read " + path);
+  record_input_file(path);
   CsvTable t;
   t.path = path;
   std::string line;

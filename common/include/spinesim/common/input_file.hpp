@@ -6,6 +6,8 @@
 // value, no key twice in one object; require_known_keys refuses fields a reader does not know). Every JSON file the project reads goes through read_json_file.
 #pragma once
 
+#include "spinesim/common/provenance.hpp"
+
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -74,6 +76,7 @@ inline std::string read_regular_file(const std::string& path, const std::string&
   }
   ::close(fd);
   text.resize(done);  // a file that shrank while read: what was there
+  record_input_file(path);
   return text;
 }
 
@@ -94,6 +97,7 @@ inline std::ifstream open_regular_file(const std::string& path, const std::strin
                  std::to_string(limits.max_bytes));
   std::ifstream in(path, std::ios::binary);
   if (!in) throw refuse(std::strerror(errno));
+  record_input_file(path);
   return in;
 }
 

@@ -7,6 +7,7 @@
 #include "spinesim/mss/model.hpp"
 
 #include <Eigen/Core>
+#include <nlohmann/json.hpp>
 
 #include <functional>
 #include <string>
@@ -17,6 +18,18 @@ namespace spinesim::output {
 /// Writes `text` to `path` completely or not at all (spinesim/common/atomic_file.hpp). Throws
 /// std::runtime_error naming the file when the system refuses.
 void write_text_file(const std::string& path, const std::string& text);
+
+/// `j` written as JSON (indented by `indent`, a final newline), atomically, with the run's
+/// provenance (spinesim/common/provenance.hpp) under "provenance" when `j` is an object.
+void write_json_file(const std::string& path, const nlohmann::json& j, int indent = 2);
+
+/// A CSV table written atomically after the provenance line "# provenance: {…}" (readers that
+/// skip '#' lines — ours, numpy, pandas with comment='#' — see the table as before).
+void write_csv_file(const std::string& path, const std::string& csv);
+
+/// The run's provenance as a markdown section ("## Provenance": program, commit, command,
+/// folder, the inputs' sizes and SHA-256), for the end of a markdown report; "" outside a run.
+std::string markdown_provenance();
 
 /// Throws std::invalid_argument "<option> <path>: folder … does not exist" unless `path`'s
 /// folder exists (checked before long runs, so nothing is lost at the end).

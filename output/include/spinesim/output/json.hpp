@@ -33,7 +33,8 @@ inline nlohmann::json path_or_null(const std::string& path) {
   return path.empty() ? nlohmann::json(nullptr) : nlohmann::json(path);
 }
 
-/// Prints `j` as the only thing on stdout (pretty, one object).
+/// Prints `j` as the only thing on stdout (pretty, one object), with the run's provenance
+/// (spinesim/common/provenance.hpp) under "provenance" when `j` is an object.
 void print_json(const nlohmann::json& j);
 /// Whether print_json has printed (the program's last word with --json: a run that failed
 /// after its work began still prints one object, saying so).
