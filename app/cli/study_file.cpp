@@ -55,7 +55,7 @@ void collect_verbs(CLI::App& app, const std::string& prefix, std::vector<std::st
                    std::vector<CLI::App*>* apps) {
   for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) {
     const std::string path = prefix.empty() ? sub->get_name() : prefix + " " + sub->get_name();
-    if (path == "run") continue;
+    if (path == "run" || sub->get_group().empty()) continue;  // hidden helpers are no studies
     if (sub->get_require_subcommand_min() == 0) {
       out.push_back(path);
       if (apps) apps->push_back(sub);

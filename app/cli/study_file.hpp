@@ -32,7 +32,7 @@ inline constexpr int kStudyFileVersion = 1;
 
 /// The verbs of `app` that can run (every sub-command that does not require a further one), as
 /// their space-separated paths ("fem", "mss compare", "study disc-validation"), in help order;
-/// `run` itself excluded.
+/// `run` itself and hidden helpers (the bench's one-run children) excluded.
 std::vector<std::string> study_verbs(CLI::App& app);
 
 /// Adds --save-study FILE to every verb of `app` (study_verbs); its folder is checked when the
