@@ -170,8 +170,9 @@ void add_save_study_options(CLI::App& app) {
               try {
                 output::require_output_folder(path, "--save-study");
                 return std::string();
-              } catch (const std::exception& e) {
-                return std::string(e.what());
+              } catch (const std::exception& e) {  // CLI11 puts the option's name first
+                const std::string why = e.what(), name = "--save-study ";
+                return why.rfind(name, 0) == 0 ? why.substr(name.size()) : why;
               }
             },
             "", "save-study folder"));

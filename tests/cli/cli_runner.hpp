@@ -47,6 +47,21 @@ inline void spit(const std::string& path, const std::string& text) {
   os << text;
 }
 
+/// Whether Debian's python3-jsonschema is installed (the independent schema validator).
+inline bool has_jsonschema() {
+  return fs::exists("/usr/bin/python3") &&
+         std::system("/usr/bin/python3 -c 'import jsonschema' >/dev/null 2>&1") == 0;
+}
+
+/// Debian's jsonschema on the JSON file `document` against the schema file: true when valid.
+inline bool schema_accepts(const std::string& schema, const std::string& document) {
+  const std::string cmd =
+      "/usr/bin/python3 -c 'import json,sys,jsonschema; jsonschema.validate("
+      "json.load(open(sys.argv[2])), json.load(open(sys.argv[1])))' '" +
+      schema + "' '" + document + "' >/dev/null 2>&1";
+  return std::system(cmd.c_str()) == 0;
+}
+
 /// The table of a CSV file the program wrote, after checking its first line: the provenance,
 /// "# provenance: {…}" with the program, its commit and the command line.
 inline std::string csv_table(const std::string& path) {
