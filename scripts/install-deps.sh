@@ -16,6 +16,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-meshio python3-numpy   # independent VTU reader used by the tests
   python3-jsonschema       # an independent validator of the study files' JSON Schema (tests)
+  python3-dev pybind11-dev python3-pytest   # the Python module `spinesim` and its tests
   python3-vtk9             # VTK itself (what ParaView reads and writes with): the tests' second VTU oracle
   calculix-ccx             # CalculiX 2.20: the independent FEM reference of the tests
   python3-matplotlib python3-markdown    # the demo's report.html and its plots (scripts/report.py)

@@ -46,6 +46,7 @@ std::unique_ptr<CLI::App> make_app();
 // Sub-command registration; each lives in its own cli_<verb>.cpp.
 void register_mesh(CLI::App& app);
 void register_mesh_vertebrae(CLI::App& mesh);  ///< mesh vertebrae, under `mesh`
+void register_mesh_import(CLI::App& mesh);     ///< mesh import, under `mesh` (cli_mesh.cpp)
 void register_fem(CLI::App& app);
 void register_export(CLI::App& app);  ///< in cli_fem.cpp: the fem problem for other solvers
 void register_mss(CLI::App& app);        ///< mss, mss compare (cli_mss.cpp)

@@ -79,13 +79,47 @@ void run_fem(const FemArgs& a) {
     print_fem_run(std::cout, r, a.mesh_path);
 }
 
+/// `export --format febio`: the .feb file and its summary.
+void run_febio_export(const FemArgs& a, const FemRunRequest& rq,
+                      const mesh::RegionMaterials& materials, const mesh::TetMesh& m) {
+  const FebioExport e = export_febio_deck(
+      a.out, m, materials, rq, m.source + ", material " + materials.name + " (spinesim export)");
+  nlohmann::json j = {{"out", a.out},
+                      {"format", "febio"},
+                      {"element", e.element},
+                      {"tets", m.num_tets()},
+                      {"material", materials.name},
+                      {"load", "motion"},
+                      {"load_value", to_json(Eigen::VectorXd(motion_rad_to_deg(e.motion)))},
+                      {"load_units", "tx,ty,tz [mm], rx,ry,rz [deg]"},
+                      {"plate_center_mm", to_json(Eigen::VectorXd(e.center))}};
+  if (e.solved) {
+    j["motion_solved_for_wrench"] = to_json(Eigen::VectorXd(e.from_wrench));
+    j["wrench_units"] = "Fx,Fy,Fz [N], Mx,My,Mz [N·mm]";
+  }
+  if (a.json) {
+    print_json(j);
+    return;
+  }
+  std::cout << "wrote " << a.out << ": " << m.num_tets() << " " << e.element
+            << " elements, material " << materials.name << ", plate motion "
+            << j["load_value"].dump() << " (mm, deg)"
+            << (e.solved ? ": this FEM's answer to the wrench " + j["motion_solved_for_wrench"].dump() +
+                               " (N, N·mm), since FEBio needs a rigid part for a wrench"
+                         : std::string())
+            << "\nrun it with: febio4 -i " << a.out << "\n";
+}
+
 void run_export(const FemArgs& a, const std::string& format) {
-  if (format != "abaqus")
-    throw std::invalid_argument("--format '" + format + "' is not known (abaqus: an .inp deck CalculiX runs)");
+  if (format != "abaqus" && format != "febio")
+    throw std::invalid_argument("--format '" + format +
+                                "' is not known (abaqus: an .inp deck CalculiX runs; febio: a "
+                                ".feb file)");
   const FemRunRequest rq = fem_request(a);
   const auto materials = mesh::load_material(a.material, data_dir());
   require_output_folder(a.out, "--out");
   const mesh::TetMesh m = mesh::read_tet_mesh(a.mesh_path);
+  if (format == "febio") return run_febio_export(a, rq, materials, m);
   const DeckExport e = export_abaqus_deck(
       a.out, m, materials, rq, m.source + ", material " + materials.name + " (spinesim export)");
   nlohmann::json j = {{"out", a.out},
@@ -115,15 +149,19 @@ void register_export(CLI::App& app) {
   auto a = std::make_shared<FemArgs>();
   auto format = std::make_shared<std::string>("abaqus");
   auto* cmd = app.add_subcommand(
-      "export", "Write the linear disc problem for another solver (abaqus: a CalculiX/Abaqus .inp deck)");
-  cmd->add_option("--format", *format, "abaqus (.inp: C3D4/C3D10, materials with the fibres as "
-                                        "per-element anisotropic elasticity, endplates, the load)")
+      "export", "Write the linear disc problem for another solver (abaqus: a CalculiX/Abaqus .inp "
+                "deck; febio: an FEBio .feb file)");
+  cmd->add_option("--format", *format,
+                  "abaqus (.inp: C3D4/C3D10, materials with the fibres as per-element anisotropic "
+                  "elasticity, endplates, the load) or febio (.feb, spec 4.0: tet4/tet10, each "
+                  "fibre tet an orthotropic material in its fibre axes, the plate motion; a wrench "
+                  "or case is written as the motion this FEM finds under it)")
       ->capture_default_str();
   cmd->add_option("--mesh", a->mesh_path, "Disc mesh (VTU with `surface` endplate labels)")->required();
   cmd->add_option("--material", a->material, "Preset or JSON file, as for `fem`")->capture_default_str();
-  cmd->add_option("--order", a->order, "1 (C3D4) or 2 (C3D10)")->capture_default_str();
+  cmd->add_option("--order", a->order, "1 (C3D4, tet4) or 2 (C3D10, tet10)")->capture_default_str();
   add_plate_load_options(cmd, a->motion, a->wrench, a->load_case, a->center);
-  cmd->add_option("--out", a->out, "The deck to write (.inp)")->required();
+  cmd->add_option("--out", a->out, "The file to write (.inp or .feb)")->required();
   add_output_flags(cmd, a->json, a->quiet);
   cmd->callback([a, format] { run_export(*a, *format); });
 }

@@ -9,6 +9,8 @@
 // prints the quality report (tet count, dihedral angles, radius-edge ratio, volume vs exact).
 #include "cli_common.hpp"
 
+#include "spinesim/studies/peer_disc.hpp"
+
 #include "spinesim/studies/mesh_disc.hpp"
 #include "spinesim/studies/mesh_report.hpp"
 
@@ -94,6 +96,7 @@ void run_mesh_disc(const MeshArgs& a) {
   rq.structured_options = a.structured_opt;
   rq.structured_options.max_elements = a.max_elements;
   rq.cgal = cgal_options(a);
+  if (a.out.empty()) throw std::invalid_argument("--out: give the output VTU");
   rq.out = a.out;
   rq.medit = a.medit;
 
@@ -107,7 +110,58 @@ void run_mesh_disc(const MeshArgs& a) {
     print_quality(std::cout, r.quality, r.mesh.source);
 }
 
+struct ImportArgs {
+  studies::PeerDiscRequest request;
+  bool json = false, quiet = false;
+};
+
+void run_mesh_import(const ImportArgs& a) {
+  if (a.request.out.empty()) throw std::invalid_argument("--out: give the output VTU");
+  const studies::PeerDiscResult r = studies::import_peer_disc(a.request, data_dir());
+  const nlohmann::json j = studies::peer_disc_json(r, a.request);
+  if (a.json) {
+    print_json(j);
+    return;
+  }
+  std::cout << r.mesh.source << ": " << r.hexahedra << " hexahedra -> " << r.mesh.num_tets()
+            << " tets (annulus " << r.quality.annulus_tets << ", nucleus "
+            << r.quality.nucleus_tets << "), " << r.mesh.num_vertices() << " nodes\n"
+            << "  endplate nodes: inferior " << r.quality.inferior_nodes << ", superior "
+            << r.quality.superior_nodes << "; wall " << r.quality.wall_nodes << "\n"
+            << "  dihedral angle  min " << fixed(r.quality.min_dihedral_deg, 2) << " deg, max "
+            << fixed(r.quality.max_dihedral_deg, 2) << " deg\n"
+            << "  volume          " << fixed(r.quality.volume_mm3, 1) << " mm^3\n"
+            << "  fibres          the peer's at " << fixed(r.peer_inclination_deg, 1)
+            << " deg to the transverse plane, ours (fibre-reinforced) at "
+            << fixed(r.our_inclination_deg, 1) << " deg; " << fixed(r.mean_pair_angle_deg, 1)
+            << " deg apart on average\n"
+            << "wrote " << a.request.out << "\n";
+}
+
 }  // namespace
+
+void register_mesh_import(CLI::App& mesh_cmd) {
+  auto a = std::make_shared<ImportArgs>();
+  auto* cmd = mesh_cmd.add_subcommand(
+      "import", "A peer model's meshed disc as a spinesim disc (the ArtiSynth lumbosacral "
+                "spine's hexahedral discs, split into tets)");
+  cmd->add_option("--artisynth", a->request.folder,
+                  "The model's fe-discs folder (LXX_AN_R1…R4 and LXX_NP .node/.elem files)")
+      ->required();
+  cmd->add_option("--level", a->request.level, "L1-L2, L2-L3, L3-L4, L4-L5 or L5-S1")->required();
+  cmd->add_option("--out", a->request.out, "Output VTU file")->required();
+  add_output_flags(cmd, a->json, a->quiet);
+  cmd->footer(
+      "Metres and the model's z-up frame become mm and ours; each hexahedron becomes six tets "
+      "cut along\n"
+      "its faces' lowest-numbered diagonals (conforming); rings are annulus, the nucleus "
+      "nucleus; upper and\n"
+      "lower faces the endplates. The peer's fibre polylines give cell data "
+      "peer_fibre_direction_1/2.\n"
+      "Then: spinesim fem --mesh OUT --case flexion; spinesim mss compare --mesh OUT; spinesim "
+      "calibrate --mesh OUT");
+  cmd->callback([a] { run_mesh_import(*a); });
+}
 
 void register_mesh(CLI::App& app) {
   auto* mesh_cmd = app.add_subcommand(
@@ -184,6 +238,7 @@ void register_mesh(CLI::App& app) {
     run_mesh_disc(*a);
   });
   register_mesh_vertebrae(*mesh_cmd);
+  register_mesh_import(*mesh_cmd);
 }
 
 }  // namespace spinesim::cli

@@ -35,25 +35,6 @@ namespace {
 using Kernel = CGAL::Simple_cartesian<double>;
 using Point = Kernel::Point_3;
 
-/// File coordinates (already in mm) -> spinesim frame; the maps are documented in io.hpp.
-Eigen::Vector3d to_spinesim_frame(const Eigen::Vector3d& p, UpAxis up) {
-  switch (up) {
-    case UpAxis::y:
-      return {p.x(), p.y(), p.z()};
-    case UpAxis::z:
-      return {p.y(), p.z(), p.x()};
-    case UpAxis::x:
-      return {p.z(), p.x(), p.y()};
-    case UpAxis::minus_y:
-      return {p.x(), -p.y(), -p.z()};
-    case UpAxis::minus_z:
-      return {p.y(), -p.z(), -p.x()};
-    case UpAxis::minus_x:
-      return {p.z(), -p.x(), -p.y()};
-  }
-  return p;
-}
-
 /// Checks a binary STL before CGAL reads it; returns "" or the reason to refuse it.
 ///
 /// CGAL reads a file that does not begin with the word "solid" as binary, as many facets as the
@@ -110,6 +91,25 @@ detail::PolygonSoup read_with_cgal(const std::string& path, const std::string& e
 }
 
 }  // namespace
+
+Eigen::Vector3d to_spinesim_frame(const Eigen::Vector3d& p, UpAxis up) {
+  switch (up) {
+    case UpAxis::y:
+      return {p.x(), p.y(), p.z()};
+    case UpAxis::z:
+      return {p.y(), p.z(), p.x()};
+    case UpAxis::x:
+      return {p.z(), p.x(), p.y()};
+    case UpAxis::minus_y:
+      return {p.x(), -p.y(), -p.z()};
+    case UpAxis::minus_z:
+      return {p.y(), -p.z(), -p.x()};
+    case UpAxis::minus_x:
+      return {p.z(), -p.x(), -p.y()};
+  }
+  return p;
+}
+
 
 TriSurface read_surface(const std::string& path, double units_to_mm, UpAxis up) {
   auto fail = [&](const std::string& msg) {

@@ -17,4 +17,6 @@ void print_json(const nlohmann::json& j) {
 
 bool json_printed() { return g_json_printed; }
 
+void reset_json_printed() { g_json_printed = false; }
+
 }  // namespace spinesim::output

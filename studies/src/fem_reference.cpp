@@ -4,6 +4,7 @@
 #include "spinesim/common/atomic_file.hpp"
 #include "spinesim/common/timer.hpp"
 #include "spinesim/fem/abaqus_deck.hpp"
+#include "spinesim/fem/febio_deck.hpp"
 #include "spinesim/mesh/io.hpp"
 
 #include "spinesim/studies/toolkit.hpp"
@@ -129,7 +130,7 @@ const char* formulation_name(fem::Formulation f) {
   return f == fem::Formulation::mixed ? "mixed" : "displacement";
 }
 
-void write_fem_vtu(const std::string& path, const mesh::TetMesh& m, const FemRunResult& r) {
+FemArrays fem_run_arrays(const mesh::TetMesh& m, const FemRunResult& r) {
   std::vector<mesh::DataArray> points{{"displacement", r.solution.displacement_mm}};
   if (r.solution.pressure_mpa.size() == m.num_vertices())
     points.push_back({"pressure", r.solution.pressure_mpa});
@@ -157,7 +158,12 @@ void write_fem_vtu(const std::string& path, const mesh::TetMesh& m, const FemRun
                                {"fibre_angle_deg", finite_or(r.fibres.angle_deg, 0.0)},
                                {"annulus_depth", finite_or(r.fibres.depth, -1.0)}});
   }
-  mesh::write_vtu(path, m, points, cells);
+  return {std::move(points), std::move(cells)};
+}
+
+void write_fem_vtu(const std::string& path, const mesh::TetMesh& m, const FemRunResult& r) {
+  const FemArrays a = fem_run_arrays(m, r);
+  mesh::write_vtu(path, m, a.points, a.cells);
 }
 
 DeckExport export_abaqus_deck(const std::string& path, const mesh::TetMesh& m,
@@ -185,6 +191,38 @@ DeckExport export_abaqus_deck(const std::string& path, const mesh::TetMesh& m,
                    [&](std::ostream& os) { fem::write_abaqus_deck(os, m, materials, deck); });
   return {rq.order == 1 ? "C3D4" : "C3D10", deck.prescribed_motion ? "motion" : "wrench",
           deck.load, deck.plate_center_mm};
+}
+
+FebioExport export_febio_deck(const std::string& path, const mesh::TetMesh& m,
+                              const mesh::RegionMaterials& materials, const FemRunRequest& rq,
+                              const std::string& title) {
+  if (int(rq.motion.has_value()) + int(rq.wrench.has_value()) + int(rq.load_case != nullptr) > 1)
+    throw std::invalid_argument("give at most one of --motion, --wrench and --case");
+  if (rq.formulation == fem::Formulation::mixed)
+    throw std::invalid_argument("--formulation mixed: export the displacement form (tet10)");
+  mesh::require_endplate_labels(m);
+  fem::FebioDeck deck;
+  deck.order = rq.order;
+  deck.title = title;
+  deck.plate_center_mm = rq.center ? *rq.center : fem::DiscFem::default_plate_center(m);
+  FebioExport e;
+  if (rq.wrench || rq.load_case) {
+    // FEBio takes a wrench through a rigid body the disc mesh has not got: the file prescribes
+    // the plate motion this FEM finds under the wrench, and the reactions FEBio reports on the
+    // superior nodes then sum to the wrench's opposite.
+    const FemRunResult r = run_fem_reference(m, materials, rq);
+    deck.motion = r.solution.plate_motion;
+    e.from_wrench = rq.load_case ? fem::global_wrench(*rq.load_case, m.frame) : *rq.wrench;
+    e.solved = true;
+  } else if (rq.motion) {
+    deck.motion = *rq.motion;
+  }
+  write_atomically("export", path,
+                   [&](std::ostream& os) { fem::write_febio_deck(os, m, materials, deck); });
+  e.element = rq.order == 1 ? "tet4" : "tet10";
+  e.motion = deck.motion;
+  e.center = deck.plate_center_mm;
+  return e;
 }
 
 void print_fem_run(std::ostream& os, const FemRunResult& r, const std::string& mesh_label) {

@@ -19,8 +19,9 @@ void check(const MeshDiscRequest& r) {
   if (from_vertebrae && (r.inferior.empty() || r.superior.empty()))
     throw std::invalid_argument("a disc between vertebrae needs both --inferior and --superior");
   if (r.structured) mesh::validate(r.structured_options);
-  if (r.out.empty()) throw std::invalid_argument("--out: give the output VTU");
-  require_output_folder(r.out, "--out");  // a device, FIFO or link is refused before meshing
+  if (!r.out.empty()) require_output_folder(r.out, "--out");  // a device, FIFO or link: refused
+  if (r.out.empty() && !r.medit.empty())
+    throw std::invalid_argument("--medit is a copy of --out: give --out too");
   if (!r.medit.empty()) require_output_folder(r.medit, "--medit");
 }
 
@@ -103,7 +104,9 @@ double mesh_level(const MeshDiscRequest& r, const std::string& data_dir, const S
 
 }  // namespace
 
-int mesh_disc_stages(const MeshDiscRequest& r) { return r.level.empty() ? 3 : 2; }
+int mesh_disc_stages(const MeshDiscRequest& r) {
+  return (r.level.empty() ? 2 : 1) + int(!r.out.empty());
+}
 
 MeshDiscResult run_mesh_disc(const MeshDiscRequest& request, const std::string& data_dir,
                              const StageHooks& hooks) {
@@ -113,6 +116,7 @@ MeshDiscResult run_mesh_disc(const MeshDiscRequest& request, const std::string& 
   const double exact_volume = request.level.empty() ? mesh_between_vertebrae(request, hooks, r)
                                                     : mesh_level(request, data_dir, hooks, r);
   r.quality = mesh::quality_report(r.mesh, exact_volume);
+  if (request.out.empty()) return r;  // the mesh alone (the Python module)
   hooks.begin_stage("writing " + request.out);
   OutputSet outputs("mesh disc");  // the VTU and the Medit copy: both or neither
   mesh::write_vtu(outputs.stage(request.out), r.mesh);
@@ -126,7 +130,7 @@ nlohmann::json mesh_disc_json(const MeshDiscResult& r) {
   nlohmann::json j = r.disc;
   j.update(quality_json(r.quality));
   j["mesh_seconds"] = r.mesh_seconds;
-  j["out"] = r.request.out;
+  j["out"] = path_or_null(r.request.out);
   if (!r.request.medit.empty()) j["medit"] = r.request.medit;
   j["options"] = options_json(r.request);
   return j;

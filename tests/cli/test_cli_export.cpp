@@ -1,6 +1,7 @@
 // `spinesim export --format abaqus`: the deck CalculiX runs as it is gives our `fem` answer
 // (the element-by-element comparison is tests/fem/test_abaqus_deck_calculix_reference.cpp);
-// bad requests are one line and write nothing.
+// `--format febio` writes the plate motion our `fem` finds under a case (the file's structure is
+// tests/fem/test_febio_deck.cpp); bad requests are one line and write nothing.
 #include "cli_runner.hpp"
 
 #include <gtest/gtest.h>
@@ -67,11 +68,35 @@ TEST(CliExport, CalculixRunsTheAbaqusDeckToOurAnswer) {
   EXPECT_NEAR(max_displacement(slurp(dir + "/flexion.dat")), ours, 1e-5 * ours);
 }
 
+TEST(CliExport, FebioFileCarriesThePlateMotionOfOurFemUnderTheCase) {
+  const std::string out = tmp("export_flexion.feb");
+  const std::string common =
+      "--mesh '" + structured_disc() + "' --material fibre-reinforced --case flexion --json";
+  const CliRun e = run_spinesim("export --format febio " + common + " --out '" + out + "'");
+  ASSERT_EQ(e.status, 0) << e.err;
+  const auto j = nlohmann::json::parse(e.out);
+  EXPECT_EQ(j["element"], "tet10");
+  EXPECT_EQ(j["load"], "motion");
+  const CliRun f = run_spinesim("fem " + common);
+  ASSERT_EQ(f.status, 0) << f.err;
+  const auto fem = nlohmann::json::parse(f.out);
+  for (int k = 0; k < 6; ++k) {
+    EXPECT_NEAR(j["load_value"][k].get<double>(), fem["plate_motion"][k].get<double>(), 1e-12);
+    // The case's wrench, which the plate's reaction balances.
+    EXPECT_NEAR(j["motion_solved_for_wrench"][k].get<double>(),
+                -fem["reaction_wrench"][k].get<double>(), 1e-6);
+  }
+  const std::string text = slurp(out);
+  EXPECT_NE(text.find("<febio_spec version=\"4.0\">"), std::string::npos);
+  EXPECT_NE(text.find("type=\"orthotropic elastic\""), std::string::npos);
+}
+
 TEST(CliExport, BadRequestsAreOneLineAndWriteNothing) {
   const std::string out = tmp("export_bad.inp");
   std::filesystem::remove(out);
   const std::string mesh = "--mesh '" + structured_disc() + "' --out '" + out + "'";
-  expect_refused(run_spinesim("export " + mesh + " --format febio"), "febio");
+  expect_refused(run_spinesim("export " + mesh + " --format ansys"), "ansys");
+  expect_refused(run_spinesim("export " + mesh + " --format febio --order 3"), "order");
   expect_refused(run_spinesim("export " + mesh + " --case flexion --motion 0,0,0,0,0,0"),
                  "at most one");
   expect_refused(run_spinesim("export " + mesh + " --order 3"), "order");

@@ -98,12 +98,15 @@ inline RunRecord& run_record() {
 
 }  // namespace detail
 
-/// Records the command that runs this process (argv as given) and the working folder.
+/// Records the command that runs this process (argv as given) and the working folder, and starts
+/// the list of inputs afresh (a process that runs several commands, such as the Python module,
+/// records each).
 inline void record_run_command(int argc, const char* const* argv) {
   auto& r = detail::run_record();
   std::lock_guard<std::mutex> lock(r.mutex);
   r.recorded = true;
   r.arguments.assign(argv, argv + argc);
+  r.inputs.clear();
   std::error_code ec;
   r.working_directory = std::filesystem::current_path(ec).string();
 }

@@ -143,6 +143,10 @@ enum class UpAxis { x, y, z, minus_x, minus_y, minus_z };
 /// non-finite coordinates; also for units_to_mm that is not finite and positive.
 TriSurface read_surface(const std::string& path, double units_to_mm, UpAxis up);
 
+/// The rotation read_surface applies: a point in file coordinates (already in mm) in the
+/// spinesim frame.
+Eigen::Vector3d to_spinesim_frame(const Eigen::Vector3d& p, UpAxis up);
+
 /// One dataset of a ParaView data collection: the time it shows (s), its file and the part it
 /// belongs to (a collection of several parts shows them together at each time: discs and
 /// vertebrae, say). A relative `file` is resolved by ParaView against the .pvd file's folder.

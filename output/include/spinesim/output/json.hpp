@@ -39,5 +39,7 @@ void print_json(const nlohmann::json& j);
 /// Whether print_json has printed (the program's last word with --json: a run that failed
 /// after its work began still prints one object, saying so).
 bool json_printed();
+/// Forgets that print_json printed: a new run in the same process (the Python module).
+void reset_json_printed();
 
 }  // namespace spinesim::output

@@ -7,6 +7,7 @@
 #include "spinesim/fem/load_cases.hpp"
 #include "spinesim/fem/plate_stiffness.hpp"
 #include "spinesim/fem/stress_fields.hpp"
+#include "spinesim/mesh/io.hpp"
 #include "spinesim/mesh/material.hpp"
 #include "spinesim/mesh/tet_mesh.hpp"
 #include "spinesim/studies/toolkit.hpp"
@@ -16,6 +17,7 @@
 #include <optional>
 #include <ostream>
 #include <string>
+#include <vector>
 
 namespace spinesim::studies {
 
@@ -81,8 +83,31 @@ DeckExport export_abaqus_deck(const std::string& path, const mesh::TetMesh& m,
                               const mesh::RegionMaterials& materials, const FemRunRequest& request,
                               const std::string& title);
 
+/// What `export --format febio` wrote: the element type and the plate motion it prescribes.
+struct FebioExport {
+  std::string element;                           ///< tet4 or tet10
+  fem::Vector6d motion = fem::Vector6d::Zero();  ///< (t mm, theta rad), global
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();
+  bool solved = false;  ///< the motion is this FEM's answer to `from_wrench` (a wrench or case)
+  fem::Vector6d from_wrench = fem::Vector6d::Zero();  ///< (F N, M N·mm), global
+};
+
+/// Writes the problem `request` describes as an FEBio file at `path` (fem/febio_deck.hpp),
+/// atomically. FEBio prescribes plate motions only (a wrench needs a rigid part): a wrench or a
+/// named case is written as the plate motion run_fem_reference finds under it. Throws
+/// std::invalid_argument for the mixed formulation or more than one load.
+FebioExport export_febio_deck(const std::string& path, const mesh::TetMesh& m,
+                              const mesh::RegionMaterials& materials, const FemRunRequest& request,
+                              const std::string& title);
+
 /// The readable summary: plate centre, motion, reaction and the 6x6 stiffness.
 void print_fem_run(std::ostream& os, const FemRunResult& r, const std::string& mesh_label);
+
+/// The run's point and cell arrays, named as write_fem_vtu writes them (units in the names).
+struct FemArrays {
+  std::vector<mesh::DataArray> points, cells;
+};
+FemArrays fem_run_arrays(const mesh::TetMesh& m, const FemRunResult& r);
 
 /// Writes the run to a VTU: point data `displacement` (mm) and, from the mixed formulation,
 /// `pressure` (MPa, hydrostatic); cell data of the fibre field when there is one:

@@ -25,7 +25,7 @@ struct MeshDiscRequest {
   bool structured = false;                                     ///< the structured sweep, not CGAL
   mesh::StructuredDiscOptions structured_options;
   mesh::MeshOptions cgal;
-  std::string out, medit;  ///< the VTU, and an optional Medit copy
+  std::string out, medit;  ///< the VTU (empty: nothing written), and an optional Medit copy
 };
 
 struct MeshDiscResult {

@@ -1,0 +1,216 @@
+"""The Python module against the program it shares its drivers with, and against properties
+(linearity, equilibrium, the stress invariants recomputed in NumPy)."""
+import json
+import math
+
+import numpy as np
+import pytest
+
+import spinesim
+from conftest import assert_json_close
+
+
+def test_mesh_arrays_and_round_trip(tmp_path):
+    m = spinesim.mesh_disc("L4-L5", structured=True)
+    assert m.nodes.shape == (m.num_nodes, 3) and m.tets.shape == (m.num_tets, 4)
+    assert set(np.unique(m.region)) == {1, 2}
+    assert {1, 2} <= set(np.unique(m.surface))
+    # Positively oriented tets: the volume is the sum of det/6, recomputed here.
+    a, b, c, d = (m.nodes[m.tets[:, i]] for i in range(4))
+    dets = np.einsum("ij,ij->i", np.cross(b - a, c - a), d - a)
+    assert (dets > 0).all()
+    assert math.isclose(dets.sum() / 6, m.volume_mm3, rel_tol=1e-12)
+    assert math.isclose(m.info["volume_mm3"], m.volume_mm3, rel_tol=1e-9)
+    assert m.info["tets"] == m.num_tets and m.info["out"] is None
+    path = tmp_path / "m.vtu"
+    m.write(str(path))
+    back = spinesim.read_mesh(str(path))
+    np.testing.assert_array_equal(back.tets, m.tets)
+    np.testing.assert_array_equal(back.region, m.region)
+    np.testing.assert_array_equal(back.nodes, m.nodes)
+    np.testing.assert_allclose(back.frame_axes, m.frame_axes)
+
+
+def test_mesh_views_write_through():
+    m = spinesim.mesh_disc("L4-L5", structured=True)
+    v0 = m.volume_mm3
+    m.nodes[:, 1] *= 2.0  # the arrays are views: doubling the heights doubles the volume
+    assert math.isclose(m.volume_mm3, 2 * v0, rel_tol=1e-12)
+
+
+def test_bad_input_is_a_value_error():
+    with pytest.raises(ValueError, match="L9-L10|level"):
+        spinesim.mesh_disc("L9-L10", structured=True)
+    with pytest.raises(ValueError, match="motion_deg"):
+        spinesim.fem(spinesim.mesh_disc("L4-L5", structured=True), motion_deg=[1, 2])
+    with pytest.raises(ValueError, match="case"):
+        spinesim.fem(spinesim.mesh_disc("L4-L5", structured=True), case="somersault")
+
+
+def test_fem_equals_the_program(disc, disc_file, program):
+    r = spinesim.fem(disc, case="flexion", order=2)
+    p = program("fem", "--mesh", disc_file, "--case", "flexion", "--order", 2)
+    np.testing.assert_allclose(r.summary["reaction_wrench"], p["reaction_wrench"], rtol=1e-12,
+                               atol=1e-9)
+    np.testing.assert_allclose(r.reaction_wrench, p["reaction_wrench"], rtol=1e-12, atol=1e-9)
+    np.testing.assert_allclose(r.plate_motion_deg, p["plate_motion"], rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(r.stiffness_per_deg, p["stiffness_6x6"], rtol=1e-12)
+
+
+def test_fem_is_linear_and_its_stiffness_maps_motion_to_reaction(disc):
+    motion = np.array([0.01, -0.05, 0.02, 0.3, 0.1, -0.2])  # mm, deg
+    r1 = spinesim.fem(disc, motion_deg=motion, order=1)
+    r2 = spinesim.fem(disc, motion_deg=2 * motion, order=1)
+    np.testing.assert_allclose(r2.displacement_mm, 2 * r1.displacement_mm, rtol=1e-9, atol=1e-12)
+    # The stiffness gives the load that holds the plate there: minus the disc's reaction on it.
+    np.testing.assert_allclose(r1.stiffness_per_deg @ motion, -r1.reaction_wrench, rtol=1e-8,
+                               atol=1e-8 * np.abs(r1.reaction_wrench).max())
+    # The plate takes the prescribed motion; the fixed endplate does not move.
+    np.testing.assert_allclose(r1.plate_motion_deg, motion, atol=1e-12)
+    assert np.abs(r1.displacement_mm[disc.surface == 1]).max() == 0.0
+
+
+def test_fem_fields_satisfy_their_definitions(disc):
+    r = spinesim.fem(disc, case="compression", material="fibre-reinforced")
+    s = r.fields["stress_MPa"]  # xx yy zz xy yz xz
+    assert s.shape == (disc.num_tets, 6)
+    vm = np.sqrt(0.5 * ((s[:, 0] - s[:, 1]) ** 2 + (s[:, 1] - s[:, 2]) ** 2 +
+                        (s[:, 2] - s[:, 0]) ** 2) + 3 * (s[:, 3] ** 2 + s[:, 4] ** 2 + s[:, 5] ** 2))
+    np.testing.assert_allclose(r.fields["von_mises_MPa"], vm, rtol=1e-10, atol=1e-14)
+    np.testing.assert_allclose(r.fields["pressure_MPa"], -s[:, :3].sum(axis=1) / 3, rtol=1e-10,
+                               atol=1e-14)
+    assert r.fields["fibre_stretch"].shape == (disc.num_tets, 2)
+    assert set(r.point_data) >= {"displacement"}
+
+
+def test_strain_energy_is_the_work_of_the_plate(disc):
+    # Linear P1 (constant strain per tet): the sum of energy density × volume is the stored
+    # energy, which equals the work done on the plate, -1/2 reaction · motion (theta in rad).
+    motion = np.array([0.02, -0.05, 0.01, 0.3, -0.2, 0.1])  # mm, deg
+    r = spinesim.fem(disc, motion_deg=motion, order=1, material="fibre-reinforced")
+    a, b, c, d = (disc.nodes[disc.tets[:, i]] for i in range(4))
+    vol = np.einsum("ij,ij->i", np.cross(b - a, c - a), d - a) / 6
+    energy = (r.fields["strain_energy_density_MPa"] * vol).sum()
+    work = -0.5 * r.reaction_wrench @ np.concatenate([motion[:3], np.radians(motion[3:])])
+    assert energy > 0
+    assert math.isclose(energy, work, rel_tol=1e-8)
+
+
+def test_mss_static_equals_the_program(disc, disc_file, program):
+    mss = spinesim.MassSpringDisc(disc)
+    s = mss.solve(motion_deg=[0, -0.1, 0, 0, 0, 0])
+    p = program("mss", "--mesh", disc_file, "--motion", "0,-0.1,0,0,0,0")
+    np.testing.assert_allclose(s.reaction_wrench, p["reaction_wrench"], rtol=1e-9, atol=1e-9)
+    assert s.fields["green_lagrange_strain"].shape == (disc.num_tets, 6)
+    # The network's internal forces balance at equilibrium: the plate pushes back up.
+    assert s.reaction_wrench[1] > 0
+
+
+def test_simulation_settles_to_the_static_equilibrium(disc):
+    mss = spinesim.MassSpringDisc(disc)
+    motion = [0, -0.1, 0, 0.2, 0, 0]
+    static = mss.solve(motion_deg=motion)
+    sim = mss.simulation(dt_s=1e-3)
+    for k in range(1, 11):  # the plate ramped over 10 ms, then held
+        sim.step(motion_deg=[k / 10 * x for x in motion])
+    sim.step(motion_deg=motion, steps=990)
+    assert math.isclose(sim.time_s, 1.0, rel_tol=1e-9)
+    err = np.abs(sim.displacement_mm - static.displacement_mm).max()
+    assert err < 1e-3 * np.abs(static.displacement_mm).max()
+    np.testing.assert_allclose(sim.reaction_wrench(), static.reaction_wrench, rtol=1e-3,
+                               atol=1e-3 * np.abs(static.reaction_wrench).max())
+    sim.reset()
+    assert sim.time_s == 0 and np.abs(sim.displacement_mm).max() == 0
+    with pytest.raises(ValueError):
+        sim.step(steps=0)
+
+
+def test_calibration_brings_the_mss_to_the_fem(disc, tmp_path):
+    tuned = tmp_path / "tuned.json"
+    c = spinesim.calibrate(disc, train=["compression", "flexion"], holdout=["torsion"],
+                           check=False, out=str(tuned))
+    assert c.success and c.out == str(tuned)
+    assert json.loads(tuned.read_text())["provenance"]["program"] == "spinesim"
+    fem = spinesim.fem(disc, case="compression")
+    untuned = spinesim.MassSpringDisc(disc).solve(case="compression")
+    tuned_mss = spinesim.MassSpringDisc(disc, params=str(tuned)).solve(case="compression")
+
+    def error(r):
+        return np.abs(r.displacement_mm - fem.displacement_mm).max()
+
+    assert error(tuned_mss) < 0.5 * error(untuned)
+
+
+def test_spine_equals_the_program(program):
+    s = spinesim.spine(forces={"T7": [0, 0, 300]})
+    p = program("spine", "solve", "--force", "T7:0,0,300", quiet=False)
+    assert s.converged and p["converged"]
+    assert_json_close(s.joints, p["joints"], rtol=1e-9, atol=1e-6)
+    assert_json_close(s.vertebrae, p["vertebrae"], rtol=1e-9, atol=1e-9)
+    with pytest.raises(ValueError):
+        spinesim.spine(forces={"T13": [0, 0, 1]})
+
+
+def test_seated_spine(program):
+    s = spinesim.seated_spine(backrest_recline=110, lumbar_support=20)
+    p = program("study", "seating", "--backrest-recline", 110, "--lumbar-support", 20)
+    assert_json_close(s.joints, p["joints"], rtol=1e-9, atol=1e-6)
+    assert_json_close(s.contacts, p["contacts"], rtol=1e-9, atol=1e-6)
+    with pytest.raises(ValueError, match="backrest_recline"):
+        spinesim.seated_spine(recline=110)
+
+
+def test_study_file_round_trip(disc_file, tmp_path):
+    study = tmp_path / "flexion.json"
+    assert spinesim.main(["fem", "--mesh", str(disc_file), "--case", "flexion",
+                          "--save-study", str(study), "--quiet"]) == 0
+    r = spinesim.run_study(str(study))
+    direct = spinesim.fem(spinesim.read_mesh(str(disc_file)), case="flexion")
+    np.testing.assert_allclose(r.reaction_wrench, direct.reaction_wrench, rtol=1e-12, atol=1e-9)
+    assert r.provenance["command"].startswith("spinesim run")
+    assert any(i["path"].endswith("disc.vtu") for i in r.provenance["inputs"])
+
+
+def test_wrong_study_names_the_field(tmp_path):
+    study = tmp_path / "bad.json"
+    study.write_text(json.dumps({"spinesim_study": 1, "verb": "fem",
+                                 "options": {"mesh": "disc.vtu", "orderr": 2}}))
+    with pytest.raises(ValueError, match="orderr"):
+        spinesim.run_study(str(study))
+    assert spinesim.main(["fem", "--no-such-flag"]) == 1
+
+
+def test_outputs_name_the_script(disc, tmp_path):
+    out = tmp_path / "f.vtu"
+    spinesim.fem(disc, case="torsion", out=str(out))
+    text = out.read_bytes()
+    assert b"provenance" in text
+
+
+def test_febio_export_prescribes_our_plate_motion(disc, tmp_path):
+    import xml.etree.ElementTree as ET
+    path = tmp_path / "flexion.feb"
+    e = spinesim.export_febio(str(path), disc, case="flexion", material="fibre-reinforced")
+    r = spinesim.fem(disc, case="flexion", material="fibre-reinforced")
+    np.testing.assert_allclose(e.plate_motion_deg, r.plate_motion_deg, rtol=1e-12, atol=1e-14)
+    root = ET.parse(path).getroot()
+    assert root.tag == "febio_spec" and root.get("version") == "4.0"
+    assert len(root.find("Mesh/Nodes")) == r.summary["fem_nodes"]
+    assert sum(len(p) for p in root.findall("Mesh/Elements")) == disc.num_tets
+    kinds = {m.get("type") for m in root.findall("Material/material")}
+    assert kinds == {"isotropic elastic", "orthotropic elastic"}
+
+
+def test_peer_disc_imports_and_solves():
+    import os
+    folder = os.path.join(os.environ.get("SPINESIM_TESTDATA_DIR", "/nonexistent"),
+                          "artisynth-lss", "fe-discs")
+    if not os.path.exists(os.path.join(folder, "L45_NP.node")):
+        pytest.skip("shared test data absent")
+    disc = spinesim.import_artisynth(folder, "L4-L5")
+    assert disc.num_nodes == 2149 and disc.num_tets % 6 == 0
+    annulus = disc.region == 1
+    np.testing.assert_allclose(np.linalg.norm(disc.peer_fibre_direction_1[annulus], axis=1), 1.0)
+    r = spinesim.fem(disc, case="torsion", order=1)
+    axial = disc.frame_axes[:, 1]
+    assert math.isclose(r.reaction_wrench[3:] @ axial, -7500.0, rel_tol=1e-6)
