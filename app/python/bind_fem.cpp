@@ -4,6 +4,7 @@
 #include "spinesim/fem/load_cases.hpp"
 #include "spinesim/mesh/material.hpp"
 #include "spinesim/studies/fem_reference.hpp"
+#include "spinesim/studies/nonlinear_fem_run.hpp"
 
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
@@ -62,6 +63,38 @@ py::dict fem_solve(const mesh::TetMesh& m, const std::string& material,
   return d;
 }
 
+py::dict fem_nonlinear(const mesh::TetMesh& m, const std::string& material,
+                       const studies::FemRunRequest& rq, int increments, const std::string& out) {
+  const mesh::RegionMaterials materials = mesh::load_material(material, data_folder());
+  studies::NonlinearFemRun r;
+  {
+    py::gil_scoped_release release;
+    mesh::validate(m);
+    r = studies::run_nonlinear_fem(m, materials, rq, increments);
+    if (!out.empty()) studies::write_nonlinear_fem_vtu(out, m, r);
+  }
+  const fem::NonlinearElementFields& f = r.fields;
+  py::dict fields;
+  fields["cauchy_stress_MPa"] = f.cauchy_stress_mpa;
+  fields["von_mises_MPa"] = f.von_mises_mpa;
+  fields["pressure_MPa"] = f.pressure_mpa;
+  fields["green_lagrange_strain"] = f.green_lagrange_strain;
+  fields["principal_stretch"] = f.principal_stretch;
+  fields["fibre_stretch"] = f.fibre_stretch;
+  fields["fibre_stress_MPa"] = f.fibre_stress_mpa;
+  fields["volume_ratio"] = f.volume_ratio;
+  fields["strain_energy_density_MPa"] = f.strain_energy_density_mpa;
+  nlohmann::json summary = studies::nonlinear_fem_json(r, m.source, materials.name);
+  if (!out.empty()) summary["out"] = out;
+  py::dict d;
+  d["displacement_mm"] = Eigen::MatrixX3d(r.solution.body.displacement_mm.topRows(m.num_vertices()));
+  d["plate_motion_deg"] = fem::Vector6d(studies::motion_rad_to_deg(r.solution.plate_motion));
+  d["reaction_wrench"] = r.solution.reaction_wrench;
+  d["fields"] = fields;
+  d["summary"] = to_python(summary);
+  return d;
+}
+
 }  // namespace
 
 void bind_fem(py::module_& m) {
@@ -87,6 +120,18 @@ void bind_fem(py::module_& m) {
       py::arg("mesh"), py::arg("material"), py::arg("case"), py::arg("motion_deg"),
       py::arg("wrench"), py::arg("center"), py::arg("order"), py::arg("formulation"),
       py::arg("out"));
+
+  m.def(
+      "_fem_nonlinear",
+      [](const mesh::TetMesh& mesh, const std::string& material, const std::string& load_case,
+         const std::optional<fem::Vector6d>& motion_deg, const std::optional<fem::Vector6d>& wrench,
+         const std::optional<Eigen::Vector3d>& center, int order, int increments,
+         const std::string& out) {
+        return fem_nonlinear(
+            mesh, material,
+            fem_request(load_case, motion_deg, wrench, center, order, "displacement"), increments,
+            out);
+      });
 
   m.def(
       "_export_abaqus",

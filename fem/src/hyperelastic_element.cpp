@@ -32,18 +32,6 @@ Eigen::Matrix<double, 6, 3> strain_displacement(const Eigen::Matrix3d& F,
 
 namespace {
 
-/// The quadrature rule of an element order: one point for P1, the symmetric 4-point rule for P2.
-const TetQuadrature& element_rule(int order) {
-  static const TetQuadrature p1 = [] {
-    TetQuadrature q;
-    q.barycentric = Eigen::RowVector4d::Constant(0.25);
-    q.weights = Eigen::VectorXd::Ones(1);
-    return q;
-  }();
-  static const TetQuadrature p2 = tet_rule_degree2();
-  return order == 1 ? p1 : p2;
-}
-
 /// Adds one point's ∫ Bᵀ S and ∫ Bᵀ ℂ B + (∇N_a · S ∇N_b) I (weight dV) to the element.
 void add_point(const Eigen::Matrix3d& F, const Eigen::MatrixX3d& G, const MaterialPointState& p,
                double dV, bool with_tangent, HyperelasticElement& out) {

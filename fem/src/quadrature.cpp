@@ -67,4 +67,15 @@ TetQuadrature tet_rule_collapsed(int n) {
   return q;
 }
 
+const TetQuadrature& element_rule(int order) {
+  static const TetQuadrature p1 = [] {
+    TetQuadrature q;
+    q.barycentric = Eigen::RowVector4d::Constant(0.25);
+    q.weights = Eigen::VectorXd::Ones(1);
+    return q;
+  }();
+  static const TetQuadrature p2 = tet_rule_degree2();
+  return order == 1 ? p1 : p2;
+}
+
 }  // namespace spinesim::fem

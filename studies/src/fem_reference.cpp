@@ -166,16 +166,26 @@ void write_fem_vtu(const std::string& path, const mesh::TetMesh& m, const FemRun
   mesh::write_vtu(path, m, a.points, a.cells);
 }
 
-DeckExport export_abaqus_deck(const std::string& path, const mesh::TetMesh& m,
-                              const mesh::RegionMaterials& materials, const FemRunRequest& rq,
-                              const std::string& title) {
+namespace {
+
+/// What every export refuses: more than one load, the mixed formulation (neither CalculiX nor
+/// FEBio has a Taylor-Hood P2-P1 element), a mesh without endplates.
+void check_export(const mesh::TetMesh& m, const FemRunRequest& rq, const std::string& element) {
   if (int(rq.motion.has_value()) + int(rq.wrench.has_value()) + int(rq.load_case != nullptr) > 1)
     throw std::invalid_argument("give at most one of --motion, --wrench and --case");
   if (rq.formulation == fem::Formulation::mixed)
-    throw std::invalid_argument(
-        "--formulation mixed has no CalculiX element (Taylor-Hood P2-P1); export the displacement "
-        "form (C3D10)");
+    throw std::invalid_argument("--formulation mixed has no element in the other solver "
+                                "(Taylor-Hood P2-P1); export the displacement form (" +
+                                element + ")");
   mesh::require_endplate_labels(m);
+}
+
+}  // namespace
+
+DeckExport export_abaqus_deck(const std::string& path, const mesh::TetMesh& m,
+                              const mesh::RegionMaterials& materials, const FemRunRequest& rq,
+                              const std::string& title) {
+  check_export(m, rq, "C3D10");
   fem::AbaqusDeck deck;
   deck.order = rq.order;
   deck.title = title;
@@ -196,11 +206,7 @@ DeckExport export_abaqus_deck(const std::string& path, const mesh::TetMesh& m,
 FebioExport export_febio_deck(const std::string& path, const mesh::TetMesh& m,
                               const mesh::RegionMaterials& materials, const FemRunRequest& rq,
                               const std::string& title) {
-  if (int(rq.motion.has_value()) + int(rq.wrench.has_value()) + int(rq.load_case != nullptr) > 1)
-    throw std::invalid_argument("give at most one of --motion, --wrench and --case");
-  if (rq.formulation == fem::Formulation::mixed)
-    throw std::invalid_argument("--formulation mixed: export the displacement form (tet10)");
-  mesh::require_endplate_labels(m);
+  check_export(m, rq, "tet10");
   fem::FebioDeck deck;
   deck.order = rq.order;
   deck.title = title;

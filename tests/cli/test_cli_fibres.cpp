@@ -145,6 +145,36 @@ TEST(CliFibres, FemWritesStressStrainAndFibreFieldsThatVtkReadsWhole) {
                             3 /* frame, source, provenance */);
 }
 
+TEST(CliFibres, NonlinearFemWritesItsFieldsAndBalancesTheCase) {
+  const std::string out = tmp("nonlinear_flexion.vtu");
+  const CliRun r = run_spinesim("fem --mesh '" + disc_vtu() +
+                                "' --material fibre-reinforced --case flexion --nonlinear --order 1 "
+                                "--increments 4 --json --out '" + out + "'");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["model"], "nonlinear");
+  EXPECT_EQ(j["volumetric_form"], "nodal average");
+  std::vector<mesh::DataArray> points, cells;
+  const mesh::TetMesh m = mesh::read_vtu(out, &points, &cells);
+  // The plate holds the case's 7.5 N·m about the disc's lateral axis.
+  const Eigen::Vector3d M(j["reaction_wrench"][3], j["reaction_wrench"][4], j["reaction_wrench"][5]);
+  EXPECT_NEAR(M.dot(m.frame.axes.col(0)), -7500.0, 1e-3);
+  std::map<std::string, const mesh::DataArray*> by_name;
+  for (const auto& a : cells) by_name[a.name] = &a;
+  for (const char* name : {"cauchy_stress_MPa", "von_mises_MPa", "pressure_MPa",
+                           "green_lagrange_strain", "principal_stretch", "fibre_stretch",
+                           "fibre_stress_MPa", "volume_ratio", "strain_energy_density_MPa"})
+    ASSERT_TRUE(by_name.count(name)) << name;
+  ASSERT_EQ(points.size(), 1u);
+  // Flexion stretches the posterior annulus's fibres and compresses the anterior disc.
+  EXPECT_GT(by_name["fibre_stretch"]->values.maxCoeff(), 1.0);
+  EXPECT_LT(by_name["volume_ratio"]->values.minCoeff(), 1.0);
+  EXPECT_NEAR(by_name["von_mises_MPa"]->values.maxCoeff(),
+              j["fields"]["max_von_mises_mpa"].get<double>(), 1e-9);
+  expect_refused(run_spinesim("fem --mesh '" + disc_vtu() + "' --nonlinear --formulation mixed"),
+                 "mixed");
+}
+
 TEST(CliFibres, BadFormulationsAreOneLine) {
   expect_refused(run_spinesim("fem --mesh '" + disc_vtu() + "' --formulation mixed --order 1"),
                  "needs --order 2");

@@ -21,4 +21,18 @@ inline FibreHyperelastic annulus(const Eigen::Vector3d& circumferential = Eigen:
   return m;
 }
 
+/// A plate motion (mm, rad) that strains a test disc's annulus well beyond the linear range.
+inline Eigen::Matrix<double, 6, 1> flexion_and_compression() {
+  Eigen::Matrix<double, 6, 1> q;
+  q << 0.02, -0.4, 0.05, 0.04, -0.01, 0.02;
+  return q;
+}
+
+/// #nodes×3 displacements as a body's node-major vector.
+inline Eigen::VectorXd flat(const Eigen::MatrixX3d& d) {
+  Eigen::VectorXd u(3 * d.rows());
+  for (Eigen::Index n = 0; n < d.rows(); ++n) u.segment<3>(3 * n) = d.row(n).transpose();
+  return u;
+}
+
 }  // namespace spinesim::fem::fixtures

@@ -214,3 +214,21 @@ def test_peer_disc_imports_and_solves():
     r = spinesim.fem(disc, case="torsion", order=1)
     axial = disc.frame_axes[:, 1]
     assert math.isclose(r.reaction_wrench[3:] @ axial, -7500.0, rel_tol=1e-6)
+
+
+def test_nonlinear_fem_is_linear_for_tiny_motions_and_balances_the_case(disc):
+    # Tiny motions: the stress doubles with the motion, and the pressure is -tr/3. (Its equality
+    # with the linear FEM's stress holds for the pointwise volume only: tests/fem.)
+    q = np.array([0, -1e-4, 0, 1e-3, 0, 0])
+    one = spinesim.fem(disc, motion_deg=q, order=1, nonlinear=True, increments=1)
+    two = spinesim.fem(disc, motion_deg=2 * q, order=1, nonlinear=True, increments=1)
+    s1, s2 = one.fields["cauchy_stress_MPa"], two.fields["cauchy_stress_MPa"]
+    assert np.abs(s2 - 2 * s1).max() < 1e-3 * np.abs(s2).max()
+    np.testing.assert_allclose(one.fields["pressure_MPa"], -s1[:, :3].sum(axis=1) / 3,
+                               rtol=1e-10, atol=1e-16)
+    # The case's moment is held.
+    r = spinesim.fem(disc, case="flexion", material="fibre-reinforced", order=1, nonlinear=True,
+                     increments=4)
+    lateral = disc.frame_axes[:, 0]
+    assert math.isclose(r.reaction_wrench[3:] @ lateral, -7500.0, rel_tol=1e-6)
+    assert r.fields["fibre_stretch"].max() > 1.0

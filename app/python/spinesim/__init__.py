@@ -64,22 +64,22 @@ def _result(d):
     return d
 
 
-def _six(v, what):
+def _numbers(v, n, what):
+    """`v` as n floats (None stays None); ValueError naming `what` otherwise."""
     if v is None:
         return None
     values = [float(x) for x in v]
-    if len(values) != 6:
-        raise ValueError(f"{what}: give 6 numbers, not {len(values)}")
+    if len(values) != n:
+        raise ValueError(f"{what}: give {n} numbers, not {len(values)}")
     return values
+
+
+def _six(v, what):
+    return _numbers(v, 6, what)
 
 
 def _three(v, what):
-    if v is None:
-        return None
-    values = [float(x) for x in v]
-    if len(values) != 3:
-        raise ValueError(f"{what}: give 3 numbers, not {len(values)}")
-    return values
+    return _numbers(v, 3, what)
 
 
 def mesh_disc(level="", *, inferior="", superior="", surface_mm_per_unit=1.0, up="y",
@@ -97,7 +97,7 @@ def mesh_disc(level="", *, inferior="", superior="", surface_mm_per_unit=1.0, up
 
 
 def fem(mesh, *, material="real-disc", case="", motion_deg=None, wrench=None, center=None,
-        order=2, formulation="displacement", out=""):
+        order=2, formulation="displacement", nonlinear=False, increments=10, out=""):
     """The linear FEM reference: the inferior endplate fixed, the superior one a rigid plate
     under one load — a named `case` (load_cases()), a `motion_deg` (tx, ty, tz mm; rx, ry, rz
     deg) or a `wrench` (Fx, Fy, Fz N; Mx, My, Mz N·mm), about `center` (mm; default the plate's
@@ -108,7 +108,20 @@ def fem(mesh, *, material="real-disc", case="", motion_deg=None, wrench=None, ce
     (per-tet arrays named as in the VTU, units in the names: stress_MPa (M, 6: xx yy zz xy yz
     xz), von_mises_MPa, pressure_MPa, strain, principal_strain, fibre_stretch, ...) and the
     summary the program prints with --json. Writes `out` (VTU) when given.
+
+    `nonlinear`: the nonlinear disc (finite strain, tension-only fibres, nearly incompressible
+    nucleus) in `increments` load steps; its fields: cauchy_stress_MPa, von_mises_MPa,
+    pressure_MPa, green_lagrange_strain, principal_stretch, fibre_stretch, fibre_stress_MPa,
+    volume_ratio, strain_energy_density_MPa (no stiffness_per_deg or point_data).
     """
+    if nonlinear:
+        if formulation != "displacement":
+            raise ValueError("nonlinear: the nonlinear disc takes its own volumetric form; "
+                             "leave out formulation")
+        return _result(_spinesim._fem_nonlinear(mesh, material, case,
+                                                _six(motion_deg, "motion_deg"),
+                                                _six(wrench, "wrench"), _three(center, "center"),
+                                                int(order), int(increments), out))
     return _result(_spinesim._fem(mesh, material, case, _six(motion_deg, "motion_deg"),
                                   _six(wrench, "wrench"), _three(center, "center"), int(order),
                                   formulation, out))

@@ -88,6 +88,7 @@ class HyperelasticBody {
                              const NewtonOptions& options = NewtonOptions()) const;
 
   const FeSpace& space() const { return space_; }
+  const std::vector<FibreHyperelastic>& materials() const { return materials_; }
   VolumetricForm form() const { return form_; }
 
  private:

@@ -19,6 +19,10 @@ struct TetQuadrature {
 
 TetQuadrature tet_rule_degree2();
 
+/// The rule of the nonlinear elements of an order (hyperelastic_element.hpp, nonlinear_fields.hpp):
+/// one point (the centroid) for P1, the symmetric 4-point rule for P2, as CalculiX's C3D4/C3D10.
+const TetQuadrature& element_rule(int order);
+
 /// n >= 1 Gauss points per direction; throws std::invalid_argument for n < 1 or n > 10.
 TetQuadrature tet_rule_collapsed(int n);
 

@@ -1,0 +1,48 @@
+// Per-tet fields of the nonlinear disc (nonlinear_fields.hpp); the virial and energy identities
+// in every volumetric form are in test_nonlinear_fields_reference.cpp. Here:
+//   - the small-strain limit: the Cauchy stress over the motion tends to the linear FEM's stress
+//     (stress_fields.hpp) for the same small-strain moduli, the fibres aside;
+//   - at rest: no stress, unit principal stretches.
+#include "spinesim/fem/disc_fem.hpp"
+#include "spinesim/fem/nonlinear_disc.hpp"
+#include "spinesim/fem/nonlinear_fields.hpp"
+#include "spinesim/fem/stress_fields.hpp"
+
+#include "fibre_fixtures.hpp"
+#include "hyperelastic_fixtures.hpp"
+
+#include <gtest/gtest.h>
+
+using namespace spinesim;
+using namespace spinesim::fem;
+
+namespace {
+
+using fixtures::flat;
+using fixtures::flexion_and_compression;
+
+TEST(NonlinearFields, SmallStrainLimitIsTheLinearStressAndRestIsZero) {
+  const mesh::TetMesh m = test::structured_test_disc(12, 3, 2);
+  mesh::RegionMaterials iso = test::fibre_annulus();
+  iso.fibres.clear();
+  const auto materials = disc_element_materials(m, iso, 20.0);
+  const Eigen::Vector3d c = DiscFem::default_plate_center(m);
+  const NonlinearDisc disc(m, materials, 1, c, VolumetricForm::pointwise);
+  const double eps = 1e-6;
+  const Eigen::Matrix<double, 6, 1> q = eps * flexion_and_compression();
+  const NonlinearPlateSolution sol = disc.solve_motion(q);
+  ASSERT_TRUE(sol.body.converged);
+  const Eigen::VectorXd u = flat(sol.body.displacement_mm);
+  const NonlinearElementFields f = nonlinear_element_fields(disc.body(), u);
+  // The linear FEM's stress for the same displacements (P1: strain from the same nodes).
+  const ElementFields lin = element_fields(m, iso, {}, 1, sol.body.displacement_mm);
+  EXPECT_LT((f.cauchy_stress_mpa - lin.stress_mpa).norm(), 1e-4 * lin.stress_mpa.norm());
+  EXPECT_LT((f.green_lagrange_strain - lin.strain).norm(), 1e-4 * lin.strain.norm());
+  // At rest: no stress, unit stretches.
+  const NonlinearElementFields rest =
+      nonlinear_element_fields(disc.body(), Eigen::VectorXd::Zero(u.size()));
+  EXPECT_LT(rest.cauchy_stress_mpa.cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_LT((rest.principal_stretch.array() - 1).abs().maxCoeff(), 1e-12);
+}
+
+}  // namespace
