@@ -135,6 +135,10 @@ void run_mesh_import(const ImportArgs& a) {
             << " deg to the transverse plane, ours (fibre-reinforced) at "
             << fixed(r.our_inclination_deg, 1) << " deg; " << fixed(r.mean_pair_angle_deg, 1)
             << " deg apart on average\n"
+            << "  fibre paths     "
+            << (a.request.fibre_paths ? "the peer's (fibre materials follow them)"
+                                      : "none (fibre materials follow the annulus geometry)")
+            << "\n"
             << "wrote " << a.request.out << "\n";
 }
 
@@ -150,16 +154,22 @@ void register_mesh_import(CLI::App& mesh_cmd) {
       ->required();
   cmd->add_option("--level", a->request.level, "L1-L2, L2-L3, L3-L4, L4-L5 or L5-S1")->required();
   cmd->add_option("--out", a->request.out, "Output VTU file")->required();
+  cmd->add_flag("!--no-fibre-paths", a->request.fibre_paths,
+                "Leave the peer's fibres out of the mesh: a fibre material then lays its own "
+                "along the annulus geometry");
   add_output_flags(cmd, a->json, a->quiet);
   cmd->footer(
       "Metres and the model's z-up frame become mm and ours; each hexahedron becomes six tets "
       "cut along\n"
       "its faces' lowest-numbered diagonals (conforming); rings are annulus, the nucleus "
       "nucleus; upper and\n"
-      "lower faces the endplates. The peer's fibre polylines give cell data "
-      "peer_fibre_direction_1/2.\n"
-      "Then: spinesim fem --mesh OUT --case flexion; spinesim mss compare --mesh OUT; spinesim "
-      "calibrate --mesh OUT");
+      "lower faces the endplates. The peer's fibre polylines become the mesh's fibre paths "
+      "(cell data\n"
+      "fibre_path_direction_1/2), which fem, mss and calibrate lay a fibre material's fibres "
+      "along.\n"
+      "Then: spinesim fem --mesh OUT --material fibre-reinforced --case flexion; spinesim mss "
+      "compare --mesh OUT;\n"
+      "spinesim calibrate --mesh OUT");
   cmd->callback([a] { run_mesh_import(*a); });
 }
 

@@ -57,9 +57,25 @@ py::cpp_function assign(M mesh::TetMesh::*member) {
   return py::cpp_function([member](mesh::TetMesh& t, const M& value) { t.*member = value; });
 }
 
-}  // namespace
+/// A family of the mesh's fibre paths as a NumPy copy, or None without paths.
+py::object fibre_path(const mesh::TetMesh& t, int family) {
+  if (t.fibre_paths.empty()) return py::none();
+  return py::cast(Eigen::MatrixX3d(family == 0 ? t.fibre_paths.direction_1
+                                               : t.fibre_paths.direction_2));
+}
 
-void bind_mesh(py::module_& m) {
+/// Sets a family of fibre paths (None clears both); validate() checks the pair.
+void set_fibre_path(mesh::TetMesh& t, int family, const py::object& d) {
+  if (d.is_none()) {
+    t.fibre_paths = {};
+    return;
+  }
+  (family == 0 ? t.fibre_paths.direction_1 : t.fibre_paths.direction_2) =
+      d.cast<Eigen::MatrixX3d>();
+}
+
+/// spinesim.Mesh: the mesh's arrays as NumPy, its frame, fibre paths, checks and writing.
+void bind_mesh_class(py::module_& m) {
   py::class_<mesh::TetMesh>(m, "Mesh", py::dynamic_attr(), R"(A tetrahedral disc mesh (mm).
 
 nodes    (N, 3) float64 positions, mm; frame x lateral (the body's right is -x), y superior,
@@ -68,7 +84,9 @@ tets     (M, 4) int32 node indices, positively oriented
 region   (M,) int32: 1 annulus, 2 nucleus
 surface  (N,) int32: 0 interior, 1 inferior endplate (fixed), 2 superior endplate (the plate),
          3 outer wall
-The arrays are views of the mesh: writing into them changes it.)")
+The arrays are views of the mesh: writing into them changes it.
+fibre_path_direction_1/2  (M, 3) float64 or None: fibre directions the mesh brings (a peer's
+         fibres), followed by fibre materials; copies, set them whole.)")
       .def(py::init<>())
       .def_property("nodes", view(&mesh::TetMesh::V), assign(&mesh::TetMesh::V))
       .def_property("tets", view(&mesh::TetMesh::T), assign(&mesh::TetMesh::T))
@@ -83,6 +101,17 @@ The arrays are views of the mesh: writing into them changes it.)")
           "frame_axes", [](const mesh::TetMesh& t) { return t.frame.axes; },
           [](mesh::TetMesh& t, const Eigen::Matrix3d& a) { t.frame.axes = a; },
           "The disc frame's axes as columns (lateral, axial, anterior), in the global frame")
+      .def_property(
+          "fibre_path_direction_1",
+          [](const mesh::TetMesh& t) -> py::object { return fibre_path(t, 0); },
+          [](mesh::TetMesh& t, const py::object& d) { set_fibre_path(t, 0, d); },
+          "(M, 3) fibre directions the mesh brings, family 1 (a peer's fibres), or None; a fibre "
+          "material follows them instead of the annulus geometry")
+      .def_property(
+          "fibre_path_direction_2",
+          [](const mesh::TetMesh& t) -> py::object { return fibre_path(t, 1); },
+          [](mesh::TetMesh& t, const py::object& d) { set_fibre_path(t, 1, d); },
+          "(M, 3) fibre directions the mesh brings, family 2, or None")
       .def_property_readonly("num_nodes", &mesh::TetMesh::num_vertices)
       .def_property_readonly("num_tets", &mesh::TetMesh::num_tets)
       .def_property_readonly("volume_mm3", [](const mesh::TetMesh& t) { return mesh::mesh_volume(t); })
@@ -100,6 +129,12 @@ The arrays are views of the mesh: writing into them changes it.)")
                std::to_string(t.num_tets()) + " tets" +
                (t.source.empty() ? std::string() : ", " + t.source) + ">";
       });
+}
+
+}  // namespace
+
+void bind_mesh(py::module_& m) {
+  bind_mesh_class(m);
 
   m.def(
       "read_mesh", [](const std::string& path) { return mesh::read_tet_mesh(path); },
@@ -128,8 +163,9 @@ The arrays are views of the mesh: writing into them changes it.)")
 
   m.def(
       "import_artisynth",
-      [](const std::string& folder, const std::string& level, const std::string& out) {
-        studies::PeerDiscRequest rq{folder, level, out};
+      [](const std::string& folder, const std::string& level, const std::string& out,
+         bool fibre_paths) {
+        studies::PeerDiscRequest rq{folder, level, out, fibre_paths};
         studies::PeerDiscResult r;
         {
           py::gil_scoped_release release;
@@ -138,15 +174,15 @@ The arrays are views of the mesh: writing into them changes it.)")
         const py::object info = to_python(studies::peer_disc_json(r, rq));
         py::object o = py::cast(std::move(r.mesh));
         o.attr("info") = info;
-        o.attr("peer_fibre_direction_1") = r.fibres.direction_1;
-        o.attr("peer_fibre_direction_2") = r.fibres.direction_2;
         return o;
       },
-      py::arg("folder"), py::arg("level"), py::arg("out") = "",
+      py::arg("folder"), py::arg("level"), py::arg("out") = "", py::kw_only(),
+      py::arg("fibre_paths") = true,
       "A peer model's disc: the ArtiSynth lumbosacral spine's hexahedral disc of `level` (L1-L2 … "
       "L5-S1) from its fe-discs `folder`, split into tets, labelled, in mm and our frame; "
-      "`info` has its quality and its fibres beside ours, peer_fibre_direction_1/2 (M, 3) the "
-      "peer's fibre directions per tet. Writes `out` (VTU) when given.");
+      "`info` has its quality and its fibres beside ours. With `fibre_paths` the peer's fibres "
+      "are the mesh's fibre_path_direction_1/2, which a fibre material follows. Writes `out` "
+      "(VTU) when given.");
 }
 
 }  // namespace spinesim::python

@@ -226,13 +226,13 @@ void write_points_cells_and_close(std::ostream& os, const Eigen::MatrixX3d& poin
 }
 
 void check_arrays(const std::string& path, const std::vector<DataArray>& arrays, Eigen::Index rows,
-                  const char* kind, const char* reserved) {
+                  const char* kind, const std::vector<std::string>& reserved) {
   for (const DataArray& a : arrays) {
     const std::string head = "write_vtu: " + path + ": " + kind + " array '" + a.name + "'";
     if (a.name.empty())
       throw std::invalid_argument("write_vtu: " + path + ": a " + kind + " array has no name");
-    if (*reserved && a.name == reserved)
-      throw std::invalid_argument(head + " uses a reserved name (written from the mesh labels)");
+    if (std::find(reserved.begin(), reserved.end(), a.name) != reserved.end())
+      throw std::invalid_argument(head + " uses a reserved name (written from the mesh itself)");
     if (a.values.rows() != rows || a.values.cols() < 1)
       throw std::invalid_argument(head + " has " + std::to_string(a.values.rows()) + "x" +
                                   std::to_string(a.values.cols()) + " values, expected " +
@@ -628,8 +628,18 @@ void write_vtu(const std::string& path, const TetMesh& m, const std::vector<Data
   detail::check_mesh_for_writing(m, who);
   if (!m.frame.origin_mm.allFinite() || !m.frame.axes.allFinite())
     throw std::invalid_argument(who + "disc frame contains non-finite values");
-  check_arrays(path, point_data, m.num_vertices(), "point", "surface");
-  check_arrays(path, cell_data, m.num_tets(), "cell", "region");
+  check_arrays(path, point_data, m.num_vertices(), "point", {"surface"});
+  check_arrays(path, cell_data, m.num_tets(), "cell",
+               {"region", kFibrePathArray[0], kFibrePathArray[1]});
+  try {
+    validate_fibre_paths(m);
+  } catch (const std::invalid_argument& ex) {
+    throw std::invalid_argument(who + ex.what());
+  }
+  std::vector<DataArray> paths;  // the mesh's own fibre directions, after `region`
+  if (!m.fibre_paths.empty())
+    paths = {{kFibrePathArray[0], m.fibre_paths.direction_1},
+             {kFibrePathArray[1], m.fibre_paths.direction_2}};
   if (!host_is_little_endian())
     throw std::runtime_error(who + "writing VTU on a big-endian host is not implemented");
 
@@ -670,6 +680,7 @@ void write_vtu(const std::string& path, const TetMesh& m, const std::vector<Data
     os << "      </PointData>\n"
        << "      <CellData Scalars=\"region\">\n";
     write_data_array(os, "Int32", "region", 1, region, enc, in);
+    write_extra_arrays(os, paths, enc, in);
     write_extra_arrays(os, cell_data, enc, in);
     os << "      </CellData>\n";
     write_points_cells_and_close(os, m.V, m.T, 10, enc);  // VTK_TETRA
@@ -686,8 +697,8 @@ void write_surface_vtu(const std::string& path, const TriSurface& s,
     throw std::invalid_argument(who + "vertex coordinates contain non-finite values");
   if (s.F.minCoeff() < 0 || s.F.maxCoeff() >= s.V.rows())
     throw std::invalid_argument(who + "a triangle has a vertex index out of range");
-  check_arrays(path, point_data, s.V.rows(), "point", "");
-  check_arrays(path, cell_data, s.F.rows(), "cell", "");
+  check_arrays(path, point_data, s.V.rows(), "point", {});
+  check_arrays(path, cell_data, s.F.rows(), "cell", {});
   if (!host_is_little_endian())
     throw std::runtime_error(who + "writing VTU on a big-endian host is not implemented");
 

@@ -38,6 +38,29 @@ void validate_frame(const DiscFrame& f, const std::string& what) {
   }
 }
 
+void validate_fibre_paths(const TetMesh& m) {
+  const FibrePaths& f = m.fibre_paths;
+  if (f.empty()) return;
+  const Eigen::MatrixX3d* family[2] = {&f.direction_1, &f.direction_2};
+  for (int k = 0; k < 2; ++k) {
+    const std::string name = "mesh fibre_path_direction_" + std::to_string(k + 1);
+    const Eigen::MatrixX3d& d = *family[k];
+    if (d.rows() != m.num_tets())
+      throw std::invalid_argument(name + ": " + std::to_string(d.rows()) + " rows for " +
+                                  std::to_string(m.num_tets()) +
+                                  " tetrahedra (both families, one row per tet)");
+    for (Eigen::Index t = 0; t < d.rows(); ++t) {
+      const double n = d.row(t).norm();
+      if (!std::isfinite(n) || (n != 0.0 && std::abs(n - 1.0) > 1e-4)) {
+        std::ostringstream os;
+        os << name << ": tet #" << t << " has a direction of length " << n
+           << " (expected a unit vector, or zero where the tet has no fibres)";
+        throw std::invalid_argument(os.str());
+      }
+    }
+  }
+}
+
 void validate(const TetMesh& m) {
   validate_frame(m.frame, "mesh disc_frame");
   if (m.num_vertices() == 0 || m.num_tets() == 0)
@@ -58,6 +81,7 @@ void validate(const TetMesh& m) {
     throw std::invalid_argument("mesh surface labels: expected one per vertex");
   if (m.T.minCoeff() < 0 || m.T.maxCoeff() >= m.num_vertices())
     throw std::invalid_argument("mesh has a tetrahedron with a vertex index out of range");
+  validate_fibre_paths(m);
   // Zero volume is judged relative to the mean edge length cubed (scale-free).
   double edge_sum = 0.0;
   for (Eigen::Index t = 0; t < m.num_tets(); ++t)

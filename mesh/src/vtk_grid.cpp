@@ -1,5 +1,6 @@
 #include "vtk_grid.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <string>
@@ -62,6 +63,26 @@ void split_section(const FileError& e, const std::vector<RawArray>& arrays, cons
       others.push_back({a.name, to_matrix(a)});
     }
   }
+}
+
+/// Moves the cell arrays `fibre_path_direction_1/2` out of `cdata` into m.fibre_paths (both
+/// families or neither, 3 components each; validate() checks the lengths).
+void take_fibre_paths(const FileError& e, std::vector<DataArray>& cdata, TetMesh& m) {
+  Eigen::MatrixX3d* family[2] = {&m.fibre_paths.direction_1, &m.fibre_paths.direction_2};
+  int found = 0;
+  for (int k = 0; k < 2; ++k) {
+    const auto it = std::find_if(cdata.begin(), cdata.end(),
+                                 [&](const DataArray& a) { return a.name == kFibrePathArray[k]; });
+    if (it == cdata.end()) continue;
+    if (it->values.cols() != 3)
+      e.fail(std::string("CellData '") + kFibrePathArray[k] + "' must have 3 components");
+    *family[k] = it->values;
+    cdata.erase(it);
+    ++found;
+  }
+  if (found == 1)
+    e.fail(std::string("CellData has one of '") + kFibrePathArray[0] + "' and '" +
+           kFibrePathArray[1] + "' without the other (a fibre path needs both families)");
 }
 
 /// The cells as tetrahedra (corners of quadratic ones); returns whether any was quadratic.
@@ -192,6 +213,7 @@ TetMesh assemble_tet_mesh(const FileError& e, RawGrid g, std::vector<DataArray>*
   std::vector<DataArray> pdata, cdata;
   split_section(e, g.point_data, "PointData", np, "surface", m.surface, pdata);
   split_section(e, g.cell_data, "CellData", nc, "region", m.region, cdata);
+  take_fibre_paths(e, cdata, m);
   m.source = e.path;
   read_field_data(e, g, m);
   if (any_quadratic) drop_mid_edge_nodes(m, pdata);

@@ -18,8 +18,10 @@ double line_angle_deg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
 }
 
 void compare_fibres(PeerDiscResult& r, const std::string& data_dir) {
+  mesh::TetMesh bare = r.mesh;  // ours: the field laid along the annulus geometry alone
+  bare.fibre_paths = {};
   const mesh::ElementFibres ours =
-      mesh::fibre_field(r.mesh, mesh::load_material("fibre-reinforced", data_dir));
+      mesh::fibre_field(bare, mesh::load_material("fibre-reinforced", data_dir));
   const Eigen::Vector3d axis = r.mesh.frame.axes.col(1);
   double pair = 0, peer_incl = 0, our_incl = 0;
   Eigen::Index n = 0;
@@ -53,10 +55,8 @@ PeerDiscResult import_peer_disc(const PeerDiscRequest& rq, const std::string& da
   r.quality = mesh::quality_report(r.mesh);
   r.fibres = mesh::peer_fibre_field(r.mesh, mesh::read_artisynth_fibres(rq.folder, rq.level));
   compare_fibres(r, data_dir);
-  if (!rq.out.empty())
-    mesh::write_vtu(rq.out, r.mesh, {},
-                    {{"peer_fibre_direction_1", r.fibres.direction_1},
-                     {"peer_fibre_direction_2", r.fibres.direction_2}});
+  if (rq.fibre_paths) r.mesh.fibre_paths = {r.fibres.direction_1, r.fibres.direction_2};
+  if (!rq.out.empty()) mesh::write_vtu(rq.out, r.mesh);
   return r;
 }
 
@@ -70,7 +70,10 @@ nlohmann::json peer_disc_json(const PeerDiscResult& r, const PeerDiscRequest& rq
   j["fibres"] = {{"mean_pair_angle_to_ours_deg", r.mean_pair_angle_deg},
                  {"peer_inclination_deg", r.peer_inclination_deg},
                  {"our_inclination_deg", r.our_inclination_deg},
-                 {"ours", "the fibre-reinforced preset's field on this mesh"}};
+                 {"ours", "the fibre-reinforced preset's field on this mesh"},
+                 {"fibre_paths", rq.fibre_paths ? "the peer's (a fibre material follows them)"
+                                                : "none (a fibre material follows the "
+                                                  "annulus geometry)"}};
   j["out"] = path_or_null(rq.out);
   return j;
 }

@@ -229,4 +229,50 @@ TEST(FibreField, TurnsWithTheDisc) {
   }
 }
 
+// A mesh that brings fibre paths (a peer's fibres) sets the directions tet by tet: the field
+// takes them normalised, reports their inclination in the lamella frame as alpha, keeps E_f by
+// depth, and falls back to the lamella angle in tets whose paths are zero.
+TEST(FibreField, FollowsTheMeshsFibrePathsAndKeepsTheStiffnessByDepth) {
+  const mesh::TetMesh bare = sample_disc();
+  const ElementFibres geometric = fibre_field(bare, fibre_annulus());
+  const mesh::AnnulusFrames fr = mesh::annulus_frames(bare);
+  mesh::TetMesh m = bare;
+  const Eigen::Index nt = m.num_tets();
+  m.fibre_paths.direction_1.setZero(nt, 3);
+  m.fibre_paths.direction_2.setZero(nt, 3);
+  const double beta = 20.0 * kRadPerDeg;  // the peer's angle, not the material's
+  for (Eigen::Index t = 0; t < nt; ++t) {
+    if (m.region(t) != 1 || t % 7 == 0) continue;  // every 7th annulus tet: no path
+    const Eigen::RowVector3d c = std::cos(beta) * fr.circumferential.row(t);
+    const Eigen::RowVector3d z = std::sin(beta) * fr.axial.row(t);
+    // Both families given a little long (as a Float32 copy might be): they are normalised.
+    m.fibre_paths.direction_1.row(t) = (1 + 5e-5) * (c + z);
+    m.fibre_paths.direction_2.row(t) = (1 - 5e-5) * (c - z);
+  }
+  mesh::validate(m);
+  const ElementFibres f = fibre_field(m, fibre_annulus());
+  int followed = 0, fell_back = 0;
+  for (Eigen::Index t = 0; t < nt; ++t) {
+    EXPECT_EQ(f.stiffness_mpa(t), geometric.stiffness_mpa(t)) << t;
+    if (!(geometric.stiffness_mpa(t) > 0)) {
+      EXPECT_EQ(f.direction_1.row(t).norm(), 0.0);
+      continue;
+    }
+    EXPECT_EQ(f.toe_k2(t), geometric.toe_k2(t));
+    if (t % 7 == 0) {
+      ++fell_back;
+      EXPECT_EQ((f.direction_1.row(t) - geometric.direction_1.row(t)).norm(), 0.0) << t;
+      EXPECT_EQ(f.angle_deg(t), geometric.angle_deg(t));
+      continue;
+    }
+    ++followed;
+    EXPECT_LT((f.direction_1.row(t) - m.fibre_paths.direction_1.row(t).normalized()).norm(), 1e-15);
+    EXPECT_LT((f.direction_2.row(t) - m.fibre_paths.direction_2.row(t).normalized()).norm(), 1e-15);
+    EXPECT_NEAR(f.direction_1.row(t).norm(), 1.0, 1e-15);
+    EXPECT_NEAR(f.angle_deg(t), 20.0, 1e-9);
+  }
+  EXPECT_GT(followed, 100);
+  EXPECT_GT(fell_back, 10);
+}
+
 }  // namespace

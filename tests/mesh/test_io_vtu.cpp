@@ -713,3 +713,61 @@ TEST(IoVtu, ADiscFrameThatIsNotARotationIsRefused) {
   mirror.axes = Eigen::Vector3d(-1, 1, 1).asDiagonal();
   EXPECT_NO_THROW(validate_frame(mirror));
 }
+
+// A mesh's fibre paths travel with it: written as `fibre_path_direction_1/2` after `region`, read
+// back bit-exactly into TetMesh::fibre_paths (not into the caller's arrays), in every encoding;
+// the names are reserved, and a file with one family, or a direction that is not a unit vector,
+// is refused in one line.
+TEST(IoVtu, FibrePathsTravelWithTheMesh) {
+  const std::string dir = tmp_dir("fibre_paths");
+  TetMesh m = cube_mesh();
+  m.fibre_paths.direction_1.setZero(m.num_tets(), 3);
+  m.fibre_paths.direction_2.setZero(m.num_tets(), 3);
+  for (Eigen::Index t = 1; t < m.num_tets(); ++t) {  // tet 0 has none
+    m.fibre_paths.direction_1.row(t) = Eigen::RowVector3d(1, 0.1 * t, -0.3).normalized();
+    m.fibre_paths.direction_2.row(t) = Eigen::RowVector3d(-0.2, 1, 0.01 * t).normalized();
+  }
+  for (const VtuEncoding enc : {VtuEncoding::binary, VtuEncoding::ascii, VtuEncoding::zlib}) {
+    const std::string path = dir + "/paths.vtu";
+    Eigen::MatrixXd volume(m.num_tets(), 1);
+    volume.setOnes();
+    write_vtu(path, m, {}, {{"volume", volume}}, {enc});
+    std::vector<DataArray> cells;
+    const TetMesh r = read_vtu(path, nullptr, &cells);
+    expect_same_mesh(m, r);
+    EXPECT_TRUE((r.fibre_paths.direction_1.array() == m.fibre_paths.direction_1.array()).all());
+    EXPECT_TRUE((r.fibre_paths.direction_2.array() == m.fibre_paths.direction_2.array()).all());
+    ASSERT_EQ(cells.size(), 1u);
+    EXPECT_EQ(cells[0].name, "volume");
+  }
+  // A mesh without paths reads back without them.
+  write_vtu(dir + "/bare.vtu", cube_mesh());
+  EXPECT_TRUE(read_vtu(dir + "/bare.vtu").fibre_paths.empty());
+  // Reserved names, and paths that are not one unit row per tet, are refused before writing.
+  const Eigen::MatrixXd rows = Eigen::MatrixXd::Zero(m.num_tets(), 3);
+  EXPECT_THROW(write_vtu(dir + "/x.vtu", cube_mesh(), {}, {{kFibrePathArray[0], rows}}),
+               std::invalid_argument);
+  TetMesh bad = m;
+  bad.fibre_paths.direction_2.row(2) *= 1.01;
+  test::expect_one_line_refusal([&] { write_vtu(dir + "/x.vtu", bad); }, dir + "/x.vtu",
+                                "fibre_path_direction_2: tet #2 has a direction of length");
+  bad = m;
+  bad.fibre_paths.direction_1.conservativeResize(m.num_tets() - 1, 3);
+  EXPECT_THROW(write_vtu(dir + "/x.vtu", bad), std::invalid_argument);
+  EXPECT_FALSE(fs::exists(dir + "/x.vtu"));
+  // Files: one family alone; a non-unit direction (both through the reader).
+  write_vtu(dir + "/one.vtu", cube_mesh(), {}, {{"fibre_path_direction_9", rows}},
+            {VtuEncoding::ascii});
+  std::string text = slurp(dir + "/one.vtu");
+  text.replace(text.find("fibre_path_direction_9"), 22, kFibrePathArray[0]);
+  spit(dir + "/one.vtu", text);
+  test::expect_one_line_refusal([&] { read_vtu(dir + "/one.vtu"); }, dir + "/one.vtu",
+                                "without the other");
+  write_vtu(dir + "/long.vtu", m, {}, {}, {VtuEncoding::ascii});
+  text = slurp(dir + "/long.vtu");
+  const auto at = text.find('>', text.find("Name=\"fibre_path_direction_1\"")) + 1;
+  text.replace(text.find_first_not_of(" \n", at), 1, "7");  // tet 0's x: 0 -> 7
+  spit(dir + "/long.vtu", text);
+  test::expect_one_line_refusal([&] { read_vtu(dir + "/long.vtu"); }, dir + "/long.vtu",
+                                "tet #0 has a direction of length 7");
+}

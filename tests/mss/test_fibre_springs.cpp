@@ -58,10 +58,11 @@ Eigen::Matrix3d stretch_along(const Eigen::Vector3d& a, double lambda, double sh
 
 /// The nonlinear FEM's energy of one fibre family (k1 2.5 MPa, k2 20) along a in a tet of rest
 /// volume V0 under F: the material point's energy with the family minus without it, times V0.
-double fem_fibre_energy(const Eigen::Matrix3d& F, const Eigen::Vector3d& a, double V0) {
+double fem_fibre_energy(const Eigen::Matrix3d& F, const Eigen::Vector3d& a, double V0,
+                        double k1 = 2.5, double k2 = 20.0) {
   const fem::FibreHyperelastic matrix = fem::neo_hookean_from_linear(1.0, 0.45);
   fem::FibreHyperelastic with = matrix;
-  with.fibres.push_back({a, 2.5, 20.0});
+  with.fibres.push_back({a, k1, k2});
   const Eigen::Matrix3d C = F.transpose() * F;
   return V0 * (fem::fibre_hyperelastic_point(C, with, false).energy -
                fem::fibre_hyperelastic_point(C, matrix, false).energy);
@@ -482,6 +483,45 @@ TEST_F(FibreModel, TheIsochoricFibreForceIsTheElementKernelSummed) {
       EXPECT_GT(e, 0.0);
     }
   }
+}
+
+// A mesh that brings its own fibre paths: the network's isochoric fibre elements lie along them.
+// Under a homogeneous isochoric deformation the fibre term's energy is then the nonlinear FEM's
+// fibre energy summed over the tets with the paths' directions (an independent implementation),
+// and it differs from the energy with the annulus geometry's directions.
+TEST_F(FibreModel, FollowsTheMeshsFibrePathsAsTheNonlinearFemDoes) {
+  const mesh::TetMesh bare = disc();
+  mesh::TetMesh m = bare;
+  const Eigen::Index nt = m.num_tets();
+  std::mt19937 rng(5);
+  std::normal_distribution<double> n;
+  m.fibre_paths.direction_1.setZero(nt, 3);
+  m.fibre_paths.direction_2.setZero(nt, 3);
+  for (Eigen::Index t = 0; t < nt; ++t)
+    if (m.region(t) == 1) {
+      m.fibre_paths.direction_1.row(t) = Eigen::RowVector3d(n(rng), n(rng), n(rng)).normalized();
+      m.fibre_paths.direction_2.row(t) = Eigen::RowVector3d(n(rng), n(rng), n(rng)).normalized();
+    }
+  MssOptions o;
+  o.fibre_springs = true;
+  const MssModel model(m, material(), o), geometric(bare, material(), o);
+  const mesh::ElementFibres k = mesh::fibre_field(bare, material());  // E_f by depth
+  const Eigen::Matrix3d F = stretch_along(Eigen::Vector3d(0.3, 1, -0.2).normalized(), 1.06, 0.1);
+  const Eigen::VectorXd X = model.rest_positions_mm();
+  Eigen::VectorXd x(X.size());
+  for (Eigen::Index i = 0; i < model.num_nodes(); ++i) x.segment<3>(3 * i) = F * X.segment<3>(3 * i);
+  double reference = 0;
+  for (Eigen::Index t = 0; t < nt; ++t) {
+    if (!(k.stiffness_mpa(t) > 0)) continue;
+    const double V0 = mesh::tet_volume(m, t);
+    for (const Eigen::MatrixX3d* d : {&m.fibre_paths.direction_1, &m.fibre_paths.direction_2})
+      reference += fem_fibre_energy(F, d->row(t).transpose(), V0, k.stiffness_mpa(t) / 4,
+                                    k.toe_k2(t));
+  }
+  const double e = model.term_energy(x, Term::fibre, 0);
+  ASSERT_GT(reference, 0.0);
+  EXPECT_NEAR(e, reference, 1e-10 * reference);
+  EXPECT_GT(std::abs(geometric.term_energy(x, Term::fibre, 0) - e), 0.05 * e);
 }
 
 // rest_tangent: the rest Hessian plus every fibre's tension side. At rest each fibre is in

@@ -201,6 +201,34 @@ def test_febio_export_prescribes_our_plate_motion(disc, tmp_path):
     assert kinds == {"isotropic elastic", "orthotropic elastic"}
 
 
+def test_fibre_paths_set_from_python_are_followed_and_checked(disc, tmp_path):
+    # Every annulus tet's fibres made circumferential-ish and flat: a fibre material follows them.
+    assert disc.fibre_path_direction_1 is None
+    n = disc.num_tets
+    a = np.tile([1.0, 0.0, 0.0], (n, 1))
+    b = np.tile([0.0, 0.0, 1.0], (n, 1))
+    disc.fibre_path_direction_1, disc.fibre_path_direction_2 = a, b
+    disc.validate()
+    r = spinesim.fem(disc, case="compression", order=1, material="fibre-reinforced")
+    annulus = disc.region == 1
+    np.testing.assert_allclose(r.fields["fibre_direction_1"][annulus], a[annulus], atol=1e-15)
+    np.testing.assert_allclose(r.fields["fibre_direction_2"][annulus], b[annulus], atol=1e-15)
+    assert np.all(r.fields["fibre_angle_deg"][annulus] < 90.0)
+    # They are written with the mesh and read back.
+    disc.write(str(tmp_path / "paths.vtu"))
+    back = spinesim.read_mesh(str(tmp_path / "paths.vtu"))
+    np.testing.assert_array_equal(back.fibre_path_direction_2, b)
+    # One family alone, or a direction that is not a unit vector, is refused.
+    disc.fibre_path_direction_2 = 2 * b
+    with pytest.raises(ValueError, match="fibre_path_direction_2"):
+        disc.validate()
+    disc.fibre_path_direction_2 = b[:-1]
+    with pytest.raises(ValueError, match="rows for"):
+        spinesim.fem(disc, case="compression", order=1, material="fibre-reinforced")
+    disc.fibre_path_direction_1 = None
+    assert disc.fibre_path_direction_2 is None
+
+
 def test_peer_disc_imports_and_solves():
     import os
     folder = os.path.join(os.environ.get("SPINESIM_TESTDATA_DIR", "/nonexistent"),
@@ -210,10 +238,18 @@ def test_peer_disc_imports_and_solves():
     disc = spinesim.import_artisynth(folder, "L4-L5")
     assert disc.num_nodes == 2149 and disc.num_tets % 6 == 0
     annulus = disc.region == 1
-    np.testing.assert_allclose(np.linalg.norm(disc.peer_fibre_direction_1[annulus], axis=1), 1.0)
+    np.testing.assert_allclose(np.linalg.norm(disc.fibre_path_direction_1[annulus], axis=1), 1.0)
     r = spinesim.fem(disc, case="torsion", order=1)
     axial = disc.frame_axes[:, 1]
     assert math.isclose(r.reaction_wrench[3:] @ axial, -7500.0, rel_tol=1e-6)
+    # A fibre material follows the peer's fibres; without them, the annulus geometry.
+    fib = spinesim.fem(disc, case="torsion", order=1, material="fibre-reinforced")
+    np.testing.assert_allclose(fib.fields["fibre_direction_1"][annulus],
+                               disc.fibre_path_direction_1[annulus], rtol=0, atol=1e-12)
+    bare = spinesim.import_artisynth(folder, "L4-L5", fibre_paths=False)
+    assert bare.fibre_path_direction_1 is None
+    ours = spinesim.fem(bare, case="torsion", order=1, material="fibre-reinforced")
+    assert not np.allclose(ours.fields["fibre_direction_1"], fib.fields["fibre_direction_1"])
 
 
 def test_nonlinear_fem_is_linear_for_tiny_motions_and_balances_the_case(disc):

@@ -4,7 +4,8 @@
 //   - Points: Float64 ×3, mm, full precision (binary is bit-exact; ASCII uses the shortest
 //     round-trip decimal form, so it is exact too);
 //   - Cells: connectivity/offsets Int64, types UInt8 = 10 (VTK_TETRA);
-//   - CellData `region` (Int32) then the caller's cell arrays (Float64);
+//   - CellData `region` (Int32), the mesh's fibre paths when it has any
+//     (`fibre_path_direction_1/2`, Float64 ×3), then the caller's cell arrays (Float64);
 //   - PointData `surface` (Int32) then the caller's point arrays (Float64, NumberOfComponents =
 //     columns), e.g. `displacement`, 3 components, mm;
 //   - FieldData (always ASCII, with NumberOfTuples, which VTK needs to size a field array)
@@ -28,6 +29,10 @@
 
 namespace spinesim::mesh {
 
+/// The cell arrays that carry TetMesh::fibre_paths in a VTU (read and written with the mesh).
+inline constexpr const char* kFibrePathArray[2] = {"fibre_path_direction_1",
+                                                   "fibre_path_direction_2"};
+
 /// A named point- or cell-data array: #rows × ncomponents (rows = #V for point data, #T for
 /// cell data).
 struct DataArray {
@@ -50,8 +55,8 @@ struct VtuWriteOptions {
   VtuEncoding encoding = VtuEncoding::binary;
 };
 
-/// Writes `m` and the extra arrays to `path` (layout above). Names `surface` and `region` are
-/// reserved. Throws std::invalid_argument "... contains non-finite values" for NaN/Inf in the
+/// Writes `m` and the extra arrays to `path` (layout above). Names `surface`, `region` and
+/// `fibre_path_direction_1/2` are reserved. Throws std::invalid_argument "... contains non-finite values" for NaN/Inf in the
 /// coordinates or any array, and for label/array size mismatches or indices out of range;
 /// nothing is written then.
 void write_vtu(const std::string& path, const TetMesh& m,
@@ -76,7 +81,8 @@ void write_surface_vtu(const std::string& path, const TriSurface& s,
 /// vertices used only as mid-edge nodes are dropped (indices and point arrays are remapped).
 /// Any other cell type is an error naming it. Missing `region` -> all 1; missing `surface` ->
 /// all 0 (fem then refuses: no endplate labels). `disc_frame` and `source` FieldData fill
-/// m.frame and m.source when present (else identity frame and the file name).
+/// m.frame and m.source when present (else identity frame and the file name); CellData
+/// `fibre_path_direction_1/2` (both or neither, 3 components) fill m.fibre_paths.
 /// The other PointData arrays go to `point_data`, the other CellData arrays to `cell_data`
 /// (when non-null). Finally calls validate(m), so inverted/zero-volume tets are reported.
 /// Throws std::invalid_argument with one line "read_vtu: PATH: problem" for any bad file.

@@ -32,6 +32,16 @@ struct DiscFrame {
   Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();
 };
 
+/// Collagen fibre directions a mesh brings with it, per tet: a peer model's fibre paths, say.
+/// Both #T×3 with unit rows (zero rows where the tet has none), or both empty when the mesh
+/// brings none. A fibre-reinforced material then lays its two families along these instead of
+/// along the annulus geometry; stiffness, toe and depth still come from the material
+/// (fibre_field.hpp). VTU cell data `fibre_path_direction_1/2` (io.hpp).
+struct FibrePaths {
+  Eigen::MatrixX3d direction_1, direction_2;
+  bool empty() const { return direction_1.rows() == 0 && direction_2.rows() == 0; }
+};
+
 struct TetMesh {
   Eigen::MatrixX3d V;       ///< #V×3 vertex positions, mm
   Eigen::MatrixX4i T;       ///< #T×4 vertex indices, positively oriented
@@ -39,6 +49,7 @@ struct TetMesh {
   Eigen::VectorXi surface;  ///< #V point labels (Surface)
   DiscFrame frame;          ///< disc frame (identity when unknown)
   std::string source;       ///< provenance, e.g. "parametric L4-L5" or a file name
+  FibrePaths fibre_paths;   ///< fibre directions given with the mesh (usually none)
 
   Eigen::Index num_vertices() const { return V.rows(); }
   Eigen::Index num_tets() const { return T.rows(); }
@@ -53,7 +64,8 @@ double mesh_volume(const TetMesh& m);
 /// Throws std::invalid_argument with a one-line message when the mesh is unusable:
 /// empty, index out of range, non-finite coordinates, inverted or zero-volume tets
 /// (relative to the mean edge length cubed), label arrays of the wrong size, a disc frame whose
-/// axes are not orthonormal (validate_frame).
+/// axes are not orthonormal (validate_frame), fibre paths that are not one unit or zero row per
+/// tet in both families (validate_fibre_paths).
 void validate(const TetMesh& m);
 
 /// Throws std::invalid_argument (one line, naming `what`) unless the frame's axes are orthonormal
@@ -61,6 +73,11 @@ void validate(const TetMesh& m);
 /// A frame of zero, scaled or skewed axes would turn every load case into another load (a zero
 /// load, a 1000-fold one, a sideways one) without an error.
 void validate_frame(const DiscFrame& frame, const std::string& what = "disc frame");
+
+/// Throws std::invalid_argument (one line) unless `m.fibre_paths` is empty, or both families have
+/// one row per tet, each row finite and either zero or of unit length to 1e-4 (Float32 copies
+/// pass; fibre_field normalises them).
+void validate_fibre_paths(const TetMesh& m);
 
 /// The boundary of tetrahedra `T` (#T×4): the faces used by exactly one tet, oriented outward
 /// (for positively oriented tets), in the order their tets come; `owner` (when not null) gets

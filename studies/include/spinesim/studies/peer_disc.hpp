@@ -16,10 +16,13 @@ struct PeerDiscRequest {
   std::string folder;  ///< the model's fe-discs folder
   std::string level;   ///< L1-L2 … L5-S1
   std::string out;     ///< the VTU (empty: nothing written)
+  /// Whether the mesh carries the peer's fibres (TetMesh::fibre_paths), so that a fibre
+  /// material lays its fibres along them; without, it lays them along the annulus geometry.
+  bool fibre_paths = true;
 };
 
 struct PeerDiscResult {
-  mesh::TetMesh mesh;
+  mesh::TetMesh mesh;  ///< with the peer's fibres as fibre_paths when the request asks
   mesh::QualityReport quality;
   mesh::PeerFibreField fibres;  ///< the peer's fibres per annulus tet
   /// Per annulus tet, the angle between the peer's fibre pair and the fibre-reinforced preset's
@@ -29,7 +32,8 @@ struct PeerDiscResult {
   Eigen::Index hexahedra = 0;
 };
 
-/// Reads, checks and (with `out`) writes the disc: cell data `peer_fibre_direction_1/2`.
+/// Reads, checks and (with `out`) writes the disc, with the peer's fibres as its fibre paths
+/// (cell data `fibre_path_direction_1/2`) unless the request leaves them out.
 /// Throws std::invalid_argument (one line) for a missing folder or file, or a bad level.
 PeerDiscResult import_peer_disc(const PeerDiscRequest& request, const std::string& data_dir);
 
