@@ -80,6 +80,9 @@ py::dict fem_nonlinear(const mesh::TetMesh& m, const std::string& material,
   fields["pressure_MPa"] = f.pressure_mpa;
   fields["green_lagrange_strain"] = f.green_lagrange_strain;
   fields["principal_stretch"] = f.principal_stretch;
+  for (int k = 0; k < 3; ++k)
+    fields[py::str("principal_stretch_direction_" + std::to_string(k + 1))] =
+        Eigen::MatrixX3d(f.principal_stretch_directions.middleCols(3 * k, 3));
   fields["fibre_stretch"] = f.fibre_stretch;
   fields["fibre_stress_MPa"] = f.fibre_stress_mpa;
   fields["volume_ratio"] = f.volume_ratio;

@@ -120,6 +120,7 @@ NonlinearElementFields nonlinear_element_fields(const HyperelasticBody& body,
   f.von_mises_mpa.resize(nt);
   f.pressure_mpa.resize(nt);
   f.principal_stretch.resize(nt, 3);
+  f.principal_stretch_directions.resize(nt, 9);
   f.fibre_stretch = Eigen::MatrixX2d::Zero(nt, 2);
   f.fibre_stress_mpa = Eigen::MatrixX2d::Zero(nt, 2);
   f.volume_ratio.resize(nt);
@@ -152,8 +153,12 @@ NonlinearElementFields nonlinear_element_fields(const HyperelasticBody& body,
     const Eigen::Matrix3d C = s.C / s.V0;
     f.green_lagrange_strain.row(t) =
         paraview_order(0.5 * (C - Eigen::Matrix3d::Identity())).transpose();
-    Eigen::Vector3d ev = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(C).eigenvalues();
-    f.principal_stretch.row(t) << std::sqrt(ev(2)), std::sqrt(ev(1)), std::sqrt(ev(0));
+    Eigen::Vector3d ev;
+    Eigen::Matrix3d axes;
+    principal(C, ev, axes);
+    f.principal_stretch.row(t) = ev.cwiseSqrt().transpose();
+    for (int k = 0; k < 3; ++k)
+      f.principal_stretch_directions.block<1, 3>(t, 3 * k) = axes.col(k).transpose();
     for (Eigen::Index k = 0; k < Eigen::Index(std::min<std::size_t>(2, m.fibres.size())); ++k) {
       f.fibre_stretch(t, k) = s.stretch(k) / s.V0;
       const Eigen::Vector3d a = s.fibre_now.col(k).normalized();

@@ -64,19 +64,6 @@ double add_fibres(const Families& f, const Eigen::Matrix3d& eps, Eigen::Matrix3d
   return energy;
 }
 
-/// Principal values (descending) and unit directions (columns), each direction signed so that
-/// its largest-magnitude component is positive.
-void principal(const Eigen::Matrix3d& eps, Eigen::Vector3d& values, Eigen::Matrix3d& directions) {
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(eps);
-  for (int k = 0; k < 3; ++k) {
-    values(k) = es.eigenvalues()(2 - k);
-    Eigen::Vector3d d = es.eigenvectors().col(2 - k);
-    Eigen::Index big = 0;
-    d.cwiseAbs().maxCoeff(&big);
-    directions.col(k) = d(big) < 0 ? Eigen::Vector3d(-d) : d;
-  }
-}
-
 void check_sizes(const mesh::TetMesh& mesh, const FeSpace& space, const ElementFibres& fibres,
                  const Eigen::MatrixX3d& u, const Eigen::MatrixX4d* p) {
   const std::string who = "element_fields: ";
@@ -92,6 +79,17 @@ void check_sizes(const mesh::TetMesh& mesh, const FeSpace& space, const ElementF
 }
 
 }  // namespace
+
+void principal(const Eigen::Matrix3d& eps, Eigen::Vector3d& values, Eigen::Matrix3d& directions) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(eps);
+  for (int k = 0; k < 3; ++k) {
+    values(k) = es.eigenvalues()(2 - k);
+    Eigen::Vector3d d = es.eigenvectors().col(2 - k);
+    Eigen::Index big = 0;
+    d.cwiseAbs().maxCoeff(&big);
+    directions.col(k) = d(big) < 0 ? Eigen::Vector3d(-d) : d;
+  }
+}
 
 double von_mises(const Eigen::Matrix<double, 6, 1>& s) {
   const double a = s(0) - s(1), b = s(1) - s(2), c = s(2) - s(0);

@@ -162,7 +162,9 @@ TEST(CliFibres, NonlinearFemWritesItsFieldsAndBalancesTheCase) {
   std::map<std::string, const mesh::DataArray*> by_name;
   for (const auto& a : cells) by_name[a.name] = &a;
   for (const char* name : {"cauchy_stress_MPa", "von_mises_MPa", "pressure_MPa",
-                           "green_lagrange_strain", "principal_stretch", "fibre_stretch",
+                           "green_lagrange_strain", "principal_stretch",
+                           "principal_stretch_direction_1", "principal_stretch_direction_2",
+                           "principal_stretch_direction_3", "fibre_stretch",
                            "fibre_stress_MPa", "volume_ratio", "strain_energy_density_MPa"})
     ASSERT_TRUE(by_name.count(name)) << name;
   ASSERT_EQ(points.size(), 1u);

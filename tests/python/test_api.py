@@ -268,3 +268,5 @@ def test_nonlinear_fem_is_linear_for_tiny_motions_and_balances_the_case(disc):
     lateral = disc.frame_axes[:, 0]
     assert math.isclose(r.reaction_wrench[3:] @ lateral, -7500.0, rel_tol=1e-6)
     assert r.fields["fibre_stretch"].max() > 1.0
+    n1 = r.fields["principal_stretch_direction_1"]
+    np.testing.assert_allclose(np.linalg.norm(n1, axis=1), 1.0, rtol=0, atol=1e-12)

@@ -111,8 +111,9 @@ def fem(mesh, *, material="real-disc", case="", motion_deg=None, wrench=None, ce
 
     `nonlinear`: the nonlinear disc (finite strain, tension-only fibres, nearly incompressible
     nucleus) in `increments` load steps; its fields: cauchy_stress_MPa, von_mises_MPa,
-    pressure_MPa, green_lagrange_strain, principal_stretch, fibre_stretch, fibre_stress_MPa,
-    volume_ratio, strain_energy_density_MPa (no stiffness_per_deg or point_data).
+    pressure_MPa, green_lagrange_strain, principal_stretch, principal_stretch_direction_1..3,
+    fibre_stretch, fibre_stress_MPa, volume_ratio, strain_energy_density_MPa (no
+    stiffness_per_deg or point_data).
     """
     if nonlinear:
         if formulation != "displacement":

@@ -32,6 +32,9 @@ struct NonlinearElementFields {
   Eigen::VectorXd pressure_mpa;               ///< #T, −tr σ / 3 (positive in compression)
   Eigen::MatrixXd green_lagrange_strain;      ///< #T×6, same order, tensor shears (volume mean)
   Eigen::MatrixX3d principal_stretch;         ///< #T×3, descending (of the mean C)
+  /// #T×9: their unit directions e1, e2, e3, the eigenvectors of the mean C (material
+  /// directions, on the reference tet), each signed so its largest component is positive
+  Eigen::MatrixXd principal_stretch_directions;
   Eigen::MatrixX2d fibre_stretch;             ///< #T×2, families 1 and 2 (0: no family)
   Eigen::MatrixX2d fibre_stress_mpa;          ///< #T×2 (0: no family)
   Eigen::VectorXd volume_ratio;               ///< #T, v / V₀

@@ -56,4 +56,8 @@ ElementFields element_fields(const mesh::TetMesh& mesh, const mesh::RegionMateri
 /// Von Mises stress (MPa) of a stress stored in the order above (xx, yy, zz, xy, yz, xz).
 double von_mises(const Eigen::Matrix<double, 6, 1>& s);
 
+/// Eigenvalues of the symmetric `eps`, descending, and their unit eigenvectors as columns, each
+/// signed so that its largest-magnitude component is positive.
+void principal(const Eigen::Matrix3d& eps, Eigen::Vector3d& values, Eigen::Matrix3d& directions);
+
 }  // namespace spinesim::fem

@@ -38,7 +38,8 @@ nlohmann::json nonlinear_fem_json(const NonlinearFemRun& r, const std::string& m
                                   const std::string& material);
 
 /// Point data `displacement` (mm); cell data cauchy_stress_MPa (xx yy zz xy yz xz),
-/// von_mises_MPa, pressure_MPa, green_lagrange_strain, principal_stretch, fibre_stretch,
+/// von_mises_MPa, pressure_MPa, green_lagrange_strain, principal_stretch,
+/// principal_stretch_direction_1..3, fibre_stretch,
 /// fibre_stress_MPa, volume_ratio, strain_energy_density_MPa.
 void write_nonlinear_fem_vtu(const std::string& path, const mesh::TetMesh& m,
                              const NonlinearFemRun& r);
