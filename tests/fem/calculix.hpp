@@ -89,4 +89,10 @@ inline std::vector<Eigen::VectorXd> last_block(const std::string& dat, const std
   return rows;
 }
 
+/// The largest row difference of `a` and `b` over the largest row of `b` (row norms): how two
+/// per-node or per-element fields compare, relative to the field's size.
+inline double relative_difference(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  return (a - b).rowwise().norm().maxCoeff() / b.rowwise().norm().maxCoeff();
+}
+
 }  // namespace spinesim::test

@@ -84,10 +84,6 @@ Eigen::MatrixXd to_calculix_order(const Eigen::MatrixXd& a) {
   return b;
 }
 
-/// max over rows of |a - b| over max over rows of |b| (row norms).
-double relative(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
-  return (a - b).rowwise().norm().maxCoeff() / b.rowwise().norm().maxCoeff();
-}
 
 struct Case {
   const char* name;
@@ -136,17 +132,17 @@ void compare(const Case& c) {
   ASSERT_EQ(E.rows(), m.num_tets());
   ASSERT_EQ(W.rows(), m.num_tets());
 
-  const double eu = relative(u, s.node_displacement_mm);
-  const double es = relative(S, to_calculix_order(ours.stress_mpa));
-  const double ee = relative(E, to_calculix_order(ours.strain));
-  const double ew = relative(W, ours.strain_energy_density_mpa);
+  const double eu = test::relative_difference(u, s.node_displacement_mm);
+  const double es = test::relative_difference(S, to_calculix_order(ours.stress_mpa));
+  const double ee = test::relative_difference(E, to_calculix_order(ours.strain));
+  const double ew = test::relative_difference(W, ours.strain_energy_density_mpa);
   Eigen::VectorXd vm(m.num_tets());
   for (Eigen::Index t = 0; t < vm.rows(); ++t) {
     Vector6d st;
     st << S(t, 0), S(t, 1), S(t, 2), S(t, 3), S(t, 5), S(t, 4);
     vm(t) = von_mises(st);
   }
-  const double evm = relative(vm, ours.von_mises_mpa);
+  const double evm = test::relative_difference(vm, ours.von_mises_mpa);
   std::printf("| %s | %ld | %.1e | %.1e | %.1e | %.1e | %.1e | max von Mises %.4g MPa |\n", c.name,
               long(m.num_tets()), eu, es, evm, ee, ew, ours.von_mises_mpa.maxCoeff());
   // CalculiX prints 7 significant digits: agreement to its print precision.

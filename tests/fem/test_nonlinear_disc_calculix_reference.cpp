@@ -124,10 +124,6 @@ CalculixFields calculix_fields(const std::string& dat, Eigen::Index tets, int np
   return c;
 }
 
-/// max over rows of |a - b| over max over rows of |b| (row norms).
-double relative(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
-  return (a - b).rowwise().norm().maxCoeff() / b.rowwise().norm().maxCoeff();
-}
 
 class DiscAgainstCalculix : public ::testing::TestWithParam<int> {};
 
@@ -194,12 +190,12 @@ TEST_P(DiscAgainstCalculix, SameDisplacementsAndWrench) {
   ASSERT_EQ(ccx.stress.rows(), m.num_tets()) << "CalculiX printed no fields for every element";
   ASSERT_EQ(ccx_coarse.stress.rows(), m.num_tets());
   const Eigen::VectorXd energy = (4 * ccx.energy - ccx_coarse.energy) / 3;
-  const double es = relative(f.cauchy_stress_mpa, ccx.stress),
-               evm = relative(f.von_mises_mpa, ccx.von_mises),
-               ep = relative(f.pressure_mpa, ccx.pressure),
-               ee = relative(f.green_lagrange_strain, ccx.strain),
-               ew20 = relative(f.strain_energy_density_mpa, ccx.energy),
-               ew = relative(f.strain_energy_density_mpa, energy),
+  const double es = test::relative_difference(f.cauchy_stress_mpa, ccx.stress),
+               evm = test::relative_difference(f.von_mises_mpa, ccx.von_mises),
+               ep = test::relative_difference(f.pressure_mpa, ccx.pressure),
+               ee = test::relative_difference(f.green_lagrange_strain, ccx.strain),
+               ew20 = test::relative_difference(f.strain_energy_density_mpa, ccx.energy),
+               ew = test::relative_difference(f.strain_energy_density_mpa, energy),
                el = (f.fibre_stretch - ccx.fibre_stretch).cwiseAbs().maxCoeff();
   std::ostringstream fields;
   fields << std::scientific << std::setprecision(1) << "| C3D" << (order == 1 ? 4 : 10) << " | "
