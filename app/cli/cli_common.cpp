@@ -34,6 +34,36 @@ void add_output_flags(CLI::App* cmd, bool& json, bool& quiet, const std::string&
   cmd->add_flag("--quiet", quiet, "No progress on stderr");
 }
 
+void add_subject_options(CLI::App* cmd, SubjectFlags& flags) {
+  cmd->add_option("--height", flags.height_m,
+                  "Body height, m (default: the thesis's reference body, 1.778 m); the spine's "
+                  "lengths and stiffnesses scale with it (spine/README.md)");
+  cmd->add_option("--mass", flags.mass_kg,
+                  "Body mass, kg (default 70); segment masses and muscle strength follow it");
+  cmd->add_option("--sex", flags.sex, "male or female: de Leva's segment masses of that sex")
+      ->check(CLI::IsMember({"male", "female"}))
+      ->capture_default_str();
+}
+
+spine::Subject subject_of(const SubjectFlags& flags) {
+  if (flags.height_m < 0) throw std::invalid_argument("--height must be a number > 0 m");
+  if (flags.mass_kg < 0) throw std::invalid_argument("--mass must be a number > 0 kg");
+  spine::Subject s;
+  s.height_m = flags.height_m;
+  s.body_mass_kg = flags.mass_kg;
+  s.sex = spine::parse_sex(flags.sex);
+  return s;
+}
+
+void add_ligaments_option(CLI::App* cmd, std::string& ligaments) {
+  cmd->add_option("--ligaments", ligaments,
+                  "The F.6/F.7 ligaments: auto (only with --disc-joints: F.4's whole-segment "
+                  "springs include them), on (with F.4 the thesis's model, which counts them "
+                  "twice) or off")
+      ->check(CLI::IsMember({"auto", "on", "off"}))
+      ->capture_default_str();
+}
+
 void add_plate_load_options(CLI::App* cmd, std::string& motion, std::string& wrench,
                             std::string& load_case, std::string& center) {
   cmd->add_option("--motion", motion, "Plate motion tx,ty,tz,rx,ry,rz (mm, degrees)");

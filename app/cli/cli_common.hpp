@@ -11,6 +11,7 @@
 #include "spinesim/output/json.hpp"
 #include "spinesim/output/progress.hpp"
 #include "spinesim/output/table.hpp"
+#include "spinesim/spine/model.hpp"
 #include "spinesim/studies/data.hpp"
 #include "spinesim/studies/haptics_run.hpp"
 #include "spinesim/studies/toolkit.hpp"
@@ -34,6 +35,18 @@ void require_plain_numbers(CLI::App& app);
 /// --json (one JSON object on stdout; `what` says which) and --quiet (no progress on stderr).
 void add_output_flags(CLI::App* cmd, bool& json, bool& quiet,
                       const std::string& what = "a JSON summary");
+
+/// --height, --mass, --sex: the body the spine belongs to (spine::Subject; 0: the reference body's).
+struct SubjectFlags {
+  double height_m = 0, mass_kg = 0;
+  std::string sex = "male";
+  bool given() const { return height_m != 0 || mass_kg != 0 || sex != "male"; }
+};
+void add_subject_options(CLI::App* cmd, SubjectFlags& flags);
+spine::Subject subject_of(const SubjectFlags& flags);
+
+/// --ligaments auto|on|off (spine::Ligaments, read with spine::parse_ligaments) on the spine verbs.
+void add_ligaments_option(CLI::App* cmd, std::string& ligaments);
 
 /// The plate load options of `fem` and `mss`: --motion, --wrench, --case, --center.
 void add_plate_load_options(CLI::App* cmd, std::string& motion, std::string& wrench,
@@ -89,5 +102,6 @@ void register_spine_database(
 void register_spine_disc_joints(
     CLI::App& spine);                        ///< spine disc-joints (cli_spine_disc_joints.cpp)
 void register_spine_discs(CLI::App& spine);  ///< spine discs, under `spine` (cli_spine_discs.cpp)
+void register_spine_schedule(CLI::App& spine);  ///< spine schedule (cli_spine_schedule.cpp)
 
 }  // namespace spinesim::cli

@@ -42,12 +42,13 @@ namespace {
 
 struct SpineSolveArgs {
   std::vector<std::string> forces, moments, points;
-  std::string fusion, criterion = "polynomial", csv, disc_joints;
+  std::string fusion, criterion = "polynomial", csv, disc_joints, ligaments = "auto";
   double power = 3;
   double tolerance_nmm = spine::SolveOptions().tolerance;
   int max_iterations = spine::SolveOptions().max_iterations;
   int top = 10;
   bool no_muscles = false, no_trunk_muscles = false, no_gravity = false, json = false;
+  SubjectFlags subject;
 };
 
 void solve(const SpineSolveArgs& a) {
@@ -116,6 +117,8 @@ void solve(const SpineSolveArgs& a) {
   model_options.trunk_muscles = !a.no_trunk_muscles;
   model_options.gravity = !a.no_gravity;
   model_options.disc_joints = a.disc_joints;
+  model_options.ligaments = spine::parse_ligaments(a.ligaments);
+  model_options.subject = spine::resolve_subject(data_dir(), subject_of(a.subject));
   if (!a.csv.empty()) require_output_folder(a.csv, "--csv");
 
   // 2. Model and equilibrium (studies/spine_solve.hpp).
@@ -165,6 +168,8 @@ void register_spine(CLI::App& app) {
                   "Joint springs from each level's disc (a data/spine/disc_joints/ preset such as "
                   "fibre-reinforced, or a file from `spine disc-joints`) in place of the thesis's "
                   "F.4");
+  add_ligaments_option(cmd, a->ligaments);
+  add_subject_options(cmd, a->subject);
   cmd->add_option("--tolerance", a->tolerance_nmm, "Newton tolerance on max |dPi/dtheta|, N·mm")
       ->capture_default_str();
   cmd->add_option("--max-iterations", a->max_iterations, "Newton iterations before giving up")
@@ -197,6 +202,7 @@ void register_spine(CLI::App& app) {
   // `spinesim spine database` (thesis 3.5) lives in cli_spine_database.cpp.
   register_spine_database(*spine_cmd);
   register_spine_discs(*spine_cmd);
+  register_spine_schedule(*spine_cmd);
   register_spine_disc_joints(*spine_cmd);
 }
 

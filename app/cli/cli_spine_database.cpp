@@ -35,7 +35,7 @@ namespace sp = spinesim::spine;
 
 struct DatabaseArgs {
   std::string out = "displacement_db.json", vertebrae, fusion, superposition_on = "T1,T7,L3";
-  std::string magnitudes = "200,400,600";
+  std::string magnitudes = "200,400,600", ligaments = "auto";
   CLI::Option* out_option = nullptr;
   int workers = 0;
   bool check = false, no_recruit = false, json = false, quiet = false;
@@ -82,6 +82,7 @@ std::string command_line(const DatabaseArgs& a) {
   std::string c = "spinesim spine database --out " + a.out;
   if (!a.vertebrae.empty()) c += " --vertebrae " + a.vertebrae;
   if (!a.fusion.empty()) c += " --fusion " + a.fusion;
+  if (a.ligaments != DatabaseArgs().ligaments) c += " --ligaments " + a.ligaments;
   if (a.no_recruit) c += " --no-recruit";
   if (a.superposition_on != DatabaseArgs().superposition_on)
     c += " --superposition-on " + a.superposition_on;
@@ -107,6 +108,7 @@ void run_generate(const DatabaseArgs& a) {
   const Timer t0;
   DatabaseRequest rq;
   if (!a.fusion.empty()) rq.model.fused_joints = sp::parse_fusion(a.fusion);
+  rq.model.ligaments = sp::parse_ligaments(a.ligaments);
   rq.solve = solve_options(!a.no_recruit);
   rq.loaded_vertebrae = vertebra_list(a.vertebrae);
   rq.workers = a.workers;
@@ -172,6 +174,7 @@ void register_spine_database(CLI::App& spine) {
                 "Verify an existing file against direct solves instead of generating one");
   cmd->add_option("--vertebrae", a->vertebrae, "Loaded vertebrae, e.g. T1,L3 (default: T1…L5)");
   cmd->add_option("--fusion", a->fusion, "Fused levels of the model, e.g. L3-L4,L4-L5");
+  add_ligaments_option(cmd, a->ligaments);
   cmd->add_flag("--no-recruit", a->no_recruit, "Muscles off (passive spine)");
   cmd->add_option("--superposition-on", a->superposition_on,
                   "Vertebrae loaded by the oblique forces")

@@ -40,6 +40,7 @@
 #include "spinesim/studies/fem_reference.hpp"
 #include "spinesim/studies/materials_study.hpp"
 #include "spinesim/studies/mss_run.hpp"
+#include "spinesim/studies/spine_solve.hpp"
 #include "spinesim/studies/spine_studies.hpp"
 
 #include "spinesim/fem/disc_fem.hpp"
@@ -363,12 +364,14 @@ void register_materials(CLI::App& study) {
 
 struct SpineStudyArgs {
   double force_n = 300;
-  std::string csv, disc_joints;
-  bool json = false, quiet = false, no_trunk_muscles = false, no_ligaments = false;
+  std::string csv, disc_joints, ligaments = "auto";
+  bool json = false, quiet = false, no_trunk_muscles = false;
+  SubjectFlags subject;
   spine::ModelOptions model() const {
     spine::ModelOptions o;
     o.trunk_muscles = !no_trunk_muscles;
-    o.ligaments = !no_ligaments;
+    o.ligaments = spine::parse_ligaments(ligaments);
+    o.subject = subject_of(subject);
     o.disc_joints = disc_joints;
     return o;
   }
@@ -379,7 +382,15 @@ void print_muscle_set(const SpineStudyArgs& a) {
   if (a.no_trunk_muscles)
     std::cout << "Muscles: F.8-F.19 only (--no-trunk-muscles: no thoracic erector spinae, no "
                  "rectus abdominis)\n\n";
-  if (a.no_ligaments) std::cout << "Ligaments: none (--no-ligaments)\n\n";
+  const spine::ModelOptions o = a.model();
+  if (spine::has_ligaments(o) && o.disc_joints.empty())
+    std::cout << "Ligaments: F.6/F.7 on top of F.4 (--ligaments on: the thesis's model, which "
+                 "counts them twice)\n\n";
+  if (!spine::has_ligaments(o) && !o.disc_joints.empty())
+    std::cout << "Ligaments: none (--ligaments off) on the disc joints\n\n";
+  if (a.subject.given())
+    std::cout << "Body: " << subject_text(spine::resolve_subject(data_dir(), o.subject))
+              << " (--height/--mass/--sex; the reference body is male, 1.778 m, 70 kg)\n\n";
   if (!a.disc_joints.empty())
     std::cout << "Joint springs: the discs of " << a.disc_joints
               << " (--disc-joints) in place of the thesis's F.4\n\n";
@@ -394,9 +405,8 @@ void add_spine_study_options(CLI::App* cmd, SpineStudyArgs& a, bool with_force) 
                 "Lumbar muscles F.8-F.19 only: leave out the restored thoracic erector spinae and "
                 "rectus abdominis");
   cmd->add_flag("--quiet", a.quiet, "No progress on stderr");
-  cmd->add_flag("--no-ligaments", a.no_ligaments,
-                "Without the ligaments: the F.4 joint springs alone (Schultz & Ashton-Miller's "
-                "whole-segment stiffness, which includes them)");
+  add_ligaments_option(cmd, a.ligaments);
+  add_subject_options(cmd, a.subject);
   cmd->add_option("--disc-joints", a.disc_joints,
                   "Joint springs from each level's disc (a data/spine/disc_joints/ preset such as "
                   "fibre-reinforced, or a file from `spine disc-joints`) in place of F.4");
@@ -409,6 +419,7 @@ StageHooks spine_study_hooks(const SpineStudyArgs& a, Progress& progress) {
   if (a.force_n > 600)
     std::cerr << "spinesim: warning: --force " << a.force_n
               << " N is beyond the 600 N the thesis validated; solving anyway" << std::endl;
+  spine::resolve_subject(data_dir(), subject_of(a.subject));  // a body out of range: refused now
   if (!a.csv.empty()) require_writable(a.csv, "--csv");
   StageHooks hooks;
   hooks.begin = [&progress](const std::string& what) { progress.begin(what); };

@@ -22,16 +22,10 @@ namespace fs = std::filesystem;
 struct SeatingArgs {
   SeatingRequest request;
   double pelvic_tilt_deg = NAN;
-  std::string chair_file, csv, out, parameter, values;
-  bool json = false, quiet = false, markdown = false, no_trunk_muscles = false,
-       no_ligaments = false;
+  std::string chair_file, csv, out, parameter, values, ligaments = "auto";
+  bool json = false, quiet = false, markdown = false, no_trunk_muscles = false;
+  SubjectFlags subject;
 };
-
-void add_ligament_flag(CLI::App* cmd, SeatingArgs& a) {
-  cmd->add_flag("--no-ligaments", a.no_ligaments,
-                "Without the ligaments: the joints' F.4 springs alone (Schultz & Ashton-Miller's "
-                "whole-segment stiffness, ligaments included)");
-}
 
 void add_chair_options(CLI::App* cmd, SeatingArgs& a) {
   spine::Chair& c = a.request.chair;
@@ -58,7 +52,8 @@ void add_chair_options(CLI::App* cmd, SeatingArgs& a) {
                   "parametric backrest");
   cmd->add_flag("--no-trunk-muscles", a.no_trunk_muscles,
                 "Lumbar muscles F.8-F.19 only (no thoracic erector spinae, no rectus abdominis)");
-  add_ligament_flag(cmd, a);
+  add_ligaments_option(cmd, a.ligaments);
+  add_subject_options(cmd, a.subject);
   cmd->add_option("--csv", a.csv, "Write the results as CSV");
   cmd->add_option("--out", a.out, "Write JSON, CSV, plots and report.html into this folder");
   cmd->add_flag("--markdown", a.markdown, "Print the tables as markdown");
@@ -69,7 +64,8 @@ void add_chair_options(CLI::App* cmd, SeatingArgs& a) {
 void resolve(SeatingArgs& a) {
   if (!std::isnan(a.pelvic_tilt_deg)) a.request.pelvic_tilt_deg = a.pelvic_tilt_deg;
   a.request.model.trunk_muscles = !a.no_trunk_muscles;
-  a.request.model.ligaments = !a.no_ligaments;
+  a.request.model.ligaments = spine::parse_ligaments(a.ligaments);
+  a.request.model.subject = spine::resolve_subject(data_dir(), subject_of(a.subject));
   spine::check_chair(a.request.chair);
   if (!a.chair_file.empty()) {
     a.request.chair.surface = read_chair_surface(a.chair_file);
@@ -121,7 +117,8 @@ void run_sweep(SeatingArgs& a) {
 
 void run_validation(SeatingArgs& a) {
   a.request.model.trunk_muscles = !a.no_trunk_muscles;
-  a.request.model.ligaments = !a.no_ligaments;
+  a.request.model.ligaments = spine::parse_ligaments(a.ligaments);
+  a.request.model.subject = spine::resolve_subject(data_dir(), subject_of(a.subject));
   if (!a.csv.empty()) require_output_folder(a.csv, "--csv");
   Progress progress(kSittingValidationStages, a.quiet || a.json);
   const SittingValidation v = run_sitting_validation(data_dir(), a.request.model, progress.hooks());
@@ -181,7 +178,8 @@ void register_seating(CLI::App& study) {
       "Standing and seated L4-L5 loads and the chair trends beside in-vivo data (MATCH / DIFFERS)");
   val->add_option("--csv", v->csv, "Write the comparison as CSV");
   val->add_flag("--no-trunk-muscles", v->no_trunk_muscles, "Lumbar muscles F.8-F.19 only");
-  add_ligament_flag(val, *v);
+  add_ligaments_option(val, v->ligaments);
+  add_subject_options(val, v->subject);
   add_output_flags(val, v->json, v->quiet, "the JSON comparison");
   val->callback([v] { run_validation(*v); });
 }

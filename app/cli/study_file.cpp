@@ -22,7 +22,7 @@ const std::set<std::string> kPathOptions = {
     "mesh",   "out",     "csv",       "paths",      "targets",     "held-out", "preset",
     "medit",  "inferior", "superior", "transfer-mesh", "mesh-out", "testdata", "cache-dir",
     "replay", "record",  "write-scene", "database", "chair",       "play",     "cursor-script",
-    "screenshot"};
+    "screenshot", "loads"};
 // Options that take a shipped preset's name or a file.
 const std::set<std::string> kPresetOrPathOptions = {
     "material", "params", "disc-joints", "tuned", "script", "vertebrae", "spine",

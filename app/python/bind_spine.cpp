@@ -15,9 +15,21 @@ namespace {
 
 using VectorsByVertebra = std::map<std::string, Eigen::Vector3d>;
 
+/// The body: height (m), mass (kg), sex; zeros are the reference body's.
+struct Body {
+  double height_m = 0, body_mass_kg = 0;
+  std::string sex = "male";
+};
+
 spine::ModelOptions model_options(const std::string& fusion, bool muscles, bool trunk_muscles,
-                                  bool gravity, const std::string& disc_joints) {
+                                  bool gravity, const std::string& disc_joints,
+                                  const std::string& ligaments, const Body& body) {
   spine::ModelOptions o;
+  o.ligaments = spine::parse_ligaments(ligaments);
+  o.subject.height_m = body.height_m;
+  o.subject.body_mass_kg = body.body_mass_kg;
+  o.subject.sex = spine::parse_sex(body.sex);
+  o.subject = spine::resolve_subject(data_folder(), o.subject);
   if (!fusion.empty()) o.fused_joints = spine::parse_fusion(fusion);
   o.muscles = muscles;
   o.trunk_muscles = trunk_muscles;
@@ -28,7 +40,8 @@ spine::ModelOptions model_options(const std::string& fusion, bool muscles, bool 
 
 py::object solve_spine(const VectorsByVertebra& forces, const VectorsByVertebra& moments,
                        const std::string& fusion, bool muscles, bool trunk_muscles, bool gravity,
-                       const std::string& disc_joints) {
+                       const std::string& disc_joints, const std::string& ligaments,
+                       double height_m, double body_mass_kg, const std::string& sex) {
   studies::SpineSolveRequest rq;
   for (const auto& [name, f] : forces) {
     spine::ExternalLoad l;
@@ -42,7 +55,8 @@ py::object solve_spine(const VectorsByVertebra& forces, const VectorsByVertebra&
     l.moment_nmm = mo;
     rq.loads.push_back(l);
   }
-  rq.model = model_options(fusion, muscles, trunk_muscles, gravity, disc_joints);
+  rq.model = model_options(fusion, muscles, trunk_muscles, gravity, disc_joints, ligaments,
+                           {height_m, body_mass_kg, sex});
   rq.solve.recruit = muscles;
   nlohmann::json j;
   {
@@ -54,7 +68,8 @@ py::object solve_spine(const VectorsByVertebra& forces, const VectorsByVertebra&
 
 py::object seated(const std::map<std::string, double>& chair, bool armrests,
                   const std::string& chair_surface, const std::string& fusion,
-                  const std::string& disc_joints) {
+                  const std::string& disc_joints, const std::string& ligaments, double height_m,
+                  double body_mass_kg, const std::string& sex) {
   studies::SeatingRequest rq;
   for (const auto& [name, value] : chair) rq = studies::with_parameter(rq, name, value);
   rq.chair.armrests = armrests;
@@ -62,7 +77,8 @@ py::object seated(const std::map<std::string, double>& chair, bool armrests,
     rq.chair.surface = studies::read_chair_surface(chair_surface);
     rq.chair.surface_name = chair_surface;
   }
-  rq.model = model_options(fusion, true, true, true, disc_joints);
+  rq.model = model_options(fusion, true, true, true, disc_joints, ligaments,
+                           {height_m, body_mass_kg, sex});
   studies::check_seating_request(rq);
   nlohmann::json j;
   {

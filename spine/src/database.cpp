@@ -132,13 +132,13 @@ PolynomialFit fit_by_residual(const Eigen::VectorXd& force_n, const Eigen::Vecto
 
 // --- solving load cases ----------------------------------------------------------------------
 
-void solve_cases(const SpineModel& m, const std::vector<std::vector<ExternalLoad>>& loads,
-                 const SolveOptions& options, int workers,
-                 std::vector<VertebraResponse>& displacement, std::vector<std::string>& errors,
-                 const std::function<void(int, int)>& progress) {
+void solve_many(const SpineModel& m, const std::vector<std::vector<ExternalLoad>>& loads,
+                const SolveOptions& options, int workers, std::vector<SpineSolution>& solutions,
+                std::vector<std::string>& errors, const std::function<void(int, int)>& progress) {
   const int n = int(loads.size());
-  displacement.assign(std::size_t(n), VertebraResponse::Zero());
+  solutions.assign(std::size_t(n), SpineSolution());
   errors.assign(std::size_t(n), std::string());
+  if (n == 0) return;
   if (workers <= 0) workers = int(std::max(1u, std::thread::hardware_concurrency()));
   workers = std::max(1, std::min(workers, n));
 
@@ -150,9 +150,9 @@ void solve_cases(const SpineModel& m, const std::vector<std::vector<ExternalLoad
   auto work = [&] {
     for (int i = next++; i < n && !stop; i = next++) {
       std::string error;
-      VertebraResponse d = VertebraResponse::Zero();
+      SpineSolution solution;
       try {
-        d = as_response(solve_spine(m, loads[std::size_t(i)], options).displacement);
+        solution = solve_spine(m, loads[std::size_t(i)], options);
       } catch (const std::exception& e) {  // SolveError above all; anything else is kept too
         error = e.what();
         if (error.empty()) error = "solve failed (no message)";
@@ -160,7 +160,7 @@ void solve_cases(const SpineModel& m, const std::vector<std::vector<ExternalLoad
         error = "solve failed (unknown exception)";
       }
       std::lock_guard<std::mutex> lock(mutex);
-      displacement[std::size_t(i)] = d;
+      solutions[std::size_t(i)] = std::move(solution);
       errors[std::size_t(i)] = error;
       ++done;
       changed.notify_one();
@@ -186,6 +186,17 @@ void solve_cases(const SpineModel& m, const std::vector<std::vector<ExternalLoad
     throw;
   }
   for (auto& t : pool) t.join();
+}
+
+void solve_cases(const SpineModel& m, const std::vector<std::vector<ExternalLoad>>& loads,
+                 const SolveOptions& options, int workers,
+                 std::vector<VertebraResponse>& displacement, std::vector<std::string>& errors,
+                 const std::function<void(int, int)>& progress) {
+  std::vector<SpineSolution> solutions;
+  solve_many(m, loads, options, workers, solutions, errors, progress);
+  displacement.assign(solutions.size(), VertebraResponse::Zero());
+  for (std::size_t i = 0; i < solutions.size(); ++i)
+    if (errors[i].empty()) displacement[i] = as_response(solutions[i].displacement);
 }
 
 namespace {
@@ -563,12 +574,14 @@ json model_json(const DatabaseInfo& i) {
   for (int j : i.model.fused_joints) fused.push_back(joint_names().at(std::size_t(j)));
   return {
       {"fused_joints", fused},
-      {"ligaments", i.model.ligaments},
+      {"ligaments", has_ligaments(i.model)},
       {"muscles", i.model.muscles},
       {"iap", i.model.iap},
       {"gravity", i.model.gravity},
       {"arms_forward", i.model.arms_forward},
-      {"body_mass_kg", i.model.body_mass_kg},
+      {"body_mass_kg", i.model.subject.body_mass_kg},
+      {"height_m", i.model.subject.height_m},
+      {"sex", sex_name(i.model.subject.sex)},
       {"recruit", i.solve.recruit},
       {"criterion", i.solve.recruitment.criterion == Criterion::MinMax ? "min-max" : "polynomial"},
       {"criterion_power", i.solve.recruitment.power},
@@ -579,12 +592,15 @@ void model_from_json(const json& j, DatabaseInfo& i) {
   i.model.fused_joints.clear();
   for (const auto& n : j.at("fused_joints"))
     i.model.fused_joints.push_back(joint_index(n.get<std::string>()));
-  i.model.ligaments = j.at("ligaments").get<bool>();
+  i.model.ligaments = j.at("ligaments").get<bool>() ? Ligaments::On : Ligaments::Off;
   i.model.muscles = j.at("muscles").get<bool>();
   i.model.iap = j.at("iap").get<bool>();
   i.model.gravity = j.at("gravity").get<bool>();
   i.model.arms_forward = j.at("arms_forward").get<bool>();
-  i.model.body_mass_kg = j.at("body_mass_kg").get<double>();
+  i.model.subject.body_mass_kg = j.at("body_mass_kg").get<double>();
+  // Files written before subjects existed are the reference body's.
+  i.model.subject.height_m = j.value("height_m", 0.0);
+  i.model.subject.sex = parse_sex(j.value("sex", std::string("male")));
   i.solve = SolveOptions();
   i.solve.recruit = j.at("recruit").get<bool>();
   const std::string criterion = j.at("criterion").get<std::string>();

@@ -6,6 +6,7 @@
 #include "spinesim/common/input_file.hpp"
 
 #include "json_fields.hpp"
+#include "subject.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <nlohmann/json.hpp>
@@ -185,16 +186,16 @@ void load_weights(SpineModel& m, const json& config, const std::string& file, bo
   const json& pct = config.at("vertebra_mass_percent");
   for (std::size_t i = 0; i < m.vertebrae.size(); ++i) {
     Vertebra& v = m.vertebrae[i];
-    v.mass_kg = number(pct, v.name, file) / 100.0 * m.body_mass_kg;
+    v.mass_kg = number(pct, v.name, file) / 100.0 * m.scale.trunk_mass * m.body_mass_kg;
     m.weights.push_back({v.name + " weight", int(i), v.centre_mm, v.mass_kg * g_n_per_kg * down});
   }
   const json& head = config.at("head_neck");
-  const double head_kg = number(head, "mass_percent", file) / 100.0 * m.body_mass_kg;
+  const double head_kg = m.segment_mass_percent.head_neck / 100.0 * m.body_mass_kg;
   m.weights.push_back({"head and neck weight",
                        vertebra_index(head.at("carried_by").get<std::string>()),
                        vec3(head, "point_mm", file), head_kg * g_n_per_kg * down});
   const json& arms = config.at("arms");
-  const double arm_kg = number(arms, "mass_percent_each", file) / 100.0 * m.body_mass_kg;
+  const double arm_kg = m.segment_mass_percent.arm_each / 100.0 * m.body_mass_kg;
   const int carrier = vertebra_index(arms.at("carried_by").get<std::string>());
   Vector3d p = vec3(arms, arms_forward ? "forward_point_mm" : "hanging_point_mm", file);
   for (int side : {-1, 1}) {
@@ -270,15 +271,47 @@ std::vector<int> parse_fusion(const std::string& levels) {
   return joints;
 }
 
-IapStiffness iap_from_appendix_c(const std::string& path) {
+const char* ligaments_name(Ligaments l) {
+  switch (l) {
+    case Ligaments::On:
+      return "on";
+    case Ligaments::Off:
+      return "off";
+    case Ligaments::Auto:
+      break;
+  }
+  return "auto";
+}
+
+Ligaments parse_ligaments(const std::string& name) {
+  for (Ligaments l : {Ligaments::Auto, Ligaments::On, Ligaments::Off})
+    if (name == ligaments_name(l)) return l;
+  throw std::invalid_argument("unknown ligament setting '" + name +
+                              "' (known: auto, on, off)");
+}
+
+bool has_ligaments(const ModelOptions& options) {
+  switch (options.ligaments) {
+    case Ligaments::On:
+      return true;
+    case Ligaments::Off:
+      return false;
+    case Ligaments::Auto:
+      break;
+  }
+  // F.4 is the whole motion segment, ligaments included; a disc joint is the disc alone.
+  return !options.disc_joints.empty();
+}
+
+IapStiffness iap_from_appendix_c(const std::string& path, double length_scale) {
   const json c = read_json(path);
   IapStiffness s;
-  const double volume = number(c, "V_L1L5_mm3", path);
+  const double volume = number(c, "V_L1L5_mm3", path) * length_scale * length_scale * length_scale;
   const auto& areas = c.at("section_areas_mm2");
   if (!areas.is_array() || areas.empty())
     throw std::runtime_error(path + ": section_areas_mm2 must be a non-empty array");
   for (const auto& a : areas) s.s_mean_mm2 += a.get<double>();
-  s.s_mean_mm2 /= double(areas.size());                               // (3.1)
+  s.s_mean_mm2 *= length_scale * length_scale / double(areas.size());  // (3.1)
   s.h_l1l5_mm = volume / s.s_mean_mm2;                                // (3.2)
   s.h_mm = number(c, "abdominal_height_factor", path) * s.h_l1l5_mm;  // (3.3)
   s.a_mm = std::sqrt(s.s_mean_mm2);                                   // (3.4)
@@ -300,8 +333,6 @@ SpineModel load_spine_model(const std::string& data_dir, const ModelOptions& opt
   const json config = read_json(config_file);
   SpineModel m;
   m.data_dir = data_dir;
-  m.body_mass_kg =
-      options.body_mass_kg > 0 ? options.body_mass_kg : number(config, "body_mass_kg", config_file);
   m.gravity_mm_s2 = number(config, "gravity_m_s2", config_file) * 1000.0;
   m.muscle_q = number(config, "muscle_short_range_stiffness_q", config_file);
   m.rom_bump_factor = number(config, "joint_rom_bump_factor", config_file);
@@ -313,6 +344,9 @@ SpineModel load_spine_model(const std::string& data_dir, const ModelOptions& opt
                              ": need muscle q > 0, a ROM bump factor >= 1 and a bump onset > 0");
 
   try {
+    m.subject = options.subject;
+    m.scale = detail::subject_scale(config, config_file, m.subject, m.segment_mass_percent);
+    m.body_mass_kg = m.subject.body_mass_kg;
     const CsvTable cm = read_csv((thesis / "F1_vertebra_cm.csv").string());
     for (const auto& name : vertebra_names())
       m.vertebrae.push_back({name, row_point(cm, cm.find("segment", name)), 0});
@@ -348,9 +382,9 @@ SpineModel load_spine_model(const std::string& data_dir, const ModelOptions& opt
       m.recruited_joints.push_back(joint_index(name.get<std::string>()));
 
     if (options.gravity) load_weights(m, config, config_file, options.arms_forward);
-    if (options.ligaments) load_ligaments(m, data, config);
+    if (has_ligaments(options)) load_ligaments(m, data, config);
     if (options.muscles) load_muscles(m, data, config, options.trunk_muscles);
-    m.iap = iap_from_appendix_c((thesis / "appendix_c_iap.json").string());
+    m.iap = iap_from_appendix_c((thesis / "appendix_c_iap.json").string(), m.scale.length);
     if (options.iap) {
       const json c = read_json((thesis / "appendix_c_iap.json").string());
       m.has_bushing = true;
@@ -364,6 +398,7 @@ SpineModel load_spine_model(const std::string& data_dir, const ModelOptions& opt
                    m.iap.bushing_m_xz_per_deg) /
           kRadPerDeg;
     }
+    detail::scale_to_subject(m, m.scale);
   } catch (const nlohmann::json::exception& e) {
     throw std::runtime_error(config_file + ": " + e.what());
   }

@@ -220,25 +220,31 @@ Sitter load_sitter(const SpineModel& model) {
   s.pelvic_tilt_deg = number(j, "pelvic_tilt_deg", file);
   s.lumbar_flexion_deg = number(j, "lumbar_flexion_deg", file);
   s.seat_pelvis_coupling = number(j, "seat_pelvis_coupling", file);
-  s.ischia_mm = vec3(j, "ischia_mm", file);
-  s.sacrum_back_mm = vec3(j, "sacrum_back_mm", file);
+  // The body's points scale with the subject as the spine's do (spine/README.md); the soft
+  // tissue's thickness does not (it is fat and skin, not skeleton).
+  const double length = model.scale.length;
+  s.ischia_mm = vec3(j, "ischia_mm", file) * length;
+  s.sacrum_back_mm = vec3(j, "sacrum_back_mm", file) * length;
   s.tissue_thoracic_mm = number(j.at("tissue_thickness_mm"), "thoracic", file);
   s.tissue_lumbar_mm = number(j.at("tissue_thickness_mm"), "lumbar", file);
   s.tissue_stiffness_n_per_mm = number(j, "tissue_stiffness_n_per_mm", file);
-  s.pelvis_mass_percent = number(j, "pelvis_mass_percent", file);
-  s.pelvis_com_mm = vec3(j, "pelvis_com_mm", file);
-  s.forearm_hand_percent_each = number(j, "forearm_hand_percent_each", file);
+  s.pelvis_mass_percent = model.segment_mass_percent.pelvis;
+  s.pelvis_com_mm = vec3(j, "pelvis_com_mm", file) * length;
+  s.forearm_hand_percent_each = model.segment_mass_percent.forearm_hand_each;
   const std::string model_file = model.data_dir + "/spine/spine_model.json";
   const nlohmann::json lengths =
       detail::read_json(model_file).at("ligaments").at("spinous_length_mm");
-  s.spinous_thoracic_mm = number(lengths, "thoracic", model_file);
-  s.spinous_lumbar_mm = number(lengths, "lumbar", model_file);
+  s.spinous_thoracic_mm = number(lengths, "thoracic", model_file) * length;
+  s.spinous_lumbar_mm = number(lengths, "lumbar", model_file) * length;
   // The posterior elements' geometry is the ligaments' (spine_model.json): a model built without
   // ligaments takes it from one built with them.
   SpineModel with_ligaments;
   const SpineModel* geometry = &model;
   if (model.ligaments.empty()) {
-    with_ligaments = load_spine_model(model.data_dir);
+    ModelOptions geometry_options;
+    geometry_options.ligaments = Ligaments::On;
+    geometry_options.subject = model.subject;
+    with_ligaments = load_spine_model(model.data_dir, geometry_options);
     geometry = &with_ligaments;
   }
   for (std::size_t i = 0; i < model.vertebrae.size(); ++i) {

@@ -1,5 +1,6 @@
 // The seating studies (seating_study.hpp; docs/seating.md).
 #include "spinesim/studies/seating_study.hpp"
+#include "spinesim/studies/spine_solve.hpp"
 
 #include "spinesim/common/input_file.hpp"
 #include "spinesim/common/timer.hpp"
@@ -173,6 +174,7 @@ json seating_json(const SeatingRun& run) {
                 {"lumbar_support_height_mm", c.lumbar_support_height_mm},
                 {"armrests", c.armrests},
                 {"surface", c.surface ? json(c.surface_name) : json(nullptr)}};
+  j["subject"] = subject_json(run.model.subject);
   j["sitter"] = {{"pelvic_tilt_deg", s.pelvic_tilt_deg},
                  {"sitting_tilt_deg", run.sitter.pelvic_tilt_deg},
                  {"lean_deg", s.lean_deg},

@@ -171,7 +171,8 @@ nlohmann::json spine_solve_json(const SpineSolveRun& r, const std::string& csv) 
         {"criterion", polynomial(r) ? "polynomial" : "minmax"},
         {"power", options.recruitment.power},
         {"tolerance_nmm", options.tolerance},
-        {"max_iterations", options.max_iterations}}},
+        {"max_iterations", options.max_iterations},
+        {"subject", subject_json(r.model.subject)}}},
       {"converged", s.converged},
       {"iterations", s.iterations},
       {"gradient_norm_nmm", s.gradient_norm},
@@ -221,7 +222,8 @@ void print_header(std::ostream& os, const SpineSolveRun& r) {
      << "  model: " << (r.request.model.gravity ? "gravity" : "no gravity") << ", "
      << (r.request.solve.recruit ? "muscles recruited (" + criterion + ")" : "no muscles") << ", "
      << m.ligaments.size() << " ligaments" << (m.has_bushing ? ", IAP bushing" : "")
-     << "; fusion: " << (fused.empty() ? "none" : fused) << "\n";
+     << "; fusion: " << (fused.empty() ? "none" : fused) << "\n"
+     << "  body: " << subject_text(m.subject) << "\n";
   for (std::size_t i = 0; i < r.request.loads.size(); ++i) {
     const auto& l = r.request.loads[i];
     os << "  load " << i + 1 << ": " << names[std::size_t(l.vertebra)];
@@ -341,6 +343,17 @@ void print_spine_solve(std::ostream& os, const SpineSolveRun& r, int top, const 
   if (r.request.solve.recruit) print_muscles(os, r.model, r.solution, top);
   print_ligaments(os, r.model, r.solution, top);
   print_footer(os, r, csv);
+}
+
+nlohmann::json subject_json(const spine::Subject& subject) {
+  return {{"height_m", subject.height_m},
+          {"body_mass_kg", subject.body_mass_kg},
+          {"sex", spine::sex_name(subject.sex)}};
+}
+
+std::string subject_text(const spine::Subject& subject) {
+  return std::string(spine::sex_name(subject.sex)) + ", " + fixed(subject.height_m, 3) + " m, " +
+         fixed(subject.body_mass_kg, 1) + " kg";
 }
 
 }  // namespace spinesim::studies

@@ -6,6 +6,7 @@
 #include "spinesim/common/input_file.hpp"
 
 #include "spinesim/common/timer.hpp"
+#include "spinesim/studies/spine_solve.hpp"
 #include "spinesim/studies/toolkit.hpp"
 
 #include "spinesim/spine/kinematics.hpp"
@@ -265,6 +266,8 @@ ValidationStudy run_validation_study(const std::string& data_dir, const spine::M
   begin(hooks, "Wilke: crate held in front of the chest");
   s.wilke = wilke_case(data_dir, model, j);
   s.trunk_muscles = model.trunk_muscles;
+  s.ligaments = spine::has_ligaments(model);
+  s.subject = spine::resolve_subject(data_dir, model.subject);
   end(hooks, "");
   s.seconds = t0.seconds();
   return s;
@@ -372,6 +375,8 @@ nlohmann::json validation_json(const ValidationStudy& s) {
   return {{"study", "validation"},
           {"thesis", "3.4"},
           {"trunk_muscles", s.trunk_muscles},
+          {"ligaments", s.ligaments},
+          {"subject", subject_json(s.subject)},
           {"units",
            {{"force", "N"},
             {"moment", "N·mm"},
@@ -506,6 +511,8 @@ FusionStudy run_fusion_study(const std::string& data_dir, double force_n,
   Timer t0;
   FusionStudy s;
   s.trunk_muscles = model.trunk_muscles;
+  s.ligaments = spine::has_ligaments(model);
+  s.subject = spine::resolve_subject(data_dir, model.subject);
   s.force_n = force_n;
   s.fusions = {"normal", "L3-L4", "L4-L5", "L3-L4-L5"};
   for (const auto& d : t1_load_directions()) s.loads.push_back(d.name);
@@ -591,6 +598,8 @@ nlohmann::json fusion_json(const FusionStudy& s) {
       {"study", "fusion"},
       {"thesis", "6.1, fig. 6.1-6.6"},
       {"trunk_muscles", s.trunk_muscles},
+          {"ligaments", s.ligaments},
+          {"subject", subject_json(s.subject)},
       {"force_n", s.force_n},
       {"fusions", s.fusions},
       {"loads", s.loads},
@@ -886,6 +895,8 @@ TrendsStudy run_trends_study(const std::string& data_dir, double force_n,
   s.force_n = force_n;
   begin(hooks, "trends: gravity only and 3 loads on T1");
   s.trunk_muscles = model.trunk_muscles;
+  s.ligaments = spine::has_ligaments(model);
+  s.subject = spine::resolve_subject(data_dir, model.subject);
   const SpineModel m = spine::load_spine_model(data_dir, model);
   const spine::SolveOptions options = study_solve_options();
   const int t1 = spine::vertebra_index("T1");
@@ -971,6 +982,8 @@ nlohmann::json trends_json(const TrendsStudy& s) {
   return {{"study", "trends"},
           {"thesis", "6.3 (relative translations), 6.4 (relative rotations)"},
           {"trunk_muscles", s.trunk_muscles},
+          {"ligaments", s.ligaments},
+          {"subject", subject_json(s.subject)},
           {"force_n", s.force_n},
           {"units",
            {{"translation_mm",

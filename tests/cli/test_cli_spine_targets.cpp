@@ -1,6 +1,6 @@
-// Thesis findings the model does NOT reproduce (measured, not loosened): "fusion reduces motion"
-// under the forward force, and a stable equilibrium under a backward force on T1 (spine/README.md,
-// "What the model does not reproduce"). Label `targets`: left out of the default and sanitizer runs
+// Thesis findings the model does NOT reproduce (measured, not loosened): a stable equilibrium
+// under a backward force on T1, and the Wilke crate with disc joints (spine/README.md,
+// "Limitations we keep"). Label `targets`: left out of the default and sanitizer runs
 // so main stays green; run them with `ctest --test-dir build/release -L targets`.
 #include "spine_cli_fixtures.hpp"
 
@@ -20,17 +20,6 @@ TEST(SpineTargets, BackwardForceOnT1GivesAStableEquilibrium) {
   ASSERT_FALSE(j.empty());
   EXPECT_GT(j["stability"]["min_stiffness_nmm_per_rad"].get<double>(), 0.0)
       << j["stability"]["softest_mode"];
-}
-
-// "spinal fusion at L3-L4-L5 will restrict the range of motion of the whole spine the most ...
-// The same results are achieved when applying equal backward and lateral forces".
-// Backward and lateral hold (FusionStudy.FusionReducesT1MotionUnderBackwardAndLateralForces); forward
-// does not: the recruited extensors over-extend L4-L5 under the forward force, and a fused L4-L5
-// cannot give that extension back.
-TEST(SpineTargets, FusionReducesT1MotionUnderTheForwardForce) {
-  for (const char* load : {"forward"})
-    for (const auto& f : fused_levels())
-      EXPECT_LT(t1_motion(f, load), t1_motion("normal", load)) << f << ", " << load;
 }
 
 // With the discs as joint springs (--disc-joints, docs/disc-model.md) the Wilke crate case puts

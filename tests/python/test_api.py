@@ -151,6 +151,20 @@ def test_spine_equals_the_program(program):
         spinesim.spine(forces={"T13": [0, 0, 1]})
 
 
+def test_a_scaled_body_and_the_ligaments_equal_the_program(program):
+    s = spinesim.spine(forces={"T1": [0, 0, 100]}, height_m=1.6, body_mass_kg=55, sex="female",
+                       ligaments="on")
+    p = program("spine", "solve", "--force", "T1:0,0,100", "--height", 1.6, "--mass", 55,
+                "--sex", "female", "--ligaments", "on", quiet=False)
+    assert s.options["subject"] == p["options"]["subject"]
+    assert len(s.ligaments) == 17 * 6
+    assert_json_close(s.joints, p["joints"], rtol=1e-9, atol=1e-6)
+    with pytest.raises(ValueError, match="height"):
+        spinesim.spine(height_m=2.5)
+    with pytest.raises(ValueError, match="ligament"):
+        spinesim.spine(ligaments="maybe")
+
+
 def test_seated_spine(program):
     s = spinesim.seated_spine(backrest_recline=110, lumbar_support=20)
     p = program("study", "seating", "--backrest-recline", 110, "--lumbar-support", 20)

@@ -171,8 +171,31 @@ TEST(SpineModel, TrunkMusclesCanBeLeftOut) {
   for (const auto& mu : m.muscles) EXPECT_EQ(mu.name.rfind("NStiss_", 0), 0u) << mu.name;
 }
 
+// F.4's joint springs are whole motion segments, ligaments included (Schultz & Ashton-Miller
+// 1991): the default model adds the F.6/F.7 ligaments only on disc joints, which are the disc
+// alone; `On` restores the thesis's double count, `Off` leaves them out everywhere.
+TEST(SpineModel, LigamentsAreAddedOnlyWhereTheJointSpringsLackThem) {
+  sp::ModelOptions o;
+  EXPECT_EQ(o.ligaments, sp::Ligaments::Auto);
+  EXPECT_FALSE(sp::has_ligaments(o));
+  EXPECT_TRUE(model().ligaments.empty());
+  o.disc_joints = "fibre-reinforced";
+  EXPECT_TRUE(sp::has_ligaments(o));
+  EXPECT_EQ(sp::load_spine_model(SPINESIM_DATA_DIR, o).ligaments.size(), 17u * 6);
+  o.ligaments = sp::Ligaments::Off;
+  EXPECT_TRUE(sp::load_spine_model(SPINESIM_DATA_DIR, o).ligaments.empty());
+  o.disc_joints.clear();
+  o.ligaments = sp::Ligaments::On;
+  EXPECT_TRUE(sp::has_ligaments(o));
+  for (sp::Ligaments l : {sp::Ligaments::Auto, sp::Ligaments::On, sp::Ligaments::Off})
+    EXPECT_EQ(sp::parse_ligaments(sp::ligaments_name(l)), l);
+  EXPECT_THROW(sp::parse_ligaments("yes"), std::invalid_argument);
+}
+
 TEST(SpineModel, LigamentsSpanEveryJointThoracicTakesTheMeanOfCervicalAndLumbar) {
-  const auto& m = model();
+  sp::ModelOptions o;
+  o.ligaments = sp::Ligaments::On;
+  const auto m = sp::load_spine_model(SPINESIM_DATA_DIR, o);
   ASSERT_EQ(m.ligaments.size(), 17u * 6);  // ISL, LF, ALL, PLL, two capsules
   for (const auto& l : m.ligaments) {
     EXPECT_EQ(l.body_a, l.joint);

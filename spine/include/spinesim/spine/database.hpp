@@ -135,8 +135,14 @@ struct ResponseSamples {
 ResponseSamples sample_responses(const SpineModel& m, const GenerationOptions& options);
 
 /// Solves each case of `loads` (external loads beside gravity) on `workers` threads (0: one per
-/// core); the displacement (17×6) per case, or the error message in `errors[i]` (empty: ok).
-/// `progress(done, total)` is called in the calling thread.
+/// core): the whole solution per case, or the error message in `errors[i]` (empty: ok; the
+/// solution is then default). `progress(done, total)` is called in the calling thread.
+void solve_many(const SpineModel& m, const std::vector<std::vector<ExternalLoad>>& loads,
+                const SolveOptions& options, int workers, std::vector<SpineSolution>& solutions,
+                std::vector<std::string>& errors,
+                const std::function<void(int, int)>& progress = {});
+
+/// solve_many, keeping each case's displacement (17×6).
 void solve_cases(const SpineModel& m, const std::vector<std::vector<ExternalLoad>>& loads,
                  const SolveOptions& options, int workers,
                  std::vector<VertebraResponse>& displacement, std::vector<std::string>& errors,

@@ -130,21 +130,75 @@ struct IapStiffness {
   double bushing_k_xz = 0, bushing_k_y = 0;  ///< k'x = k'z = 4 k_x, k'y = 4 k_y (N/mm)
   double bushing_m_xz_per_deg = 0, bushing_m_y_per_deg = 0;  ///< M'x = M'z, M'y (N·mm/deg)
 };
-IapStiffness iap_from_appendix_c(const std::string& appendix_c_json_path);
+/// `length_scale` scales appendix C's geometry (areas by its square, the volume by its cube) for
+/// a subject's body; the pressure stays.
+IapStiffness iap_from_appendix_c(const std::string& appendix_c_json_path,
+                                 double length_scale = 1.0);
+
+enum class Sex { Male, Female };
+/// "male", "female".
+const char* sex_name(Sex sex);
+/// The inverse of sex_name; throws std::invalid_argument listing the names.
+Sex parse_sex(const std::string& name);
+
+/// The body the spine belongs to (spine/README.md, "A spine for a given body"). A zero height or
+/// mass is the reference body's (spine_model.json: the thesis's GeBod median male, 1.778 m and
+/// 70 kg), and the reference body's model is the tables' own, bit for bit.
+struct Subject {
+  double height_m = 0;
+  double body_mass_kg = 0;
+  Sex sex = Sex::Male;
+};
+
+/// `subject` with a zero height or mass replaced by the reference body's, checked against the
+/// range the scaling laws are applied to (std::invalid_argument, one line, when outside).
+Subject resolve_subject(const std::string& data_dir, Subject subject);
+
+/// Segment masses of one sex, % of body mass (de Leva 1996; spine_model.json "anthropometry").
+struct SegmentMassPercent {
+  double trunk = 0, head_neck = 0, arm_each = 0, pelvis = 0, forearm_hand_each = 0;
+};
+
+/// How a subject's model differs from the reference body's.
+struct SubjectScale {
+  double length = 1;      ///< every length: height / reference height (geometric similarity)
+  double mass = 1;        ///< body mass / reference mass
+  double muscle = 1;      ///< every pCSA: muscle volume ratio (Handsfield 2014) / length
+  double trunk_mass = 1;  ///< per-level trunk masses: this sex's trunk % / the male's
+};
+
+/// Whether the F.6/F.7 ligaments are elements of the model. Table F.4's joint springs are
+/// Schultz & Ashton-Miller's (1991) whole motion segments, ligaments and facets included, so
+/// adding the ligaments to them counts them twice (the thesis did). `Auto` adds them only where
+/// the joint springs are discs alone (ModelOptions::disc_joints).
+enum class Ligaments {
+  Auto,  ///< with disc joints, none with F.4 (the default)
+  On,    ///< always; with F.4 this is the thesis's model, which counts them twice
+  Off,   ///< never
+};
+/// "auto", "on", "off" (the CLI's and the study files' names).
+const char* ligaments_name(Ligaments l);
+/// The inverse of ligaments_name; throws std::invalid_argument listing the names.
+Ligaments parse_ligaments(const std::string& name);
 
 struct ModelOptions {
   std::vector<int> fused_joints;  ///< joint indices (parse_fusion)
-  bool ligaments = true, muscles = true, iap = true, gravity = true;
+  Ligaments ligaments = Ligaments::Auto;
+  bool muscles = true, iap = true, gravity = true;
   /// The LifeMOD default trunk muscles appendix F names without data (thoracic erector spinae, rectus
   /// abdominis), restored in data/spine/trunk_muscles.csv; false: the F.8-F.19 lumbar muscles only.
   bool trunk_muscles = true;
   bool arms_forward = false;  ///< arms reaching forward (crate case) instead of hanging
-  double body_mass_kg = 0;    ///< 0: spine_model.json's value
+  Subject subject;            ///< the body (default: the reference body)
   /// A disc-joint stiffness file (`spinesim spine disc-joints`; data/spine/disc_joints/): each
   /// joint's spring becomes that level's disc 3×3 rotational stiffness about the joint point, in
   /// place of F.4. A preset name (file stem in data/spine/disc_joints/) or a path; empty: F.4.
   std::string disc_joints;
 };
+
+/// Does a model built with these options carry the F.6/F.7 ligaments? (Ligaments::Auto: only
+/// on disc joints.)
+bool has_ligaments(const ModelOptions& options);
 
 /// Reads a disc-joint file into the joints (every joint must be there, each 3×3 symmetric
 /// positive definite and finite). Throws std::invalid_argument with one line otherwise.
@@ -169,13 +223,17 @@ struct SpineModel {
   double rom_bump_factor = 100;       ///< joint stiffness multiplier beyond the F.5 range
   double rom_bump_onset = 0;          ///< rad over which the bump's stiffness ramps up (C² energy)
   double body_mass_kg = 70, gravity_mm_s2 = 9810;
+  Subject subject;                          ///< resolved: height and mass filled in
+  SubjectScale scale;                       ///< applied to the reference body's tables
+  SegmentMassPercent segment_mass_percent;  ///< the subject's sex's
   Eigen::Vector3d chest_front_mm;  ///< for loads held "in front of the chest"
   int ribs_body = 5;               ///< T6
   std::string data_dir;
 };
 
-/// Builds the model from `data_dir` (thesis/ tables, disc_morphometry.csv, spine/spine_model.json).
-/// Throws std::runtime_error naming the file for missing or malformed data.
+/// Builds the model from `data_dir` (thesis/ tables, disc_morphometry.csv, spine/spine_model.json),
+/// scaled to options.subject. Throws std::runtime_error naming the file for missing or malformed
+/// data, std::invalid_argument for a subject outside the scaling laws' range.
 SpineModel load_spine_model(const std::string& data_dir,
                             const ModelOptions& options = ModelOptions());
 

@@ -44,6 +44,11 @@ nlohmann::json spine_solve_json(const SpineSolveRun& run, const std::string& csv
 /// One row per vertebra and the joint below it.
 std::string spine_solve_csv(const spine::SpineSolution& s);
 
+/// A resolved subject (spine::resolve_subject) as JSON: height_m, body_mass_kg, sex.
+nlohmann::json subject_json(const spine::Subject& subject);
+/// "female, 1.600 m, 55.0 kg" for the tables' headers.
+std::string subject_text(const spine::Subject& subject);
+
 /// Readable tables; `top` muscles and ligaments are listed, `csv` is named at the end if given.
 void print_spine_solve(std::ostream& os, const SpineSolveRun& run, int top, const std::string& csv);
 

@@ -113,6 +113,8 @@ struct ValidationStudy {
   McGillCase mcgill;
   WilkeCase wilke;
   bool trunk_muscles = true;  ///< the model's muscle set (spine::ModelOptions::trunk_muscles)
+  bool ligaments = false;     ///< the F.6/F.7 ligaments were elements (spine::has_ligaments)
+  spine::Subject subject;     ///< the body, resolved (spine::resolve_subject)
   double seconds = 0;
 };
 /// `model` gives the muscle set (trunk_muscles); each case sets its own loads and arm posture.
@@ -151,6 +153,8 @@ struct FusionStudy {
   std::vector<FusionRun> runs;  ///< fusion-major
   std::vector<Finding> findings;
   bool trunk_muscles = true;  ///< the model's muscle set (spine::ModelOptions::trunk_muscles)
+  bool ligaments = false;     ///< the F.6/F.7 ligaments were elements (spine::has_ligaments)
+  spine::Subject subject;     ///< the body, resolved (spine::resolve_subject)
   double seconds = 0;
   const FusionRun& run(const std::string& fusion, const std::string& load) const;
 };
@@ -178,6 +182,8 @@ struct TrendsStudy {
   std::vector<TrendRun> runs;  ///< lateral, forward, backward
   std::vector<Finding> findings;
   bool trunk_muscles = true;  ///< the model's muscle set (spine::ModelOptions::trunk_muscles)
+  bool ligaments = false;     ///< the F.6/F.7 ligaments were elements (spine::has_ligaments)
+  spine::Subject subject;     ///< the body, resolved (spine::resolve_subject)
   double seconds = 0;
 };
 TrendsStudy run_trends_study(const std::string& data_dir, double force_n,

@@ -1,0 +1,314 @@
+// Loads that vary in time, solved as a quasi-static sequence (spine_schedule.hpp).
+#include "spinesim/studies/spine_schedule.hpp"
+
+#include "spinesim/common/csv_table.hpp"
+#include "spinesim/common/timer.hpp"
+#include "spinesim/haptics/recording.hpp"
+#include "spinesim/spine/database.hpp"
+#include "spinesim/spine/kinematics.hpp"
+#include "spinesim/studies/spine_solve.hpp"
+#include "spinesim/studies/toolkit.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+#include <stdexcept>
+
+namespace spinesim::studies {
+namespace {
+
+const char* const kComponents[6] = {"fx_n", "fy_n", "fz_n", "mx_nmm", "my_nmm", "mz_nmm"};
+
+/// "T7.fz_n" → vertebra 6, component 2; throws naming the column.
+std::pair<int, int> parse_column(const std::string& column, const std::string& path) {
+  const auto dot = column.find('.');
+  const std::string where = path + ": column '" + column + "'";
+  if (dot == std::string::npos)
+    throw std::invalid_argument(where + " is not VERTEBRA.COMPONENT (e.g. T7.fz_n)");
+  int vertebra = 0;
+  try {
+    vertebra = spine::vertebra_index(column.substr(0, dot));
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(where + ": " + e.what());
+  }
+  const std::string component = column.substr(dot + 1);
+  for (int k = 0; k < 6; ++k)
+    if (component == kComponents[k]) return {vertebra, k};
+  throw std::invalid_argument(where +
+                              ": unknown component (known: fx_n, fy_n, fz_n, mx_nmm, my_nmm, "
+                              "mz_nmm)");
+}
+
+}  // namespace
+
+LoadSchedule read_load_schedule(const std::string& path) {
+  const CsvTable t = read_csv(path);  // a ragged row (a missing cell) is refused here
+  LoadSchedule s;
+  s.path = path;
+  if (t.header.empty() || t.header.front() != "time_s")
+    throw std::invalid_argument(path + ": the first column must be time_s");
+  if (t.header.size() < 2)
+    throw std::invalid_argument(path + ": no load column (e.g. T7.fz_n) after time_s");
+  s.columns.assign(t.header.begin() + 1, t.header.end());
+  std::vector<std::pair<int, int>> targets;
+  for (const auto& c : s.columns) {
+    const auto target = parse_column(c, path);
+    if (std::find(targets.begin(), targets.end(), target) != targets.end())
+      throw std::invalid_argument(path + ": column '" + c + "' is given twice");
+    targets.push_back(target);
+  }
+  if (t.rows.empty()) throw std::invalid_argument(path + ": no rows");
+  for (std::size_t r = 0; r < t.rows.size(); ++r) {
+    for (const auto& name : t.header)
+      if (t.text(r, name).empty())
+        throw std::invalid_argument(path + ": row " + std::to_string(r + 1) + " column '" + name +
+                                    "' is empty (a gap in the schedule)");
+    const double time = t.number(r, "time_s");
+    if (!s.time_s.empty() && !(time > s.time_s.back()))
+      throw std::invalid_argument(path + ": row " + std::to_string(r + 1) + ": time " +
+                                  t.text(r, "time_s") +
+                                  " s does not come after the row before (times must increase)");
+    std::vector<double> row;
+    for (std::size_t c = 0; c < s.columns.size(); ++c) {
+      const double v = t.number(r, s.columns[c]);
+      const double limit = targets[c].second < 3 ? spine::kMaxForceN : spine::kMaxMomentNmm;
+      if (std::abs(v) > limit)
+        throw std::invalid_argument(path + ": row " + std::to_string(r + 1) + " column '" +
+                                    s.columns[c] + "': " + t.text(r, s.columns[c]) +
+                                    " is beyond any body (limit " + fixed(limit, 0) + ")");
+      row.push_back(v);
+    }
+    s.time_s.push_back(time);
+    s.values.push_back(std::move(row));
+  }
+  return s;
+}
+
+std::vector<spine::ExternalLoad> schedule_loads(const LoadSchedule& s, double t) {
+  if (s.time_s.empty() || t < s.time_s.front() || t > s.time_s.back())
+    throw std::invalid_argument("time " + fixed(t, 6) + " s is outside the schedule");
+  std::size_t k = 0;  // the key interval [k, k + 1] holding t
+  while (k + 1 < s.time_s.size() && s.time_s[k + 1] < t) ++k;
+  const double w = k + 1 < s.time_s.size()
+                       ? (t - s.time_s[k]) / (s.time_s[k + 1] - s.time_s[k])
+                       : 0.0;
+  std::vector<spine::ExternalLoad> loads;
+  for (std::size_t c = 0; c < s.columns.size(); ++c) {
+    const auto [vertebra, component] = parse_column(s.columns[c], s.path);
+    const double v0 = s.values[k][c];
+    const double v = k + 1 < s.time_s.size() ? v0 + w * (s.values[k + 1][c] - v0) : v0;
+    auto it = std::find_if(loads.begin(), loads.end(), [v = vertebra](const spine::ExternalLoad& l) {
+      return l.vertebra == v;
+    });
+    if (it == loads.end()) {
+      spine::ExternalLoad l;
+      l.vertebra = vertebra;
+      loads.push_back(l);
+      it = loads.end() - 1;
+    }
+    if (component < 3)
+      it->force_n(component) = v;
+    else
+      it->moment_nmm(component - 3) = v;
+  }
+  return loads;
+}
+
+std::vector<double> schedule_times(const LoadSchedule& s, double step_s) {
+  std::vector<double> times = s.time_s;
+  if (step_s > 0) {
+    const double t0 = s.time_s.front(), t1 = s.time_s.back();
+    for (long k = 1; t0 + double(k) * step_s < t1; ++k) times.push_back(t0 + double(k) * step_s);
+  }
+  std::sort(times.begin(), times.end());
+  // A sample within a nanosecond of a key time is that key time.
+  times.erase(std::unique(times.begin(), times.end(),
+                          [](double a, double b) { return std::abs(a - b) < 1e-9; }),
+              times.end());
+  return times;
+}
+
+ScheduleRun run_load_schedule(const std::string& data_dir, const LoadSchedule& schedule,
+                              const spine::ModelOptions& model, const spine::SolveOptions& solve,
+                              double step_s, int workers,
+                              const std::function<void(int, int)>& progress) {
+  const Timer timer;
+  ScheduleRun run;
+  run.schedule = schedule;
+  run.model = spine::load_spine_model(data_dir, model);
+  const std::vector<double> times = schedule_times(schedule, step_s);
+  std::vector<std::vector<spine::ExternalLoad>> loads;
+  for (double t : times) loads.push_back(schedule_loads(schedule, t));
+  std::vector<spine::SpineSolution> solutions;
+  std::vector<std::string> errors;
+  spine::solve_many(run.model, loads, solve, workers, solutions, errors, progress);
+  for (std::size_t i = 0; i < times.size(); ++i) {
+    run.steps.push_back({times[i], loads[i], std::move(solutions[i]), errors[i]});
+    if (!errors[i].empty()) ++run.failed;
+  }
+  run.seconds = timer.seconds();
+  return run;
+}
+
+namespace {
+
+/// The value of `column` (a schedule column) in a step's loads.
+double load_value(const ScheduleStep& step, const std::string& column, const std::string& path) {
+  const auto [vertebra, component] = parse_column(column, path);
+  for (const auto& l : step.loads)
+    if (l.vertebra == vertebra) return component < 3 ? l.force_n(component) : l.moment_nmm(component - 3);
+  return 0;
+}
+
+}  // namespace
+
+std::string schedule_csv(const ScheduleRun& run) {
+  std::ostringstream os;
+  os << std::setprecision(10) << "time_s,converged";
+  for (const auto& c : run.schedule.columns) os << "," << c;
+  for (const auto& j : spine::joint_names())
+    os << "," << j << ".axial_n," << j << ".shear_ap_n," << j << ".shear_lat_n";
+  const char* d[6] = {"tx_mm", "ty_mm", "tz_mm", "rx_deg", "ry_deg", "rz_deg"};
+  for (const auto& v : spine::vertebra_names())
+    for (const char* k : d) os << "," << v << "." << k;
+  os << "\n";
+  for (const auto& step : run.steps) {
+    const bool ok = step.error.empty();
+    os << step.t_s << "," << (ok ? 1 : 0);
+    for (const auto& c : run.schedule.columns) os << "," << load_value(step, c, run.schedule.path);
+    for (std::size_t j = 0; j < spine::joint_names().size(); ++j) {
+      if (!ok) {
+        os << ",,,";
+        continue;
+      }
+      const auto& r = step.solution.joints[j];
+      os << "," << r.axial_n << "," << r.shear_ap_n << "," << r.shear_lat_n;
+    }
+    for (Eigen::Index v = 0; v < Eigen::Index(spine::vertebra_names().size()); ++v)
+      for (int k = 0; k < 6; ++k)
+        if (ok)
+          os << "," << step.solution.displacement(v, k);
+        else
+          os << ",";
+    os << "\n";
+  }
+  return os.str();
+}
+
+nlohmann::json schedule_json(const ScheduleRun& run) {
+  nlohmann::json steps = nlohmann::json::array();
+  for (const auto& step : run.steps) {
+    nlohmann::json s = {{"time_s", step.t_s}, {"converged", step.error.empty()}};
+    nlohmann::json loads = nlohmann::json::object();
+    for (const auto& c : run.schedule.columns) loads[c] = load_value(step, c, run.schedule.path);
+    s["loads"] = loads;
+    if (!step.error.empty()) {
+      s["error"] = step.error;
+    } else {
+      nlohmann::json joints = nlohmann::json::object();
+      for (const auto& r : step.solution.joints)
+        joints[r.joint] = {{"axial_n", r.axial_n}, {"shear_ap_n", r.shear_ap_n},
+                           {"shear_lat_n", r.shear_lat_n}};
+      s["joints"] = joints;
+      nlohmann::json t1 = nlohmann::json::array();
+      for (int k = 0; k < 6; ++k) t1.push_back(step.solution.displacement(0, k));
+      s["t1_displacement"] = t1;
+      s["iterations"] = step.solution.iterations;
+      s["stable"] = step.solution.min_stiffness_nmm_per_rad > 0;
+      if (!step.solution.warnings.empty()) s["warnings"] = step.solution.warnings;
+    }
+    steps.push_back(s);
+  }
+  return {{"schedule", run.schedule.path},
+          {"columns", run.schedule.columns},
+          {"key_times_s", run.schedule.time_s},
+          {"subject", subject_json(run.model.subject)},
+          {"steps", steps},
+          {"failed", run.failed},
+          {"seconds", run.seconds},
+          {"units",
+           {{"force", "N"}, {"moment", "N·mm"}, {"translation", "mm"}, {"rotation", "deg"},
+            {"t1_displacement", "tx, ty, tz (mm), rx, ry, rz (deg)"}}}};
+}
+
+void print_schedule(std::ostream& os, const ScheduleRun& run) {
+  os << "Loads in time (" << run.schedule.path << "): " << run.steps.size()
+     << " quasi-static equilibria, body " << subject_text(run.model.subject) << "\n\n";
+  std::vector<std::string> header = {"time (s)"};
+  for (const auto& c : run.schedule.columns) header.push_back(c);
+  for (const char* h : {"L4-L5 axial (N)", "L5-S1 axial (N)", "L5-S1 shear AP (N)",
+                        "T1 tz (mm)", "T1 rx (deg)"})
+    header.push_back(h);
+  TextTable table(header, 0);
+  const int l4 = spine::joint_index("L4-L5"), l5 = spine::joint_index("L5-S1");
+  for (const auto& step : run.steps) {
+    std::vector<std::string> row = {fixed(step.t_s, 3)};
+    for (const auto& c : run.schedule.columns)
+      row.push_back(fixed(load_value(step, c, run.schedule.path), 1));
+    if (step.error.empty()) {
+      const auto& s = step.solution;
+      row.push_back(fixed(s.joints[std::size_t(l4)].axial_n, 1));
+      row.push_back(fixed(s.joints[std::size_t(l5)].axial_n, 1));
+      row.push_back(fixed(s.joints[std::size_t(l5)].shear_ap_n, 1));
+      row.push_back(fixed(s.displacement(0, 2), 2));
+      row.push_back(fixed(s.displacement(0, 3), 2));
+    } else {
+      for (int k = 0; k < 5; ++k) row.push_back("-");
+    }
+    table.add(row);
+  }
+  table.print(os, false);
+  for (const auto& step : run.steps)
+    if (!step.error.empty())
+      os << "no equilibrium at " << fixed(step.t_s, 3) << " s: " << step.error << "\n";
+  os << "\nTotal " << fixed(run.seconds, 2) << " s\n";
+}
+
+void write_schedule_recording(const ScheduleRun& run, const std::string& path) {
+  std::vector<const ScheduleStep*> solved;
+  for (const auto& step : run.steps)
+    if (step.error.empty()) solved.push_back(&step);
+  if (solved.size() < 2)
+    throw std::invalid_argument("--record: fewer than two steps reached equilibrium");
+  // The recording is a servo's: one row a millisecond (the offline discs step 1 ms a row).
+  // Between solved steps each vertebra moves along the straight line and the geodesic rotation
+  // from one equilibrium pose to the next.
+  constexpr double kTickS = 1e-3;
+  const double t0 = solved.front()->t_s, t1 = solved.back()->t_s;
+  const auto ticks = static_cast<std::int64_t>(std::floor((t1 - t0) / kTickS + 1e-9)) + 1;
+  if (ticks > 10'000'000)
+    throw std::invalid_argument("--record: the schedule lasts over 10000 s of 1 ms rows");
+  haptics::HapticRecordingWriter writer(path, "a load schedule (" + run.schedule.path + ")",
+                                        &run.model, "quasi-static schedule");
+  std::vector<haptics::TickRecord> block;
+  std::size_t seg = 0;
+  for (std::int64_t k = 0; k < ticks; ++k) {
+    const double t = t0 + double(k) * kTickS;
+    while (seg + 2 < solved.size() && solved[seg + 1]->t_s <= t) ++seg;
+    const ScheduleStep& a = *solved[seg];
+    const ScheduleStep& b = *solved[seg + 1];
+    const double w = std::clamp((t - a.t_s) / (b.t_s - a.t_s), 0.0, 1.0);
+    haptics::TickRecord r;
+    r.t_s = t;
+    r.tick = k + 1;
+    r.probe_mm = r.force_n = r.proxy_mm = Eigen::Vector3d::Zero();
+    r.compliant = true;
+    for (std::size_t v = 0; v < a.solution.poses.size(); ++v) {
+      const spine::Pose& pa = a.solution.poses[v];
+      const spine::Pose& pb = b.solution.poses[v];
+      const Eigen::Matrix3d R =
+          pa.R * spine::rotation_exp(w * spine::rotation_log(pa.R.transpose() * pb.R));
+      r.R[v] = R.cast<float>();
+      r.t[v] = (pa.t + w * (pb.t - pa.t)).cast<float>();
+    }
+    block.push_back(r);
+    if (block.size() == 4096 || k + 1 == ticks) {
+      writer.append(block.data(), block.size());
+      block.clear();
+    }
+  }
+  writer.finish();
+}
+
+}  // namespace spinesim::studies
