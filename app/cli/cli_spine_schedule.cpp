@@ -7,6 +7,7 @@
 
 #include "spinesim/studies/spine_schedule.hpp"
 
+#include <filesystem>
 #include <iostream>
 #include <memory>
 
@@ -14,7 +15,7 @@ namespace spinesim::cli {
 namespace {
 
 struct ScheduleArgs {
-  std::string loads, csv, record, fusion, disc_joints, ligaments = "auto";
+  std::string loads, csv, record, out, fusion, disc_joints, ligaments = "auto";
   double step_s = 0;
   int workers = 0;
   bool json = false, quiet = false, no_muscles = false;
@@ -38,6 +39,7 @@ void run_schedule(const ScheduleArgs& a) {
                                 " s samples the schedule more than 100000 times");
   if (!a.csv.empty()) require_output_folder(a.csv, "--csv");
   if (!a.record.empty()) require_output_folder(a.record, "--record");
+  if (!a.out.empty()) prepare_output_folder(a.out, "--out");
   spine::SolveOptions solve;
   solve.recruit = !a.no_muscles;
 
@@ -53,6 +55,14 @@ void run_schedule(const ScheduleArgs& a) {
   if (bar) bar->finish();
   if (!a.csv.empty()) write_csv_file(a.csv, schedule_csv(run));
   if (!a.record.empty()) write_schedule_recording(run, a.record);
+  if (!a.out.empty()) {
+    namespace fs = std::filesystem;
+    write_json_file((fs::path(a.out) / "schedule.json").string(), schedule_json(run));
+    write_csv_file((fs::path(a.out) / "schedule.csv").string(), schedule_csv(run));
+    const HtmlReport r = write_html_report(a.out, "schedule_report.py");
+    if (r.failed) throw std::runtime_error("--out " + a.out + ": " + r.message);
+    std::cerr << (r.written ? "" : "spinesim: warning: ") << r.message << std::endl;
+  }
   if (a.json)
     print_json(schedule_json(run));
   else
@@ -82,6 +92,9 @@ void register_spine_schedule(CLI::App& spine) {
                   "One row per time: loads, every joint's forces, every vertebra's motion");
   cmd->add_option("--record", a->record,
                   "Write the vertebrae's motions as a spine recording for `spine discs --record`");
+  cmd->add_option("--out", a->out,
+                  "Write schedule.json, schedule.csv, a plot of the loads, the discs' forces and "
+                  "T1's motion over time, and report.html into this folder");
   cmd->add_option("--workers", a->workers, "Threads (0: one per core)")->capture_default_str();
   cmd->add_option("--fusion", a->fusion, "Fused levels, e.g. L3-L4 or L3-L4-L5");
   cmd->add_flag("--no-muscles", a->no_muscles, "Passive spine: no muscles");

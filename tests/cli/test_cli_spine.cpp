@@ -431,22 +431,26 @@ TEST(SpineSolveCli, ABodyOfGivenHeightMassAndSexScalesTheSpine) {
 TEST(SpineScheduleCli, ASchedulesStepsTheirCsvAndARecordingTheDiscsFollow) {
   const std::string loads = tmp("lift.csv"), csv = tmp("schedule.csv"), rec = tmp("motion.csv");
   spit(loads, "time_s,T7.fz_n,L1.mx_nmm\n0,0,0\n1,200,0\n2,200,4000\n");
+  const std::string out = tmp("schedule-out");
   const CliRun r = run_spinesim("spine schedule --loads " + in_quotes(loads) +
                                 " --step 0.5 --quiet --csv " + in_quotes(csv) + " --record " +
-                                in_quotes(rec));
+                                in_quotes(rec) + " --out " + in_quotes(out));
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find("5 quasi-static equilibria"), std::string::npos) << r.out;
   EXPECT_EQ(count_lines(csv_table(csv)), 6);
+  EXPECT_EQ(json::parse(slurp(out + "/schedule.json"))["steps"].size(), 5u);
+  EXPECT_TRUE(fs::exists(out + "/report.html")) << r.err;
+  EXPECT_TRUE(fs::exists(out + "/plots/schedule.png")) << r.err;
   const CliRun discs = run_spinesim("spine discs --record " + in_quotes(rec) + " --out " +
                                     in_quotes(tmp("schedule-discs")) + " --quiet --json");
   ASSERT_EQ(discs.status, 0) << discs.err;
 
-  const std::string bad = tmp("gap.csv"), out = tmp("never.csv");
+  const std::string bad = tmp("gap.csv"), never = tmp("never.csv");
   spit(bad, "time_s,T7.fz_n\n0,0\n1,\n");
   expect_refused(run_spinesim("spine schedule --loads " + in_quotes(bad) + " --csv " +
-                              in_quotes(out)),
+                              in_quotes(never)),
                  "gap");
-  EXPECT_FALSE(fs::exists(out));
+  EXPECT_FALSE(fs::exists(never));
   spit(bad, "time_s,T7.fz_n\n1,0\n0,5\n");
   expect_refused(run_spinesim("spine schedule --loads " + in_quotes(bad)), "increase");
   expect_refused(run_spinesim("spine schedule --loads " + in_quotes(loads) + " --step -1"),
