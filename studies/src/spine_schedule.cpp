@@ -51,12 +51,11 @@ LoadSchedule read_load_schedule(const std::string& path) {
   if (t.header.size() < 2)
     throw std::invalid_argument(path + ": no load column (e.g. T7.fz_n) after time_s");
   s.columns.assign(t.header.begin() + 1, t.header.end());
-  std::vector<std::pair<int, int>> targets;
   for (const auto& c : s.columns) {
     const auto target = parse_column(c, path);
-    if (std::find(targets.begin(), targets.end(), target) != targets.end())
+    if (std::find(s.targets.begin(), s.targets.end(), target) != s.targets.end())
       throw std::invalid_argument(path + ": column '" + c + "' is given twice");
-    targets.push_back(target);
+    s.targets.push_back(target);
   }
   if (t.rows.empty()) throw std::invalid_argument(path + ": no rows");
   for (std::size_t r = 0; r < t.rows.size(); ++r) {
@@ -72,7 +71,7 @@ LoadSchedule read_load_schedule(const std::string& path) {
     std::vector<double> row;
     for (std::size_t c = 0; c < s.columns.size(); ++c) {
       const double v = t.number(r, s.columns[c]);
-      const double limit = targets[c].second < 3 ? spine::kMaxForceN : spine::kMaxMomentNmm;
+      const double limit = s.targets[c].second < 3 ? spine::kMaxForceN : spine::kMaxMomentNmm;
       if (std::abs(v) > limit)
         throw std::invalid_argument(path + ": row " + std::to_string(r + 1) + " column '" +
                                     s.columns[c] + "': " + t.text(r, s.columns[c]) +
@@ -95,7 +94,7 @@ std::vector<spine::ExternalLoad> schedule_loads(const LoadSchedule& s, double t)
                        : 0.0;
   std::vector<spine::ExternalLoad> loads;
   for (std::size_t c = 0; c < s.columns.size(); ++c) {
-    const auto [vertebra, component] = parse_column(s.columns[c], s.path);
+    const auto [vertebra, component] = s.targets[c];
     const double v0 = s.values[k][c];
     const double v = k + 1 < s.time_s.size() ? v0 + w * (s.values[k + 1][c] - v0) : v0;
     auto it = std::find_if(loads.begin(), loads.end(), [v = vertebra](const spine::ExternalLoad& l) {
@@ -153,9 +152,9 @@ ScheduleRun run_load_schedule(const std::string& data_dir, const LoadSchedule& s
 
 namespace {
 
-/// The value of `column` (a schedule column) in a step's loads.
-double load_value(const ScheduleStep& step, const std::string& column, const std::string& path) {
-  const auto [vertebra, component] = parse_column(column, path);
+/// The value of a schedule column's target (vertebra, component) in a step's loads.
+double load_value(const ScheduleStep& step, const std::pair<int, int>& target) {
+  const auto [vertebra, component] = target;
   for (const auto& l : step.loads)
     if (l.vertebra == vertebra) return component < 3 ? l.force_n(component) : l.moment_nmm(component - 3);
   return 0;
@@ -176,7 +175,7 @@ std::string schedule_csv(const ScheduleRun& run) {
   for (const auto& step : run.steps) {
     const bool ok = step.error.empty();
     os << step.t_s << "," << (ok ? 1 : 0);
-    for (const auto& c : run.schedule.columns) os << "," << load_value(step, c, run.schedule.path);
+    for (const auto& t : run.schedule.targets) os << "," << load_value(step, t);
     for (std::size_t j = 0; j < spine::joint_names().size(); ++j) {
       if (!ok) {
         os << ",,,";
@@ -201,7 +200,8 @@ nlohmann::json schedule_json(const ScheduleRun& run) {
   for (const auto& step : run.steps) {
     nlohmann::json s = {{"time_s", step.t_s}, {"converged", step.error.empty()}};
     nlohmann::json loads = nlohmann::json::object();
-    for (const auto& c : run.schedule.columns) loads[c] = load_value(step, c, run.schedule.path);
+    for (std::size_t c = 0; c < run.schedule.columns.size(); ++c)
+      loads[run.schedule.columns[c]] = load_value(step, run.schedule.targets[c]);
     s["loads"] = loads;
     if (!step.error.empty()) {
       s["error"] = step.error;
@@ -244,8 +244,7 @@ void print_schedule(std::ostream& os, const ScheduleRun& run) {
   const int l4 = spine::joint_index("L4-L5"), l5 = spine::joint_index("L5-S1");
   for (const auto& step : run.steps) {
     std::vector<std::string> row = {fixed(step.t_s, 3)};
-    for (const auto& c : run.schedule.columns)
-      row.push_back(fixed(load_value(step, c, run.schedule.path), 1));
+    for (const auto& t : run.schedule.targets) row.push_back(fixed(load_value(step, t), 1));
     if (step.error.empty()) {
       const auto& s = step.solution;
       row.push_back(fixed(s.joints[std::size_t(l4)].axial_n, 1));

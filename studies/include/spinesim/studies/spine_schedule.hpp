@@ -22,6 +22,7 @@
 
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace spinesim::studies {
@@ -29,6 +30,8 @@ namespace spinesim::studies {
 struct LoadSchedule {
   std::string path;
   std::vector<std::string> columns;  ///< "T7.fz_n", … (the header after time_s)
+  /// Per column: the vertebra index and the component (0–2 force x, y, z; 3–5 couple x, y, z).
+  std::vector<std::pair<int, int>> targets;
   std::vector<double> time_s;        ///< key times, strictly increasing
   /// Per key time, per column: the value (N or N·mm).
   std::vector<std::vector<double>> values;
