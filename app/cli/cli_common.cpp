@@ -64,6 +64,13 @@ void add_ligaments_option(CLI::App* cmd, std::string& ligaments) {
       ->capture_default_str();
 }
 
+void add_rib_cage_option(CLI::App* cmd, bool& rib_cage) {
+  cmd->add_flag("--rib-cage", rib_cage,
+                "Add the rib cage: 24 ribs and the sternum on the thoracic vertebrae "
+                "(costovertebral joints, costal cartilage; data/spine/rib_cage.json). Default: "
+                "none, as in the thesis");
+}
+
 void add_plate_load_options(CLI::App* cmd, std::string& motion, std::string& wrench,
                             std::string& load_case, std::string& center) {
   cmd->add_option("--motion", motion, "Plate motion tx,ty,tz,rx,ry,rz (mm, degrees)");

@@ -47,6 +47,8 @@ spine::Subject subject_of(const SubjectFlags& flags);
 
 /// --ligaments auto|on|off (spine::Ligaments, read with spine::parse_ligaments) on the spine verbs.
 void add_ligaments_option(CLI::App* cmd, std::string& ligaments);
+/// --rib-cage (spine::ModelOptions::rib_cage) on the spine verbs.
+void add_rib_cage_option(CLI::App* cmd, bool& rib_cage);
 
 /// The plate load options of `fem` and `mss`: --motion, --wrench, --case, --center.
 void add_plate_load_options(CLI::App* cmd, std::string& motion, std::string& wrench,

@@ -47,7 +47,8 @@ struct SpineSolveArgs {
   double tolerance_nmm = spine::SolveOptions().tolerance;
   int max_iterations = spine::SolveOptions().max_iterations;
   int top = 10;
-  bool no_muscles = false, no_trunk_muscles = false, no_gravity = false, json = false;
+  bool no_muscles = false, no_trunk_muscles = false, no_gravity = false, json = false,
+       rib_cage = false;
   SubjectFlags subject;
 };
 
@@ -118,6 +119,7 @@ void solve(const SpineSolveArgs& a) {
   model_options.gravity = !a.no_gravity;
   model_options.disc_joints = a.disc_joints;
   model_options.ligaments = spine::parse_ligaments(a.ligaments);
+  model_options.rib_cage = a.rib_cage;
   model_options.subject = spine::resolve_subject(data_dir(), subject_of(a.subject));
   if (!a.csv.empty()) require_output_folder(a.csv, "--csv");
 
@@ -169,6 +171,7 @@ void register_spine(CLI::App& app) {
                   "fibre-reinforced, or a file from `spine disc-joints`) in place of the thesis's "
                   "F.4");
   add_ligaments_option(cmd, a->ligaments);
+  add_rib_cage_option(cmd, a->rib_cage);
   add_subject_options(cmd, a->subject);
   cmd->add_option("--tolerance", a->tolerance_nmm, "Newton tolerance on max |dPi/dtheta|, N·mm")
       ->capture_default_str();

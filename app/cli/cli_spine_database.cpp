@@ -38,7 +38,7 @@ struct DatabaseArgs {
   std::string magnitudes = "200,400,600", ligaments = "auto";
   CLI::Option* out_option = nullptr;
   int workers = 0;
-  bool check = false, no_recruit = false, json = false, quiet = false;
+  bool check = false, no_recruit = false, rib_cage = false, json = false, quiet = false;
 };
 
 std::vector<int> vertebra_list(const std::string& text) {
@@ -69,6 +69,11 @@ void validate(const DatabaseArgs& a) {
     throw std::invalid_argument("--superposition-on: no vertebra given");
   magnitudes(a);
   if (!a.fusion.empty()) sp::parse_fusion(a.fusion);
+  if (a.check && (!a.fusion.empty() || a.ligaments != DatabaseArgs().ligaments || a.rib_cage ||
+                  a.no_recruit))
+    throw std::invalid_argument(
+        "--check solves the file's own model: --fusion, --ligaments, --rib-cage and --no-recruit "
+        "are for generating a file");
   if (!a.check) {
     const auto dir = std::filesystem::absolute(a.out).parent_path();
     if (!std::filesystem::is_directory(dir))
@@ -84,6 +89,7 @@ std::string command_line(const DatabaseArgs& a) {
   if (!a.fusion.empty()) c += " --fusion " + a.fusion;
   if (a.ligaments != DatabaseArgs().ligaments) c += " --ligaments " + a.ligaments;
   if (a.no_recruit) c += " --no-recruit";
+  if (a.rib_cage) c += " --rib-cage";
   if (a.superposition_on != DatabaseArgs().superposition_on)
     c += " --superposition-on " + a.superposition_on;
   if (a.magnitudes != DatabaseArgs().magnitudes) c += " --magnitudes " + a.magnitudes;
@@ -109,6 +115,7 @@ void run_generate(const DatabaseArgs& a) {
   DatabaseRequest rq;
   if (!a.fusion.empty()) rq.model.fused_joints = sp::parse_fusion(a.fusion);
   rq.model.ligaments = sp::parse_ligaments(a.ligaments);
+  rq.model.rib_cage = a.rib_cage;
   rq.solve = solve_options(!a.no_recruit);
   rq.loaded_vertebrae = vertebra_list(a.vertebrae);
   rq.workers = a.workers;
@@ -175,6 +182,7 @@ void register_spine_database(CLI::App& spine) {
   cmd->add_option("--vertebrae", a->vertebrae, "Loaded vertebrae, e.g. T1,L3 (default: T1…L5)");
   cmd->add_option("--fusion", a->fusion, "Fused levels of the model, e.g. L3-L4,L4-L5");
   add_ligaments_option(cmd, a->ligaments);
+  add_rib_cage_option(cmd, a->rib_cage);
   cmd->add_flag("--no-recruit", a->no_recruit, "Muscles off (passive spine)");
   cmd->add_option("--superposition-on", a->superposition_on,
                   "Vertebrae loaded by the oblique forces")

@@ -18,7 +18,7 @@ struct ScheduleArgs {
   std::string loads, csv, record, out, fusion, disc_joints, ligaments = "auto";
   double step_s = 0;
   int workers = 0;
-  bool json = false, quiet = false, no_muscles = false;
+  bool json = false, quiet = false, no_muscles = false, rib_cage = false;
   SubjectFlags subject;
 };
 
@@ -32,6 +32,7 @@ void run_schedule(const ScheduleArgs& a) {
   model.muscles = !a.no_muscles;
   model.disc_joints = a.disc_joints;
   model.ligaments = spine::parse_ligaments(a.ligaments);
+  model.rib_cage = a.rib_cage;
   model.subject = spine::resolve_subject(data_dir(), subject_of(a.subject));
   if (a.step_s > 0 &&
       (schedule.time_s.back() - schedule.time_s.front()) / a.step_s > 1e5)
@@ -102,6 +103,7 @@ void register_spine_schedule(CLI::App& spine) {
                   "Joint springs from each level's disc (a data/spine/disc_joints/ preset or a "
                   "file) in place of F.4");
   add_ligaments_option(cmd, a->ligaments);
+  add_rib_cage_option(cmd, a->rib_cage);
   add_subject_options(cmd, a->subject);
   add_output_flags(cmd, a->json, a->quiet, "every step as JSON");
   cmd->footer(

@@ -41,6 +41,7 @@
 #include "spinesim/studies/materials_study.hpp"
 #include "spinesim/studies/mss_run.hpp"
 #include "spinesim/studies/spine_solve.hpp"
+#include "spinesim/studies/rib_cage_study.hpp"
 #include "spinesim/studies/spine_studies.hpp"
 
 #include "spinesim/fem/disc_fem.hpp"
@@ -365,10 +366,11 @@ void register_materials(CLI::App& study) {
 struct SpineStudyArgs {
   double force_n = 300;
   std::string csv, disc_joints, ligaments = "auto";
-  bool json = false, quiet = false, no_trunk_muscles = false;
+  bool json = false, quiet = false, no_trunk_muscles = false, rib_cage = false;
   SubjectFlags subject;
   spine::ModelOptions model() const {
     spine::ModelOptions o;
+    o.rib_cage = rib_cage;
     o.trunk_muscles = !no_trunk_muscles;
     o.ligaments = spine::parse_ligaments(ligaments);
     o.subject = subject_of(subject);
@@ -388,6 +390,8 @@ void print_muscle_set(const SpineStudyArgs& a) {
                  "counts them twice)\n\n";
   if (!spine::has_ligaments(o) && !o.disc_joints.empty())
     std::cout << "Ligaments: none (--ligaments off) on the disc joints\n\n";
+  if (a.rib_cage)
+    std::cout << "Rib cage: on (--rib-cage; data/spine/rib_cage.json)\n\n";
   if (a.subject.given())
     std::cout << "Body: " << subject_text(spine::resolve_subject(data_dir(), o.subject))
               << " (--height/--mass/--sex; the reference body is male, 1.778 m, 70 kg)\n\n";
@@ -406,6 +410,7 @@ void add_spine_study_options(CLI::App* cmd, SpineStudyArgs& a, bool with_force) 
                 "rectus abdominis");
   cmd->add_flag("--quiet", a.quiet, "No progress on stderr");
   add_ligaments_option(cmd, a.ligaments);
+  add_rib_cage_option(cmd, a.rib_cage);
   add_subject_options(cmd, a.subject);
   cmd->add_option("--disc-joints", a.disc_joints,
                   "Joint springs from each level's disc (a data/spine/disc_joints/ preset such as "
@@ -527,6 +532,49 @@ void register_trends(CLI::App& study) {
 }
 }  // namespace
 
+// --- study rib-cage (rib_cage_study.hpp) ----------------------------------------------------
+
+void register_rib_cage(CLI::App& study) {
+  struct Args {
+    SpineStudyArgs spine;
+    double moment_nm = 2;
+  };
+  auto a = std::make_shared<Args>();
+  auto* cmd = study.add_subcommand(
+      "rib-cage",
+      "The rib cage's stiffening of the thoracic spine beside cadaver tests that removed it");
+  cmd->add_option("--moment", a->moment_nm, "Pure moment on T1, N·m (Liebsch et al. 2017: 2)")
+      ->capture_default_str();
+  cmd->add_flag("--json", a->spine.json, "Print the JSON summary on stdout (instead of the tables)");
+  cmd->add_flag("--quiet", a->spine.quiet, "No progress on stderr");
+  add_ligaments_option(cmd, a->spine.ligaments);
+  add_subject_options(cmd, a->spine.subject);
+  cmd->footer(
+      "The thoracic spine T1-T12 alone (T12 held; no gravity, muscles or IAP), a couple of "
+      "+-M about each axis\n"
+      "on T1: T1's range of motion without the cage, with the ribs on their heads only (the "
+      "costal cartilage\n"
+      "removed), with the whole cage and with its springs' stiffness changed; how much the range "
+      "grows when the\n"
+      "cage is removed, beside Liebsch et al. 2017 and Mannen et al. 2018. Then standing and a "
+      "300 N forward\n"
+      "force on T1 with and without the cage (the full model). Nothing is tuned.");
+  cmd->callback([a] {
+    if (!std::isfinite(a->moment_nm) || a->moment_nm < 0.1 || a->moment_nm > 20)
+      throw std::invalid_argument("--moment must lie within 0.1 … 20 N·m");
+    Progress progress(8, a->spine.quiet || a->spine.json);
+    const RibCageStudy s = run_rib_cage_study(data_dir(), a->moment_nm, a->spine.model(),
+                                              spine_study_hooks(a->spine, progress));
+    if (a->spine.json) {
+      print_json(rib_cage_study_json(s));
+      return;
+    }
+    std::cout << "The rib cage and the thoracic spine's stiffness (in vitro: Liebsch et al. "
+                 "2017, Mannen et al. 2018)\n\n";
+    print_rib_cage_study(std::cout, s, false);
+  });
+}
+
 void register_study(CLI::App& app) {
   auto* study = app.add_subcommand(
       "study",
@@ -538,6 +586,7 @@ void register_study(CLI::App& app) {
   register_validation(*study);
   register_fusion(*study);
   register_trends(*study);
+  register_rib_cage(*study);
   register_haptic_plane(*study);
   register_haptic_drag(*study);
   register_disc_validation(*study);

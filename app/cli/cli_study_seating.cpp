@@ -23,7 +23,8 @@ struct SeatingArgs {
   SeatingRequest request;
   double pelvic_tilt_deg = NAN;
   std::string chair_file, csv, out, parameter, values, ligaments = "auto";
-  bool json = false, quiet = false, markdown = false, no_trunk_muscles = false;
+  bool json = false, quiet = false, markdown = false, no_trunk_muscles = false,
+       rib_cage = false;
   SubjectFlags subject;
 };
 
@@ -53,6 +54,7 @@ void add_chair_options(CLI::App* cmd, SeatingArgs& a) {
   cmd->add_flag("--no-trunk-muscles", a.no_trunk_muscles,
                 "Lumbar muscles F.8-F.19 only (no thoracic erector spinae, no rectus abdominis)");
   add_ligaments_option(cmd, a.ligaments);
+  add_rib_cage_option(cmd, a.rib_cage);
   add_subject_options(cmd, a.subject);
   cmd->add_option("--csv", a.csv, "Write the results as CSV");
   cmd->add_option("--out", a.out, "Write JSON, CSV, plots and report.html into this folder");
@@ -65,6 +67,7 @@ void resolve(SeatingArgs& a) {
   if (!std::isnan(a.pelvic_tilt_deg)) a.request.pelvic_tilt_deg = a.pelvic_tilt_deg;
   a.request.model.trunk_muscles = !a.no_trunk_muscles;
   a.request.model.ligaments = spine::parse_ligaments(a.ligaments);
+  a.request.model.rib_cage = a.rib_cage;
   a.request.model.subject = spine::resolve_subject(data_dir(), subject_of(a.subject));
   spine::check_chair(a.request.chair);
   if (!a.chair_file.empty()) {
@@ -118,6 +121,7 @@ void run_sweep(SeatingArgs& a) {
 void run_validation(SeatingArgs& a) {
   a.request.model.trunk_muscles = !a.no_trunk_muscles;
   a.request.model.ligaments = spine::parse_ligaments(a.ligaments);
+  a.request.model.rib_cage = a.rib_cage;
   a.request.model.subject = spine::resolve_subject(data_dir(), subject_of(a.subject));
   if (!a.csv.empty()) require_output_folder(a.csv, "--csv");
   Progress progress(kSittingValidationStages, a.quiet || a.json);
@@ -179,6 +183,7 @@ void register_seating(CLI::App& study) {
   val->add_option("--csv", v->csv, "Write the comparison as CSV");
   val->add_flag("--no-trunk-muscles", v->no_trunk_muscles, "Lumbar muscles F.8-F.19 only");
   add_ligaments_option(val, v->ligaments);
+  add_rib_cage_option(val, v->rib_cage);
   add_subject_options(val, v->subject);
   add_output_flags(val, v->json, v->quiet, "the JSON comparison");
   val->callback([v] { run_validation(*v); });

@@ -15,10 +15,12 @@ namespace {
 
 using VectorsByVertebra = std::map<std::string, Eigen::Vector3d>;
 
-/// The body: height (m), mass (kg), sex; zeros are the reference body's.
+/// The body: height (m), mass (kg), sex (zeros are the reference body's) and whether its rib
+/// cage is modelled.
 struct Body {
   double height_m = 0, body_mass_kg = 0;
   std::string sex = "male";
+  bool rib_cage = false;
 };
 
 spine::ModelOptions model_options(const std::string& fusion, bool muscles, bool trunk_muscles,
@@ -35,13 +37,15 @@ spine::ModelOptions model_options(const std::string& fusion, bool muscles, bool 
   o.trunk_muscles = trunk_muscles;
   o.gravity = gravity;
   o.disc_joints = disc_joints;
+  o.rib_cage = body.rib_cage;
   return o;
 }
 
 py::object solve_spine(const VectorsByVertebra& forces, const VectorsByVertebra& moments,
                        const std::string& fusion, bool muscles, bool trunk_muscles, bool gravity,
                        const std::string& disc_joints, const std::string& ligaments,
-                       double height_m, double body_mass_kg, const std::string& sex) {
+                       double height_m, double body_mass_kg, const std::string& sex,
+                       bool rib_cage) {
   studies::SpineSolveRequest rq;
   for (const auto& [name, f] : forces) {
     spine::ExternalLoad l;
@@ -56,7 +60,7 @@ py::object solve_spine(const VectorsByVertebra& forces, const VectorsByVertebra&
     rq.loads.push_back(l);
   }
   rq.model = model_options(fusion, muscles, trunk_muscles, gravity, disc_joints, ligaments,
-                           {height_m, body_mass_kg, sex});
+                           {height_m, body_mass_kg, sex, rib_cage});
   rq.solve.recruit = muscles;
   nlohmann::json j;
   {
@@ -69,7 +73,7 @@ py::object solve_spine(const VectorsByVertebra& forces, const VectorsByVertebra&
 py::object seated(const std::map<std::string, double>& chair, bool armrests,
                   const std::string& chair_surface, const std::string& fusion,
                   const std::string& disc_joints, const std::string& ligaments, double height_m,
-                  double body_mass_kg, const std::string& sex) {
+                  double body_mass_kg, const std::string& sex, bool rib_cage) {
   studies::SeatingRequest rq;
   for (const auto& [name, value] : chair) rq = studies::with_parameter(rq, name, value);
   rq.chair.armrests = armrests;
@@ -78,7 +82,7 @@ py::object seated(const std::map<std::string, double>& chair, bool armrests,
     rq.chair.surface_name = chair_surface;
   }
   rq.model = model_options(fusion, true, true, true, disc_joints, ligaments,
-                           {height_m, body_mass_kg, sex});
+                           {height_m, body_mass_kg, sex, rib_cage});
   studies::check_seating_request(rq);
   nlohmann::json j;
   {

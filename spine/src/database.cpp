@@ -575,6 +575,7 @@ json model_json(const DatabaseInfo& i) {
   return {
       {"fused_joints", fused},
       {"ligaments", has_ligaments(i.model)},
+      {"rib_cage", i.model.rib_cage},
       {"muscles", i.model.muscles},
       {"iap", i.model.iap},
       {"gravity", i.model.gravity},
@@ -593,6 +594,7 @@ void model_from_json(const json& j, DatabaseInfo& i) {
   for (const auto& n : j.at("fused_joints"))
     i.model.fused_joints.push_back(joint_index(n.get<std::string>()));
   i.model.ligaments = j.at("ligaments").get<bool>() ? Ligaments::On : Ligaments::Off;
+  i.model.rib_cage = j.value("rib_cage", false);  // files written before the rib cage have none
   i.model.muscles = j.at("muscles").get<bool>();
   i.model.iap = j.at("iap").get<bool>();
   i.model.gravity = j.at("gravity").get<bool>();

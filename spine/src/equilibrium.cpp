@@ -2,6 +2,7 @@
 // coordinates, its analytic gradient by accumulating every element's force on the vertebrae
 // above each joint, and a modified Newton method with a finite-difference Hessian.
 #include "spinesim/spine/equilibrium.hpp"
+#include "spinesim/spine/rib_cage.hpp"
 #include "spinesim/common/constants.hpp"
 
 #include "spinesim/common/timer.hpp"
@@ -214,6 +215,15 @@ State evaluate(const SpineModel& m, const std::vector<ExternalLoad>& ext, const 
     const Vector3d tau = -left_jacobian_inverse(phi).transpose() * Kphi;
     s.loads.couple(b.body, tau);
     s.bushing << f, tau;
+  }
+  if (m.rib_cage) {
+    std::vector<Vector3d> force, couple;
+    s.energy += rib_cage_energy(*m.rib_cage, m.vertebrae, P, force, couple);
+    for (std::size_t v = 0; v < n; ++v) {
+      if (force[v].isZero() && couple[v].isZero()) continue;
+      s.loads.add(int(v), P[v].apply(m.vertebrae[v].centre_mm), force[v]);
+      s.loads.couple(int(v), couple[v]);
+    }
   }
   add_contacts(m, dead_contacts, s);
   return s;

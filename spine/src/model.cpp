@@ -1,5 +1,6 @@
 // Builds the spine model from data/ (spine/README.md): no number of the model is in this file.
 #include "spinesim/spine/model.hpp"
+#include "spinesim/spine/rib_cage.hpp"
 #include "spinesim/common/constants.hpp"
 
 #include "spinesim/common/csv_table.hpp"
@@ -399,6 +400,9 @@ SpineModel load_spine_model(const std::string& data_dir, const ModelOptions& opt
           kRadPerDeg;
     }
     detail::scale_to_subject(m, m.scale);
+    if (options.rib_cage)
+      m.rib_cage =
+          std::make_shared<const RibCage>(build_rib_cage(data_dir, m.vertebrae, m.scale.length));
   } catch (const nlohmann::json::exception& e) {
     throw std::runtime_error(config_file + ": " + e.what());
   }

@@ -137,6 +137,8 @@ void check_haptics_request(const HapticsRunRequest& r) {
     throw std::invalid_argument("--force-scale is for --spine multirate|database or --scene disc");
   if (r.spine.empty() && !r.database.empty())
     throw std::invalid_argument("--database is for --spine multirate|database");
+  if (r.spine.empty() && r.rib_cage)
+    throw std::invalid_argument("--rib-cage is for --spine multirate|database");
   if (r.spine.empty() && r.scene.scene != "disc" &&
       (r.coupling_stiffness_n_per_mm != 0 || r.coupling_damping_n_s_per_mm != 0))
     throw std::invalid_argument(
@@ -308,12 +310,19 @@ void set_torsion(const HapticsRunRequest& request, HapticsRunResult& result,
 CompliantSetup make_compliant_stage(const HapticsRunRequest& request, const std::string& data_dir,
                                     const haptics::Scene& scene, HapticsRunResult& result) {
   CompliantSetup c;
-  c.model = std::make_unique<spine::SpineModel>(spine::load_spine_model(data_dir));
+  spine::ModelOptions options;
+  options.rib_cage = request.rib_cage;
+  c.model = std::make_unique<spine::SpineModel>(spine::load_spine_model(data_dir, options));
   if (request.spine == "database") {
     const std::string path = request.database.empty()
                                  ? (fs::path(data_dir) / "spine" / "displacement_db.json").string()
                                  : request.database;
     c.database = std::make_unique<spine::DisplacementDatabase>(read_database(path));
+    if (c.database->info.model.rib_cage != request.rib_cage)
+      throw std::invalid_argument(
+          path + (request.rib_cage ? " is a spine without a rib cage: build one with `spinesim "
+                                     "spine database --rib-cage`"
+                                   : " is the rib-caged spine's: add --rib-cage"));
     c.response = std::make_unique<haptics::DatabaseResponse>(*c.database);
   } else {
     haptics::MultirateOptions o;
@@ -764,6 +773,7 @@ nlohmann::json haptics_run_json(const HapticsRunResult& r) {
                ? nlohmann::json()
                : nlohmann::json{{"spine", r.spine},
                                 {"posture", r.request.posture},
+                                {"rib_cage", r.request.rib_cage},
                                 {"force_scale", r.force_scale},
                                 {"coupling_stiffness_n_per_mm", r.coupling_stiffness_n_per_mm},
                                 {"spine_max_force_n", r.spine_max_force_n},

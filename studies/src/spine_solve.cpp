@@ -168,6 +168,8 @@ nlohmann::json spine_solve_json(const SpineSolveRun& r, const std::string& csv) 
                                                       : nlohmann::json(fused_list(model_options))},
         {"muscles", options.recruit},
         {"gravity", model_options.gravity},
+        {"ligaments", spine::ligaments_name(model_options.ligaments)},
+        {"rib_cage", r.model.rib_cage != nullptr},
         {"criterion", polynomial(r) ? "polynomial" : "minmax"},
         {"power", options.recruitment.power},
         {"tolerance_nmm", options.tolerance},

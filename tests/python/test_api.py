@@ -165,6 +165,20 @@ def test_a_scaled_body_and_the_ligaments_equal_the_program(program):
         spinesim.spine(ligaments="maybe")
 
 
+def test_the_rib_cage_equals_the_program_and_stiffens_the_thorax(program):
+    s = spinesim.spine(forces={"T1": [0, 0, 100]}, rib_cage=True)
+    p = program("spine", "solve", "--force", "T1:0,0,100", "--rib-cage", quiet=False)
+    assert s.options["rib_cage"] and p["options"]["rib_cage"]
+    assert_json_close(s.joints, p["joints"], rtol=1e-9, atol=1e-6)
+    bare = spinesim.spine(forces={"T1": [0, 0, 100]})
+    assert not bare.options["rib_cage"]
+
+    def thoracic_flexion(r):
+        turn = {v["name"]: v["rotation_deg"][0] for v in r.vertebrae}
+        return turn["T1"] - turn["T12"]
+    assert 0 < thoracic_flexion(s) < thoracic_flexion(bare)
+
+
 def test_seated_spine(program):
     s = spinesim.seated_spine(backrest_recline=110, lumbar_support=20)
     p = program("study", "seating", "--backrest-recline", 110, "--lumbar-support", 20)

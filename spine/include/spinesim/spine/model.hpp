@@ -19,6 +19,8 @@
 
 namespace spinesim::spine {
 
+struct RibCage;  // rib_cage.hpp
+
 /// Body index of everything fixed to the pelvis (sacrum, ilium, femur, lower torso, rectus sheath).
 inline constexpr int kGround = -1;
 
@@ -189,6 +191,9 @@ struct ModelOptions {
   /// abdominis), restored in data/spine/trunk_muscles.csv; false: the F.8-F.19 lumbar muscles only.
   bool trunk_muscles = true;
   bool arms_forward = false;  ///< arms reaching forward (crate case) instead of hanging
+  /// The rib cage on the twelve thoracic vertebrae (rib_cage.hpp); false: none (the thesis's
+  /// model, whose thoracic spine is its F.4 joints alone).
+  bool rib_cage = false;
   Subject subject;            ///< the body (default: the reference body)
   /// A disc-joint stiffness file (`spinesim spine disc-joints`; data/spine/disc_joints/): each
   /// joint's spring becomes that level's disc 3×3 rotational stiffness about the joint point, in
@@ -226,6 +231,8 @@ struct SpineModel {
   Subject subject;                          ///< resolved: height and mass filled in
   SubjectScale scale;                       ///< applied to the reference body's tables
   SegmentMassPercent segment_mass_percent;  ///< the subject's sex's
+  /// The rib cage (rib_cage.hpp; ModelOptions::rib_cage), or none.
+  std::shared_ptr<const RibCage> rib_cage;
   Eigen::Vector3d chest_front_mm;  ///< for loads held "in front of the chest"
   int ribs_body = 5;               ///< T6
   std::string data_dir;
