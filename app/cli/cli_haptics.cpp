@@ -287,9 +287,10 @@ void add_haptics_run_flags(CLI::App* cmd, HapticsRunFlags& f, bool viewer) {
                   "--force-scale (default: the device's usable rotational stiffness; 0: off)");
   cmd->add_flag("--no-recruit{false}", f.request.spine_recruit,
                 "--spine multirate: passive spine solves (muscles off)");
-  cmd->add_flag("--rib-cage", f.request.rib_cage,
-                "--spine multirate|database: the spine carries its rib cage (24 ribs and the "
-                "sternum; a database built with `spine database --rib-cage`)");
+  cmd->add_flag("--rib-cage", f.request.scene.rib_cage,
+                "--scene spine: add the ribs and the sternum (drawn and touched); with --spine "
+                "they stiffen the thorax and move with it (--spine database: a database built "
+                "with `spine database --rib-cage`)");
   cmd->add_option("--posture", f.request.posture,
                   "--spine multirate: standing, or seated in a chair (study seating's model; "
                   "--chair, --backrest-recline, --lumbar-support)")

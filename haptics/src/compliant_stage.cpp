@@ -310,6 +310,33 @@ void CompliantStage::update(const DeviceState& device, const RenderOutput& last,
   response_.publish(s.load);
   absolute_ = response_.baseline() + relative_;
   relative_poses(centres_, response_.baseline(), absolute_, body_of_, poses);
+  if (ribs_) {
+    for (std::size_t i = 0; i < thoracic_bodies_.size(); ++i)
+      thoracic_[i] = poses.pose[std::size_t(thoracic_bodies_[i])];
+    ribs_->pose(thoracic_.data(), rib_poses_.data());
+    for (std::size_t b = 0; b < rib_bodies_.size(); ++b)
+      poses.pose[std::size_t(rib_bodies_[b])] = rib_poses_[b];
+  }
+}
+
+void CompliantStage::attach_rib_cage(const spine::RibCage& cage,
+                                     const std::vector<spine::Vertebra>& vertebrae,
+                                     const std::vector<int>& bodies) {
+  if (bodies.size() != cage.body_centres_mm.size())
+    throw std::invalid_argument("compliant stage: one scene body per rib and the sternum");
+  for (int b : bodies)
+    if (b < 0 || b >= kMaxBodies)
+      throw std::invalid_argument("compliant stage: a rib body outside the scene");
+  thoracic_bodies_.clear();
+  for (int v : cage.vertebrae) {
+    if (v < 0 || v >= kSpineVertebrae)
+      throw std::invalid_argument("compliant stage: the rib cage hangs on T1-T12");
+    thoracic_bodies_.push_back(body_of_[std::size_t(v)]);
+  }
+  ribs_ = std::make_unique<spine::RibCagePoser>(cage, vertebrae);
+  rib_bodies_ = bodies;
+  thoracic_.assign(thoracic_bodies_.size(), spine::Pose());
+  rib_poses_.assign(bodies.size(), spine::Pose());
 }
 
 Eigen::Vector3d CompliantStage::hook_at(const Vector6d& W, Eigen::Matrix3d* rotation) {

@@ -5,8 +5,11 @@
 #include "spinesim/common/timer.hpp"
 #include "spinesim/mesh/disc_geometry.hpp"
 #include "spinesim/mesh/io.hpp"
+#include "spinesim/mesh/tube.hpp"
 #include "spinesim/mesh/vertebra_cache.hpp"
 #include "spinesim/mesh/vertebra_geometry.hpp"
+#include "spinesim/spine/model.hpp"
+#include "spinesim/spine/rib_cage.hpp"
 
 #include <Eigen/Geometry>
 
@@ -186,6 +189,36 @@ nlohmann::json registration_json(const Registration& r) {
           {"rms_mm", r.rms_mm}};
 }
 
+namespace {
+
+/// The ribs (with their cartilage) and the sternum as tubes at the reference posture. Cross
+/// sections: a rib's shaft about 12 × 6 mm, its cartilage 10 × 6 mm, the sternum 30 × 10 mm
+/// (drawn and touched; the cage's mechanics do not depend on them).
+void add_rib_cage_bodies(HapticScene& out, const std::string& data_dir) {
+  const spine::SpineModel model = spine::load_spine_model(data_dir);
+  const spine::RibCage cage = spine::build_rib_cage(data_dir, model.vertebrae);
+  mesh::TubeOptions o;
+  o.width_direction = Eigen::Vector3d::UnitY();  // a rib's broad faces look in and out
+  for (const spine::Rib& rib : cage.ribs) {
+    std::vector<Eigen::Vector3d> p{rib.head_mm, rib.tubercle_mm, rib.lateral_mm, rib.front_mm};
+    std::vector<double> w{5, 6, 6, 6}, d{3, 3, 3, 3};
+    if ((rib.cartilage_end_mm - rib.front_mm).norm() > 1) {
+      p.push_back(rib.cartilage_end_mm);
+      w.push_back(5);
+      d.push_back(3);
+    }
+    out.scene.add_body(rib.name, mesh::tube_surface(p, w, d, o));
+    out.sources.push_back("generated");
+  }
+  o.width_direction = Eigen::Vector3d::UnitX();
+  o.sides = 16;
+  out.scene.add_body("sternum", mesh::tube_surface({cage.sternum_top_mm, cage.sternum_bottom_mm},
+                                                   {18, 13}, {5, 5}, o));
+  out.sources.push_back("generated");
+}
+
+}  // namespace
+
 void check_scene_name(const std::string& scene) {
   if (scene != "plane" && scene != "vertebra" && scene != "spine" && scene != "disc")
     throw std::invalid_argument("--scene " + scene + ": give spine, vertebra, disc or plane");
@@ -196,6 +229,8 @@ HapticScene build_haptic_scene(const HapticSceneRequest& r, const std::string& d
   const Timer timer;
   HapticScene out;
   check_scene_name(r.scene);
+  if (r.rib_cage && r.scene != "spine")
+    throw std::invalid_argument("--rib-cage is for --scene spine");
   std::vector<std::string> level_bodies;
   if (r.scene == "disc") {
     mesh::disc_dimensions(r.level, data_dir);  // a known level
@@ -254,8 +289,11 @@ HapticScene build_haptic_scene(const HapticSceneRequest& r, const std::string& d
     const std::string what = r.vertebrae == "generated" ? "parametric"
                              : r.vertebrae == "real" ? "real L1-S1 (ArtiSynth), parametric thoracic"
                                                      : "scene file + parametric";
+    if (r.rib_cage) add_rib_cage_bodies(out, data_dir);
     out.description = r.scene == "spine"
-                          ? "the spine T1-L5 + sacrum (" + what + ") at the reference posture"
+                          ? "the spine T1-L5 + sacrum (" + what + ")" +
+                                (r.rib_cage ? " with the rib cage" : "") +
+                                " at the reference posture"
                       : r.scene == "disc" ? "the " + r.level + " disc between " + names[0] +
                                                 " and " + names[1] + " (" + what + ")"
                                           : "L3 (" + what + ") at its reference posture";

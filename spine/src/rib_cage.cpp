@@ -122,18 +122,38 @@ void condense(RibCage& cage, const std::vector<Vertebra>& vertebrae, const RibCa
 
 /// Each thoracic vertebra's small motion relative to T6: the translation of its centre and its
 /// rotation vector, in T6's reference frame.
-Eigen::VectorXd relative_motion(const RibCage& cage, const std::vector<Vertebra>& vertebrae,
-                                const std::vector<Pose>& poses) {
-  const Pose& P0 = poses[std::size_t(cage.frame_body)];
-  Eigen::VectorXd u(6 * Eigen::Index(cage.vertebrae.size()));
+/// u = (p, φ) per thoracic vertebra in T6's frame; `pose_at(i)` is the pose of cage.vertebrae[i]
+/// and P0 T6's. No allocation.
+template <class PoseAt>
+void relative_motion_into(const RibCage& cage, const std::vector<Vertebra>& vertebrae,
+                          const Pose& P0, PoseAt pose_at, Eigen::VectorXd& u) {
   for (std::size_t i = 0; i < cage.vertebrae.size(); ++i) {
-    const int v = cage.vertebrae[i];
-    const Pose& P = poses[std::size_t(v)];
-    const Vector3d& c = vertebrae[std::size_t(v)].centre_mm;
+    const Pose& P = pose_at(i);
+    const Vector3d& c = vertebrae[std::size_t(cage.vertebrae[i])].centre_mm;
     u.segment<3>(6 * Eigen::Index(i)) = P0.R.transpose() * (P.apply(c) - P0.t) - c;
     u.segment<3>(6 * Eigen::Index(i) + 3) = rotation_log(P0.R.transpose() * P.R);
   }
+}
+
+Eigen::VectorXd relative_motion(const RibCage& cage, const std::vector<Vertebra>& vertebrae,
+                                const std::vector<Pose>& poses) {
+  Eigen::VectorXd u(6 * Eigen::Index(cage.vertebrae.size()));
+  relative_motion_into(
+      cage, vertebrae, poses[std::size_t(cage.frame_body)],
+      [&](std::size_t i) -> const Pose& { return poses[std::size_t(cage.vertebrae[i])]; }, u);
   return u;
+}
+
+/// The ribs' and the sternum's world poses from their motions q relative to T6 (pose P0).
+void recovered_poses(const RibCage& cage, const Eigen::VectorXd& q, const Pose& P0, Pose* out) {
+  for (std::size_t b = 0; b < cage.body_centres_mm.size(); ++b) {
+    const Vector3d& c = cage.body_centres_mm[b];
+    const Matrix3d R = rotation_exp(q.segment<3>(6 * Eigen::Index(b) + 3));
+    // Relative to T6: X ↦ c + p + R (X − c); then T6's pose.
+    const Vector3d t = c + q.segment<3>(6 * Eigen::Index(b)) - R * c;
+    out[b].R = P0.R * R;
+    out[b].t = P0.R * t + P0.t;
+  }
 }
 
 }  // namespace
@@ -247,18 +267,26 @@ double rib_cage_energy(const RibCage& cage, const std::vector<Vertebra>& vertebr
 std::vector<Pose> rib_cage_poses(const RibCage& cage, const std::vector<Vertebra>& vertebrae,
                                  const std::vector<Pose>& poses) {
   const Eigen::VectorXd q = cage.recovery * relative_motion(cage, vertebrae, poses);
-  const Pose& P0 = poses[std::size_t(cage.frame_body)];
-  std::vector<Pose> out;
-  for (std::size_t b = 0; b < cage.body_centres_mm.size(); ++b) {
-    const Vector3d& c = cage.body_centres_mm[b];
-    const Matrix3d R = rotation_exp(q.segment<3>(6 * Eigen::Index(b) + 3));
-    // Relative to T6: X ↦ c + p + R (X − c); then T6's pose.
-    Pose rel;
-    rel.R = R;
-    rel.t = c + q.segment<3>(6 * Eigen::Index(b)) - R * c;
-    out.push_back({P0.R * rel.R, P0.R * rel.t + P0.t});
-  }
+  std::vector<Pose> out(cage.body_centres_mm.size());
+  recovered_poses(cage, q, poses[std::size_t(cage.frame_body)], out.data());
   return out;
+}
+
+RibCagePoser::RibCagePoser(const RibCage& cage, const std::vector<Vertebra>& vertebrae)
+    : cage_(cage),
+      vertebrae_(vertebrae),
+      u_(Eigen::VectorXd::Zero(cage.recovery.cols())),
+      q_(Eigen::VectorXd::Zero(cage.recovery.rows())) {
+  for (std::size_t i = 0; i < cage.vertebrae.size(); ++i)
+    if (cage.vertebrae[i] == cage.frame_body) frame_ = i;
+}
+
+void RibCagePoser::pose(const Pose* thoracic, Pose* out) {
+  relative_motion_into(
+      cage_, vertebrae_, thoracic[frame_],
+      [thoracic](std::size_t i) -> const Pose& { return thoracic[i]; }, u_);
+  q_.noalias() = cage_.recovery * u_;
+  recovered_poses(cage_, q_, thoracic[frame_], out);
 }
 
 }  // namespace spinesim::spine

@@ -137,8 +137,8 @@ void check_haptics_request(const HapticsRunRequest& r) {
     throw std::invalid_argument("--force-scale is for --spine multirate|database or --scene disc");
   if (r.spine.empty() && !r.database.empty())
     throw std::invalid_argument("--database is for --spine multirate|database");
-  if (r.spine.empty() && r.rib_cage)
-    throw std::invalid_argument("--rib-cage is for --spine multirate|database");
+  if (r.scene.rib_cage && r.scene.scene != "spine")
+    throw std::invalid_argument("--rib-cage is for --scene spine");
   if (r.spine.empty() && r.scene.scene != "disc" &&
       (r.coupling_stiffness_n_per_mm != 0 || r.coupling_damping_n_s_per_mm != 0))
     throw std::invalid_argument(
@@ -311,16 +311,16 @@ CompliantSetup make_compliant_stage(const HapticsRunRequest& request, const std:
                                     const haptics::Scene& scene, HapticsRunResult& result) {
   CompliantSetup c;
   spine::ModelOptions options;
-  options.rib_cage = request.rib_cage;
+  options.rib_cage = request.scene.rib_cage;
   c.model = std::make_unique<spine::SpineModel>(spine::load_spine_model(data_dir, options));
   if (request.spine == "database") {
     const std::string path = request.database.empty()
                                  ? (fs::path(data_dir) / "spine" / "displacement_db.json").string()
                                  : request.database;
     c.database = std::make_unique<spine::DisplacementDatabase>(read_database(path));
-    if (c.database->info.model.rib_cage != request.rib_cage)
+    if (c.database->info.model.rib_cage != request.scene.rib_cage)
       throw std::invalid_argument(
-          path + (request.rib_cage ? " is a spine without a rib cage: build one with `spinesim "
+          path + (request.scene.rib_cage ? " is a spine without a rib cage: build one with `spinesim "
                                      "spine database --rib-cage`"
                                    : " is the rib-caged spine's: add --rib-cage"));
     c.response = std::make_unique<haptics::DatabaseResponse>(*c.database);
@@ -355,6 +355,12 @@ CompliantSetup make_compliant_stage(const HapticsRunRequest& request, const std:
     body_of[std::size_t(i)] = scene.index(spine::vertebra_names()[std::size_t(i)]);
   }
   c.stage = std::make_unique<haptics::CompliantStage>(*c.response, centres, body_of, p);
+  if (c.model->rib_cage) {
+    std::vector<int> ribs;
+    for (const spine::Rib& rib : c.model->rib_cage->ribs) ribs.push_back(scene.index(rib.name));
+    ribs.push_back(scene.index("sternum"));
+    c.stage->attach_rib_cage(*c.model->rib_cage, c.model->vertebrae, ribs);
+  }
   result.spine = request.spine;
   result.force_scale = p.force_scale;
   result.coupling_stiffness_n_per_mm = p.stiffness_n_per_mm;
@@ -773,7 +779,7 @@ nlohmann::json haptics_run_json(const HapticsRunResult& r) {
                ? nlohmann::json()
                : nlohmann::json{{"spine", r.spine},
                                 {"posture", r.request.posture},
-                                {"rib_cage", r.request.rib_cage},
+                                {"rib_cage", r.request.scene.rib_cage},
                                 {"force_scale", r.force_scale},
                                 {"coupling_stiffness_n_per_mm", r.coupling_stiffness_n_per_mm},
                                 {"spine_max_force_n", r.spine_max_force_n},

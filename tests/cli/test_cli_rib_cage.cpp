@@ -109,7 +109,7 @@ TEST(RibCageSolve, TheOptionIsReportedAndStiffensTheThorax) {
 }
 
 // The haptic scene: a scripted drag of T1 on the rib-caged multirate spine hooks and solves
-// without a failure; the database spine must be the rib-caged one, and the flag needs a spine.
+// without a failure; the database spine must be the rib-caged one, and the ribs need the spine.
 TEST(RibCageHaptics, TheMultirateSpineCarriesTheCageAndTheDatabaseMustMatch) {
   const std::string script = std::string(SPINESIM_DATA_DIR) + "/haptics/drag_t1_lateral.csv";
   const CliRun r = run_spinesim(
@@ -122,8 +122,8 @@ TEST(RibCageHaptics, TheMultirateSpineCarriesTheCageAndTheDatabaseMustMatch) {
   EXPECT_GT(c["worker_solves"].get<int>(), 2);
   EXPECT_EQ(c["worker_failures"].get<int>(), 0);
 
-  const std::string base = "haptics run --duration 1 --scene spine ";
-  expect_refused(run_spinesim(base + "--rib-cage"), "--spine");
-  expect_refused(run_spinesim(base + "--spine database --rib-cage"), "rib cage");
+  expect_refused(run_spinesim("haptics run --duration 1 --scene plane --rib-cage"), "--scene spine");
+  expect_refused(run_spinesim("haptics run --duration 1 --scene spine --spine database --rib-cage"),
+                 "rib cage");
   expect_refused(run_spinesim("spine database --check --rib-cage"), "--check");
 }

@@ -300,3 +300,43 @@ TEST(MultirateSpine, NewLocalModelsAreBlendedInWithoutAStep) {
       },
       std::invalid_argument);
 }
+
+// With the rib cage attached, every update poses the ribs and the sternum from the thoracic
+// vertebrae's poses exactly as spine::rib_cage_poses does, and still allocates nothing.
+TEST(CompliantStage, TheRibCageFollowsTheThoraxWithoutAllocating) {
+  Column col;
+  sp::ModelOptions o;
+  o.rib_cage = true;
+  const sp::SpineModel m = sp::load_spine_model(SPINESIM_DATA_DIR, o);
+  std::vector<int> ribs;
+  for (std::size_t b = 0; b < m.rib_cage->body_centres_mm.size(); ++b) {
+    ribs.push_back(col.scene.size());
+    col.scene.add_body("rib" + std::to_string(b),
+                       spinesim::haptics::testing::box(Vector3d(100, 600 - 10.0 * double(b), 0), 3));
+  }
+  LinearSpine spine(20);
+  sh::CompliantStage stage(spine, col.centres, col.body_of, sh::CouplingParameters());
+  EXPECT_THROW(stage.attach_rib_cage(*m.rib_cage, m.vertebrae, {1, 2}), std::invalid_argument);
+  stage.attach_rib_cage(*m.rib_cage, m.vertebrae, ribs);
+  sh::ScenePoses poses;
+  const Vector3d c = col.centres[0];
+  stage.update(at(c + Vector3d(0, 0, 7), 1), touching(0, c + Vector3d(0, 0, 5)), 1e-3, poses);
+  ASSERT_TRUE(stage.state().attached);
+  long allocations = 0;
+  {
+    sh::testing::CountAllocations count;
+    for (int k = 1; k <= 300; ++k)
+      stage.update(at(c + Vector3d(0, 0, 7 + 0.05 * k), 1), touching(0, c + Vector3d(0, 0, 5)),
+                   1e-3, poses);
+    allocations = count.allocations();
+  }
+  EXPECT_EQ(allocations, 0);
+  std::vector<sp::Pose> P(m.vertebrae.size());
+  for (int i = 0; i < sh::kSpineVertebrae; ++i) P[std::size_t(i)] = poses.pose[std::size_t(col.body_of[std::size_t(i)])];
+  const auto expected = sp::rib_cage_poses(*m.rib_cage, m.vertebrae, P);
+  for (std::size_t b = 0; b < ribs.size(); ++b) {
+    EXPECT_LT((poses.pose[std::size_t(ribs[b])].R - expected[b].R).norm(), 1e-14) << b;
+    EXPECT_LT((poses.pose[std::size_t(ribs[b])].t - expected[b].t).norm(), 1e-11) << b;
+  }
+  EXPECT_GT(poses.pose[std::size_t(ribs[0])].t.norm(), 0.01);  // the pulled thorax moved R1
+}

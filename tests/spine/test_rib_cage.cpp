@@ -158,3 +158,22 @@ TEST(SpineRibCage, TheCageIsItsOwnMirrorImageAndStiffensEveryThoracicDirection) 
     }
   }
 }
+
+// The real-time poser gives the ribs and the sternum exactly the poses rib_cage_poses gives.
+TEST(SpineRibCage, TheRealTimePoserAgreesWithTheRibPoses) {
+  const auto m = caged();
+  const auto P = sp::vertebra_poses(m, wiggle(m, 0.02));
+  const auto expected = sp::rib_cage_poses(*m.rib_cage, m.vertebrae, P);
+  sp::RibCagePoser poser(*m.rib_cage, m.vertebrae);
+  ASSERT_EQ(poser.bodies(), expected.size());
+  std::vector<sp::Pose> thoracic;
+  for (int v : m.rib_cage->vertebrae) thoracic.push_back(P[std::size_t(v)]);
+  std::vector<sp::Pose> got(poser.bodies());
+  poser.pose(thoracic.data(), got.data());
+  for (std::size_t b = 0; b < got.size(); ++b) {
+    EXPECT_LT((got[b].R - expected[b].R).norm(), 1e-14) << b;
+    EXPECT_LT((got[b].t - expected[b].t).norm(), 1e-11) << b;
+  }
+  // The ribs did move with the bent thorax (the comparison is not between two identities).
+  EXPECT_GT((expected[0].t).norm(), 0.1);
+}

@@ -29,6 +29,7 @@
 #include "spinesim/haptics/triple_buffer.hpp"
 #include "spinesim/spine/database.hpp"
 #include "spinesim/spine/equilibrium.hpp"
+#include "spinesim/spine/rib_cage.hpp"
 
 #include <Eigen/Core>
 
@@ -231,8 +232,15 @@ class CompliantStage {
   /// F = s·k·(probe − hook(F)) with hook(F) from the response (Newton, finite-difference 3×3
   /// Jacobian: taking the hook from the previous tick instead is a fixed-point iteration with a
   /// gain of s·k times the spine's compliance, ~30 at T1, and diverges); predicts the poses for
-  /// it into `poses` (bodies of T1…L5; others untouched). No allocation.
+  /// it into `poses` (bodies of T1…L5 and an attached rib cage's; others untouched). No
+  /// allocation.
   void update(const DeviceState& device, const RenderOutput& last, double dt_s, ScenePoses& poses);
+  /// From now on update() also poses the rib cage's bodies from the thoracic vertebrae's:
+  /// `bodies[b]` is the scene body of cage rib b, the last one the sternum's. `cage` and
+  /// `vertebrae` must outlive the stage. Throws std::invalid_argument for a wrong count or a
+  /// body outside the scene's range.
+  void attach_rib_cage(const spine::RibCage& cage, const std::vector<spine::Vertebra>& vertebrae,
+                       const std::vector<int>& bodies);
   /// After the render: the force for the hand — the rendered contact force blended with the
   /// hook spring's by the attach gain.
   Eigen::Vector3d blend(const Eigen::Vector3d& contact_force_n) const;
@@ -269,6 +277,10 @@ class CompliantStage {
   Eigen::Matrix3d grip_at_press_ = Eigen::Matrix3d::Identity();      ///< stylus, at the press
   Eigen::Matrix3d vertebra_at_press_ = Eigen::Matrix3d::Identity();  ///< from the baseline
   Eigen::Matrix3d last_vertebra_ = Eigen::Matrix3d::Identity();
+  /// The rib cage, when attached: its poser, the scene bodies it poses and its buffers.
+  std::unique_ptr<spine::RibCagePoser> ribs_;
+  std::vector<int> rib_bodies_, thoracic_bodies_;
+  std::vector<spine::Pose> thoracic_, rib_poses_;
 };
 
 }  // namespace spinesim::haptics

@@ -17,7 +17,7 @@
 namespace spinesim::haptics {
 
 /// At most this many bodies (the spine has 18: T1…L5 and the sacrum).
-inline constexpr int kMaxBodies = 32;
+inline constexpr int kMaxBodies = 48;  ///< the spine's 18 bodies and the rib cage's 25
 
 /// Points on a surface for the probe-normal method: every triangle is cut into an n × n grid of
 /// similar sub-triangles (n = ⌈longest edge / spacing⌉) and each sub-triangle's centroid is a

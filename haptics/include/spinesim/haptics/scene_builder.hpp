@@ -29,6 +29,9 @@ struct HapticSceneRequest {
   /// Where generated vertebrae are kept between runs (mesh/vertebra_cache.hpp); empty: mesh
   /// them every time.
   std::string cache_dir;
+  /// spine: also the rib cage (spine/rib_cage.hpp), bodies R1, L1, …, R12, L12 and "sternum":
+  /// tubes through each rib's points, with its cartilage to where that ends.
+  bool rib_cage = false;
 };
 
 /// How the real vertebrae were registered: one rigid motion (a rotation about the lateral axis

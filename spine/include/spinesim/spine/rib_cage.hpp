@@ -84,4 +84,21 @@ double rib_cage_energy(const RibCage& cage, const std::vector<Vertebra>& vertebr
 std::vector<Pose> rib_cage_poses(const RibCage& cage, const std::vector<Vertebra>& vertebrae,
                                  const std::vector<Pose>& poses);
 
+/// rib_cage_poses for a real-time loop: its buffers are allocated once, here; pose() allocates
+/// nothing. Holds references to `cage` and `vertebrae`, which must outlive it.
+class RibCagePoser {
+ public:
+  RibCagePoser(const RibCage& cage, const std::vector<Vertebra>& vertebrae);
+  /// `thoracic`: the poses of cage.vertebrae (T1 … T12, in that order); `out`: the ribs' and
+  /// then the sternum's poses (cage.body_centres_mm.size() of them).
+  void pose(const Pose* thoracic, Pose* out);
+  std::size_t bodies() const { return cage_.body_centres_mm.size(); }
+
+ private:
+  const RibCage& cage_;
+  const std::vector<Vertebra>& vertebrae_;
+  Eigen::VectorXd u_, q_;
+  std::size_t frame_ = 0;
+};
+
 }  // namespace spinesim::spine

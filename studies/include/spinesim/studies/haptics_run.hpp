@@ -91,9 +91,6 @@ struct HapticsRunRequest {
   /// peak force).
   double force_scale = 0;
   bool spine_recruit = true;  ///< muscles recruited in the spine solves (as the database)
-  /// The spine carries its rib cage (spine::ModelOptions::rib_cage): the multirate spine is built
-  /// with it; a database must have been built with it (`spine database --rib-cage`).
-  bool rib_cage = false;
   /// The spine's posture for --spine multirate: "standing" or "seated" (in `chair`, solved by
   /// spine::solve_seated; the hook pushes on the seated spine leaning on the backrest).
   std::string posture = "standing";
