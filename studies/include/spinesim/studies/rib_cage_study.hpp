@@ -3,8 +3,8 @@
 //
 // In vitro (T1 loaded by pure moments, T12 held): Liebsch et al. 2017 (PLoS One 12:e0178733),
 // six specimens at ±2 N·m, report how much the T1-T12 range of motion grows when the anterior
-// rib cage is removed (FE +52.2 %, LB +42.0 %, AR +94.4 %); Mannen et al. 2018 (J Mech Behav
-// Biomed Mater 84:258), eight specimens at ±5 N·m under a 400 N follower load, when the whole
+// rib cage is removed (FE +52.2 %, LB +42.0 %, AR +94.4 %); Mannen et al. 2018 (author
+// manuscript PMC6016553), eight specimens at ±5 N·m under a 400 N follower load, when the whole
 // cage is removed (FE +63.0 %, LB +63.5 %, AR +58.8 %).
 //
 // The model's test is the same: the thoracic spine alone (no gravity, muscles, IAP), every joint
