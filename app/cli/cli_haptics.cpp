@@ -202,6 +202,55 @@ void add_scene_flags(CLI::App* cmd, haptics::HapticSceneRequest& scene) {
       ->capture_default_str();
 }
 
+namespace {
+
+/// The compliant stage's flags (--spine and what goes with it).
+void add_compliant_stage_flags(CLI::App* cmd, HapticsRunFlags& f) {
+  cmd->add_option("--spine", f.request.spine,
+                  "Compliant stage (--scene spine): press the stylus button on a vertebra to drag "
+                  "it; multirate (equilibrium solves in a worker + their sensitivity) or database "
+                  "(the thesis's displacement-force polynomials)");
+  cmd->add_option("--database", f.request.database,
+                  "--spine database: the database file (default data/spine/displacement_db.json)");
+  cmd->add_option("--force-scale", f.request.force_scale,
+                  "Spine or disc force per felt force, N/N (default: 600 N on the spine, 100 N on "
+                  "the disc, at the device's peak force)");
+  cmd->add_option("--coupling-stiffness", f.request.coupling_stiffness_n_per_mm,
+                  "Felt stiffness of the hook spring (--spine) or of the disc coupling (--scene "
+                  "disc), N/mm (default: the rendering stiffness)");
+  cmd->add_option("--coupling-damping", f.request.coupling_damping_n_s_per_mm,
+                  "Felt damping of the hook spring or the disc coupling, N*s/mm (0: none; the "
+                  "FEM disc's coupling gets k_c T / 2, the least that keeps a sampled spring "
+                  "passive)")
+      ->capture_default_str();
+  cmd->add_option("--rotational-stiffness", f.request.rotational_stiffness_nmm_per_rad,
+                  "--spine multirate on a 6-DOF device with torque (--model sigma.7, "
+                  "premium-1.5-6dof): the hook's torsional spring, felt, N*mm/rad; the stylus's "
+                  "turn twists the hooked vertebra and the hand feels the spine's moment / "
+                  "--force-scale (default: the device's usable rotational stiffness; 0: off)");
+  cmd->add_flag("--no-recruit{false}", f.request.spine_recruit,
+                "--spine multirate: passive spine solves (muscles off)");
+  cmd->add_flag("--rib-cage", f.request.scene.rib_cage,
+                "--scene spine: add the ribs and the sternum (drawn and touched); with --spine "
+                "they stiffen the thorax and move with it (--spine database: a database built "
+                "with `spine database --rib-cage`)");
+  cmd->add_option("--posture", f.request.posture,
+                  "--spine multirate: standing, or seated in a chair (study seating's model; "
+                  "--chair, --backrest-recline, --lumbar-support)")
+      ->capture_default_str();
+  cmd->add_option("--chair", f.chair_file,
+                  "--posture seated: the backrest as a surface file (STL, OBJ; mm; see study "
+                  "seating --help)");
+  cmd->add_option("--backrest-recline", f.request.chair.backrest_recline_deg,
+                  "--posture seated: backrest angle to the horizontal, deg")
+      ->capture_default_str();
+  cmd->add_option("--lumbar-support", f.request.chair.lumbar_support_mm,
+                  "--posture seated: lumbar pad depth, mm")
+      ->capture_default_str();
+}
+
+}  // namespace
+
 void add_haptics_run_flags(CLI::App* cmd, HapticsRunFlags& f, bool viewer) {
   add_scene_flags(cmd, f.request.scene);
   add_disc_flags(cmd, f.request);
@@ -263,47 +312,7 @@ void add_haptics_run_flags(CLI::App* cmd, HapticsRunFlags& f, bool viewer) {
                 "Do not measure the machine's floor beside the loop (a bare periodic thread, like "
                 "cyclictest, whose late wake-ups are reported next to the loop's missed "
                 "deadlines)");
-  cmd->add_option("--spine", f.request.spine,
-                  "Compliant stage (--scene spine): press the stylus button on a vertebra to drag "
-                  "it; multirate (equilibrium solves in a worker + their sensitivity) or database "
-                  "(the thesis's displacement-force polynomials)");
-  cmd->add_option("--database", f.request.database,
-                  "--spine database: the database file (default data/spine/displacement_db.json)");
-  cmd->add_option("--force-scale", f.request.force_scale,
-                  "Spine or disc force per felt force, N/N (default: 600 N on the spine, 100 N on "
-                  "the disc, at the device's peak force)");
-  cmd->add_option("--coupling-stiffness", f.request.coupling_stiffness_n_per_mm,
-                  "Felt stiffness of the hook spring (--spine) or of the disc coupling (--scene "
-                  "disc), N/mm (default: the rendering stiffness)");
-  cmd->add_option("--coupling-damping", f.request.coupling_damping_n_s_per_mm,
-                  "Felt damping of the hook spring or the disc coupling, N*s/mm (0: none; the "
-                  "FEM disc's coupling gets k_c T / 2, the least that keeps a sampled spring "
-                  "passive)")
-      ->capture_default_str();
-  cmd->add_option("--rotational-stiffness", f.request.rotational_stiffness_nmm_per_rad,
-                  "--spine multirate on a 6-DOF device with torque (--model sigma.7, "
-                  "premium-1.5-6dof): the hook's torsional spring, felt, N*mm/rad; the stylus's "
-                  "turn twists the hooked vertebra and the hand feels the spine's moment / "
-                  "--force-scale (default: the device's usable rotational stiffness; 0: off)");
-  cmd->add_flag("--no-recruit{false}", f.request.spine_recruit,
-                "--spine multirate: passive spine solves (muscles off)");
-  cmd->add_flag("--rib-cage", f.request.scene.rib_cage,
-                "--scene spine: add the ribs and the sternum (drawn and touched); with --spine "
-                "they stiffen the thorax and move with it (--spine database: a database built "
-                "with `spine database --rib-cage`)");
-  cmd->add_option("--posture", f.request.posture,
-                  "--spine multirate: standing, or seated in a chair (study seating's model; "
-                  "--chair, --backrest-recline, --lumbar-support)")
-      ->capture_default_str();
-  cmd->add_option("--chair", f.chair_file,
-                  "--posture seated: the backrest as a surface file (STL, OBJ; mm; see study "
-                  "seating --help)");
-  cmd->add_option("--backrest-recline", f.request.chair.backrest_recline_deg,
-                  "--posture seated: backrest angle to the horizontal, deg")
-      ->capture_default_str();
-  cmd->add_option("--lumbar-support", f.request.chair.lumbar_support_mm,
-                  "--posture seated: lumbar pad depth, mm")
-      ->capture_default_str();
+  add_compliant_stage_flags(cmd, f);
 }
 
 void resolve_haptics_run_flags(HapticsRunFlags& f) {
