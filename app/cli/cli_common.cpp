@@ -1,6 +1,7 @@
 #include "cli_common.hpp"
 
 #include "spinesim/common/numbers.hpp"
+#include "spinesim/spine/scoliosis.hpp"
 
 #include <cmath>
 #include <cstdlib>
@@ -53,6 +54,47 @@ spine::Subject subject_of(const SubjectFlags& flags) {
   s.body_mass_kg = flags.mass_kg;
   s.sex = spine::parse_sex(flags.sex);
   return s;
+}
+
+void add_scoliosis_options(CLI::App* cmd, ScoliosisFlags& f) {
+  cmd->add_option("--scoliosis", f.type,
+                  "A scoliotic spine resting in its curve: thoracic (T5-T11, apex T8, convex "
+                  "right), thoracolumbar (T10-L2, apex T12, right) or lumbar (T12-L4, apex L2, "
+                  "left); with --cobb (spine/README.md)");
+  cmd->add_option("--cobb", f.cobb_deg, "--scoliosis: the Cobb angle between the end vertebrae, deg");
+  cmd->add_option("--apex", f.apex, "--scoliosis: the apical vertebra (default: the type's)");
+  cmd->add_option("--curve-ends", f.ends,
+                  "--scoliosis: the end vertebrae, upper,lower, e.g. T6,T12 (default: the type's)");
+  cmd->add_option("--apical-rotation", f.apical_rotation_deg,
+                  "--scoliosis: the apical vertebra's axial rotation toward the convexity, deg "
+                  "(default 0)");
+  cmd->add_option("--convex", f.convex, "--scoliosis: right or left (default: the type's)")
+      ->check(CLI::IsMember({"right", "left"}));
+}
+
+spine::ScoliosisCurve scoliosis_of(const ScoliosisFlags& f) {
+  if (f.type.empty()) {
+    if (f.cobb_deg != 0 || !f.apex.empty() || !f.ends.empty() || !f.convex.empty() ||
+        f.apical_rotation_deg != 0)
+      throw std::invalid_argument(
+          "--cobb, --apex, --curve-ends, --apical-rotation and --convex are for --scoliosis");
+    return {};
+  }
+  if (f.cobb_deg == 0) throw std::invalid_argument("--scoliosis needs --cobb DEG");
+  spine::ScoliosisCurve c = spine::scoliosis_curve(f.type, f.cobb_deg);
+  if (!f.apex.empty()) c.apex = f.apex;
+  if (!f.ends.empty()) {
+    const auto ends = split_list(f.ends);
+    if (ends.size() != 2)
+      throw std::invalid_argument("--curve-ends " + f.ends + ": give upper,lower, e.g. T6,T12");
+    c.upper_end = ends[0];
+    c.lower_end = ends[1];
+  }
+  if (!f.convex.empty()) c.convex_right = f.convex == "right";
+  c.apical_rotation_deg = f.apical_rotation_deg;
+  if (!f.apex.empty() || !f.ends.empty() || !f.convex.empty()) c.type = "custom (" + c.type + ")";
+  spine::check_scoliosis_curve(c);
+  return c;
 }
 
 void add_ligaments_option(CLI::App* cmd, std::string& ligaments) {

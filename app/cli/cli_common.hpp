@@ -50,6 +50,17 @@ void add_ligaments_option(CLI::App* cmd, std::string& ligaments);
 /// --rib-cage (spine::ModelOptions::rib_cage) on the spine verbs.
 void add_rib_cage_option(CLI::App* cmd, bool& rib_cage);
 
+/// A scoliotic spine (spine/scoliosis.hpp): --scoliosis TYPE --cobb DEG [--apex V]
+/// [--curve-ends U,L] [--apical-rotation DEG] [--convex right|left].
+struct ScoliosisFlags {
+  std::string type, apex, ends, convex;
+  double cobb_deg = 0, apical_rotation_deg = 0;
+};
+void add_scoliosis_options(CLI::App* cmd, ScoliosisFlags& flags);
+/// The curve the flags describe (cobb_deg 0: none); std::invalid_argument (one line) for a flag
+/// without --scoliosis or a bad value.
+spine::ScoliosisCurve scoliosis_of(const ScoliosisFlags& flags);
+
 /// The plate load options of `fem` and `mss`: --motion, --wrench, --case, --center.
 void add_plate_load_options(CLI::App* cmd, std::string& motion, std::string& wrench,
                             std::string& load_case, std::string& center);

@@ -50,6 +50,7 @@ struct SpineSolveArgs {
   bool no_muscles = false, no_trunk_muscles = false, no_gravity = false, json = false,
        rib_cage = false;
   SubjectFlags subject;
+  ScoliosisFlags scoliosis;
 };
 
 void solve(const SpineSolveArgs& a) {
@@ -121,6 +122,7 @@ void solve(const SpineSolveArgs& a) {
   model_options.ligaments = spine::parse_ligaments(a.ligaments);
   model_options.rib_cage = a.rib_cage;
   model_options.subject = spine::resolve_subject(data_dir(), subject_of(a.subject));
+  model_options.scoliosis = scoliosis_of(a.scoliosis);
   if (!a.csv.empty()) require_output_folder(a.csv, "--csv");
 
   // 2. Model and equilibrium (studies/spine_solve.hpp).
@@ -172,6 +174,7 @@ void register_spine(CLI::App& app) {
                   "F.4");
   add_ligaments_option(cmd, a->ligaments);
   add_rib_cage_option(cmd, a->rib_cage);
+  add_scoliosis_options(cmd, a->scoliosis);
   add_subject_options(cmd, a->subject);
   cmd->add_option("--tolerance", a->tolerance_nmm, "Newton tolerance on max |dPi/dtheta|, N·mm")
       ->capture_default_str();

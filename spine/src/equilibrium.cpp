@@ -145,7 +145,8 @@ State evaluate(const SpineModel& m, const std::vector<ExternalLoad>& ext, const 
   const auto& P = s.poses;
   for (std::size_t k = 0; k < n; ++k) {
     Vector3d dE;
-    s.energy += joint_energy(m, m.joints[k], theta.segment<3>(3 * Eigen::Index(k)), dE);
+    s.energy += joint_energy(m, m.joints[k],
+                             theta.segment<3>(3 * Eigen::Index(k)) - m.joints[k].rest_rad, dE);
   }
   // Dead loads: Π = −f·(x − X).
   for (const auto& w : m.weights) {
@@ -262,7 +263,7 @@ VectorXd gradient_of(const SpineModel& m, const State& s, const VectorXd& theta)
     }
     const Vector3d th = theta.segment<3>(o);
     Vector3d dE;
-    joint_energy(m, m.joints[k], th, dE);
+    joint_energy(m, m.joints[k], th - m.joints[k].rest_rad, dE);
     // δx = (R_k J_r δθ) × (x − c_k) for every point above joint k.
     g.segment<3>(o) = dE - right_jacobian(th).transpose() * s.poses[k].R.transpose() * M[k];
   }
@@ -613,6 +614,8 @@ SpineSolution solve_spine(const SpineModel& m, const std::vector<ExternalLoad>& 
   if (o.posture.size() && (o.posture.size() != dof_count(m) || !o.posture.allFinite()))
     throw std::invalid_argument("solve_spine: the posture needs " + std::to_string(dof_count(m)) +
                                 " finite joint coordinates");
+  // Without a posture asked for, the model's own rest posture (a scoliotic curve) or θ = 0.
+  const VectorXd& posture = o.posture.size() ? o.posture : m.rest_posture;
   Timer timer;
 
   VectorXd F;  // recruited muscle forces (empty: muscles off)
@@ -621,7 +624,7 @@ SpineSolution solve_spine(const SpineModel& m, const std::vector<ExternalLoad>& 
     VectorXd b;
     std::vector<int> joints;
     recruitment_problem(
-        m, loads, arm, b, joints, o.posture,
+        m, loads, arm, b, joints, posture,
         o.recruitment_contact_forces.empty() ? nullptr : &o.recruitment_contact_forces);
     out.recruitment = recruit(m, arm, b, o.recruitment);
     if (!out.recruitment.success)
@@ -637,10 +640,10 @@ SpineSolution solve_spine(const SpineModel& m, const std::vector<ExternalLoad>& 
   const SpineModel* model = &m;
   SpineModel posed;
   VectorXd start = VectorXd::Zero(dof_count(m));
-  if (o.posture.size()) {
-    start = o.posture;
+  if (posture.size()) {
+    start = posture;
     posed = m;
-    const std::vector<Pose> P = vertebra_poses(m, o.posture);
+    const std::vector<Pose> P = vertebra_poses(m, posture);
     for (Muscle& mu : posed.muscles)
       mu.rest_length_mm = (place(P, mu.body_a, mu.a_mm) - place(P, mu.body_b, mu.b_mm)).norm();
     model = &posed;

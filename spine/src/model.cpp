@@ -1,6 +1,8 @@
 // Builds the spine model from data/ (spine/README.md): no number of the model is in this file.
 #include "spinesim/spine/model.hpp"
+#include "spinesim/spine/kinematics.hpp"
 #include "spinesim/spine/rib_cage.hpp"
+#include "spinesim/spine/scoliosis.hpp"
 #include "spinesim/common/constants.hpp"
 
 #include "spinesim/common/csv_table.hpp"
@@ -403,10 +405,30 @@ SpineModel load_spine_model(const std::string& data_dir, const ModelOptions& opt
     if (options.rib_cage)
       m.rib_cage =
           std::make_shared<const RibCage>(build_rib_cage(data_dir, m.vertebrae, m.scale.length));
+    if (options.scoliosis.cobb_deg != 0) rest_in_scoliosis(m, options);
   } catch (const nlohmann::json::exception& e) {
     throw std::runtime_error(config_file + ": " + e.what());
   }
   return m;
+}
+
+void rest_in_scoliosis(SpineModel& m, const ModelOptions& options) {
+  if (options.rib_cage)
+    throw std::invalid_argument(
+        "scoliosis: not with the rib cage (the ribs' scoliotic shape is not modelled)");
+  const ScoliosisPosture p = scoliotic_posture(m, options.scoliosis);
+  m.rest_posture = p.theta;
+  m.scoliosis = options.scoliosis;
+  for (std::size_t k = 0; k < m.joints.size(); ++k)
+    m.joints[k].rest_rad = p.theta.segment<3>(3 * Eigen::Index(k));
+  // The ligaments are slack-free and the IAP bushing rests in the curve, as the joints do.
+  const std::vector<Pose> P = vertebra_poses(m, p.theta);
+  for (Ligament& l : m.ligaments)
+    l.rest_length_mm = (place(P, l.body_a, l.a_mm) - place(P, l.body_b, l.b_mm)).norm();
+  if (m.has_bushing) {
+    m.bushing.rest_rotation = P[std::size_t(m.bushing.body)].R;
+    m.bushing.rest_translation_mm = P[std::size_t(m.bushing.body)].t;
+  }
 }
 
 namespace {

@@ -318,9 +318,10 @@ SeatedModel seat_model(const SpineModel& standing, const Chair& chair, const Sit
                     : (chair.backrest_height_mm > 0 ? parametric_backrest(chair) : nullptr);
   if (back)
     m.contact_surface = std::make_shared<PlacedSurface>(back, out.rotation, I, out.ischia_world_mm);
-  out.posture = VectorXd::Zero(dof_count(m));
+  // A scoliotic spine sits in its curve: the seated flexion adds to its rest posture.
+  out.posture = m.rest_posture.size() ? m.rest_posture : VectorXd::Zero(dof_count(m));
   for (std::size_t k = 0; k < m.joints.size(); ++k)
-    out.posture[3 * Eigen::Index(k)] =
+    out.posture[3 * Eigen::Index(k)] +=
         sitter.lumbar_flexion_deg * kRadPerDeg * sitter.lumbar_share[k];
   // The IAP bushing stands for the abdomen's pressure, not for an elastic memory of standing:
   // seated, the abdomen settles into the sitting posture and the bushing rests there (stress-free

@@ -1,6 +1,7 @@
 #include "spinesim/studies/spine_solve.hpp"
 
 #include "spinesim/common/timer.hpp"
+#include "spinesim/spine/scoliosis.hpp"
 #include "spinesim/studies/spine_studies.hpp"
 #include "spinesim/studies/toolkit.hpp"
 
@@ -154,6 +155,27 @@ SpineSolveRun run_spine_solve(const std::string& data_dir, const SpineSolveReque
   return r;
 }
 
+nlohmann::json scoliosis_json(const spine::SpineModel& m) {
+  const spine::ScoliosisCurve& c = m.scoliosis;
+  if (c.cobb_deg == 0) return nullptr;
+  const spine::ScoliosisPosture p = spine::scoliotic_posture(m, c);
+  return {{"type", c.type},
+          {"cobb_deg", c.cobb_deg},
+          {"upper_end", c.upper_end},
+          {"apex", c.apex},
+          {"lower_end", c.lower_end},
+          {"apical_rotation_deg", c.apical_rotation_deg},
+          {"convex", c.convex_right ? "right" : "left"},
+          {"rest_posture",
+           {{"cobb_deg", p.cobb_deg},
+            {"apex_offset_mm", p.apex_offset_mm},
+            {"apical_rotation_deg", p.apical_rotation_deg},
+            {"t1_offset_mm", p.t1_offset_mm},
+            {"t1_tilt_deg", p.t1_tilt_deg},
+            {"largest_disc_closure", p.largest_share},
+            {"largest_disc_closure_joint", p.largest_share_joint}}}};
+}
+
 nlohmann::json spine_solve_json(const SpineSolveRun& r, const std::string& csv) {
   const spine::SpineSolution& s = r.solution;
   const spine::SolveOptions& options = r.request.solve;
@@ -170,6 +192,7 @@ nlohmann::json spine_solve_json(const SpineSolveRun& r, const std::string& csv) 
         {"gravity", model_options.gravity},
         {"ligaments", spine::ligaments_name(model_options.ligaments)},
         {"rib_cage", r.model.rib_cage != nullptr},
+        {"scoliosis", scoliosis_json(r.model)},
         {"criterion", polynomial(r) ? "polynomial" : "minmax"},
         {"power", options.recruitment.power},
         {"tolerance_nmm", options.tolerance},

@@ -56,6 +56,8 @@ struct Joint {
   Eigen::Matrix3d coupling = Eigen::Matrix3d::Zero();  ///< N·mm/rad, zero diagonal
   std::string stiffness_source = "thesis F.4";
   bool fused = false;  ///< fixed joint (spinal fusion): θ ≡ 0
+  /// The springs' stress-free rotation (rad): zero, or a scoliotic curve's wedged disc.
+  Eigen::Vector3d rest_rad = Eigen::Vector3d::Zero();
 };
 
 /// A straight line element between two bodies (attachment points in the reference posture).
@@ -152,6 +154,15 @@ struct Subject {
   Sex sex = Sex::Male;
 };
 
+/// A scoliotic curve (scoliosis.hpp): none while cobb_deg is 0.
+struct ScoliosisCurve {
+  std::string type = "custom";  ///< thoracic, thoracolumbar, lumbar (scoliosis_curve) or custom
+  double cobb_deg = 0;          ///< between the end vertebrae's outer endplates
+  std::string upper_end, apex, lower_end;  ///< vertebra names (T1 … L5)
+  double apical_rotation_deg = 0;  ///< the apex's axial turn toward the convexity, vs the ends
+  bool convex_right = true;        ///< the convexity on the body's right (−x)
+};
+
 /// `subject` with a zero height or mass replaced by the reference body's, checked against the
 /// range the scaling laws are applied to (std::invalid_argument, one line, when outside).
 Subject resolve_subject(const std::string& data_dir, Subject subject);
@@ -195,11 +206,21 @@ struct ModelOptions {
   /// model, whose thoracic spine is its F.4 joints alone).
   bool rib_cage = false;
   Subject subject;            ///< the body (default: the reference body)
+  /// A scoliotic spine: its joints rest in the curve's posture (scoliosis.hpp). Not with the
+  /// rib cage (its scoliotic shape is not modelled).
+  ScoliosisCurve scoliosis;
   /// A disc-joint stiffness file (`spinesim spine disc-joints`; data/spine/disc_joints/): each
   /// joint's spring becomes that level's disc 3×3 rotational stiffness about the joint point, in
   /// place of F.4. A preset name (file stem in data/spine/disc_joints/) or a path; empty: F.4.
   std::string disc_joints;
 };
+
+/// Makes `m` rest in the scoliotic curve options.scoliosis (scoliosis.hpp): the joints' springs,
+/// the ligaments' slack lengths and the IAP bushing are stress-free in its posture, and
+/// rest_posture is that posture. load_spine_model calls it; throws std::invalid_argument (one
+/// line) for a curve the model cannot pose or together with the rib cage.
+struct SpineModel;
+void rest_in_scoliosis(SpineModel& m, const ModelOptions& options);
 
 /// Does a model built with these options carry the F.6/F.7 ligaments? (Ligaments::Auto: only
 /// on disc joints.)
@@ -233,6 +254,10 @@ struct SpineModel {
   SegmentMassPercent segment_mass_percent;  ///< the subject's sex's
   /// The rib cage (rib_cage.hpp; ModelOptions::rib_cage), or none.
   std::shared_ptr<const RibCage> rib_cage;
+  /// The joints' stress-free posture (rad, 3 per joint; empty: θ = 0, the thesis's upright
+  /// spine): a scoliotic curve (ModelOptions::scoliosis). Recruitment and Newton start there.
+  Eigen::VectorXd rest_posture;
+  ScoliosisCurve scoliosis;  ///< the curve that made rest_posture (cobb_deg 0: none)
   Eigen::Vector3d chest_front_mm;  ///< for loads held "in front of the chest"
   int ribs_body = 5;               ///< T6
   std::string data_dir;

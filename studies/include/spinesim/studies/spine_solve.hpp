@@ -46,6 +46,10 @@ std::string spine_solve_csv(const spine::SpineSolution& s);
 
 /// A resolved subject (spine::resolve_subject) as JSON: height_m, body_mass_kg, sex.
 nlohmann::json subject_json(const spine::Subject& subject);
+
+/// The model's scoliotic curve and its measured rest posture (Cobb angle, apex offset, T1's
+/// balance, the largest disc closure); null for a straight spine.
+nlohmann::json scoliosis_json(const spine::SpineModel& model);
 /// "female, 1.600 m, 55.0 kg" for the tables' headers.
 std::string subject_text(const spine::Subject& subject);
 
