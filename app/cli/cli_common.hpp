@@ -99,6 +99,7 @@ void add_scene_flags(CLI::App* cmd, haptics::HapticSceneRequest& scene);
 struct HapticsRunFlags {
   studies::HapticsRunRequest request;
   std::string workspace_center, chair_file;
+  ScoliosisFlags scoliosis;
   bool no_realtime = false;
   bool no_floor = false;
   /// A run that misses more than this share of its deadlines ends with a warning (--strict: an

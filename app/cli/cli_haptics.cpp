@@ -230,6 +230,7 @@ void add_compliant_stage_flags(CLI::App* cmd, HapticsRunFlags& f) {
                   "--force-scale (default: the device's usable rotational stiffness; 0: off)");
   cmd->add_flag("--no-recruit{false}", f.request.spine_recruit,
                 "--spine multirate: passive spine solves (muscles off)");
+  add_scoliosis_options(cmd, f.scoliosis);
   cmd->add_flag("--rib-cage", f.request.scene.rib_cage,
                 "--scene spine: add the ribs and the sternum (drawn and touched); with --spine "
                 "they stiffen the thorax and move with it (--spine database: a database built "
@@ -323,6 +324,7 @@ void resolve_haptics_run_flags(HapticsRunFlags& f) {
     f.request.workspace_center_mm = Eigen::Vector3d(v[0], v[1], v[2]);
   }
   if (f.request.scene.testdata_dir.empty()) f.request.scene.testdata_dir = testdata_dir();
+  f.request.scene.scoliosis = scoliosis_of(f.scoliosis);
   if (!f.chair_file.empty()) {
     if (f.request.posture != "seated")
       throw std::invalid_argument("--chair is for --posture seated");

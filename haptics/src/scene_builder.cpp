@@ -8,6 +8,7 @@
 #include "spinesim/mesh/tube.hpp"
 #include "spinesim/mesh/vertebra_cache.hpp"
 #include "spinesim/mesh/vertebra_geometry.hpp"
+#include "spinesim/spine/kinematics.hpp"
 #include "spinesim/spine/model.hpp"
 #include "spinesim/spine/rib_cage.hpp"
 
@@ -15,6 +16,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <map>
 #include <set>
@@ -217,6 +219,25 @@ void add_rib_cage_bodies(HapticScene& out, const std::string& data_dir) {
   out.sources.push_back("generated");
 }
 
+std::string degrees(double x) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%g", x);
+  return b;
+}
+
+/// Each vertebra's pose in the scoliotic curve's rest posture, by name (empty: straight).
+std::map<std::string, spine::Pose> scoliotic_poses(const spine::ScoliosisCurve& curve,
+                                                   const std::string& data_dir) {
+  std::map<std::string, spine::Pose> out;
+  if (curve.cobb_deg == 0) return out;
+  spine::ModelOptions o;
+  o.scoliosis = curve;
+  const spine::SpineModel m = spine::load_spine_model(data_dir, o);
+  const std::vector<spine::Pose> P = spine::vertebra_poses(m, m.rest_posture);
+  for (std::size_t i = 0; i < P.size(); ++i) out[spine::vertebra_names()[i]] = P[i];
+  return out;
+}
+
 }  // namespace
 
 void check_scene_name(const std::string& scene) {
@@ -231,6 +252,8 @@ HapticScene build_haptic_scene(const HapticSceneRequest& r, const std::string& d
   check_scene_name(r.scene);
   if (r.rib_cage && r.scene != "spine")
     throw std::invalid_argument("--rib-cage is for --scene spine");
+  if (r.scoliosis.cobb_deg != 0 && r.scene != "spine")
+    throw std::invalid_argument("--scoliosis is for --scene spine");
   std::vector<std::string> level_bodies;
   if (r.scene == "disc") {
     mesh::disc_dimensions(r.level, data_dir);  // a known level
@@ -270,17 +293,22 @@ HapticScene build_haptic_scene(const HapticSceneRequest& r, const std::string& d
     const std::vector<std::string> names = r.scene == "spine"  ? mesh::scene_body_names()
                                            : r.scene == "disc" ? level_bodies
                                                                : std::vector<std::string>{"L3"};
+    const std::map<std::string, spine::Pose> curve = scoliotic_poses(r.scoliosis, data_dir);
+    auto add = [&](const std::string& name, const mesh::TriSurface& surface) {
+      const auto p = curve.find(name);
+      out.scene.add_body(name, p == curve.end() ? surface
+                                                : transformed(surface, p->second.R, p->second.t));
+    };
     for (std::size_t i = 0; i < names.size(); ++i) {
       const auto it = given.find(names[i]);
       if (it != given.end()) {
-        out.scene.add_body(names[i], it->second.first);
+        add(names[i], it->second.first);
         out.sources.push_back(it->second.second);
       } else {
         const auto v = mesh::parametric_vertebra(names[i], data_dir);
         bool hit = false;
         const std::string cache = r.cache_dir == "none" ? "" : r.cache_dir;
-        out.scene.add_body(names[i],
-                           mesh::cached_vertebra_surface(v, r.triangles, cache, &hit).surface);
+        add(names[i], mesh::cached_vertebra_surface(v, r.triangles, cache, &hit).surface);
         out.sources.push_back("generated");
         out.cached += hit;
       }
@@ -293,7 +321,10 @@ HapticScene build_haptic_scene(const HapticSceneRequest& r, const std::string& d
     out.description = r.scene == "spine"
                           ? "the spine T1-L5 + sacrum (" + what + ")" +
                                 (r.rib_cage ? " with the rib cage" : "") +
-                                " at the reference posture"
+                                (r.scoliosis.cobb_deg != 0
+                                     ? " in a " + degrees(r.scoliosis.cobb_deg) + " deg " +
+                                           r.scoliosis.type + " scoliosis"
+                                     : " at the reference posture")
                       : r.scene == "disc" ? "the " + r.level + " disc between " + names[0] +
                                                 " and " + names[1] + " (" + what + ")"
                                           : "L3 (" + what + ") at its reference posture";

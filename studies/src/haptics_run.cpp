@@ -312,12 +312,17 @@ CompliantSetup make_compliant_stage(const HapticsRunRequest& request, const std:
   CompliantSetup c;
   spine::ModelOptions options;
   options.rib_cage = request.scene.rib_cage;
+  options.scoliosis = request.scene.scoliosis;
   c.model = std::make_unique<spine::SpineModel>(spine::load_spine_model(data_dir, options));
   if (request.spine == "database") {
     const std::string path = request.database.empty()
                                  ? (fs::path(data_dir) / "spine" / "displacement_db.json").string()
                                  : request.database;
     c.database = std::make_unique<spine::DisplacementDatabase>(read_database(path));
+    if (request.scene.scoliosis.cobb_deg != 0)
+      throw std::invalid_argument(
+          "--spine database with --scoliosis: the database is the straight spine's (use --spine "
+          "multirate)");
     if (c.database->info.model.rib_cage != request.scene.rib_cage)
       throw std::invalid_argument(
           path + (request.scene.rib_cage ? " is a spine without a rib cage: build one with `spinesim "

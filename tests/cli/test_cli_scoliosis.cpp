@@ -51,3 +51,25 @@ TEST(ScoliosisSolve, BadCurvesAreRefused) {
   expect_refused(run_spinesim("spine solve --scoliosis thoracic --cobb 30 --convex up"),
                  "--convex");
 }
+
+// The haptic scene: the scoliotic spine is dragged on the multirate spine (its solves start from
+// the curve; a mild curve, because the scripted hand reaches for T1 where the straight spine has
+// it and a curve lowers T1 — by 6 mm at 30°); the displacement database is the straight spine's
+// and is refused with a curve.
+TEST(ScoliosisHaptics, TheCurvedSpineIsDraggedAndTheDatabaseRefused) {
+  const std::string script = std::string(SPINESIM_DATA_DIR) + "/haptics/drag_t1_lateral.csv";
+  const CliRun r = run_spinesim(
+      "haptics run --scene spine --triangles 1500 --spine multirate --scoliosis lumbar --cobb 15 "
+      "--script '" + script + "' --duration 2 --no-realtime --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const json j = json::parse(r.out);
+  EXPECT_NE(j["scene_description"].get<std::string>().find("scoliosis"), std::string::npos);
+  EXPECT_GT(j["compliant_stage"]["hooked_ticks"].get<int>(), 500);
+  EXPECT_GT(j["compliant_stage"]["worker_solves"].get<int>(), 2);
+  EXPECT_EQ(j["compliant_stage"]["worker_failures"].get<int>(), 0);
+  expect_refused(run_spinesim("haptics run --duration 1 --scene spine --spine database "
+                              "--scoliosis thoracic --cobb 30"),
+                 "straight spine");
+  expect_refused(run_spinesim("haptics run --duration 1 --scene plane --scoliosis thoracic --cobb 30"),
+                 "--scene spine");
+}

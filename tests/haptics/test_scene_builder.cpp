@@ -3,6 +3,7 @@
 // ArtiSynth vertebrae register to the model's lumbar frames (skipped without the test data).
 #include "spinesim/haptics/scene_builder.hpp"
 #include "spinesim/mesh/vertebra_geometry.hpp"
+#include "spinesim/spine/scoliosis.hpp"
 
 #include <gtest/gtest.h>
 
@@ -113,4 +114,38 @@ TEST(HapticScene, RealVertebraeRegisterToTheModelsLumbarFrames) {
   EXPECT_NEAR(reg.R(0, 0), 1.0, 1e-12);  // the lateral axis is kept
   // Without the test data folder, `real` is refused in one line.
   EXPECT_THROW(st::register_real_vertebrae("/nonexistent", kData), std::invalid_argument);
+}
+
+// A scoliotic scene: every vertebra moved by its rest-posture pose — the apex toward the convex
+// side by the posture's offset, its shape unchanged — and the sacrum left where it was; the rib
+// cage adds 25 closed bodies to the straight spine; neither is for another scene.
+TEST(HapticScene, AScoliosisPosesTheVertebraeAndTheRibCageAddsItsBodies) {
+  st::HapticSceneRequest r;
+  r.triangles = 400;
+  r.cache_dir = "none";
+  const auto straight = st::build_haptic_scene(r, kData);
+  r.scoliosis = spinesim::spine::scoliosis_curve("thoracic", 40);
+  const auto curved = st::build_haptic_scene(r, kData);
+  ASSERT_EQ(curved.scene.size(), straight.scene.size());
+  auto mean = [](const st::HapticScene& s, const std::string& name) -> Eigen::Vector3d {
+    return s.scene.body(s.scene.index(name)).tree.vertices().colwise().mean();
+  };
+  EXPECT_LT(mean(curved, "T8").x() - mean(straight, "T8").x(), -5);  // convex right: −x
+  EXPECT_LT((mean(curved, "S1") - mean(straight, "S1")).norm(), 1e-12);  // the sacrum
+  const auto& a = straight.scene.body(straight.scene.index("T8")).tree.vertices();
+  const auto& b = curved.scene.body(curved.scene.index("T8")).tree.vertices();
+  EXPECT_NEAR((a.row(0) - a.row(7)).norm(), (b.row(0) - b.row(7)).norm(), 1e-9);  // rigid
+  EXPECT_NE(curved.description.find("scoliosis"), std::string::npos);
+
+  r.scoliosis = {};
+  r.rib_cage = true;
+  const auto caged = st::build_haptic_scene(r, kData);
+  EXPECT_EQ(caged.scene.size(), straight.scene.size() + 25);
+  EXPECT_GE(caged.scene.index("sternum"), 0);
+  EXPECT_GE(caged.scene.index("L12"), 0);
+  r.scene = "plane";
+  EXPECT_THROW(st::build_haptic_scene(r, kData), std::invalid_argument);
+  r.rib_cage = false;
+  r.scoliosis = spinesim::spine::scoliosis_curve("lumbar", 20);
+  EXPECT_THROW(st::build_haptic_scene(r, kData), std::invalid_argument);
 }

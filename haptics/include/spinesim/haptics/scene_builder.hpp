@@ -32,6 +32,9 @@ struct HapticSceneRequest {
   /// spine: also the rib cage (spine/rib_cage.hpp), bodies R1, L1, …, R12, L12 and "sternum":
   /// tubes through each rib's points, with its cartilage to where that ends.
   bool rib_cage = false;
+  /// spine: a scoliotic spine (spine/scoliosis.hpp; cobb_deg 0: straight), its vertebrae placed
+  /// in the curve's rest posture (the sacrum stays).
+  spine::ScoliosisCurve scoliosis;
 };
 
 /// How the real vertebrae were registered: one rigid motion (a rotation about the lateral axis
