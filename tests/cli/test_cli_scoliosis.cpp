@@ -73,3 +73,15 @@ TEST(ScoliosisHaptics, TheCurvedSpineIsDraggedAndTheDatabaseRefused) {
   expect_refused(run_spinesim("haptics run --duration 1 --scene plane --scoliosis thoracic --cobb 30"),
                  "--scene spine");
 }
+
+TEST(ScoliosisStudyCli, TablesNameTheSourcesAndTheJsonHasEveryCurve) {
+  const CliRun r = run_spinesim("study scoliosis --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const char* s : {"Meir", "Modi", "concave (MPa)", "MATCH", "DIFFERS", "Body: male"})
+    EXPECT_NE(r.out.find(s), std::string::npos) << s;
+  const json& j = study("scoliosis");
+  ASSERT_EQ(j["cases"].size(), 9u);
+  for (const auto& c : j["cases"])
+    if (c["posed"].get<bool>()) EXPECT_FALSE(c["discs"].empty()) << c["type"];
+  expect_refused(run_spinesim("study scoliosis --height 3"), "height");
+}
