@@ -32,6 +32,7 @@ struct MeshArgs {
   mesh::StructuredDiscOptions structured_opt;
   double max_elements = mesh::MeshOptions().max_elements;
   std::vector<std::string> cgal_flags_given, structured_flags_given;  ///< filled after parsing
+  ScoliosisFlags scoliosis;  ///< a level of a scoliotic spine: the disc wedged as the curve has it
 };
 
 std::string joined(const std::vector<std::string>& names) {
@@ -99,6 +100,7 @@ void run_mesh_disc(const MeshArgs& a) {
   if (a.out.empty()) throw std::invalid_argument("--out: give the output VTU");
   rq.out = a.out;
   rq.medit = a.medit;
+  rq.scoliosis = scoliosis_of(a.scoliosis);
 
   // 2. The driver, then the report.
   Progress progress(mesh_disc_stages(rq), a.quiet || a.json);
@@ -237,6 +239,7 @@ void register_mesh(CLI::App& app) {
           "Structured: stretch each section to the outline's exact area (exact volume)")};
   disc->add_option("--out", a->out, "Output VTU file")->capture_default_str();
   disc->add_option("--medit", a->medit, "Also write a Medit .mesh file");
+  add_scoliosis_options(disc, a->scoliosis);
   add_output_flags(disc, a->json, a->quiet);
   disc->callback([a, cgal, structured] {
     a->cgal_flags_given.clear();

@@ -217,7 +217,8 @@ class PlaybackController final : public Controller {
     if (part.cells != g.cells.rows())
       part.surface = FieldSurface(g.cells), part.cells = g.cells.rows();
     body.name = "tetrahedra";
-    const std::string& name = fields_[std::size_t(field_)];
+    // A mesh without fields (`spinesim mesh disc --out`) is drawn in one colour.
+    const std::string name = fields_.empty() ? "" : fields_[std::size_t(field_)];
     Eigen::VectorXd values;
     double floor = 0.01;
     for (const auto& a : g.point_data)

@@ -2,6 +2,10 @@
 
 #include "spinesim/mesh/disc_geometry.hpp"
 
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+
 namespace spinesim::mesh {
 
 DiscFrame disc_level_frame(const std::string& level, const std::string& data_dir,
@@ -28,6 +32,22 @@ TetMesh mesh_structured_level(const std::string& level, const StructuredDiscOpti
                               const std::string& data_dir, DiscPlacement placement) {
   const auto dims = disc_dimensions(level, data_dir);
   return mesh_structured_disc(dims, options, disc_level_frame(dims.level, data_dir, placement));
+}
+
+void carry_between(TetMesh& m, const DiscFrame& frame, double height_mm, const RigidMotion& lower,
+                   const RigidMotion& upper) {
+  if (!(height_mm > 0)) throw std::invalid_argument("carry_between: the disc height must be > 0 mm");
+  const TetMesh before = m;
+  for (Eigen::Index i = 0; i < m.V.rows(); ++i) {
+    const Eigen::Vector3d x = before.V.row(i).transpose();
+    const double y = (frame.axes.transpose() * (x - frame.origin_mm)).y();
+    const double s = std::clamp((y + 0.5 * height_mm) / height_mm, 0.0, 1.0);
+    m.V.row(i) = ((1 - s) * lower.apply(x) + s * upper.apply(x)).transpose();
+  }
+  for (Eigen::Index t = 0; t < m.T.rows(); ++t)
+    if (!(tet_volume(m, t) > 0))
+      throw std::invalid_argument("carry_between: tet " + std::to_string(t) +
+                                  " inverts between the posed vertebrae");
 }
 
 }  // namespace spinesim::mesh

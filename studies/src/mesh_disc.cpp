@@ -4,6 +4,7 @@
 #include "spinesim/common/timer.hpp"
 #include "spinesim/mesh/disc_geometry.hpp"
 #include "spinesim/mesh/vertebra_disc.hpp"
+#include "spinesim/spine/kinematics.hpp"
 #include "spinesim/studies/mesh_report.hpp"
 #include "spinesim/studies/toolkit.hpp"
 
@@ -19,6 +20,8 @@ void check(const MeshDiscRequest& r) {
   if (from_vertebrae && (r.inferior.empty() || r.superior.empty()))
     throw std::invalid_argument("a disc between vertebrae needs both --inferior and --superior");
   if (r.structured) mesh::validate(r.structured_options);
+  if (r.scoliosis.cobb_deg != 0 && r.level.empty())
+    throw std::invalid_argument("--scoliosis is for a parametric --level");
   if (!r.out.empty()) require_output_folder(r.out, "--out");  // a device, FIFO or link: refused
   if (r.out.empty() && !r.medit.empty())
     throw std::invalid_argument("--medit is a copy of --out: give --out too");
@@ -79,9 +82,37 @@ double mesh_between_vertebrae(const MeshDiscRequest& r, const StageHooks& hooks,
   return info.volume_mm3;
 }
 
+/// The disc of `level` carried between its vertebrae in the curve's rest posture. The mesh comes
+/// in the spine placement; a local one is then expressed in the lower vertebra's frame.
+nlohmann::json carry_in_scoliosis(const MeshDiscRequest& r, const std::string& data_dir,
+                                  mesh::TetMesh& m) {
+  spine::ModelOptions o;
+  o.gravity = o.muscles = o.iap = false;
+  o.scoliosis = r.scoliosis;
+  const spine::SpineModel model = spine::load_spine_model(data_dir, o);
+  const std::size_t k = std::size_t(spine::joint_index(mesh::disc_dimensions(r.level, data_dir).level));
+  const std::vector<spine::Pose> P = spine::vertebra_poses(model, model.rest_posture);
+  auto motion = [](const spine::Pose& p) { return mesh::RigidMotion{p.R, p.t}; };
+  const mesh::RigidMotion upper = motion(P[k]),
+                          lower = k + 1 < P.size() ? motion(P[k + 1]) : mesh::RigidMotion();
+  const mesh::DiscFrame frame = mesh::disc_level_frame(r.level, data_dir);
+  mesh::carry_between(m, frame, mesh::disc_dimensions(r.level, data_dir).height_mm, lower, upper);
+  if (r.placement == mesh::DiscPlacement::local)
+    for (Eigen::Index i = 0; i < m.V.rows(); ++i) {
+      const Eigen::Vector3d x = lower.R.transpose() * (m.V.row(i).transpose() - lower.t);
+      m.V.row(i) = (frame.axes.transpose() * (x - frame.origin_mm)).transpose();
+    }
+  const Eigen::Vector3d rest = model.joints[k].rest_rad * 180 / M_PI;
+  return {{"type", r.scoliosis.type},
+          {"cobb_deg", r.scoliosis.cobb_deg},
+          {"apex", r.scoliosis.apex},
+          {"joint_rest_rotation_deg", {rest.x(), rest.y(), rest.z()}},
+          {"frontal_wedge_deg", rest.z()}};
+}
+
 /// A parametric level, CGAL or structured; returns the exact volume of the parametric disc.
-double mesh_level(const MeshDiscRequest& r, const std::string& data_dir, const StageHooks& hooks,
-                  MeshDiscResult& out) {
+double mesh_straight_level(const MeshDiscRequest& r, const std::string& data_dir,
+                           const StageHooks& hooks, MeshDiscResult& out) {
   const auto dims = mesh::disc_dimensions(r.level, data_dir);
   const Timer t;
   if (r.structured) {
@@ -89,17 +120,31 @@ double mesh_level(const MeshDiscRequest& r, const std::string& data_dir, const S
     hooks.begin_stage("meshing " + dims.level + " (structured, " + std::to_string(so.sectors) +
                       " sectors, " + std::to_string(so.rings) + " rings, " +
                       std::to_string(so.layers) + " layers)");
-    out.mesh = mesh::mesh_structured_level(dims.level, so, data_dir, r.placement);
+    out.mesh = mesh::mesh_structured_level(dims.level, so, data_dir,
+                                           r.scoliosis.cobb_deg != 0 ? mesh::DiscPlacement::spine
+                                                                     : r.placement);
   } else {
     hooks.begin_stage("meshing " + dims.level + " (cell size " +
                       std::to_string(r.cgal.cell_size_mm).substr(0, 4) + " mm)");
-    out.mesh = mesh::mesh_disc_level(dims.level, r.cgal, data_dir, r.placement);
+    out.mesh = mesh::mesh_disc_level(dims.level, r.cgal, data_dir,
+                                     r.scoliosis.cobb_deg != 0 ? mesh::DiscPlacement::spine
+                                                               : r.placement);
   }
   out.mesh_seconds = t.seconds();
   hooks.end_stage(std::to_string(out.mesh.num_tets()) + " tets");
   out.disc = {{"level", dims.level},
               {"placement", r.placement == mesh::DiscPlacement::spine ? "spine" : "local"}};
   return mesh::parametric_disc_volume(dims);
+}
+
+/// A parametric level, CGAL or structured; returns the exact volume of the parametric disc (−1
+/// when a scoliotic curve wedges it).
+double mesh_level(const MeshDiscRequest& r, const std::string& data_dir, const StageHooks& hooks,
+                  MeshDiscResult& out) {
+  const double volume = mesh_straight_level(r, data_dir, hooks, out);
+  if (r.scoliosis.cobb_deg == 0) return volume;
+  out.disc["scoliosis"] = carry_in_scoliosis(r, data_dir, out.mesh);
+  return -1;
 }
 
 }  // namespace

@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <cstdlib>
+#include <filesystem>
 #include <string>
 
 using nlohmann::json;
@@ -84,4 +86,28 @@ TEST(ScoliosisStudyCli, TablesNameTheSourcesAndTheJsonHasEveryCurve) {
   for (const auto& c : j["cases"])
     if (c["posed"].get<bool>()) EXPECT_FALSE(c["discs"].empty()) << c["type"];
   expect_refused(run_spinesim("study scoliosis --height 3"), "height");
+}
+
+// A disc of the curve meshed wedged between its posed vertebrae: its frontal wedge is the
+// joint's rest bend (toward the concavity: negative for a right-convex curve), its endplates
+// meet at an angle of that size, no tet inverts; the viewer draws the mesh (it has no fields).
+TEST(ScoliosisMesh, TheApicalDiscIsWedgedAsTheCurveHasIt) {
+  const std::string vtu = tmp("wedged_t7t8.vtu");
+  const CliRun r = run_spinesim("mesh disc --level T7-T8 --structured --placement local "
+                                "--scoliosis thoracic --cobb 40 --out '" + vtu + "' --json --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const json j = json::parse(r.out);
+  const double wedge = j["scoliosis"]["frontal_wedge_deg"].get<double>();
+  EXPECT_LT(wedge, -3);
+  EXPECT_GT(j["min_dihedral_deg"].get<double>(), 5);
+  expect_refused(run_spinesim("mesh disc --inferior a.stl --superior b.stl --scoliosis thoracic "
+                              "--cobb 30 --out '" + tmp("x.vtu") + "'"),
+                 "--level");
+  if (std::system("command -v xvfb-run >/dev/null 2>&1") != 0) GTEST_SKIP() << "no xvfb-run";
+  const std::string png = tmp("wedged.png");
+  const CliRun v = run_spinesim("view --play '" + vtu + "' --no-panel --width 320 --height 240 "
+                                "--frames 2 --screenshot '" + png + "'",
+                                "xvfb-run -a -s '-screen 0 640x480x24' ");
+  EXPECT_EQ(v.status, 0) << v.err;
+  EXPECT_TRUE(std::filesystem::exists(png));
 }

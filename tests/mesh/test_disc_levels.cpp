@@ -157,3 +157,56 @@ TEST(DiscLevels, ALevelMeshedInTheSpineIsTheUprightMeshInItsFrame) {
   EXPECT_TRUE(placed.frame.axes.isApprox(frame.axes));
   EXPECT_THROW(spinesim::mesh::disc_level_frame("T12-L2", kData), std::invalid_argument);
 }
+
+// A disc carried between two vertebrae: unchanged when neither moves; its lower endplate stays
+// and its upper one follows the upper vertebra rigidly; lifted by δ along its axis it is
+// stretched to (h + δ)/h of its volume exactly; wedged by 5° about its AP axis it keeps its
+// volume to second order and no tet inverts; a wedge that would invert tets is refused.
+TEST(DiscCarry, EndplatesFollowTheirVertebraeAndTheWallStretchesLinearly) {
+  using namespace spinesim::mesh;
+  StructuredDiscOptions so;
+  const auto d = disc_dimensions("T7-T8", kData);
+  const TetMesh straight = mesh_structured_level("T7-T8", so, kData, DiscPlacement::local);
+  const DiscFrame frame;  // local placement: the identity
+  const double h = d.height_mm, v0 = mesh_volume(straight);
+  auto endplate = [&](Eigen::Index i) {
+    const double y = straight.V(i, 1);
+    return std::abs(y + h / 2) < 1e-9 ? -1 : std::abs(y - h / 2) < 1e-9 ? 1 : 0;
+  };
+
+  TetMesh m = straight;
+  carry_between(m, frame, h, RigidMotion(), RigidMotion());
+  EXPECT_LT((m.V - straight.V).cwiseAbs().maxCoeff(), 1e-12);
+
+  RigidMotion lift;
+  lift.t = Eigen::Vector3d(0, 0.5, 0);
+  m = straight;
+  carry_between(m, frame, h, RigidMotion(), lift);
+  EXPECT_NEAR(mesh_volume(m), v0 * (h + 0.5) / h, 1e-9 * v0);
+
+  RigidMotion wedge;
+  wedge.R = Eigen::AngleAxisd(5 * M_PI / 180, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  wedge.t = Eigen::Vector3d(0, h / 2, 0) - wedge.R * Eigen::Vector3d(0, h / 2, 0);  // about the upper centre
+  m = straight;
+  carry_between(m, frame, h, RigidMotion(), wedge);
+  int lower = 0, upper = 0;
+  for (Eigen::Index i = 0; i < m.V.rows(); ++i) {
+    const Eigen::Vector3d x = straight.V.row(i).transpose(), y = m.V.row(i).transpose();
+    if (endplate(i) < 0) {
+      ++lower;
+      EXPECT_LT((y - x).norm(), 1e-12);
+    } else if (endplate(i) > 0) {
+      ++upper;
+      EXPECT_LT((y - wedge.apply(x)).norm(), 1e-12);
+    }
+  }
+  EXPECT_GT(lower, 20);
+  EXPECT_GT(upper, 20);
+  EXPECT_NEAR(mesh_volume(m), v0, 0.01 * v0);
+  for (Eigen::Index t = 0; t < m.T.rows(); ++t) ASSERT_GT(tet_volume(m, t), 0);
+
+  RigidMotion flip;
+  flip.R = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  m = straight;
+  EXPECT_THROW(carry_between(m, frame, h, RigidMotion(), flip), std::invalid_argument);
+}

@@ -28,6 +28,21 @@ TetMesh mesh_disc_level(const std::string& level, const MeshOptions& options,
 /// The same with default options and the cell size given, mm.
 TetMesh mesh_disc_level(const std::string& level, double cell_size_mm, const std::string& data_dir);
 
+/// A rigid motion x ↦ R x + t (mm).
+struct RigidMotion {
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d t = Eigen::Vector3d::Zero();
+  Eigen::Vector3d apply(const Eigen::Vector3d& x) const { return R * x + t; }
+};
+
+/// Carries a disc meshed at `frame` (its local y from −h/2 at the lower endplate to +h/2 at the
+/// upper one) along with its two vertebrae: each node moves to (1 − s)·lower(x) + s·upper(x), s
+/// its height fraction (local y + h/2)/h clamped to [0, 1]. The endplates move rigidly with their
+/// vertebrae and the wall follows linearly: for two vertebrae of a scoliotic curve, the wedged
+/// and twisted disc between them. Throws std::invalid_argument (one line) if a tet would invert.
+void carry_between(TetMesh& m, const DiscFrame& frame, double height_mm, const RigidMotion& lower,
+                   const RigidMotion& upper);
+
 /// The structured disc of `level` (sectors × rings × layers).
 TetMesh mesh_structured_level(const std::string& level, const StructuredDiscOptions& options,
                               const std::string& data_dir,

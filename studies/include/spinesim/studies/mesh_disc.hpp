@@ -8,6 +8,7 @@
 #include "spinesim/mesh/mesher.hpp"
 #include "spinesim/mesh/quality.hpp"
 #include "spinesim/mesh/structured_disc.hpp"
+#include "spinesim/spine/model.hpp"
 #include "spinesim/studies/toolkit.hpp"
 
 #include <nlohmann/json.hpp>
@@ -25,6 +26,10 @@ struct MeshDiscRequest {
   bool structured = false;                                     ///< the structured sweep, not CGAL
   mesh::StructuredDiscOptions structured_options;
   mesh::MeshOptions cgal;
+  /// A parametric level of a scoliotic spine (cobb_deg 0: straight): the disc is carried between
+  /// its two vertebrae in the curve's rest posture (mesh::carry_between), wedged and twisted as
+  /// the curve has them; placed in the curved spine, or (local) in its lower vertebra's frame.
+  spine::ScoliosisCurve scoliosis;
   std::string out, medit;  ///< the VTU (empty: nothing written), and an optional Medit copy
 };
 
