@@ -100,6 +100,7 @@ struct HapticsRunFlags {
   studies::HapticsRunRequest request;
   std::string workspace_center, chair_file;
   ScoliosisFlags scoliosis;
+  SubjectFlags body;  ///< --body-height, --body-mass, --sex (view's --height is the window's)
   bool no_realtime = false;
   bool no_floor = false;
   /// A run that misses more than this share of its deadlines ends with a warning (--strict: an

@@ -231,6 +231,13 @@ void add_compliant_stage_flags(CLI::App* cmd, HapticsRunFlags& f) {
   cmd->add_flag("--no-recruit{false}", f.request.spine_recruit,
                 "--spine multirate: passive spine solves (muscles off)");
   add_scoliosis_options(cmd, f.scoliosis);
+  cmd->add_option("--body-height", f.body.height_m,
+                  "--scene spine: body height, m (default: the reference body, 1.778 m); the "
+                  "spine and its surfaces scale with it (spine/README.md)");
+  cmd->add_option("--body-mass", f.body.mass_kg, "--scene spine: body mass, kg (default 70)");
+  cmd->add_option("--sex", f.body.sex, "--scene spine: male or female")
+      ->check(CLI::IsMember({"male", "female"}))
+      ->capture_default_str();
   cmd->add_flag("--rib-cage", f.request.scene.rib_cage,
                 "--scene spine: add the ribs and the sternum (drawn and touched); with --spine "
                 "they stiffen the thorax and move with it (--spine database: a database built "
@@ -325,6 +332,10 @@ void resolve_haptics_run_flags(HapticsRunFlags& f) {
   }
   if (f.request.scene.testdata_dir.empty()) f.request.scene.testdata_dir = testdata_dir();
   f.request.scene.scoliosis = scoliosis_of(f.scoliosis);
+  f.request.scene.subject = subject_of(f.body);
+  if (f.body.given() && f.request.scene.scene != "spine")
+    throw std::invalid_argument("--body-height, --body-mass and --sex are for --scene spine");
+  if (f.body.given()) spine::resolve_subject(data_dir(), f.request.scene.subject);  // in range
   if (!f.chair_file.empty()) {
     if (f.request.posture != "seated")
       throw std::invalid_argument("--chair is for --posture seated");

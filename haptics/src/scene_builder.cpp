@@ -196,26 +196,32 @@ namespace {
 /// The ribs (with their cartilage) and the sternum as tubes at the reference posture. Cross
 /// sections: a rib's shaft about 12 × 6 mm, its cartilage 10 × 6 mm, the sternum 30 × 10 mm
 /// (drawn and touched; the cage's mechanics do not depend on them).
-void add_rib_cage_bodies(HapticScene& out, const std::string& data_dir) {
-  const spine::SpineModel model = spine::load_spine_model(data_dir);
-  const spine::RibCage cage = spine::build_rib_cage(data_dir, model.vertebrae);
+void add_rib_cage_bodies(HapticScene& out, const std::string& data_dir,
+                         const spine::Subject& subject) {
+  spine::ModelOptions body;
+  body.subject = subject;
+  body.rib_cage = true;
+  const spine::SpineModel model = spine::load_spine_model(data_dir, body);
+  const spine::RibCage& cage = *model.rib_cage;
   mesh::TubeOptions o;
   o.width_direction = Eigen::Vector3d::UnitY();  // a rib's broad faces look in and out
   for (const spine::Rib& rib : cage.ribs) {
     std::vector<Eigen::Vector3d> p{rib.head_mm, rib.tubercle_mm, rib.lateral_mm, rib.front_mm};
-    std::vector<double> w{5, 6, 6, 6}, d{3, 3, 3, 3};
+    const double s = model.scale.length;  // the sections scale with the body too
+    std::vector<double> w{5 * s, 6 * s, 6 * s, 6 * s}, d(4, 3 * s);
     if ((rib.cartilage_end_mm - rib.front_mm).norm() > 1) {
       p.push_back(rib.cartilage_end_mm);
-      w.push_back(5);
-      d.push_back(3);
+      w.push_back(5 * s);
+      d.push_back(3 * s);
     }
     out.scene.add_body(rib.name, mesh::tube_surface(p, w, d, o));
     out.sources.push_back("generated");
   }
   o.width_direction = Eigen::Vector3d::UnitX();
   o.sides = 16;
+  const double s = model.scale.length;
   out.scene.add_body("sternum", mesh::tube_surface({cage.sternum_top_mm, cage.sternum_bottom_mm},
-                                                   {18, 13}, {5, 5}, o));
+                                                   {18 * s, 13 * s}, {5 * s, 5 * s}, o));
   out.sources.push_back("generated");
 }
 
@@ -225,16 +231,37 @@ std::string degrees(double x) {
   return b;
 }
 
-/// Each vertebra's pose in the scoliotic curve's rest posture, by name (empty: straight).
-std::map<std::string, spine::Pose> scoliotic_poses(const spine::ScoliosisCurve& curve,
-                                                   const std::string& data_dir) {
-  std::map<std::string, spine::Pose> out;
-  if (curve.cobb_deg == 0) return out;
+/// Where each body of the spine goes, by name: the body's length scale s about the origin (the
+/// model's scaling, spine/README.md), then its pose in a scoliotic curve's rest posture
+/// (identity when straight, and for the sacrum).
+struct Placement {
+  double scale = 1;
+  std::map<std::string, spine::Pose> poses;
+  mesh::TriSurface place(const std::string& name, const mesh::TriSurface& s) const {
+    const auto p = poses.find(name);
+    const spine::Pose P = p == poses.end() ? spine::Pose() : p->second;
+    return transformed(s, scale * P.R, P.t);
+  }
+};
+
+spine::ModelOptions body_options(const HapticSceneRequest& r) {
   spine::ModelOptions o;
-  o.scoliosis = curve;
-  const spine::SpineModel m = spine::load_spine_model(data_dir, o);
+  o.gravity = o.muscles = false;
+  o.subject = r.subject;
+  o.scoliosis = r.scoliosis;
+  return o;
+}
+
+Placement placement(const HapticSceneRequest& r, const std::string& data_dir) {
+  Placement out;
+  if (r.scene != "spine" || (r.scoliosis.cobb_deg == 0 && r.subject.height_m == 0 &&
+                             r.subject.body_mass_kg == 0))
+    return out;
+  const spine::SpineModel m = spine::load_spine_model(data_dir, body_options(r));
+  out.scale = m.scale.length;
+  if (m.rest_posture.size() == 0) return out;
   const std::vector<spine::Pose> P = spine::vertebra_poses(m, m.rest_posture);
-  for (std::size_t i = 0; i < P.size(); ++i) out[spine::vertebra_names()[i]] = P[i];
+  for (std::size_t i = 0; i < P.size(); ++i) out.poses[spine::vertebra_names()[i]] = P[i];
   return out;
 }
 
@@ -254,6 +281,9 @@ HapticScene build_haptic_scene(const HapticSceneRequest& r, const std::string& d
     throw std::invalid_argument("--rib-cage is for --scene spine");
   if (r.scoliosis.cobb_deg != 0 && r.scene != "spine")
     throw std::invalid_argument("--scoliosis is for --scene spine");
+  if (r.scoliosis.cobb_deg != 0 && r.rib_cage)
+    throw std::invalid_argument(
+        "--scoliosis with --rib-cage: not modelled (the ribs' scoliotic shape is unknown)");
   std::vector<std::string> level_bodies;
   if (r.scene == "disc") {
     mesh::disc_dimensions(r.level, data_dir);  // a known level
@@ -293,11 +323,9 @@ HapticScene build_haptic_scene(const HapticSceneRequest& r, const std::string& d
     const std::vector<std::string> names = r.scene == "spine"  ? mesh::scene_body_names()
                                            : r.scene == "disc" ? level_bodies
                                                                : std::vector<std::string>{"L3"};
-    const std::map<std::string, spine::Pose> curve = scoliotic_poses(r.scoliosis, data_dir);
+    const Placement where = placement(r, data_dir);
     auto add = [&](const std::string& name, const mesh::TriSurface& surface) {
-      const auto p = curve.find(name);
-      out.scene.add_body(name, p == curve.end() ? surface
-                                                : transformed(surface, p->second.R, p->second.t));
+      out.scene.add_body(name, where.place(name, surface));
     };
     for (std::size_t i = 0; i < names.size(); ++i) {
       const auto it = given.find(names[i]);
@@ -317,10 +345,17 @@ HapticScene build_haptic_scene(const HapticSceneRequest& r, const std::string& d
     const std::string what = r.vertebrae == "generated" ? "parametric"
                              : r.vertebrae == "real" ? "real L1-S1 (ArtiSynth), parametric thoracic"
                                                      : "scene file + parametric";
-    if (r.rib_cage) add_rib_cage_bodies(out, data_dir);
+    if (r.rib_cage) add_rib_cage_bodies(out, data_dir, r.subject);
     out.description = r.scene == "spine"
                           ? "the spine T1-L5 + sacrum (" + what + ")" +
                                 (r.rib_cage ? " with the rib cage" : "") +
+                                (r.subject.height_m != 0 || r.subject.body_mass_kg != 0 ||
+                                         r.subject.sex != spine::Sex::Male
+                                     ? std::string(" of a ") + spine::sex_name(r.subject.sex) + " body" +
+                                           (r.subject.height_m != 0
+                                                ? " " + degrees(r.subject.height_m) + " m tall"
+                                                : std::string())
+                                     : std::string()) +
                                 (r.scoliosis.cobb_deg != 0
                                      ? " in a " + degrees(r.scoliosis.cobb_deg) + " deg " +
                                            r.scoliosis.type + " scoliosis"

@@ -2,6 +2,7 @@
 
 #include "spinesim/haptics/hostile.hpp"
 #include "spinesim/studies/spine_database.hpp"
+#include "spinesim/studies/spine_solve.hpp"
 
 #include "spinesim/common/atomic_file.hpp"
 #include "spinesim/common/machine.hpp"
@@ -313,6 +314,7 @@ CompliantSetup make_compliant_stage(const HapticsRunRequest& request, const std:
   spine::ModelOptions options;
   options.rib_cage = request.scene.rib_cage;
   options.scoliosis = request.scene.scoliosis;
+  options.subject = request.scene.subject;
   c.model = std::make_unique<spine::SpineModel>(spine::load_spine_model(data_dir, options));
   if (request.spine == "database") {
     const std::string path = request.database.empty()
@@ -323,6 +325,13 @@ CompliantSetup make_compliant_stage(const HapticsRunRequest& request, const std:
       throw std::invalid_argument(
           "--spine database with --scoliosis: the database is the straight spine's (use --spine "
           "multirate)");
+    const spine::Subject asked = spine::resolve_subject(data_dir, request.scene.subject),
+                         built = spine::resolve_subject(data_dir, c.database->info.model.subject);
+    if (asked.height_m != built.height_m || asked.body_mass_kg != built.body_mass_kg ||
+        asked.sex != built.sex)
+      throw std::invalid_argument(path + " is the spine of a " + subject_text(built) +
+                                  " body, not of the " + subject_text(asked) +
+                                  " one asked for (use --spine multirate)");
     if (c.database->info.model.rib_cage != request.scene.rib_cage)
       throw std::invalid_argument(
           path + (request.scene.rib_cage ? " is a spine without a rib cage: build one with `spinesim "

@@ -143,9 +143,30 @@ TEST(HapticScene, AScoliosisPosesTheVertebraeAndTheRibCageAddsItsBodies) {
   EXPECT_EQ(caged.scene.size(), straight.scene.size() + 25);
   EXPECT_GE(caged.scene.index("sternum"), 0);
   EXPECT_GE(caged.scene.index("L12"), 0);
+  r.scoliosis = spinesim::spine::scoliosis_curve("thoracic", 30);  // with the cage: refused
+  EXPECT_THROW(st::build_haptic_scene(r, kData), std::invalid_argument);
+  r.scoliosis = {};
   r.scene = "plane";
   EXPECT_THROW(st::build_haptic_scene(r, kData), std::invalid_argument);
   r.rib_cage = false;
   r.scoliosis = spinesim::spine::scoliosis_curve("lumbar", 20);
   EXPECT_THROW(st::build_haptic_scene(r, kData), std::invalid_argument);
+}
+
+// A smaller body's scene is the reference scene scaled by its length ratio about the origin,
+// as the model's positions are (spine/README.md).
+TEST(HapticScene, AScaledBodysSurfacesScaleWithItsLengths) {
+  st::HapticSceneRequest r;
+  r.triangles = 400;
+  r.cache_dir = "none";
+  const auto reference = st::build_haptic_scene(r, kData);
+  r.subject.height_m = 1.6;
+  const auto small = st::build_haptic_scene(r, kData);
+  const double s = 1.6 / 1.778;
+  for (const char* name : {"T1", "T8", "L5", "S1"}) {
+    const auto& a = reference.scene.body(reference.scene.index(name)).tree.vertices();
+    const auto& b = small.scene.body(small.scene.index(name)).tree.vertices();
+    EXPECT_LT((b - s * a).cwiseAbs().maxCoeff(), 1e-9) << name;
+  }
+  EXPECT_NE(small.description.find("1.6 m tall"), std::string::npos) << small.description;
 }

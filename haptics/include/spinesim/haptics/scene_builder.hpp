@@ -35,6 +35,8 @@ struct HapticSceneRequest {
   /// spine: a scoliotic spine (spine/scoliosis.hpp; cobb_deg 0: straight), its vertebrae placed
   /// in the curve's rest posture (the sacrum stays).
   spine::ScoliosisCurve scoliosis;
+  /// spine: the body (zeros: the reference body); every surface is scaled with its lengths.
+  spine::Subject subject;
 };
 
 /// How the real vertebrae were registered: one rigid motion (a rotation about the lateral axis
