@@ -2,6 +2,7 @@
 #include "bindings.hpp"
 
 #include "spinesim/spine/model.hpp"
+#include "spinesim/spine/scoliosis.hpp"
 #include "spinesim/studies/seating_study.hpp"
 #include "spinesim/studies/spine_solve.hpp"
 
@@ -21,7 +22,44 @@ struct Body {
   double height_m = 0, body_mass_kg = 0;
   std::string sex = "male";
   bool rib_cage = false;
+  spine::ScoliosisCurve scoliosis;  ///< cobb_deg 0: straight
 };
+
+/// A curve from Python's scoliosis dict (empty: straight): type and cobb_deg, optionally apex,
+/// curve_ends (upper, lower), apical_rotation_deg and convex ("right" or "left").
+spine::ScoliosisCurve curve_of(const py::dict& d) {
+  if (d.empty()) return {};
+  for (const auto& [key, value] : d) {
+    const std::string k = py::str(key);
+    if (k != "type" && k != "cobb_deg" && k != "apex" && k != "curve_ends" &&
+        k != "apical_rotation_deg" && k != "convex")
+      throw std::invalid_argument("scoliosis: unknown key '" + k +
+                                  "' (type, cobb_deg, apex, curve_ends, apical_rotation_deg, "
+                                  "convex)");
+  }
+  if (!d.contains("type") || !d.contains("cobb_deg"))
+    throw std::invalid_argument("scoliosis: give at least type and cobb_deg");
+  spine::ScoliosisCurve c =
+      spine::scoliosis_curve(d["type"].cast<std::string>(), d["cobb_deg"].cast<double>());
+  if (d.contains("apex")) c.apex = d["apex"].cast<std::string>();
+  if (d.contains("curve_ends")) {
+    const auto ends = d["curve_ends"].cast<std::pair<std::string, std::string>>();
+    c.upper_end = ends.first;
+    c.lower_end = ends.second;
+  }
+  if (d.contains("apical_rotation_deg"))
+    c.apical_rotation_deg = d["apical_rotation_deg"].cast<double>();
+  if (d.contains("convex")) {
+    const std::string side = d["convex"].cast<std::string>();
+    if (side != "right" && side != "left")
+      throw std::invalid_argument("scoliosis: convex must be 'right' or 'left'");
+    c.convex_right = side == "right";
+  }
+  if (d.contains("apex") || d.contains("curve_ends") || d.contains("convex"))
+    c.type = "custom (" + c.type + ")";
+  spine::check_scoliosis_curve(c);
+  return c;
+}
 
 spine::ModelOptions model_options(const std::string& fusion, bool muscles, bool trunk_muscles,
                                   bool gravity, const std::string& disc_joints,
@@ -38,6 +76,7 @@ spine::ModelOptions model_options(const std::string& fusion, bool muscles, bool 
   o.gravity = gravity;
   o.disc_joints = disc_joints;
   o.rib_cage = body.rib_cage;
+  o.scoliosis = body.scoliosis;
   return o;
 }
 
@@ -45,7 +84,7 @@ py::object solve_spine(const VectorsByVertebra& forces, const VectorsByVertebra&
                        const std::string& fusion, bool muscles, bool trunk_muscles, bool gravity,
                        const std::string& disc_joints, const std::string& ligaments,
                        double height_m, double body_mass_kg, const std::string& sex,
-                       bool rib_cage) {
+                       bool rib_cage, const py::dict& scoliosis) {
   studies::SpineSolveRequest rq;
   for (const auto& [name, f] : forces) {
     spine::ExternalLoad l;
@@ -60,7 +99,7 @@ py::object solve_spine(const VectorsByVertebra& forces, const VectorsByVertebra&
     rq.loads.push_back(l);
   }
   rq.model = model_options(fusion, muscles, trunk_muscles, gravity, disc_joints, ligaments,
-                           {height_m, body_mass_kg, sex, rib_cage});
+                           {height_m, body_mass_kg, sex, rib_cage, curve_of(scoliosis)});
   rq.solve.recruit = muscles;
   nlohmann::json j;
   {
@@ -73,7 +112,8 @@ py::object solve_spine(const VectorsByVertebra& forces, const VectorsByVertebra&
 py::object seated(const std::map<std::string, double>& chair, bool armrests,
                   const std::string& chair_surface, const std::string& fusion,
                   const std::string& disc_joints, const std::string& ligaments, double height_m,
-                  double body_mass_kg, const std::string& sex, bool rib_cage) {
+                  double body_mass_kg, const std::string& sex, bool rib_cage,
+                  const py::dict& scoliosis) {
   studies::SeatingRequest rq;
   for (const auto& [name, value] : chair) rq = studies::with_parameter(rq, name, value);
   rq.chair.armrests = armrests;
@@ -82,7 +122,7 @@ py::object seated(const std::map<std::string, double>& chair, bool armrests,
     rq.chair.surface_name = chair_surface;
   }
   rq.model = model_options(fusion, true, true, true, disc_joints, ligaments,
-                           {height_m, body_mass_kg, sex, rib_cage});
+                           {height_m, body_mass_kg, sex, rib_cage, curve_of(scoliosis)});
   studies::check_seating_request(rq);
   nlohmann::json j;
   {

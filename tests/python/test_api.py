@@ -179,6 +179,21 @@ def test_the_rib_cage_equals_the_program_and_stiffens_the_thorax(program):
     assert 0 < thoracic_flexion(s) < thoracic_flexion(bare)
 
 
+def test_a_scoliotic_spine_equals_the_program(program):
+    curve = {"type": "thoracic", "cobb_deg": 40, "apical_rotation_deg": 15}
+    s = spinesim.spine(scoliosis=curve)
+    p = program("spine", "solve", "--scoliosis", "thoracic", "--cobb", 40, "--apical-rotation",
+                15, quiet=False)
+    assert s.options["scoliosis"]["rest_posture"]["cobb_deg"] == pytest.approx(40, abs=1e-6)
+    assert_json_close(s.joints, p["joints"], rtol=1e-9, atol=1e-6)
+    left = spinesim.spine(scoliosis=dict(curve, convex="left"), muscles=False, gravity=False)
+    assert left.options["scoliosis"]["convex"] == "left"
+    with pytest.raises(ValueError, match="closes its disc"):
+        spinesim.spine(scoliosis={"type": "lumbar", "cobb_deg": 100})
+    with pytest.raises(ValueError, match="unknown key"):
+        spinesim.spine(scoliosis={"type": "lumbar", "cobb_deg": 20, "cob": 3})
+
+
 def test_seated_spine(program):
     s = spinesim.seated_spine(backrest_recline=110, lumbar_support=20)
     p = program("study", "seating", "--backrest-recline", 110, "--lumbar-support", 20)

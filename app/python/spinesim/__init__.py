@@ -188,27 +188,32 @@ def calibrate(mesh, *, material="real-disc", train=("compression", "shear-ap", "
 
 def spine(*, forces=None, moments=None, fusion="", muscles=True, trunk_muscles=True,
           gravity=True, disc_joints="", ligaments="auto", height_m=0.0, body_mass_kg=0.0,
-          sex="male", rib_cage=False):
+          sex="male", rib_cage=False, scoliosis=None):
     """The standing thoracolumbar spine's equilibrium under gravity and dead loads: `forces`
     {"T7": [Fx, Fy, Fz]} in N at the vertebra's centre, `moments` {"L1": [Mx, My, Mz]} in N·mm;
     `fusion` such as "L3-L4-L5"; `disc_joints` a preset or file of disc joint stiffnesses;
     `ligaments` "auto" (only on disc joints: the thesis's F.4 springs include them), "on" or "off";
     the body `height_m`, `body_mass_kg`, `sex` ("male"/"female"; zeros: the reference 1.778 m,
     70 kg male) scales the spine (a height or body-mass index out of range raises ValueError);
-    `rib_cage` adds the ribs and sternum on the thoracic vertebrae (off: the thesis's spine).
+    `rib_cage` adds the ribs and sternum on the thoracic vertebrae (off: the thesis's spine);
+    `scoliosis` a dict {"type": "thoracic"|"thoracolumbar"|"lumbar", "cobb_deg": 40, optional
+    "apex", "curve_ends": ("T6", "T12"), "apical_rotation_deg", "convex": "right"|"left"} makes
+    the spine rest in that curve (spine/README.md; a curve it cannot pose raises ValueError).
     Returns the Result `spinesim spine solve --json` prints (vertebrae, joints, muscles,
     ligaments, bushing, warnings, units). Raises RuntimeError when it does not converge."""
     return _result(_spinesim._spine(dict(forces or {}), dict(moments or {}), fusion, muscles,
                                     trunk_muscles, gravity, disc_joints, ligaments,
-                                    float(height_m), float(body_mass_kg), sex, bool(rib_cage)))
+                                    float(height_m), float(body_mass_kg), sex, bool(rib_cage),
+                                    dict(scoliosis or {})))
 
 
 def seated_spine(*, armrests=False, chair_surface="", fusion="", disc_joints="", ligaments="auto",
-                 height_m=0.0, body_mass_kg=0.0, sex="male", rib_cage=False, **chair):
+                 height_m=0.0, body_mass_kg=0.0, sex="male", rib_cage=False, scoliosis=None,
+                 **chair):
     """The spine seated on a chair: keyword arguments from seating_parameters() (e.g.
     backrest_recline=110 (deg), lumbar_support=20 (mm), seat_angle, backrest_height,
     pelvic_tilt; hyphens or underscores), `armrests`, a backrest surface file `chair_surface`,
-    `ligaments`, `height_m`, `body_mass_kg`, `sex` and `rib_cage` as in spine().
+    `ligaments`, `height_m`, `body_mass_kg`, `sex`, `rib_cage` and `scoliosis` as in spine().
     Returns the Result `spinesim study seating --json` prints."""
     known = seating_parameters()
     values = {}
@@ -220,7 +225,7 @@ def seated_spine(*, armrests=False, chair_surface="", fusion="", disc_joints="",
         values[name] = float(value)
     return _result(_spinesim._seated_spine(values, armrests, chair_surface, fusion, disc_joints,
                                            ligaments, float(height_m), float(body_mass_kg), sex,
-                                           bool(rib_cage)))
+                                           bool(rib_cage), dict(scoliosis or {})))
 
 
 def run_study(path, *extra):
