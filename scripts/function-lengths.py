@@ -5,8 +5,9 @@
 
 A definition starts at a line indented 0 or 2 spaces that looks like `type name(` and whose
 statement (within 8 lines) opens a brace before a ';'; its length runs from that line to the
-matching closing brace (braces counted naively, which is enough for this code base: no braces
-in string literals across lines). build/ and .git/ are skipped. Exit 1 if any is too long.
+matching closing brace (braces counted outside one-line string and character literals and
+line comments, which is enough for this code base: no braces in literals that span lines).
+build/ and .git/ are skipped. Exit 1 if any is too long.
 """
 import os
 import re
@@ -14,6 +15,14 @@ import sys
 # Function lengths by brace matching: a definition starts at a line at indentation 0 or 2 that
 # looks like `type name(` and whose statement (up to 6 lines) ends in '{' rather than ';'.
 sig=re.compile(r'^(  )?(?!(if|for|while|switch|return|else|namespace|struct|class|enum|using|case|do)\b)[A-Za-z_][\w:<>,\*&\s]*?[\w:~\]]+\s*\(')
+literal=re.compile(r'"(?:[^"\\]|\\.)*"|\'(?:[^\'\\]|\\.)*\'|//.*$')
+
+
+def code_only(line):
+    """The line without its string and character literals and its // comment."""
+    return literal.sub('""', line)
+
+
 res=[]
 root_dir = sys.argv[1] if len(sys.argv) > 1 else "."
 for root,_,files in os.walk(root_dir):
@@ -34,7 +43,7 @@ for root,_,files in os.walk(root_dir):
                 if ok:
                     depth=0; k=j; started=False
                     while k<len(lines):
-                        for ch in lines[k]:
+                        for ch in code_only(lines[k]):
                             if ch=='{': depth+=1; started=True
                             elif ch=='}': depth-=1
                         if started and depth<=0: break

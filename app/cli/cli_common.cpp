@@ -61,7 +61,8 @@ void add_scoliosis_options(CLI::App* cmd, ScoliosisFlags& f) {
                   "A scoliotic spine resting in its curve: thoracic (T5-T11, apex T8, convex "
                   "right), thoracolumbar (T10-L2, apex T12, right) or lumbar (T12-L4, apex L2, "
                   "left); with --cobb (spine/README.md)");
-  cmd->add_option("--cobb", f.cobb_deg, "--scoliosis: the Cobb angle between the end vertebrae, deg");
+  cmd->add_option("--cobb", f.cobb_deg,
+                  "--scoliosis: the Cobb angle between the end vertebrae, deg");
   cmd->add_option("--apex", f.apex, "--scoliosis: the apical vertebra (default: the type's)");
   cmd->add_option("--curve-ends", f.ends,
                   "--scoliosis: the end vertebrae, upper,lower, e.g. T6,T12 (default: the type's)");

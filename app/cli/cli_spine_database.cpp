@@ -69,8 +69,8 @@ void validate(const DatabaseArgs& a) {
     throw std::invalid_argument("--superposition-on: no vertebra given");
   magnitudes(a);
   if (!a.fusion.empty()) sp::parse_fusion(a.fusion);
-  if (a.check && (!a.fusion.empty() || a.ligaments != DatabaseArgs().ligaments || a.rib_cage ||
-                  a.no_recruit))
+  if (a.check &&
+      (!a.fusion.empty() || a.ligaments != DatabaseArgs().ligaments || a.rib_cage || a.no_recruit))
     throw std::invalid_argument(
         "--check solves the file's own model: --fusion, --ligaments, --rib-cage and --no-recruit "
         "are for generating a file");

@@ -40,9 +40,9 @@
 #include "spinesim/studies/fem_reference.hpp"
 #include "spinesim/studies/materials_study.hpp"
 #include "spinesim/studies/mss_run.hpp"
-#include "spinesim/studies/spine_solve.hpp"
 #include "spinesim/studies/rib_cage_study.hpp"
 #include "spinesim/studies/scoliosis_study.hpp"
+#include "spinesim/studies/spine_solve.hpp"
 #include "spinesim/studies/spine_studies.hpp"
 
 #include "spinesim/fem/disc_fem.hpp"
@@ -391,8 +391,7 @@ void print_muscle_set(const SpineStudyArgs& a) {
                  "counts them twice)\n\n";
   if (!spine::has_ligaments(o) && !o.disc_joints.empty())
     std::cout << "Ligaments: none (--ligaments off) on the disc joints\n\n";
-  if (a.rib_cage)
-    std::cout << "Rib cage: on (--rib-cage; data/spine/rib_cage.json)\n\n";
+  if (a.rib_cage) std::cout << "Rib cage: on (--rib-cage; data/spine/rib_cage.json)\n\n";
   if (a.subject.given())
     std::cout << "Body: " << subject_text(spine::resolve_subject(data_dir(), o.subject))
               << " (--height/--mass/--sex; the reference body is male, 1.778 m, 70 kg)\n\n";
@@ -546,7 +545,8 @@ void register_rib_cage(CLI::App& study) {
       "The rib cage's stiffening of the thoracic spine beside cadaver tests that removed it");
   cmd->add_option("--moment", a->moment_nm, "Pure moment on T1, N·m (Liebsch et al. 2017: 2)")
       ->capture_default_str();
-  cmd->add_flag("--json", a->spine.json, "Print the JSON summary on stdout (instead of the tables)");
+  cmd->add_flag("--json", a->spine.json,
+                "Print the JSON summary on stdout (instead of the tables)");
   cmd->add_flag("--quiet", a->spine.quiet, "No progress on stderr");
   add_ligaments_option(cmd, a->spine.ligaments);
   add_subject_options(cmd, a->spine.subject);
@@ -580,9 +580,10 @@ void register_rib_cage(CLI::App& study) {
 
 void register_scoliosis(CLI::App& study) {
   auto a = std::make_shared<SpineStudyArgs>();
-  auto* cmd = study.add_subcommand(
-      "scoliosis", "Disc loads on the concave and convex sides of scoliotic spines beside "
-                   "published findings");
+  auto* cmd =
+      study.add_subcommand("scoliosis",
+                           "Disc loads on the concave and convex sides of scoliotic spines beside "
+                           "published findings");
   cmd->add_flag("--json", a->json, "Print the JSON summary on stdout (instead of the tables)");
   cmd->add_flag("--quiet", a->quiet, "No progress on stderr");
   add_ligaments_option(cmd, a->ligaments);

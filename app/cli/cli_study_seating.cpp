@@ -23,8 +23,7 @@ struct SeatingArgs {
   SeatingRequest request;
   double pelvic_tilt_deg = NAN;
   std::string chair_file, csv, out, parameter, values, ligaments = "auto";
-  bool json = false, quiet = false, markdown = false, no_trunk_muscles = false,
-       rib_cage = false;
+  bool json = false, quiet = false, markdown = false, no_trunk_muscles = false, rib_cage = false;
   SubjectFlags subject;
 };
 

@@ -83,8 +83,8 @@ spine::ModelOptions model_options(const std::string& fusion, bool muscles, bool 
 py::object solve_spine(const VectorsByVertebra& forces, const VectorsByVertebra& moments,
                        const std::string& fusion, bool muscles, bool trunk_muscles, bool gravity,
                        const std::string& disc_joints, const std::string& ligaments,
-                       double height_m, double body_mass_kg, const std::string& sex,
-                       bool rib_cage, const py::dict& scoliosis) {
+                       double height_m, double body_mass_kg, const std::string& sex, bool rib_cage,
+                       const py::dict& scoliosis) {
   studies::SpineSolveRequest rq;
   for (const auto& [name, f] : forces) {
     spine::ExternalLoad l;

@@ -254,8 +254,8 @@ spine::ModelOptions body_options(const HapticSceneRequest& r) {
 
 Placement placement(const HapticSceneRequest& r, const std::string& data_dir) {
   Placement out;
-  if (r.scene != "spine" || (r.scoliosis.cobb_deg == 0 && r.subject.height_m == 0 &&
-                             r.subject.body_mass_kg == 0))
+  if (r.scene != "spine" ||
+      (r.scoliosis.cobb_deg == 0 && r.subject.height_m == 0 && r.subject.body_mass_kg == 0))
     return out;
   const spine::SpineModel m = spine::load_spine_model(data_dir, body_options(r));
   out.scale = m.scale.length;
@@ -263,6 +263,21 @@ Placement placement(const HapticSceneRequest& r, const std::string& data_dir) {
   const std::vector<spine::Pose> P = spine::vertebra_poses(m, m.rest_posture);
   for (std::size_t i = 0; i < P.size(); ++i) out.poses[spine::vertebra_names()[i]] = P[i];
   return out;
+}
+
+/// "the spine T1-L5 + sacrum (WHAT) with the rib cage of a female body 1.6 m tall in a 30 deg
+/// thoracic scoliosis", as much of it as the request asks for.
+std::string spine_description(const HapticSceneRequest& r, const std::string& what) {
+  std::string d = "the spine T1-L5 + sacrum (" + what + ")";
+  if (r.rib_cage) d += " with the rib cage";
+  const spine::Subject& b = r.subject;
+  if (b.height_m != 0 || b.body_mass_kg != 0 || b.sex != spine::Sex::Male) {
+    d += std::string(" of a ") + spine::sex_name(b.sex) + " body";
+    if (b.height_m != 0) d += " " + degrees(b.height_m) + " m tall";
+  }
+  return d + (r.scoliosis.cobb_deg != 0 ? " in a " + degrees(r.scoliosis.cobb_deg) + " deg " +
+                                              r.scoliosis.type + " scoliosis"
+                                        : " at the reference posture");
 }
 
 }  // namespace
@@ -346,20 +361,7 @@ HapticScene build_haptic_scene(const HapticSceneRequest& r, const std::string& d
                              : r.vertebrae == "real" ? "real L1-S1 (ArtiSynth), parametric thoracic"
                                                      : "scene file + parametric";
     if (r.rib_cage) add_rib_cage_bodies(out, data_dir, r.subject);
-    out.description = r.scene == "spine"
-                          ? "the spine T1-L5 + sacrum (" + what + ")" +
-                                (r.rib_cage ? " with the rib cage" : "") +
-                                (r.subject.height_m != 0 || r.subject.body_mass_kg != 0 ||
-                                         r.subject.sex != spine::Sex::Male
-                                     ? std::string(" of a ") + spine::sex_name(r.subject.sex) + " body" +
-                                           (r.subject.height_m != 0
-                                                ? " " + degrees(r.subject.height_m) + " m tall"
-                                                : std::string())
-                                     : std::string()) +
-                                (r.scoliosis.cobb_deg != 0
-                                     ? " in a " + degrees(r.scoliosis.cobb_deg) + " deg " +
-                                           r.scoliosis.type + " scoliosis"
-                                     : " at the reference posture")
+    out.description = r.scene == "spine"  ? spine_description(r, what)
                       : r.scene == "disc" ? "the " + r.level + " disc between " + names[0] +
                                                 " and " + names[1] + " (" + what + ")"
                                           : "L3 (" + what + ") at its reference posture";

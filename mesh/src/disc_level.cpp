@@ -36,7 +36,8 @@ TetMesh mesh_structured_level(const std::string& level, const StructuredDiscOpti
 
 void carry_between(TetMesh& m, const DiscFrame& frame, double height_mm, const RigidMotion& lower,
                    const RigidMotion& upper) {
-  if (!(height_mm > 0)) throw std::invalid_argument("carry_between: the disc height must be > 0 mm");
+  if (!(height_mm > 0))
+    throw std::invalid_argument("carry_between: the disc height must be > 0 mm");
   const TetMesh before = m;
   for (Eigen::Index i = 0; i < m.V.rows(); ++i) {
     const Eigen::Vector3d x = before.V.row(i).transpose();

@@ -18,7 +18,8 @@ void check_tube(const std::vector<Vector3d>& p, const std::vector<double>& w,
   if (w.size() != p.size() || d.size() != p.size())
     throw std::invalid_argument("tube: one width and one depth per point");
   for (std::size_t i = 0; i < p.size(); ++i) {
-    if (!p[i].allFinite()) throw std::invalid_argument("tube: point " + std::to_string(i) + " is not finite");
+    if (!p[i].allFinite())
+      throw std::invalid_argument("tube: point " + std::to_string(i) + " is not finite");
     if (!(w[i] > 0) || !(d[i] > 0) || !std::isfinite(w[i]) || !std::isfinite(d[i]))
       throw std::invalid_argument("tube: the half-axes must be > 0 mm");
     if (i > 0 && (p[i] - p[i - 1]).norm() < 1e-6)
@@ -104,7 +105,7 @@ TriSurface tube_surface(const std::vector<Vector3d>& points, const std::vector<d
       s.F.row(f++) << at(k, j + 1), at(k + 1, j + 1), at(k + 1, j);
     }
   for (int j = 0; j < m; ++j) {
-    s.F.row(f++) << start, at(0, j + 1), at(0, j);            // faces −t
+    s.F.row(f++) << start, at(0, j + 1), at(0, j);          // faces −t
     s.F.row(f++) << end, at(nr - 1, j), at(nr - 1, j + 1);  // faces +t
   }
   return s;

@@ -2,8 +2,8 @@
 // coordinates, its analytic gradient by accumulating every element's force on the vertebrae
 // above each joint, and a modified Newton method with a finite-difference Hessian.
 #include "spinesim/spine/equilibrium.hpp"
-#include "spinesim/spine/rib_cage.hpp"
 #include "spinesim/common/constants.hpp"
+#include "spinesim/spine/rib_cage.hpp"
 
 #include "spinesim/common/timer.hpp"
 

@@ -49,7 +49,8 @@ Vector3d point(const json& j, const std::string& what, const std::string& file) 
 class Network {
  public:
   explicit Network(std::vector<Vector3d> centres)
-      : c_(std::move(centres)), K_(MatrixXd::Zero(6 * Eigen::Index(c_.size()), 6 * Eigen::Index(c_.size()))) {}
+      : c_(std::move(centres)),
+        K_(MatrixXd::Zero(6 * Eigen::Index(c_.size()), 6 * Eigen::Index(c_.size()))) {}
 
   /// A translational spring k (N/mm, isotropic) joining bodies a and b at X.
   void point_spring(int a, int b, const Vector3d& X, double k) {
@@ -79,7 +80,8 @@ class Network {
   MatrixXd K_;
 };
 
-/// The condensed stiffness and the recovery matrix for the cage's springs with `parts`. Bodies: the 12 vertebrae, then the ribs, then the sternum.
+/// The condensed stiffness and the recovery matrix for the cage's springs with `parts`. Bodies:
+/// the 12 vertebrae, then the ribs, then the sternum.
 void condense(RibCage& cage, const std::vector<Vertebra>& vertebrae, const RibCageParts& parts) {
   const int nv = int(cage.vertebrae.size()), nr = int(cage.ribs.size());
   std::vector<Vector3d> centres;
@@ -120,10 +122,9 @@ void condense(RibCage& cage, const std::vector<Vertebra>& vertebrae, const RibCa
   cage.stiffness = 0.5 * (cage.stiffness + cage.stiffness.transpose()).eval();
 }
 
-/// Each thoracic vertebra's small motion relative to T6: the translation of its centre and its
-/// rotation vector, in T6's reference frame.
-/// u = (p, φ) per thoracic vertebra in T6's frame; `pose_at(i)` is the pose of cage.vertebrae[i]
-/// and P0 T6's. No allocation.
+/// Each thoracic vertebra's small motion relative to T6, u = (p, φ): the translation of its
+/// centre and its rotation vector, in T6's reference frame. `pose_at(i)` is the pose of
+/// cage.vertebrae[i] and P0 T6's. No allocation.
 template <class PoseAt>
 void relative_motion_into(const RibCage& cage, const std::vector<Vertebra>& vertebrae,
                           const Pose& P0, PoseAt pose_at, Eigen::VectorXd& u) {

@@ -30,7 +30,8 @@ std::string fixed1(double x) {
 double sine_weight(int k, double from, double peak, double to) {
   const double p = k + 0.5;
   if (p <= from || p >= to) return 0;
-  const double s = p <= peak ? 0.5 * (p - from) / (peak - from) : 0.5 + 0.5 * (p - peak) / (to - peak);
+  const double s =
+      p <= peak ? 0.5 * (p - from) / (peak - from) : 0.5 + 0.5 * (p - peak) / (to - peak);
   return std::sin(M_PI * s);
 }
 
@@ -71,7 +72,6 @@ VectorXd posture(const Shapes& s, double side, double bend, double above, double
   }
   return theta;
 }
-
 
 /// T1's residual: its frontal tilt (rad) and its lateral offset from the sacrum's vertical (in
 /// units of 100 mm).
@@ -172,8 +172,8 @@ ScoliosisPosture scoliotic_posture(const SpineModel& m, const ScoliosisCurve& c)
     }
     theta = posture(s, side, bend, above, below, turn);
     const std::vector<Pose> P = vertebra_poses(m, theta);
-    const double measured = std::abs(frontal_tilt_deg(P[std::size_t(u)].R) -
-                                     frontal_tilt_deg(P[std::size_t(l)].R));
+    const double measured =
+        std::abs(frontal_tilt_deg(P[std::size_t(u)].R) - frontal_tilt_deg(P[std::size_t(l)].R));
     if (std::abs(measured - c.cobb_deg) < 1e-9 * c.cobb_deg) break;
     bend *= c.cobb_deg / measured;
   }
@@ -183,7 +183,9 @@ ScoliosisPosture scoliotic_posture(const SpineModel& m, const ScoliosisCurve& c)
   const std::vector<Pose> P = vertebra_poses(m, theta);
   out.cobb_deg =
       std::abs(frontal_tilt_deg(P[std::size_t(u)].R) - frontal_tilt_deg(P[std::size_t(l)].R));
-  auto centre = [&](int v) { return P[std::size_t(v)].apply(m.vertebrae[std::size_t(v)].centre_mm); };
+  auto centre = [&](int v) {
+    return P[std::size_t(v)].apply(m.vertebrae[std::size_t(v)].centre_mm);
+  };
   const Vector3d cu = centre(u), cl = centre(l), ca = centre(a);
   const double f = (ca.y() - cl.y()) / (cu.y() - cl.y());
   out.apex_offset_mm = ca.x() - (cl.x() + f * (cu.x() - cl.x()));

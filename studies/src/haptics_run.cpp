@@ -333,10 +333,11 @@ CompliantSetup make_compliant_stage(const HapticsRunRequest& request, const std:
                                   " body, not of the " + subject_text(asked) +
                                   " one asked for (use --spine multirate)");
     if (c.database->info.model.rib_cage != request.scene.rib_cage)
-      throw std::invalid_argument(
-          path + (request.scene.rib_cage ? " is a spine without a rib cage: build one with `spinesim "
-                                     "spine database --rib-cage`"
-                                   : " is the rib-caged spine's: add --rib-cage"));
+      throw std::invalid_argument(path +
+                                  (request.scene.rib_cage
+                                       ? " is a spine without a rib cage: build one with `spinesim "
+                                         "spine database --rib-cage`"
+                                       : " is the rib-caged spine's: add --rib-cage"));
     c.response = std::make_unique<haptics::DatabaseResponse>(*c.database);
   } else {
     haptics::MultirateOptions o;

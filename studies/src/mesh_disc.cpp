@@ -90,7 +90,8 @@ nlohmann::json carry_in_scoliosis(const MeshDiscRequest& r, const std::string& d
   o.gravity = o.muscles = o.iap = false;
   o.scoliosis = r.scoliosis;
   const spine::SpineModel model = spine::load_spine_model(data_dir, o);
-  const std::size_t k = std::size_t(spine::joint_index(mesh::disc_dimensions(r.level, data_dir).level));
+  const std::size_t k =
+      std::size_t(spine::joint_index(mesh::disc_dimensions(r.level, data_dir).level));
   const std::vector<spine::Pose> P = spine::vertebra_poses(model, model.rest_posture);
   auto motion = [](const spine::Pose& p) { return mesh::RigidMotion{p.R, p.t}; };
   const mesh::RigidMotion upper = motion(P[k]),
@@ -120,15 +121,15 @@ double mesh_straight_level(const MeshDiscRequest& r, const std::string& data_dir
     hooks.begin_stage("meshing " + dims.level + " (structured, " + std::to_string(so.sectors) +
                       " sectors, " + std::to_string(so.rings) + " rings, " +
                       std::to_string(so.layers) + " layers)");
-    out.mesh = mesh::mesh_structured_level(dims.level, so, data_dir,
-                                           r.scoliosis.cobb_deg != 0 ? mesh::DiscPlacement::spine
-                                                                     : r.placement);
+    out.mesh = mesh::mesh_structured_level(
+        dims.level, so, data_dir,
+        r.scoliosis.cobb_deg != 0 ? mesh::DiscPlacement::spine : r.placement);
   } else {
     hooks.begin_stage("meshing " + dims.level + " (cell size " +
                       std::to_string(r.cgal.cell_size_mm).substr(0, 4) + " mm)");
-    out.mesh = mesh::mesh_disc_level(dims.level, r.cgal, data_dir,
-                                     r.scoliosis.cobb_deg != 0 ? mesh::DiscPlacement::spine
-                                                               : r.placement);
+    out.mesh =
+        mesh::mesh_disc_level(dims.level, r.cgal, data_dir,
+                              r.scoliosis.cobb_deg != 0 ? mesh::DiscPlacement::spine : r.placement);
   }
   out.mesh_seconds = t.seconds();
   hooks.end_stage(std::to_string(out.mesh.num_tets()) + " tets");

@@ -25,12 +25,15 @@ struct InVitro {
 };
 const InVitro kInVitro[] = {
     {"Liebsch et al. 2017", "6 specimens, ±2 N·m", "anterior rib cage", {52.2, 42.0, 94.4}},
-    {"Mannen et al. 2018", "8 specimens, ±5 N·m, 400 N follower load", "whole rib cage",
+    {"Mannen et al. 2018",
+     "8 specimens, ±5 N·m, 400 N follower load",
+     "whole rib cage",
      {63.0, 63.5, 58.8}},
 };
 
 /// The thoracic spine alone, T12 held: the in-vitro specimen.
-spine::SpineModel specimen(const std::string& data_dir, spine::ModelOptions o, const RibCageCase& c) {
+spine::SpineModel specimen(const std::string& data_dir, spine::ModelOptions o,
+                           const RibCageCase& c) {
   o.gravity = o.muscles = o.iap = o.trunk_muscles = false;
   o.rib_cage = c.cage;
   o.fused_joints.clear();
@@ -148,9 +151,8 @@ void print_rib_cage_study(std::ostream& os, const RibCageStudy& s, bool markdown
     t.add(row);
   }
   for (const auto& v : kInVitro) {
-    std::vector<std::string> row{std::string("in vitro: ") + v.study + ", " + v.removed +
-                                     " removed",
-                                 "", "", ""};
+    std::vector<std::string> row{
+        std::string("in vitro: ") + v.study + ", " + v.removed + " removed", "", "", ""};
     for (double g : v.growth_pct) row.push_back(fixed(g, 1) + " %");
     t.add(row);
   }
@@ -184,33 +186,32 @@ nlohmann::json rib_cage_study_json(const RibCageStudy& s) {
                      {"cartilage", c.cartilage},
                      {"cartilage_scale", c.cartilage_scale},
                      {"costovertebral_scale", c.costovertebral_scale},
-                     {"rom_deg", {{"flexion_extension", c.rom_deg[0]},
-                                  {"lateral_bending", c.rom_deg[1]},
-                                  {"axial_rotation", c.rom_deg[2]}}},
-                     {"growth_when_removed_pct", {{"flexion_extension", c.growth_pct[0]},
-                                                  {"lateral_bending", c.growth_pct[1]},
-                                                  {"axial_rotation", c.growth_pct[2]}}}});
+                     {"rom_deg",
+                      {{"flexion_extension", c.rom_deg[0]},
+                       {"lateral_bending", c.rom_deg[1]},
+                       {"axial_rotation", c.rom_deg[2]}}},
+                     {"growth_when_removed_pct",
+                      {{"flexion_extension", c.growth_pct[0]},
+                       {"lateral_bending", c.growth_pct[1]},
+                       {"axial_rotation", c.growth_pct[2]}}}});
   for (const auto& v : kInVitro)
     vitro.push_back({{"study", v.study},
                      {"conditions", v.conditions},
                      {"removed", v.removed},
-                     {"growth_when_removed_pct", {{"flexion_extension", v.growth_pct[0]},
-                                                  {"lateral_bending", v.growth_pct[1]},
-                                                  {"axial_rotation", v.growth_pct[2]}}}});
+                     {"growth_when_removed_pct",
+                      {{"flexion_extension", v.growth_pct[0]},
+                       {"lateral_bending", v.growth_pct[1]},
+                       {"axial_rotation", v.growth_pct[2]}}}});
   for (const auto& c : s.scenes)
-    scenes.push_back({{"scene", c.name},
-                      {"thoracic_flexion_deg", {{"without", c.thoracic_flexion_deg[0]},
-                                                {"with", c.thoracic_flexion_deg[1]}}},
-                      {"t1_translation_mm", {{"without", c.t1_translation_mm[0]},
-                                             {"with", c.t1_translation_mm[1]}}},
-                      {"l4l5_axial_n", {{"without", c.l4l5_axial_n[0]},
-                                        {"with", c.l4l5_axial_n[1]}}}});
-  return {{"study", "rib-cage"},
-          {"moment_nm", s.moment_nm},
-          {"subject", subject_json(s.subject)},
-          {"cases", cases},
-          {"in_vitro", vitro},
-          {"scenes", scenes},
+    scenes.push_back(
+        {{"scene", c.name},
+         {"thoracic_flexion_deg",
+          {{"without", c.thoracic_flexion_deg[0]}, {"with", c.thoracic_flexion_deg[1]}}},
+         {"t1_translation_mm",
+          {{"without", c.t1_translation_mm[0]}, {"with", c.t1_translation_mm[1]}}},
+         {"l4l5_axial_n", {{"without", c.l4l5_axial_n[0]}, {"with", c.l4l5_axial_n[1]}}}});
+  return {{"study", "rib-cage"}, {"moment_nm", s.moment_nm}, {"subject", subject_json(s.subject)},
+          {"cases", cases},      {"in_vitro", vitro},        {"scenes", scenes},
           {"seconds", s.seconds}};
 }
 

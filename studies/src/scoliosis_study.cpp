@@ -19,16 +19,14 @@ constexpr double kCobbs[] = {20, 40, 60};
 struct DiscSection {
   double width_mm = 0, depth_mm = 0;
 };
-std::vector<DiscSection> disc_sections(const std::string& data_dir,
-                                       const spine::SpineModel& m) {
+std::vector<DiscSection> disc_sections(const std::string& data_dir, const spine::SpineModel& m) {
   const CsvTable t = read_csv((std::filesystem::path(data_dir) / "disc_morphometry.csv").string());
   std::vector<DiscSection> out;
   for (const spine::Joint& j : m.joints) {
     const std::size_t r = t.find("level", j.name);
-    out.push_back({0.5 * (t.number(r, "lower_width_mm") + t.number(r, "upper_width_mm")) *
-                       m.scale.length,
-                   0.5 * (t.number(r, "lower_depth_mm") + t.number(r, "upper_depth_mm")) *
-                       m.scale.length});
+    out.push_back(
+        {0.5 * (t.number(r, "lower_width_mm") + t.number(r, "upper_width_mm")) * m.scale.length,
+         0.5 * (t.number(r, "lower_depth_mm") + t.number(r, "upper_depth_mm")) * m.scale.length});
   }
   return out;
 }
@@ -57,8 +55,9 @@ void run_case(const std::string& data_dir, spine::ModelOptions o, ScoliosisCase&
             l = spine::vertebra_index(c.curve.lower_end);
   double most = -1e300;
   for (int k = u; k < l; ++k) {
-    const DiscEdgeStress e = disc_edge_stress(s.joints[std::size_t(k)], sections[std::size_t(k)].width_mm,
-                                              sections[std::size_t(k)].depth_mm);
+    const DiscEdgeStress e =
+        disc_edge_stress(s.joints[std::size_t(k)], sections[std::size_t(k)].width_mm,
+                         sections[std::size_t(k)].depth_mm);
     ScoliosisDisc d;
     d.joint = s.joints[std::size_t(k)].joint;
     d.axial_n = s.joints[std::size_t(k)].disc_axial_n;
@@ -80,10 +79,10 @@ void run_case(const std::string& data_dir, spine::ModelOptions o, ScoliosisCase&
   const spine::SpineModel bare = spine::load_spine_model(data_dir, o);
   const spine::SpineSolution r = stand(bare, false);
   for (int k : {a - 1, a})
-    c.unloaded_apical_mpa += 0.5 * disc_edge_stress(r.joints[std::size_t(k)],
-                                                    sections[std::size_t(k)].width_mm,
-                                                    sections[std::size_t(k)].depth_mm)
-                                       .mean_mpa;
+    c.unloaded_apical_mpa +=
+        0.5 * disc_edge_stress(r.joints[std::size_t(k)], sections[std::size_t(k)].width_mm,
+                               sections[std::size_t(k)].depth_mm)
+                  .mean_mpa;
 }
 
 std::vector<ScoliosisFinding> findings(const std::vector<ScoliosisCase>& cases) {
@@ -157,8 +156,8 @@ void print_scoliosis_study(std::ostream& os, const ScoliosisStudy& s) {
   os << "Standing under gravity, muscles recruited; the two discs next to the apex, compressive "
         "stress at their\nconcave and convex lateral edges (N/A ± M c / I on the disc's elliptic "
         "section; MPa)\n\n";
-  TextTable t({"curve", "Cobb (deg)", "apex", "apex offset (mm)", "concave (MPa)",
-               "convex (MPa)", "most asymmetric disc", "unloaded (MPa)"},
+  TextTable t({"curve", "Cobb (deg)", "apex", "apex offset (mm)", "concave (MPa)", "convex (MPa)",
+               "most asymmetric disc", "unloaded (MPa)"},
               1);
   for (const auto& c : s.cases) {
     const std::string name = c.curve.type + (c.curve.convex_right ? " (right)" : " (left)");
@@ -172,10 +171,12 @@ void print_scoliosis_study(std::ostream& os, const ScoliosisStudy& s) {
   }
   t.print(os, false);
   for (const auto& c : s.cases)
-    if (!c.refusal.empty()) os << "\n  " << c.curve.type << " " << fixed(c.curve.cobb_deg, 0) << " deg: " << c.refusal;
+    if (!c.refusal.empty())
+      os << "\n  " << c.curve.type << " " << fixed(c.curve.cobb_deg, 0) << " deg: " << c.refusal;
   os << "\n\n";
   TextTable f({"source", "finding", "model", "verdict"}, 3);
-  for (const auto& x : s.findings) f.add({x.source, x.finding, x.model, x.match ? "MATCH" : "DIFFERS"});
+  for (const auto& x : s.findings)
+    f.add({x.source, x.finding, x.model, x.match ? "MATCH" : "DIFFERS"});
   f.print(os, false);
   os << "\n  The joint spring is the whole motion segment (facets and ligaments included); the "
         "edge stresses put\n  all of its moment on the disc. Body: "

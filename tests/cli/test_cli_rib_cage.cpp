@@ -57,13 +57,14 @@ TEST(RibCageStudy, GrowthIsTheRatioOfTheRangesOfMotion) {
 // Each part only adds stiffness: the ribs on their heads stiffen the bare spine, the cartilage
 // stiffens it further, and a stiffer cartilage or costovertebral joint never loosens it.
 TEST(RibCageStudy, StifferPartsNeverLoosenTheThorax) {
-  const char* const chain[][2] = {{"no cage", "ribs on their heads (no cartilage)"},
-                                  {"ribs on their heads (no cartilage)", "whole cage, cartilage x0.25"},
-                                  {"whole cage, cartilage x0.25", "whole cage"},
-                                  {"whole cage", "whole cage, cartilage x4"},
-                                  {"whole cage", "whole cage, costovertebral x4"},
-                                  {"whole cage, cartilage x4", "whole cage, both x4"},
-                                  {"whole cage, costovertebral x4", "whole cage, both x4"}};
+  const char* const chain[][2] = {
+      {"no cage", "ribs on their heads (no cartilage)"},
+      {"ribs on their heads (no cartilage)", "whole cage, cartilage x0.25"},
+      {"whole cage, cartilage x0.25", "whole cage"},
+      {"whole cage", "whole cage, cartilage x4"},
+      {"whole cage", "whole cage, costovertebral x4"},
+      {"whole cage, cartilage x4", "whole cage, both x4"},
+      {"whole cage, costovertebral x4", "whole cage, both x4"}};
   for (const auto& [looser, stiffer] : chain)
     for (const char* d : kDirections)
       EXPECT_LT(rom(rib_case(stiffer), d), rom(rib_case(looser), d))
@@ -73,7 +74,8 @@ TEST(RibCageStudy, StifferPartsNeverLoosenTheThorax) {
 // In the whole, loaded spine the cage bends the thorax less under gravity and a forward push.
 TEST(RibCageStudy, TheCageBendsTheLoadedThoraxLess) {
   for (const auto& sc : study("rib-cage")["scenes"]) {
-    const double without = sc["thoracic_flexion_deg"]["without"], with = sc["thoracic_flexion_deg"]["with"];
+    const double without = sc["thoracic_flexion_deg"]["without"],
+                 with = sc["thoracic_flexion_deg"]["with"];
     EXPECT_GT(without, 0) << sc["scene"];
     EXPECT_LT(with, without) << sc["scene"];
     EXPECT_GT(sc["l4l5_axial_n"]["with"].get<double>(), 0) << sc["scene"];
@@ -83,7 +85,8 @@ TEST(RibCageStudy, TheCageBendsTheLoadedThoraxLess) {
 TEST(RibCageStudy, TextNamesTheSourcesAndTheBody) {
   const CliRun r = run_spinesim("study rib-cage --quiet");
   ASSERT_EQ(r.status, 0) << r.err;
-  for (const char* s : {"Liebsch", "Mannen", "Lebschy", "whole cage", "T1-T12 flexion", "Body: male"})
+  for (const char* s :
+       {"Liebsch", "Mannen", "Lebschy", "whole cage", "T1-T12 flexion", "Body: male"})
     EXPECT_NE(r.out.find(s), std::string::npos) << s;
 }
 
@@ -122,7 +125,8 @@ TEST(RibCageHaptics, TheMultirateSpineCarriesTheCageAndTheDatabaseMustMatch) {
   EXPECT_GT(c["worker_solves"].get<int>(), 2);
   EXPECT_EQ(c["worker_failures"].get<int>(), 0);
 
-  expect_refused(run_spinesim("haptics run --duration 1 --scene plane --rib-cage"), "--scene spine");
+  expect_refused(run_spinesim("haptics run --duration 1 --scene plane --rib-cage"),
+                 "--scene spine");
   expect_refused(run_spinesim("haptics run --duration 1 --scene spine --spine database --rib-cage"),
                  "rib cage");
   expect_refused(run_spinesim("spine database --check --rib-cage"), "--check");

@@ -48,8 +48,7 @@ TEST(ScoliosisSolve, BadCurvesAreRefused) {
   expect_refused(run_spinesim("spine solve --scoliosis thoracic --cobb 30 --curve-ends T6"),
                  "upper,lower");
   expect_refused(run_spinesim("spine solve --scoliosis thoracic --cobb 30 --apex L3"), "apex");
-  expect_refused(run_spinesim("spine solve --scoliosis thoracic --cobb 30 --rib-cage"),
-                 "rib cage");
+  expect_refused(run_spinesim("spine solve --scoliosis thoracic --cobb 30 --rib-cage"), "rib cage");
   expect_refused(run_spinesim("spine solve --scoliosis thoracic --cobb 30 --convex up"),
                  "--convex");
 }
@@ -62,7 +61,8 @@ TEST(ScoliosisHaptics, TheCurvedSpineIsDraggedAndTheDatabaseRefused) {
   const std::string script = std::string(SPINESIM_DATA_DIR) + "/haptics/drag_t1_lateral.csv";
   const CliRun r = run_spinesim(
       "haptics run --scene spine --triangles 1500 --spine multirate --scoliosis lumbar --cobb 15 "
-      "--script '" + script + "' --duration 2 --no-realtime --json");
+      "--script '" +
+      script + "' --duration 2 --no-realtime --json");
   ASSERT_EQ(r.status, 0) << r.err;
   const json j = json::parse(r.out);
   EXPECT_NE(j["scene_description"].get<std::string>().find("scoliosis"), std::string::npos);
@@ -72,8 +72,9 @@ TEST(ScoliosisHaptics, TheCurvedSpineIsDraggedAndTheDatabaseRefused) {
   expect_refused(run_spinesim("haptics run --duration 1 --scene spine --spine database "
                               "--scoliosis thoracic --cobb 30"),
                  "straight spine");
-  expect_refused(run_spinesim("haptics run --duration 1 --scene plane --scoliosis thoracic --cobb 30"),
-                 "--scene spine");
+  expect_refused(
+      run_spinesim("haptics run --duration 1 --scene plane --scoliosis thoracic --cobb 30"),
+      "--scene spine");
 }
 
 TEST(ScoliosisStudyCli, TablesNameTheSourcesAndTheJsonHasEveryCurve) {
@@ -93,20 +94,25 @@ TEST(ScoliosisStudyCli, TablesNameTheSourcesAndTheJsonHasEveryCurve) {
 // meet at an angle of that size, no tet inverts; the viewer draws the mesh (it has no fields).
 TEST(ScoliosisMesh, TheApicalDiscIsWedgedAsTheCurveHasIt) {
   const std::string vtu = tmp("wedged_t7t8.vtu");
-  const CliRun r = run_spinesim("mesh disc --level T7-T8 --structured --placement local "
-                                "--scoliosis thoracic --cobb 40 --out '" + vtu + "' --json --quiet");
+  const CliRun r = run_spinesim(
+      "mesh disc --level T7-T8 --structured --placement local "
+      "--scoliosis thoracic --cobb 40 --out '" +
+      vtu + "' --json --quiet");
   ASSERT_EQ(r.status, 0) << r.err;
   const json j = json::parse(r.out);
   const double wedge = j["scoliosis"]["frontal_wedge_deg"].get<double>();
   EXPECT_LT(wedge, -3);
   EXPECT_GT(j["min_dihedral_deg"].get<double>(), 5);
   expect_refused(run_spinesim("mesh disc --inferior a.stl --superior b.stl --scoliosis thoracic "
-                              "--cobb 30 --out '" + tmp("x.vtu") + "'"),
+                              "--cobb 30 --out '" +
+                              tmp("x.vtu") + "'"),
                  "--level");
   if (std::system("command -v xvfb-run >/dev/null 2>&1") != 0) GTEST_SKIP() << "no xvfb-run";
   const std::string png = tmp("wedged.png");
-  const CliRun v = run_spinesim("view --play '" + vtu + "' --no-panel --width 320 --height 240 "
-                                "--frames 2 --screenshot '" + png + "'",
+  const CliRun v = run_spinesim("view --play '" + vtu +
+                                    "' --no-panel --width 320 --height 240 "
+                                    "--frames 2 --screenshot '" +
+                                    png + "'",
                                 "xvfb-run -a -s '-screen 0 640x480x24' ");
   EXPECT_EQ(v.status, 0) << v.err;
   EXPECT_TRUE(std::filesystem::exists(png));

@@ -311,8 +311,8 @@ TEST(CompliantStage, TheRibCageFollowsTheThoraxWithoutAllocating) {
   std::vector<int> ribs;
   for (std::size_t b = 0; b < m.rib_cage->body_centres_mm.size(); ++b) {
     ribs.push_back(col.scene.size());
-    col.scene.add_body("rib" + std::to_string(b),
-                       spinesim::haptics::testing::box(Vector3d(100, 600 - 10.0 * double(b), 0), 3));
+    col.scene.add_body("rib" + std::to_string(b), spinesim::haptics::testing::box(
+                                                      Vector3d(100, 600 - 10.0 * double(b), 0), 3));
   }
   LinearSpine spine(20);
   sh::CompliantStage stage(spine, col.centres, col.body_of, sh::CouplingParameters());
@@ -332,7 +332,8 @@ TEST(CompliantStage, TheRibCageFollowsTheThoraxWithoutAllocating) {
   }
   EXPECT_EQ(allocations, 0);
   std::vector<sp::Pose> P(m.vertebrae.size());
-  for (int i = 0; i < sh::kSpineVertebrae; ++i) P[std::size_t(i)] = poses.pose[std::size_t(col.body_of[std::size_t(i)])];
+  for (int i = 0; i < sh::kSpineVertebrae; ++i)
+    P[std::size_t(i)] = poses.pose[std::size_t(col.body_of[std::size_t(i)])];
   const auto expected = sp::rib_cage_poses(*m.rib_cage, m.vertebrae, P);
   for (std::size_t b = 0; b < ribs.size(); ++b) {
     EXPECT_LT((poses.pose[std::size_t(ribs[b])].R - expected[b].R).norm(), 1e-14) << b;

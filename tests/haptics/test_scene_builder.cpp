@@ -130,7 +130,7 @@ TEST(HapticScene, AScoliosisPosesTheVertebraeAndTheRibCageAddsItsBodies) {
   auto mean = [](const st::HapticScene& s, const std::string& name) -> Eigen::Vector3d {
     return s.scene.body(s.scene.index(name)).tree.vertices().colwise().mean();
   };
-  EXPECT_LT(mean(curved, "T8").x() - mean(straight, "T8").x(), -5);  // convex right: −x
+  EXPECT_LT(mean(curved, "T8").x() - mean(straight, "T8").x(), -5);      // convex right: −x
   EXPECT_LT((mean(curved, "S1") - mean(straight, "S1")).norm(), 1e-12);  // the sacrum
   const auto& a = straight.scene.body(straight.scene.index("T8")).tree.vertices();
   const auto& b = curved.scene.body(curved.scene.index("T8")).tree.vertices();

@@ -186,7 +186,8 @@ TEST(DiscCarry, EndplatesFollowTheirVertebraeAndTheWallStretchesLinearly) {
 
   RigidMotion wedge;
   wedge.R = Eigen::AngleAxisd(5 * M_PI / 180, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  wedge.t = Eigen::Vector3d(0, h / 2, 0) - wedge.R * Eigen::Vector3d(0, h / 2, 0);  // about the upper centre
+  wedge.t = Eigen::Vector3d(0, h / 2, 0) -
+            wedge.R * Eigen::Vector3d(0, h / 2, 0);  // about the upper centre
   m = straight;
   carry_between(m, frame, h, RigidMotion(), wedge);
   int lower = 0, upper = 0;

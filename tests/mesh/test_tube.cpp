@@ -52,7 +52,8 @@ TEST(Tube, ArcHasPappussVolumeAndPassesThroughItsPoints) {
   // Every given point is a ring's centre.
   for (std::size_t i = 0; i < p.size(); ++i) {
     Vector3d centre = Vector3d::Zero();
-    for (int j = 0; j < o.sides; ++j) centre += s.V.row(Eigen::Index(i) * 10 * o.sides + j).transpose();
+    for (int j = 0; j < o.sides; ++j)
+      centre += s.V.row(Eigen::Index(i) * 10 * o.sides + j).transpose();
     EXPECT_LT((centre / o.sides - p[i]).norm(), 1e-9) << i;
   }
 }

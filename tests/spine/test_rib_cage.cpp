@@ -4,8 +4,8 @@
 #include "spinesim/spine/equilibrium.hpp"
 #include "spinesim/spine/rib_cage.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
+#include <Eigen/Eigenvalues>
 
 #include <cmath>
 
@@ -53,8 +53,9 @@ SpringSum sum_springs(const sp::SpineModel& m, const std::vector<sp::Pose>& P) {
     for (int v : rib.vertebrae) {
       const Vector3d d = Q[r].apply(rib.head_mm) - P[std::size_t(v)].apply(rib.head_mm);
       const Vector3d phi = log_of(P[std::size_t(v)].R.transpose() * Q[r].R);
-      s.energy += 0.5 * share * (c.k_costovertebral_n_per_mm * d.squaredNorm() +
-                                 c.k_costovertebral_nmm_per_rad * phi.squaredNorm());
+      s.energy += 0.5 * share *
+                  (c.k_costovertebral_n_per_mm * d.squaredNorm() +
+                   c.k_costovertebral_nmm_per_rad * phi.squaredNorm());
       s.net_force[r] -= share * c.k_costovertebral_n_per_mm * d;
     }
     const std::size_t other = rib.front == sp::RibFront::Sternum ? sternum : r - 2;

@@ -61,11 +61,12 @@ TEST(Scoliosis, ALeftCurveIsTheMirrorImageOfTheRightOne) {
   right.apical_rotation_deg = 12;
   sp::ScoliosisCurve left = right;
   left.convex_right = false;
-  const VectorXd a = sp::scoliotic_posture(m, right).theta, b = sp::scoliotic_posture(m, left).theta;
+  const VectorXd a = sp::scoliotic_posture(m, right).theta,
+                 b = sp::scoliotic_posture(m, left).theta;
   for (int k = 0; k < 17; ++k) {
-    EXPECT_NEAR(a[3 * k], b[3 * k], 1e-12);           // no flexion either way
-    EXPECT_NEAR(a[3 * k + 1], -b[3 * k + 1], 1e-9);   // torsion mirrored
-    EXPECT_NEAR(a[3 * k + 2], -b[3 * k + 2], 1e-9);   // lateral bending mirrored
+    EXPECT_NEAR(a[3 * k], b[3 * k], 1e-12);          // no flexion either way
+    EXPECT_NEAR(a[3 * k + 1], -b[3 * k + 1], 1e-9);  // torsion mirrored
+    EXPECT_NEAR(a[3 * k + 2], -b[3 * k + 2], 1e-9);  // lateral bending mirrored
   }
 }
 

@@ -43,8 +43,8 @@ struct Rib {
 /// Which parts of the cage act (the in-vitro comparison removes the anterior cage, which leaves
 /// the ribs on their heads; no cage at all is ModelOptions::rib_cage = false).
 struct RibCageParts {
-  bool cartilage = true;         ///< the costal cartilage (the anterior cage)
-  double cartilage_scale = 1.0;  ///< its stiffness × this (sensitivity)
+  bool cartilage = true;              ///< the costal cartilage (the anterior cage)
+  double cartilage_scale = 1.0;       ///< its stiffness × this (sensitivity)
   double costovertebral_scale = 1.0;  ///< the costovertebral complexes' stiffness × this
 };
 

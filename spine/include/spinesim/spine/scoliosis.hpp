@@ -48,13 +48,13 @@ const std::vector<std::string>& scoliosis_curve_types();
 void check_scoliosis_curve(const ScoliosisCurve& c);
 
 struct ScoliosisPosture {
-  Eigen::VectorXd theta;      ///< the rest posture, rad, 3 per joint
-  double cobb_deg = 0;        ///< measured on the posed vertebrae
-  double apex_offset_mm = 0;  ///< the apical vertebra's centre from the line through the ends
+  Eigen::VectorXd theta;           ///< the rest posture, rad, 3 per joint
+  double cobb_deg = 0;             ///< measured on the posed vertebrae
+  double apex_offset_mm = 0;       ///< the apical vertebra's centre from the line through the ends
   double apical_rotation_deg = 0;  ///< measured: the apex's axial turn against the ends' mean
-  double t1_offset_mm = 0;    ///< T1's centre from the sacrum's vertical, lateral (+x left)
-  double t1_tilt_deg = 0;     ///< T1's frontal-plane tilt
-  double largest_share = 0;   ///< the largest |θ_z| over its disc's closing angle (≤ 1)
+  double t1_offset_mm = 0;         ///< T1's centre from the sacrum's vertical, lateral (+x left)
+  double t1_tilt_deg = 0;          ///< T1's frontal-plane tilt
+  double largest_share = 0;        ///< the largest |θ_z| over its disc's closing angle (≤ 1)
   std::string largest_share_joint;
 };
 

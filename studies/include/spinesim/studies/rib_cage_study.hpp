@@ -31,11 +31,11 @@
 namespace spinesim::studies {
 
 struct RibCageCase {
-  std::string name;       ///< "no cage", "ribs on their heads", "whole cage", …
+  std::string name;  ///< "no cage", "ribs on their heads", "whole cage", …
   double cartilage_scale = 1, costovertebral_scale = 1;
   bool cage = true, cartilage = true;
-  std::array<double, 3> rom_deg{};       ///< flexion/extension, lateral bending, axial rotation
-  std::array<double, 3> growth_pct{};    ///< ROM(no cage)/ROM(case) − 1, %
+  std::array<double, 3> rom_deg{};     ///< flexion/extension, lateral bending, axial rotation
+  std::array<double, 3> growth_pct{};  ///< ROM(no cage)/ROM(case) − 1, %
 };
 
 /// A loaded scene with and without the cage.

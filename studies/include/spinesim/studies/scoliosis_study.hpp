@@ -43,11 +43,11 @@ struct ScoliosisDisc {
 
 struct ScoliosisCase {
   spine::ScoliosisCurve curve;
-  std::string refusal;                ///< why the model cannot pose it ("": posed)
-  std::vector<ScoliosisDisc> discs;   ///< every disc of the curve, top down
-  std::string most_asymmetric;        ///< the disc with the largest concave − convex stress
+  std::string refusal;               ///< why the model cannot pose it ("": posed)
+  std::vector<ScoliosisDisc> discs;  ///< every disc of the curve, top down
+  std::string most_asymmetric;       ///< the disc with the largest concave − convex stress
   double apical_concave_mpa = 0, apical_convex_mpa = 0;  ///< mean over the two apical discs
-  double unloaded_apical_mpa = 0;     ///< the same discs' mean stress without gravity or muscles
+  double unloaded_apical_mpa = 0;  ///< the same discs' mean stress without gravity or muscles
   double apex_offset_mm = 0;
 };
 
