@@ -23,6 +23,7 @@ packages=(
   libglfw3-dev libimgui-dev libstb-dev libgl-dev   # `spinesim view` (GLFW, Dear ImGui, PNG)
   libgl1-mesa-dri xvfb xauth             # Mesa's software OpenGL and a virtual X server (view tests)
   clang libclang-rt-14-dev # libFuzzer, for the fuzz targets of the file readers (fuzz/)
+  rt-tests                 # cyclictest: the machine's own real-time floor beside the loop's figures
 )
 
 missing=()
