@@ -357,6 +357,7 @@ SpineModel load_spine_model(const std::string& data_dir, const ModelOptions& opt
     const CsvTable markers = read_csv((thesis / "F2_joint_markers.csv").string());
     const CsvTable k = read_csv((thesis / "F4_joint_torsional_stiffness.csv").string());
     const CsvTable rom = read_csv((thesis / "F5_range_of_motion.csv").string());
+    const CsvTable discs = read_csv((data / "disc_morphometry.csv").string());
     for (const auto& name : joint_names()) {
       Joint j;
       j.name = name;
@@ -371,6 +372,10 @@ SpineModel load_spine_model(const std::string& data_dir, const ModelOptions& opt
       j.rom_extension = rom.number(r, "extension_deg") * kRadPerDeg;
       j.rom_lateral = rom.number(r, "lateral_bending_deg") * kRadPerDeg;
       j.rom_torsion = rom.number(r, "torsion_deg") * kRadPerDeg;
+      const std::size_t d = discs.find("level", name);
+      j.disc_height_mm = discs.number(d, "height_mm");
+      j.disc_width_mm = 0.5 * (discs.number(d, "lower_width_mm") + discs.number(d, "upper_width_mm"));
+      j.disc_depth_mm = 0.5 * (discs.number(d, "lower_depth_mm") + discs.number(d, "upper_depth_mm"));
       if (!(j.k_flexion > 0 && j.k_extension > 0 && j.k_lateral > 0 && j.k_torsion > 0))
         throw std::runtime_error(k.path + ": joint stiffness of " + name + " must be > 0");
       m.joints.push_back(j);

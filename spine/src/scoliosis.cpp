@@ -2,13 +2,11 @@
 #include "spinesim/spine/scoliosis.hpp"
 
 #include "spinesim/common/constants.hpp"
-#include "spinesim/common/csv_table.hpp"
 #include "spinesim/spine/kinematics.hpp"
 
 #include <Eigen/Dense>
 
 #include <cmath>
-#include <filesystem>
 #include <stdexcept>
 
 namespace spinesim::spine {
@@ -81,17 +79,10 @@ Eigen::Vector2d balance(const SpineModel& m, const VectorXd& theta) {
   return {frontal_tilt_deg(P[0].R) * kRadPerDeg, (c.x() - m.vertebrae[0].centre_mm.x()) / 100};
 }
 
-/// Each joint's closing angle: tan θ = 2 h / w of its disc (mid height, mean width; scaled).
+/// Each joint's closing angle: tan θ = 2 h / w of its disc (mid height, mean width).
 std::vector<double> closing_angles(const SpineModel& m) {
-  const CsvTable t =
-      read_csv((std::filesystem::path(m.data_dir) / "disc_morphometry.csv").string());
   std::vector<double> out;
-  for (const Joint& j : m.joints) {
-    const std::size_t r = t.find("level", j.name);
-    const double h = t.number(r, "height_mm"),
-                 w = 0.5 * (t.number(r, "lower_width_mm") + t.number(r, "upper_width_mm"));
-    out.push_back(std::atan(2 * h / w));  // the body's scale cancels in the ratio
-  }
+  for (const Joint& j : m.joints) out.push_back(std::atan(2 * j.disc_height_mm / j.disc_width_mm));
   return out;
 }
 

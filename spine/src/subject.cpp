@@ -107,6 +107,9 @@ void scale_to_subject(SpineModel& m, const SubjectScale& scale) {
   for (Vertebra& v : m.vertebrae) v.centre_mm *= s;
   for (Joint& j : m.joints) {
     j.point_mm *= s;
+    j.disc_height_mm *= s;
+    j.disc_width_mm *= s;
+    j.disc_depth_mm *= s;
     j.k_flexion *= s3;
     j.k_extension *= s3;
     j.k_lateral *= s3;

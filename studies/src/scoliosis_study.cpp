@@ -1,35 +1,17 @@
 // `spinesim study scoliosis` (scoliosis_study.hpp).
 #include "spinesim/studies/scoliosis_study.hpp"
 
-#include "spinesim/common/csv_table.hpp"
 #include "spinesim/common/timer.hpp"
 #include "spinesim/spine/scoliosis.hpp"
 #include "spinesim/studies/spine_solve.hpp"
 
 #include <cmath>
-#include <filesystem>
 #include <stdexcept>
 
 namespace spinesim::studies {
 namespace {
 
 constexpr double kCobbs[] = {20, 40, 60};
-
-/// Each joint's disc width and depth (mm, the reference body's; disc_morphometry.csv).
-struct DiscSection {
-  double width_mm = 0, depth_mm = 0;
-};
-std::vector<DiscSection> disc_sections(const std::string& data_dir, const spine::SpineModel& m) {
-  const CsvTable t = read_csv((std::filesystem::path(data_dir) / "disc_morphometry.csv").string());
-  std::vector<DiscSection> out;
-  for (const spine::Joint& j : m.joints) {
-    const std::size_t r = t.find("level", j.name);
-    out.push_back(
-        {0.5 * (t.number(r, "lower_width_mm") + t.number(r, "upper_width_mm")) * m.scale.length,
-         0.5 * (t.number(r, "lower_depth_mm") + t.number(r, "upper_depth_mm")) * m.scale.length});
-  }
-  return out;
-}
 
 spine::SpineSolution stand(const spine::SpineModel& m, bool loaded) {
   spine::SolveOptions o;
@@ -49,15 +31,17 @@ void run_case(const std::string& data_dir, spine::ModelOptions o, ScoliosisCase&
     return;
   }
   c.apex_offset_mm = spine::scoliotic_posture(m, c.curve).apex_offset_mm;
-  const std::vector<DiscSection> sections = disc_sections(data_dir, m);
   const spine::SpineSolution s = stand(m, true);
   const int u = spine::vertebra_index(c.curve.upper_end), a = spine::vertebra_index(c.curve.apex),
             l = spine::vertebra_index(c.curve.lower_end);
+  // Joint k's disc stresses for a solution's reaction there (the disc's section is the joint's).
+  auto edge = [&m](const spine::SpineSolution& sol, int k) {
+    const spine::Joint& j = m.joints[std::size_t(k)];
+    return disc_edge_stress(sol.joints[std::size_t(k)], j.disc_width_mm, j.disc_depth_mm);
+  };
   double most = -1e300;
   for (int k = u; k < l; ++k) {
-    const DiscEdgeStress e =
-        disc_edge_stress(s.joints[std::size_t(k)], sections[std::size_t(k)].width_mm,
-                         sections[std::size_t(k)].depth_mm);
+    const DiscEdgeStress e = edge(s, k);
     ScoliosisDisc d;
     d.joint = s.joints[std::size_t(k)].joint;
     d.axial_n = s.joints[std::size_t(k)].disc_axial_n;
@@ -78,11 +62,7 @@ void run_case(const std::string& data_dir, spine::ModelOptions o, ScoliosisCase&
   o.gravity = o.muscles = false;
   const spine::SpineModel bare = spine::load_spine_model(data_dir, o);
   const spine::SpineSolution r = stand(bare, false);
-  for (int k : {a - 1, a})
-    c.unloaded_apical_mpa +=
-        0.5 * disc_edge_stress(r.joints[std::size_t(k)], sections[std::size_t(k)].width_mm,
-                               sections[std::size_t(k)].depth_mm)
-                  .mean_mpa;
+  for (int k : {a - 1, a}) c.unloaded_apical_mpa += 0.5 * edge(r, k).mean_mpa;
 }
 
 std::vector<ScoliosisFinding> findings(const std::vector<ScoliosisCase>& cases) {

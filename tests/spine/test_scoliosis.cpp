@@ -124,3 +124,22 @@ TEST(Scoliosis, CurvesTheModelCannotPoseAreRefused) {
   o.scoliosis = sp::scoliosis_curve("thoracic", 30);
   EXPECT_THROW(sp::load_spine_model(SPINESIM_DATA_DIR, o), std::invalid_argument);
 }
+
+// The joints carry their discs' sections (disc_morphometry.csv), scaled with the body like every
+// other length: the closing angles of the refusal above do not depend on the body.
+TEST(Scoliosis, EachJointCarriesItsDiscScaledWithTheBody) {
+  const auto m = plain();
+  sp::ModelOptions o;
+  o.gravity = o.muscles = o.iap = false;
+  o.subject.height_m = 1.6;
+  const auto small = sp::load_spine_model(SPINESIM_DATA_DIR, o);
+  const double s = 1.6 / 1.778;
+  for (std::size_t k = 0; k < m.joints.size(); ++k) {
+    EXPECT_GT(m.joints[k].disc_height_mm, 2) << m.joints[k].name;
+    EXPECT_GT(m.joints[k].disc_width_mm, 20) << m.joints[k].name;
+    EXPECT_GT(m.joints[k].disc_width_mm, m.joints[k].disc_depth_mm) << m.joints[k].name;
+    EXPECT_NEAR(small.joints[k].disc_height_mm, s * m.joints[k].disc_height_mm, 1e-12);
+    EXPECT_NEAR(small.joints[k].disc_width_mm, s * m.joints[k].disc_width_mm, 1e-12);
+    EXPECT_NEAR(small.joints[k].disc_depth_mm, s * m.joints[k].disc_depth_mm, 1e-12);
+  }
+}

@@ -58,6 +58,9 @@ struct Joint {
   bool fused = false;  ///< fixed joint (spinal fusion): θ ≡ 0
   /// The springs' stress-free rotation (rad): zero, or a scoliotic curve's wedged disc.
   Eigen::Vector3d rest_rad = Eigen::Vector3d::Zero();
+  /// Its disc (disc_morphometry.csv, scaled with the body): mid height, and the means of the
+  /// lower and upper outlines' lateral width and antero-posterior depth, mm.
+  double disc_height_mm = 0, disc_width_mm = 0, disc_depth_mm = 0;
 };
 
 /// A straight line element between two bodies (attachment points in the reference posture).
