@@ -249,6 +249,16 @@ void print_header(std::ostream& os, const SpineSolveRun& r) {
      << m.ligaments.size() << " ligaments" << (m.has_bushing ? ", IAP bushing" : "")
      << "; fusion: " << (fused.empty() ? "none" : fused) << "\n"
      << "  body: " << subject_text(m.subject) << "\n";
+  if (m.rib_cage) os << "  rib cage: 24 ribs and the sternum on T1-T12\n";
+  if (m.scoliosis.cobb_deg != 0) {
+    const spine::ScoliosisPosture p = spine::scoliotic_posture(m, m.scoliosis);
+    os << "  scoliosis: " << m.scoliosis.type << ", " << m.scoliosis.upper_end << "-"
+       << m.scoliosis.lower_end << ", apex " << m.scoliosis.apex << ", convex "
+       << (m.scoliosis.convex_right ? "right" : "left") << "; at rest Cobb "
+       << fixed(p.cobb_deg, 1) << " deg, apex " << fixed(p.apex_offset_mm, 1)
+       << " mm off the ends' line, apical rotation " << fixed(p.apical_rotation_deg, 1)
+       << " deg\n";
+  }
   for (std::size_t i = 0; i < r.request.loads.size(); ++i) {
     const auto& l = r.request.loads[i];
     os << "  load " << i + 1 << ": " << names[std::size_t(l.vertebra)];

@@ -26,6 +26,11 @@ TEST(ScoliosisSolve, TheCurveAndItsRestPostureAreReportedAndTheSpineStandsInIt) 
   // Under gravity the apex stays on the convex side, off the midline by millimetres.
   EXPECT_LT(j["vertebrae"][7]["translation_mm"][0].get<double>(), -5) << j["vertebrae"][7];
   EXPECT_TRUE(solve_json("--force T1:0,0,100")["options"]["scoliosis"].is_null());
+  const CliRun text = run_spinesim("spine solve --scoliosis thoracic --cobb 40");
+  ASSERT_EQ(text.status, 0) << text.err;
+  EXPECT_NE(text.out.find("scoliosis: thoracic, T5-T11, apex T8, convex right; at rest Cobb 40.0"),
+            std::string::npos)
+      << text.out.substr(0, 600);
 }
 
 TEST(ScoliosisSolve, ACustomLeftCurveMirrorsTheRightOne) {
