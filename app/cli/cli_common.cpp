@@ -44,11 +44,25 @@ void add_subject_options(CLI::App* cmd, SubjectFlags& flags) {
   cmd->add_option("--sex", flags.sex, "male or female: de Leva's segment masses of that sex")
       ->check(CLI::IsMember({"male", "female"}))
       ->capture_default_str();
+  add_named_subject_option(cmd, flags, "--height, --mass or --sex");
+}
+
+void add_named_subject_option(CLI::App* cmd, SubjectFlags& flags, const std::string& instead_of) {
+  cmd->add_option("--subject", flags.named,
+                  "A sourced body instead of " + instead_of +
+                      ": reference (the thesis's), p5-female (1.501 m, 49.0 kg) or p95-male (1.880 "
+                      "m, 101.2 kg); data/spine/spine_model.json anthropometry.bodies");
 }
 
 spine::Subject subject_of(const SubjectFlags& flags) {
   if (flags.height_m < 0) throw std::invalid_argument("--height must be a number > 0 m");
   if (flags.mass_kg < 0) throw std::invalid_argument("--mass must be a number > 0 kg");
+  if (!flags.named.empty()) {
+    if (flags.height_m != 0 || flags.mass_kg != 0 || flags.sex != "male")
+      throw std::invalid_argument(
+          "--subject names a whole body: give it without a height, mass or sex");
+    return spine::named_body(studies::data_dir(), flags.named).subject;
+  }
   spine::Subject s;
   s.height_m = flags.height_m;
   s.body_mass_kg = flags.mass_kg;

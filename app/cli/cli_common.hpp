@@ -36,13 +36,16 @@ void require_plain_numbers(CLI::App& app);
 void add_output_flags(CLI::App* cmd, bool& json, bool& quiet,
                       const std::string& what = "a JSON summary");
 
-/// --height, --mass, --sex: the body the spine belongs to (spine::Subject; 0: the reference body's).
+/// --height, --mass, --sex, or --subject NAME (a sourced body, spine::named_body): the body the
+/// spine belongs to (spine::Subject; 0: the reference body's).
 struct SubjectFlags {
   double height_m = 0, mass_kg = 0;
-  std::string sex = "male";
-  bool given() const { return height_m != 0 || mass_kg != 0 || sex != "male"; }
+  std::string sex = "male", named;
+  bool given() const { return height_m != 0 || mass_kg != 0 || sex != "male" || !named.empty(); }
 };
 void add_subject_options(CLI::App* cmd, SubjectFlags& flags);
+/// --subject alone (`instead_of` names the flags it replaces, for the help).
+void add_named_subject_option(CLI::App* cmd, SubjectFlags& flags, const std::string& instead_of);
 spine::Subject subject_of(const SubjectFlags& flags);
 
 /// --ligaments auto|on|off (spine::Ligaments, read with spine::parse_ligaments) on the spine verbs.

@@ -238,6 +238,7 @@ void add_compliant_stage_flags(CLI::App* cmd, HapticsRunFlags& f) {
   cmd->add_option("--sex", f.body.sex, "--scene spine: male or female")
       ->check(CLI::IsMember({"male", "female"}))
       ->capture_default_str();
+  add_named_subject_option(cmd, f.body, "--body-height, --body-mass or --sex (--scene spine)");
   cmd->add_flag("--rib-cage", f.request.scene.rib_cage,
                 "--scene spine: add the ribs and the sternum (drawn and touched); with --spine "
                 "they stiffen the thorax and move with it (--spine database: a database built "
@@ -334,7 +335,8 @@ void resolve_haptics_run_flags(HapticsRunFlags& f) {
   f.request.scene.scoliosis = scoliosis_of(f.scoliosis);
   f.request.scene.subject = subject_of(f.body);
   if (f.body.given() && f.request.scene.scene != "spine")
-    throw std::invalid_argument("--body-height, --body-mass and --sex are for --scene spine");
+    throw std::invalid_argument(
+        "--body-height, --body-mass, --sex and --subject are for --scene spine");
   if (f.body.given()) spine::resolve_subject(data_dir(), f.request.scene.subject);  // in range
   if (!f.chair_file.empty()) {
     if (f.request.posture != "seated")

@@ -36,6 +36,7 @@
 
 #include "model_flags.hpp"
 #include "spinesim/common/timer.hpp"
+#include "spinesim/studies/body_study.hpp"
 #include "spinesim/studies/comparison_report.hpp"
 #include "spinesim/studies/fem_reference.hpp"
 #include "spinesim/studies/materials_study.hpp"
@@ -394,7 +395,10 @@ void print_muscle_set(const SpineStudyArgs& a) {
   if (a.rib_cage) std::cout << "Rib cage: on (--rib-cage; data/spine/rib_cage.json)\n\n";
   if (a.subject.given())
     std::cout << "Body: " << subject_text(spine::resolve_subject(data_dir(), o.subject))
-              << " (--height/--mass/--sex; the reference body is male, 1.778 m, 70 kg)\n\n";
+              << (a.subject.named.empty()
+                      ? " (--height/--mass/--sex; the reference body is male, 1.778 m, 70 kg)"
+                      : " (--subject " + a.subject.named + ")")
+              << "\n\n";
   if (!a.disc_joints.empty())
     std::cout << "Joint springs: the discs of " << a.disc_joints
               << " (--disc-joints) in place of the thesis's F.4\n\n";
@@ -612,6 +616,58 @@ void register_scoliosis(CLI::App& study) {
   });
 }
 
+// --- study bodies (body_study.hpp) ------------------------------------------------------------
+
+void register_bodies(CLI::App& study) {
+  struct Args {
+    SpineStudyArgs spine;
+    std::vector<std::string> bodies;
+    bool markdown = false;
+  };
+  auto a = std::make_shared<Args>();
+  auto* cmd = study.add_subcommand(
+      "bodies",
+      "Validation, fusion, trends and the in-vivo postures for a 5th-percentile woman, the "
+      "thesis's man and a 95th-percentile man");
+  cmd->add_option("--force", a->spine.force_n, "Force on the T1 centre (fusion, trends), N")
+      ->capture_default_str();
+  cmd->add_option("--bodies", a->bodies,
+                  "Named bodies to compare, e.g. p5-female,reference (default: every one in "
+                  "data/spine/spine_model.json anthropometry.bodies)")
+      ->delimiter(',');
+  cmd->add_option("--csv", a->spine.csv, "Write the comparison as CSV (a row per quantity)");
+  cmd->add_flag("--json", a->spine.json, "Print every study's JSON on stdout");
+  cmd->add_flag("--markdown", a->markdown, "Print the tables as Markdown");
+  cmd->add_flag("--quiet", a->spine.quiet, "No progress on stderr");
+  add_ligaments_option(cmd, a->spine.ligaments);
+  add_rib_cage_option(cmd, a->spine.rib_cage);
+  cmd->footer(
+      "Every body is scaled from the reference body as --height/--mass/--sex would scale it "
+      "(spine/README.md);\n"
+      "the loads stay the thesis's. The validation windows are one male subject's each: for the "
+      "other bodies\n"
+      "they are shown for scale. A few seconds per body.");
+  cmd->callback([a] {
+    const std::size_t n = a->bodies.empty() ? spine::named_bodies(data_dir()).size() : a->bodies.size();
+    const int stages = kBodyStudyStagesPerBody * int(n);
+    Progress progress(stages, a->spine.quiet || a->spine.json);
+    const StageHooks hooks = spine_study_hooks(a->spine, progress);
+    const BodyStudy s =
+        run_body_study(data_dir(), a->spine.force_n, a->spine.model(), a->bodies, hooks);
+    if (!a->spine.csv.empty()) write_csv_file(a->spine.csv, body_study_csv(s));
+    if (a->spine.json) {
+      print_json(body_study_json(s));
+      return;
+    }
+    std::cout << "The spine studies for three sourced bodies (data/spine/spine_model.json "
+                 "anthropometry.bodies)\n\n";
+    print_muscle_set(a->spine);
+    print_body_study(std::cout, s, a->markdown);
+    std::cout << "Total " << fixed(s.seconds, 1) << " s"
+              << (a->spine.csv.empty() ? "" : "; wrote " + a->spine.csv) << "\n";
+  });
+}
+
 void register_study(CLI::App& app) {
   auto* study = app.add_subcommand(
       "study",
@@ -625,6 +681,7 @@ void register_study(CLI::App& app) {
   register_trends(*study);
   register_rib_cage(*study);
   register_scoliosis(*study);
+  register_bodies(*study);
   register_haptic_plane(*study);
   register_haptic_drag(*study);
   register_disc_validation(*study);

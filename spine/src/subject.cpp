@@ -4,6 +4,7 @@
 
 #include "json_fields.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <iomanip>
 #include <sstream>
@@ -29,6 +30,49 @@ Subject resolve_subject(const std::string& data_dir, Subject subject) {
     throw std::runtime_error(file + ": " + e.what());
   }
   return subject;
+}
+
+std::vector<NamedBody> named_bodies(const std::string& data_dir) {
+  const std::string file = data_dir + "/spine/spine_model.json";
+  const nlohmann::json config = detail::read_json(file);
+  std::vector<NamedBody> out;
+  try {
+    const nlohmann::json& bodies = config.at("anthropometry").at("bodies");
+    for (auto it = bodies.begin(); it != bodies.end(); ++it) {
+      NamedBody b;
+      b.name = it.key();
+      b.source = it->at("source").get<std::string>();
+      b.subject.height_m = detail::number(*it, "height_m", file);
+      b.subject.body_mass_kg = detail::number(*it, "body_mass_kg", file);
+      b.subject.sex = parse_sex(it->at("sex").get<std::string>());
+      out.push_back(b);
+    }
+  } catch (const nlohmann::json::exception& e) {
+    throw std::runtime_error(file + ": anthropometry.bodies: " + e.what());
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(file + ": anthropometry.bodies: " + e.what());
+  }
+  // The file's keys come back sorted by name; the bodies go smallest first.
+  std::stable_sort(out.begin(), out.end(), [](const NamedBody& a, const NamedBody& b) {
+    return a.subject.height_m < b.subject.height_m;
+  });
+  for (NamedBody& b : out) {
+    try {
+      b.subject = resolve_subject(data_dir, b.subject);
+    } catch (const std::invalid_argument& e) {
+      throw std::runtime_error(file + ": anthropometry.bodies." + b.name + ": " + e.what());
+    }
+  }
+  return out;
+}
+
+NamedBody named_body(const std::string& data_dir, const std::string& name) {
+  std::string known;
+  for (const NamedBody& b : named_bodies(data_dir)) {
+    if (b.name == name) return b;
+    known += (known.empty() ? "" : ", ") + b.name;
+  }
+  throw std::invalid_argument("unknown body '" + name + "' (known: " + known + ")");
 }
 
 namespace detail {

@@ -172,10 +172,8 @@ std::string seating_sweep_csv(const SeatingSweep& s) {
   return os.str();
 }
 
-SittingValidation run_sitting_validation(const std::string& data_dir,
-                                         const spine::ModelOptions& model,
-                                         const StageHooks& hooks) {
-  Timer timer;
+SittingValidation run_posture_comparison(const std::string& data_dir,
+                                         const spine::ModelOptions& model) {
   const json targets = read_targets(data_dir);
   const double area = number_at(targets, "disc_area_mm2", "the file");
   const double tol = number_at(targets, "tolerance", "the file");
@@ -183,7 +181,6 @@ SittingValidation run_sitting_validation(const std::string& data_dir,
   auto mpa = [&](const std::string& k) { return number_at(p.at(k), "mpa", k); };
   auto source = [&](const std::string& k) { return p.at(k).at("source").get<std::string>(); };
   SittingValidation v;
-  hooks.begin_stage("standing, sitting with and without a backrest, crate");
   const double standing = l4l5(spine::solve_spine(spine::load_spine_model(data_dir, model), {}));
   SeatingRequest stool;
   stool.model = model;
@@ -194,7 +191,6 @@ SittingValidation run_sitting_validation(const std::string& data_dir,
   slouched.chair.backrest_recline_deg = 110;
   const double in_chair = l4l5(run_seating(data_dir, slouched).seated.spine);
   const double crate = run_wilke_case(data_dir, model).l4l5.axial_n;
-  hooks.end_stage();
   auto row = [&](const std::string& id, const std::string& what, double ours, double target,
                  const std::string& unit, const std::string& src) {
     SittingValidation::Row r{id,   what, ours, target, target * (1 - tol), target * (1 + tol),
@@ -219,6 +215,17 @@ SittingValidation run_sitting_validation(const std::string& data_dir,
     f.match = r.pass;
     v.findings.push_back(f);
   }
+  return v;
+}
+
+SittingValidation run_sitting_validation(const std::string& data_dir,
+                                         const spine::ModelOptions& model,
+                                         const StageHooks& hooks) {
+  Timer timer;
+  const json targets = read_targets(data_dir);
+  hooks.begin_stage("standing, sitting with and without a backrest, crate");
+  SittingValidation v = run_posture_comparison(data_dir, model);
+  hooks.end_stage();
   std::vector<std::string> parameters;
   for (const json& t : targets.at("trends")) {
     const std::string par = t.at("parameter").get<std::string>();

@@ -549,5 +549,10 @@ TEST(CliHaptics, BadCompliantStageInputIsRefused) {
   expect_refused(run_spinesim(base + "--scene spine --spine database --force-scale 1000"),
                  "beyond the 600 N");
   expect_refused(run_spinesim(base + "--scene plane --force-scale 10"), "--spine");
+  // A body is the spine scene's: elsewhere, out of range or unknown it is refused.
+  expect_refused(run_spinesim(base + "--scene disc --subject p5-female"), "--scene spine");
+  expect_refused(run_spinesim(base + "--scene plane --body-height 1.6"), "--scene spine");
+  expect_refused(run_spinesim(base + "--scene spine --body-height 2.6"), "height");
+  expect_refused(run_spinesim(base + "--scene spine --subject giant"), "p95-male");
   EXPECT_FALSE(fs::exists(rec));
 }

@@ -426,6 +426,32 @@ TEST(SpineSolveCli, ABodyOfGivenHeightMassAndSexScalesTheSpine) {
   expect_refused(run_spinesim("study fusion --height 1.1 --quiet"), "height");
 }
 
+// A sourced body by name (--subject): the same spine as its height, mass and sex given by
+// hand; combined with them or misspelt it is refused in one line that lists the bodies. The
+// bodies study compares them side by side and writes its CSV.
+TEST(SpineSolveCli, ANamedBodyIsItsHeightMassAndSexAndTheBodiesStudyComparesThem) {
+  const json named = solve_json("--subject p5-female");
+  const json by_hand = solve_json("--height 1.501 --mass 49 --sex female");
+  ASSERT_FALSE(named.empty() || by_hand.empty());
+  EXPECT_EQ(named["options"]["subject"], by_hand["options"]["subject"]);
+  EXPECT_EQ(joint(named, "L4-L5")["axial_n"], joint(by_hand, "L4-L5")["axial_n"]);
+  expect_refused(run_spinesim("spine solve --subject p5-female --height 1.6"), "--subject");
+  expect_refused(run_spinesim("spine solve --subject tall"), "p95-male");
+  expect_refused(run_spinesim("study bodies --bodies reference,tall --quiet"), "p5-female");
+
+  const std::string csv = tmp("bodies.csv");
+  const CliRun r =
+      run_spinesim("study bodies --bodies p5-female,reference --quiet --csv " + in_quotes(csv));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("Hybrid III 5th-percentile"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("standing, L4-L5 compression"), std::string::npos) << r.out;
+  EXPECT_EQ(count_lines(csv_table(csv)), 12);  // header + 11 quantities
+  const CliRun v = run_spinesim("study validation --subject p95-male --quiet");
+  ASSERT_EQ(v.status, 0) << v.err;
+  EXPECT_NE(v.out.find("Body: male, 1.880 m, 101.2 kg (--subject p95-male)"), std::string::npos)
+      << v.out;
+}
+
 // Loads in time (`spine schedule`): the table, the CSV and the recording; the recording drives
 // the offline discs; a malformed schedule is refused in one line with nothing written.
 TEST(SpineScheduleCli, ASchedulesStepsTheirCsvAndARecordingTheDiscsFollow) {

@@ -186,3 +186,41 @@ TEST(SpineSubject, TheMaleTableIsTheReferenceModelsMasses) {
   EXPECT_EQ(m.segment_mass_percent.forearm_hand_each, 2.23);
   EXPECT_NEAR(m.segment_mass_percent.arm_each, 2.71 + 1.62 + 0.61, 1e-12);
 }
+
+// The named bodies: the reference is the default body exactly, every body lies in the scaling
+// laws' range, they come smallest first, and an unknown name is refused with the names.
+TEST(SpineSubject, NamedBodiesAreSourcedAndTheReferenceIsTheDefault) {
+  const std::vector<sp::NamedBody> bodies = sp::named_bodies(kData);
+  ASSERT_GE(bodies.size(), 3u);
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    EXPECT_FALSE(bodies[i].source.empty()) << bodies[i].name;
+    const sp::Subject& s = bodies[i].subject;
+    const sp::Subject again = sp::resolve_subject(kData, s);  // in range: no throw
+    EXPECT_EQ(again.height_m, s.height_m);
+    if (i > 0) EXPECT_LE(bodies[i - 1].subject.height_m, s.height_m);
+  }
+  const sp::Subject ref = sp::named_body(kData, "reference").subject;
+  const sp::Subject def = sp::resolve_subject(kData, sp::Subject());
+  EXPECT_EQ(ref.height_m, def.height_m);
+  EXPECT_EQ(ref.body_mass_kg, def.body_mass_kg);
+  EXPECT_EQ(ref.sex, def.sex);
+  sp::ModelOptions o;
+  o.subject = ref;
+  expect_identical(sp::load_spine_model(kData, o), sp::load_spine_model(kData));
+
+  const sp::NamedBody small = sp::named_body(kData, "p5-female");
+  EXPECT_EQ(small.subject.sex, sp::Sex::Female);
+  EXPECT_NEAR(small.subject.height_m, 59.1 * 0.0254, 0.001);            // 59.1 in
+  EXPECT_NEAR(small.subject.body_mass_kg, 108.0 * 0.45359237, 0.05);    // 108.0 lb
+  const sp::NamedBody large = sp::named_body(kData, "p95-male");
+  EXPECT_NEAR(large.subject.height_m, 74 * 0.0254, 0.001);             // 74 in
+  EXPECT_NEAR(large.subject.body_mass_kg, 223 * 0.45359237, 0.05);     // 223 lb
+  try {
+    sp::named_body(kData, "p50-female");
+    FAIL() << "an unknown body was accepted";
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("p5-female"), std::string::npos) << what;
+    EXPECT_NE(what.find("reference"), std::string::npos) << what;
+  }
+}

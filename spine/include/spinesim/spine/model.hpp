@@ -170,6 +170,17 @@ struct ScoliosisCurve {
 /// range the scaling laws are applied to (std::invalid_argument, one line, when outside).
 Subject resolve_subject(const std::string& data_dir, Subject subject);
 
+/// A sourced body by name (spine_model.json "anthropometry.bodies": reference, p5-female,
+/// p95-male), with where its stature and mass come from.
+struct NamedBody {
+  std::string name, source;
+  Subject subject;
+};
+/// Every named body, shortest first; each one resolved and checked like any subject.
+std::vector<NamedBody> named_bodies(const std::string& data_dir);
+/// The named body `name`; std::invalid_argument listing the names when there is none.
+NamedBody named_body(const std::string& data_dir, const std::string& name);
+
 /// Segment masses of one sex, % of body mass (de Leva 1996; spine_model.json "anthropometry").
 struct SegmentMassPercent {
   double trunk = 0, head_neck = 0, arm_each = 0, pelvis = 0, forearm_hand_each = 0;

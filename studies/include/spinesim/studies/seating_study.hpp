@@ -90,6 +90,10 @@ struct SittingValidation {
   std::vector<Finding> findings;  ///< the rows and the trends, MATCH / DIFFERS
   double seconds = 0;
 };
+/// The first part alone: standing, sitting without and with a backrest, and the crate (rows and
+/// their findings; no sweeps, seconds 0).
+SittingValidation run_posture_comparison(const std::string& data_dir,
+                                         const spine::ModelOptions& model = spine::ModelOptions());
 inline constexpr int kSittingValidationStages = 5;  ///< postures, then one per swept parameter
 SittingValidation run_sitting_validation(const std::string& data_dir,
                                          const spine::ModelOptions& model = spine::ModelOptions(),
