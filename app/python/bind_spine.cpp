@@ -132,9 +132,28 @@ py::object seated(const std::map<std::string, double>& chair, bool armrests,
   return to_python(j);
 }
 
+/// A named body as a dict (name, height_m, body_mass_kg, sex, source).
+py::dict body_dict(const spine::NamedBody& b) {
+  py::dict d;
+  d["name"] = b.name;
+  d["height_m"] = b.subject.height_m;
+  d["body_mass_kg"] = b.subject.body_mass_kg;
+  d["sex"] = spine::sex_name(b.subject.sex);
+  d["source"] = b.source;
+  return d;
+}
+
 }  // namespace
 
 void bind_spine(py::module_& m) {
+  m.def("named_bodies", [] {
+    py::list out;
+    for (const spine::NamedBody& b : spine::named_bodies(data_folder())) out.append(body_dict(b));
+    return out;
+  }, "The sourced bodies (spine_model.json anthropometry.bodies), smallest first: name, "
+     "height_m, body_mass_kg, sex, source");
+  m.def("_named_body",
+        [](const std::string& name) { return body_dict(spine::named_body(data_folder(), name)); });
   m.def("_spine", &solve_spine);
   m.def("_seated_spine", &seated);
   m.def("seating_parameters", &studies::seating_parameters,

@@ -165,6 +165,24 @@ def test_a_scaled_body_and_the_ligaments_equal_the_program(program):
         spinesim.spine(ligaments="maybe")
 
 
+def test_a_named_body_equals_the_program_and_its_own_numbers(program):
+    bodies = spinesim.named_bodies()
+    assert [b["name"] for b in bodies][0] == "p5-female"
+    small = next(b for b in bodies if b["name"] == "p5-female")
+    assert small["sex"] == "female" and "Hybrid III" in small["source"]
+    s = spinesim.spine(subject="p5-female")
+    p = program("spine", "solve", "--subject", "p5-female", quiet=False)
+    assert s.options["subject"] == p["options"]["subject"]
+    assert_json_close(s.joints, p["joints"], rtol=1e-9, atol=1e-6)
+    by_hand = spinesim.spine(height_m=small["height_m"], body_mass_kg=small["body_mass_kg"],
+                             sex="female")
+    assert_json_close(s.joints, by_hand.joints, rtol=0, atol=0)
+    with pytest.raises(ValueError, match="p95-male"):
+        spinesim.spine(subject="giant")
+    with pytest.raises(ValueError, match="whole body"):
+        spinesim.seated_spine(subject="p5-female", height_m=1.6)
+
+
 def test_the_rib_cage_equals_the_program_and_stiffens_the_thorax(program):
     s = spinesim.spine(forces={"T1": [0, 0, 100]}, rib_cage=True)
     p = program("spine", "solve", "--force", "T1:0,0,100", "--rib-cage", quiet=False)

@@ -33,12 +33,12 @@ except ImportError:
             and _os.path.isdir(_os.path.join(_debian, "numpy"))):
         _sys.path.append(_debian)
 from ._spinesim import (Mesh, MassSpringDisc, Simulation, data_dir, import_artisynth,
-                        load_cases, main, read_mesh, seating_parameters)
+                        load_cases, main, named_bodies, read_mesh, seating_parameters)
 
 __all__ = ["Mesh", "MassSpringDisc", "Simulation", "Result", "mesh_disc", "read_mesh",
            "import_artisynth", "fem",
            "export_abaqus", "export_febio", "calibrate", "spine", "seated_spine", "run_study", "main",
-           "load_cases", "seating_parameters", "data_dir"]
+           "load_cases", "seating_parameters", "named_bodies", "data_dir"]
 
 # What the script writes names the script (its provenance: program, commit, command, inputs).
 _spinesim._record_script([_os.path.basename(_sys.executable) or "python3"] +
@@ -186,34 +186,49 @@ def calibrate(mesh, *, material="real-disc", train=("compression", "shear-ap", "
                                         bool(check), out))
 
 
+def _body(subject, height_m, body_mass_kg, sex):
+    """(height_m, body_mass_kg, sex) of the named body `subject`, or the given ones."""
+    if not subject:
+        return float(height_m), float(body_mass_kg), sex
+    if height_m or body_mass_kg or sex != "male":
+        raise ValueError("subject names a whole body: give it without height_m, body_mass_kg "
+                         "or sex")
+    b = _spinesim._named_body(subject)
+    return b["height_m"], b["body_mass_kg"], b["sex"]
+
+
 def spine(*, forces=None, moments=None, fusion="", muscles=True, trunk_muscles=True,
           gravity=True, disc_joints="", ligaments="auto", height_m=0.0, body_mass_kg=0.0,
-          sex="male", rib_cage=False, scoliosis=None):
+          sex="male", subject="", rib_cage=False, scoliosis=None):
     """The standing thoracolumbar spine's equilibrium under gravity and dead loads: `forces`
     {"T7": [Fx, Fy, Fz]} in N at the vertebra's centre, `moments` {"L1": [Mx, My, Mz]} in N·mm;
     `fusion` such as "L3-L4-L5"; `disc_joints` a preset or file of disc joint stiffnesses;
     `ligaments` "auto" (only on disc joints: the thesis's F.4 springs include them), "on" or "off";
     the body `height_m`, `body_mass_kg`, `sex` ("male"/"female"; zeros: the reference 1.778 m,
-    70 kg male) scales the spine (a height or body-mass index out of range raises ValueError);
+    70 kg male) scales the spine (a height or body-mass index out of range raises ValueError),
+    or `subject` names a sourced body instead (named_bodies(): "p5-female", "reference",
+    "p95-male");
     `rib_cage` adds the ribs and sternum on the thoracic vertebrae (off: the thesis's spine);
     `scoliosis` a dict {"type": "thoracic"|"thoracolumbar"|"lumbar", "cobb_deg": 40, optional
     "apex", "curve_ends": ("T6", "T12"), "apical_rotation_deg", "convex": "right"|"left"} makes
     the spine rest in that curve (spine/README.md; a curve it cannot pose raises ValueError).
     Returns the Result `spinesim spine solve --json` prints (vertebrae, joints, muscles,
     ligaments, bushing, warnings, units). Raises RuntimeError when it does not converge."""
+    height_m, body_mass_kg, sex = _body(subject, height_m, body_mass_kg, sex)
     return _result(_spinesim._spine(dict(forces or {}), dict(moments or {}), fusion, muscles,
                                     trunk_muscles, gravity, disc_joints, ligaments,
-                                    float(height_m), float(body_mass_kg), sex, bool(rib_cage),
+                                    height_m, body_mass_kg, sex, bool(rib_cage),
                                     dict(scoliosis or {})))
 
 
 def seated_spine(*, armrests=False, chair_surface="", fusion="", disc_joints="", ligaments="auto",
-                 height_m=0.0, body_mass_kg=0.0, sex="male", rib_cage=False, scoliosis=None,
-                 **chair):
+                 height_m=0.0, body_mass_kg=0.0, sex="male", subject="", rib_cage=False,
+                 scoliosis=None, **chair):
     """The spine seated on a chair: keyword arguments from seating_parameters() (e.g.
     backrest_recline=110 (deg), lumbar_support=20 (mm), seat_angle, backrest_height,
     pelvic_tilt; hyphens or underscores), `armrests`, a backrest surface file `chair_surface`,
-    `ligaments`, `height_m`, `body_mass_kg`, `sex`, `rib_cage` and `scoliosis` as in spine().
+    `ligaments`, `height_m`, `body_mass_kg`, `sex`, `subject`, `rib_cage` and `scoliosis` as in
+    spine().
     Returns the Result `spinesim study seating --json` prints."""
     known = seating_parameters()
     values = {}
@@ -223,8 +238,9 @@ def seated_spine(*, armrests=False, chair_surface="", fusion="", disc_joints="",
             raise ValueError(f"seated_spine: unknown chair parameter '{key}' "
                              f"(use {', '.join(k.replace('-', '_') for k in known)})")
         values[name] = float(value)
+    height_m, body_mass_kg, sex = _body(subject, height_m, body_mass_kg, sex)
     return _result(_spinesim._seated_spine(values, armrests, chair_surface, fusion, disc_joints,
-                                           ligaments, float(height_m), float(body_mass_kg), sex,
+                                           ligaments, height_m, body_mass_kg, sex,
                                            bool(rib_cage), dict(scoliosis or {})))
 
 
