@@ -45,6 +45,7 @@
 #include "spinesim/studies/scoliosis_study.hpp"
 #include "spinesim/studies/spine_solve.hpp"
 #include "spinesim/studies/spine_studies.hpp"
+#include "spinesim/studies/standing_gap_study.hpp"
 
 #include "spinesim/fem/disc_fem.hpp"
 #include "spinesim/mesh/disc_geometry.hpp"
@@ -668,6 +669,52 @@ void register_bodies(CLI::App& study) {
   });
 }
 
+// --- study standing-gap (standing_gap_study.hpp) ----------------------------------------------
+
+void register_standing_gap(CLI::App& study) {
+  struct Args {
+    SpineStudyArgs spine;
+    double prestress_mpa = 0.10;
+    bool markdown = false;
+  };
+  auto a = std::make_shared<Args>();
+  auto* cmd = study.add_subcommand(
+      "standing-gap",
+      "Why standing L4-L5 is too light: the disc's swelling pressure, co-contraction and resting "
+      "muscle tone, each measured against the in-vivo postures");
+  cmd->add_option("--swelling-pressure", a->prestress_mpa,
+                  "The unloaded disc's pressure, MPa (Wilke et al. 1999, lying prone: 0.10)")
+      ->capture_default_str();
+  cmd->add_flag("--json", a->spine.json, "Print the JSON summary on stdout");
+  cmd->add_flag("--markdown", a->markdown, "Print the table as Markdown");
+  cmd->add_flag("--quiet", a->spine.quiet, "No progress on stderr");
+  add_ligaments_option(cmd, a->spine.ligaments);
+  add_rib_cage_option(cmd, a->spine.rib_cage);
+  add_subject_options(cmd, a->spine.subject);
+  cmd->footer(
+      "Each case solves standing, sitting without a backrest, leaning back in a chair (110 deg) "
+      "and holding\n"
+      "Wilke's crate, and reads L4-L5 beside Wilke et al. 1999/2001 (as `study "
+      "seating-validation`). The last two\n"
+      "cases find, by bisection, the co-contraction or tone that closes standing on top of the "
+      "swelling pressure,\n"
+      "and show what that does to the other rows. docs/seating.md discusses the result.");
+  cmd->callback([a] {
+    Progress progress(kStandingGapStages, a->spine.quiet || a->spine.json);
+    const StandingGapStudy s = run_standing_gap_study(
+        data_dir(), a->spine.model(), a->prestress_mpa, spine_study_hooks(a->spine, progress));
+    if (a->spine.json) {
+      print_json(standing_gap_study_json(s));
+      return;
+    }
+    std::cout << "The standing gap: mechanisms that raise the standing disc load, each measured "
+                 "(in vivo: Wilke et al. 1999, 2001)\n\n";
+    print_muscle_set(a->spine);
+    print_standing_gap_study(std::cout, s, a->markdown);
+    std::cout << "Total " << fixed(s.seconds, 1) << " s\n";
+  });
+}
+
 void register_study(CLI::App& app) {
   auto* study = app.add_subcommand(
       "study",
@@ -682,6 +729,7 @@ void register_study(CLI::App& app) {
   register_rib_cage(*study);
   register_scoliosis(*study);
   register_bodies(*study);
+  register_standing_gap(*study);
   register_haptic_plane(*study);
   register_haptic_drag(*study);
   register_disc_validation(*study);

@@ -346,6 +346,12 @@ SpineModel load_spine_model(const std::string& data_dir, const ModelOptions& opt
     throw std::runtime_error(config_file +
                              ": need muscle q > 0, a ROM bump factor >= 1 and a bump onset > 0");
 
+  for (const double f : {options.co_contraction, options.muscle_tone})
+    if (!(f >= 0 && f <= 0.5))
+      throw std::invalid_argument(
+          "co-contraction and muscle tone are fractions of the muscles' maximum force, 0 … 0.5");
+  m.muscle_floor = options.co_contraction;
+  m.muscle_tone = options.muscle_tone;
   try {
     m.subject = options.subject;
     m.scale = detail::subject_scale(config, config_file, m.subject, m.segment_mass_percent);

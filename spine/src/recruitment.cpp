@@ -29,8 +29,11 @@ struct JointStrength {
 class RecruitmentNlp : public Ipopt::TNLP {
  public:
   RecruitmentNlp(const Eigen::MatrixXd& arm, const Eigen::VectorXd& b, const Eigen::VectorXd& fmax,
-                 std::vector<JointStrength> strength, const RecruitmentOptions& o)
-      : arm_(arm),
+                 std::vector<JointStrength> strength, const RecruitmentOptions& o, double floor,
+                 double tone)
+      : floor_(floor),
+        tone_(tone),
+        arm_(arm),
         b_(b),
         fmax_(fmax),
         strength_(std::move(strength)),
@@ -56,7 +59,7 @@ class RecruitmentNlp : public Ipopt::TNLP {
   bool get_bounds_info(Ipopt::Index n, Ipopt::Number* xl, Ipopt::Number* xu, Ipopt::Index m,
                        Ipopt::Number* gl, Ipopt::Number* gu) override {
     for (int i = 0; i < nm_; ++i) {
-      xl[i] = 0;
+      xl[i] = floor_ * fmax_[i];
       xu[i] = fmax_[i];
     }
     for (int i = nm_; i < nm_ + nr_; ++i) {
@@ -77,7 +80,7 @@ class RecruitmentNlp : public Ipopt::TNLP {
 
   bool get_starting_point(Ipopt::Index n, bool, Ipopt::Number* x, bool, Ipopt::Number*,
                           Ipopt::Number*, Ipopt::Index, bool, Ipopt::Number*) override {
-    for (int i = 0; i < nm_; ++i) x[i] = 0.05 * fmax_[i];
+    for (int i = 0; i < nm_; ++i) x[i] = (floor_ + 0.05 * (1 - floor_)) * fmax_[i];
     for (int i = nm_; i < nm_ + nr_; ++i) x[i] = 0;
     if (minmax_) x[n - 1] = 0.1;
     return true;
@@ -86,7 +89,7 @@ class RecruitmentNlp : public Ipopt::TNLP {
   bool eval_f(Ipopt::Index, const Ipopt::Number* x, bool, Ipopt::Number& f) override {
     f = 0;
     for (int i = 0; i < nm_; ++i) {
-      const double a = x[i] / fmax_[i];
+      const double a = x[i] / fmax_[i] - tone_;  // the tone is not recruited
       f += minmax_ ? kMinMaxRegularisation * a * a : std::pow(std::max(a, 0.0), o_.power);
     }
     for (int k = 0; k < nr_; ++k) {
@@ -99,7 +102,7 @@ class RecruitmentNlp : public Ipopt::TNLP {
 
   bool eval_grad_f(Ipopt::Index, const Ipopt::Number* x, bool, Ipopt::Number* g) override {
     for (int i = 0; i < nm_; ++i) {
-      const double a = std::max(x[i] / fmax_[i], 0.0);
+      const double a = std::max(x[i] / fmax_[i] - tone_, 0.0);
       g[i] = minmax_ ? 2 * kMinMaxRegularisation * a / fmax_[i]
                      : o_.power * std::pow(a, o_.power - 1) / fmax_[i];
     }
@@ -119,7 +122,7 @@ class RecruitmentNlp : public Ipopt::TNLP {
     for (const auto& [r, c] : nz_) g[r] += arm_(r, c) * x[c];
     if (minmax_) {
       const double t = x[nm_ + nr_];
-      for (int i = 0; i < nm_; ++i) g[nr_ + i] = x[i] / fmax_[i] - t;
+      for (int i = 0; i < nm_; ++i) g[nr_ + i] = x[i] / fmax_[i] - tone_ - t;
       for (int k = 0; k < nr_; ++k) {
         g[nr_ + nm_ + 2 * k] = x[nm_ + k] / strength_[std::size_t(k)].pos - t;
         g[nr_ + nm_ + 2 * k + 1] = -x[nm_ + k] / strength_[std::size_t(k)].neg - t;
@@ -187,7 +190,7 @@ class RecruitmentNlp : public Ipopt::TNLP {
       return true;
     }
     for (int i = 0; i < nm_; ++i) {
-      const double a = std::max(x[i] / fmax_[i], 0.0);
+      const double a = std::max(x[i] / fmax_[i] - tone_, 0.0);
       const double h = minmax_ ? 2 * kMinMaxRegularisation
                                : o_.power * (o_.power - 1) * std::pow(a, o_.power - 2);
       values[i] = sigma * h / (fmax_[i] * fmax_[i]);
@@ -225,6 +228,7 @@ class RecruitmentNlp : public Ipopt::TNLP {
   int iterations = 0;
 
  private:
+  double floor_, tone_;  ///< the muscles' least activation; the part of it not recruited
   const Eigen::MatrixXd& arm_;
   const Eigen::VectorXd& b_;
   const Eigen::VectorXd& fmax_;
@@ -309,8 +313,11 @@ Recruitment recruit(const SpineModel& m, const Eigen::MatrixXd& arm,
     out.status = nm == 0 ? "no muscles" : "no recruited joints";
     return out;
   }
+  if (!(m.muscle_floor >= 0 && m.muscle_floor < 1) || !(m.muscle_tone >= 0 && m.muscle_tone < 1))
+    throw std::invalid_argument("recruit: muscle floor and tone must lie in [0, 1)");
   Ipopt::SmartPtr<RecruitmentNlp> nlp =
-      new RecruitmentNlp(arm, load_moment_nmm, fmax, strength, options);
+      new RecruitmentNlp(arm, load_moment_nmm, fmax, strength, options,
+                         std::max(m.muscle_floor, m.muscle_tone), m.muscle_tone);
   {
     std::lock_guard<std::mutex> lock(ipopt_mutex());
     Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();

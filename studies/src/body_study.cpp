@@ -149,7 +149,8 @@ void print_body_study(std::ostream& os, const BodyStudy& s, bool markdown) {
      << " N on T1 (fusion, trends), McGill's 238 N·m, Wilke's 19.8 kg crate. The windows are "
         "one male\n  subject's (McGill & Norman's lifter, Wilke's 70 kg volunteer): for the other "
         "bodies they are shown\n  for scale, not as targets. in/out: inside or outside the "
-        "window.\n";
+        "window. The posture rows include the disc's\n  swelling pressure (`study "
+        "seating-validation`).\n";
 }
 
 json body_study_json(const BodyStudy& s) {

@@ -173,24 +173,33 @@ std::string seating_sweep_csv(const SeatingSweep& s) {
 }
 
 SittingValidation run_posture_comparison(const std::string& data_dir,
-                                         const spine::ModelOptions& model) {
+                                         const spine::ModelOptions& model, double swelling_mpa) {
   const json targets = read_targets(data_dir);
   const double area = number_at(targets, "disc_area_mm2", "the file");
   const double tol = number_at(targets, "tolerance", "the file");
   const json& p = targets.at("pressures");
   auto mpa = [&](const std::string& k) { return number_at(p.at(k), "mpa", k); };
   auto source = [&](const std::string& k) { return p.at(k).at("source").get<std::string>(); };
+  if (std::isnan(swelling_mpa)) swelling_mpa = number_at(targets, "swelling_pressure_mpa", "the file");
+  if (!(swelling_mpa >= 0 && swelling_mpa <= 0.5))
+    throw std::invalid_argument("the disc's swelling pressure must lie within 0 … 0.5 MPa");
   SittingValidation v;
-  const double standing = l4l5(spine::solve_spine(spine::load_spine_model(data_dir, model), {}));
+  v.disc_area_mm2 = area;
+  const spine::SpineModel standing_model = spine::load_spine_model(data_dir, model);
+  // The swelling pressure on this body's L4-L5 disc: the area scales with the body's length².
+  const double s = standing_model.scale.length;
+  v.swelling_mpa = swelling_mpa;
+  v.swelling_n = swelling_mpa * area * s * s;
+  const double standing = l4l5(spine::solve_spine(standing_model, {})) + v.swelling_n;
   SeatingRequest stool;
   stool.model = model;
   stool.chair.backrest_height_mm = 0;
-  const double unsupported = l4l5(run_seating(data_dir, stool).seated.spine);
+  const double unsupported = l4l5(run_seating(data_dir, stool).seated.spine) + v.swelling_n;
   SeatingRequest slouched = stool;  // leaning back in an ordinary chair
   slouched.chair = spine::Chair();
   slouched.chair.backrest_recline_deg = 110;
-  const double in_chair = l4l5(run_seating(data_dir, slouched).seated.spine);
-  const double crate = run_wilke_case(data_dir, model).l4l5.axial_n;
+  const double in_chair = l4l5(run_seating(data_dir, slouched).seated.spine) + v.swelling_n;
+  const double crate = run_wilke_case(data_dir, model).l4l5.axial_n + v.swelling_n;
   auto row = [&](const std::string& id, const std::string& what, double ours, double target,
                  const std::string& unit, const std::string& src) {
     SittingValidation::Row r{id,   what, ours, target, target * (1 - tol), target * (1 + tol),
@@ -250,6 +259,10 @@ void print_sitting_validation(std::ostream& os, const SittingValidation& v, bool
            significant(r.target, 3), significant(r.low, 3) + " … " + significant(r.high, 3),
            r.pass ? "MATCH" : "DIFFERS", r.source});
   t.print(os, markdown);
+  os << "  L4-L5 compression: the joint's axial force + the disc's swelling pressure, "
+     << fixed(v.swelling_mpa, 2) << " MPa × the disc area = " << fixed(v.swelling_n, 0)
+     << " N in every posture (Wilke et al. 1999, lying prone; self-equilibrated, so no joint "
+        "force changes)\n";
   for (const auto& s : v.sweeps) {
     os << "\nSweep: " << s.parameter << "\n";
     print_seating_sweep(os, s, markdown);
@@ -276,6 +289,8 @@ json sitting_validation_json(const SittingValidation& v) {
   return {{"rows", rows},
           {"sweeps", sweeps},
           {"findings", findings_json(v.findings)},
+          {"swelling_mpa", v.swelling_mpa},
+          {"swelling_n", v.swelling_n},
           {"seconds", v.seconds}};
 }
 

@@ -452,6 +452,21 @@ TEST(SpineSolveCli, ANamedBodyIsItsHeightMassAndSexAndTheBodiesStudyComparesThem
       << v.out;
 }
 
+// The standing-gap study prints its cases as JSON with the in-vivo load it closes to, and
+// refuses a swelling pressure outside 0 … 0.5 MPa before any work.
+TEST(SpineSolveCli, TheStandingGapStudyMeasuresEachMechanism) {
+  expect_refused(run_spinesim("study standing-gap --swelling-pressure 0.7 --quiet"),
+                 "swelling pressure");
+  const CliRun r = run_spinesim("study standing-gap --json --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const json j = json::parse(r.out);
+  EXPECT_EQ(j["standing_target_n"].get<double>(), 900.0);
+  ASSERT_EQ(j["cases"].size(), 10u);
+  EXPECT_EQ(j["cases"][0]["mechanism"], "none");
+  EXPECT_NEAR(j["cases"][1]["standing_n"].get<double>() - j["cases"][0]["standing_n"].get<double>(),
+              j["prestress_force_n"].get<double>(), 1e-6);
+}
+
 // Loads in time (`spine schedule`): the table, the CSV and the recording; the recording drives
 // the offline discs; a malformed schedule is refused in one line with nothing written.
 TEST(SpineScheduleCli, ASchedulesStepsTheirCsvAndARecordingTheDiscsFollow) {

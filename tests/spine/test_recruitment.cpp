@@ -112,3 +112,80 @@ TEST(Recruitment, SatisfiesTheKktConditionsOfItsCriterion) {
           f0 - 1e-9 * f0);
   }
 }
+
+namespace {
+
+struct Problem {
+  sp::SpineModel m;
+  Eigen::MatrixXd A;
+  Eigen::VectorXd b, fmax;
+};
+
+Problem forward_push(double co_contraction, double tone) {
+  sp::ModelOptions o;
+  o.co_contraction = co_contraction;
+  o.muscle_tone = tone;
+  Problem p{sp::load_spine_model(SPINESIM_DATA_DIR, o), {}, {}, {}};
+  sp::ExternalLoad load;
+  load.vertebra = sp::vertebra_index("T7");
+  load.force_n = Eigen::Vector3d(0, 0, 150);
+  std::vector<int> joints;
+  sp::recruitment_problem(p.m, {load}, p.A, p.b, joints);
+  p.fmax.resize(Eigen::Index(p.m.muscles.size()));
+  for (std::size_t i = 0; i < p.m.muscles.size(); ++i)
+    p.fmax(Eigen::Index(i)) = p.m.muscles[i].max_force_n();
+  return p;
+}
+
+}  // namespace
+
+// Resting tone τ is carried, not chosen: with it, the recruitment must equal τ·F_max plus the
+// plain recruitment of the load that is left once the tone's own moments are taken off
+// (b − A τ F_max) — a second, independent problem. Co-contraction keeps every muscle at or above
+// its floor, balances the load, and no feasible step lowers its criterion.
+TEST(Recruitment, ToneIsCarriedAndCoContractionIsAFloor) {
+  const double tau = 0.03;
+  const Problem toned = forward_push(0, tau);
+  const sp::Recruitment with_tone = sp::recruit(toned.m, toned.A, toned.b);
+  ASSERT_TRUE(with_tone.success) << with_tone.status;
+  const Problem plain = forward_push(0, 0);
+  const Eigen::VectorXd shifted = plain.b - tau * plain.A * plain.fmax;
+  const sp::Recruitment rest = sp::recruit(plain.m, plain.A, shifted);
+  ASSERT_TRUE(rest.success) << rest.status;
+  ASSERT_LT(rest.activation.maxCoeff(), 1 - tau);  // no upper bound active: the oracle holds
+  const Eigen::VectorXd expected = tau * plain.fmax + rest.force_n;
+  EXPECT_LE((with_tone.force_n - expected).cwiseAbs().maxCoeff(), 1e-3 * plain.fmax.maxCoeff())
+      << (with_tone.force_n - expected).cwiseAbs().maxCoeff();
+  EXPECT_GE(with_tone.activation.minCoeff(), tau - 1e-8);
+
+  const double floor = 0.04, p = sp::RecruitmentOptions().power;
+  const Problem cc = forward_push(floor, 0);
+  const sp::Recruitment co = sp::recruit(cc.m, cc.A, cc.b);
+  ASSERT_TRUE(co.success) << co.status;
+  const Eigen::VectorXd& F = co.force_n;
+  const Eigen::VectorXd& r = co.reserve_nmm;
+  EXPECT_GE(co.activation.minCoeff(), floor - 1e-8);
+  EXPECT_LE((cc.A * F + r - cc.b).cwiseAbs().maxCoeff(), 1e-5 * cc.b.cwiseAbs().maxCoeff());
+  int at_floor = 0;
+  const std::vector<Axis> axes = joint_axes(cc.m);
+  const double f0 = objective(F, cc.fmax, r, axes, p);
+  for (Eigen::Index i = 0; i < F.size(); ++i) {
+    const double h = 1e-4 * cc.fmax(i);
+    at_floor += F(i) < (floor + 1e-4) * cc.fmax(i);
+    EXPECT_GE(objective(F + h * Eigen::VectorXd::Unit(F.size(), i), cc.fmax, r - h * cc.A.col(i),
+                        axes, p),
+              f0 - 1e-9 * f0);
+    if (F(i) - h >= floor * cc.fmax(i))
+      EXPECT_GE(objective(F - h * Eigen::VectorXd::Unit(F.size(), i), cc.fmax,
+                          r + h * cc.A.col(i), axes, p),
+                f0 - 1e-9 * f0);
+  }
+  EXPECT_GT(at_floor, 10);  // the flexors idle at the floor, not at zero
+
+  sp::ModelOptions bad;
+  bad.co_contraction = 0.6;
+  EXPECT_THROW(sp::load_spine_model(SPINESIM_DATA_DIR, bad), std::invalid_argument);
+  bad.co_contraction = 0;
+  bad.muscle_tone = -0.01;
+  EXPECT_THROW(sp::load_spine_model(SPINESIM_DATA_DIR, bad), std::invalid_argument);
+}

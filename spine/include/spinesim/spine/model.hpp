@@ -227,6 +227,12 @@ struct ModelOptions {
   /// joint's spring becomes that level's disc 3×3 rotational stiffness about the joint point, in
   /// place of F.4. A preset name (file stem in data/spine/disc_joints/) or a path; empty: F.4.
   std::string disc_joints;
+  /// Muscle activity the recruitment does not choose (the standing-gap mechanisms; 0: none,
+  /// the thesis's static optimisation). co_contraction: every muscle's activation is at least
+  /// this, and the criterion counts it; muscle_tone: every muscle carries this activation as
+  /// resting tone, and the criterion counts only what is recruited above it. Fractions of each
+  /// muscle's maximum force, 0 … 0.5.
+  double co_contraction = 0, muscle_tone = 0;
 };
 
 /// Makes `m` rest in the scoliotic curve options.scoliosis (scoliosis.hpp): the joints' springs,
@@ -260,6 +266,9 @@ struct SpineModel {
   std::shared_ptr<const ContactSurface> contact_surface;
   std::vector<int> recruited_joints;  ///< joints whose equilibrium the muscles are recruited for
   double muscle_q = 10;               ///< short-range stiffness factor (k = q F / L0)
+  /// The muscles' least activation and its unrecruited part (ModelOptions::co_contraction,
+  /// muscle_tone; recruit() uses max(floor, tone) as the lower bound).
+  double muscle_floor = 0, muscle_tone = 0;
   double rom_bump_factor = 100;       ///< joint stiffness multiplier beyond the F.5 range
   double rom_bump_onset = 0;          ///< rad over which the bump's stiffness ramps up (C² energy)
   double body_mass_kg = 70, gravity_mm_s2 = 9810;

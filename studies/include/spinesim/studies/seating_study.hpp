@@ -14,6 +14,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <limits>
 #include <optional>
 #include <ostream>
 #include <string>
@@ -88,12 +89,21 @@ struct SittingValidation {
   std::vector<Row> rows;
   std::vector<SeatingSweep> sweeps;
   std::vector<Finding> findings;  ///< the rows and the trends, MATCH / DIFFERS
+  double disc_area_mm2 = 0;       ///< the area the in-vivo pressures are converted with
+  /// The disc's swelling pressure (MPa) and its force on this body's L4-L5 disc (N: pressure ×
+  /// disc_area_mm2 × the body's length scale²), in every posture's compression.
+  double swelling_mpa = 0, swelling_n = 0;
   double seconds = 0;
 };
 /// The first part alone: standing, sitting without and with a backrest, and the crate (rows and
-/// their findings; no sweeps, seconds 0).
-SittingValidation run_posture_comparison(const std::string& data_dir,
-                                         const spine::ModelOptions& model = spine::ModelOptions());
+/// their findings; no sweeps, seconds 0). Each L4-L5 compression is the joint's axial force plus
+/// the disc's swelling pressure times the disc area (`swelling_mpa`; NaN: the validation file's
+/// "swelling_pressure_mpa", Wilke et al. 1999's unloaded disc). The pre-stress is
+/// self-equilibrated (the annulus fibres and ligaments hold it in), so no joint reaction changes;
+/// the in-vivo pressures it is compared with include it.
+SittingValidation run_posture_comparison(
+    const std::string& data_dir, const spine::ModelOptions& model = spine::ModelOptions(),
+    double swelling_mpa = std::numeric_limits<double>::quiet_NaN());
 inline constexpr int kSittingValidationStages = 5;  ///< postures, then one per swept parameter
 SittingValidation run_sitting_validation(const std::string& data_dir,
                                          const spine::ModelOptions& model = spine::ModelOptions(),
