@@ -33,6 +33,7 @@ struct MeshArgs {
   double max_elements = mesh::MeshOptions().max_elements;
   std::vector<std::string> cgal_flags_given, structured_flags_given;  ///< filled after parsing
   ScoliosisFlags scoliosis;  ///< a level of a scoliotic spine: the disc wedged as the curve has it
+  SubjectFlags subject;      ///< a level of another body's spine: the disc scaled with it
 };
 
 std::string joined(const std::vector<std::string>& names) {
@@ -101,6 +102,7 @@ void run_mesh_disc(const MeshArgs& a) {
   rq.out = a.out;
   rq.medit = a.medit;
   rq.scoliosis = scoliosis_of(a.scoliosis);
+  rq.subject = subject_of(a.subject);
 
   // 2. The driver, then the report.
   Progress progress(mesh_disc_stages(rq), a.quiet || a.json);
@@ -240,6 +242,7 @@ void register_mesh(CLI::App& app) {
   disc->add_option("--out", a->out, "Output VTU file")->capture_default_str();
   disc->add_option("--medit", a->medit, "Also write a Medit .mesh file");
   add_scoliosis_options(disc, a->scoliosis);
+  add_subject_options(disc, a->subject);
   add_output_flags(disc, a->json, a->quiet);
   disc->callback([a, cgal, structured] {
     a->cgal_flags_given.clear();

@@ -6,6 +6,7 @@
 #include "spinesim/mesh/vertebra_disc.hpp"
 #include "spinesim/spine/kinematics.hpp"
 #include "spinesim/studies/mesh_report.hpp"
+#include "spinesim/studies/spine_solve.hpp"
 #include "spinesim/studies/toolkit.hpp"
 
 #include <stdexcept>
@@ -22,6 +23,11 @@ void check(const MeshDiscRequest& r) {
   if (r.structured) mesh::validate(r.structured_options);
   if (r.scoliosis.cobb_deg != 0 && r.level.empty())
     throw std::invalid_argument("--scoliosis is for a parametric --level");
+  if ((r.subject.height_m != 0 || r.subject.body_mass_kg != 0 ||
+       r.subject.sex != spine::Sex::Male) &&
+      r.level.empty())
+    throw std::invalid_argument(
+        "a body (--height, --mass, --sex, --subject) is for a parametric --level");
   if (!r.out.empty()) require_output_folder(r.out, "--out");  // a device, FIFO or link: refused
   if (r.out.empty() && !r.medit.empty())
     throw std::invalid_argument("--medit is a copy of --out: give --out too");
@@ -82,22 +88,31 @@ double mesh_between_vertebrae(const MeshDiscRequest& r, const StageHooks& hooks,
   return info.volume_mm3;
 }
 
+/// The model of the request's body and curve, without loads (its scale and rest posture).
+spine::SpineModel unloaded_model(const MeshDiscRequest& r, const std::string& data_dir) {
+  spine::ModelOptions o;
+  o.gravity = o.muscles = o.iap = false;
+  o.scoliosis = r.scoliosis;
+  o.subject = r.subject;
+  return spine::load_spine_model(data_dir, o);
+}
+
 /// The disc of `level` carried between its vertebrae in the curve's rest posture. The mesh comes
 /// in the spine placement; a local one is then expressed in the lower vertebra's frame.
 nlohmann::json carry_in_scoliosis(const MeshDiscRequest& r, const std::string& data_dir,
                                   mesh::TetMesh& m) {
-  spine::ModelOptions o;
-  o.gravity = o.muscles = o.iap = false;
-  o.scoliosis = r.scoliosis;
-  const spine::SpineModel model = spine::load_spine_model(data_dir, o);
+  const spine::SpineModel model = unloaded_model(r, data_dir);
+  const double s = model.scale.length;
   const std::size_t k =
       std::size_t(spine::joint_index(mesh::disc_dimensions(r.level, data_dir).level));
   const std::vector<spine::Pose> P = spine::vertebra_poses(model, model.rest_posture);
   auto motion = [](const spine::Pose& p) { return mesh::RigidMotion{p.R, p.t}; };
   const mesh::RigidMotion upper = motion(P[k]),
                           lower = k + 1 < P.size() ? motion(P[k + 1]) : mesh::RigidMotion();
-  const mesh::DiscFrame frame = mesh::disc_level_frame(r.level, data_dir);
-  mesh::carry_between(m, frame, mesh::disc_dimensions(r.level, data_dir).height_mm, lower, upper);
+  mesh::DiscFrame frame = mesh::disc_level_frame(r.level, data_dir);
+  frame.origin_mm *= s;  // the body's disc, scaled about the origin as its spine is
+  mesh::carry_between(m, frame, s * mesh::disc_dimensions(r.level, data_dir).height_mm, lower,
+                      upper);
   if (r.placement == mesh::DiscPlacement::local)
     for (Eigen::Index i = 0; i < m.V.rows(); ++i) {
       const Eigen::Vector3d x = lower.R.transpose() * (m.V.row(i).transpose() - lower.t);
@@ -115,6 +130,13 @@ nlohmann::json carry_in_scoliosis(const MeshDiscRequest& r, const std::string& d
 double mesh_straight_level(const MeshDiscRequest& r, const std::string& data_dir,
                            const StageHooks& hooks, MeshDiscResult& out) {
   const auto dims = mesh::disc_dimensions(r.level, data_dir);
+  const double s = unloaded_model(r, data_dir).scale.length;
+  // The reference disc is meshed with sizes 1/s as large and scaled by s: the body's disc with
+  // the asked sizes.
+  mesh::MeshOptions cgal = r.cgal;
+  for (double* size : {&cgal.cell_size_mm, &cgal.facet_distance_mm, &cgal.facet_size_mm,
+                       &cgal.edge_size_mm})
+    *size /= s;
   const Timer t;
   if (r.structured) {
     const mesh::StructuredDiscOptions& so = r.structured_options;
@@ -128,14 +150,17 @@ double mesh_straight_level(const MeshDiscRequest& r, const std::string& data_dir
     hooks.begin_stage("meshing " + dims.level + " (cell size " +
                       std::to_string(r.cgal.cell_size_mm).substr(0, 4) + " mm)");
     out.mesh =
-        mesh::mesh_disc_level(dims.level, r.cgal, data_dir,
+        mesh::mesh_disc_level(dims.level, cgal, data_dir,
                               r.scoliosis.cobb_deg != 0 ? mesh::DiscPlacement::spine : r.placement);
   }
+  out.mesh.V *= s;
   out.mesh_seconds = t.seconds();
   hooks.end_stage(std::to_string(out.mesh.num_tets()) + " tets");
   out.disc = {{"level", dims.level},
-              {"placement", r.placement == mesh::DiscPlacement::spine ? "spine" : "local"}};
-  return mesh::parametric_disc_volume(dims);
+              {"placement", r.placement == mesh::DiscPlacement::spine ? "spine" : "local"},
+              {"length_scale", s},
+              {"subject", subject_json(spine::resolve_subject(data_dir, r.subject))}};
+  return s * s * s * mesh::parametric_disc_volume(dims);
 }
 
 /// A parametric level, CGAL or structured; returns the exact volume of the parametric disc (−1

@@ -1,8 +1,10 @@
-// The bodies study: the reference body's column is the single-body studies' own numbers, and the
+// The bodies study and the discs of a body: the reference body's column is the single-body studies' own numbers, and the
 // bodies differ the way statics says they must — the same external moment on a smaller trunk
 // (shorter muscle lever arms) needs a larger spine compression, and standing loads grow with
 // the body's weight.
+#include "spinesim/spine/scoliosis.hpp"
 #include "spinesim/studies/body_study.hpp"
+#include "spinesim/studies/mesh_disc.hpp"
 
 #include <gtest/gtest.h>
 
@@ -56,4 +58,30 @@ TEST(BodyStudy, ReferenceColumnIsTheDefaultStudyAndBodiesScaleAsStaticsSays) {
 
 TEST(BodyStudy, AnUnknownBodyIsRefusedBeforeAnyWork) {
   EXPECT_THROW(st::run_body_study(kData, 300, {}, {"p5-female", "giant"}), std::invalid_argument);
+}
+
+// A disc meshed for another body is the reference body's disc scaled by its length scale, node
+// for node — straight, and wedged in a scoliotic curve (whose angles do not change with size).
+TEST(BodyStudy, ADiscMeshedForABodyIsTheReferenceDiscScaled) {
+  namespace sp = spinesim::spine;
+  for (const bool curved : {false, true}) {
+    st::MeshDiscRequest rq;
+    rq.level = "T7-T8";
+    rq.structured = true;
+    if (curved) rq.scoliosis = sp::scoliosis_curve("thoracic", 40);
+    const st::MeshDiscResult ref = st::run_mesh_disc(rq, kData);
+    rq.subject = sp::named_body(kData, "p5-female").subject;
+    const st::MeshDiscResult small = st::run_mesh_disc(rq, kData);
+    const double s = small.disc["length_scale"].get<double>();
+    EXPECT_NEAR(s, 1.501 / 1.778, 1e-12);
+    ASSERT_EQ(small.mesh.V.rows(), ref.mesh.V.rows());
+    EXPECT_LE((small.mesh.V - s * ref.mesh.V).cwiseAbs().maxCoeff(), 1e-9) << curved;
+    EXPECT_EQ(small.mesh.T, ref.mesh.T);
+    EXPECT_EQ(small.disc["subject"]["sex"], "female");
+  }
+  st::MeshDiscRequest between;
+  between.inferior = "a.stl";
+  between.superior = "b.stl";
+  between.subject.height_m = 1.6;
+  EXPECT_THROW(st::run_mesh_disc(between, kData), std::invalid_argument);
 }

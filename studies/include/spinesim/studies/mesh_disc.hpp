@@ -30,6 +30,10 @@ struct MeshDiscRequest {
   /// its two vertebrae in the curve's rest posture (mesh::carry_between), wedged and twisted as
   /// the curve has them; placed in the curved spine, or (local) in its lower vertebra's frame.
   spine::ScoliosisCurve scoliosis;
+  /// A parametric level of another body's spine (zeros: the reference body): the disc is the
+  /// reference disc scaled by height / 1.778 m (geometric similarity, as the spine is); CGAL's
+  /// sizes stay the asked ones in millimetres.
+  spine::Subject subject;
   std::string out, medit;  ///< the VTU (empty: nothing written), and an optional Medit copy
 };
 
