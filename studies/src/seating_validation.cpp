@@ -180,7 +180,8 @@ SittingValidation run_posture_comparison(const std::string& data_dir,
   const json& p = targets.at("pressures");
   auto mpa = [&](const std::string& k) { return number_at(p.at(k), "mpa", k); };
   auto source = [&](const std::string& k) { return p.at(k).at("source").get<std::string>(); };
-  if (std::isnan(swelling_mpa)) swelling_mpa = number_at(targets, "swelling_pressure_mpa", "the file");
+  if (std::isnan(swelling_mpa))
+    swelling_mpa = number_at(targets, "swelling_pressure_mpa", "the file");
   if (!(swelling_mpa >= 0 && swelling_mpa <= 0.5))
     throw std::invalid_argument("the disc's swelling pressure must lie within 0 … 0.5 MPa");
   SittingValidation v;
