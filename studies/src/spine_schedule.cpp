@@ -5,6 +5,7 @@
 #include "spinesim/common/timer.hpp"
 #include "spinesim/haptics/recording.hpp"
 #include "spinesim/spine/database.hpp"
+#include "spinesim/spine/dynamics.hpp"
 #include "spinesim/spine/kinematics.hpp"
 #include "spinesim/studies/spine_solve.hpp"
 #include "spinesim/studies/toolkit.hpp"
@@ -17,6 +18,11 @@
 
 namespace spinesim::studies {
 namespace {
+
+/// A number, or null in JSON when it is not finite (unknown, or no load ever changes).
+nlohmann::json finite_or_null(double v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
+}
 
 const char* const kComponents[6] = {"fx_n", "fy_n", "fz_n", "mx_nmm", "my_nmm", "mz_nmm"};
 
@@ -128,6 +134,36 @@ std::vector<double> schedule_times(const LoadSchedule& s, double step_s) {
   return times;
 }
 
+namespace {
+
+double fastest_ramp_s(const LoadSchedule& s) {
+  double fastest = INFINITY;
+  for (std::size_t i = 1; i < s.time_s.size(); ++i)
+    if (s.values[i] != s.values[i - 1]) fastest = std::min(fastest, s.time_s[i] - s.time_s[i - 1]);
+  return fastest;
+}
+
+void check_inertia(ScheduleRun& run) {
+  const ScheduleStep* first = nullptr;
+  for (const ScheduleStep& s : run.steps)
+    if (s.error.empty()) {
+      first = &s;
+      break;
+    }
+  run.fastest_ramp_s = fastest_ramp_s(run.schedule);
+  if (!first || run.model.weights.empty()) return;
+  try {
+    run.first_frequency_hz =
+        spine::spine_natural_modes(run.model, first->loads, first->solution, 1).frequency_hz[0];
+  } catch (const std::invalid_argument&) {
+    return;  // an unstable first posture: no modes to compare with
+  }
+  if (std::isfinite(run.fastest_ramp_s))
+    run.overshoot_bound = spine::ramp_overshoot_bound(run.first_frequency_hz, run.fastest_ramp_s);
+}
+
+}  // namespace
+
 ScheduleRun run_load_schedule(const std::string& data_dir, const LoadSchedule& schedule,
                               const spine::ModelOptions& model, const spine::SolveOptions& solve,
                               double step_s, int workers,
@@ -146,6 +182,7 @@ ScheduleRun run_load_schedule(const std::string& data_dir, const LoadSchedule& s
     run.steps.push_back({times[i], loads[i], std::move(solutions[i]), errors[i]});
     if (!errors[i].empty()) ++run.failed;
   }
+  check_inertia(run);
   run.seconds = timer.seconds();
   return run;
 }
@@ -226,10 +263,32 @@ nlohmann::json schedule_json(const ScheduleRun& run) {
           {"subject", subject_json(run.model.subject)},
           {"steps", steps},
           {"failed", run.failed},
+          {"inertia",
+           {{"first_frequency_hz", finite_or_null(run.first_frequency_hz)},
+            {"fastest_ramp_s", finite_or_null(run.fastest_ramp_s)},
+            {"overshoot_bound", finite_or_null(run.overshoot_bound)}}},
           {"seconds", run.seconds},
           {"units",
            {{"force", "N"}, {"moment", "N·mm"}, {"translation", "mm"}, {"rotation", "deg"},
             {"t1_displacement", "tx, ty, tz (mm), rx, ry, rz (deg)"}}}};
+}
+
+/// Whether inertia matters: the first natural frequency beside the fastest ramp.
+void print_inertia(std::ostream& os, const ScheduleRun& run) {
+  if (!std::isfinite(run.first_frequency_hz)) return;
+  os << "\nInertia: the spine's first natural frequency at " << fixed(run.steps.front().t_s, 3)
+     << " s is " << fixed(run.first_frequency_hz, 2) << " Hz (period "
+     << fixed(1 / run.first_frequency_hz, 3) << " s)";
+  if (!std::isfinite(run.fastest_ramp_s)) {
+    os << "; the loads do not change.\n";
+    return;
+  }
+  os << "; the fastest ramp lasts " << fixed(run.fastest_ramp_s, 3)
+     << " s, so the motion may overshoot the quasi-static answer by up to "
+     << fixed(100 * run.overshoot_bound, 1) << " % of a ramp's step"
+     << (run.overshoot_bound > kInertiaMatters
+             ? ": inertia matters here, and this quasi-static sequence is not the motion.\n"
+             : " (undamped bound): quasi-static.\n");
 }
 
 void print_schedule(std::ostream& os, const ScheduleRun& run) {
@@ -261,6 +320,7 @@ void print_schedule(std::ostream& os, const ScheduleRun& run) {
   for (const auto& step : run.steps)
     if (!step.error.empty())
       os << "no equilibrium at " << fixed(step.t_s, 3) << " s: " << step.error << "\n";
+  print_inertia(os, run);
   os << "\nTotal " << fixed(run.seconds, 2) << " s\n";
 }
 

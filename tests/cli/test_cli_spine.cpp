@@ -467,6 +467,27 @@ TEST(SpineSolveCli, TheStandingGapStudyMeasuresEachMechanism) {
               j["prestress_force_n"].get<double>(), 1e-6);
 }
 
+// Whether inertia matters: a schedule ramping in 0.1 s is flagged against the spine's first
+// natural frequency, one ramping over 10 s is called quasi-static; the JSON carries the numbers.
+TEST(SpineScheduleCli, TheScheduleSaysWhetherInertiaMatters) {
+  const std::string fast = tmp("fast.csv"), slow = tmp("slow.csv");
+  spit(fast, "time_s,T7.fz_n\n0,0\n0.1,200\n");
+  spit(slow, "time_s,T7.fz_n\n0,0\n10,200\n");
+  const CliRun f = run_spinesim("spine schedule --quiet --loads " + in_quotes(fast));
+  ASSERT_EQ(f.status, 0) << f.err;
+  EXPECT_NE(f.out.find("inertia matters here"), std::string::npos) << f.out;
+  const CliRun s = run_spinesim("spine schedule --quiet --loads " + in_quotes(slow));
+  ASSERT_EQ(s.status, 0) << s.err;
+  EXPECT_NE(s.out.find("quasi-static."), std::string::npos) << s.out;
+  const json j = json::parse(run_spinesim("spine schedule --quiet --json --loads " +
+                                          in_quotes(slow)).out);
+  const double f1 = j["inertia"]["first_frequency_hz"].get<double>();
+  EXPECT_GT(f1, 0.2);
+  EXPECT_LT(f1, 20);
+  EXPECT_DOUBLE_EQ(j["inertia"]["fastest_ramp_s"].get<double>(), 10.0);
+  EXPECT_NEAR(j["inertia"]["overshoot_bound"].get<double>(), 1 / (M_PI * f1 * 10), 1e-12);
+}
+
 // Loads in time (`spine schedule`): the table, the CSV and the recording; the recording drives
 // the offline discs; a malformed schedule is refused in one line with nothing written.
 TEST(SpineScheduleCli, ASchedulesStepsTheirCsvAndARecordingTheDiscsFollow) {

@@ -12,7 +12,10 @@
 //
 // Quasi-static: the spine model is elastic and keeps no history (recruitment and equilibrium
 // depend on the loads of the moment only), so each sampled time is its own equilibrium and the
-// sequence's answer does not depend on how finely it is sampled. Inertia is not modelled.
+// sequence's answer does not depend on how finely it is sampled. Inertia is not modelled; it is
+// measured: the spine's first natural frequency f1 at the first step (spine/dynamics.hpp) beside
+// the schedule's fastest ramp T_r bounds the motion's overshoot of the quasi-static answer by
+// 1/(π f1 T_r) of a ramp's step; above kInertiaMatters the output says inertia matters.
 #pragma once
 
 #include "spinesim/spine/equilibrium.hpp"
@@ -20,6 +23,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <functional>
 #include <string>
 #include <utility>
@@ -50,6 +54,9 @@ std::vector<spine::ExternalLoad> schedule_loads(const LoadSchedule& s, double t)
 /// key time on as well (sorted, duplicates removed).
 std::vector<double> schedule_times(const LoadSchedule& s, double step_s);
 
+/// A ramp whose undamped overshoot bound exceeds this share of its step: inertia matters.
+inline constexpr double kInertiaMatters = 0.05;
+
 struct ScheduleStep {
   double t_s = 0;
   std::vector<spine::ExternalLoad> loads;
@@ -62,6 +69,10 @@ struct ScheduleRun {
   spine::SpineModel model;
   std::vector<ScheduleStep> steps;
   int failed = 0;  ///< steps whose equilibrium was not found (kept, with their error)
+  /// Inertia (see the header): f1 (Hz) at the first converged step, the shortest interval
+  /// between key times over which a load changes (s), and the overshoot bound (a fraction);
+  /// NaN / infinity when unknown or the loads never change.
+  double first_frequency_hz = NAN, fastest_ramp_s = INFINITY, overshoot_bound = 0;
   double seconds = 0;
 };
 
