@@ -287,7 +287,8 @@ void print_inertia(std::ostream& os, const ScheduleRun& run) {
      << " s, so the motion may overshoot the quasi-static answer by up to "
      << fixed(100 * run.overshoot_bound, 1) << " % of a ramp's step"
      << (run.overshoot_bound > kInertiaMatters
-             ? ": inertia matters here, and this quasi-static sequence is not the motion.\n"
+             ? " (undamped bound; damping lowers it): inertia may matter here, and this "
+               "quasi-static sequence may not be the motion.\n"
              : " (undamped bound): quasi-static.\n");
 }
 

@@ -15,7 +15,7 @@
 // sequence's answer does not depend on how finely it is sampled. Inertia is not modelled; it is
 // measured: the spine's first natural frequency f1 at the first step (spine/dynamics.hpp) beside
 // the schedule's fastest ramp T_r bounds the motion's overshoot of the quasi-static answer by
-// 1/(π f1 T_r) of a ramp's step; above kInertiaMatters the output says inertia matters.
+// min(1, 1/(π f1 T_r)) of a ramp's step; above kInertiaMatters the output says inertia may matter.
 #pragma once
 
 #include "spinesim/spine/equilibrium.hpp"
