@@ -441,8 +441,8 @@ StageHooks spine_study_hooks(const SpineStudyArgs& a, Progress& progress) {
 template <class Study>
 void emit_spine_study(const SpineStudyArgs& a, const Study& s, const char* title,
                       std::string (*to_csv)(const Study&), nlohmann::json (*to_json)(const Study&),
-                      void (*print)(std::ostream&, const Study&, bool)) {
-  if (!a.csv.empty()) write_csv_file(a.csv, to_csv(s));
+                      void (*print)(std::ostream&, const Study&, bool), bool markdown = false) {
+  if (!a.csv.empty() && to_csv) write_csv_file(a.csv, to_csv(s));
   if (a.json) {
     nlohmann::json j = to_json(s);
     j["csv"] = a.csv.empty() ? nlohmann::json(nullptr) : nlohmann::json(a.csv);
@@ -451,7 +451,7 @@ void emit_spine_study(const SpineStudyArgs& a, const Study& s, const char* title
   }
   std::cout << title << "\n\n";
   print_muscle_set(a);
-  print(std::cout, s, false);
+  print(std::cout, s, markdown);
   std::cout << "Total " << fixed(s.seconds, 2) << " s" << (a.csv.empty() ? "" : "; wrote " + a.csv)
             << "\n";
 }
@@ -619,6 +619,15 @@ void register_scoliosis(CLI::App& study) {
 
 // --- study bodies (body_study.hpp) ------------------------------------------------------------
 
+/// --json, --markdown, --quiet, --ligaments and --rib-cage of the studies over many spines.
+void add_model_and_output_flags(CLI::App* cmd, SpineStudyArgs& a, bool& markdown) {
+  cmd->add_flag("--json", a.json, "Print the JSON summary on stdout (instead of the tables)");
+  cmd->add_flag("--markdown", markdown, "Print the tables as Markdown");
+  cmd->add_flag("--quiet", a.quiet, "No progress on stderr");
+  add_ligaments_option(cmd, a.ligaments);
+  add_rib_cage_option(cmd, a.rib_cage);
+}
+
 void register_bodies(CLI::App& study) {
   struct Args {
     SpineStudyArgs spine;
@@ -637,11 +646,7 @@ void register_bodies(CLI::App& study) {
                   "data/spine/spine_model.json anthropometry.bodies)")
       ->delimiter(',');
   cmd->add_option("--csv", a->spine.csv, "Write the comparison as CSV (a row per quantity)");
-  cmd->add_flag("--json", a->spine.json, "Print every study's JSON on stdout");
-  cmd->add_flag("--markdown", a->markdown, "Print the tables as Markdown");
-  cmd->add_flag("--quiet", a->spine.quiet, "No progress on stderr");
-  add_ligaments_option(cmd, a->spine.ligaments);
-  add_rib_cage_option(cmd, a->spine.rib_cage);
+  add_model_and_output_flags(cmd, a->spine, a->markdown);
   cmd->footer(
       "Every body is scaled from the reference body as --height/--mass/--sex would scale it "
       "(spine/README.md);\n"
@@ -649,23 +654,15 @@ void register_bodies(CLI::App& study) {
       "other bodies\n"
       "they are shown for scale. A few seconds per body.");
   cmd->callback([a] {
-    const std::size_t n = a->bodies.empty() ? spine::named_bodies(data_dir()).size() : a->bodies.size();
-    const int stages = kBodyStudyStagesPerBody * int(n);
-    Progress progress(stages, a->spine.quiet || a->spine.json);
-    const StageHooks hooks = spine_study_hooks(a->spine, progress);
-    const BodyStudy s =
-        run_body_study(data_dir(), a->spine.force_n, a->spine.model(), a->bodies, hooks);
-    if (!a->spine.csv.empty()) write_csv_file(a->spine.csv, body_study_csv(s));
-    if (a->spine.json) {
-      print_json(body_study_json(s));
-      return;
-    }
-    std::cout << "The spine studies for three sourced bodies (data/spine/spine_model.json "
-                 "anthropometry.bodies)\n\n";
-    print_muscle_set(a->spine);
-    print_body_study(std::cout, s, a->markdown);
-    std::cout << "Total " << fixed(s.seconds, 1) << " s"
-              << (a->spine.csv.empty() ? "" : "; wrote " + a->spine.csv) << "\n";
+    const std::size_t n =
+        a->bodies.empty() ? spine::named_bodies(data_dir()).size() : a->bodies.size();
+    Progress progress(kBodyStudyStagesPerBody * int(n), a->spine.quiet || a->spine.json);
+    const BodyStudy s = run_body_study(data_dir(), a->spine.force_n, a->spine.model(), a->bodies,
+                                       spine_study_hooks(a->spine, progress));
+    emit_spine_study(a->spine, s,
+                     "The spine studies for sourced bodies (data/spine/spine_model.json "
+                     "anthropometry.bodies)",
+                     body_study_csv, body_study_json, print_body_study, a->markdown);
   });
 }
 
@@ -685,11 +682,7 @@ void register_standing_gap(CLI::App& study) {
   cmd->add_option("--swelling-pressure", a->prestress_mpa,
                   "The unloaded disc's pressure, MPa (Wilke et al. 1999, lying prone: 0.10)")
       ->capture_default_str();
-  cmd->add_flag("--json", a->spine.json, "Print the JSON summary on stdout");
-  cmd->add_flag("--markdown", a->markdown, "Print the table as Markdown");
-  cmd->add_flag("--quiet", a->spine.quiet, "No progress on stderr");
-  add_ligaments_option(cmd, a->spine.ligaments);
-  add_rib_cage_option(cmd, a->spine.rib_cage);
+  add_model_and_output_flags(cmd, a->spine, a->markdown);
   add_subject_options(cmd, a->spine.subject);
   cmd->footer(
       "Each case solves standing, sitting without a backrest, leaning back in a chair (110 deg) "
@@ -703,15 +696,11 @@ void register_standing_gap(CLI::App& study) {
     Progress progress(kStandingGapStages, a->spine.quiet || a->spine.json);
     const StandingGapStudy s = run_standing_gap_study(
         data_dir(), a->spine.model(), a->prestress_mpa, spine_study_hooks(a->spine, progress));
-    if (a->spine.json) {
-      print_json(standing_gap_study_json(s));
-      return;
-    }
-    std::cout << "The standing gap: mechanisms that raise the standing disc load, each measured "
-                 "(in vivo: Wilke et al. 1999, 2001)\n\n";
-    print_muscle_set(a->spine);
-    print_standing_gap_study(std::cout, s, a->markdown);
-    std::cout << "Total " << fixed(s.seconds, 1) << " s\n";
+    emit_spine_study<StandingGapStudy>(
+        a->spine, s,
+        "The standing gap: mechanisms that raise the standing disc load, each measured (in vivo: "
+        "Wilke et al. 1999, 2001)",
+        nullptr, standing_gap_study_json, print_standing_gap_study, a->markdown);
   });
 }
 
