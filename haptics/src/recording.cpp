@@ -70,6 +70,10 @@ HapticRecordingWriter::HapticRecordingWriter(const std::string& path,
                  "# spine model %s; compliant stage %s; vertebra motion: the F.1 centre's "
                  "displacement (mm) and the rotation vector (deg) from the reference posture\n",
                  spine_model_fingerprint(*model).c_str(), response.c_str());
+  if (model)  // whose spine: spine discs rebuilds the model (and the discs) for this body
+    std::fprintf(file_, "# body: height_m %.17g, body_mass_kg %.17g, sex %s\n",
+                 model->subject.height_m, model->subject.body_mass_kg,
+                 spine::sex_name(model->subject.sex));
   std::fprintf(file_,
                "t_s,x_mm,y_mm,z_mm,button,fx_n,fy_n,fz_n,proxy_x_mm,proxy_y_mm,proxy_z_mm,"
                "contact,tick");
@@ -224,6 +228,23 @@ bool parse_row(const std::string& line, bool six_dof, DragFrame& f, std::string&
 }
 
 }  // namespace
+
+spine::Subject recording_body(const std::string& path) {
+  std::ifstream in = open_regular_file(path, "the recording");
+  std::string line;
+  spine::Subject s;
+  while (std::getline(in, line) && !line.empty() && line[0] == '#') {
+    if (line.rfind("# body: ", 0) != 0) continue;
+    char sex[16] = {0};
+    if (std::sscanf(line.c_str(), "# body: height_m %lf, body_mass_kg %lf, sex %15s",
+                    &s.height_m, &s.body_mass_kg, sex) != 3 ||
+        !std::isfinite(s.height_m) || !std::isfinite(s.body_mass_kg))
+      throw std::invalid_argument(path + ": a malformed body line: " + line);
+    s.sex = spine::parse_sex(sex);
+    break;
+  }
+  return s;
+}
 
 DragRecording read_drag_recording(const std::string& path, const spine::SpineModel& model) {
   // Streamed: a recording near the size limit is never held in memory as text besides its rows.

@@ -11,6 +11,7 @@
 #include "spinesim/mss/solver.hpp"
 #include "spinesim/spine/kinematics.hpp"
 #include "spinesim/studies/data.hpp"
+#include "spinesim/studies/spine_solve.hpp"
 #include "spinesim/studies/toolkit.hpp"
 #include "spinesim/studies/vertebra_surfaces.hpp"
 
@@ -124,7 +125,7 @@ CombinedVertebrae combine(const VertebraSurfacesResult& s, const spine::SpineMod
     const mesh::TriSurface& b = s.surfaces[i].surface;
     c.vertebra.push_back(vertebra_index(m, s.surfaces[i].name));
     c.first.push_back(v0), c.count.push_back(b.V.rows());
-    c.rest.V.middleRows(v0, b.V.rows()) = b.V;
+    c.rest.V.middleRows(v0, b.V.rows()) = m.scale.length * b.V;  // the body's vertebrae
     c.rest.F.middleRows(f0, b.F.rows()) = b.F.array() + int(v0);
     c.body.middleRows(f0, b.F.rows()).setConstant(double(i));
     v0 += b.V.rows(), f0 += b.F.rows();
@@ -264,7 +265,7 @@ SpineDiscs build_spine_discs(const spine::SpineModel& model, const calibration::
   d.resolution = resolution;
   for (const std::string& level : mesh::disc_levels()) {
     const calibration::TunedDisc& entry = calibration::tuned_level(tuned, level);
-    const mesh::TetMesh m = mesh::mesh_structured_level(level, options, studies::data_dir());
+    mesh::TetMesh m = mesh::mesh_structured_level(level, options, studies::data_dir());
     const calibration::MeshFingerprint here = calibration::fingerprint(m);
     if (!(entry.mesh == here))
       throw std::invalid_argument(
@@ -272,6 +273,10 @@ SpineDiscs build_spine_discs(const spine::SpineModel& model, const calibration::
           ") than the structured disc simulated (" + resolution + ", " + mesh_label(here) +
           "): calibrate the structured discs with `spinesim calibrate --level all --structured`");
     d.levels.push_back(level);
+    // Another body's disc is the reference disc scaled (geometric similarity, as its spine is):
+    // the tuned scales were fitted on the reference mesh; springs and masses follow the scaled
+    // geometry.
+    m.V *= model.scale.length;
     d.models.push_back(calibration::build_tuned_model(entry, m, entry.materials()));
     const std::size_t dash = level.find('-');
     d.upper.push_back(vertebra_index(model, level.substr(0, dash)));
@@ -289,7 +294,10 @@ SpineDiscsResult run_spine_discs(const SpineDiscsRequest& request, const std::st
   Timer total;
   SpineDiscsResult r;
   r.request = request;
-  const spine::SpineModel model = spine::load_spine_model(data_dir);
+  spine::ModelOptions body;  // the recorded spine's body (the reference when not recorded)
+  body.subject = haptics::recording_body(request.recording);
+  const spine::SpineModel model = spine::load_spine_model(data_dir, body);
+  r.subject = model.subject;
   const DragRecording rec = read_drag_recording(request.recording, model);
   r.fingerprint = rec.fingerprint;
   r.recording_complete = rec.complete;
@@ -405,6 +413,7 @@ nlohmann::json spine_discs_json(const SpineDiscsResult& r) {
           {"diverged", !r.diverged.empty()},
           {"diverged_reason", r.diverged},
           {"spine_model", r.fingerprint},
+          {"subject", subject_json(r.subject)},
           {"tuned", r.request.tuned.empty() ? "real-disc" : r.request.tuned},
           {"resolution", r.resolution},
           {"integrator", "implicit Euler"},

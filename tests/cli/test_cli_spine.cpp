@@ -5,6 +5,8 @@
 // (6.1). Each solve takes tens of milliseconds; each study a fraction of a second.
 #include "spine_cli_fixtures.hpp"
 
+#include "spinesim/mesh/io.hpp"
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -465,6 +467,52 @@ TEST(SpineSolveCli, TheStandingGapStudyMeasuresEachMechanism) {
   EXPECT_EQ(j["cases"][0]["mechanism"], "none");
   EXPECT_NEAR(j["cases"][1]["standing_n"].get<double>() - j["cases"][0]["standing_n"].get<double>(),
               j["prestress_force_n"].get<double>(), 1e-6);
+}
+
+// The offline discs follow a scaled body's schedule: the recording names the body, `spine discs`
+// rebuilds that spine, and its discs are the reference discs scaled by the body's length scale
+// (the first frame's discs span s times the reference discs' box). An unknown sex on
+// the body line is refused.
+TEST(SpineScheduleCli, TheOfflineDiscsFollowAScaledBody) {
+  const std::string loads = tmp("body-loads.csv");
+  spit(loads, "time_s,T7.fz_n\n0,0\n0.2,100\n");
+  std::vector<spinesim::mesh::TetMesh> first;
+  std::string rec;
+  for (const std::string body : {"", " --height 1.55 --mass 50 --sex female"}) {
+    rec = tmp("body-rec" + std::to_string(first.size()) + ".csv");
+    const std::string out = tmp("body-discs" + std::to_string(first.size()));
+    ASSERT_EQ(run_spinesim("spine schedule --quiet --step 0.1 --loads " + in_quotes(loads) +
+                           " --record " + in_quotes(rec) + body)
+                  .status,
+              0);
+    const CliRun d = run_spinesim("spine discs --quiet --json --vertebra-triangles 0 --record " +
+                                  in_quotes(rec) + " --out " + in_quotes(out));
+    ASSERT_EQ(d.status, 0) << d.err;
+    EXPECT_DOUBLE_EQ(json::parse(d.out)["subject"]["height_m"].get<double>(),
+                     body.empty() ? 1.778 : 1.55);
+    first.push_back(spinesim::mesh::read_vtu(out + "/spine/spine_000000.vtu"));
+  }
+  // The first frame is each body's standing equilibrium, not exactly similar (its muscles and
+  // masses do not scale as lengths do): 0.5 mm, where unscaled discs would be 3-60 mm off.
+  const double s = 1.55 / 1.778;
+  ASSERT_EQ(first[0].V.rows(), first[1].V.rows());
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_NEAR(first[1].V.col(k).maxCoeff(), s * first[0].V.col(k).maxCoeff(), 0.5) << k;
+    EXPECT_NEAR(first[1].V.col(k).minCoeff(), s * first[0].V.col(k).minCoeff(), 0.5) << k;
+  }
+  const std::string bad = tmp("body-bad.csv");
+  {
+    std::ifstream in(rec);  // the scaled body's
+    std::ofstream o(bad);
+    std::string line;
+    while (std::getline(in, line))
+      o << (line.rfind("# body: ", 0) == 0 ? "# body: height_m 1.55, body_mass_kg 50, sex other"
+                                           : line)
+        << "\n";
+  }
+  expect_refused(run_spinesim("spine discs --record " + in_quotes(bad) + " --out " +
+                              in_quotes(tmp("body-bad-out"))),
+                 "sex");
 }
 
 // Whether inertia matters: a schedule ramping in 0.1 s is flagged against the spine's first

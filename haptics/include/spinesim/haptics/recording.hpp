@@ -95,4 +95,9 @@ inline constexpr double kMaxVertebraShiftMm = 500, kMaxVertebraTurnDeg = 180;
 /// cut off mid-row (a killed run) is dropped.
 DragRecording read_drag_recording(const std::string& path, const spine::SpineModel& model);
 
+/// The body a compliant-stage recording's spine belongs to (its "# body:" line; a recording
+/// without one is the reference body's: zeros). Reads the header only; std::invalid_argument for
+/// a malformed body line.
+spine::Subject recording_body(const std::string& path);
+
 }  // namespace spinesim::haptics

@@ -97,6 +97,7 @@ struct DiscPeaks {
 struct SpineDiscsResult {
   SpineDiscsRequest request;
   std::string fingerprint;  ///< the spine model's
+  spine::Subject subject;   ///< the recorded spine's body (resolved)
   bool recording_complete = false;
   std::string recording_incomplete;  ///< why the recording is not whole (empty when it is)
   /// Why the discs' answer means nothing (empty when it holds): a rejected step, a tet turned
