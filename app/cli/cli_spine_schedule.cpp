@@ -16,7 +16,8 @@ namespace {
 
 struct ScheduleArgs {
   std::string loads, csv, record, out, fusion, disc_joints, ligaments = "auto";
-  double step_s = 0;
+  double step_s = 0, dt_s = 0.005, damping_ratio = 0;
+  bool dynamic = false;
   int workers = 0;
   bool json = false, quiet = false, no_muscles = false, rib_cage = false;
   SubjectFlags subject;
@@ -25,6 +26,12 @@ struct ScheduleArgs {
 void run_schedule(const ScheduleArgs& a) {
   // Every input checked before any solve; nothing is written on bad input.
   if (!(a.step_s >= 0)) throw std::invalid_argument("--step must be a number >= 0 s");
+  if (a.dynamic && !(a.dt_s > 0 && a.dt_s <= 0.05))
+    throw std::invalid_argument("--dt must lie in (0, 0.05] s");
+  if (a.dynamic && !(a.damping_ratio >= 0 && a.damping_ratio <= 1))
+    throw std::invalid_argument("--damping-ratio must lie in [0, 1]");
+  if (!a.dynamic && (a.dt_s != 0.005 || a.damping_ratio != 0))
+    throw std::invalid_argument("--dt and --damping-ratio are for --dynamic");
   if (a.workers < 0) throw std::invalid_argument("--workers must be >= 0");
   const LoadSchedule schedule = read_load_schedule(a.loads);
   spine::ModelOptions model;
@@ -45,7 +52,7 @@ void run_schedule(const ScheduleArgs& a) {
   solve.recruit = !a.no_muscles;
 
   std::unique_ptr<ProgressBar> bar;
-  const ScheduleRun run =
+  ScheduleRun run =
       run_load_schedule(data_dir(), schedule, model, solve, a.step_s, a.workers,
                         [&](int done, int total) {
                           if (!bar)
@@ -54,6 +61,13 @@ void run_schedule(const ScheduleArgs& a) {
                           bar->update(done, "solving the schedule");
                         });
   if (bar) bar->finish();
+  if (a.dynamic) {
+    spine::DynamicsOptions d;
+    d.dt_s = a.dt_s;
+    d.damping_ratio = a.damping_ratio;
+    if (!a.quiet && !a.json) std::cerr << "integrating the motion ..." << std::endl;
+    run_schedule_dynamics(run, d);
+  }
   if (!a.csv.empty()) write_csv_file(a.csv, schedule_csv(run));
   if (!a.record.empty()) write_schedule_recording(run, a.record);
   if (!a.out.empty()) {
@@ -88,6 +102,15 @@ void register_spine_schedule(CLI::App& spine) {
       ->required();
   cmd->add_option("--step", a->step_s,
                   "Also solve every this many seconds between the rows, s (0: the rows only)")
+      ->capture_default_str();
+  cmd->add_flag("--dynamic", a->dynamic,
+                "Also integrate the motion (inertia; spine/README.md): from the first step at "
+                "rest, the muscles held as each step recruited them; shown beside the "
+                "quasi-static answer at every sampled time");
+  cmd->add_option("--dt", a->dt_s, "--dynamic: time step, s")->capture_default_str();
+  cmd->add_option("--damping-ratio", a->damping_ratio,
+                  "--dynamic: stiffness-proportional damping, this ratio at the first mode (0: "
+                  "undamped, the bound the inertia check uses)")
       ->capture_default_str();
   cmd->add_option("--csv", a->csv,
                   "One row per time: loads, every joint's forces, every vertebra's motion");

@@ -5,16 +5,27 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
+#include <Eigen/QR>
 
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <string>
 
 namespace spinesim::spine {
 
-Eigen::MatrixXd mass_matrix(const SpineModel& m, const Eigen::VectorXd& theta) {
-  if (m.weights.empty())
-    throw std::invalid_argument("mass_matrix: the model has no weights (gravity off): no masses");
+namespace {
+
+/// kg·mm² times rad/s² is 1e-3 N·mm: the mass matrix in the equations of motion, whose other
+/// terms are in N·mm.
+constexpr double kInertiaNmm = 1e-3;
+
+double point_mass_kg(const SpineModel& m, const PointLoad& w) {
+  return w.force_n.norm() / (m.gravity_mm_s2 / 1000.0);
+}
+
+/// ∂x_i/∂θ of every weight's point (3 rows a weight), central differences of the poses.
+Eigen::MatrixXd point_jacobian(const SpineModel& m, const Eigen::VectorXd& theta) {
   const int n = dof_count(m);
   const double h = 1e-6;  // rad
   Eigen::MatrixXd J(3 * Eigen::Index(m.weights.size()), n);
@@ -35,10 +46,18 @@ Eigen::MatrixXd mass_matrix(const SpineModel& m, const Eigen::VectorXd& theta) {
           (place(up, w.body, w.point_mm) - place(down, w.body, w.point_mm)) / (2 * h);
     }
   }
+  return J;
+}
+
+}  // namespace
+
+Eigen::MatrixXd mass_matrix(const SpineModel& m, const Eigen::VectorXd& theta) {
+  if (m.weights.empty())
+    throw std::invalid_argument("mass_matrix: the model has no weights (gravity off): no masses");
+  const Eigen::MatrixXd J = point_jacobian(m, theta);
   Eigen::VectorXd mass(J.rows());
   for (std::size_t i = 0; i < m.weights.size(); ++i)
-    mass.segment<3>(3 * Eigen::Index(i))
-        .setConstant(m.weights[i].force_n.norm() / (m.gravity_mm_s2 / 1000.0));
+    mass.segment<3>(3 * Eigen::Index(i)).setConstant(point_mass_kg(m, m.weights[i]));
   return J.transpose() * mass.asDiagonal() * J;
 }
 
@@ -107,6 +126,139 @@ NaturalModes spine_natural_modes(const SpineModel& m, const std::vector<External
                     mass_matrix(m, solution.theta), free, count);
   for (const PointLoad& w : m.weights) modes.mass_kg += w.force_n.norm() / (m.gravity_mm_s2 / 1000);
   return modes;
+}
+
+std::vector<ExternalLoad> inertial_loads(const SpineModel& m, const Eigen::VectorXd& theta,
+                                         const Eigen::VectorXd& acceleration) {
+  const Eigen::VectorXd a = point_jacobian(m, theta) * acceleration;  // mm/s²
+  std::vector<ExternalLoad> out;
+  for (std::size_t i = 0; i < m.weights.size(); ++i) {
+    const PointLoad& w = m.weights[i];
+    if (w.body == kGround) continue;
+    ExternalLoad l;
+    l.vertebra = w.body;
+    l.has_point = true;
+    l.point_mm = w.point_mm;
+    l.force_n = -point_mass_kg(m, w) * a.segment<3>(3 * Eigen::Index(i)) / 1000.0;  // kg·m/s²
+    out.push_back(l);
+  }
+  return out;
+}
+
+namespace {
+
+/// One Newmark average-acceleration step from `s` to time t (Newton on θ_{n+1}); false, with the
+/// reason, when it does not converge.
+bool newmark_step(const SpineModel& m, const TimeLoads& at, const Eigen::MatrixXd& C,
+                  const std::vector<int>& free, const DynamicStep& s, double t,
+                  const DynamicsOptions& o, DynamicStep& next, std::string& why) {
+  const double dt = t - s.t_s;
+  std::vector<ExternalLoad> loads;
+  Eigen::VectorXd F, g;
+  at(t, loads, F);
+  const Eigen::MatrixXd M = kInertiaNmm * mass_matrix(m, s.theta);
+  // The iteration matrix 4/h² M + 2/h C + K(θ) over the free coordinates; K from the step's
+  // start (modified Newton), refreshed at the iterate every fourth iteration.
+  Eigen::LDLT<Eigen::MatrixXd> solver;
+  const auto factor = [&](const Eigen::VectorXd& at_theta) {
+    const Eigen::MatrixXd J =
+        (4 / (dt * dt)) * M + (2 / dt) * C + stiffness_matrix(m, loads, F, at_theta);
+    Eigen::MatrixXd Jf(free.size(), free.size());
+    for (std::size_t a = 0; a < free.size(); ++a)
+      for (std::size_t b = 0; b < free.size(); ++b)
+        Jf(Eigen::Index(a), Eigen::Index(b)) = J(free[a], free[b]);
+    solver.compute(Jf);
+  };
+  factor(s.theta);
+  next = {t, s.theta + dt * s.velocity, s.velocity, s.acceleration, 0};
+  double scale = 0;
+  for (int it = 1;; ++it) {
+    // Newmark, average acceleration: a_{n+1} from θ_{n+1}; v_{n+1} trapezoidal.
+    next.acceleration = (4 / (dt * dt)) * (next.theta - s.theta - dt * s.velocity) - s.acceleration;
+    next.velocity = s.velocity + 0.5 * dt * (s.acceleration + next.acceleration);
+    potential(m, loads, F, next.theta, &g);
+    const Eigen::VectorXd r = M * next.acceleration + C * next.velocity + g;
+    Eigen::VectorXd rf(free.size());
+    for (std::size_t a = 0; a < free.size(); ++a) rf[Eigen::Index(a)] = r[free[a]];
+    if (it == 1)
+      scale =
+          std::max({1.0, g.cwiseAbs().maxCoeff(), (M * next.acceleration).cwiseAbs().maxCoeff()});
+    next.iterations = it;
+    if (rf.cwiseAbs().maxCoeff() <= o.tolerance * scale) return true;
+    if (it >= o.max_iterations || !rf.allFinite()) {
+      why = "no convergence at t = " + std::to_string(t) + " s (residual " +
+            std::to_string(rf.cwiseAbs().maxCoeff()) + " N·mm)";
+      return false;
+    }
+    if (it % 4 == 0) factor(next.theta);
+    const Eigen::VectorXd d = solver.solve(rf);
+    for (std::size_t a = 0; a < free.size(); ++a) next.theta[free[a]] -= d[Eigen::Index(a)];
+  }
+}
+
+}  // namespace
+
+std::vector<DynamicStep> integrate_spine(const SpineModel& m, const TimeLoads& at,
+                                         const Eigen::VectorXd& theta0, double t0, double t1,
+                                         const DynamicsOptions& o) {
+  const int n = dof_count(m);
+  if (!(o.dt_s > 0 && o.dt_s <= 0.05) || !(o.damping_ratio >= 0 && o.damping_ratio <= 1) ||
+      o.max_iterations < 1 || !(o.tolerance > 0) || !(t1 > t0) || theta0.size() != n)
+    throw std::invalid_argument(
+        "integrate_spine: a time step in (0, 0.05] s, a damping ratio in [0, 1], t1 > t0 and "
+        "one start coordinate per joint coordinate");
+  if (m.rest_posture.size())
+    throw std::invalid_argument(
+        "the motion of a scoliotic spine is not integrated (its muscles "
+        "rest in the curve)");
+  std::vector<int> free;
+  for (int c = 0; c < n; ++c)
+    if (!m.joints[std::size_t(c / 3)].fused) free.push_back(c);
+  std::vector<ExternalLoad> loads;
+  Eigen::VectorXd F;
+  at(t0, loads, F);
+  // Rayleigh damping proportional to the start's stiffness: ζ at the first mode.
+  const Eigen::MatrixXd K0 = stiffness_matrix(m, loads, F, theta0);
+  Eigen::MatrixXd C = Eigen::MatrixXd::Zero(n, n);
+  if (o.damping_ratio > 0) {
+    const double f1 = natural_modes(K0, mass_matrix(m, theta0), free, 1).frequency_hz[0];
+    C = (2 * o.damping_ratio / (2 * M_PI * f1)) * K0;
+  }
+  // At rest: M a0 = −∇Π(θ0) (zero at an equilibrium). M is singular along the coordinates that
+  // turn a segment about its own point mass; the least-norm solution leaves those at rest.
+  Eigen::VectorXd a0 = Eigen::VectorXd::Zero(n);
+  {
+    Eigen::VectorXd g0;
+    potential(m, loads, F, theta0, &g0);
+    const Eigen::MatrixXd M0 = kInertiaNmm * mass_matrix(m, theta0);
+    Eigen::MatrixXd Mf(free.size(), free.size());
+    Eigen::VectorXd gf(free.size());
+    for (std::size_t a = 0; a < free.size(); ++a) {
+      gf[Eigen::Index(a)] = g0[free[a]];
+      for (std::size_t b = 0; b < free.size(); ++b)
+        Mf(Eigen::Index(a), Eigen::Index(b)) = M0(free[a], free[b]);
+    }
+    Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(Mf);
+    cod.setThreshold(1e-10);
+    const Eigen::VectorXd af = -cod.solve(gf);
+    for (std::size_t a = 0; a < free.size(); ++a) a0[free[a]] = af[Eigen::Index(a)];
+  }
+  DynamicStep s{t0, theta0, Eigen::VectorXd::Zero(n), a0, 0};
+  std::vector<DynamicStep> out = {s};
+  while (s.t_s < t1 - 1e-12) {
+    double t = std::min(t1, s.t_s + o.dt_s);
+    DynamicStep next;
+    std::string why;
+    // A step whose Newton iteration fails (a joint striking its range-of-motion bump) is halved,
+    // up to 2⁶ times; the next step tries the full one again.
+    for (int halvings = 0; !newmark_step(m, at, C, free, s, t, o, next, why); ++halvings) {
+      if (halvings == 6) throw SolveError("integrate_spine: " + why);
+      t = s.t_s + 0.5 * (t - s.t_s);
+    }
+    s = next;
+    out.push_back(s);
+  }
+  return out;
 }
 
 double ramp_overshoot_bound(double first_frequency_hz, double ramp_s) {

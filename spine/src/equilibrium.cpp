@@ -548,6 +548,18 @@ void report(const SpineModel& m, const State& s, SpineSolution& out) {
 
 }  // namespace
 
+SpineSolution spine_state(const SpineModel& m, const std::vector<ExternalLoad>& loads,
+                          const VectorXd& muscle_force_n, const VectorXd& theta) {
+  check_loads(m, loads, nullptr);
+  if (theta.size() != dof_count(m) || !theta.allFinite())
+    throw std::invalid_argument("spine_state: the posture needs " + std::to_string(dof_count(m)) +
+                                " finite joint coordinates");
+  SpineSolution out;
+  out.theta = theta;
+  report(m, evaluate(m, loads, muscle_force_n, theta), out);
+  return out;
+}
+
 double potential(const SpineModel& m, const std::vector<ExternalLoad>& loads,
                  const VectorXd& muscle_force_n, const VectorXd& theta, VectorXd* gradient) {
   check_loads(m, loads, nullptr);

@@ -232,6 +232,28 @@ std::string schedule_csv(const ScheduleRun& run) {
   return os.str();
 }
 
+namespace {
+
+/// The motion (null when not integrated).
+nlohmann::json dynamic_json(const ScheduleRun& run) {
+  if (run.dynamic.empty()) return nullptr;
+  nlohmann::json samples = nlohmann::json::array();
+  for (const DynamicSample& d : run.dynamic)
+    samples.push_back({{"time_s", d.t_s},
+                       {"l4l5_axial_n", d.l4l5_axial_n},
+                       {"l5s1_axial_n", d.l5s1_axial_n},
+                       {"t1_displacement", std::vector<double>(d.t1_displacement.data(),
+                                                               d.t1_displacement.data() + 6)}});
+  return {{"integrator", "Newmark average acceleration"},
+          {"dt_s", run.dynamic_dt_s},
+          {"damping_ratio", run.damping_ratio},
+          {"steps", run.dynamic_steps},
+          {"seconds", run.dynamic_seconds},
+          {"samples", samples}};
+}
+
+}  // namespace
+
 nlohmann::json schedule_json(const ScheduleRun& run) {
   nlohmann::json steps = nlohmann::json::array();
   for (const auto& step : run.steps) {
@@ -267,10 +289,83 @@ nlohmann::json schedule_json(const ScheduleRun& run) {
            {{"first_frequency_hz", finite_or_null(run.first_frequency_hz)},
             {"fastest_ramp_s", finite_or_null(run.fastest_ramp_s)},
             {"overshoot_bound", finite_or_null(run.overshoot_bound)}}},
+          {"dynamic", dynamic_json(run)},
           {"seconds", run.seconds},
           {"units",
            {{"force", "N"}, {"moment", "N·mm"}, {"translation", "mm"}, {"rotation", "deg"},
             {"t1_displacement", "tx, ty, tz (mm), rx, ry, rz (deg)"}}}};
+}
+
+void run_schedule_dynamics(ScheduleRun& run, const spine::DynamicsOptions& options) {
+  if (run.failed)
+    throw std::invalid_argument("--dynamic: a step reached no equilibrium; the motion needs all");
+  if (run.steps.size() < 2) throw std::invalid_argument("--dynamic: the schedule has one time");
+  const Timer timer;
+  const auto& steps = run.steps;
+  // The muscle forces of the step interval holding t, linear in time.
+  const auto forces_at = [&steps](double t) {
+    std::size_t k = 1;
+    while (k + 1 < steps.size() && steps[k].t_s < t) ++k;
+    const Eigen::VectorXd& a = steps[k - 1].solution.recruitment.force_n;
+    const Eigen::VectorXd& b = steps[k].solution.recruitment.force_n;
+    if (a.size() == 0 || b.size() == 0) return Eigen::VectorXd();
+    const double w = std::clamp((t - steps[k - 1].t_s) / (steps[k].t_s - steps[k - 1].t_s), 0.0, 1.0);
+    return Eigen::VectorXd((1 - w) * a + w * b);
+  };
+  const spine::TimeLoads at = [&](double t, std::vector<spine::ExternalLoad>& loads,
+                                  Eigen::VectorXd& F) {
+    loads = schedule_loads(run.schedule, std::clamp(t, steps.front().t_s, steps.back().t_s));
+    F = forces_at(t);
+  };
+  const std::vector<spine::DynamicStep> motion =
+      spine::integrate_spine(run.model, at, steps.front().solution.theta, steps.front().t_s,
+                             steps.back().t_s, options);
+  run.dynamic.clear();
+  std::size_t j = 1;
+  for (const ScheduleStep& step : steps) {
+    while (j + 1 < motion.size() && motion[j].t_s < step.t_s) ++j;
+    const spine::DynamicStep &p = motion[j - 1], &q = motion[j];
+    const double w = q.t_s > p.t_s ? std::clamp((step.t_s - p.t_s) / (q.t_s - p.t_s), 0.0, 1.0) : 1;
+    const Eigen::VectorXd theta = (1 - w) * p.theta + w * q.theta,
+                          accel = (1 - w) * p.acceleration + w * q.acceleration;
+    std::vector<spine::ExternalLoad> loads;
+    Eigen::VectorXd F;
+    at(step.t_s, loads, F);
+    for (const spine::ExternalLoad& l : spine::inertial_loads(run.model, theta, accel))
+      loads.push_back(l);
+    const spine::SpineSolution s = spine::spine_state(run.model, loads, F, theta);
+    DynamicSample d;
+    d.t_s = step.t_s;
+    d.t1_displacement = s.displacement.row(0).transpose();
+    d.l4l5_axial_n = s.joints[std::size_t(spine::joint_index("L4-L5"))].axial_n;
+    d.l5s1_axial_n = s.joints.back().axial_n;
+    run.dynamic.push_back(d);
+  }
+  run.dynamic_dt_s = options.dt_s;
+  run.damping_ratio = options.damping_ratio;
+  run.dynamic_steps = int(motion.size()) - 1;
+  run.dynamic_seconds = timer.seconds();
+}
+
+/// The motion beside the quasi-static answer, when it was integrated.
+void print_dynamics(std::ostream& os, const ScheduleRun& run) {
+  if (run.dynamic.empty()) return;
+  os << "\nThe motion (Newmark average acceleration, " << fixed(1000 * run.dynamic_dt_s, 1)
+     << " ms steps, damping ratio " << fixed(run.damping_ratio, 2) << " at the first mode; "
+     << run.dynamic_steps << " steps in " << fixed(run.dynamic_seconds, 2)
+     << " s), beside the quasi-static answer:\n";
+  TextTable table({"time (s)", "L4-L5 axial (N)", "quasi-static", "L5-S1 axial (N)",
+                   "quasi-static", "T1 tz (mm)", "quasi-static"},
+                  0);
+  const int l4 = spine::joint_index("L4-L5");
+  for (std::size_t k = 0; k < run.dynamic.size(); ++k) {
+    const DynamicSample& d = run.dynamic[k];
+    const spine::SpineSolution& s = run.steps[k].solution;
+    table.add({fixed(d.t_s, 3), fixed(d.l4l5_axial_n, 1), fixed(s.joints[std::size_t(l4)].axial_n, 1),
+               fixed(d.l5s1_axial_n, 1), fixed(s.joints.back().axial_n, 1),
+               fixed(d.t1_displacement[2], 2), fixed(s.displacement(0, 2), 2)});
+  }
+  table.print(os, false);
 }
 
 /// Whether inertia matters: the first natural frequency beside the fastest ramp.
@@ -322,7 +417,8 @@ void print_schedule(std::ostream& os, const ScheduleRun& run) {
     if (!step.error.empty())
       os << "no equilibrium at " << fixed(step.t_s, 3) << " s: " << step.error << "\n";
   print_inertia(os, run);
-  os << "\nTotal " << fixed(run.seconds, 2) << " s\n";
+  print_dynamics(os, run);
+  os << "\nTotal " << fixed(run.seconds + run.dynamic_seconds, 2) << " s\n";
 }
 
 void write_schedule_recording(const ScheduleRun& run, const std::string& path) {

@@ -536,6 +536,46 @@ TEST(SpineScheduleCli, TheScheduleSaysWhetherInertiaMatters) {
   EXPECT_NEAR(j["inertia"]["overshoot_bound"].get<double>(), 1 / (M_PI * f1 * 10), 1e-12);
 }
 
+// The motion (`spine schedule --dynamic`): under a slow ramp it ends on the quasi-static answer
+// (within the inertia check's bound), under a fast one it swings past it; halving the time step
+// changes it by little (second order); --dt without --dynamic is refused.
+TEST(SpineScheduleCli, TheMotionFollowsASlowRampAndOvershootsAFastOne) {
+  const std::string slow = tmp("dyn-slow.csv"), fast = tmp("dyn-fast.csv");
+  spit(slow, "time_s,T1.fz_n\n0,0\n8,20\n9,20\n");
+  spit(fast, "time_s,T1.fz_n\n0,0\n0.05,20\n1.5,20\n");
+  const auto motion = [&](const std::string& loads, const std::string& extra) {
+    const CliRun r = run_spinesim("spine schedule --quiet --json --dynamic --step 0.05 --loads " +
+                                  in_quotes(loads) + extra);
+    EXPECT_EQ(r.status, 0) << r.err;
+    return r.status == 0 ? json::parse(r.out) : json();
+  };
+  const auto tz = [](const json& j, std::size_t k, bool dynamic) {
+    return dynamic ? j["dynamic"]["samples"][k]["t1_displacement"][2].get<double>()
+                   : j["steps"][k]["t1_displacement"][2].get<double>();
+  };
+  const json s = motion(slow, "");
+  ASSERT_FALSE(s.empty());
+  const std::size_t last = s["steps"].size() - 1;
+  const double step = tz(s, last, false) - tz(s, 0, false);
+  EXPECT_GT(std::abs(step), 1.0);
+  EXPECT_LE(std::abs(tz(s, last, true) - tz(s, last, false)),
+            s["inertia"]["overshoot_bound"].get<double>() * std::abs(step) + 0.05);
+  const json f = motion(fast, "");
+  ASSERT_FALSE(f.empty());
+  double peak = 0;
+  for (std::size_t k = 0; k < f["steps"].size(); ++k)
+    peak = std::max(peak, (tz(f, k, true) - tz(f, 0, true)) / (tz(f, k, false) - tz(f, 0, false) +
+                                                              (k == 0 ? 1 : 0)));
+  EXPECT_GT(peak, 1.3);  // a 50 ms ramp swings T1 well past its quasi-static place
+  const json fine = motion(fast, " --dt 0.0025");
+  ASSERT_FALSE(fine.empty());
+  for (std::size_t k = 0; k < f["steps"].size(); k += 5)
+    EXPECT_NEAR(tz(fine, k, true), tz(f, k, true), 0.05 * std::abs(step) + 0.05) << k;
+  expect_refused(run_spinesim("spine schedule --dt 0.01 --loads " + in_quotes(slow)), "--dynamic");
+  expect_refused(run_spinesim("spine schedule --dynamic --dt 0.5 --loads " + in_quotes(slow)),
+                 "--dt");
+}
+
 // Loads in time (`spine schedule`): the table, the CSV and the recording; the recording drives
 // the offline discs; a malformed schedule is refused in one line with nothing written.
 TEST(SpineScheduleCli, ASchedulesStepsTheirCsvAndARecordingTheDiscsFollow) {

@@ -20,6 +20,7 @@
 
 #include <Eigen/Core>
 
+#include <functional>
 #include <vector>
 
 namespace spinesim::spine {
@@ -49,6 +50,42 @@ NaturalModes natural_modes(const Eigen::MatrixXd& K, const Eigen::MatrixXd& M,
 /// The modes of `solution` (solve_spine of `m` under `loads`).
 NaturalModes spine_natural_modes(const SpineModel& m, const std::vector<ExternalLoad>& loads,
                                  const SpineSolution& solution, int count = 6);
+
+// --- the motion -------------------------------------------------------------------------------
+
+/// The loads and the muscle forces at time t (the forces held as recruited: a schedule's
+/// quasi-static recruitment, interpolated in time).
+using TimeLoads = std::function<void(double t_s, std::vector<ExternalLoad>& loads,
+                                     Eigen::VectorXd& muscle_force_n)>;
+
+struct DynamicsOptions {
+  double dt_s = 0.005;       ///< time step (> 0, ≤ 0.05 s)
+  double damping_ratio = 0;  ///< stiffness-proportional damping, this ratio at the first mode
+  int max_iterations = 30;   ///< Newton per step
+  double tolerance = 1e-6;   ///< on the residual, relative to the generalised loads' size
+};
+
+struct DynamicStep {
+  double t_s = 0;
+  Eigen::VectorXd theta, velocity, acceleration;  ///< rad, rad/s, rad/s²
+  int iterations = 0;
+};
+
+/// Integrates M(θ) θ̈ + C θ̇ + ∇Π(θ; F(t), loads(t)) = 0 from θ0 at rest over [t0, t1] with the
+/// Newmark average-acceleration rule (trapezoidal: unconditionally stable, no numerical damping),
+/// M evaluated at each step's start, C = β K(θ0) with β = 2ζ/ω1. The velocity-squared (Coriolis
+/// and centripetal) terms of the equations of motion are left out: they are second order in
+/// the slow motions a schedule drives. Fused joints stay at zero. Throws std::invalid_argument for
+/// bad options or a scoliotic model (its muscles rest in the curve; not handled here), and
+/// SolveError when a step's Newton iteration does not converge.
+std::vector<DynamicStep> integrate_spine(const SpineModel& m, const TimeLoads& at,
+                                         const Eigen::VectorXd& theta0, double t0, double t1,
+                                         const DynamicsOptions& options = DynamicsOptions());
+
+/// The d'Alembert loads −m a of the model's point masses for the joint accelerations θ̈ at θ
+/// (a = J θ̈, velocity-squared terms left out as above), one per weight on a vertebra.
+std::vector<ExternalLoad> inertial_loads(const SpineModel& m, const Eigen::VectorXd& theta,
+                                         const Eigen::VectorXd& acceleration);
 
 /// The bound min(1, T_1 / (π T_r)) on a ramp's dynamic overshoot (a fraction of the ramp's step).
 double ramp_overshoot_bound(double first_frequency_hz, double ramp_s);

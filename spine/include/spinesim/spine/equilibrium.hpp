@@ -139,6 +139,14 @@ DisplacementSensitivity displacement_sensitivity(
     int load, const SolveOptions& options = SolveOptions(), double step_n = 5.0,
     SensitivityMethod method = SensitivityMethod::automatic);
 
+/// The spine's state at the posture `theta` for recruited muscle forces `muscle_force_n` (empty:
+/// none) under `loads`, without solving: poses, displacements, joint reactions and element
+/// forces, as solve_spine reports them (iterations 0, converged false, no recruitment). For a
+/// posture that is not an equilibrium the reactions balance whatever loads are given: with the
+/// d'Alembert loads of a motion (dynamics.hpp, inertial_loads), they are the motion's.
+SpineSolution spine_state(const SpineModel& m, const std::vector<ExternalLoad>& loads,
+                          const Eigen::VectorXd& muscle_force_n, const Eigen::VectorXd& theta);
+
 // --- pieces, exposed for tests and the database ---------------------------------------------
 
 /// Total potential energy Π(θ) (N·mm) and its gradient for fixed muscle forces `muscle_force_n`

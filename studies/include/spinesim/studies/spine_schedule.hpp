@@ -12,12 +12,13 @@
 //
 // Quasi-static: the spine model is elastic and keeps no history (recruitment and equilibrium
 // depend on the loads of the moment only), so each sampled time is its own equilibrium and the
-// sequence's answer does not depend on how finely it is sampled. Inertia is not modelled; it is
-// measured: the spine's first natural frequency f1 at the first step (spine/dynamics.hpp) beside
+// sequence's answer does not depend on how finely it is sampled. With --dynamic the motion is
+// integrated as well (run_schedule_dynamics). Whether inertia matters is measured: the spine's first natural frequency f1 at the first step (spine/dynamics.hpp) beside
 // the schedule's fastest ramp T_r bounds the motion's overshoot of the quasi-static answer by
 // min(1, 1/(π f1 T_r)) of a ramp's step; above kInertiaMatters the output says inertia may matter.
 #pragma once
 
+#include "spinesim/spine/dynamics.hpp"
 #include "spinesim/spine/equilibrium.hpp"
 #include "spinesim/spine/model.hpp"
 
@@ -64,6 +65,14 @@ struct ScheduleStep {
   std::string error;  ///< empty: converged
 };
 
+/// The motion at one sampled time (run_schedule_dynamics): T1's displacement and the lumbar
+/// joints' axial forces with the d'Alembert loads of the motion.
+struct DynamicSample {
+  double t_s = 0;
+  Eigen::Matrix<double, 6, 1> t1_displacement = Eigen::Matrix<double, 6, 1>::Zero();
+  double l4l5_axial_n = 0, l5s1_axial_n = 0;
+};
+
 struct ScheduleRun {
   LoadSchedule schedule;
   spine::SpineModel model;
@@ -73,6 +82,11 @@ struct ScheduleRun {
   /// between key times over which a load changes (s), and the overshoot bound (a fraction);
   /// NaN / infinity when unknown or the loads never change.
   double first_frequency_hz = NAN, fastest_ramp_s = INFINITY, overshoot_bound = 0;
+  /// The motion (run_schedule_dynamics; empty when not run), its time step and damping ratio.
+  std::vector<DynamicSample> dynamic;
+  double dynamic_dt_s = 0, damping_ratio = 0;
+  int dynamic_steps = 0;
+  double dynamic_seconds = 0;
   double seconds = 0;
 };
 
@@ -83,6 +97,13 @@ ScheduleRun run_load_schedule(const std::string& data_dir, const LoadSchedule& s
                               const spine::ModelOptions& model, const spine::SolveOptions& solve,
                               double step_s, int workers,
                               const std::function<void(int, int)>& progress = {});
+
+/// Integrates the motion through the schedule (spine/dynamics.hpp): from the first step's
+/// equilibrium at rest, the loads as scheduled and the muscle forces held as the quasi-static
+/// steps recruited them (linear in time between steps); fills run.dynamic at every sampled time.
+/// Throws std::invalid_argument when a step reached no equilibrium or for bad options,
+/// spine::SolveError when a time step does not converge.
+void run_schedule_dynamics(ScheduleRun& run, const spine::DynamicsOptions& options);
 
 /// One row per step: time, converged, the loads, each joint's compression and shear (joint
 /// frame) and each vertebra's displacement (mm, deg). A failed step's numbers are empty cells.
