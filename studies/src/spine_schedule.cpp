@@ -309,7 +309,8 @@ void run_schedule_dynamics(ScheduleRun& run, const spine::DynamicsOptions& optio
     const Eigen::VectorXd& a = steps[k - 1].solution.recruitment.force_n;
     const Eigen::VectorXd& b = steps[k].solution.recruitment.force_n;
     if (a.size() == 0 || b.size() == 0) return Eigen::VectorXd();
-    const double w = std::clamp((t - steps[k - 1].t_s) / (steps[k].t_s - steps[k - 1].t_s), 0.0, 1.0);
+    const double w =
+        std::clamp((t - steps[k - 1].t_s) / (steps[k].t_s - steps[k - 1].t_s), 0.0, 1.0);
     return Eigen::VectorXd((1 - w) * a + w * b);
   };
   const spine::TimeLoads at = [&](double t, std::vector<spine::ExternalLoad>& loads,
@@ -361,7 +362,8 @@ void print_dynamics(std::ostream& os, const ScheduleRun& run) {
   for (std::size_t k = 0; k < run.dynamic.size(); ++k) {
     const DynamicSample& d = run.dynamic[k];
     const spine::SpineSolution& s = run.steps[k].solution;
-    table.add({fixed(d.t_s, 3), fixed(d.l4l5_axial_n, 1), fixed(s.joints[std::size_t(l4)].axial_n, 1),
+    table.add({fixed(d.t_s, 3), fixed(d.l4l5_axial_n, 1),
+               fixed(s.joints[std::size_t(l4)].axial_n, 1),
                fixed(d.l5s1_axial_n, 1), fixed(s.joints.back().axial_n, 1),
                fixed(d.t1_displacement[2], 2), fixed(s.displacement(0, 2), 2)});
   }
