@@ -56,6 +56,13 @@ def draw(s, d):
         axes[3].plot(t, series(steps, lambda st, k=k: st["t1_displacement"][k]),
                      ".-" if k < 3 else ".--", label=name)
     axes[3].set_title("T1's motion from the tables' reference posture (F.1)")
+    motion = s.get("dynamic")
+    if motion:  # the integrated motion beside the quasi-static answer (--dynamic)
+        td = [m["time_s"] for m in motion["samples"]]
+        axes[1].plot(td, [m["l4l5_axial_n"] for m in motion["samples"]], "k-", lw=1.5,
+                     label="L4-L5, the motion")
+        axes[3].plot(td, [m["t1_displacement"][2] for m in motion["samples"]], "k-", lw=1.5,
+                     label="tz (mm), the motion")
     axes[3].set_xlabel("time (s)")
     for ax in axes:
         ax.grid(alpha=0.3)
@@ -66,6 +73,23 @@ def draw(s, d):
     return "schedule.png"
 
 
+def inertia_text(s):
+    """The inertia check and, when integrated, the motion, as a paragraph."""
+    i = s.get("inertia") or {}
+    parts = []
+    if i.get("first_frequency_hz") is not None:
+        parts.append(f"The spine's first natural frequency is {i['first_frequency_hz']:.2f} Hz")
+        if i.get("overshoot_bound") is not None:
+            parts.append(f"the fastest ramp ({i['fastest_ramp_s']:.3f} s) may overshoot its "
+                         f"quasi-static answer by up to {100 * i['overshoot_bound']:.1f} % "
+                         "(undamped bound)")
+    m = s.get("dynamic")
+    if m:
+        parts.append(f"the motion was integrated (Newmark, {1000 * m['dt_s']:.1f} ms steps, damping "
+                     f"ratio {m['damping_ratio']:.2f}) and is drawn in black")
+    return f"<p>{html.escape('; '.join(parts))}.</p>" if parts else ""
+
+
 def write_report(d):
     s = load_summary(d, "schedule.json")
     figure = draw(s, d)
@@ -74,6 +98,7 @@ def write_report(d):
     parts = [page_head(title, 1100),
              f"<p>{len(s['steps'])} quasi-static equilibria ({s['failed']} without one); body "
              f"{html.escape(b['sex'])}, {b['height_m']:.3f} m, {b['body_mass_kg']:.1f} kg.</p>",
+             inertia_text(s),
              f"<figure><img src='plots/{figure}' alt='{figure}'></figure></body></html>"]
     write_page(d, parts, s.get("provenance"))
     return [figure]

@@ -571,6 +571,13 @@ TEST(SpineScheduleCli, TheMotionFollowsASlowRampAndOvershootsAFastOne) {
   ASSERT_FALSE(fine.empty());
   for (std::size_t k = 0; k < f["steps"].size(); k += 5)
     EXPECT_NEAR(tz(fine, k, true), tz(f, k, true), 0.05 * std::abs(step) + 0.05) << k;
+  const std::string out = tmp("dyn-out");
+  ASSERT_EQ(run_spinesim("spine schedule --quiet --dynamic --loads " + in_quotes(fast) +
+                         " --out " + in_quotes(out))
+                .status,
+            0);
+  EXPECT_NE(slurp(out + "/report.html").find("drawn in black"), std::string::npos);
+  EXPECT_TRUE(fs::exists(out + "/plots/schedule.png"));
   expect_refused(run_spinesim("spine schedule --dt 0.01 --loads " + in_quotes(slow)), "--dynamic");
   expect_refused(run_spinesim("spine schedule --dynamic --dt 0.5 --loads " + in_quotes(slow)),
                  "--dt");
