@@ -84,12 +84,7 @@ NaturalModes natural_modes(const Eigen::MatrixXd& K, const Eigen::MatrixXd& M,
                            const std::vector<int>& free, int count) {
   const Eigen::Index f = Eigen::Index(free.size());
   if (f == 0 || count < 1) throw std::invalid_argument("natural_modes: no free coordinates");
-  Eigen::MatrixXd Kf(f, f), Mf(f, f);
-  for (Eigen::Index a = 0; a < f; ++a)
-    for (Eigen::Index b = 0; b < f; ++b) {
-      Kf(a, b) = K(free[std::size_t(a)], free[std::size_t(b)]);
-      Mf(a, b) = M(free[std::size_t(a)], free[std::size_t(b)]);
-    }
+  const Eigen::MatrixXd Kf = K(free, free), Mf = M(free, free);
   // K = L Lᵀ; then L⁻¹ M L⁻ᵀ ψ = μ ψ with μ = 1/λ: the lowest frequencies are its largest μ, and a
   // singular M (a segment turning about its own point mass) only gives μ = 0 (infinite ω).
   const Eigen::LLT<Eigen::MatrixXd> llt(Kf);
@@ -109,8 +104,7 @@ NaturalModes natural_modes(const Eigen::MatrixXd& K, const Eigen::MatrixXd& M,
     out.frequency_hz[i] = mu > 0 ? std::sqrt(1000.0 / mu) / (2 * M_PI) : INFINITY;
     // φ = L⁻ᵀ ψ; φᵀ M φ = ψᵀ A ψ = μ: normalise to 1.
     const Eigen::VectorXd phi = Linv.transpose() * es.eigenvectors().col(f - 1 - i);
-    for (Eigen::Index a = 0; a < f; ++a)
-      out.shape(free[std::size_t(a)], i) = phi[a] / std::sqrt(std::max(mu, 1e-300));
+    out.shape(free, i) = phi / std::sqrt(std::max(mu, 1e-300));
   }
   return out;
 }
@@ -163,11 +157,7 @@ bool newmark_step(const SpineModel& m, const TimeLoads& at, const Eigen::MatrixX
   const auto factor = [&](const Eigen::VectorXd& at_theta) {
     const Eigen::MatrixXd J =
         (4 / (dt * dt)) * M + (2 / dt) * C + stiffness_matrix(m, loads, F, at_theta);
-    Eigen::MatrixXd Jf(free.size(), free.size());
-    for (std::size_t a = 0; a < free.size(); ++a)
-      for (std::size_t b = 0; b < free.size(); ++b)
-        Jf(Eigen::Index(a), Eigen::Index(b)) = J(free[a], free[b]);
-    solver.compute(Jf);
+    solver.compute(J(free, free));
   };
   factor(s.theta);
   next = {t, s.theta + dt * s.velocity, s.velocity, s.acceleration, 0};
@@ -178,8 +168,7 @@ bool newmark_step(const SpineModel& m, const TimeLoads& at, const Eigen::MatrixX
     next.velocity = s.velocity + 0.5 * dt * (s.acceleration + next.acceleration);
     potential(m, loads, F, next.theta, &g);
     const Eigen::VectorXd r = M * next.acceleration + C * next.velocity + g;
-    Eigen::VectorXd rf(free.size());
-    for (std::size_t a = 0; a < free.size(); ++a) rf[Eigen::Index(a)] = r[free[a]];
+    const Eigen::VectorXd rf = r(free);
     if (it == 1)
       scale =
           std::max({1.0, g.cwiseAbs().maxCoeff(), (M * next.acceleration).cwiseAbs().maxCoeff()});
@@ -192,7 +181,7 @@ bool newmark_step(const SpineModel& m, const TimeLoads& at, const Eigen::MatrixX
     }
     if (it % 4 == 0) factor(next.theta);
     const Eigen::VectorXd d = solver.solve(rf);
-    for (std::size_t a = 0; a < free.size(); ++a) next.theta[free[a]] -= d[Eigen::Index(a)];
+    next.theta(free) -= d;
   }
 }
 
@@ -231,17 +220,9 @@ std::vector<DynamicStep> integrate_spine(const SpineModel& m, const TimeLoads& a
     Eigen::VectorXd g0;
     potential(m, loads, F, theta0, &g0);
     const Eigen::MatrixXd M0 = kInertiaNmm * mass_matrix(m, theta0);
-    Eigen::MatrixXd Mf(free.size(), free.size());
-    Eigen::VectorXd gf(free.size());
-    for (std::size_t a = 0; a < free.size(); ++a) {
-      gf[Eigen::Index(a)] = g0[free[a]];
-      for (std::size_t b = 0; b < free.size(); ++b)
-        Mf(Eigen::Index(a), Eigen::Index(b)) = M0(free[a], free[b]);
-    }
-    Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(Mf);
+    Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(M0(free, free));
     cod.setThreshold(1e-10);
-    const Eigen::VectorXd af = -cod.solve(gf);
-    for (std::size_t a = 0; a < free.size(); ++a) a0[free[a]] = af[Eigen::Index(a)];
+    a0(free) = -cod.solve(g0(free));
   }
   DynamicStep s{t0, theta0, Eigen::VectorXd::Zero(n), a0, 0};
   std::vector<DynamicStep> out = {s};
