@@ -6,6 +6,7 @@
 #include "spinesim/output/format.hpp"
 #include "spinesim/spine/equilibrium.hpp"
 #include "spinesim/spine/kinematics.hpp"
+#include "spinesim/spine/scoliosis.hpp"
 
 #include <unistd.h>
 
@@ -46,6 +47,9 @@ std::string spine_model_fingerprint(const spine::SpineModel& m) {
     for (int a = 0; a < 3; ++a) fnv(h, j.point_mm[a]);
     fnv(h, j.fused ? 1.0 : 0.0);
   }
+  // A curved spine's rest posture (the motions are recorded from it); a straight spine has none,
+  // so its fingerprint is what it always was.
+  for (Eigen::Index i = 0; i < m.rest_posture.size(); ++i) fnv(h, m.rest_posture[i]);
   char out[17];
   std::snprintf(out, sizeof out, "%016llx", static_cast<unsigned long long>(h));
   return out;
@@ -74,6 +78,14 @@ HapticRecordingWriter::HapticRecordingWriter(const std::string& path,
     std::fprintf(file_, "# body: height_m %.17g, body_mass_kg %.17g, sex %s\n",
                  model->subject.height_m, model->subject.body_mass_kg,
                  spine::sex_name(model->subject.sex));
+  if (model && model->scoliosis.cobb_deg != 0) {  // and its curve: the discs rest wedged in it
+    const spine::ScoliosisCurve& c = model->scoliosis;
+    std::fprintf(file_,
+                 "# scoliosis: type %s, cobb_deg %.17g, upper_end %s, apex %s, lower_end %s, "
+                 "apical_rotation_deg %.17g, convex %s\n",
+                 c.type.c_str(), c.cobb_deg, c.upper_end.c_str(), c.apex.c_str(),
+                 c.lower_end.c_str(), c.apical_rotation_deg, c.convex_right ? "right" : "left");
+  }
   std::fprintf(file_,
                "t_s,x_mm,y_mm,z_mm,button,fx_n,fy_n,fz_n,proxy_x_mm,proxy_y_mm,proxy_z_mm,"
                "contact,tick");
@@ -229,21 +241,38 @@ bool parse_row(const std::string& line, bool six_dof, DragFrame& f, std::string&
 
 }  // namespace
 
-spine::Subject recording_body(const std::string& path) {
+RecordedSpine recording_spine(const std::string& path) {
   std::ifstream in = open_regular_file(path, "the recording");
   std::string line;
-  spine::Subject s;
+  RecordedSpine r;
   while (std::getline(in, line) && !line.empty() && line[0] == '#') {
-    if (line.rfind("# body: ", 0) != 0) continue;
-    char sex[16] = {0};
-    if (std::sscanf(line.c_str(), "# body: height_m %lf, body_mass_kg %lf, sex %15s",
-                    &s.height_m, &s.body_mass_kg, sex) != 3 ||
-        !std::isfinite(s.height_m) || !std::isfinite(s.body_mass_kg))
-      throw std::invalid_argument(path + ": a malformed body line: " + line);
-    s.sex = spine::parse_sex(sex);
-    break;
+    if (line.rfind("# body: ", 0) == 0) {
+      spine::Subject& s = r.subject;
+      char sex[16] = {0};
+      if (std::sscanf(line.c_str(), "# body: height_m %lf, body_mass_kg %lf, sex %15s", &s.height_m,
+                      &s.body_mass_kg, sex) != 3 ||
+          !std::isfinite(s.height_m) || !std::isfinite(s.body_mass_kg))
+        throw std::invalid_argument(path + ": a malformed body line: " + line);
+      s.sex = spine::parse_sex(sex);
+    } else if (line.rfind("# scoliosis: ", 0) == 0) {
+      spine::ScoliosisCurve& c = r.scoliosis;
+      char type[32] = {0}, upper[8] = {0}, apex[8] = {0}, lower[8] = {0}, convex[8] = {0};
+      if (std::sscanf(line.c_str(),
+                      "# scoliosis: type %31[^,], cobb_deg %lf, upper_end %7[^,], apex %7[^,], "
+                      "lower_end %7[^,], apical_rotation_deg %lf, convex %7s",
+                      type, &c.cobb_deg, upper, apex, lower, &c.apical_rotation_deg, convex) != 7 ||
+          (std::strcmp(convex, "right") != 0 && std::strcmp(convex, "left") != 0))
+        throw std::invalid_argument(path + ": a malformed scoliosis line: " + line);
+      c.type = type, c.upper_end = upper, c.apex = apex, c.lower_end = lower;
+      c.convex_right = std::strcmp(convex, "right") == 0;
+      try {
+        spine::check_scoliosis_curve(c);
+      } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument(path + ": the recorded curve: " + e.what());
+      }
+    }
   }
-  return s;
+  return r;
 }
 
 DragRecording read_drag_recording(const std::string& path, const spine::SpineModel& model) {

@@ -53,6 +53,9 @@ SurfaceSamples sample_surface(const mesh::TriSurface& s, double spacing_mm) {
 void Scene::add_body(const std::string& name, const mesh::TriSurface& surface) {
   if (int(bodies_.size()) >= kMaxBodies)
     throw std::invalid_argument("scene: more than " + std::to_string(kMaxBodies) + " bodies");
+  // Bodies are found by name (index()): a second body of the same name would be found as the
+  // first, and poses meant for one would move the other.
+  if (index(name) >= 0) throw std::invalid_argument("scene: a second body named " + name);
   RigidBody b;
   b.name = name;
   b.tree = AabbTree(surface.V, surface.F);

@@ -2,6 +2,8 @@
 
 #include "spinesim/mesh/disc_geometry.hpp"
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <stdexcept>
 #include <string>
@@ -39,12 +41,19 @@ void carry_between(TetMesh& m, const DiscFrame& frame, double height_mm, const R
   if (!(height_mm > 0))
     throw std::invalid_argument("carry_between: the disc height must be > 0 mm");
   const TetMesh before = m;
+  const DiscFrame f = frame;  // `frame` may be m.frame, which is carried below
   for (Eigen::Index i = 0; i < m.V.rows(); ++i) {
     const Eigen::Vector3d x = before.V.row(i).transpose();
-    const double y = (frame.axes.transpose() * (x - frame.origin_mm)).y();
+    const double y = (f.axes.transpose() * (x - f.origin_mm)).y();
     const double s = std::clamp((y + 0.5 * height_mm) / height_mm, 0.0, 1.0);
     m.V.row(i) = ((1 - s) * lower.apply(x) + s * upper.apply(x)).transpose();
   }
+  // The disc's own frame goes to mid-height: its origin midway, its axes turned halfway from the
+  // lower vertebra's rotation to the upper one's (the mid-plane of a wedged disc).
+  Eigen::AngleAxisd turn(lower.R.transpose() * upper.R);
+  turn.angle() *= 0.5;
+  m.frame.origin_mm = 0.5 * (lower.apply(f.origin_mm) + upper.apply(f.origin_mm));
+  m.frame.axes = lower.R * turn.toRotationMatrix() * f.axes;
   for (Eigen::Index t = 0; t < m.T.rows(); ++t)
     if (!(tet_volume(m, t) > 0))
       throw std::invalid_argument("carry_between: tet " + std::to_string(t) +

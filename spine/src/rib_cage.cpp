@@ -196,7 +196,8 @@ RibCage build_rib_cage(const std::string& data_dir, const std::vector<Vertebra>&
         Rib r;
         r.number = n;
         r.side = side;
-        r.name = (side < 0 ? "R" : "L") + std::to_string(n);
+        // "rib_L4", not "L4": a rib's name must not be a vertebra's (the scene finds bodies by name).
+        r.name = std::string(side < 0 ? "rib_R" : "rib_L") + std::to_string(n);
         auto at = [&](std::size_t col, const char* what) {
           const Vector3d p = s * point(row.at(col), who + " " + what, file);
           return side < 0 ? p : mirror(p);

@@ -107,6 +107,12 @@ void write_discs_frame(const std::string& path, CombinedDiscs& c, const mss::Dis
                   {mesh::VtuEncoding::zlib});
 }
 
+/// The vertebrae's poses in a curved spine's rest posture; none for a straight spine.
+std::vector<spine::Pose> rest_poses(const spine::SpineModel& m) {
+  return m.rest_posture.size() > 0 ? spine::vertebra_poses(m, m.rest_posture)
+                                   : std::vector<spine::Pose>();
+}
+
 /// The vertebra surfaces as one surface, each body's vertices in a block.
 struct CombinedVertebrae {
   mesh::TriSurface rest, moved;
@@ -117,6 +123,7 @@ struct CombinedVertebrae {
 
 CombinedVertebrae combine(const VertebraSurfacesResult& s, const spine::SpineModel& m) {
   CombinedVertebrae c;
+  const std::vector<spine::Pose> rest = rest_poses(m);
   Eigen::Index nv = 0, nf = 0;
   for (const auto& b : s.surfaces) nv += b.surface.V.rows(), nf += b.surface.F.rows();
   c.rest.V.resize(nv, 3), c.rest.F.resize(nf, 3), c.body.resize(nf, 1);
@@ -126,6 +133,11 @@ CombinedVertebrae combine(const VertebraSurfacesResult& s, const spine::SpineMod
     c.vertebra.push_back(vertebra_index(m, s.surfaces[i].name));
     c.first.push_back(v0), c.count.push_back(b.V.rows());
     c.rest.V.middleRows(v0, b.V.rows()) = m.scale.length * b.V;  // the body's vertebrae
+    if (!rest.empty() && c.vertebra.back() >= 0) {               // a curve's rest posture
+      const spine::Pose& p = rest[std::size_t(c.vertebra.back())];
+      for (Eigen::Index k = v0; k < v0 + b.V.rows(); ++k)
+        c.rest.V.row(k) = (p.R * c.rest.V.row(k).transpose() + p.t).transpose();
+    }
     c.rest.F.middleRows(f0, b.F.rows()) = b.F.array() + int(v0);
     c.body.middleRows(f0, b.F.rows()).setConstant(double(i));
     v0 += b.V.rows(), f0 += b.F.rows();
@@ -263,6 +275,12 @@ SpineDiscs build_spine_discs(const spine::SpineModel& model, const calibration::
                                  std::to_string(options.layers) + " layers";
   SpineDiscs d;
   d.resolution = resolution;
+  const std::vector<spine::Pose> rest = rest_poses(model);
+  auto rest_motion = [&](int vertebra) {  // the sacrum (-1) never moves
+    return vertebra < 0
+               ? mesh::RigidMotion()
+               : mesh::RigidMotion{rest[std::size_t(vertebra)].R, rest[std::size_t(vertebra)].t};
+  };
   for (const std::string& level : mesh::disc_levels()) {
     const calibration::TunedDisc& entry = calibration::tuned_level(tuned, level);
     mesh::TetMesh m = mesh::mesh_structured_level(level, options, studies::data_dir());
@@ -277,12 +295,20 @@ SpineDiscs build_spine_discs(const spine::SpineModel& model, const calibration::
     // the tuned scales were fitted on the reference mesh; springs and masses follow the scaled
     // geometry.
     m.V *= model.scale.length;
-    d.models.push_back(calibration::build_tuned_model(entry, m, entry.materials()));
+    m.frame.origin_mm *= model.scale.length;
     const std::size_t dash = level.find('-');
     d.upper.push_back(vertebra_index(model, level.substr(0, dash)));
     d.lower.push_back(vertebra_index(model, level.substr(dash + 1)));
     if (d.upper.back() < 0)
       throw std::invalid_argument(level + ": its upper vertebra is not in the spine model");
+    // A curved spine's disc rests wedged between its vertebrae's rest poses (the recorded motions
+    // start there); its springs are stress-free in that shape, as the spine's joints are.
+    if (!rest.empty())
+      mesh::carry_between(
+          m, m.frame,
+          model.scale.length * mesh::disc_dimensions(level, studies::data_dir()).height_mm,
+          rest_motion(d.lower.back()), rest_motion(d.upper.back()));
+    d.models.push_back(calibration::build_tuned_model(entry, m, entry.materials()));
   }
   return d;
 }
@@ -295,9 +321,12 @@ SpineDiscsResult run_spine_discs(const SpineDiscsRequest& request, const std::st
   SpineDiscsResult r;
   r.request = request;
   spine::ModelOptions body;  // the recorded spine's body (the reference when not recorded)
-  body.subject = haptics::recording_body(request.recording);
+  const haptics::RecordedSpine recorded = haptics::recording_spine(request.recording);
+  body.subject = recorded.subject;
+  body.scoliosis = recorded.scoliosis;
   const spine::SpineModel model = spine::load_spine_model(data_dir, body);
   r.subject = model.subject;
+  r.scoliosis = model.scoliosis;
   const DragRecording rec = read_drag_recording(request.recording, model);
   r.fingerprint = rec.fingerprint;
   r.recording_complete = rec.complete;
@@ -414,6 +443,7 @@ nlohmann::json spine_discs_json(const SpineDiscsResult& r) {
           {"diverged_reason", r.diverged},
           {"spine_model", r.fingerprint},
           {"subject", subject_json(r.subject)},
+          {"scoliosis", scoliosis_curve_json(r.scoliosis)},
           {"tuned", r.request.tuned.empty() ? "real-disc" : r.request.tuned},
           {"resolution", r.resolution},
           {"integrator", "implicit Euler"},
@@ -448,7 +478,12 @@ std::string spine_discs_table(const SpineDiscsResult& r) {
      << (r.request.refactorize ? "refactorised" : "frozen matrix") << ", " << r.request.threads
      << (r.request.threads == 1 ? " thread" : " threads") << "); with the per-step reactions "
      << "and volumes " << fixed(r.speedup_measured(), 2) << "x; total " << fixed(r.total_s, 1)
-     << " s\n\n";
+     << " s\n";
+  if (r.scoliosis.cobb_deg != 0)
+    os << "the spine rests in a " << fixed(r.scoliosis.cobb_deg, 0) << " deg " << r.scoliosis.type
+       << " scoliosis (" << r.scoliosis.upper_end << "-" << r.scoliosis.lower_end << ", apex "
+       << r.scoliosis.apex << "): each disc rests wedged between its vertebrae in the curve\n";
+  os << "\n";
   TextTable t({"disc", "compression (mm)", "shear (mm)", "rotation (deg)", "volume change (%)",
                "inverted", "force (N)", "moment (N·m)", "rejected"});
   for (const DiscPeaks& p : r.peaks)

@@ -155,25 +155,30 @@ SpineSolveRun run_spine_solve(const std::string& data_dir, const SpineSolveReque
   return r;
 }
 
-nlohmann::json scoliosis_json(const spine::SpineModel& m) {
-  const spine::ScoliosisCurve& c = m.scoliosis;
+nlohmann::json scoliosis_curve_json(const spine::ScoliosisCurve& c) {
   if (c.cobb_deg == 0) return nullptr;
-  const spine::ScoliosisPosture p = spine::scoliotic_posture(m, c);
   return {{"type", c.type},
           {"cobb_deg", c.cobb_deg},
           {"upper_end", c.upper_end},
           {"apex", c.apex},
           {"lower_end", c.lower_end},
           {"apical_rotation_deg", c.apical_rotation_deg},
-          {"convex", c.convex_right ? "right" : "left"},
-          {"rest_posture",
-           {{"cobb_deg", p.cobb_deg},
-            {"apex_offset_mm", p.apex_offset_mm},
-            {"apical_rotation_deg", p.apical_rotation_deg},
-            {"t1_offset_mm", p.t1_offset_mm},
-            {"t1_tilt_deg", p.t1_tilt_deg},
-            {"largest_disc_closure", p.largest_share},
-            {"largest_disc_closure_joint", p.largest_share_joint}}}};
+          {"convex", c.convex_right ? "right" : "left"}};
+}
+
+nlohmann::json scoliosis_json(const spine::SpineModel& m) {
+  const spine::ScoliosisCurve& c = m.scoliosis;
+  if (c.cobb_deg == 0) return nullptr;
+  const spine::ScoliosisPosture p = spine::scoliotic_posture(m, c);
+  nlohmann::json j = scoliosis_curve_json(c);
+  j["rest_posture"] = {{"cobb_deg", p.cobb_deg},
+                       {"apex_offset_mm", p.apex_offset_mm},
+                       {"apical_rotation_deg", p.apical_rotation_deg},
+                       {"t1_offset_mm", p.t1_offset_mm},
+                       {"t1_tilt_deg", p.t1_tilt_deg},
+                       {"largest_disc_closure", p.largest_share},
+                       {"largest_disc_closure_joint", p.largest_share_joint}};
+  return j;
 }
 
 nlohmann::json spine_solve_json(const SpineSolveRun& r, const std::string& csv) {

@@ -64,16 +64,30 @@ TEST(ScoliosisSolve, BadCurvesAreRefused) {
 // and is refused with a curve.
 TEST(ScoliosisHaptics, TheCurvedSpineIsDraggedAndTheDatabaseRefused) {
   const std::string script = std::string(SPINESIM_DATA_DIR) + "/haptics/drag_t1_lateral.csv";
+  const std::string rec = tmp("curved-drag.csv");
   const CliRun r = run_spinesim(
       "haptics run --scene spine --triangles 1500 --spine multirate --scoliosis lumbar --cobb 15 "
       "--script '" +
-      script + "' --duration 2 --no-realtime --json");
+      script + "' --duration 2 --no-realtime --json --record '" + rec + "'");
   ASSERT_EQ(r.status, 0) << r.err;
   const json j = json::parse(r.out);
   EXPECT_NE(j["scene_description"].get<std::string>().find("scoliosis"), std::string::npos);
   EXPECT_GT(j["compliant_stage"]["hooked_ticks"].get<int>(), 500);
   EXPECT_GT(j["compliant_stage"]["worker_solves"].get<int>(), 2);
   EXPECT_EQ(j["compliant_stage"]["worker_failures"].get<int>(), 0);
+  // The offline discs follow the curved spine: the recording names its curve, and `spine discs`
+  // steps the wedged discs through the drag without a rejected step.
+  const std::string out = tmp("curved-discs");
+  const CliRun d = run_spinesim("spine discs --quiet --json --vertebra-triangles 0 --record '" +
+                                rec + "' --out '" + out + "'");
+  ASSERT_EQ(d.status, 0) << d.err;
+  const json dj = json::parse(d.out);
+  EXPECT_EQ(dj["scoliosis"]["cobb_deg"].get<double>(), 15);
+  ASSERT_EQ(dj["per_disc"].size(), 17u);
+  for (const auto& disc : dj["per_disc"]) {
+    EXPECT_EQ(disc["rejected_steps"].get<int>(), 0) << disc["level"];
+    EXPECT_EQ(disc["inverted_tets_max"].get<int>(), 0) << disc["level"];
+  }
   expect_refused(run_spinesim("haptics run --duration 1 --scene spine --spine database "
                               "--scoliosis thoracic --cobb 30"),
                  "straight spine");

@@ -277,3 +277,15 @@ TEST(Renderers, RefuseANonPositiveRadius) {
   g.radius_mm = std::nan("");
   EXPECT_THROW(sh::GaoGibsonRenderer{g}, std::invalid_argument);
 }
+
+// Bodies are found by name: a second body of a name already in the scene is refused (a rib
+// named as a vertebra once took that vertebra's poses).
+TEST(Scene, RefusesASecondBodyOfTheSameName) {
+  sh::Scene scene;
+  scene.add_body("L4", sh::square_plane(10, 2));
+  EXPECT_THROW(scene.add_body("L4", sh::square_plane(10, 2)), std::invalid_argument);
+  scene.add_body("rib_L4", sh::square_plane(10, 2));
+  EXPECT_EQ(scene.size(), 2);
+  EXPECT_EQ(scene.index("L4"), 0);
+  EXPECT_EQ(scene.index("rib_L4"), 1);
+}

@@ -154,7 +154,10 @@ TEST(HapticScene, AScoliosisPosesTheVertebraeAndTheRibCageAddsItsBodies) {
   const auto caged = st::build_haptic_scene(r, kData);
   EXPECT_EQ(caged.scene.size(), straight.scene.size() + 25);
   EXPECT_GE(caged.scene.index("sternum"), 0);
-  EXPECT_GE(caged.scene.index("L12"), 0);
+  EXPECT_GE(caged.scene.index("rib_L12"), 0);
+  // The vertebrae keep their names: the left ribs 1-5 are not found as L1-L5.
+  for (int i = 0; i < straight.scene.size(); ++i)
+    EXPECT_EQ(caged.scene.index(straight.scene.body(i).name), i) << straight.scene.body(i).name;
   r.scoliosis = spinesim::spine::scoliosis_curve("thoracic", 30);  // with the cage: refused
   EXPECT_THROW(st::build_haptic_scene(r, kData), std::invalid_argument);
   r.scoliosis = {};

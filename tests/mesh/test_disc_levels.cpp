@@ -205,6 +205,20 @@ TEST(DiscCarry, EndplatesFollowTheirVertebraeAndTheWallStretchesLinearly) {
   EXPECT_GT(upper, 20);
   EXPECT_NEAR(mesh_volume(m), v0, 0.01 * v0);
   for (Eigen::Index t = 0; t < m.T.rows(); ++t) ASSERT_GT(tet_volume(m, t), 0);
+  // The frame goes halfway: its axis turned 2.5 deg about z, its origin midway.
+  const Eigen::Matrix3d half =
+      Eigen::AngleAxisd(2.5 * M_PI / 180, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  EXPECT_LT((m.frame.axes - half * straight.frame.axes).norm(), 1e-12);
+  EXPECT_LT((m.frame.origin_mm - 0.5 * wedge.apply(straight.frame.origin_mm)).norm(), 1e-12);
+
+  // Carried rigidly (both vertebrae the same motion), the frame is that motion's image.
+  RigidMotion both;
+  both.R = Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  both.t = Eigen::Vector3d(4, -5, 6);
+  m = straight;
+  carry_between(m, frame, h, both, both);
+  EXPECT_LT((m.frame.axes - both.R * straight.frame.axes).norm(), 1e-12);
+  EXPECT_LT((m.frame.origin_mm - both.apply(straight.frame.origin_mm)).norm(), 1e-12);
 
   RigidMotion flip;
   flip.R = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ()).toRotationMatrix();

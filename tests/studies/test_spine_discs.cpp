@@ -7,6 +7,7 @@
 #include "spinesim/mss/boundary.hpp"
 #include "spinesim/mss/solver.hpp"
 #include "spinesim/spine/kinematics.hpp"
+#include "spinesim/spine/scoliosis.hpp"
 #include "spinesim/studies/spine_discs.hpp"
 
 #include <gtest/gtest.h>
@@ -242,6 +243,76 @@ TEST(SpineDiscs, ShippedFibreSetIsMeshedAtItsOwnFinerResolution) {
   for (const auto& m : d.models) {
     EXPECT_EQ(m.mesh().num_tets(), 2016);
     EXPECT_GT(m.num_fibre_springs(), 0);
+  }
+}
+
+// A scoliotic spine's discs rest wedged in its curve: every disc's endplates sit on its
+// vertebrae's rest poses (the straight disc's endplates carried by them), and its axis is turned
+// halfway between them. A recording of that spine says so in its header, and a still one leaves
+// every disc at rest: the wedged discs are stress-free in the curve.
+TEST(SpineDiscs, AScolioticSpinesDiscsRestWedgedInItsCurve) {
+  sp::ModelOptions o;
+  o.scoliosis = sp::scoliosis_curve("lumbar", 30);
+  const sp::SpineModel curved = sp::load_spine_model(SPINESIM_DATA_DIR, o);
+  ASSERT_GT(curved.rest_posture.size(), 0);
+  const std::vector<sp::Pose> P = sp::vertebra_poses(curved, curved.rest_posture);
+  const st::SpineDiscs straight = st::build_spine_discs(model(), structured_set());
+  const st::SpineDiscs wedged = st::build_spine_discs(curved, structured_set());
+  ASSERT_EQ(wedged.models.size(), straight.models.size());
+  double largest_wedge = 0;
+  for (std::size_t i = 0; i < wedged.models.size(); ++i) {
+    const auto& a = straight.models[i].mesh();
+    const auto& b = wedged.models[i].mesh();
+    const int up = wedged.upper[i], low = wedged.lower[i];
+    auto pose = [&](int v) { return v < 0 ? sp::Pose() : P[std::size_t(v)]; };
+    int plates = 0;
+    for (Eigen::Index k = 0; k < a.V.rows(); ++k) {
+      const int s = a.surface(k);
+      if (s != int(spinesim::mesh::Surface::superior_endplate) &&
+          s != int(spinesim::mesh::Surface::inferior_endplate))
+        continue;
+      const sp::Pose p = pose(s == int(spinesim::mesh::Surface::superior_endplate) ? up : low);
+      EXPECT_LT((b.V.row(k).transpose() - (p.R * a.V.row(k).transpose() + p.t)).norm(), 1e-9)
+          << wedged.levels[i] << " node " << k;
+      ++plates;
+    }
+    EXPECT_GT(plates, 20) << wedged.levels[i];
+    const double turn =
+        std::acos(std::clamp(b.frame.axes.col(1).dot(a.frame.axes.col(1)), -1.0, 1.0));
+    largest_wedge = std::max(largest_wedge, turn);
+  }
+  EXPECT_GT(largest_wedge * 180 / M_PI, 2);  // a 30 deg curve over a few joints
+
+  // The recording carries the curve; a still one leaves the wedged discs at rest.
+  std::vector<sh::TickRecord> rows(20);
+  for (int k = 0; k < 20; ++k) {
+    sh::TickRecord& r = rows[std::size_t(k)];
+    r.t_s = 1e-3 * k;
+    r.tick = k + 1;
+    r.probe_mm = r.force_n = r.proxy_mm = Eigen::Vector3d::Zero();
+    r.compliant = true;
+    for (int i = 0; i < 17; ++i) r.R[std::size_t(i)].setIdentity(), r.t[std::size_t(i)].setZero();
+  }
+  st::SpineDiscsRequest rq;
+  rq.recording = scratch("curved-still.csv").string();
+  {
+    sh::HapticRecordingWriter w(rq.recording, "test", &curved, "multirate");
+    w.append(rows.data(), rows.size());
+    w.finish();
+  }
+  const sh::RecordedSpine rs = sh::recording_spine(rq.recording);
+  EXPECT_EQ(rs.scoliosis.type, "lumbar");
+  EXPECT_EQ(rs.scoliosis.cobb_deg, 30);
+  EXPECT_EQ(rs.scoliosis.apex, o.scoliosis.apex);
+  EXPECT_EQ(rs.scoliosis.convex_right, o.scoliosis.convex_right);
+  EXPECT_NE(sh::spine_model_fingerprint(curved), sh::spine_model_fingerprint(model()));
+  rq.out = scratch("curved-still-out").string();
+  rq.vertebra_triangles = 0;
+  const st::SpineDiscsResult r = st::run_spine_discs(rq, SPINESIM_DATA_DIR);
+  for (const auto& p : r.peaks) {
+    EXPECT_LT(p.force_n, 1e-6) << p.level;
+    EXPECT_LT(std::abs(p.volume_change_min), 1e-12) << p.level;
+    EXPECT_EQ(p.rejected_steps, 0) << p.level;
   }
 }
 

@@ -95,9 +95,15 @@ inline constexpr double kMaxVertebraShiftMm = 500, kMaxVertebraTurnDeg = 180;
 /// cut off mid-row (a killed run) is dropped.
 DragRecording read_drag_recording(const std::string& path, const spine::SpineModel& model);
 
-/// The body a compliant-stage recording's spine belongs to (its "# body:" line; a recording
-/// without one is the reference body's: zeros). Reads the header only; std::invalid_argument for
-/// a malformed body line.
-spine::Subject recording_body(const std::string& path);
+/// Whose spine a compliant-stage recording dragged: the body (its "# body:" line; without one
+/// the reference body's: zeros) and the scoliotic curve it rested in (its "# scoliosis:" line;
+/// without one straight: cobb_deg 0).
+struct RecordedSpine {
+  spine::Subject subject;
+  spine::ScoliosisCurve scoliosis;
+};
+/// Reads the header only; std::invalid_argument (one line) for a malformed body or scoliosis
+/// line or a curve the model cannot pose.
+RecordedSpine recording_spine(const std::string& path);
 
 }  // namespace spinesim::haptics

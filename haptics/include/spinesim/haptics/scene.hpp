@@ -45,7 +45,8 @@ struct ScenePoses {
 
 class Scene {
  public:
-  /// Adds a body; throws std::invalid_argument beyond kMaxBodies or for an empty surface.
+  /// Adds a body; throws std::invalid_argument beyond kMaxBodies, for an empty surface or for a
+  /// name already in the scene (bodies are found by name).
   void add_body(const std::string& name, const mesh::TriSurface& surface);
   /// Samples every body's surface for the Gao–Gibson renderer (spacing in mm, > 0).
   void sample_surfaces(double spacing_mm);

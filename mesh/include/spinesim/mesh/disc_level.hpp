@@ -39,7 +39,9 @@ struct RigidMotion {
 /// upper one) along with its two vertebrae: each node moves to (1 − s)·lower(x) + s·upper(x), s
 /// its height fraction (local y + h/2)/h clamped to [0, 1]. The endplates move rigidly with their
 /// vertebrae and the wall follows linearly: for two vertebrae of a scoliotic curve, the wedged
-/// and twisted disc between them. Throws std::invalid_argument (one line) if a tet would invert.
+/// and twisted disc between them. The mesh's frame goes with it: its origin midway between the
+/// two vertebrae's images of the old one, its axes turned halfway from the lower rotation to the
+/// upper. Throws std::invalid_argument (one line) if a tet would invert.
 void carry_between(TetMesh& m, const DiscFrame& frame, double height_mm, const RigidMotion& lower,
                    const RigidMotion& upper);
 

@@ -27,7 +27,7 @@ namespace spinesim::spine {
 enum class RibFront { Sternum, RibAbove, Floating };
 
 struct Rib {
-  std::string name;  ///< "R7" (right) or "L7" (left)
+  std::string name;  ///< "rib_R7" (right) or "rib_L7" (left); never a vertebra's name
   int number = 0;    ///< 1 … 12
   int side = -1;     ///< −1 right (x < 0), +1 left
   /// The vertebrae its head articulates with (ribs 2-9: the one above and its own; the others

@@ -62,7 +62,8 @@ struct SpineDiscs {
 std::string spine_discs_params_path(const std::string& params, const std::string& data_dir);
 
 /// Builds the discs, each meshed at the structured resolution the set was calibrated on
-/// (calibration::structured_resolution). Throws std::invalid_argument (one line) for a level
+/// (calibration::structured_resolution), scaled to the model's body and, for a scoliotic model,
+/// carried wedged between its vertebrae's rest poses (mesh::carry_between). Throws std::invalid_argument (one line) for a level
 /// missing from `tuned`, or an entry fitted on another mesh than this level's structured disc
 /// (naming both meshes and how to calibrate the structured ones), or another material than the
 /// set's.
@@ -98,6 +99,7 @@ struct SpineDiscsResult {
   SpineDiscsRequest request;
   std::string fingerprint;  ///< the spine model's
   spine::Subject subject;   ///< the recorded spine's body (resolved)
+  spine::ScoliosisCurve scoliosis;  ///< its curve (cobb_deg 0: straight); the discs rest in it
   bool recording_complete = false;
   std::string recording_incomplete;  ///< why the recording is not whole (empty when it is)
   /// Why the discs' answer means nothing (empty when it holds): a rejected step, a tet turned

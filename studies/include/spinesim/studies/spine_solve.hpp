@@ -50,6 +50,8 @@ nlohmann::json subject_json(const spine::Subject& subject);
 /// The model's scoliotic curve and its measured rest posture (Cobb angle, apex offset, T1's
 /// balance, the largest disc closure); null for a straight spine.
 nlohmann::json scoliosis_json(const spine::SpineModel& model);
+/// A curve's parameters alone (null for a straight spine).
+nlohmann::json scoliosis_curve_json(const spine::ScoliosisCurve& curve);
 /// "female, 1.600 m, 55.0 kg" for the tables' headers.
 std::string subject_text(const spine::Subject& subject);
 
