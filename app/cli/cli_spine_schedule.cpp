@@ -21,6 +21,7 @@ struct ScheduleArgs {
   int workers = 0;
   bool json = false, quiet = false, no_muscles = false, rib_cage = false;
   SubjectFlags subject;
+  ScoliosisFlags scoliosis;
 };
 
 void run_schedule(const ScheduleArgs& a) {
@@ -41,6 +42,7 @@ void run_schedule(const ScheduleArgs& a) {
   model.ligaments = spine::parse_ligaments(a.ligaments);
   model.rib_cage = a.rib_cage;
   model.subject = spine::resolve_subject(data_dir(), subject_of(a.subject));
+  model.scoliosis = scoliosis_of(a.scoliosis);
   if (a.step_s > 0 &&
       (schedule.time_s.back() - schedule.time_s.front()) / a.step_s > 1e5)
     throw std::invalid_argument("--step " + fixed(a.step_s, 6) +
@@ -127,6 +129,7 @@ void register_spine_schedule(CLI::App& spine) {
                   "file) in place of F.4");
   add_ligaments_option(cmd, a->ligaments);
   add_rib_cage_option(cmd, a->rib_cage);
+  add_scoliosis_options(cmd, a->scoliosis);
   add_subject_options(cmd, a->subject);
   add_output_flags(cmd, a->json, a->quiet, "every step as JSON");
   cmd->footer(

@@ -283,6 +283,7 @@ nlohmann::json schedule_json(const ScheduleRun& run) {
           {"columns", run.schedule.columns},
           {"key_times_s", run.schedule.time_s},
           {"subject", subject_json(run.model.subject)},
+          {"scoliosis", scoliosis_curve_json(run.model.scoliosis)},
           {"steps", steps},
           {"failed", run.failed},
           {"inertia",
@@ -292,7 +293,10 @@ nlohmann::json schedule_json(const ScheduleRun& run) {
           {"dynamic", dynamic_json(run)},
           {"seconds", run.seconds},
           {"units",
-           {{"force", "N"}, {"moment", "N·mm"}, {"translation", "mm"}, {"rotation", "deg"},
+           {{"force", "N"},
+            {"moment", "N·mm"},
+            {"translation", "mm"},
+            {"rotation", "deg"},
             {"t1_displacement", "tx, ty, tz (mm), rx, ry, rz (deg)"}}}};
 }
 
@@ -391,7 +395,12 @@ void print_inertia(std::ostream& os, const ScheduleRun& run) {
 
 void print_schedule(std::ostream& os, const ScheduleRun& run) {
   os << "Loads in time (" << run.schedule.path << "): " << run.steps.size()
-     << " quasi-static equilibria, body " << subject_text(run.model.subject) << "\n\n";
+     << " quasi-static equilibria, body " << subject_text(run.model.subject);
+  const spine::ScoliosisCurve& c = run.model.scoliosis;
+  if (c.cobb_deg != 0)
+    os << ", resting in a " << fixed(c.cobb_deg, 0) << " deg " << c.type << " scoliosis ("
+       << c.upper_end << "-" << c.lower_end << ", apex " << c.apex << ")";
+  os << "\n\n";
   std::vector<std::string> header = {"time (s)"};
   for (const auto& c : run.schedule.columns) header.push_back(c);
   for (const char* h : {"L4-L5 axial (N)", "L5-S1 axial (N)", "L5-S1 shear AP (N)",
@@ -431,7 +440,11 @@ void write_schedule_recording(const ScheduleRun& run, const std::string& path) {
     throw std::invalid_argument("--record: fewer than two steps reached equilibrium");
   // The recording is a servo's: one row a millisecond (the offline discs step 1 ms a row).
   // Between solved steps each vertebra moves along the straight line and the geodesic rotation
-  // from one equilibrium pose to the next.
+  // from one equilibrium pose to the next. A curved spine's motions are recorded from its rest
+  // posture, where its (wedged) discs are stress-free, as the haptic stage records them.
+  const std::vector<spine::Pose> rest =
+      run.model.rest_posture.size() > 0 ? spine::vertebra_poses(run.model, run.model.rest_posture)
+                                        : std::vector<spine::Pose>();
   constexpr double kTickS = 1e-3;
   const double t0 = solved.front()->t_s, t1 = solved.back()->t_s;
   const auto ticks = static_cast<std::int64_t>(std::floor((t1 - t0) / kTickS + 1e-9)) + 1;
@@ -457,8 +470,15 @@ void write_schedule_recording(const ScheduleRun& run, const std::string& path) {
       const spine::Pose& pb = b.solution.poses[v];
       const Eigen::Matrix3d R =
           pa.R * spine::rotation_exp(w * spine::rotation_log(pa.R.transpose() * pb.R));
-      r.R[v] = R.cast<float>();
-      r.t[v] = (pa.t + w * (pb.t - pa.t)).cast<float>();
+      const Eigen::Vector3d t_abs = pa.t + w * (pb.t - pa.t);
+      if (rest.empty()) {
+        r.R[v] = R.cast<float>();
+        r.t[v] = t_abs.cast<float>();
+      } else {  // x = R (R0ᵀ(y − t0)) + t for y on the vertebra at rest
+        const Eigen::Matrix3d Rr = R * rest[v].R.transpose();
+        r.R[v] = Rr.cast<float>();
+        r.t[v] = (t_abs - Rr * rest[v].t).cast<float>();
+      }
     }
     block.push_back(r);
     if (block.size() == 4096 || k + 1 == ticks) {

@@ -6,14 +6,50 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <map>
+#include <sstream>
 #include <string>
 #include <vector>
 
 namespace spinesim::test_cli {
 
 inline std::string in_quotes(const std::string& path) { return "'" + path + "'"; }
+
+/// One column of a CSV whose first row not starting with '#' names the columns (a spine
+/// recording, say), row by row; a failure and nothing when there is no such column.
+inline std::vector<double> csv_column(const std::string& csv, const std::string& column) {
+  std::ifstream in(csv);
+  std::string line;
+  int col = -1;
+  std::vector<double> out;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::stringstream ss(line);
+    std::string cell;
+    std::vector<std::string> cells;
+    while (std::getline(ss, cell, ',')) cells.push_back(cell);
+    if (col >= 0) {
+      out.push_back(std::stod(cells.at(std::size_t(col))));
+      continue;
+    }
+    const auto at = std::find(cells.begin(), cells.end(), column);
+    if (at == cells.end()) {
+      ADD_FAILURE() << column << " is not a column of " << csv;
+      return out;
+    }
+    col = int(at - cells.begin());
+  }
+  return out;
+}
+
+inline double max_abs(const std::vector<double>& v) {
+  double most = 0;
+  for (double x : v) most = std::max(most, std::abs(x));
+  return most;
+}
 
 /// `spinesim spine solve ARGS --json`, parsed; an empty object (and a failure) on a non-zero exit.
 inline nlohmann::json solve_json(const std::string& args) {

@@ -7,41 +7,12 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include <algorithm>
-#include <cmath>
-#include <fstream>
-#include <sstream>
 #include <string>
-#include <vector>
 
 using nlohmann::json;
 using namespace spinesim::test_cli;
 
 namespace {
-
-/// The largest |value| in one column of a recording (its header row names the columns).
-double max_abs_column(const std::string& csv, const std::string& column) {
-  std::ifstream in(csv);
-  std::string line;
-  int col = -1;
-  double most = 0;
-  while (std::getline(in, line)) {
-    if (line.empty() || line[0] == '#') continue;
-    std::stringstream ss(line);
-    std::string cell;
-    std::vector<std::string> cells;
-    while (std::getline(ss, cell, ',')) cells.push_back(cell);
-    if (col < 0) {
-      for (std::size_t i = 0; i < cells.size(); ++i)
-        if (cells[i] == column) col = int(i);
-      if (col < 0) ADD_FAILURE() << column << " is not a column of " << csv;
-      if (col < 0) return 0;
-      continue;
-    }
-    most = std::max(most, std::abs(std::stod(cells.at(std::size_t(col)))));
-  }
-  return most;
-}
 
 const char* const kDirections[] = {"flexion_extension", "lateral_bending", "axial_rotation"};
 
@@ -157,10 +128,10 @@ TEST(RibCageHaptics, TheMultirateSpineCarriesTheCageAndTheDatabaseMustMatch) {
   // T1 pulled sideways moves the lumbar vertebrae far less than T1 (a static solve: L4 0.1 % of
   // T1). Once the left ribs 1-5 were named as L1-L5 and their poses moved the lumbar vertebrae
   // of the scene and the recording by more than T1 moved.
-  const double t1 = max_abs_column(rec, "T1_tx_mm");
+  const double t1 = max_abs(csv_column(rec, "T1_tx_mm"));
   EXPECT_GT(t1, 2);
   for (const char* v : {"L1_tx_mm", "L2_tx_mm", "L3_tx_mm", "L4_tx_mm", "L5_tx_mm"})
-    EXPECT_LT(max_abs_column(rec, v), 0.25 * t1) << v;
+    EXPECT_LT(max_abs(csv_column(rec, v)), 0.25 * t1) << v;
 
   expect_refused(run_spinesim("haptics run --duration 1 --scene plane --rib-cage"),
                  "--scene spine");

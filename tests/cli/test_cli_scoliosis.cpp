@@ -96,6 +96,39 @@ TEST(ScoliosisHaptics, TheCurvedSpineIsDraggedAndTheDatabaseRefused) {
       "--scene spine");
 }
 
+// A schedule on a curved spine: the curve is reported, its recording is measured from the
+// curve's rest posture (so the first frame is the standing sag, a few mm, not the curve's own
+// offsets from the straight spine), and the offline discs rest wedged in the curve and follow it.
+TEST(ScoliosisScheduleCli, ACurvedSpinesScheduleIsRecordedFromItsCurveAndItsDiscsFollow) {
+  const std::string loads = tmp("curved-loads.csv");
+  spit(loads, "time_s,T7.fz_n\n0,0\n0.2,100\n");
+  const std::string rec = tmp("curved-schedule.csv");
+  const CliRun r = run_spinesim(
+      "spine schedule --quiet --json --step 0.1 --scoliosis lumbar "
+      "--cobb 30 --loads " +
+      in_quotes(loads) + " --record " + in_quotes(rec));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(json::parse(r.out)["scoliosis"]["cobb_deg"].get<double>(), 30);
+  // L2 rests 29.6 mm to the side of the straight spine; standing sags it 3 mm further.
+  const json rest = solve_json("--scoliosis lumbar --cobb 30 --no-gravity --no-muscles");
+  double at_rest = 0;
+  for (const auto& v : rest["vertebrae"])
+    if (v["name"] == "L2") at_rest = v["translation_mm"][0].get<double>();
+  EXPECT_GT(std::abs(at_rest), 20);
+  EXPECT_LT(std::abs(csv_column(rec, "L2_tx_mm").front()), 0.25 * std::abs(at_rest));
+
+  const std::string out = tmp("curved-schedule-discs");
+  const CliRun d = run_spinesim("spine discs --quiet --json --vertebra-triangles 0 --record " +
+                                in_quotes(rec) + " --out " + in_quotes(out));
+  ASSERT_EQ(d.status, 0) << d.err;
+  const json dj = json::parse(d.out);
+  EXPECT_EQ(dj["scoliosis"]["type"], "lumbar");
+  for (const auto& disc : dj["per_disc"]) {
+    EXPECT_EQ(disc["rejected_steps"].get<int>(), 0) << disc["level"];
+    EXPECT_EQ(disc["inverted_tets_max"].get<int>(), 0) << disc["level"];
+  }
+}
+
 TEST(ScoliosisStudyCli, TablesNameTheSourcesAndTheJsonHasEveryCurve) {
   const CliRun r = run_spinesim("study scoliosis --quiet");
   ASSERT_EQ(r.status, 0) << r.err;
