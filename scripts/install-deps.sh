@@ -24,6 +24,7 @@ packages=(
   libgl1-mesa-dri xvfb xauth             # Mesa's software OpenGL and a virtual X server (view tests)
   clang libclang-rt-14-dev # libFuzzer, for the fuzz targets of the file readers (fuzz/)
   rt-tests                 # cyclictest: the machine's own real-time floor beside the loop's figures
+  libopenmpi-dev openmpi-bin   # `spinesim sweep` under mpirun (OpenMPI)
 )
 
 missing=()

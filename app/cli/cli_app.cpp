@@ -24,6 +24,7 @@ std::unique_ptr<CLI::App> make_app() {
   register_view(*app);
   register_bench(*app);
   register_run(*app);
+  register_sweep(*app);
   add_save_study_options(*app);
   require_plain_numbers(*app);
   return app;

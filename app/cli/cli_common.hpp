@@ -77,6 +77,7 @@ void register_mesh(CLI::App& app);
 void register_mesh_vertebrae(CLI::App& mesh);  ///< mesh vertebrae, under `mesh`
 void register_mesh_import(CLI::App& mesh);     ///< mesh import, under `mesh` (cli_mesh.cpp)
 void register_fem(CLI::App& app);
+void register_sweep(CLI::App& app);   ///< sweep PLAN: many studies on MPI, Slurm or here
 void register_export(CLI::App& app);  ///< in cli_fem.cpp: the fem problem for other solvers
 void register_mss(CLI::App& app);        ///< mss, mss compare (cli_mss.cpp)
 void register_calibrate(CLI::App& app);  ///< calibrate (cli_calibrate.cpp)

@@ -333,4 +333,28 @@ nlohmann::json study_schema(CLI::App& app) {
           {"allOf", per_verb}};
 }
 
+nlohmann::json rebase_study_inputs(CLI::App& app, nlohmann::json study, const std::string& from,
+                                   const std::string& to) {
+  CLI::App* verb = find_verb(app, study.value("verb", ""));
+  if (!verb || !study.contains("options") || !study["options"].is_object()) return study;
+  const fs::path base = fs::absolute(from).lexically_normal();
+  const fs::path target = fs::absolute(to).lexically_normal();
+  auto moved = [&](nlohmann::json& v) {
+    if (!v.is_string()) return;
+    const fs::path p(v.get<std::string>());
+    std::error_code ec;
+    if (p.empty() || p.is_absolute() || !fs::exists(base / p, ec)) return;
+    v = (base / p).lexically_normal().lexically_relative(target).string();
+  };
+  for (auto& item : study["options"].items()) {
+    const CLI::Option* o = verb->get_option_no_throw("--" + item.key());
+    if (!o || !(is_path_option(*o) || is_preset_or_path_option(*o))) continue;
+    if (item.value().is_array())
+      for (auto& v : item.value()) moved(v);
+    else
+      moved(item.value());
+  }
+  return study;
+}
+
 }  // namespace spinesim::cli

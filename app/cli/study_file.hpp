@@ -54,6 +54,13 @@ nlohmann::json study_of(CLI::App& verb, const std::string& verb_path,
 std::vector<std::string> study_arguments(CLI::App& app, const nlohmann::json& study,
                                          const std::string& where);
 
+/// `study` moved from folder `from` to folder `to`: each relative value of a path option (or a
+/// preset-or-path option) that names an existing file or folder in `from` is rewritten relative
+/// to `to`; the others (outputs, preset names) stay as they are, so a sweep point's outputs land
+/// in its own folder and its inputs are still found. An unknown verb leaves the study as it is.
+nlohmann::json rebase_study_inputs(CLI::App& app, nlohmann::json study, const std::string& from,
+                                   const std::string& to);
+
 /// The JSON Schema (draft 2020-12) of the study files of `app`.
 nlohmann::json study_schema(CLI::App& app);
 

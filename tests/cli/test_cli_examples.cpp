@@ -68,6 +68,14 @@ TEST(Examples, EveryExampleIsAValidStudyThatRuns) {
       SCOPED_TRACE(study.string());
       const json s = json::parse(slurp(study.string()));
       EXPECT_TRUE(s.contains("description")) << "an example explains itself";
+      if (s.contains("spinesim_sweep")) {  // a sweep plan: its points run, its summary written
+        const fs::path out = study.parent_path() / "sweep-out";
+        const CliRun r =
+            run_spinesim("sweep '" + study.string() + "' --out '" + out.string() + "' --quiet");
+        ASSERT_EQ(r.status, 0) << r.err;
+        expect_output_with_provenance(out / "summary.csv");
+        continue;
+      }
       const CliRun r = run_spinesim("run '" + study.string() + "'");
       ASSERT_EQ(r.status, 0) << r.err;
       if (s["options"].value("json", false)) EXPECT_TRUE(json::parse(r.out).contains("provenance"));
@@ -85,8 +93,16 @@ TEST(Examples, TheSchemaAcceptsEveryExample) {
   const std::string schema_file = tmp("schema.json");
   spit(schema_file, schema.out);
   for (const fs::path& folder : example_folders())
-    for (const fs::path& study : studies_in(folder))
+    for (const fs::path& study : studies_in(folder)) {
+      if (json::parse(slurp(study.string())).contains("spinesim_sweep")) {
+        // A sweep plan is not a study; each of its points is (checked before any point runs).
+        const CliRun r = run_spinesim("sweep '" + study.string() + "' --out '" +
+                                      tmp("dry-" + folder.filename().string()) + "' --dry-run");
+        EXPECT_EQ(r.status, 0) << r.err;
+        continue;
+      }
       EXPECT_TRUE(schema_accepts(schema_file, study.string())) << study;
+    }
 }
 
 }  // namespace

@@ -1,0 +1,86 @@
+// A sweep plan: one study (a verb and its fixed options, as in a study file) and the options
+// that vary, expanded into points. `spinesim sweep PLAN` runs the points (docs/sweeps.md).
+//
+//   {"spinesim_sweep": 1,
+//    "description": "…",                                   (optional text)
+//    "verb": "spine solve",
+//    "options": {"force": ["T7:0,0,300"]},                 the options every point shares
+//    "parameters": {
+//      "height": {"values": [1.6, 1.778]},                 a list
+//      "mass": {"from": 50, "to": 100, "steps": 3},         evenly spaced, both ends included
+//      "sex": {"values": ["male", "female"]}},
+//    "design": "grid",                                      or "zip", or
+//              {"latin_hypercube": {"points": 20, "seed": 1}}
+//    "outputs": {"L5-S1 axial (N)": "/joints/16/axial_n"}}  JSON pointers into a point's --json
+//
+// Designs: "grid" is every combination (the first parameter varies slowest); "zip" takes the
+// i-th value of every list (all of one length); a Latin hypercube draws `points` points of the
+// parameters' ranges ({"from", "to"}, continuous; a list is drawn from by index), one per
+// stratum in every parameter, from a seeded generator whose stream is fixed here (SplitMix64),
+// so the same plan gives the same points on every machine.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace spinesim::studies {
+
+/// The sweep plan format's version, "spinesim_sweep".
+inline constexpr int kSweepPlanVersion = 1;
+
+struct SweepParameter {
+  std::string option;                  ///< the verb's option, without "--"
+  std::vector<nlohmann::json> values;  ///< a list (or the evenly spaced steps); empty: a range
+  double from = 0, to = 0;             ///< a continuous range (values empty)
+};
+
+struct SweepPlan {
+  std::string description;
+  std::string verb;
+  nlohmann::json options = nlohmann::json::object();  ///< shared by every point
+  std::vector<SweepParameter> parameters;
+  std::string design = "grid";  ///< grid, zip or latin_hypercube
+  int sample_points = 0;        ///< latin_hypercube: how many
+  std::uint64_t seed = 1;       ///< latin_hypercube: the generator's seed
+  std::vector<std::pair<std::string, std::string>> outputs;  ///< column name, JSON pointer
+};
+
+struct SweepPoint {
+  int index = 0;
+  nlohmann::json values = nlohmann::json::object();  ///< the parameters' values, by option
+};
+
+/// Reads a plan (already parsed JSON). Throws std::invalid_argument (one line, naming `where`
+/// and the field) for an unknown or missing field, a parameter also among the fixed options,
+/// an empty list, a range whose ends are not finite numbers with from < to, steps < 2, a grid
+/// or zip over a continuous range, zip lists of different lengths, a Latin hypercube of fewer
+/// than 2 or more than 10^6 points, an output that is not a JSON pointer, or a plan of more
+/// than 10^6 points.
+SweepPlan parse_sweep_plan(const nlohmann::json& plan, const std::string& where);
+
+/// The plan's points, indexed 0 … n-1 in the design's order.
+std::vector<SweepPoint> expand_sweep(const SweepPlan& plan);
+
+/// The study file of one point: the plan's verb with its options and the point's values.
+nlohmann::json point_study(const SweepPlan& plan, const SweepPoint& point);
+
+/// The outputs of one point read from its JSON result (null where the pointer finds nothing).
+nlohmann::json point_outputs(const SweepPlan& plan, const nlohmann::json& result);
+
+/// SplitMix64 (Steele, Lea & Flood 2014): the sweep's own random stream, the same on every
+/// platform and standard library. uniform() is in [0, 1) with 53 random bits.
+class SplitMix64 {
+ public:
+  explicit SplitMix64(std::uint64_t seed) : state_(seed) {}
+  std::uint64_t next();
+  double uniform() { return double(next() >> 11) * 0x1.0p-53; }
+
+ private:
+  std::uint64_t state_;
+};
+
+}  // namespace spinesim::studies

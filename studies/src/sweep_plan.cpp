@@ -1,0 +1,242 @@
+#include "spinesim/studies/sweep_plan.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <stdexcept>
+
+namespace spinesim::studies {
+namespace {
+
+using nlohmann::json;
+
+constexpr std::size_t kMostPoints = 1'000'000;
+
+[[noreturn]] void refuse(const std::string& where, const std::string& field,
+                         const std::string& why) {
+  throw std::invalid_argument(where + ": " + field + ": " + why);
+}
+
+void require_known(const json& object, const std::vector<std::string>& known,
+                   const std::string& where, const std::string& field) {
+  for (const auto& item : object.items())
+    if (std::find(known.begin(), known.end(), item.key()) == known.end())
+      refuse(where, field + item.key(), "not a field of a sweep plan here");
+}
+
+double finite_number(const json& v, const std::string& where, const std::string& field) {
+  if (!v.is_number() || !std::isfinite(v.get<double>()))
+    refuse(where, field, "give a finite number");
+  return v.get<double>();
+}
+
+SweepParameter parse_parameter(const std::string& name, const json& p, const std::string& where) {
+  const std::string field = "parameters." + name;
+  if (!p.is_object()) refuse(where, field, "give {\"values\": [...]} or {\"from\", \"to\"}");
+  require_known(p, {"values", "from", "to", "steps"}, where, field + ".");
+  SweepParameter out;
+  out.option = name;
+  if (p.contains("values")) {
+    if (p.contains("from") || p.contains("to") || p.contains("steps"))
+      refuse(where, field, "give either values or a range, not both");
+    const json& v = p.at("values");
+    if (!v.is_array() || v.empty()) refuse(where, field + ".values", "give a non-empty list");
+    for (const auto& x : v) {
+      if (!(x.is_number() || x.is_string() || x.is_boolean()))
+        refuse(where, field + ".values", "each value is a number, a string or true/false");
+      if (x.is_number()) finite_number(x, where, field + ".values");
+      out.values.push_back(x);
+    }
+    return out;
+  }
+  if (!p.contains("from") || !p.contains("to"))
+    refuse(where, field, "give values, or a range from … to");
+  out.from = finite_number(p.at("from"), where, field + ".from");
+  out.to = finite_number(p.at("to"), where, field + ".to");
+  if (!(out.from < out.to)) refuse(where, field, "the range needs from < to");
+  if (p.contains("steps")) {
+    const json& s = p.at("steps");
+    if (!s.is_number_integer() || s.get<long long>() < 2 || s.get<long long>() > 100000)
+      refuse(where, field + ".steps", "give a whole number from 2 to 100000");
+    const long long n = s.get<long long>();
+    for (long long k = 0; k < n; ++k)
+      out.values.push_back(k + 1 == n ? out.to
+                                      : out.from + (out.to - out.from) * double(k) / double(n - 1));
+  }
+  return out;
+}
+
+void parse_design(const json& d, SweepPlan& plan, const std::string& where) {
+  if (d.is_string()) {
+    plan.design = d.get<std::string>();
+    if (plan.design != "grid" && plan.design != "zip")
+      refuse(where, "design",
+             "\"" + plan.design +
+                 "\": give \"grid\", \"zip\" or {\"latin_hypercube\": {\"points\": "
+                 "N, \"seed\": S}}");
+    return;
+  }
+  if (!d.is_object() || d.size() != 1 || !d.contains("latin_hypercube"))
+    refuse(where, "design", "give \"grid\", \"zip\" or {\"latin_hypercube\": {…}}");
+  const json& l = d.at("latin_hypercube");
+  if (!l.is_object()) refuse(where, "design.latin_hypercube", "give {\"points\": N, \"seed\": S}");
+  require_known(l, {"points", "seed"}, where, "design.latin_hypercube.");
+  plan.design = "latin_hypercube";
+  const json& n = l.value("points", json());
+  if (!n.is_number_integer() || n.get<long long>() < 2 ||
+      n.get<long long>() > static_cast<long long>(kMostPoints))
+    refuse(where, "design.latin_hypercube.points", "give a whole number from 2 to 1000000");
+  plan.sample_points = int(n.get<long long>());
+  if (l.contains("seed")) {
+    const json& s = l.at("seed");
+    if (!s.is_number_unsigned() && !(s.is_number_integer() && s.get<long long>() >= 0))
+      refuse(where, "design.latin_hypercube.seed", "give a whole number >= 0");
+    plan.seed = s.is_number_unsigned() ? s.get<std::uint64_t>() : std::uint64_t(s.get<long long>());
+  }
+}
+
+void check_design(const SweepPlan& plan, const std::string& where) {
+  std::size_t total = plan.design == "latin_hypercube" ? std::size_t(plan.sample_points) : 1;
+  for (const auto& p : plan.parameters) {
+    if (plan.design == "latin_hypercube") continue;
+    if (p.values.empty())
+      refuse(where, "parameters." + p.option,
+             "a continuous range needs a sampling design (latin_hypercube) or steps");
+    if (plan.design == "zip") {
+      if (p.values.size() != plan.parameters.front().values.size())
+        refuse(where, "parameters." + p.option,
+               "zip needs lists of one length (" + std::to_string(p.values.size()) + " against " +
+                   std::to_string(plan.parameters.front().values.size()) + ")");
+      total = p.values.size();
+    } else {
+      total *= p.values.size();
+      if (total > kMostPoints) refuse(where, "parameters", "the grid has more than 10^6 points");
+    }
+  }
+}
+
+}  // namespace
+
+std::uint64_t SplitMix64::next() {
+  std::uint64_t z = (state_ += 0x9e3779b97f4a7c15ull);
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+  return z ^ (z >> 31);
+}
+
+SweepPlan parse_sweep_plan(const json& j, const std::string& where) {
+  if (!j.is_object()) refuse(where, "the plan", "give a JSON object");
+  require_known(j,
+                {"spinesim_sweep", "description", "verb", "options", "parameters", "design",
+                 "outputs", "provenance"},
+                where, "");
+  if (!j.contains("spinesim_sweep") || j.at("spinesim_sweep") != kSweepPlanVersion)
+    refuse(where, "spinesim_sweep", "give 1 (the plan format's version)");
+  SweepPlan plan;
+  if (j.contains("description")) {
+    const json& d = j.at("description");
+    if (d.is_string())
+      plan.description = d.get<std::string>();
+    else if (d.is_array() &&
+             std::all_of(d.begin(), d.end(), [](const json& x) { return x.is_string(); }))
+      for (const auto& line : d)
+        plan.description += (plan.description.empty() ? "" : "\n") + line.get<std::string>();
+    else
+      refuse(where, "description", "give a string or a list of lines");
+  }
+  if (!j.contains("verb") || !j.at("verb").is_string() || j.at("verb").get<std::string>().empty())
+    refuse(where, "verb", "give the verb, e.g. \"spine solve\"");
+  plan.verb = j.at("verb").get<std::string>();
+  if (j.contains("options")) {
+    if (!j.at("options").is_object()) refuse(where, "options", "give an object");
+    plan.options = j.at("options");
+  }
+  if (!j.contains("parameters") || !j.at("parameters").is_object() || j.at("parameters").empty())
+    refuse(where, "parameters", "give at least one option to vary");
+  for (const auto& item : j.at("parameters").items()) {
+    if (plan.options.contains(item.key()))
+      refuse(where, "parameters." + item.key(), "also a fixed option: give it in one place");
+    plan.parameters.push_back(parse_parameter(item.key(), item.value(), where));
+  }
+  if (j.contains("design")) parse_design(j.at("design"), plan, where);
+  check_design(plan, where);
+  if (j.contains("outputs")) {
+    if (!j.at("outputs").is_object())
+      refuse(where, "outputs", "give {\"column\": \"/json/pointer\"}");
+    for (const auto& item : j.at("outputs").items()) {
+      const json& p = item.value();
+      if (!p.is_string()) refuse(where, "outputs." + item.key(), "give a JSON pointer string");
+      try {
+        json::json_pointer(p.get<std::string>());
+      } catch (const json::exception&) {
+        refuse(
+            where, "outputs." + item.key(),
+            "\"" + p.get<std::string>() + "\" is not a JSON pointer (e.g. \"/joints/16/axial_n\")");
+      }
+      plan.outputs.emplace_back(item.key(), p.get<std::string>());
+    }
+  }
+  return plan;
+}
+
+std::vector<SweepPoint> expand_sweep(const SweepPlan& plan) {
+  std::vector<SweepPoint> points;
+  const std::size_t m = plan.parameters.size();
+  if (plan.design == "latin_hypercube") {
+    const std::size_t n = std::size_t(plan.sample_points);
+    SplitMix64 rng(plan.seed);
+    points.resize(n);
+    for (std::size_t k = 0; k < m; ++k) {
+      const SweepParameter& p = plan.parameters[k];
+      std::vector<std::size_t> stratum(n);
+      std::iota(stratum.begin(), stratum.end(), std::size_t(0));
+      for (std::size_t i = n - 1; i > 0; --i)  // Fisher-Yates
+        std::swap(stratum[i], stratum[std::size_t(rng.next() % (i + 1))]);
+      for (std::size_t i = 0; i < n; ++i) {
+        const double u = (double(stratum[i]) + rng.uniform()) / double(n);
+        points[i].values[p.option] =
+            p.values.empty()
+                ? json(p.from + u * (p.to - p.from))
+                : p.values[std::min(p.values.size() - 1, std::size_t(u * double(p.values.size())))];
+      }
+    }
+  } else if (plan.design == "zip") {
+    points.resize(plan.parameters.front().values.size());
+    for (std::size_t i = 0; i < points.size(); ++i)
+      for (const auto& p : plan.parameters) points[i].values[p.option] = p.values[i];
+  } else {  // grid: the first parameter varies slowest
+    std::size_t total = 1;
+    for (const auto& p : plan.parameters) total *= p.values.size();
+    points.resize(total);
+    for (std::size_t i = 0; i < total; ++i) {
+      std::size_t rest = i;
+      for (std::size_t k = m; k-- > 0;) {
+        const SweepParameter& p = plan.parameters[k];
+        points[i].values[p.option] = p.values[rest % p.values.size()];
+        rest /= p.values.size();
+      }
+    }
+  }
+  for (std::size_t i = 0; i < points.size(); ++i) points[i].index = int(i);
+  return points;
+}
+
+json point_study(const SweepPlan& plan, const SweepPoint& point) {
+  json options = plan.options;
+  for (const auto& v : point.values.items()) options[v.key()] = v.value();
+  json study = {{"spinesim_study", 1}, {"verb", plan.verb}, {"options", options}};
+  study["description"] = "point " + std::to_string(point.index) + " of a sweep" +
+                         (plan.description.empty() ? "" : ": " + plan.description);
+  return study;
+}
+
+json point_outputs(const SweepPlan& plan, const json& result) {
+  json out = json::object();
+  for (const auto& [column, pointer] : plan.outputs) {
+    const json::json_pointer at(pointer);
+    out[column] = result.contains(at) ? result.at(at) : json();
+  }
+  return out;
+}
+
+}  // namespace spinesim::studies

@@ -1,0 +1,166 @@
+// `spinesim sweep`: a plan's points are the verb run directly; the summary is the same bytes run
+// serially, on two MPI ranks and as three Slurm array tasks; a sweep stopped by SIGTERM or killed
+// by SIGKILL resumes to the same summary; a failed point is recorded and the others go on; bad
+// plans are refused before anything runs.
+#include "spine_cli_fixtures.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <string>
+#include <thread>
+
+namespace {
+
+using namespace spinesim::test_cli;
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+const fs::path kExamplePlan =
+    fs::path(SPINESIM_DATA_DIR).parent_path() / "examples" / "sweep-bodies" / "plan.json";
+
+/// 32 points (8 statures x 4 masses), two of them outside the scaling laws' body-mass index.
+std::string slow_plan() {
+  const std::string path = tmp("plan32.json");
+  spit(path,
+       R"JSON({"spinesim_sweep": 1, "verb": "spine solve", "options": {"force": ["T7:0,0,100"]},
+    "parameters": {"height": {"from": 1.55, "to": 1.9, "steps": 8},
+                   "mass": {"from": 50, "to": 90, "steps": 4}},
+    "outputs": {"L5-S1 axial (N)": "/joints/16/axial_n"}})JSON");
+  return path;
+}
+
+std::string sweep(const std::string& plan, const std::string& out, const std::string& before = "") {
+  const CliRun r =
+      run_spinesim("sweep " + in_quotes(plan) + " --out " + in_quotes(out) + " --quiet", before);
+  EXPECT_EQ(r.status, 0) << r.err;
+  return slurp(out + "/summary.csv");
+}
+
+int statuses(const std::string& out) {
+  int n = 0;
+  for (const auto& e : fs::directory_iterator(out + "/points"))
+    n += fs::exists(e.path() / "status.json");
+  return n;
+}
+
+}  // namespace
+
+// Each row is the verb run by hand with the point's values; the JSON summary says the same.
+TEST(SweepCli, EveryPointIsTheVerbRunWithItsValues) {
+  const std::string out = tmp("sweep-serial");
+  const CliRun r = run_spinesim("sweep " + in_quotes(kExamplePlan.string()) + " --out " +
+                                in_quotes(out) + " --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const json j = json::parse(r.out);
+  EXPECT_EQ(j["points"], 12);
+  EXPECT_EQ(j["ok"], 12);
+  const json summary = json::parse(slurp(out + "/summary.json"));
+  ASSERT_EQ(summary["points"].size(), 12u);
+  for (int i : {0, 7, 11}) {
+    const json& row = summary["points"][std::size_t(i)];
+    const json& v = row["values"];
+    const json direct =
+        solve_json("--force T7:0,0,100 --height " + v["height"].dump() + " --mass " +
+                   v["mass"].dump() + " --sex " + v["sex"].get<std::string>());
+    EXPECT_EQ(row["outputs"]["L5-S1 axial (N)"].get<double>(),
+              direct["joints"][16]["axial_n"].get<double>())
+        << i;
+    EXPECT_EQ(row["outputs"]["T1 forward (mm)"].get<double>(),
+              direct["vertebrae"][0]["translation_mm"][2].get<double>())
+        << i;
+  }
+  const std::string csv = slurp(out + "/summary.csv");
+  EXPECT_NE(csv.find("# provenance: {"), std::string::npos);
+  EXPECT_NE(csv.find("point,height,mass,sex,status,L4-L5 axial (N)"), std::string::npos);
+  EXPECT_EQ(count_lines(csv), 2 + 12);
+}
+
+TEST(SweepCli, TwoMpiRanksAndThreeSlurmTasksWriteTheSerialSummary) {
+  const std::string serial = sweep(kExamplePlan.string(), tmp("sweep-one"));
+  if (std::system("command -v mpirun >/dev/null 2>&1") != 0) GTEST_SKIP() << "no mpirun";
+  const std::string mpi =
+      sweep(kExamplePlan.string(), tmp("sweep-mpi"),
+            "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 "
+            "OMPI_MCA_rmaps_base_oversubscribe=1 mpirun -np 2 --oversubscribe ");
+  EXPECT_EQ(mpi, serial);
+  EXPECT_EQ(slurp(tmp("sweep-mpi") + "/summary.json"), slurp(tmp("sweep-one") + "/summary.json"));
+  const std::string array = tmp("sweep-array");
+  for (int task = 3; task <= 5; ++task) {  // an array submitted as --array=3-5
+    const CliRun r = run_spinesim(
+        "sweep " + in_quotes(kExamplePlan.string()) + " --out " + in_quotes(array) + " --json",
+        "SLURM_ARRAY_TASK_ID=" + std::to_string(task) +
+            " SLURM_ARRAY_TASK_MIN=3 SLURM_ARRAY_TASK_COUNT=3 ");
+    ASSERT_EQ(r.status, 0) << r.err;
+    const json j = json::parse(r.out);
+    EXPECT_EQ(j["ran"], 4);                       // points task-3, task-3+3, …
+    EXPECT_EQ(j.contains("summary"), task == 5);  // the last task finds every point done
+  }
+  EXPECT_EQ(slurp(array + "/summary.csv"), serial);
+  expect_refused(run_spinesim("sweep " + in_quotes(kExamplePlan.string()) + " --out " +
+                                  in_quotes(tmp("sweep-bad-array")),
+                              "SLURM_ARRAY_TASK_ID=7 SLURM_ARRAY_TASK_MIN=0 "
+                              "SLURM_ARRAY_TASK_COUNT=3 "),
+                 "SLURM_ARRAY_TASK_COUNT");
+}
+
+// Stopped by SIGTERM (the point running is left without its status) or killed by SIGKILL, the
+// same command resumes: no point is lost or run twice, and the summary is the serial one. The
+// two points outside the scaling laws are recorded as failed with the program's own error.
+TEST(SweepCli, AStoppedOrKilledSweepResumesToTheSameSummary) {
+  const std::string plan = slow_plan();
+  const std::string whole = sweep(plan, tmp("sweep-whole"));
+  EXPECT_EQ(count_lines(whole), 2 + 32);
+  EXPECT_NE(whole.find(",failed,,\"spinesim: error: "), std::string::npos) << whole;
+  EXPECT_NE(whole.find("body-mass index"), std::string::npos);
+  for (const int signal : {SIGTERM, SIGKILL}) {
+    SCOPED_TRACE(signal);
+    const std::string out = tmp("sweep-stopped-" + std::to_string(signal));
+    const pid_t pid = start_spinesim("sweep " + in_quotes(plan) + " --out " + in_quotes(out));
+    for (int k = 0; k < 600 && (!fs::exists(out + "/points") || statuses(out) < 3); ++k)
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    ::kill(pid, signal);
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    const int done = statuses(out);
+    EXPECT_GE(done, 3);
+    EXPECT_LT(done, 32) << "the sweep finished before it was stopped";
+    if (signal == SIGTERM) EXPECT_EQ(WEXITSTATUS(status), 1);
+    EXPECT_FALSE(fs::exists(out + "/summary.csv"));
+    const CliRun r =
+        run_spinesim("sweep " + in_quotes(plan) + " --out " + in_quotes(out) + " --json");
+    ASSERT_EQ(r.status, 0) << r.err;
+    const json j = json::parse(r.out);
+    EXPECT_EQ(j["skipped"].get<int>() + j["ran"].get<int>(), 32);
+    EXPECT_GE(j["skipped"].get<int>(), done);
+    EXPECT_EQ(j["failed"], 2);
+    EXPECT_EQ(slurp(out + "/summary.csv"), whole);
+  }
+}
+
+TEST(SweepCli, BadPlansAreRefusedBeforeAnythingRuns) {
+  const std::string plan = tmp("bad-plan.json");
+  spit(plan, R"JSON({"spinesim_sweep": 1, "verb": "spine solve",
+    "parameters": {"heigth": {"values": [1.6]}}})JSON");
+  const std::string out = tmp("sweep-never");
+  expect_refused(run_spinesim("sweep " + in_quotes(plan) + " --out " + in_quotes(out)),
+                 "point 0: options.heigth");
+  EXPECT_FALSE(fs::exists(out));
+  spit(plan, R"JSON({"spinesim_sweep": 1, "verb": "spine solve",
+    "parameters": {"height": {"from": 1.6, "to": 1.7}}})JSON");
+  expect_refused(run_spinesim("sweep " + in_quotes(plan) + " --out " + in_quotes(out)),
+                 "latin_hypercube");
+  // A folder holds one plan's sweep.
+  const std::string other = tmp("sweep-other");
+  sweep(kExamplePlan.string(), other);
+  spit(plan, R"JSON({"spinesim_sweep": 1, "verb": "spine solve",
+    "parameters": {"height": {"values": [1.6]}}})JSON");
+  expect_refused(run_spinesim("sweep " + in_quotes(plan) + " --out " + in_quotes(other)),
+                 "another plan");
+}
