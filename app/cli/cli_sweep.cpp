@@ -140,6 +140,7 @@ std::string csv_cell(const json& v) {
 /// writes the same bytes.
 json gather(const Sweep& s) {
   json rows = json::array();
+  std::vector<json> outputs;  // per point, for the sensitivity
   for (std::size_t i = 0; i < s.points.size(); ++i) {
     const fs::path folder = s.out / point_folder_name(int(i), s.points.size());
     const json status = read_status(folder);
@@ -151,16 +152,82 @@ json gather(const Sweep& s) {
     } else {
       row["error"] = status.value("error", "");
     }
+    outputs.push_back(row.value("outputs", json()));
     rows.push_back(row);
   }
   return {{"plan", fs::path(s.plan_path).filename().string()},
           {"verb", s.plan.verb},
           {"points", rows},
+          {"sensitivity", studies::sweep_sensitivity(s.plan, s.points, outputs)},
           {"provenance",
            {{"program", "spinesim"},
             {"version", build_version()},
             {"commit", build_commit()},
             {"plan_sha256", s.plan_sha256}}}};
+}
+
+/// One row per output and parameter: Morris's mu*, mu, sigma or Sobol's first and total index.
+std::string sensitivity_csv(const Sweep& s, const json& summary) {
+  const json& sens = summary["sensitivity"];
+  const bool morris = s.plan.design == "morris";
+  std::ostringstream csv;
+  csv << "# provenance: " << summary["provenance"].dump() << "\n# "
+      << sens["method"].get<std::string>() << ", " << sens["runs"] << " runs"
+      << (morris ? "; per unit of the parameter" : "") << "\n";
+  csv << "output,parameter," << (morris ? "mu_star_over_range,mu_star,mu,sigma" : "first,total")
+      << ",error\n";
+  for (const auto& o : s.plan.outputs) {
+    const json& e = sens["outputs"][o.first];
+    if (e.contains("error")) {
+      csv << csv_cell(o.first) << ",," << (morris ? ",,," : ",") << "," << csv_cell(e["error"])
+          << "\n";
+      continue;
+    }
+    for (const auto& p : s.plan.parameters) {
+      const json& v = e[p.option];
+      csv << csv_cell(o.first) << "," << csv_cell(p.option) << ",";
+      if (morris)
+        csv << csv_cell(v["mu_star_over_range"]) << "," << csv_cell(v["mu_star"]) << ","
+            << csv_cell(v["mu"]) << "," << csv_cell(v["sigma"]);
+      else
+        csv << csv_cell(v["first"]) << "," << csv_cell(v["total"]);
+      csv << ",\n";
+    }
+  }
+  return csv.str();
+}
+
+void print_sensitivity(const Sweep& s, const json& summary) {
+  const json& sens = summary["sensitivity"];
+  if (sens.is_null()) return;
+  const bool morris = s.plan.design == "morris";
+  std::cout << "\n"
+            << sens["method"].get<std::string>() << " from " << sens["runs"] << " runs"
+            << (morris ? " (mu*, sigma: output units per unit of the parameter)" : "") << "\n";
+  TextTable t(
+      morris ? std::vector<std::string>{"output", "parameter", "mu* x range", "mu*", "mu", "sigma"}
+             : std::vector<std::string>{"output", "parameter", "first S_i", "total S_Ti"});
+  for (const auto& o : s.plan.outputs) {
+    const json& e = sens["outputs"][o.first];
+    if (e.contains("error")) {
+      t.add(morris ? std::vector<std::string>{o.first, "-", "-", "-", "-",
+                                              e["error"].get<std::string>()}
+                   : std::vector<std::string>{o.first, "-", "-", e["error"].get<std::string>()});
+      continue;
+    }
+    for (const auto& p : s.plan.parameters) {
+      const json& v = e[p.option];
+      if (morris)
+        t.add({o.first, p.option, significant(v["mu_star_over_range"].get<double>(), 4),
+               significant(v["mu_star"].get<double>(), 4), significant(v["mu"].get<double>(), 4),
+               significant(v["sigma"].get<double>(), 4)});
+      else
+        t.add({o.first, p.option, fixed(v["first"].get<double>(), 3),
+               fixed(v["total"].get<double>(), 3)});
+    }
+  }
+  t.print(std::cout, false);
+  std::cout << "\n";
 }
 
 void write_summary(const Sweep& s, const json& summary) {
@@ -182,6 +249,8 @@ void write_summary(const Sweep& s, const json& summary) {
   }
   write_atomically(s.out / "summary.csv", csv.str());
   write_atomically(s.out / "summary.json", summary.dump(2) + "\n");
+  if (!summary["sensitivity"].is_null())
+    write_atomically(s.out / "sensitivity.csv", sensitivity_csv(s, summary));
 }
 
 struct Tally {
@@ -269,7 +338,11 @@ void run_sweep(const SweepArgs& a) {
               << t.failed << " failed, " << t.pending << " to run (" << w.kind << " " << w.rank
               << " of " << w.size << " ran " << t.ran << ", found " << t.skipped << " done) in "
               << fixed(timer.seconds(), 1) << " s\n";
-    if (gathers) std::cout << "wrote " << (s.out / "summary.csv").string() << ", summary.json\n";
+    if (gathers) {
+      print_sensitivity(s, summary);
+      std::cout << "wrote " << (s.out / "summary.csv").string() << ", summary.json"
+                << (summary["sensitivity"].is_null() ? "" : ", sensitivity.csv") << "\n";
+    }
   }
   if (t.stopped)
     throw std::runtime_error("stopped by a signal: run the same command again to resume");

@@ -1,5 +1,7 @@
 #include "spinesim/studies/sweep_plan.hpp"
 
+#include "spinesim/studies/sensitivity.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -66,6 +68,42 @@ SweepParameter parse_parameter(const std::string& name, const json& p, const std
   return out;
 }
 
+/// A whole number of a design's object in [lo, hi] (`fallback` when absent and not required).
+int design_number(const json& o, const std::string& key, int lo, int hi, int fallback,
+                  const std::string& where, const std::string& field) {
+  if (!o.contains(key)) {
+    if (fallback < 0) refuse(where, field + key, "required");
+    return fallback;
+  }
+  const json& v = o.at(key);
+  if (!v.is_number_integer() || v.get<long long>() < lo || v.get<long long>() > hi)
+    refuse(where, field + key,
+           "give a whole number from " + std::to_string(lo) + " to " + std::to_string(hi));
+  return int(v.get<long long>());
+}
+
+void parse_sensitivity_design(const json& d, SweepPlan& plan, const std::string& where) {
+  plan.design = d.begin().key();
+  const json& o = d.begin().value();
+  const std::string field = "design." + plan.design + ".";
+  if (!o.is_object()) refuse(where, "design." + plan.design, "give an object");
+  if (o.contains("seed")) {
+    const json& s = o.at("seed");
+    if (!s.is_number_unsigned() && !(s.is_number_integer() && s.get<long long>() >= 0))
+      refuse(where, field + "seed", "give a whole number >= 0");
+    plan.seed = s.is_number_unsigned() ? s.get<std::uint64_t>() : std::uint64_t(s.get<long long>());
+  }
+  if (plan.design == "morris") {
+    require_known(o, {"trajectories", "levels", "seed"}, where, field);
+    plan.trajectories = design_number(o, "trajectories", 2, 100000, -1, where, field);
+    plan.levels = design_number(o, "levels", 4, 1000, 4, where, field);
+    if (plan.levels % 2 != 0) refuse(where, field + "levels", "give an even number (Morris's Δ)");
+  } else {
+    require_known(o, {"base_points", "seed"}, where, field);
+    plan.base_points = design_number(o, "base_points", 2, 1000000, -1, where, field);
+  }
+}
+
 void parse_design(const json& d, SweepPlan& plan, const std::string& where) {
   if (d.is_string()) {
     plan.design = d.get<std::string>();
@@ -76,8 +114,11 @@ void parse_design(const json& d, SweepPlan& plan, const std::string& where) {
                  "N, \"seed\": S}}");
     return;
   }
-  if (!d.is_object() || d.size() != 1 || !d.contains("latin_hypercube"))
-    refuse(where, "design", "give \"grid\", \"zip\" or {\"latin_hypercube\": {…}}");
+  if (!d.is_object() || d.size() != 1 ||
+      !(d.contains("latin_hypercube") || d.contains("morris") || d.contains("sobol")))
+    refuse(where, "design",
+           "give \"grid\", \"zip\" or {\"latin_hypercube\" | \"morris\" | \"sobol\": {…}}");
+  if (!d.contains("latin_hypercube")) return parse_sensitivity_design(d, plan, where);
   const json& l = d.at("latin_hypercube");
   if (!l.is_object()) refuse(where, "design.latin_hypercube", "give {\"points\": N, \"seed\": S}");
   require_known(l, {"points", "seed"}, where, "design.latin_hypercube.");
@@ -96,9 +137,19 @@ void parse_design(const json& d, SweepPlan& plan, const std::string& where) {
 }
 
 void check_design(const SweepPlan& plan, const std::string& where) {
-  std::size_t total = plan.design == "latin_hypercube" ? std::size_t(plan.sample_points) : 1;
+  const std::size_t k = plan.parameters.size();
+  std::size_t total = plan.design == "latin_hypercube" ? std::size_t(plan.sample_points)
+                      : plan.design == "morris"        ? std::size_t(plan.trajectories) * (k + 1)
+                      : plan.design == "sobol"         ? std::size_t(plan.base_points) * (k + 2)
+                                                       : 1;
   for (const auto& p : plan.parameters) {
     if (plan.design == "latin_hypercube") continue;
+    if (plan.design == "morris" || plan.design == "sobol") {
+      if (!p.values.empty())
+        refuse(where, "parameters." + p.option,
+               plan.design + " needs a range {\"from\", \"to\"} (without steps)");
+      continue;
+    }
     if (p.values.empty())
       refuse(where, "parameters." + p.option,
              "a continuous range needs a sampling design (latin_hypercube) or steps");
@@ -113,6 +164,14 @@ void check_design(const SweepPlan& plan, const std::string& where) {
       if (total > kMostPoints) refuse(where, "parameters", "the grid has more than 10^6 points");
     }
   }
+  if (total > kMostPoints) refuse(where, "design", "more than 10^6 points");
+}
+
+/// The unit-cube design of a morris or sobol plan.
+UnitPoints sensitivity_design(const SweepPlan& plan) {
+  const int k = int(plan.parameters.size());
+  return plan.design == "morris" ? morris_design(k, plan.trajectories, plan.levels, plan.seed)
+                                 : saltelli_design(k, plan.base_points, plan.seed);
 }
 
 }  // namespace
@@ -182,7 +241,15 @@ SweepPlan parse_sweep_plan(const json& j, const std::string& where) {
 std::vector<SweepPoint> expand_sweep(const SweepPlan& plan) {
   std::vector<SweepPoint> points;
   const std::size_t m = plan.parameters.size();
-  if (plan.design == "latin_hypercube") {
+  if (plan.design == "morris" || plan.design == "sobol") {
+    const UnitPoints unit = sensitivity_design(plan);
+    points.resize(unit.size());
+    for (std::size_t i = 0; i < unit.size(); ++i)
+      for (std::size_t k = 0; k < m; ++k) {
+        const SweepParameter& p = plan.parameters[k];
+        points[i].values[p.option] = p.from + unit[i][k] * (p.to - p.from);
+      }
+  } else if (plan.design == "latin_hypercube") {
     const std::size_t n = std::size_t(plan.sample_points);
     SplitMix64 rng(plan.seed);
     points.resize(n);
@@ -235,6 +302,51 @@ json point_outputs(const SweepPlan& plan, const json& result) {
   for (const auto& [column, pointer] : plan.outputs) {
     const json::json_pointer at(pointer);
     out[column] = result.contains(at) ? result.at(at) : json();
+  }
+  return out;
+}
+
+json sweep_sensitivity(const SweepPlan& plan, const std::vector<SweepPoint>& points,
+                       const std::vector<json>& outputs) {
+  if (plan.design != "morris" && plan.design != "sobol") return nullptr;
+  if (outputs.size() != points.size())
+    throw std::invalid_argument("sweep_sensitivity: one output object per point");
+  json out = {{"method", plan.design == "morris" ? "Morris elementary effects (mu*, sigma)"
+                                                 : "Sobol indices (Saltelli 2010, Jansen 1999)"},
+              {"runs", points.size()},
+              {"outputs", json::object()}};
+  const UnitPoints unit = sensitivity_design(plan);
+  std::vector<double> span;
+  for (const auto& p : plan.parameters) span.push_back(p.to - p.from);
+  for (const auto& [column, pointer] : plan.outputs) {
+    std::vector<double> y;
+    for (const auto& o : outputs) {
+      const json v = o.is_object() ? o.value(column, json()) : json();
+      if (!v.is_number()) break;
+      y.push_back(v.get<double>());
+    }
+    json& entry = out["outputs"][column];
+    if (y.size() != points.size()) {
+      entry = {{"error", "not a number at point " + std::to_string(y.size()) +
+                             " (a failed point or a non-numeric output)"}};
+      continue;
+    }
+    try {
+      if (plan.design == "morris") {
+        const auto e = morris_effects(unit, y, span);
+        for (std::size_t k = 0; k < e.size(); ++k)
+          entry[plan.parameters[k].option] = {{"mu_star", e[k].mu_star},
+                                              {"mu", e[k].mu},
+                                              {"sigma", e[k].sigma},
+                                              {"mu_star_over_range", e[k].mu_star * span[k]}};
+      } else {
+        const auto s = sobol_indices(int(plan.parameters.size()), y);
+        for (std::size_t k = 0; k < s.size(); ++k)
+          entry[plan.parameters[k].option] = {{"first", s[k].first}, {"total", s[k].total}};
+      }
+    } catch (const std::invalid_argument& e) {
+      entry = {{"error", e.what()}};
+    }
   }
   return out;
 }

@@ -69,7 +69,7 @@ TEST(Examples, EveryExampleIsAValidStudyThatRuns) {
       const json s = json::parse(slurp(study.string()));
       EXPECT_TRUE(s.contains("description")) << "an example explains itself";
       if (s.contains("spinesim_sweep")) {  // a sweep plan: its points run, its summary written
-        const fs::path out = study.parent_path() / "sweep-out";
+        const fs::path out = study.parent_path() / ("sweep-" + study.stem().string());
         const CliRun r =
             run_spinesim("sweep '" + study.string() + "' --out '" + out.string() + "' --quiet");
         ASSERT_EQ(r.status, 0) << r.err;

@@ -164,3 +164,23 @@ TEST(SweepCli, BadPlansAreRefusedBeforeAnythingRuns) {
   expect_refused(run_spinesim("sweep " + in_quotes(plan) + " --out " + in_quotes(other)),
                  "another plan");
 }
+
+// A Morris plan: the sensitivity table is written, and its signs are what statics says (a
+// heavier body loads L5-S1 more; a taller one, with longer levers and stiffer joints, less).
+TEST(SweepCli, AMorrisPlanWritesTheSensitivityOfEachOutput) {
+  const fs::path plan = kExamplePlan.parent_path() / "screening.json";
+  const std::string out = tmp("sweep-morris");
+  const CliRun r = run_spinesim("sweep " + in_quotes(plan.string()) + " --out " + in_quotes(out));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("Morris elementary effects"), std::string::npos) << r.out;
+  const json s = json::parse(slurp(out + "/summary.json"))["sensitivity"];
+  EXPECT_EQ(s["runs"], 30);
+  const json& load = s["outputs"]["L5-S1 axial (N)"];
+  EXPECT_GT(load["mass"]["mu"].get<double>(), 0);
+  EXPECT_LT(load["height"]["mu"].get<double>(), 0);
+  EXPECT_DOUBLE_EQ(load["mass"]["mu_star_over_range"].get<double>(),
+                   load["mass"]["mu_star"].get<double>() * 40);
+  const std::string csv = slurp(out + "/sensitivity.csv");
+  EXPECT_NE(csv.find("output,parameter,mu_star_over_range,mu_star,mu,sigma"), std::string::npos);
+  EXPECT_EQ(count_lines(csv), 3 + 4);
+}

@@ -159,3 +159,51 @@ TEST(SweepPlan, BadPlansAreRefusedNamingTheField) {
             {"b", {{"from", 0}, {"to", 1}, {"steps", 1001}}}});
   expect_refused(j, "10^6");
 }
+
+// The sensitivity designs: Morris trajectories and Saltelli's blocks mapped onto the ranges;
+// the sensitivity of a linear output is its slopes (Morris) and its variance shares (Sobol); an
+// output missing at a point gets an error instead of numbers; lists are refused.
+TEST(SweepPlan, SensitivityDesignsGiveTheSensitivityOfEachOutput) {
+  json j = base({{"a", {{"from", 0}, {"to", 2}}}, {"b", {{"from", 10}, {"to", 30}}}});
+  j["outputs"] = {{"y", "/y"}, {"z", "/z"}};
+  j["design"] = {{"morris", {{"trajectories", 10}, {"seed", 4}}}};
+  const st::SweepPlan m = plan(j);
+  const auto points = st::expand_sweep(m);
+  ASSERT_EQ(points.size(), 30u);
+  std::vector<json> outputs;
+  for (const auto& p : points) {
+    const double a = p.values["a"].get<double>(), b = p.values["b"].get<double>();
+    EXPECT_GE(a, 0);
+    EXPECT_LE(a, 2);
+    outputs.push_back({{"y", 3 * a - 0.5 * b}, {"z", p.index == 7 ? json() : json(a * b)}});
+  }
+  const json s = st::sweep_sensitivity(m, points, outputs);
+  EXPECT_EQ(s["runs"], 30);
+  EXPECT_NEAR(s["outputs"]["y"]["a"]["mu_star"].get<double>(), 3, 1e-9);
+  EXPECT_NEAR(s["outputs"]["y"]["b"]["mu"].get<double>(), -0.5, 1e-9);
+  EXPECT_NEAR(s["outputs"]["y"]["b"]["sigma"].get<double>(), 0, 1e-9);
+  EXPECT_NE(s["outputs"]["z"]["error"].get<std::string>().find("point 7"), std::string::npos);
+
+  j["design"] = {{"sobol", {{"base_points", 16384}, {"seed", 4}}}};
+  const st::SweepPlan so = plan(j);
+  const auto sp = st::expand_sweep(so);
+  ASSERT_EQ(sp.size(), 16384u * 4);
+  outputs.clear();
+  for (const auto& p : sp)  // Var(3a) = 3, Var(0.1 b) = 1/3
+    outputs.push_back(
+        {{"y", 3 * p.values["a"].get<double>() + 0.1 * p.values["b"].get<double>()}, {"z", 1.0}});
+  const json t = st::sweep_sensitivity(so, sp, outputs);
+  EXPECT_NEAR(t["outputs"]["y"]["a"]["first"].get<double>(), 0.9, 0.03);
+  EXPECT_NEAR(t["outputs"]["y"]["b"]["total"].get<double>(), 0.1, 0.03);
+  EXPECT_TRUE(t["outputs"]["z"].contains("error"));  // a constant output shares no variance
+  EXPECT_TRUE(st::sweep_sensitivity(plan(base({{"a", {{"values", {1}}}}})), {}, {}).is_null());
+
+  json bad = base({{"a", {{"values", {1, 2}}}}});
+  bad["design"] = {{"sobol", {{"base_points", 64}}}};
+  expect_refused(bad, "needs a range");
+  bad = base({{"a", {{"from", 0}, {"to", 1}}}});
+  bad["design"] = {{"morris", {{"trajectories", 5}, {"levels", 5}}}};
+  expect_refused(bad, "even");
+  bad["design"] = {{"morris", {{"levels", 4}}}};
+  expect_refused(bad, "design.morris.trajectories");
+}

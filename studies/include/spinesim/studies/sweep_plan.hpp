@@ -10,14 +10,18 @@
 //      "mass": {"from": 50, "to": 100, "steps": 3},         evenly spaced, both ends included
 //      "sex": {"values": ["male", "female"]}},
 //    "design": "grid",                                      or "zip", or
-//              {"latin_hypercube": {"points": 20, "seed": 1}}
+//              {"latin_hypercube": {"points": 20, "seed": 1}}, or (sensitivity.hpp)
+//              {"morris": {"trajectories": 10, "levels": 4, "seed": 1}}, or
+//              {"sobol": {"base_points": 256, "seed": 1}}
 //    "outputs": {"L5-S1 axial (N)": "/joints/16/axial_n"}}  JSON pointers into a point's --json
 //
 // Designs: "grid" is every combination (the first parameter varies slowest); "zip" takes the
 // i-th value of every list (all of one length); a Latin hypercube draws `points` points of the
 // parameters' ranges ({"from", "to"}, continuous; a list is drawn from by index), one per
 // stratum in every parameter, from a seeded generator whose stream is fixed here (SplitMix64),
-// so the same plan gives the same points on every machine.
+// so the same plan gives the same points on every machine. The sensitivity designs (Morris
+// screening, Sobol indices by Saltelli's scheme) take ranges only, and the summary then carries
+// each numeric output's sensitivity to each parameter (sweep_sensitivity).
 #pragma once
 
 #include <nlohmann/json.hpp>
@@ -43,9 +47,11 @@ struct SweepPlan {
   std::string verb;
   nlohmann::json options = nlohmann::json::object();  ///< shared by every point
   std::vector<SweepParameter> parameters;
-  std::string design = "grid";  ///< grid, zip or latin_hypercube
+  std::string design = "grid";  ///< grid, zip, latin_hypercube, morris or sobol
   int sample_points = 0;        ///< latin_hypercube: how many
-  std::uint64_t seed = 1;       ///< latin_hypercube: the generator's seed
+  int trajectories = 0, levels = 4;  ///< morris (sensitivity.hpp)
+  int base_points = 0;               ///< sobol: N of Saltelli's N (k + 2) runs
+  std::uint64_t seed = 1;            ///< the sampling designs' generator seed
   std::vector<std::pair<std::string, std::string>> outputs;  ///< column name, JSON pointer
 };
 
@@ -70,6 +76,15 @@ nlohmann::json point_study(const SweepPlan& plan, const SweepPoint& point);
 
 /// The outputs of one point read from its JSON result (null where the pointer finds nothing).
 nlohmann::json point_outputs(const SweepPlan& plan, const nlohmann::json& result);
+
+/// Each numeric output's sensitivity to each parameter, for a morris or sobol plan (null for the
+/// other designs): {"output": {"parameter": {"mu_star", "mu", "sigma"} or {"first", "total"}}},
+/// with the number of runs. `outputs[i]` is point i's point_outputs; an output missing at any
+/// point (a failed point, a non-number) gets {"error": why} instead. Morris's mu_star_over_range
+/// is mu* times the parameter's range: the output's mean change across it, to rank parameters of
+/// different units.
+nlohmann::json sweep_sensitivity(const SweepPlan& plan, const std::vector<SweepPoint>& points,
+                                 const std::vector<nlohmann::json>& outputs);
 
 /// SplitMix64 (Steele, Lea & Flood 2014): the sweep's own random stream, the same on every
 /// platform and standard library. uniform() is in [0, 1) with 53 random bits.
