@@ -13,6 +13,7 @@
 #include "spinesim/common/timer.hpp"
 #include "spinesim/studies/sweep_plan.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -256,6 +257,7 @@ void write_summary(const Sweep& s, const json& summary) {
 struct Tally {
   int ran = 0, skipped = 0, ok = 0, failed = 0, pending = 0;
   bool stopped = false;
+  std::vector<double> point_seconds;  ///< each done point's own time (its status.json)
 };
 
 Tally run_my_points(const Sweep& s, const SweepWorld& w, const SweepArgs& a) {
@@ -283,11 +285,34 @@ Tally run_my_points(const Sweep& s, const SweepWorld& w, const SweepArgs& a) {
 
 void count(const Sweep& s, Tally& t) {
   t.ok = t.failed = t.pending = 0;
+  t.point_seconds.clear();
   for (std::size_t i = 0; i < s.points.size(); ++i) {
-    const std::string st =
-        read_status(s.out / point_folder_name(int(i), s.points.size())).value("status", "");
+    const json status = read_status(s.out / point_folder_name(int(i), s.points.size()));
+    const std::string st = status.value("status", "");
     (st == "ok" ? t.ok : st == "failed" ? t.failed : t.pending)++;
+    if (!st.empty()) t.point_seconds.push_back(status.value("seconds", 0.0));
   }
+}
+
+/// The wall time of the done points' measured costs on `ranks` ranks, each running the points
+/// i mod ranks in turn as `spinesim sweep` deals them (the slowest rank's sum), s.
+double projected_seconds(const std::vector<double>& seconds, int ranks) {
+  std::vector<double> sum(std::size_t(ranks), 0.0);
+  for (std::size_t i = 0; i < seconds.size(); ++i) sum[i % std::size_t(ranks)] += seconds[i];
+  return *std::max_element(sum.begin(), sum.end());
+}
+
+json timing_json(const Tally& t) {
+  double total = 0;
+  for (double v : t.point_seconds) total += v;
+  json projected = json::object();
+  for (int ranks : {1, 2, 64, 512})
+    projected[std::to_string(ranks)] = projected_seconds(t.point_seconds, ranks);
+  return {{"points_timed", t.point_seconds.size()},
+          {"point_seconds_sum", total},
+          {"mean_point_seconds",
+           t.point_seconds.empty() ? 0.0 : total / double(t.point_seconds.size())},
+          {"projected_wall_seconds_by_ranks", projected}};
 }
 
 void print_dry_run(const Sweep& s, const SweepWorld& w) {
@@ -324,11 +349,16 @@ void run_sweep(const SweepArgs& a) {
   }
   if (w.rank != 0 && w.kind == "MPI") return;
   if (a.json) {
-    json j = {{"points", s.points.size()}, {"ran", t.ran},
-              {"skipped", t.skipped},      {"ok", t.ok},
-              {"failed", t.failed},        {"pending", t.pending},
-              {"world", w.kind},           {"size", w.size},
-              {"seconds", timer.seconds()}};
+    json j = {{"points", s.points.size()},
+              {"ran", t.ran},
+              {"skipped", t.skipped},
+              {"ok", t.ok},
+              {"failed", t.failed},
+              {"pending", t.pending},
+              {"world", w.kind},
+              {"size", w.size},
+              {"seconds", timer.seconds()},
+              {"timing", timing_json(t)}};
     if (gathers)
       j["summary"] = {{"csv", (s.out / "summary.csv").string()},
                       {"json", (s.out / "summary.json").string()}};
@@ -338,6 +368,13 @@ void run_sweep(const SweepArgs& a) {
               << t.failed << " failed, " << t.pending << " to run (" << w.kind << " " << w.rank
               << " of " << w.size << " ran " << t.ran << ", found " << t.skipped << " done) in "
               << fixed(timer.seconds(), 1) << " s\n";
+    const json timing = timing_json(t);
+    if (!t.point_seconds.empty())
+      std::cout << "points took " << fixed(timing["mean_point_seconds"].get<double>(), 2)
+                << " s each on average (" << fixed(timing["point_seconds_sum"].get<double>(), 1)
+                << " s in all); dealt as this sweep deals them they would take "
+                << fixed(projected_seconds(t.point_seconds, 64), 1) << " s on 64 ranks, "
+                << fixed(projected_seconds(t.point_seconds, 512), 1) << " s on 512\n";
     if (gathers) {
       print_sensitivity(s, summary);
       std::cout << "wrote " << (s.out / "summary.csv").string() << ", summary.json"

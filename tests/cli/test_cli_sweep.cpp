@@ -61,6 +61,15 @@ TEST(SweepCli, EveryPointIsTheVerbRunWithItsValues) {
   const json j = json::parse(r.out);
   EXPECT_EQ(j["points"], 12);
   EXPECT_EQ(j["ok"], 12);
+  // The projection from the points' own times: one rank takes their sum, more ranks less, and
+  // never less than the slowest point.
+  const json& timing = j["timing"];
+  const json& projected = timing["projected_wall_seconds_by_ranks"];
+  EXPECT_EQ(timing["points_timed"], 12);
+  EXPECT_DOUBLE_EQ(projected["1"].get<double>(), timing["point_seconds_sum"].get<double>());
+  EXPECT_LE(projected["2"].get<double>(), projected["1"].get<double>());
+  EXPECT_LE(projected["512"].get<double>(), projected["64"].get<double>());
+  EXPECT_GE(projected["512"].get<double>(), timing["mean_point_seconds"].get<double>() * 0.999);
   const json summary = json::parse(slurp(out + "/summary.json"));
   ASSERT_EQ(summary["points"].size(), 12u);
   for (int i : {0, 7, 11}) {
