@@ -306,6 +306,20 @@ TEST(SpineDiscs, AScolioticSpinesDiscsRestWedgedInItsCurve) {
   EXPECT_EQ(rs.scoliosis.apex, o.scoliosis.apex);
   EXPECT_EQ(rs.scoliosis.convex_right, o.scoliosis.convex_right);
   EXPECT_NE(sh::spine_model_fingerprint(curved), sh::spine_model_fingerprint(model()));
+  // A malformed curve line, or a curve the model cannot pose, is refused.
+  for (const std::string& line :
+       {std::string("# scoliosis: type lumbar, cobb_deg 30, upper_end T12, apex L2, lower_end L4, "
+                    "apical_rotation_deg 0, convex up"),
+        std::string("# scoliosis: type lumbar, cobb_deg 500, upper_end T12, apex L2, lower_end "
+                    "L4, apical_rotation_deg 0, convex left")}) {
+    const std::string bad = scratch("curved-bad.csv").string();
+    std::ifstream in(rq.recording);
+    std::ofstream o(bad);
+    std::string l;
+    while (std::getline(in, l)) o << (l.rfind("# scoliosis: ", 0) == 0 ? line : l) << "\n";
+    o.close();
+    EXPECT_THROW(sh::recording_spine(bad), std::invalid_argument) << line;
+  }
   rq.out = scratch("curved-still-out").string();
   rq.vertebra_triangles = 0;
   const st::SpineDiscsResult r = st::run_spine_discs(rq, SPINESIM_DATA_DIR);
