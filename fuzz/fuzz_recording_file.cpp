@@ -1,5 +1,6 @@
 // libFuzzer target: the compliant-stage recording reader (`spine discs --record`) on arbitrary
-// bytes: the spine-model line, the end line and its count, the rows and their bounds. Every input
+// bytes: the spine-model line, the end line and its count, the rows and their bounds, and the
+// header's body and scoliosis lines (recording_spine). Every input
 // must be read or refused with std::invalid_argument; an accepted recording must have at least two
 // frames with finite, bounded vertebra motions. Anything else is a finding.
 #include "fuzz_input.hpp"
@@ -22,6 +23,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       if (!f.motion.allFinite() ||
           !(f.motion.leftCols<3>().rowwise().norm().maxCoeff() <= st::kMaxVertebraShiftMm))
         std::abort();
+  } catch (const std::invalid_argument&) {}
+  try {  // the header's body and scoliosis lines: read, or refused in one line
+    const st::RecordedSpine spine = st::recording_spine(path);
+    if (spine.scoliosis.cobb_deg != 0 &&
+        !(spine.scoliosis.cobb_deg > 0 && spine.scoliosis.cobb_deg <= 120))
+      std::abort();
   } catch (const std::invalid_argument&) {}
   return 0;
 }
