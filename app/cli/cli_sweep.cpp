@@ -11,6 +11,7 @@
 #include "spinesim/common/input_file.hpp"
 #include "spinesim/common/provenance.hpp"
 #include "spinesim/common/timer.hpp"
+#include "spinesim/output/html_report.hpp"
 #include "spinesim/studies/sweep_plan.hpp"
 
 #include <algorithm>
@@ -27,7 +28,7 @@ using nlohmann::json;
 
 struct SweepArgs {
   std::string plan, out;
-  bool retry_failed = false, dry_run = false, json = false, quiet = false;
+  bool retry_failed = false, dry_run = false, json = false, quiet = false, no_report = false;
 };
 
 struct Sweep {
@@ -343,9 +344,15 @@ void run_sweep(const SweepArgs& a) {
   count(s, t);
   const bool gathers = (w.kind == "MPI" ? w.rank == 0 : true) && t.pending == 0;
   json summary;
+  output::HtmlReport report;
   if (gathers) {
     summary = gather(s);
     write_summary(s, summary);
+    if (!a.no_report) {
+      report = output::write_html_report(s.out.string(), "sweep_report.py");
+      if (report.failed) throw std::runtime_error("--out " + a.out + ": " + report.message);
+      if (!report.written) std::cerr << "spinesim: warning: " << report.message << std::endl;
+    }
   }
   if (w.rank != 0 && w.kind == "MPI") return;
   if (a.json) {
@@ -361,7 +368,8 @@ void run_sweep(const SweepArgs& a) {
               {"timing", timing_json(t)}};
     if (gathers)
       j["summary"] = {{"csv", (s.out / "summary.csv").string()},
-                      {"json", (s.out / "summary.json").string()}};
+                      {"json", (s.out / "summary.json").string()},
+                      {"report", report.written ? json(report.path) : json()}};
     print_json(j);
   } else {
     std::cout << s.points.size() << " points of " << s.plan.verb << ": " << t.ok << " ok, "
@@ -379,6 +387,7 @@ void run_sweep(const SweepArgs& a) {
       print_sensitivity(s, summary);
       std::cout << "wrote " << (s.out / "summary.csv").string() << ", summary.json"
                 << (summary["sensitivity"].is_null() ? "" : ", sensitivity.csv") << "\n";
+      if (report.written) std::cout << report.message << "\n";
     }
   }
   if (t.stopped)
@@ -400,6 +409,9 @@ void register_sweep(CLI::App& app) {
       ->required();
   cmd->add_flag("--retry-failed", a->retry_failed, "Run the points that failed again");
   cmd->add_flag("--dry-run", a->dry_run, "List the points and stop");
+  cmd->add_flag("--no-report", a->no_report,
+                "No DIR/report.html and plots (each output against each parameter; the "
+                "sensitivity)");
   add_output_flags(cmd, a->json, a->quiet, "the counts and the summary's files");
   cmd->footer(
       "mpirun -np N spinesim sweep PLAN --out DIR: rank r runs the points i with i mod N == r.\n"

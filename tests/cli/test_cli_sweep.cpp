@@ -192,4 +192,6 @@ TEST(SweepCli, AMorrisPlanWritesTheSensitivityOfEachOutput) {
   const std::string csv = slurp(out + "/sensitivity.csv");
   EXPECT_NE(csv.find("output,parameter,mu_star_over_range,mu_star,mu,sigma"), std::string::npos);
   EXPECT_EQ(count_lines(csv), 3 + 4);
+  for (const char* f : {"/report.html", "/plots/sweep.png", "/plots/sensitivity.png"})
+    EXPECT_TRUE(fs::exists(out + f)) << f;
 }

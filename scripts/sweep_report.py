@@ -1,0 +1,137 @@
+#!/usr/bin/python3
+"""Plots and report.html for `spinesim sweep PLAN --out DIR`.
+
+Reads DIR/summary.json and writes DIR/plots/sweep.png (each output against each parameter, one
+dot per point, failed points as crosses on the axis) and, for a Morris or Sobol plan,
+DIR/plots/sensitivity.png (mu* x range, or the first and total indices, per output and
+parameter), and DIR/report.html with the points' table. Any error is one line on stderr and exit
+status 1 (2 for a missing tool).
+
+    /usr/bin/python3 scripts/sweep_report.py DIR
+
+Needs python3-matplotlib (Debian package; scripts/install-deps.sh).
+"""
+import html
+import sys
+
+from report_tools import failer, load_summary, page_head, pyplot, report_main, write_page
+
+fail = failer("sweep report")
+plt = pyplot(fail)
+
+
+def numeric(v):
+    return isinstance(v, (int, float)) and not isinstance(v, bool)
+
+
+def parameters_and_outputs(s):
+    points = s["points"]
+    params = sorted({k for p in points for k in p["values"]})
+    outputs = sorted({k for p in points for k in (p.get("outputs") or {})})
+    return points, params, outputs
+
+
+def draw_points(s, d):
+    points, params, outputs = parameters_and_outputs(s)
+    outputs = [o for o in outputs if any(numeric((p.get("outputs") or {}).get(o)) for p in points)]
+    if not outputs:
+        return None
+    fig, axes = plt.subplots(len(outputs), len(params), squeeze=False,
+                             figsize=(4.2 * len(params), 3.2 * len(outputs)))
+    for r, o in enumerate(outputs):
+        for c, name in enumerate(params):
+            ax = axes[r][c]
+            ok = [p for p in points if numeric((p.get("outputs") or {}).get(o))]
+            xs = [p["values"][name] for p in ok]
+            if all(numeric(x) for x in xs):
+                ax.plot(xs, [p["outputs"][o] for p in ok], "o", ms=4, alpha=0.7)
+            else:  # a list of names: one column of dots per name
+                names = sorted({str(x) for x in xs})
+                ax.plot([names.index(str(x)) for x in xs], [p["outputs"][o] for p in ok], "o",
+                        ms=4, alpha=0.7)
+                ax.set_xticks(range(len(names)), names)
+            failed = [p for p in points if p["status"] != "ok" and numeric(p["values"][name])]
+            if failed:
+                ax.plot([p["values"][name] for p in failed], [ax.get_ylim()[0]] * len(failed),
+                        "x", color="C3", label="failed point")
+                ax.legend(fontsize=8)
+            ax.set_xlabel(name)
+            ax.set_ylabel(o)
+            ax.grid(alpha=0.3)
+    fig.suptitle(f"{s['verb']}: {len(points)} points of {s['plan']}")
+    fig.tight_layout()
+    fig.savefig(f"{d}/plots/sweep.png", dpi=90)
+    plt.close(fig)
+    return "sweep.png"
+
+
+def draw_sensitivity(s, d):
+    sens = s.get("sensitivity")
+    if not sens:
+        return None
+    outs = {o: e for o, e in sens["outputs"].items() if "error" not in e}
+    if not outs:
+        return None
+    morris = sens["method"].startswith("Morris")
+    fig, axes = plt.subplots(1, len(outs), squeeze=False, figsize=(4.5 * len(outs), 3.6))
+    for ax, (o, e) in zip(axes[0], sorted(outs.items())):
+        names = sorted(e)
+        if morris:
+            ax.bar(names, [e[n]["mu_star_over_range"] for n in names], color="C0")
+            ax.set_ylabel("mu* x range (output units)")
+        else:
+            x = range(len(names))
+            ax.bar([i - 0.2 for i in x], [e[n]["first"] for n in names], 0.4, label="first S_i")
+            ax.bar([i + 0.2 for i in x], [e[n]["total"] for n in names], 0.4, label="total S_Ti")
+            ax.set_xticks(list(x), names)
+            values = [e[n][k] for n in names for k in ("first", "total")]
+            ax.set_ylim(min(0, *values) - 0.05, max(1, *values) + 0.05)
+            ax.legend(fontsize=8)
+        ax.set_title(o, fontsize=10)
+        ax.grid(alpha=0.3, axis="y")
+    title = f"{sens['method']}, {sens['runs']} runs"
+    if not morris:  # N base points of Saltelli's N (k + 2) runs: the Monte Carlo error ~ 1/sqrt(N)
+        n = sens["runs"] // (len(next(iter(outs.values()))) + 2)
+        title += f" (N = {n}: the estimates scatter by about {1 / n ** 0.5:.2f})"
+    fig.suptitle(title)
+    fig.tight_layout()
+    fig.savefig(f"{d}/plots/sensitivity.png", dpi=90)
+    plt.close(fig)
+    return "sensitivity.png"
+
+
+def table(s):
+    points, params, outputs = parameters_and_outputs(s)
+    head = "".join(f"<th>{html.escape(h)}</th>" for h in ["point", *params, "status", *outputs])
+    rows = []
+    for p in points[:200]:
+        cells = [str(p["point"]), *[str(p["values"].get(n, "")) for n in params],
+                 p["status"] if p["status"] == "ok" else f"{p['status']}: {p.get('error', '')}",
+                 *[f"{v:.6g}" if numeric(v) else str(v if v is not None else "")
+                   for v in [(p.get("outputs") or {}).get(o) for o in outputs]]]
+        rows.append("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in cells) + "</tr>")
+    more = f"<p>… and {len(points) - 200} more in summary.csv.</p>" if len(points) > 200 else ""
+    return f"<table><tr>{head}</tr>{''.join(rows)}</table>{more}"
+
+
+def write_report(d):
+    s = load_summary(d, "summary.json")
+    figures = [f for f in (draw_points(s, d), draw_sensitivity(s, d)) if f]
+    points = s["points"]
+    ok = sum(p["status"] == "ok" for p in points)
+    p = s["provenance"]
+    parts = [page_head(f"Sweep: {s['plan']}", 1200),
+             f"<p>{len(points)} points of <code>{html.escape(s['verb'])}</code>: {ok} ok, "
+             f"{len(points) - ok} failed.</p>",
+             *[f"<figure><img src='plots/{f}' alt='{f}'></figure>" for f in figures],
+             table(s),
+             f"<footer><h2>Provenance</h2><p>{html.escape(p['program'])} "
+             f"{html.escape(p['version'])} (commit <code>{html.escape(p['commit'])}</code>), "
+             f"plan SHA-256 <code>{html.escape(p['plan_sha256'])}</code>; each point's own "
+             "provenance is in its points/NNNN/result.json.</p></footer></body></html>"]
+    write_page(d, parts)
+    return figures
+
+
+if __name__ == "__main__":
+    sys.exit(report_main(sys.argv, __doc__, fail, write_report))
