@@ -15,11 +15,14 @@
 #include "spinesim/studies/sweep_plan.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <sstream>
+#include <thread>
 
 namespace spinesim::cli {
 namespace {
@@ -29,6 +32,7 @@ using nlohmann::json;
 struct SweepArgs {
   std::string plan, out;
   bool retry_failed = false, dry_run = false, json = false, quiet = false, no_report = false;
+  int jobs = 1;  ///< points at once in this process (0: one per core)
 };
 
 struct Sweep {
@@ -109,22 +113,23 @@ json read_status(const fs::path& folder) {
   return read_json_file(p.string(), "point status");
 }
 
-/// Runs point i in its folder: a child `spinesim run study.json --json`. Returns false when this
-/// process was asked to stop (the point is left without a status, to run again).
-bool run_point(const Sweep& s, std::size_t i) {
+/// Starts point i in its folder: a child `spinesim run study.json --json`; returns its pid.
+int start_point(const Sweep& s, std::size_t i) {
   const fs::path folder = s.out / point_folder_name(int(i), s.points.size());
   fs::remove_all(folder);  // a point killed before its status: run afresh
   fs::create_directories(folder);
   write_atomically(folder / "study.json", s.studies[i].dump(2) + "\n");
-  const Timer timer;
-  const int code = run_child({own_executable(), "run", "study.json", "--json"}, folder.string(),
-                             (folder / "result.json").string(), (folder / "log.txt").string());
-  if (stop_requested()) return false;
-  json status = {{"point", i}, {"exit_code", code}, {"seconds", timer.seconds()}};
+  return start_child({own_executable(), "run", "study.json", "--json"}, folder.string(),
+                     (folder / "result.json").string(), (folder / "log.txt").string());
+}
+
+/// Point i's status, written last: the point is done.
+void finish_point(const Sweep& s, std::size_t i, int code, double seconds) {
+  const fs::path folder = s.out / point_folder_name(int(i), s.points.size());
+  json status = {{"point", i}, {"exit_code", code}, {"seconds", seconds}};
   status["status"] = code == 0 ? "ok" : "failed";
   if (code != 0) status["error"] = last_line(folder / "log.txt");
   write_atomically(folder / "status.json", status.dump(2) + "\n");
-  return true;
 }
 
 std::string csv_cell(const json& v) {
@@ -261,26 +266,44 @@ struct Tally {
   std::vector<double> point_seconds;  ///< each done point's own time (its status.json)
 };
 
+/// This process's points (i mod size == rank), `jobs` at a time. A point ends with its status,
+/// unless this process was asked to stop: then the running points are stopped and left without
+/// one, to run again.
 Tally run_my_points(const Sweep& s, const SweepWorld& w, const SweepArgs& a) {
+  using Clock = std::chrono::steady_clock;
   Tally t;
   std::vector<std::size_t> mine;
   for (std::size_t i = 0; i < s.points.size(); ++i)
     if (int(i % std::size_t(w.size)) == w.rank) mine.push_back(i);
   ProgressBar bar(int(mine.size()), a.quiet || a.json || w.rank != 0, "points");
-  for (std::size_t k = 0; k < mine.size(); ++k) {
-    const std::size_t i = mine[k];
+  std::map<int, std::pair<std::size_t, Clock::time_point>> running;  // pid: point, start
+  int done = 0;
+  auto reap = [&] {
+    const auto [pid, code] = wait_child(-1);
+    const auto it = running.find(pid);
+    if (it == running.end()) return;
+    if (!stop_requested()) {
+      finish_point(s, it->second.first, code,
+                   std::chrono::duration<double>(Clock::now() - it->second.second).count());
+      ++t.ran;
+      bar.update(++done, "point " + std::to_string(it->second.first));
+    }
+    running.erase(it);
+  };
+  for (const std::size_t i : mine) {
     const json status = read_status(s.out / point_folder_name(int(i), s.points.size()));
     const bool again = status.value("status", "") == "failed" && a.retry_failed;
     if (!status.empty() && !again) {
       ++t.skipped;
-    } else if (!run_point(s, i)) {
-      t.stopped = true;
-      break;
-    } else {
-      ++t.ran;
+      bar.update(++done);
+      continue;
     }
-    bar.update(int(k + 1), "point " + std::to_string(i));
+    while (int(running.size()) >= a.jobs && !stop_requested()) reap();
+    if (stop_requested()) break;
+    running[start_point(s, i)] = {i, Clock::now()};
   }
+  while (!running.empty()) reap();
+  t.stopped = stop_requested();
   return t;
 }
 
@@ -327,7 +350,9 @@ void print_dry_run(const Sweep& s, const SweepWorld& w) {
   if (s.points.size() > 20) std::cout << "  …\n";
 }
 
-void run_sweep(const SweepArgs& a) {
+void run_sweep(SweepArgs a) {
+  if (a.jobs < 0 || a.jobs > 256) throw std::invalid_argument("--jobs: give 0 to 256");
+  if (a.jobs == 0) a.jobs = int(std::max(1u, std::thread::hardware_concurrency()));
   const SweepWorld w = sweep_world();
   const Timer timer;
   const Sweep s = read_sweep(a);
@@ -408,6 +433,9 @@ void register_sweep(CLI::App& app) {
   cmd->add_option("--out", a->out, "The sweep's folder (made; the same command resumes it)")
       ->required();
   cmd->add_flag("--retry-failed", a->retry_failed, "Run the points that failed again");
+  cmd->add_option("--jobs", a->jobs,
+                  "Points at once in each process (0: one per core); on MPI, per rank")
+      ->capture_default_str();
   cmd->add_flag("--dry-run", a->dry_run, "List the points and stop");
   cmd->add_flag("--no-report", a->no_report,
                 "No DIR/report.html and plots (each output against each parameter; the "

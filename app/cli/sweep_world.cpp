@@ -22,12 +22,25 @@ extern char** environ;
 namespace spinesim::cli {
 namespace {
 
+constexpr int kMostChildren = 256;
 volatile std::sig_atomic_t g_stop = 0;
-volatile pid_t g_child = 0;
+volatile pid_t g_children[kMostChildren] = {};  ///< running children (0: a free slot)
 
 void on_stop(int signal) {
   g_stop = 1;
-  if (g_child > 0) ::kill(g_child, signal);
+  for (int i = 0; i < kMostChildren; ++i)
+    if (g_children[i] > 0) ::kill(g_children[i], signal);
+}
+
+void forget_child(pid_t pid) {
+  for (int i = 0; i < kMostChildren; ++i)
+    if (g_children[i] == pid) g_children[i] = 0;
+}
+
+int exit_status(int status) {
+  if (WIFEXITED(status)) return WEXITSTATUS(status);
+  if (WIFSIGNALED(status)) return 128 + WTERMSIG(status);
+  return 1;
 }
 
 /// A Slurm variable as a whole number >= 0 (-1 when unset).
@@ -111,8 +124,12 @@ std::string own_executable() {
   return p.string();
 }
 
-int run_child(const std::vector<std::string>& argv, const std::string& folder,
-              const std::string& out_path, const std::string& err_path) {
+int start_child(const std::vector<std::string>& argv, const std::string& folder,
+                const std::string& out_path, const std::string& err_path) {
+  int slot = 0;
+  while (slot < kMostChildren && g_children[slot] != 0) ++slot;
+  if (slot == kMostChildren)
+    throw std::runtime_error("more than " + std::to_string(kMostChildren) + " points at once");
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_addchdir_np(&actions, folder.c_str());
@@ -127,15 +144,23 @@ int run_child(const std::vector<std::string>& argv, const std::string& folder,
   const int rc = posix_spawn(&pid, args[0], &actions, nullptr, args.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
   if (rc != 0) throw std::runtime_error("cannot start " + argv[0] + ": " + std::strerror(rc));
-  g_child = pid;
+  g_children[slot] = pid;
   if (g_stop) ::kill(pid, SIGTERM);  // asked to stop while it started
+  return pid;
+}
+
+std::pair<int, int> wait_child(int pid) {
   int status = 0;
-  while (::waitpid(pid, &status, 0) < 0)
-    if (errno != EINTR) break;
-  g_child = 0;
-  if (WIFEXITED(status)) return WEXITSTATUS(status);
-  if (WIFSIGNALED(status)) return 128 + WTERMSIG(status);
-  return 1;
+  pid_t done = -1;
+  while ((done = ::waitpid(pid, &status, 0)) < 0)
+    if (errno != EINTR) throw std::runtime_error("waitpid: " + std::string(std::strerror(errno)));
+  forget_child(done);
+  return {int(done), exit_status(status)};
+}
+
+int run_child(const std::vector<std::string>& argv, const std::string& folder,
+              const std::string& out_path, const std::string& err_path) {
+  return wait_child(start_child(argv, folder, out_path, err_path)).second;
 }
 
 }  // namespace spinesim::cli

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace spinesim::cli {
@@ -26,9 +27,17 @@ SweepWorld sweep_world();
 /// Waits until every rank reached it (MPI), and ends MPI when `last`. Nothing elsewhere.
 void sweep_barrier(const SweepWorld& world, bool last);
 
-/// Runs `argv` (argv[0] an executable path) in `folder`, stdout to `out_path`, stderr to
-/// `err_path`; returns its exit status (128 + the signal when a signal ended it). While it runs,
-/// a SIGTERM or SIGINT to this process is passed on to it, and stop_requested() turns true.
+/// Starts `argv` (argv[0] an executable path) in `folder`, stdout to `out_path`, stderr to
+/// `err_path`, and returns its pid. Until it is waited for, a SIGTERM or SIGINT to this process
+/// is passed on to it (and stop_requested() turns true). At most 256 at once.
+int start_child(const std::vector<std::string>& argv, const std::string& folder,
+                const std::string& out_path, const std::string& err_path);
+
+/// Waits for the child `pid` (-1: any started child) and returns its pid and exit status (128 +
+/// the signal when a signal ended it).
+std::pair<int, int> wait_child(int pid);
+
+/// start_child and wait_child in one.
 int run_child(const std::vector<std::string>& argv, const std::string& folder,
               const std::string& out_path, const std::string& err_path);
 

@@ -1,5 +1,5 @@
 // `spinesim sweep`: a plan's points are the verb run directly; the summary is the same bytes run
-// serially, on two MPI ranks and as three Slurm array tasks; a sweep stopped by SIGTERM or killed
+// serially, three at a time, on two MPI ranks and as three Slurm array tasks; a sweep stopped by SIGTERM or killed
 // by SIGKILL resumes to the same summary; a failed point is recorded and the others go on; bad
 // plans are refused before anything runs.
 #include "spine_cli_fixtures.hpp"
@@ -91,15 +91,23 @@ TEST(SweepCli, EveryPointIsTheVerbRunWithItsValues) {
   EXPECT_EQ(count_lines(csv), 2 + 12);
 }
 
-TEST(SweepCli, TwoMpiRanksAndThreeSlurmTasksWriteTheSerialSummary) {
-  const std::string serial = sweep(kExamplePlan.string(), tmp("sweep-one"));
+TEST(SweepCli, ThreeJobsTwoMpiRanksAndThreeSlurmTasksWriteTheSerialSummary) {
+  const std::string one = tmp("sweep-one");
+  const std::string serial = sweep(kExamplePlan.string(), one);
+  // Three points at once on this machine.
+  const std::string three = tmp("sweep-jobs");  // (tmp() clears the path: called once)
+  const CliRun jobs = run_spinesim("sweep " + in_quotes(kExamplePlan.string()) + " --out " +
+                                   in_quotes(three) + " --quiet --jobs 3");
+  ASSERT_EQ(jobs.status, 0) << jobs.err;
+  EXPECT_EQ(slurp(three + "/summary.csv"), serial);
   if (std::system("command -v mpirun >/dev/null 2>&1") != 0) GTEST_SKIP() << "no mpirun";
+  const std::string on_mpi = tmp("sweep-mpi");
   const std::string mpi =
-      sweep(kExamplePlan.string(), tmp("sweep-mpi"),
+      sweep(kExamplePlan.string(), on_mpi,
             "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 "
             "OMPI_MCA_rmaps_base_oversubscribe=1 mpirun -np 2 --oversubscribe ");
   EXPECT_EQ(mpi, serial);
-  EXPECT_EQ(slurp(tmp("sweep-mpi") + "/summary.json"), slurp(tmp("sweep-one") + "/summary.json"));
+  EXPECT_EQ(slurp(on_mpi + "/summary.json"), slurp(one + "/summary.json"));
   const std::string array = tmp("sweep-array");
   for (int task = 3; task <= 5; ++task) {  // an array submitted as --array=3-5
     const CliRun r = run_spinesim(
@@ -131,7 +139,8 @@ TEST(SweepCli, AStoppedOrKilledSweepResumesToTheSameSummary) {
   for (const int signal : {SIGTERM, SIGKILL}) {
     SCOPED_TRACE(signal);
     const std::string out = tmp("sweep-stopped-" + std::to_string(signal));
-    const pid_t pid = start_spinesim("sweep " + in_quotes(plan) + " --out " + in_quotes(out));
+    const pid_t pid = start_spinesim("sweep " + in_quotes(plan) + " --out " + in_quotes(out) +
+                                     (signal == SIGTERM ? " --jobs 2" : ""));
     for (int k = 0; k < 600 && (!fs::exists(out + "/points") || statuses(out) < 3); ++k)
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
     ::kill(pid, signal);
