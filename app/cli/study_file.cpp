@@ -346,9 +346,15 @@ nlohmann::json rebase_study_inputs(CLI::App& app, nlohmann::json study, const st
     if (p.empty() || p.is_absolute() || !fs::exists(base / p, ec)) return;
     v = (base / p).lexically_normal().lexically_relative(target).string();
   };
+  // What a verb writes stays relative, even when a file of that name exists beside the plan: a
+  // point's outputs go into its own folder, never over a file of the plan's.
+  static const std::set<std::string> outputs = {
+      "out", "csv", "record", "medit", "mesh-out", "write-scene", "screenshot", "save-study"};
   for (auto& item : study["options"].items()) {
     const CLI::Option* o = verb->get_option_no_throw("--" + item.key());
-    if (!o || !(is_path_option(*o) || is_preset_or_path_option(*o))) continue;
+    if (!o || outputs.count(item.key()) > 0 ||
+        !(is_path_option(*o) || is_preset_or_path_option(*o)))
+      continue;
     if (item.value().is_array())
       for (auto& v : item.value()) moved(v);
     else

@@ -54,9 +54,10 @@ nlohmann::json study_of(CLI::App& verb, const std::string& verb_path,
 std::vector<std::string> study_arguments(CLI::App& app, const nlohmann::json& study,
                                          const std::string& where);
 
-/// `study` moved from folder `from` to folder `to`: each relative value of a path option (or a
-/// preset-or-path option) that names an existing file or folder in `from` is rewritten relative
-/// to `to`; the others (outputs, preset names) stay as they are, so a sweep point's outputs land
+/// `study` moved from folder `from` to folder `to`: each relative value of an input path option
+/// (or a preset-or-path option) that names an existing file or folder in `from` is rewritten
+/// relative to `to`; the others (outputs such as --out and --csv, whether or not a file of that
+/// name exists, and preset names) stay as they are, so a sweep point's outputs land
 /// in its own folder and its inputs are still found. An unknown verb leaves the study as it is.
 nlohmann::json rebase_study_inputs(CLI::App& app, nlohmann::json study, const std::string& from,
                                    const std::string& to);

@@ -162,6 +162,28 @@ TEST(SweepCli, AStoppedOrKilledSweepResumesToTheSameSummary) {
   }
 }
 
+// A point's outputs land in its own folder, even where a file of that name lies beside the plan
+// (which stays as it was); an input beside the plan is found from every point's folder.
+TEST(SweepCli, OutputsLandInThePointsFolderAndInputsAreFound) {
+  const std::string dir = tmp("sweep-paths");
+  fs::create_directories(dir);
+  spit(dir + "/solve.csv", "mine\n");
+  spit(dir + "/loads.csv", "time_s,T7.fz_n\n0,0\n0.1,50\n");
+  spit(dir + "/plan.json", R"JSON({"spinesim_sweep": 1, "verb": "spine schedule",
+    "options": {"loads": "loads.csv", "csv": "solve.csv"},
+    "parameters": {"height": {"values": [1.7, 1.8]}}})JSON");
+  const CliRun r = run_spinesim("sweep " + in_quotes(dir + "/plan.json") + " --out " +
+                                in_quotes(dir + "/out") + " --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(json::parse(r.out)["ok"], 2);
+  EXPECT_EQ(slurp(dir + "/solve.csv"), "mine\n");
+  for (const char* p : {"/out/points/0000", "/out/points/0001"}) {
+    EXPECT_NE(slurp(dir + p + "/solve.csv").find("# provenance"), std::string::npos) << p;
+    EXPECT_EQ(json::parse(slurp(dir + p + "/study.json"))["options"]["loads"],
+              "../../../loads.csv");
+  }
+}
+
 TEST(SweepCli, BadPlansAreRefusedBeforeAnythingRuns) {
   const std::string plan = tmp("bad-plan.json");
   spit(plan, R"JSON({"spinesim_sweep": 1, "verb": "spine solve",
