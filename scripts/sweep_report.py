@@ -4,7 +4,7 @@
 Reads DIR/summary.json and writes DIR/plots/sweep.png (each output against each parameter, one
 dot per point, failed points as crosses on the axis) and, for a Morris or Sobol plan,
 DIR/plots/sensitivity.png (mu* x range, or the first and total indices, per output and
-parameter), and DIR/report.html with the points' table. Any error is one line on stderr and exit
+parameter, with their bootstrap intervals), and DIR/report.html with the points' table. Any error is one line on stderr and exit
 status 1 (2 for a missing tool).
 
     /usr/bin/python3 scripts/sweep_report.py DIR
@@ -74,22 +74,38 @@ def draw_sensitivity(s, d):
         return None
     morris = sens["method"].startswith("Morris")
     fig, axes = plt.subplots(1, len(outs), squeeze=False, figsize=(4.5 * len(outs), 3.6))
+    def bars(ax, x, e, names, key, **kw):
+        """Bars of e[n][key] with their bootstrap intervals as error bars (when the summary
+        has them)."""
+        v = [e[n][key] for n in names]
+        lo = [e[n].get(key + "_interval", [None, None])[0] for n in names]
+        hi = [e[n].get(key + "_interval", [None, None])[1] for n in names]
+        err = None
+        if all(numeric(a) and numeric(b) for a, b in zip(lo, hi)):
+            err = [[max(0, a - b) for a, b in zip(v, lo)], [max(0, b - a) for a, b in zip(v, hi)]]
+        ax.bar(x, v, kw.pop("width", 0.8), yerr=err, capsize=3, **kw)
+        return v + [b for b in hi if numeric(b)] + [a for a in lo if numeric(a)]
+
     for ax, (o, e) in zip(axes[0], sorted(outs.items())):
         names = sorted(e)
+        x = list(range(len(names)))
         if morris:
-            ax.bar(names, [e[n]["mu_star_over_range"] for n in names], color="C0")
+            bars(ax, x, e, names, "mu_star_over_range", color="C0")
             ax.set_ylabel("mu* x range (output units)")
         else:
-            x = range(len(names))
-            ax.bar([i - 0.2 for i in x], [e[n]["first"] for n in names], 0.4, label="first S_i")
-            ax.bar([i + 0.2 for i in x], [e[n]["total"] for n in names], 0.4, label="total S_Ti")
-            ax.set_xticks(list(x), names)
-            values = [e[n][k] for n in names for k in ("first", "total")]
+            values = bars(ax, [i - 0.2 for i in x], e, names, "first", width=0.4,
+                          label="first S_i")
+            values += bars(ax, [i + 0.2 for i in x], e, names, "total", width=0.4,
+                           label="total S_Ti")
             ax.set_ylim(min(0, *values) - 0.05, max(1, *values) + 0.05)
             ax.legend(fontsize=8)
+        ax.set_xticks(x, names, rotation=20 if len(names) > 3 else 0, fontsize=8)
         ax.set_title(o, fontsize=10)
         ax.grid(alpha=0.3, axis="y")
     title = f"{sens['method']}, {sens['runs']} runs"
+    if "bootstrap" in sens:
+        b = sens["bootstrap"]
+        title += f"; bars: {round(100 * b['confidence'])} % bootstrap intervals"
     if not morris:  # N base points of Saltelli's N (k + 2) runs: the Monte Carlo error ~ 1/sqrt(N)
         n = sens["runs"] // (len(next(iter(outs.values()))) + 2)
         title += f" (N = {n}: the estimates scatter by about {1 / n ** 0.5:.2f})"

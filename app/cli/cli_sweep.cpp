@@ -16,6 +16,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -173,64 +174,84 @@ json gather(const Sweep& s) {
             {"plan_sha256", s.plan_sha256}}}};
 }
 
-/// One row per output and parameter: Morris's mu*, mu, sigma or Sobol's first and total index.
+/// One row per output and parameter: Morris's mu*, mu, sigma or Sobol's first and total index,
+/// each with its bootstrap interval.
 std::string sensitivity_csv(const Sweep& s, const json& summary) {
   const json& sens = summary["sensitivity"];
   const bool morris = s.plan.design == "morris";
   std::ostringstream csv;
   csv << "# provenance: " << summary["provenance"].dump() << "\n# "
       << sens["method"].get<std::string>() << ", " << sens["runs"] << " runs"
-      << (morris ? "; per unit of the parameter" : "") << "\n";
-  csv << "output,parameter," << (morris ? "mu_star_over_range,mu_star,mu,sigma" : "first,total")
-      << ",error\n";
+      << (morris ? "; per unit of the parameter" : "") << "; intervals: percentile bootstrap, "
+      << sens["bootstrap"]["confidence"] << " confidence, " << sens["bootstrap"]["resamples"]
+      << " resamples\n";
+  const std::vector<std::string> columns =
+      morris ? std::vector<std::string>{"mu_star_over_range", "mu_star", "mu", "sigma"}
+             : std::vector<std::string>{"first", "total"};
+  const std::vector<std::string> intervals =
+      morris ? std::vector<std::string>{"mu_star_over_range", "mu_star"}
+             : std::vector<std::string>{"first", "total"};
+  csv << "output,parameter";
+  for (const auto& c : columns) csv << "," << c;
+  for (const auto& c : intervals) csv << "," << c << "_low," << c << "_high";
+  csv << ",error\n";
   for (const auto& o : s.plan.outputs) {
     const json& e = sens["outputs"][o.first];
     if (e.contains("error")) {
-      csv << csv_cell(o.first) << ",," << (morris ? ",,," : ",") << "," << csv_cell(e["error"])
-          << "\n";
+      csv << csv_cell(o.first) << "," << std::string(1 + columns.size() + 2 * intervals.size(), ',')
+          << csv_cell(e["error"]) << "\n";
       continue;
     }
     for (const auto& p : s.plan.parameters) {
       const json& v = e[p.option];
-      csv << csv_cell(o.first) << "," << csv_cell(p.option) << ",";
-      if (morris)
-        csv << csv_cell(v["mu_star_over_range"]) << "," << csv_cell(v["mu_star"]) << ","
-            << csv_cell(v["mu"]) << "," << csv_cell(v["sigma"]);
-      else
-        csv << csv_cell(v["first"]) << "," << csv_cell(v["total"]);
+      csv << csv_cell(o.first) << "," << csv_cell(p.option);
+      for (const auto& c : columns) csv << "," << csv_cell(v[c]);
+      for (const auto& c : intervals)
+        csv << "," << csv_cell(v[c + "_interval"][0]) << "," << csv_cell(v[c + "_interval"][1]);
       csv << ",\n";
     }
   }
   return csv.str();
 }
 
+/// "value (low … high)" with `digits` significant digits (Morris) or `digits` decimals (Sobol).
+std::string with_interval(const json& v, const std::string& key, bool morris) {
+  auto text = [&](const json& x) {
+    return morris ? significant(x.get<double>(), 3) : fixed(x.get<double>(), 2);
+  };
+  return text(v[key]) + " (" + text(v[key + "_interval"][0]) + " … " +
+         text(v[key + "_interval"][1]) + ")";
+}
+
 void print_sensitivity(const Sweep& s, const json& summary) {
   const json& sens = summary["sensitivity"];
   if (sens.is_null()) return;
   const bool morris = s.plan.design == "morris";
+  const std::string ci =
+      std::to_string(int(std::lround(100 * sens["bootstrap"]["confidence"].get<double>()))) +
+      " % interval";
   std::cout << "\n"
             << sens["method"].get<std::string>() << " from " << sens["runs"] << " runs"
-            << (morris ? " (mu*, sigma: output units per unit of the parameter)" : "") << "\n";
-  TextTable t(
-      morris ? std::vector<std::string>{"output", "parameter", "mu* x range", "mu*", "mu", "sigma"}
-             : std::vector<std::string>{"output", "parameter", "first S_i", "total S_Ti"});
+            << (morris ? " (mu*, sigma: output units per unit of the parameter)" : "")
+            << "; in brackets the " << ci << " (bootstrap, " << sens["bootstrap"]["resamples"]
+            << " resamples)\n";
+  TextTable t(morris ? std::vector<std::string>{"output", "parameter", "mu* x range", "mu", "sigma"}
+                     : std::vector<std::string>{"output", "parameter", "first S_i", "total S_Ti"});
   for (const auto& o : s.plan.outputs) {
     const json& e = sens["outputs"][o.first];
     if (e.contains("error")) {
-      t.add(morris ? std::vector<std::string>{o.first, "-", "-", "-", "-",
-                                              e["error"].get<std::string>()}
+      t.add(morris ? std::vector<std::string>{o.first, "-", "-", "-", e["error"].get<std::string>()}
                    : std::vector<std::string>{o.first, "-", "-", e["error"].get<std::string>()});
       continue;
     }
     for (const auto& p : s.plan.parameters) {
       const json& v = e[p.option];
       if (morris)
-        t.add({o.first, p.option, significant(v["mu_star_over_range"].get<double>(), 4),
-               significant(v["mu_star"].get<double>(), 4), significant(v["mu"].get<double>(), 4),
-               significant(v["sigma"].get<double>(), 4)});
+        t.add({o.first, p.option, with_interval(v, "mu_star_over_range", true),
+               significant(v["mu"].get<double>(), 4), significant(v["sigma"].get<double>(), 4)});
       else
-        t.add({o.first, p.option, fixed(v["first"].get<double>(), 3),
-               fixed(v["total"].get<double>(), 3)});
+        t.add({o.first, p.option, with_interval(v, "first", false),
+               with_interval(v, "total", false)});
     }
   }
   t.print(std::cout, false);

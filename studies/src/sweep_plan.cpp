@@ -93,13 +93,20 @@ void parse_sensitivity_design(const json& d, SweepPlan& plan, const std::string&
       refuse(where, field + "seed", "give a whole number >= 0");
     plan.seed = s.is_number_unsigned() ? s.get<std::uint64_t>() : std::uint64_t(s.get<long long>());
   }
+  plan.resamples = design_number(o, "resamples", 10, 100000, 1000, where, field);
+  if (o.contains("confidence")) {
+    const json& c = o.at("confidence");
+    if (!c.is_number() || !(c.get<double>() >= 0.5 && c.get<double>() < 1))
+      refuse(where, field + "confidence", "give a number from 0.5 to below 1, e.g. 0.95");
+    plan.confidence = c.get<double>();
+  }
   if (plan.design == "morris") {
-    require_known(o, {"trajectories", "levels", "seed"}, where, field);
+    require_known(o, {"trajectories", "levels", "seed", "resamples", "confidence"}, where, field);
     plan.trajectories = design_number(o, "trajectories", 2, 100000, -1, where, field);
     plan.levels = design_number(o, "levels", 4, 1000, 4, where, field);
     if (plan.levels % 2 != 0) refuse(where, field + "levels", "give an even number (Morris's Δ)");
   } else {
-    require_known(o, {"base_points", "seed"}, where, field);
+    require_known(o, {"base_points", "seed", "resamples", "confidence"}, where, field);
     plan.base_points = design_number(o, "base_points", 2, 1000000, -1, where, field);
   }
 }
@@ -314,7 +321,11 @@ json sweep_sensitivity(const SweepPlan& plan, const std::vector<SweepPoint>& poi
   json out = {{"method", plan.design == "morris" ? "Morris elementary effects (mu*, sigma)"
                                                  : "Sobol indices (Saltelli 2010, Jansen 1999)"},
               {"runs", points.size()},
+              {"bootstrap", {{"resamples", plan.resamples}, {"confidence", plan.confidence}}},
               {"outputs", json::object()}};
+  // The intervals' own stream, apart from the design's and the same for every output.
+  const std::uint64_t seed = plan.seed ^ 0x5eed'b007'57a9'0001ull;
+  auto interval = [](const Interval& i) { return json::array({i.low, i.high}); };
   const UnitPoints unit = sensitivity_design(plan);
   std::vector<double> span;
   for (const auto& p : plan.parameters) span.push_back(p.to - p.from);
@@ -334,15 +345,25 @@ json sweep_sensitivity(const SweepPlan& plan, const std::vector<SweepPoint>& poi
     try {
       if (plan.design == "morris") {
         const auto e = morris_effects(unit, y, span);
+        const auto ci = morris_bootstrap(unit, y, span, plan.resamples, plan.confidence, seed);
         for (std::size_t k = 0; k < e.size(); ++k)
-          entry[plan.parameters[k].option] = {{"mu_star", e[k].mu_star},
-                                              {"mu", e[k].mu},
-                                              {"sigma", e[k].sigma},
-                                              {"mu_star_over_range", e[k].mu_star * span[k]}};
+          entry[plan.parameters[k].option] = {
+              {"mu_star", e[k].mu_star},
+              {"mu", e[k].mu},
+              {"sigma", e[k].sigma},
+              {"mu_star_over_range", e[k].mu_star * span[k]},
+              {"mu_star_interval", interval(ci[k].mu_star)},
+              {"mu_star_over_range_interval",
+               json::array({ci[k].mu_star.low * span[k], ci[k].mu_star.high * span[k]})}};
       } else {
-        const auto s = sobol_indices(int(plan.parameters.size()), y);
+        const int inputs = int(plan.parameters.size());
+        const auto s = sobol_indices(inputs, y);
+        const auto ci = sobol_bootstrap(inputs, y, plan.resamples, plan.confidence, seed);
         for (std::size_t k = 0; k < s.size(); ++k)
-          entry[plan.parameters[k].option] = {{"first", s[k].first}, {"total", s[k].total}};
+          entry[plan.parameters[k].option] = {{"first", s[k].first},
+                                              {"total", s[k].total},
+                                              {"first_interval", interval(ci[k].first)},
+                                              {"total_interval", interval(ci[k].total)}};
       }
     } catch (const std::invalid_argument& e) {
       entry = {{"error", e.what()}};

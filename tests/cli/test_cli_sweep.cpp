@@ -220,8 +220,20 @@ TEST(SweepCli, AMorrisPlanWritesTheSensitivityOfEachOutput) {
   EXPECT_LT(load["height"]["mu"].get<double>(), 0);
   EXPECT_DOUBLE_EQ(load["mass"]["mu_star_over_range"].get<double>(),
                    load["mass"]["mu_star"].get<double>() * 40);
+  // The bootstrap intervals hold their estimate, and mass's (nearly constant effect: the body's
+  // weight) is narrower relative to it than height's (σ/μ* 0.1 against 0.45).
+  auto relative_width = [&](const json& v) {
+    const double lo = v["mu_star_interval"][0], hi = v["mu_star_interval"][1];
+    EXPECT_LE(lo, v["mu_star"].get<double>());
+    EXPECT_GE(hi, v["mu_star"].get<double>());
+    return (hi - lo) / v["mu_star"].get<double>();
+  };
+  EXPECT_LT(relative_width(load["mass"]), relative_width(load["height"]));
+  EXPECT_EQ(s["bootstrap"]["resamples"], 1000);
   const std::string csv = slurp(out + "/sensitivity.csv");
-  EXPECT_NE(csv.find("output,parameter,mu_star_over_range,mu_star,mu,sigma"), std::string::npos);
+  EXPECT_NE(csv.find("output,parameter,mu_star_over_range,mu_star,mu,sigma,mu_star_over_range_low,"
+                     "mu_star_over_range_high,mu_star_low,mu_star_high,error"),
+            std::string::npos);
   EXPECT_EQ(count_lines(csv), 3 + 4);
   for (const char* f : {"/report.html", "/plots/sweep.png", "/plots/sensitivity.png"})
     EXPECT_TRUE(fs::exists(out + f)) << f;

@@ -195,6 +195,10 @@ TEST(SweepPlan, SensitivityDesignsGiveTheSensitivityOfEachOutput) {
   const json t = st::sweep_sensitivity(so, sp, outputs);
   EXPECT_NEAR(t["outputs"]["y"]["a"]["first"].get<double>(), 0.9, 0.03);
   EXPECT_NEAR(t["outputs"]["y"]["b"]["total"].get<double>(), 0.1, 0.03);
+  const json& ci = t["outputs"]["y"]["a"]["first_interval"];  // 95 %: holds the true 0.9
+  EXPECT_LT(ci[0].get<double>(), 0.9);
+  EXPECT_GT(ci[1].get<double>(), 0.9);
+  EXPECT_LT(ci[1].get<double>() - ci[0].get<double>(), 0.05);
   EXPECT_TRUE(t["outputs"]["z"].contains("error"));  // a constant output shares no variance
   EXPECT_TRUE(st::sweep_sensitivity(plan(base({{"a", {{"values", {1}}}}})), {}, {}).is_null());
 
@@ -206,4 +210,8 @@ TEST(SweepPlan, SensitivityDesignsGiveTheSensitivityOfEachOutput) {
   expect_refused(bad, "even");
   bad["design"] = {{"morris", {{"levels", 4}}}};
   expect_refused(bad, "design.morris.trajectories");
+  bad["design"] = {{"morris", {{"trajectories", 4}, {"confidence", 95}}}};
+  expect_refused(bad, "design.morris.confidence");
+  bad["design"] = {{"sobol", {{"base_points", 8}, {"resamples", 2}}}};
+  expect_refused(bad, "design.sobol.resamples");
 }

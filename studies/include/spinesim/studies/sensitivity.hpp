@@ -12,8 +12,15 @@
 // N (k + 2) runs. The indices are fractions of the output's variance: S_i what input i alone
 // explains, S_Ti what it explains with all its interactions.
 //
+// Confidence intervals: the percentile bootstrap (Efron & Tibshirani 1993), resampling the
+// independent units of each design with replacement: Morris's trajectories, Sobol's base rows
+// (a row of A, its row of B and its k rows of A_B^i together; Archer, Saltelli & Sobol 1997).
+// The interval says how far the finite sample leaves an index from the one an infinite sample
+// of the same model would give; it says nothing of the model's own error.
+//
 // Inputs are given as ranges [from, to]; the designs are in the unit cube and mapped onto them.
-// The random stream is the sweep's (SplitMix64), so a design is the same on every machine.
+// The random stream is the sweep's (SplitMix64), so a design and its intervals are the same on
+// every machine.
 #pragma once
 
 #include <cstdint>
@@ -51,5 +58,31 @@ struct SobolIndex {
 /// The indices of each input from the outputs `y` at saltelli_design's points (same order).
 /// Throws std::invalid_argument when the output does not vary (no variance to share).
 std::vector<SobolIndex> sobol_indices(int inputs, const std::vector<double>& y);
+
+/// A two-sided percentile interval.
+struct Interval {
+  double low = 0, high = 0;
+};
+
+struct MorrisIntervals {
+  Interval mu_star, mu, sigma;
+};
+
+/// Percentile-bootstrap intervals of morris_effects' μ*, μ and σ at `confidence` (0 … 1), from
+/// `resamples` (>= 10) resamples of the trajectories.
+std::vector<MorrisIntervals> morris_bootstrap(const UnitPoints& design,
+                                              const std::vector<double>& y,
+                                              const std::vector<double>& span, int resamples,
+                                              double confidence, std::uint64_t seed);
+
+struct SobolIntervals {
+  Interval first, total;
+};
+
+/// Percentile-bootstrap intervals of sobol_indices' S_i and S_Ti at `confidence`, from
+/// `resamples` (>= 10) resamples of the N base rows. A resample whose output does not vary is
+/// drawn again.
+std::vector<SobolIntervals> sobol_bootstrap(int inputs, const std::vector<double>& y, int resamples,
+                                            double confidence, std::uint64_t seed);
 
 }  // namespace spinesim::studies

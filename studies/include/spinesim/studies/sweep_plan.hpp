@@ -13,6 +13,8 @@
 //              {"latin_hypercube": {"points": 20, "seed": 1}}, or (sensitivity.hpp)
 //              {"morris": {"trajectories": 10, "levels": 4, "seed": 1}}, or
 //              {"sobol": {"base_points": 256, "seed": 1}}
+//              (both also take "resamples": 1000 and "confidence": 0.95, the bootstrap
+//              intervals of their indices)
 //    "outputs": {"L5-S1 axial (N)": "/joints/16/axial_n"}}  JSON pointers into a point's --json
 //
 // Designs: "grid" is every combination (the first parameter varies slowest); "zip" takes the
@@ -52,6 +54,8 @@ struct SweepPlan {
   int trajectories = 0, levels = 4;  ///< morris (sensitivity.hpp)
   int base_points = 0;               ///< sobol: N of Saltelli's N (k + 2) runs
   std::uint64_t seed = 1;            ///< the sampling designs' generator seed
+  int resamples = 1000;              ///< morris, sobol: bootstrap resamples of the intervals
+  double confidence = 0.95;          ///< morris, sobol: the intervals' confidence
   std::vector<std::pair<std::string, std::string>> outputs;  ///< column name, JSON pointer
 };
 
@@ -79,7 +83,9 @@ nlohmann::json point_outputs(const SweepPlan& plan, const nlohmann::json& result
 
 /// Each numeric output's sensitivity to each parameter, for a morris or sobol plan (null for the
 /// other designs): {"output": {"parameter": {"mu_star", "mu", "sigma"} or {"first", "total"}}},
-/// with the number of runs. `outputs[i]` is point i's point_outputs; an output missing at any
+/// with the number of runs and the bootstrap intervals at the plan's confidence ([low, high]:
+/// "mu_star_interval", "mu_star_over_range_interval", "first_interval", "total_interval").
+/// `outputs[i]` is point i's point_outputs; an output missing at any
 /// point (a failed point, a non-number) gets {"error": why} instead. Morris's mu_star_over_range
 /// is mu* times the parameter's range: the output's mean change across it, to rank parameters of
 /// different units.
