@@ -2,6 +2,7 @@
 //
 //   spinesim study disc-validation [--level L4-L5] [--material fibre-reinforced]
 //       [--formulation mixed] [--mesh disc.vtu] [--cell-size 2] [--csv FILE] [--json]
+//       [--annulus-E MPa] [--fibre-scale F] [--nucleus-E MPa]
 //       [--model nonlinear [--order 1] [--fibre-k2 K2] [--preload N] [--increments 10]
 //        [--paths FILE]]
 //       [--out DIR]
@@ -9,6 +10,7 @@
 #include "spinesim/mesh/disc_level.hpp"
 #include "spinesim/output/files.hpp"
 #include "spinesim/output/html_report.hpp"
+#include "spinesim/studies/disc_identification.hpp"
 #include "spinesim/studies/disc_validation.hpp"
 #include "spinesim/studies/fem_reference.hpp"
 
@@ -21,6 +23,7 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 namespace spinesim::cli {
@@ -31,6 +34,8 @@ struct DiscValidationArgs {
               targets, csv, model = "linear", paths, out;
   double cell_size_mm = mesh::MeshOptions().cell_size_mm;
   studies::NonlinearDiscOptions nonlinear;
+  /// The identified parameters (studies::disc_parameters) set one by one; unset: the material's.
+  std::optional<double> annulus_e, fibre_scale, nucleus_e;
   bool json = false, quiet = false, markdown = false;
   bool formulation_given = false, nonlinear_flag_given = false;
 };
@@ -51,6 +56,39 @@ void write_out_folder(const std::string& out, const DiscValidationResult& r) {
   const output::HtmlReport report = output::write_html_report(out, "disc_report.py");
   if (report.failed) throw std::runtime_error("--out " + out + ": " + report.message);
   std::cerr << (report.written ? "" : "spinesim: warning: ") << report.message << std::endl;
+}
+
+/// The material with --annulus-E, --fibre-scale and --nucleus-E applied (the parameters the
+/// identification fits; a sweep varies them), named after what changed.
+mesh::RegionMaterials with_parameters(const mesh::RegionMaterials& base,
+                                      const DiscValidationArgs& a) {
+  if (!a.annulus_e && !a.fibre_scale && !a.nucleus_e) return base;
+  const std::vector<std::pair<const char*, std::optional<double>>> given = {
+      {"--annulus-E", a.annulus_e}, {"--fibre-scale", a.fibre_scale}, {"--nucleus-E", a.nucleus_e}};
+  for (const auto& [flag, v] : given)
+    if (v && !(std::isfinite(*v) && *v > 0 && *v < 1e5))
+      throw std::invalid_argument(std::string(flag) + " must be a finite number > 0 (and < 1e5)");
+  std::vector<studies::DiscParameter> parameters;
+  try {
+    parameters = studies::disc_parameters(base);
+  } catch (const std::invalid_argument&) {
+    throw std::invalid_argument(
+        "--annulus-E, --fibre-scale and --nucleus-E need a material with a fibre-reinforced "
+        "annulus and a nucleus; '" +
+        base.name + "' is not one");
+  }
+  Eigen::VectorXd p(Eigen::Index(parameters.size()));
+  for (std::size_t i = 0; i < parameters.size(); ++i) p(Eigen::Index(i)) = parameters[i].fit.start;
+  std::string name = base.name + " with";
+  auto set = [&](Eigen::Index i, const std::optional<double>& v, const std::string& what) {
+    if (!v) return;
+    p(i) = *v;
+    name += (name.back() == 'h' ? " " : ", ") + what + " " + significant(*v, 4);
+  };
+  set(0, a.annulus_e, "annulus E (MPa)");
+  set(1, a.fibre_scale, "fibre moduli ×");
+  set(3, a.nucleus_e, "nucleus E (MPa)");
+  return studies::disc_material_at(base, p, name);
 }
 
 void run_disc_validation(const DiscValidationArgs& a) {
@@ -78,7 +116,8 @@ void run_disc_validation(const DiscValidationArgs& a) {
         a.nonlinear.preload_n > 1e4)
       throw std::invalid_argument("--preload: the preload must be 0 to 10000 N");
   }
-  const mesh::RegionMaterials materials = mesh::load_material(a.material, data_dir());
+  const mesh::RegionMaterials materials =
+      with_parameters(mesh::load_material(a.material, data_dir()), a);
   const std::string targets_path =
       a.targets.empty() ? data_dir() + "/validation/disc_in_vitro.json" : a.targets;
   const nlohmann::json targets = read_disc_targets(targets_path);
@@ -147,6 +186,18 @@ void register_disc_validation(CLI::App& study) {
                   "mixed (Taylor-Hood P2-P1: gives the nucleus pressure) or displacement (P2)")
       ->capture_default_str()
       ->each([a](const std::string&) { a->formulation_given = true; });
+  cmd->add_option_function<double>(
+      "--annulus-E", [a](double v) { a->annulus_e = v; },
+      "The annulus matrix's Young's modulus, MPa (default: the material's; the identification "
+      "searches 1.0-4.2)");
+  cmd->add_option_function<double>(
+      "--fibre-scale", [a](double v) { a->fibre_scale = v; },
+      "Multiplies the annulus fibres' moduli, inner and outer (default 1; the identification "
+      "searches 0.5-2)");
+  cmd->add_option_function<double>(
+      "--nucleus-E", [a](double v) { a->nucleus_e = v; },
+      "The nucleus's Young's modulus, MPa (default: the material's; the identification searches "
+      "0.72-1.26)");
   cmd->add_option("--model", a->model,
                   "linear (the linear FEM) or nonlinear (tension-only fibres, finite strain, "
                   "the plate loaded and free)")
