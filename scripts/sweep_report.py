@@ -4,7 +4,8 @@
 Reads DIR/summary.json and writes DIR/plots/sweep.png (each output against each parameter, one
 dot per point, failed points as crosses on the axis) and, for a Morris or Sobol plan,
 DIR/plots/sensitivity.png (mu* x range, or the first and total indices, per output and
-parameter, with their bootstrap intervals), and DIR/report.html with the points' table. Any error is one line on stderr and exit
+parameter, with their bootstrap intervals), for a plan with windows DIR/plots/uncertainty.png
+(each parameter and output before and after weighting by the windows), and DIR/report.html with the points' table. Any error is one line on stderr and exit
 status 1 (2 for a missing tool).
 
     /usr/bin/python3 scripts/sweep_report.py DIR
@@ -116,6 +117,53 @@ def draw_sensitivity(s, d):
     return "sensitivity.png"
 
 
+def draw_uncertainty(s, d):
+    """Each parameter and output: its values over the sample (the prior) and weighted by the
+    windows (the posterior), as histograms, with the window shaded."""
+    u = s.get("uncertainty")
+    if not u or "error" in u:
+        return None
+    points, weights = s["points"], u["weights"]
+    names = [("parameter", n) for n in sorted(u["parameters"])] + \
+            [("output", n) for n in sorted(u["outputs"])]
+    names = [(k, n) for k, n in names
+             if "error" not in (u["parameters"] if k == "parameter" else u["outputs"])[n]]
+    if not names:
+        return None
+    cols = min(4, len(names))
+    rows = (len(names) + cols - 1) // cols
+    fig, axes = plt.subplots(rows, cols, squeeze=False, figsize=(4.2 * cols, 3.0 * rows))
+    for ax, (kind, name) in zip([a for r in axes for a in r], names):
+        v, w = [], []
+        for p, wt in zip(points, weights):
+            x = p["values"].get(name) if kind == "parameter" else (p.get("outputs") or {}).get(name)
+            if numeric(x) and p["status"] == "ok":
+                v.append(x)
+                w.append(wt)
+        if not v:
+            continue
+        used = [1.0 if wt > 0 else 0.0 for wt in w]
+        bins = 20
+        ax.hist(v, bins=bins, weights=[x / max(1, sum(used)) for x in used], alpha=0.45,
+                color="C7", label="prior (the sample)")
+        ax.hist(v, bins=bins, weights=w, alpha=0.7, color="C0", label="posterior (weighted)")
+        if kind == "output" and name in u["windows"]:
+            win = u["windows"][name]
+            ax.axvspan(win["low"], win["high"], color="C2", alpha=0.15, label="window")
+        ax.set_title(name, fontsize=9)
+        ax.set_ylabel("weight")
+        ax.grid(alpha=0.3)
+    for ax in [a for r in axes for a in r][len(names):]:
+        ax.axis("off")
+    axes[0][0].legend(fontsize=7)
+    fig.suptitle(f"Uncertainty: {u['points_used']} of {u['points']} points weighted by the windows; "
+                 f"effective sample size {u['effective_sample_size']:.1f}")
+    fig.tight_layout()
+    fig.savefig(f"{d}/plots/uncertainty.png", dpi=90)
+    plt.close(fig)
+    return "uncertainty.png"
+
+
 def table(s):
     points, params, outputs = parameters_and_outputs(s)
     head = "".join(f"<th>{html.escape(h)}</th>" for h in ["point", *params, "status", *outputs])
@@ -132,7 +180,7 @@ def table(s):
 
 def write_report(d):
     s = load_summary(d, "summary.json")
-    figures = [f for f in (draw_points(s, d), draw_sensitivity(s, d)) if f]
+    figures = [f for f in (draw_points(s, d), draw_sensitivity(s, d), draw_uncertainty(s, d)) if f]
     points = s["points"]
     ok = sum(p["status"] == "ok" for p in points)
     p = s["provenance"]

@@ -112,6 +112,43 @@ spine::ScoliosisCurve scoliosis_of(const ScoliosisFlags& f) {
   return c;
 }
 
+void add_model_input_options(CLI::App* cmd, ModelInputFlags& f) {
+  cmd->add_option("--muscle-strength", f.muscle_strength,
+                  "Multiplies every muscle's maximum stress (its strength; 1: F.8-F.19's)")
+      ->capture_default_str();
+  cmd->add_option("--joint-stiffness", f.joint_stiffness,
+                  "Multiplies every joint's rotational stiffness (F.4's, or the --disc-joints')")
+      ->capture_default_str();
+  cmd->add_option("--ligament-stiffness", f.ligament_stiffness,
+                  "Multiplies every F.6/F.7 ligament's stiffness (when the model has them: "
+                  "--ligaments)")
+      ->capture_default_str();
+  cmd->add_option("--inclination", f.inclination_deg,
+                  "Standing posture: the body above the hips pitched forward by this angle, deg "
+                  "(gravity turns with it in the pelvis's frame; 0: upright)")
+      ->capture_default_str();
+}
+
+void apply_model_inputs(const ModelInputFlags& f, spine::ModelOptions& o) {
+  o.muscle_strength = f.muscle_strength;
+  o.joint_stiffness = f.joint_stiffness;
+  o.ligament_stiffness = f.ligament_stiffness;
+  o.inclination_deg = f.inclination_deg;
+  const std::pair<const char*, double> scales[] = {{"--muscle-strength", f.muscle_strength},
+                                                   {"--joint-stiffness", f.joint_stiffness},
+                                                   {"--ligament-stiffness", f.ligament_stiffness}};
+  for (const auto& [flag, v] : scales)
+    if (!(v >= spine::kInputScaleRange[0] && v <= spine::kInputScaleRange[1]))
+      throw std::invalid_argument(std::string(flag) + " must lie within " +
+                                  significant(spine::kInputScaleRange[0], 2) + " … " +
+                                  significant(spine::kInputScaleRange[1], 2) + " (1: the tables')");
+  if (!(f.inclination_deg >= spine::kInclinationRangeDeg[0] &&
+        f.inclination_deg <= spine::kInclinationRangeDeg[1]))
+    throw std::invalid_argument("--inclination must lie within " +
+                                significant(spine::kInclinationRangeDeg[0], 2) + " … " +
+                                significant(spine::kInclinationRangeDeg[1], 2) + " deg");
+}
+
 void add_ligaments_option(CLI::App* cmd, std::string& ligaments) {
   cmd->add_option("--ligaments", ligaments,
                   "The F.6/F.7 ligaments: auto (only with --disc-joints: F.4's whole-segment "

@@ -55,6 +55,15 @@ void add_rib_cage_option(CLI::App* cmd, bool& rib_cage);
 
 /// A scoliotic spine (spine/scoliosis.hpp): --scoliosis TYPE --cobb DEG [--apex V]
 /// [--curve-ends U,L] [--apical-rotation DEG] [--convex right|left].
+/// The spine model's uncertain inputs (spine::ModelOptions muscle_strength, joint_stiffness,
+/// ligament_stiffness, inclination_deg), for sensitivity sweeps.
+struct ModelInputFlags {
+  double muscle_strength = 1, joint_stiffness = 1, ligament_stiffness = 1, inclination_deg = 0;
+};
+void add_model_input_options(CLI::App* cmd, ModelInputFlags& f);
+/// Copies the flags into `o` and checks them (std::invalid_argument naming the option).
+void apply_model_inputs(const ModelInputFlags& f, spine::ModelOptions& o);
+
 struct ScoliosisFlags {
   std::string type, apex, ends, convex;
   double cobb_deg = 0, apical_rotation_deg = 0;

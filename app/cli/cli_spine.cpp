@@ -51,6 +51,7 @@ struct SpineSolveArgs {
        rib_cage = false;
   SubjectFlags subject;
   ScoliosisFlags scoliosis;
+  ModelInputFlags inputs;
 };
 
 void solve(const SpineSolveArgs& a) {
@@ -123,6 +124,7 @@ void solve(const SpineSolveArgs& a) {
   model_options.rib_cage = a.rib_cage;
   model_options.subject = spine::resolve_subject(data_dir(), subject_of(a.subject));
   model_options.scoliosis = scoliosis_of(a.scoliosis);
+  apply_model_inputs(a.inputs, model_options);
   if (!a.csv.empty()) require_output_folder(a.csv, "--csv");
 
   // 2. Model and equilibrium (studies/spine_solve.hpp).
@@ -176,6 +178,7 @@ void register_spine(CLI::App& app) {
   add_rib_cage_option(cmd, a->rib_cage);
   add_scoliosis_options(cmd, a->scoliosis);
   add_subject_options(cmd, a->subject);
+  add_model_input_options(cmd, a->inputs);
   cmd->add_option("--tolerance", a->tolerance_nmm, "Newton tolerance on max |dPi/dtheta|, N·mm")
       ->capture_default_str();
   cmd->add_option("--max-iterations", a->max_iterations, "Newton iterations before giving up")

@@ -6,6 +6,7 @@
 // sweep and never runs a finished point twice.
 #include "cli_common.hpp"
 #include "study_file.hpp"
+#include "sweep_tables.hpp"
 #include "sweep_world.hpp"
 
 #include "spinesim/common/input_file.hpp"
@@ -133,16 +134,6 @@ void finish_point(const Sweep& s, std::size_t i, int code, double seconds) {
   write_atomically(folder / "status.json", status.dump(2) + "\n");
 }
 
-std::string csv_cell(const json& v) {
-  if (v.is_null()) return "";
-  if (!v.is_string()) return v.dump();  // numbers: the shortest text that reads back exactly
-  const std::string t = v.get<std::string>();
-  if (t.find_first_of(",\"\n") == std::string::npos) return t;
-  std::string q = "\"";
-  for (char c : t) q += c == '"' ? std::string("\"\"") : std::string(1, c == '\n' ? ' ' : c);
-  return q + "\"";
-}
-
 /// The summary: one row per point, its values, status and outputs. Its provenance names the
 /// program and the plan (not the command or the folder), so every way of running the same plan
 /// writes the same bytes.
@@ -167,95 +158,12 @@ json gather(const Sweep& s) {
           {"verb", s.plan.verb},
           {"points", rows},
           {"sensitivity", studies::sweep_sensitivity(s.plan, s.points, outputs)},
+          {"uncertainty", studies::sweep_uncertainty(s.plan, s.points, outputs)},
           {"provenance",
            {{"program", "spinesim"},
             {"version", build_version()},
             {"commit", build_commit()},
             {"plan_sha256", s.plan_sha256}}}};
-}
-
-/// One row per output and parameter: Morris's mu*, mu, sigma or Sobol's first and total index,
-/// each with its bootstrap interval.
-std::string sensitivity_csv(const Sweep& s, const json& summary) {
-  const json& sens = summary["sensitivity"];
-  const bool morris = s.plan.design == "morris";
-  std::ostringstream csv;
-  csv << "# provenance: " << summary["provenance"].dump() << "\n# "
-      << sens["method"].get<std::string>() << ", " << sens["runs"] << " runs"
-      << (morris ? "; per unit of the parameter" : "") << "; intervals: percentile bootstrap, "
-      << sens["bootstrap"]["confidence"] << " confidence, " << sens["bootstrap"]["resamples"]
-      << " resamples\n";
-  const std::vector<std::string> columns =
-      morris ? std::vector<std::string>{"mu_star_over_range", "mu_star", "mu", "sigma"}
-             : std::vector<std::string>{"first", "total"};
-  const std::vector<std::string> intervals =
-      morris ? std::vector<std::string>{"mu_star_over_range", "mu_star"}
-             : std::vector<std::string>{"first", "total"};
-  csv << "output,parameter";
-  for (const auto& c : columns) csv << "," << c;
-  for (const auto& c : intervals) csv << "," << c << "_low," << c << "_high";
-  csv << ",error\n";
-  for (const auto& o : s.plan.outputs) {
-    const json& e = sens["outputs"][o.first];
-    if (e.contains("error")) {
-      csv << csv_cell(o.first) << "," << std::string(1 + columns.size() + 2 * intervals.size(), ',')
-          << csv_cell(e["error"]) << "\n";
-      continue;
-    }
-    for (const auto& p : s.plan.parameters) {
-      const json& v = e[p.option];
-      csv << csv_cell(o.first) << "," << csv_cell(p.option);
-      for (const auto& c : columns) csv << "," << csv_cell(v[c]);
-      for (const auto& c : intervals)
-        csv << "," << csv_cell(v[c + "_interval"][0]) << "," << csv_cell(v[c + "_interval"][1]);
-      csv << ",\n";
-    }
-  }
-  return csv.str();
-}
-
-/// "value (low … high)" with `digits` significant digits (Morris) or `digits` decimals (Sobol).
-std::string with_interval(const json& v, const std::string& key, bool morris) {
-  auto text = [&](const json& x) {
-    return morris ? significant(x.get<double>(), 3) : fixed(x.get<double>(), 2);
-  };
-  return text(v[key]) + " (" + text(v[key + "_interval"][0]) + " … " +
-         text(v[key + "_interval"][1]) + ")";
-}
-
-void print_sensitivity(const Sweep& s, const json& summary) {
-  const json& sens = summary["sensitivity"];
-  if (sens.is_null()) return;
-  const bool morris = s.plan.design == "morris";
-  const std::string ci =
-      std::to_string(int(std::lround(100 * sens["bootstrap"]["confidence"].get<double>()))) +
-      " % interval";
-  std::cout << "\n"
-            << sens["method"].get<std::string>() << " from " << sens["runs"] << " runs"
-            << (morris ? " (mu*, sigma: output units per unit of the parameter)" : "")
-            << "; in brackets the " << ci << " (bootstrap, " << sens["bootstrap"]["resamples"]
-            << " resamples)\n";
-  TextTable t(morris ? std::vector<std::string>{"output", "parameter", "mu* x range", "mu", "sigma"}
-                     : std::vector<std::string>{"output", "parameter", "first S_i", "total S_Ti"});
-  for (const auto& o : s.plan.outputs) {
-    const json& e = sens["outputs"][o.first];
-    if (e.contains("error")) {
-      t.add(morris ? std::vector<std::string>{o.first, "-", "-", "-", e["error"].get<std::string>()}
-                   : std::vector<std::string>{o.first, "-", "-", e["error"].get<std::string>()});
-      continue;
-    }
-    for (const auto& p : s.plan.parameters) {
-      const json& v = e[p.option];
-      if (morris)
-        t.add({o.first, p.option, with_interval(v, "mu_star_over_range", true),
-               significant(v["mu"].get<double>(), 4), significant(v["sigma"].get<double>(), 4)});
-      else
-        t.add({o.first, p.option, with_interval(v, "first", false),
-               with_interval(v, "total", false)});
-    }
-  }
-  t.print(std::cout, false);
-  std::cout << "\n";
 }
 
 void write_summary(const Sweep& s, const json& summary) {
@@ -278,7 +186,9 @@ void write_summary(const Sweep& s, const json& summary) {
   write_atomically(s.out / "summary.csv", csv.str());
   write_atomically(s.out / "summary.json", summary.dump(2) + "\n");
   if (!summary["sensitivity"].is_null())
-    write_atomically(s.out / "sensitivity.csv", sensitivity_csv(s, summary));
+    write_atomically(s.out / "sensitivity.csv", sensitivity_csv(s.plan, summary));
+  if (!summary["uncertainty"].is_null())
+    write_atomically(s.out / "uncertainty.csv", uncertainty_csv(s.plan, summary));
 }
 
 struct Tally {
@@ -430,9 +340,11 @@ void run_sweep(SweepArgs a) {
                 << fixed(projected_seconds(t.point_seconds, 64), 1) << " s on 64 ranks, "
                 << fixed(projected_seconds(t.point_seconds, 512), 1) << " s on 512\n";
     if (gathers) {
-      print_sensitivity(s, summary);
+      print_sensitivity(s.plan, summary);
+      print_uncertainty(s.plan, summary);
       std::cout << "wrote " << (s.out / "summary.csv").string() << ", summary.json"
-                << (summary["sensitivity"].is_null() ? "" : ", sensitivity.csv") << "\n";
+                << (summary["sensitivity"].is_null() ? "" : ", sensitivity.csv")
+                << (summary["uncertainty"].is_null() ? "" : ", uncertainty.csv") << "\n";
       if (report.written) std::cout << report.message << "\n";
     }
   }

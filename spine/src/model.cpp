@@ -12,6 +12,7 @@
 #include "subject.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -180,6 +181,44 @@ void load_ligaments(SpineModel& m, const fs::path& data, const json& config) {
         m.ligaments.push_back(l);
       }
     }
+  }
+}
+
+void check_input_scales(const ModelOptions& o) {
+  const std::pair<const char*, double> scales[] = {{"muscle strength", o.muscle_strength},
+                                                   {"joint stiffness", o.joint_stiffness},
+                                                   {"ligament stiffness", o.ligament_stiffness}};
+  for (const auto& [what, v] : scales)
+    if (!(v >= kInputScaleRange[0] && v <= kInputScaleRange[1])) {
+      std::ostringstream os;
+      os << "the " << what << " scale must lie within " << kInputScaleRange[0] << " … "
+         << kInputScaleRange[1] << " (1: the tables' values), not " << v;
+      throw std::invalid_argument(os.str());
+    }
+  if (!(o.inclination_deg >= kInclinationRangeDeg[0] &&
+        o.inclination_deg <= kInclinationRangeDeg[1])) {
+    std::ostringstream os;
+    os << "the forward inclination must lie within " << kInclinationRangeDeg[0] << " … "
+       << kInclinationRangeDeg[1] << " deg, not " << o.inclination_deg;
+    throw std::invalid_argument(os.str());
+  }
+}
+
+/// ModelOptions' uncertain inputs: strength, stiffnesses and the inclination of gravity.
+void apply_input_scales(SpineModel& m, const ModelOptions& o) {
+  for (Muscle& mu : m.muscles) mu.max_stress_mpa *= o.muscle_strength;
+  for (Joint& j : m.joints) {
+    for (double* k : {&j.k_flexion, &j.k_extension, &j.k_lateral, &j.k_torsion})
+      *k *= o.joint_stiffness;
+    j.coupling *= o.joint_stiffness;
+  }
+  for (Ligament& l : m.ligaments) l.k_n_per_mm *= o.ligament_stiffness;
+  if (o.inclination_deg != 0) {
+    // Turning the body forward by φ turns gravity backward by φ in the body's frame: down
+    // (0, −1, 0) becomes (0, −cos φ, sin φ), forward.
+    const Eigen::Matrix3d turn =
+        Eigen::AngleAxisd(-o.inclination_deg * kRadPerDeg, Vector3d::UnitX()).toRotationMatrix();
+    for (PointLoad& w : m.weights) w.force_n = turn * w.force_n;
   }
 }
 
@@ -352,6 +391,7 @@ SpineModel load_spine_model(const std::string& data_dir, const ModelOptions& opt
           "co-contraction and muscle tone are fractions of the muscles' maximum force, 0 … 0.5");
   m.muscle_floor = options.co_contraction;
   m.muscle_tone = options.muscle_tone;
+  check_input_scales(options);
   try {
     m.subject = options.subject;
     m.scale = detail::subject_scale(config, config_file, m.subject, m.segment_mass_percent);
@@ -413,6 +453,7 @@ SpineModel load_spine_model(const std::string& data_dir, const ModelOptions& opt
           kRadPerDeg;
     }
     detail::scale_to_subject(m, m.scale);
+    apply_input_scales(m, options);
     if (options.rib_cage)
       m.rib_cage =
           std::make_shared<const RibCage>(build_rib_cage(data_dir, m.vertebrae, m.scale.length));

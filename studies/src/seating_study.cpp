@@ -68,6 +68,10 @@ void check_seating_request(const SeatingRequest& request) {
   spine::check_chair(request.chair);
   if (request.pelvic_tilt_deg && !(std::abs(*request.pelvic_tilt_deg) <= 60))
     throw std::invalid_argument("--pelvic-tilt must be a number within -60 … 60 deg");
+  if (request.model.inclination_deg != 0)
+    throw std::invalid_argument(
+        "a forward inclination is a standing posture; a seated spine's is the chair's and the "
+        "pelvis's (--pelvic-tilt)");
 }
 
 SeatingRun run_seating(const std::string& data_dir, const SeatingRequest& request) {

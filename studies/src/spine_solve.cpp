@@ -202,7 +202,11 @@ nlohmann::json spine_solve_json(const SpineSolveRun& r, const std::string& csv) 
         {"power", options.recruitment.power},
         {"tolerance_nmm", options.tolerance},
         {"max_iterations", options.max_iterations},
-        {"subject", subject_json(r.model.subject)}}},
+        {"subject", subject_json(r.model.subject)},
+        {"muscle_strength", model_options.muscle_strength},
+        {"joint_stiffness", model_options.joint_stiffness},
+        {"ligament_stiffness", model_options.ligament_stiffness},
+        {"inclination_deg", model_options.inclination_deg}}},
       {"converged", s.converged},
       {"iterations", s.iterations},
       {"gradient_norm_nmm", s.gradient_norm},
@@ -255,6 +259,13 @@ void print_header(std::ostream& os, const SpineSolveRun& r) {
      << "; fusion: " << (fused.empty() ? "none" : fused) << "\n"
      << "  body: " << subject_text(m.subject) << "\n";
   if (m.rib_cage) os << "  rib cage: 24 ribs and the sternum on T1-T12\n";
+  const spine::ModelOptions& mo = r.request.model;
+  if (mo.muscle_strength != 1 || mo.joint_stiffness != 1 || mo.ligament_stiffness != 1 ||
+      mo.inclination_deg != 0)
+    os << "  inputs: muscle strength x" << significant(mo.muscle_strength, 4)
+       << ", joint stiffness x" << significant(mo.joint_stiffness, 4) << ", ligament stiffness x"
+       << significant(mo.ligament_stiffness, 4) << ", inclined forward "
+       << significant(mo.inclination_deg, 4) << " deg\n";
   if (m.scoliosis.cobb_deg != 0) {
     const spine::ScoliosisPosture p = spine::scoliotic_posture(m, m.scoliosis);
     os << "  scoliosis: " << m.scoliosis.type << ", " << m.scoliosis.upper_end << "-"

@@ -190,11 +190,42 @@ std::uint64_t SplitMix64::next() {
   return z ^ (z >> 31);
 }
 
+namespace {
+
+/// "windows": {"output": {"low": L, "high": H, "source": "…"}}: measurements of outputs, for the
+/// uncertainty a Latin hypercube's points carry (uncertainty.hpp).
+void parse_windows(const json& w, SweepPlan& plan, const std::string& where) {
+  if (!w.is_object() || w.empty())
+    refuse(where, "windows", "give {\"output\": {\"low\": L, \"high\": H, \"source\": \"…\"}}");
+  if (plan.design != "latin_hypercube")
+    refuse(where, "windows",
+           "weigh a sample of the ranges: give the design {\"latin_hypercube\": {…}}");
+  for (const auto& item : w.items()) {
+    const std::string field = "windows." + item.key();
+    const json& o = item.value();
+    if (std::none_of(plan.outputs.begin(), plan.outputs.end(),
+                     [&](const auto& out) { return out.first == item.key(); }))
+      refuse(where, field, "not one of the plan's outputs");
+    if (!o.is_object()) refuse(where, field, "give {\"low\": L, \"high\": H}");
+    require_known(o, {"low", "high", "source"}, where, field + ".");
+    const json lo = o.value("low", json()), hi = o.value("high", json());
+    if (!lo.is_number() || !hi.is_number() || !(lo.get<double>() > 0) ||
+        !(hi.get<double>() > lo.get<double>()) || !std::isfinite(hi.get<double>()))
+      refuse(where, field, "give numbers 0 < low < high (a window of a positive quantity)");
+    if (o.contains("source") && !o.at("source").is_string())
+      refuse(where, field + ".source", "give a string");
+    plan.windows.push_back({item.key(), lo.get<double>(), hi.get<double>()});
+    plan.window_sources.push_back(o.value("source", ""));
+  }
+}
+
+}  // namespace
+
 SweepPlan parse_sweep_plan(const json& j, const std::string& where) {
   if (!j.is_object()) refuse(where, "the plan", "give a JSON object");
   require_known(j,
                 {"spinesim_sweep", "description", "verb", "options", "parameters", "design",
-                 "outputs", "provenance"},
+                 "outputs", "windows", "provenance"},
                 where, "");
   if (!j.contains("spinesim_sweep") || j.at("spinesim_sweep") != kSweepPlanVersion)
     refuse(where, "spinesim_sweep", "give 1 (the plan format's version)");
@@ -242,6 +273,7 @@ SweepPlan parse_sweep_plan(const json& j, const std::string& where) {
       plan.outputs.emplace_back(item.key(), p.get<std::string>());
     }
   }
+  if (j.contains("windows")) parse_windows(j.at("windows"), plan, where);
   return plan;
 }
 

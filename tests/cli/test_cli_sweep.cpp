@@ -238,3 +238,37 @@ TEST(SweepCli, AMorrisPlanWritesTheSensitivityOfEachOutput) {
   for (const char* f : {"/report.html", "/plots/sweep.png", "/plots/sensitivity.png"})
     EXPECT_TRUE(fs::exists(out + f)) << f;
 }
+
+// A plan with a window: a Latin hypercube over body mass, weighted by a window on the L4-L5
+// load around its value at 70 kg (378 N). The load is about proportional to mass (5.4 N/kg), so
+// the window's ±4.9 % on the log scale is ±3.5 kg: the weighted mass is 70 ± 3.5 kg, the
+// weighted load sits in its window, and the report draws both.
+TEST(SweepCli, WindowsWeighTheSampleIntoThePosterior) {
+  const std::string dir = tmp("sweep-windows");
+  fs::create_directories(dir);
+  spit(dir + "/plan.json", R"JSON({"spinesim_sweep": 1, "verb": "spine solve",
+    "parameters": {"mass": {"from": 50, "to": 100}},
+    "design": {"latin_hypercube": {"points": 40, "seed": 3}},
+    "outputs": {"L4-L5 axial (N)": "/joints/15/axial_n", "T1 forward (mm)": "/vertebrae/0/translation_mm/2"},
+    "windows": {"L4-L5 axial (N)": {"low": 360, "high": 397, "source": "a test window"}}})JSON");
+  const std::string out = dir + "/out";
+  const CliRun r =
+      run_spinesim("sweep " + in_quotes(dir + "/plan.json") + " --out " + in_quotes(out));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("effective sample size"), std::string::npos) << r.out;
+  const json u = json::parse(slurp(out + "/summary.json"))["uncertainty"];
+  EXPECT_EQ(u["points_used"], 40);
+  const json& mass = u["parameters"]["mass"];
+  EXPECT_NEAR(mass["prior"]["mean"].get<double>(), 75, 1);  // uniform on 50 … 100
+  EXPECT_NEAR(mass["posterior"]["mean"].get<double>(), 70, 1.5);
+  EXPECT_NEAR(mass["posterior"]["sd"].get<double>(), 3.5, 1);
+  const json& load = u["outputs"]["L4-L5 axial (N)"]["posterior"];
+  EXPECT_GT(load["q50"].get<double>(), 360);
+  EXPECT_LT(load["q50"].get<double>(), 397);
+  EXPECT_GT(u["effective_sample_size"].get<double>(), 3);
+  EXPECT_LT(u["effective_sample_size"].get<double>(), 20);
+  const std::string csv = slurp(out + "/uncertainty.csv");
+  EXPECT_NE(csv.find("kind,name,prior_mean,prior_sd,prior_q05"), std::string::npos);
+  EXPECT_EQ(count_lines(csv), 3 + 3);  // provenance, method, header; mass and two outputs
+  EXPECT_TRUE(fs::exists(out + "/plots/uncertainty.png"));
+}

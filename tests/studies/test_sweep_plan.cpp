@@ -214,4 +214,24 @@ TEST(SweepPlan, SensitivityDesignsGiveTheSensitivityOfEachOutput) {
   expect_refused(bad, "design.morris.confidence");
   bad["design"] = {{"sobol", {{"base_points", 8}, {"resamples", 2}}}};
   expect_refused(bad, "design.sobol.resamples");
+
+  // Windows: on a Latin hypercube only, of the plan's outputs, 0 < low < high.
+  json w = base({{"a", {{"from", 0}, {"to", 1}}}});
+  w["design"] = {{"latin_hypercube", {{"points", 4}}}};
+  w["outputs"] = {{"y", "/y"}};
+  w["windows"] = {{"y", {{"low", 1}, {"high", 2}, {"source", "s"}}}};
+  const st::SweepPlan ok = plan(w);
+  ASSERT_EQ(ok.windows.size(), 1u);
+  EXPECT_EQ(ok.windows[0].name, "y");
+  EXPECT_EQ(ok.window_sources[0], "s");
+  w["windows"] = {{"z", {{"low", 1}, {"high", 2}}}};
+  expect_refused(w, "windows.z");
+  w["windows"] = {{"y", {{"low", 2}, {"high", 1}}}};
+  expect_refused(w, "0 < low < high");
+  w["windows"] = {{"y", {{"low", 1}, {"high", 2}, {"sauce", "s"}}}};
+  expect_refused(w, "windows.y.sauce");
+  w["windows"] = {{"y", {{"low", 1}, {"high", 2}}}};
+  w["design"] = "grid";
+  w["parameters"] = {{"a", {{"values", {1, 2}}}}};
+  expect_refused(w, "latin_hypercube");
 }

@@ -233,7 +233,22 @@ struct ModelOptions {
   /// resting tone, and the criterion counts only what is recruited above it. Fractions of each
   /// muscle's maximum force, 0 … 0.5.
   double co_contraction = 0, muscle_tone = 0;
+  /// The model's uncertain inputs, for sensitivity studies (1: the tables' values), each within
+  /// kInputScaleRange: every muscle's maximum stress (its strength), every joint's rotational
+  /// stiffness (F.4's, or the disc joints' with their coupling) and every F.6/F.7 ligament's
+  /// stiffness (when the model has them; ligaments).
+  double muscle_strength = 1, joint_stiffness = 1, ligament_stiffness = 1;
+  /// The standing posture's forward inclination, deg (kInclinationRangeDeg): the whole body
+  /// above the hips pitched forward about the lateral axis, so that in the pelvis's frame, the
+  /// model's, gravity turns forward by this angle (it pulls along (0, −cos φ, sin φ)). The spine
+  /// itself keeps its shape; external loads stay in the model's frame. 0: upright, the thesis's.
+  double inclination_deg = 0;
 };
+
+/// The range of ModelOptions' input scales (muscle_strength, joint_stiffness,
+/// ligament_stiffness), and of inclination_deg.
+inline constexpr double kInputScaleRange[2] = {0.1, 10};
+inline constexpr double kInclinationRangeDeg[2] = {-30, 90};
 
 /// Makes `m` rest in the scoliotic curve options.scoliosis (scoliosis.hpp): the joints' springs,
 /// the ligaments' slack lengths and the IAP bushing are stress-free in its posture, and

@@ -15,7 +15,8 @@
 //              {"sobol": {"base_points": 256, "seed": 1}}
 //              (both also take "resamples": 1000 and "confidence": 0.95, the bootstrap
 //              intervals of their indices)
-//    "outputs": {"L5-S1 axial (N)": "/joints/16/axial_n"}}  JSON pointers into a point's --json
+//    "outputs": {"L5-S1 axial (N)": "/joints/16/axial_n"},  JSON pointers into a point's --json
+//    "windows": {"L5-S1 axial (N)": {"low": 500, "high": 900, "source": "…"}}}   (optional)
 //
 // Designs: "grid" is every combination (the first parameter varies slowest); "zip" takes the
 // i-th value of every list (all of one length); a Latin hypercube draws `points` points of the
@@ -23,8 +24,13 @@
 // stratum in every parameter, from a seeded generator whose stream is fixed here (SplitMix64),
 // so the same plan gives the same points on every machine. The sensitivity designs (Morris
 // screening, Sobol indices by Saltelli's scheme) take ranges only, and the summary then carries
-// each numeric output's sensitivity to each parameter (sweep_sensitivity).
+// each numeric output's sensitivity to each parameter (sweep_sensitivity). Windows, measured
+// ranges of outputs, weigh a Latin hypercube's points by how well they meet them, and the summary
+// then carries every parameter's and output's spread before and after (sweep_uncertainty;
+// uncertainty.hpp).
 #pragma once
+
+#include "spinesim/calibration/window_fit.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -57,6 +63,8 @@ struct SweepPlan {
   int resamples = 1000;              ///< morris, sobol: bootstrap resamples of the intervals
   double confidence = 0.95;          ///< morris, sobol: the intervals' confidence
   std::vector<std::pair<std::string, std::string>> outputs;  ///< column name, JSON pointer
+  std::vector<calibration::WindowTarget> windows;  ///< latin_hypercube: measured outputs (by name)
+  std::vector<std::string> window_sources;         ///< each window's "source" ("" when none)
 };
 
 struct SweepPoint {
@@ -90,6 +98,13 @@ nlohmann::json point_outputs(const SweepPlan& plan, const nlohmann::json& result
 /// is mu* times the parameter's range: the output's mean change across it, to rank parameters of
 /// different units.
 nlohmann::json sweep_sensitivity(const SweepPlan& plan, const std::vector<SweepPoint>& points,
+                                 const std::vector<nlohmann::json>& outputs);
+
+/// For a plan with windows (null otherwise): each point's weight (uncertainty.hpp
+/// window_weights), the effective sample size, and for every parameter and numeric output its
+/// summary under equal weights ("prior") and under the weights ("posterior"): {"mean", "sd",
+/// "q05", "q50", "q95"}. Points that failed or miss a windowed output weigh 0 (counted).
+nlohmann::json sweep_uncertainty(const SweepPlan& plan, const std::vector<SweepPoint>& points,
                                  const std::vector<nlohmann::json>& outputs);
 
 /// SplitMix64 (Steele, Lea & Flood 2014): the sweep's own random stream, the same on every
