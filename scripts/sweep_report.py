@@ -56,11 +56,14 @@ def draw_points(s, d):
                 ax.plot([p["values"][name] for p in failed], [ax.get_ylim()[0]] * len(failed),
                         "x", color="C3", label="failed point")
                 ax.legend(fontsize=8)
+            win = ((s.get("uncertainty") or {}).get("windows") or {}).get(o)
+            if win:
+                ax.axhspan(win["low"], win["high"], color="C2", alpha=0.12)
             ax.set_xlabel(name)
             ax.set_ylabel(o)
             ax.grid(alpha=0.3)
     fig.suptitle(f"{s['verb']}: {len(points)} points of {s['plan']}")
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0, 1, 0.96))
     fig.savefig(f"{d}/plots/sweep.png", dpi=90)
     plt.close(fig)
     return "sweep.png"
@@ -74,7 +77,11 @@ def draw_sensitivity(s, d):
     if not outs:
         return None
     morris = sens["method"].startswith("Morris")
-    fig, axes = plt.subplots(1, len(outs), squeeze=False, figsize=(4.5 * len(outs), 3.6))
+    cols = min(3, len(outs))
+    rows = (len(outs) + cols - 1) // cols
+    fig, axes = plt.subplots(rows, cols, squeeze=False, figsize=(4.8 * cols, 3.4 * rows))
+    for ax in [a for r in axes for a in r][len(outs):]:
+        ax.axis("off")
     def bars(ax, x, e, names, key, **kw):
         """Bars of e[n][key] with their bootstrap intervals as error bars (when the summary
         has them)."""
@@ -87,7 +94,7 @@ def draw_sensitivity(s, d):
         ax.bar(x, v, kw.pop("width", 0.8), yerr=err, capsize=3, **kw)
         return v + [b for b in hi if numeric(b)] + [a for a in lo if numeric(a)]
 
-    for ax, (o, e) in zip(axes[0], sorted(outs.items())):
+    for ax, (o, e) in zip([a for r in axes for a in r], sorted(outs.items())):
         names = sorted(e)
         x = list(range(len(names)))
         if morris:
@@ -111,7 +118,7 @@ def draw_sensitivity(s, d):
         n = sens["runs"] // (len(next(iter(outs.values()))) + 2)
         title += f" (N = {n}: the estimates scatter by about {1 / n ** 0.5:.2f})"
     fig.suptitle(title)
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0, 1, 0.96))
     fig.savefig(f"{d}/plots/sensitivity.png", dpi=90)
     plt.close(fig)
     return "sensitivity.png"
@@ -158,7 +165,7 @@ def draw_uncertainty(s, d):
     axes[0][0].legend(fontsize=7)
     fig.suptitle(f"Uncertainty: {u['points_used']} of {u['points']} points weighted by the windows; "
                  f"effective sample size {u['effective_sample_size']:.1f}")
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0, 1, 0.96))
     fig.savefig(f"{d}/plots/uncertainty.png", dpi=90)
     plt.close(fig)
     return "uncertainty.png"

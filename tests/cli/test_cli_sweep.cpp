@@ -272,3 +272,21 @@ TEST(SweepCli, WindowsWeighTheSampleIntoThePosterior) {
   EXPECT_EQ(count_lines(csv), 3 + 3);  // provenance, method, header; mass and two outputs
   EXPECT_TRUE(fs::exists(out + "/plots/uncertainty.png"));
 }
+
+// The studies' plans (data/sweeps: the disc's and the spine's sensitivity, the disc material's
+// uncertainty; docs/sensitivity.md) are valid plans of runnable studies: every point's options
+// are checked by --dry-run without running one.
+TEST(SweepCli, TheStudyPlansInTheDataFolderAreValid) {
+  const fs::path folder = fs::path(SPINESIM_DATA_DIR) / "sweeps";
+  int plans = 0;
+  for (const auto& e : fs::directory_iterator(folder)) {
+    if (e.path().extension() != ".json") continue;
+    ++plans;
+    const std::string out = tmp("dry-" + e.path().stem().string());
+    const CliRun r = run_spinesim("sweep " + in_quotes(e.path().string()) + " --out " +
+                                  in_quotes(out) + " --dry-run");
+    EXPECT_EQ(r.status, 0) << e.path() << "\n" << r.err;
+    EXPECT_TRUE(json::parse(slurp(e.path().string())).contains("description")) << e.path();
+  }
+  EXPECT_GE(plans, 5);
+}
