@@ -285,3 +285,50 @@ TEST(SpineModel, BrokenTrunkMuscleTableIsRefusedNamingTheFile) {
   EXPECT_NO_THROW((void)sp::load_spine_model(dir.string(), lumbar));
   fs::remove_all(dir);
 }
+
+// The uncertain inputs: each scale multiplies exactly what it names (muscle strength the maximum
+// stress, joint stiffness F.4's springs or a disc joint's matrix with its coupling, ligament
+// stiffness the ligaments) and nothing else; the inclination turns every weight forward by its
+// angle and keeps its size; out-of-range values are refused.
+TEST(SpineModel, InputScalesMultiplyWhatTheyNameAndTheInclinationTurnsGravity) {
+  sp::ModelOptions base;
+  base.disc_joints = "fibre-reinforced";  // ligaments as elements, joints with coupling
+  const sp::SpineModel m0 = sp::load_spine_model(SPINESIM_DATA_DIR, base);
+  sp::ModelOptions o = base;
+  o.muscle_strength = 1.3, o.joint_stiffness = 0.7, o.ligament_stiffness = 2,
+  o.inclination_deg = 25;
+  const sp::SpineModel m = sp::load_spine_model(SPINESIM_DATA_DIR, o);
+  ASSERT_EQ(m.muscles.size(), m0.muscles.size());
+  ASSERT_FALSE(m.ligaments.empty());
+  for (std::size_t i = 0; i < m.muscles.size(); ++i) {
+    EXPECT_DOUBLE_EQ(m.muscles[i].max_force_n(), 1.3 * m0.muscles[i].max_force_n());
+    EXPECT_EQ(m.muscles[i].pcsa_mm2, m0.muscles[i].pcsa_mm2);
+  }
+  for (std::size_t i = 0; i < m.joints.size(); ++i) {
+    EXPECT_DOUBLE_EQ(m.joints[i].k_flexion, 0.7 * m0.joints[i].k_flexion);
+    EXPECT_DOUBLE_EQ(m.joints[i].k_torsion, 0.7 * m0.joints[i].k_torsion);
+    EXPECT_TRUE(m.joints[i].coupling.isApprox(0.7 * m0.joints[i].coupling, 1e-15) ||
+                m0.joints[i].coupling.isZero());
+    EXPECT_EQ(m.joints[i].rom_flexion, m0.joints[i].rom_flexion);
+  }
+  for (std::size_t i = 0; i < m.ligaments.size(); ++i)
+    EXPECT_DOUBLE_EQ(m.ligaments[i].k_n_per_mm, 2 * m0.ligaments[i].k_n_per_mm);
+  const double phi = 25 * M_PI / 180;
+  ASSERT_EQ(m.weights.size(), m0.weights.size());
+  for (std::size_t i = 0; i < m.weights.size(); ++i) {
+    const Eigen::Vector3d& f0 = m0.weights[i].force_n;
+    const Eigen::Vector3d& f = m.weights[i].force_n;
+    EXPECT_NEAR(f.norm(), f0.norm(), 1e-12 * f0.norm());
+    EXPECT_NEAR(f.y(), f0.y() * std::cos(phi), 1e-12 * f0.norm());
+    EXPECT_NEAR(f.z(), -f0.y() * std::sin(phi), 1e-12 * f0.norm());  // forward, +z
+    EXPECT_EQ(m.weights[i].point_mm, m0.weights[i].point_mm);
+  }
+  for (auto bad : {0.0, 11.0, std::nan("")}) {
+    sp::ModelOptions b;
+    b.joint_stiffness = bad;
+    EXPECT_THROW(sp::load_spine_model(SPINESIM_DATA_DIR, b), std::invalid_argument) << bad;
+  }
+  sp::ModelOptions steep;
+  steep.inclination_deg = 95;
+  EXPECT_THROW(sp::load_spine_model(SPINESIM_DATA_DIR, steep), std::invalid_argument);
+}
