@@ -9,6 +9,7 @@
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
+#include <array>
 #include <map>
 
 namespace spinesim::python {
@@ -84,7 +85,7 @@ py::object solve_spine(const VectorsByVertebra& forces, const VectorsByVertebra&
                        const std::string& fusion, bool muscles, bool trunk_muscles, bool gravity,
                        const std::string& disc_joints, const std::string& ligaments,
                        double height_m, double body_mass_kg, const std::string& sex, bool rib_cage,
-                       const py::dict& scoliosis) {
+                       const py::dict& scoliosis, const std::array<double, 4>& inputs) {
   studies::SpineSolveRequest rq;
   for (const auto& [name, f] : forces) {
     spine::ExternalLoad l;
@@ -100,6 +101,11 @@ py::object solve_spine(const VectorsByVertebra& forces, const VectorsByVertebra&
   }
   rq.model = model_options(fusion, muscles, trunk_muscles, gravity, disc_joints, ligaments,
                            {height_m, body_mass_kg, sex, rib_cage, curve_of(scoliosis)});
+  // muscle_strength, joint_stiffness, ligament_stiffness, inclination_deg (checked by the model)
+  rq.model.muscle_strength = inputs[0];
+  rq.model.joint_stiffness = inputs[1];
+  rq.model.ligament_stiffness = inputs[2];
+  rq.model.inclination_deg = inputs[3];
   rq.solve.recruit = muscles;
   nlohmann::json j;
   {

@@ -151,6 +151,22 @@ def test_spine_equals_the_program(program):
         spinesim.spine(forces={"T13": [0, 0, 1]})
 
 
+def test_the_uncertain_inputs_equal_the_program(program):
+    kw = dict(muscle_strength=0.8, joint_stiffness=1.2, ligament_stiffness=0.6,
+              inclination_deg=15)
+    s = spinesim.spine(disc_joints="fibre-reinforced", **kw)
+    p = program("spine", "solve", "--disc-joints", "fibre-reinforced", "--muscle-strength", 0.8,
+                "--joint-stiffness", 1.2, "--ligament-stiffness", 0.6, "--inclination", 15,
+                quiet=False)
+    for key, value in kw.items():
+        assert s.options[key] == value == p["options"][key]
+    assert_json_close(s.joints, p["joints"], rtol=1e-9, atol=1e-6)
+    upright = spinesim.spine(disc_joints="fibre-reinforced")
+    assert s.joints[15]["axial_n"] > upright.joints[15]["axial_n"] + 100  # leaning forward
+    with pytest.raises(ValueError):
+        spinesim.spine(muscle_strength=0)
+
+
 def test_a_scaled_body_and_the_ligaments_equal_the_program(program):
     s = spinesim.spine(forces={"T1": [0, 0, 100]}, height_m=1.6, body_mass_kg=55, sex="female",
                        ligaments="on")

@@ -199,7 +199,8 @@ def _body(subject, height_m, body_mass_kg, sex):
 
 def spine(*, forces=None, moments=None, fusion="", muscles=True, trunk_muscles=True,
           gravity=True, disc_joints="", ligaments="auto", height_m=0.0, body_mass_kg=0.0,
-          sex="male", subject="", rib_cage=False, scoliosis=None):
+          sex="male", subject="", rib_cage=False, scoliosis=None, muscle_strength=1.0,
+          joint_stiffness=1.0, ligament_stiffness=1.0, inclination_deg=0.0):
     """The standing thoracolumbar spine's equilibrium under gravity and dead loads: `forces`
     {"T7": [Fx, Fy, Fz]} in N at the vertebra's centre, `moments` {"L1": [Mx, My, Mz]} in N·mm;
     `fusion` such as "L3-L4-L5"; `disc_joints` a preset or file of disc joint stiffnesses;
@@ -212,13 +213,19 @@ def spine(*, forces=None, moments=None, fusion="", muscles=True, trunk_muscles=T
     `scoliosis` a dict {"type": "thoracic"|"thoracolumbar"|"lumbar", "cobb_deg": 40, optional
     "apex", "curve_ends": ("T6", "T12"), "apical_rotation_deg", "convex": "right"|"left"} makes
     the spine rest in that curve (spine/README.md; a curve it cannot pose raises ValueError).
+    The uncertain inputs, for sensitivity studies (spine/README.md; 0.1-10 and -30-90 deg, else
+    ValueError): `muscle_strength`, `joint_stiffness` and `ligament_stiffness` multiply every
+    muscle's maximum stress, joint's rotational stiffness and ligament's stiffness;
+    `inclination_deg` pitches the standing body forward (gravity turns in the pelvis's frame).
     Returns the Result `spinesim spine solve --json` prints (vertebrae, joints, muscles,
     ligaments, bushing, warnings, units). Raises RuntimeError when it does not converge."""
     height_m, body_mass_kg, sex = _body(subject, height_m, body_mass_kg, sex)
     return _result(_spinesim._spine(dict(forces or {}), dict(moments or {}), fusion, muscles,
                                     trunk_muscles, gravity, disc_joints, ligaments,
                                     height_m, body_mass_kg, sex, bool(rib_cage),
-                                    dict(scoliosis or {})))
+                                    dict(scoliosis or {}),
+                                    [float(muscle_strength), float(joint_stiffness),
+                                     float(ligament_stiffness), float(inclination_deg)]))
 
 
 def seated_spine(*, armrests=False, chair_surface="", fusion="", disc_joints="", ligaments="auto",
