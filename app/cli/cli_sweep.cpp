@@ -372,7 +372,7 @@ void register_sweep(CLI::App& app) {
   cmd->add_flag("--dry-run", a->dry_run, "List the points and stop");
   cmd->add_flag("--no-report", a->no_report,
                 "No DIR/report.html and plots (each output against each parameter; the "
-                "sensitivity)");
+                "sensitivity; the uncertainty)");
   add_output_flags(cmd, a->json, a->quiet, "the counts and the summary's files");
   cmd->footer(
       "mpirun -np N spinesim sweep PLAN --out DIR: rank r runs the points i with i mod N == r.\n"
@@ -380,7 +380,10 @@ void register_sweep(CLI::App& app) {
       "Each point runs `spinesim run study.json --json` in DIR/points/NNNN. A point is done when\n"
       "its status.json exists: the same command resumes a killed sweep; a failed point is\n"
       "recorded with its error and the others go on. DIR/summary.csv and summary.json are\n"
-      "written when every point is done, the same bytes however the points were run.");
+      "written when every point is done, the same bytes however the points were run; with them\n"
+      "a Morris or Sobol plan writes sensitivity.csv (the indices and their bootstrap intervals)\n"
+      "and a Latin hypercube with windows uncertainty.csv (the parameters and outputs before and\n"
+      "after weighting by the windows). Plans of the project's studies: data/sweeps/.");
   cmd->callback([a] { run_sweep(*a); });
 }
 
