@@ -99,6 +99,7 @@ void register_haptic_drag(CLI::App& study);      ///< study haptic-drag (cli_hap
 void register_disc_validation(CLI::App& study);  ///< study disc-validation (cli_study_disc.cpp)
 void register_disc_identify(CLI::App& study);    ///< study disc-identify (cli_study_identify.cpp)
 void register_mss_fibres(CLI::App& study);       ///< study mss-fibres (cli_study_mss_fibres.cpp)
+void register_cohort_level(CLI::App& study);     ///< study cohort-level (cli_study_cohort.cpp)
 void register_seating(CLI::App& study);          ///< study seating|seating-sweep|seating-validation
 void register_demo(CLI::App& app);
 void register_view(CLI::App& app);

@@ -724,6 +724,7 @@ void register_study(CLI::App& app) {
   register_disc_validation(*study);
   register_disc_identify(*study);
   register_mss_fibres(*study);
+  register_cohort_level(*study);
   register_seating(*study);
 }
 
