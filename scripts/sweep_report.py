@@ -33,37 +33,44 @@ def parameters_and_outputs(s):
 
 
 def draw_points(s, d):
+    """Each output against each parameter. One parameter: the outputs in rows of four panels;
+    several: one row per output, one column per parameter. Names (a list of text values) keep
+    the plan's order."""
     points, params, outputs = parameters_and_outputs(s)
     outputs = [o for o in outputs if any(numeric((p.get("outputs") or {}).get(o)) for p in points)]
     if not outputs:
         return None
-    fig, axes = plt.subplots(len(outputs), len(params), squeeze=False,
-                             figsize=(4.2 * len(params), 3.2 * len(outputs)))
-    for r, o in enumerate(outputs):
-        for c, name in enumerate(params):
-            ax = axes[r][c]
-            ok = [p for p in points if numeric((p.get("outputs") or {}).get(o))]
-            xs = [p["values"][name] for p in ok]
-            if all(numeric(x) for x in xs):
-                ax.plot(xs, [p["outputs"][o] for p in ok], "o", ms=4, alpha=0.7)
-            else:  # a list of names: one column of dots per name
-                names = sorted({str(x) for x in xs})
-                ax.plot([names.index(str(x)) for x in xs], [p["outputs"][o] for p in ok], "o",
-                        ms=4, alpha=0.7)
-                ax.set_xticks(range(len(names)), names)
-            failed = [p for p in points if p["status"] != "ok" and numeric(p["values"][name])]
-            if failed:
-                ax.plot([p["values"][name] for p in failed], [ax.get_ylim()[0]] * len(failed),
-                        "x", color="C3", label="failed point")
-                ax.legend(fontsize=8)
-            win = ((s.get("uncertainty") or {}).get("windows") or {}).get(o)
-            if win:
-                ax.axhspan(win["low"], win["high"], color="C2", alpha=0.12)
-            ax.set_xlabel(name)
-            ax.set_ylabel(o)
-            ax.grid(alpha=0.3)
+    panels = [(o, name) for o in outputs for name in params]
+    cols = min(4, len(outputs)) if len(params) == 1 else len(params)
+    rows = (len(panels) + cols - 1) // cols
+    fig, axes = plt.subplots(rows, cols, squeeze=False, figsize=(4.2 * cols, 3.2 * rows))
+    flat = [a for r in axes for a in r]
+    for ax in flat[len(panels):]:
+        ax.axis("off")
+    for ax, (o, name) in zip(flat, panels):
+        ok = [p for p in points if numeric((p.get("outputs") or {}).get(o))]
+        xs = [p["values"][name] for p in ok]
+        if all(numeric(x) for x in xs):
+            ax.plot(xs, [p["outputs"][o] for p in ok], "o", ms=4, alpha=0.7)
+        else:  # a list of names: one column of dots per name, in the points' order
+            names = list(dict.fromkeys(str(p["values"][name]) for p in points))
+            ax.plot([names.index(str(x)) for x in xs], [p["outputs"][o] for p in ok], "o",
+                    ms=4, alpha=0.7)
+            ax.set_xticks(range(len(names)), names, rotation=90 if len(names) > 6 else 0,
+                          fontsize=7 if len(names) > 6 else 9)
+        failed = [p for p in points if p["status"] != "ok" and numeric(p["values"][name])]
+        if failed:
+            ax.plot([p["values"][name] for p in failed], [ax.get_ylim()[0]] * len(failed),
+                    "x", color="C3", label="failed point")
+            ax.legend(fontsize=8)
+        win = ((s.get("uncertainty") or {}).get("windows") or {}).get(o)
+        if win:
+            ax.axhspan(win["low"], win["high"], color="C2", alpha=0.12)
+        ax.set_xlabel(name)
+        ax.set_ylabel(o, fontsize=9)
+        ax.grid(alpha=0.3)
     fig.suptitle(f"{s['verb']}: {len(points)} points of {s['plan']}")
-    fig.tight_layout(rect=(0, 0, 1, 0.96))
+    fig.tight_layout(rect=(0, 0, 1, 0.97))
     fig.savefig(f"{d}/plots/sweep.png", dpi=90)
     plt.close(fig)
     return "sweep.png"
