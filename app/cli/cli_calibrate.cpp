@@ -65,16 +65,6 @@ struct CalibrateArgs {
   bool given(const char* option) const { return cmd->count(option) > 0; }
 };
 
-std::vector<fem::LoadCase> other_cases(const std::vector<fem::LoadCase>& train) {
-  std::vector<fem::LoadCase> out;
-  for (const auto& c : fem::standard_load_cases()) {
-    bool used = false;
-    for (const auto& t : train) used = used || t.name == c.name;
-    if (!used) out.push_back(c);
-  }
-  return out;
-}
-
 /// --level all: every level's parametric disc, one tuned set file (tuned_set.hpp), written only
 /// when every level succeeded (calibration/levels.hpp).
 void run_all_levels(const CalibrateArgs& a, const CalibrationRequest& rq,
@@ -245,7 +235,7 @@ void run_calibrate(const CalibrateArgs& a) {
   check_files_and_modes(a);
   CalibrationRequest rq;
   rq.train = fem::parse_load_cases(a.train);
-  rq.holdout = a.holdout.empty()     ? other_cases(rq.train)
+  rq.holdout = a.holdout.empty()     ? calibration::held_out_cases(rq.train)
                : a.holdout == "none" ? std::vector<fem::LoadCase>()
                                      : fem::parse_load_cases(a.holdout);
   // calibrate_disc checks it too, but only after meshing (17 times for --level all).

@@ -14,6 +14,7 @@
 #include "spinesim/common/timer.hpp"
 #include "spinesim/output/html_report.hpp"
 #include "spinesim/studies/sweep_plan.hpp"
+#include "spinesim/studies/uncertainty.hpp"
 
 #include <algorithm>
 #include <chrono>

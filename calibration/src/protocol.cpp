@@ -97,6 +97,16 @@ nlohmann::json per_spring_json(const PerSpringResult& r, const CalibrationReques
 
 }  // namespace
 
+std::vector<fem::LoadCase> held_out_cases(const std::vector<fem::LoadCase>& train) {
+  std::vector<fem::LoadCase> out;
+  for (const auto& c : fem::standard_load_cases()) {
+    bool used = false;
+    for (const auto& t : train) used = used || t.name == c.name;
+    if (!used) out.push_back(c);
+  }
+  return out;
+}
+
 void check_cases(const std::vector<fem::LoadCase>& train,
                  const std::vector<fem::LoadCase>& holdout) {
   if (train.empty())

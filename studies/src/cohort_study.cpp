@@ -137,10 +137,7 @@ CohortResult run_cohort_level(const CohortRequest& request, const std::string& d
 
   calibration::CalibrationRequest rq;
   rq.train = fem::parse_load_cases("compression,shear-ap,flexion,torsion");
-  for (const auto& c : fem::parse_load_cases("all"))
-    if (std::none_of(rq.train.begin(), rq.train.end(),
-                     [&](const fem::LoadCase& t) { return t.name == c.name; }))
-      rq.holdout.push_back(c);
+  rq.holdout = calibration::held_out_cases(rq.train);
   r.train = names_of(rq.train);
   r.holdout = names_of(rq.holdout);
   std::vector<std::size_t> carried;  // members carried as transfer meshes, in order

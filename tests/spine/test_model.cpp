@@ -304,13 +304,16 @@ TEST(SpineModel, InputScalesMultiplyWhatTheyNameAndTheInclinationTurnsGravity) {
     EXPECT_DOUBLE_EQ(m.muscles[i].max_force_n(), 1.3 * m0.muscles[i].max_force_n());
     EXPECT_EQ(m.muscles[i].pcsa_mm2, m0.muscles[i].pcsa_mm2);
   }
+  int coupled = 0;  // the disc joints carry coupling, so its scaling is tested
   for (std::size_t i = 0; i < m.joints.size(); ++i) {
+    coupled += !m0.joints[i].coupling.isZero();
     EXPECT_DOUBLE_EQ(m.joints[i].k_flexion, 0.7 * m0.joints[i].k_flexion);
     EXPECT_DOUBLE_EQ(m.joints[i].k_torsion, 0.7 * m0.joints[i].k_torsion);
     EXPECT_TRUE(m.joints[i].coupling.isApprox(0.7 * m0.joints[i].coupling, 1e-15) ||
                 m0.joints[i].coupling.isZero());
     EXPECT_EQ(m.joints[i].rom_flexion, m0.joints[i].rom_flexion);
   }
+  EXPECT_GT(coupled, 0);
   for (std::size_t i = 0; i < m.ligaments.size(); ++i)
     EXPECT_DOUBLE_EQ(m.ligaments[i].k_n_per_mm, 2 * m0.ligaments[i].k_n_per_mm);
   const double phi = 25 * M_PI / 180;

@@ -35,6 +35,10 @@ mss::MssOptions term_set_options(TermSet t);
 void check_cases(const std::vector<fem::LoadCase>& train,
                  const std::vector<fem::LoadCase>& holdout);
 
+/// The standard load cases (fem/load_cases.hpp) not in `train`, in their standard order: the
+/// held-out set when none is named.
+std::vector<fem::LoadCase> held_out_cases(const std::vector<fem::LoadCase>& train);
+
 struct CalibrationRequest {
   std::vector<fem::LoadCase> train, holdout;
   int fem_order = 2;

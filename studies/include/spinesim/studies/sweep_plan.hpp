@@ -26,8 +26,8 @@
 // screening, Sobol indices by Saltelli's scheme) take ranges only, and the summary then carries
 // each numeric output's sensitivity to each parameter (sweep_sensitivity). Windows, measured
 // ranges of outputs, weigh a Latin hypercube's points by how well they meet them, and the summary
-// then carries every parameter's and output's spread before and after (sweep_uncertainty;
-// uncertainty.hpp).
+// then carries every parameter's and output's spread before and after (uncertainty.hpp
+// sweep_uncertainty).
 #pragma once
 
 #include "spinesim/calibration/window_fit.hpp"
@@ -98,13 +98,6 @@ nlohmann::json point_outputs(const SweepPlan& plan, const nlohmann::json& result
 /// is mu* times the parameter's range: the output's mean change across it, to rank parameters of
 /// different units.
 nlohmann::json sweep_sensitivity(const SweepPlan& plan, const std::vector<SweepPoint>& points,
-                                 const std::vector<nlohmann::json>& outputs);
-
-/// For a plan with windows (null otherwise): each point's weight (uncertainty.hpp
-/// window_weights), the effective sample size, and for every parameter and numeric output its
-/// summary under equal weights ("prior") and under the weights ("posterior"): {"mean", "sd",
-/// "q05", "q50", "q95"}. Points that failed or miss a windowed output weigh 0 (counted).
-nlohmann::json sweep_uncertainty(const SweepPlan& plan, const std::vector<SweepPoint>& points,
                                  const std::vector<nlohmann::json>& outputs);
 
 /// SplitMix64 (Steele, Lea & Flood 2014): the sweep's own random stream, the same on every

@@ -11,6 +11,9 @@
 #pragma once
 
 #include "spinesim/calibration/window_fit.hpp"
+#include "spinesim/studies/sweep_plan.hpp"
+
+#include <nlohmann/json.hpp>
 
 #include <vector>
 
@@ -40,5 +43,12 @@ struct WeightedSummary {
 /// usual (Hazen) quantiles.
 WeightedSummary weighted_summary(const std::vector<double>& values,
                                  const std::vector<double>& weights);
+
+/// For a plan with windows (null otherwise): each point's weight (uncertainty.hpp
+/// window_weights), the effective sample size, and for every parameter and numeric output its
+/// summary under equal weights ("prior") and under the weights ("posterior"): {"mean", "sd",
+/// "q05", "q50", "q95"}. Points that failed or miss a windowed output weigh 0 (counted).
+nlohmann::json sweep_uncertainty(const SweepPlan& plan, const std::vector<SweepPoint>& points,
+                                 const std::vector<nlohmann::json>& outputs);
 
 }  // namespace spinesim::studies
